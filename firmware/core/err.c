@@ -1,0 +1,17 @@
+#include "shadowlean/sl_err.h"
+
+const char *sl_err_str(sl_err_t err)
+{
+    switch (err) {
+    case SL_OK: return "SL_OK";
+    case SL_ERR_ARG: return "SL_ERR_ARG";
+    case SL_ERR_NEED_MORE: return "SL_ERR_NEED_MORE";
+    case SL_ERR_MALFORMED: return "SL_ERR_MALFORMED";
+    case SL_ERR_FULL: return "SL_ERR_FULL";
+    case SL_ERR_BUSY: return "SL_ERR_BUSY";
+    case SL_ERR_PORT: return "SL_ERR_PORT";
+    case SL_ERR_RANGE: return "SL_ERR_RANGE";
+    case SL_ERR_STATE: return "SL_ERR_STATE";
+    }
+    return "SL_ERR_?";
+}

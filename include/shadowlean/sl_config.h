@@ -1,0 +1,53 @@
+/// @file sl_config.h
+/// @brief Compile-time capacities of the core (`SL_CFG_*`).
+///
+/// Every buffer in the core is an array inside a caller-owned struct, sized by these
+/// knobs, so `sizeof` of a top-level object is its whole RAM. Override any knob with a
+/// compiler definition (`-DSL_CFG_ROI_BINS=256`) or by providing `sl_config_user.h` on
+/// the include path and defining `SL_CFG_USER_HEADER`. Each board's generated header
+/// checks at compile time that the board fits these capacities.
+#ifndef SHADOWLEAN_SL_CONFIG_H
+#define SHADOWLEAN_SL_CONFIG_H
+
+#ifdef SL_CFG_USER_HEADER
+#include "sl_config_user.h"
+#endif
+
+/// Azimuths per rotation the core can hold (CTS350-X: 400).
+#ifndef SL_CFG_MAX_AZIMUTHS
+#define SL_CFG_MAX_AZIMUTHS 400
+#endif
+#if SL_CFG_MAX_AZIMUTHS < 8 || SL_CFG_MAX_AZIMUTHS > 4096
+#error "SL_CFG_MAX_AZIMUTHS must be in [8, 4096]"
+#endif
+
+/// Range bins kept per azimuth (the region of interest, nearest bins only). Multiple of 32.
+#ifndef SL_CFG_ROI_BINS
+#define SL_CFG_ROI_BINS 512
+#endif
+#if SL_CFG_ROI_BINS < 32 || SL_CFG_ROI_BINS > 4096 || (SL_CFG_ROI_BINS % 32) != 0
+#error "SL_CFG_ROI_BINS must be a multiple of 32 in [32, 4096]"
+#endif
+
+/// Largest consistency window n (frames) the mask supports; the board picks n <= this.
+#ifndef SL_CFG_MASK_FRAMES_MAX
+#define SL_CFG_MASK_FRAMES_MAX 32
+#endif
+#if SL_CFG_MASK_FRAMES_MAX < 1 || SL_CFG_MASK_FRAMES_MAX > 32
+#error "SL_CFG_MASK_FRAMES_MAX must be in [1, 32]"
+#endif
+
+/// Targets reported per rotation and tracks kept over rotations.
+#ifndef SL_CFG_MAX_TARGETS
+#define SL_CFG_MAX_TARGETS 32
+#endif
+#if SL_CFG_MAX_TARGETS < 1 || SL_CFG_MAX_TARGETS > 255
+#error "SL_CFG_MAX_TARGETS must be in [1, 255]"
+#endif
+
+/// Entries in a board's elongation table d(r).
+#ifndef SL_CFG_MAX_ELONG_POINTS
+#define SL_CFG_MAX_ELONG_POINTS 16
+#endif
+
+#endif // SHADOWLEAN_SL_CONFIG_H

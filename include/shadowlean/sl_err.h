@@ -1,0 +1,61 @@
+/// @file sl_err.h
+/// @brief Error codes shared by every shadowlean module.
+///
+/// Convention (libcanard v4 / littlefs): functions return `sl_err_t`; `SL_OK` is zero and
+/// every error is negative, starting at -2. Functions that return a size or a count use
+/// `sl_ssize_t`: non-negative values are the result, negative values are `sl_err_t`.
+///
+/// Bytes that come from the radar or the bus are never asserted on: they are rejected,
+/// counted in the module's `stats`, and the module resynchronises. `SL_ASSERT` is reserved
+/// for caller bugs (NULL self, impossible state) and can be overridden before including
+/// any shadowlean header (define `SL_ASSERT(x)` yourself, for example to a breakpoint).
+#ifndef SHADOWLEAN_SL_ERR_H
+#define SHADOWLEAN_SL_ERR_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef enum sl_err {
+    SL_OK = 0,
+    SL_ERR_ARG = -2,       ///< a caller passed an invalid argument (NULL, out of range)
+    SL_ERR_NEED_MORE = -3, ///< more input is needed before anything can be produced
+    SL_ERR_MALFORMED = -4, ///< the input violates the format; it was counted and skipped
+    SL_ERR_FULL = -5,      ///< a bounded buffer or queue is full; nothing was written
+    SL_ERR_BUSY = -6,      ///< the port cannot take it now; try again later (never blocks)
+    SL_ERR_PORT = -7,      ///< the port (OS, device) reported a failure
+    SL_ERR_RANGE = -8,     ///< a value does not fit the target's documented range
+    SL_ERR_STATE = -9,     ///< the call is not valid in the object's current state
+} sl_err_t;
+
+/// Signed size: >= 0 is a count, < 0 is an `sl_err_t`.
+typedef int32_t sl_ssize_t;
+
+/// Borrowed view of bytes. The lifetime is documented by whoever hands it out.
+typedef struct sl_bytes {
+    const uint8_t *data;
+    size_t size;
+} sl_bytes_t;
+
+/// A short, constant, human-readable name for an error code ("SL_ERR_ARG", ...).
+/// Never NULL; unknown codes give "SL_ERR_?". Cost: O(1).
+const char *sl_err_str(sl_err_t err);
+
+#ifndef SL_ASSERT
+/// Caller-bug check. Default: trap (no stdio, no OS). Override before including.
+#define SL_ASSERT(x)                                                                         \
+    do {                                                                                     \
+        if (!(x)) {                                                                          \
+            __builtin_trap();                                                                \
+        }                                                                                    \
+    } while (0)
+#endif
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif // SHADOWLEAN_SL_ERR_H
