@@ -1,0 +1,330 @@
+// Scan assembly (sl_scan.h): FFT messages -> rows of one rotation, with gap, duplicate and
+// reorder bookkeeping. Rows are written exactly once per rotation: on arrival (ROI copy +
+// zero fill of a short row) or, for rows never received, zero-filled at completion.
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <string.h>
+
+#include "shadowlean/sl_scan.h"
+
+int32_t sl_scan_az_index(uint16_t azimuths, uint16_t encoder_size, uint16_t ticks)
+{
+    if (azimuths == 0U || encoder_size == 0U || ticks >= encoder_size) {
+        return -1;
+    }
+    // Nearest azimuth centre, ties upwards; < 2^33 so 64-bit is plenty (and exact).
+    const uint64_t num = (uint64_t)ticks * azimuths + (uint64_t)(encoder_size / 2U);
+    const uint32_t idx = (uint32_t)(num / encoder_size);
+    return (int32_t)(idx % azimuths);
+}
+
+static void frame_clear(sl_scan_frame_t *f)
+{
+    memset(f, 0, sizeof *f);
+}
+
+static void frame_start(sl_scan_t *s)
+{
+    sl_scan_frame_t *f = s->fill;
+    const uint16_t n = s->azimuths;
+    f->rotation = s->rotation;
+    f->azimuths = n;
+    f->encoder_size = s->encoder_size;
+    f->roi_bins = s->cfg.roi_bins;
+    f->end = SL_SCAN_END_WRAP;
+    f->head = 0;
+    f->head_sweep = 0;
+    f->t_first_us = UINT64_MAX;
+    f->t_last_us = 0;
+    memset(&f->stats, 0, sizeof f->stats);
+    memset(f->flags, 0, n);
+    s->in_frame = true;
+}
+
+static void frame_complete(sl_scan_t *s, sl_scan_end_t why)
+{
+    sl_scan_frame_t *f = s->fill;
+    const uint16_t n = f->azimuths;
+    const size_t roi = f->roi_bins;
+    for (uint16_t i = 0; i < n; i++) {
+        if ((f->flags[i] & SL_SCAN_AZ_VALID) == 0U) {
+            memset(f->power[i], 0, roi);
+            f->flags[i] = 0;
+            f->bins[i] = 0;
+            f->ticks[i] = 0;
+            f->sweep[i] = 0;
+            f->t_us[i] = 0;
+        }
+    }
+    if (f->stats.valid == 0U) {
+        f->t_first_us = 0;
+    }
+    f->stats.missing = (uint16_t)(n - f->stats.valid);
+    f->end = (uint8_t)why;
+    s->stats.frames++;
+    s->stats.missing += f->stats.missing;
+    s->rotation++;
+    s->in_frame = false;
+    if (s->cfg.on_frame != NULL) {
+        s->cfg.on_frame(s->cfg.ctx, f);
+    }
+    if (s->done != NULL) {
+        s->fill = s->done;
+        s->done = f;
+        s->done_valid = true;
+    }
+}
+
+static sl_err_t check_geometry(const sl_scan_t *s, uint16_t azimuths, uint16_t encoder_size)
+{
+    if (azimuths == 0U || azimuths > SL_CFG_MAX_AZIMUTHS || encoder_size == 0U ||
+        (s->cfg.expect_azimuths != 0U && azimuths != s->cfg.expect_azimuths) ||
+        (s->cfg.expect_encoder_size != 0U && encoder_size != s->cfg.expect_encoder_size)) {
+        return SL_ERR_RANGE;
+    }
+    return SL_OK;
+}
+
+// Geometry already checked. Completes the current frame when the geometry changes.
+static void apply_geometry(sl_scan_t *s, uint16_t azimuths, uint16_t encoder_size)
+{
+    if (azimuths == s->azimuths && encoder_size == s->encoder_size) {
+        return;
+    }
+    if (s->azimuths != 0U) {
+        s->stats.config_changes++;
+    }
+    if (s->in_frame) {
+        frame_complete(s, SL_SCAN_END_CONFIG);
+    }
+    s->azimuths = azimuths;
+    s->encoder_size = encoder_size;
+    uint16_t w = (s->cfg.reorder_azimuths != 0U) ? s->cfg.reorder_azimuths
+                                                 : (uint16_t)(azimuths / 8U);
+    const uint16_t wmax = (uint16_t)((azimuths - 1U) / 2U);
+    s->window = (w > wmax) ? wmax : w;
+    s->have_sweep = false;
+}
+
+sl_err_t sl_scan_init(sl_scan_t *s, const sl_scan_cfg_t *cfg, sl_scan_frame_t *fill,
+                      sl_scan_frame_t *spare)
+{
+    if (s == NULL || cfg == NULL || fill == NULL || fill == spare || cfg->roi_bins == 0U ||
+        cfg->roi_bins > SL_CFG_ROI_BINS || cfg->pow16_shift > 15U) {
+        return SL_ERR_ARG;
+    }
+    memset(s, 0, sizeof *s);
+    s->cfg = *cfg;
+    s->fill = fill;
+    s->done = spare;
+    frame_clear(fill);
+    if (spare != NULL) {
+        frame_clear(spare);
+    }
+    if (cfg->azimuths != 0U || cfg->encoder_size != 0U) {
+        if (check_geometry(s, cfg->azimuths, cfg->encoder_size) != SL_OK) {
+            return SL_ERR_RANGE;
+        }
+        apply_geometry(s, cfg->azimuths, cfg->encoder_size);
+    }
+    return SL_OK;
+}
+
+sl_err_t sl_scan_set_geometry(sl_scan_t *s, uint16_t azimuths, uint16_t encoder_size)
+{
+    if (s == NULL) {
+        return SL_ERR_ARG;
+    }
+    if (check_geometry(s, azimuths, encoder_size) != SL_OK) {
+        s->stats.config_rejected++;
+        return SL_ERR_RANGE;
+    }
+    apply_geometry(s, azimuths, encoder_size);
+    return SL_OK;
+}
+
+sl_err_t sl_scan_on_config(sl_scan_t *s, const sl_proto_config_t *c)
+{
+    if (s == NULL || c == NULL) {
+        return SL_ERR_ARG;
+    }
+    if (check_geometry(s, c->azimuths, c->encoder_size) != SL_OK) {
+        s->stats.config_rejected++;
+        return SL_ERR_RANGE;
+    }
+    s->stats.configs++;
+    apply_geometry(s, c->azimuths, c->encoder_size);
+    return SL_OK;
+}
+
+// Copy the ROI of one message into row idx of the filling frame and report it.
+static void store(sl_scan_t *s, const sl_proto_fft_t *f, uint16_t idx, uint8_t extra_flags)
+{
+    sl_scan_frame_t *fr = s->fill;
+    uint8_t *row = fr->power[idx];
+    const uint32_t roi = s->cfg.roi_bins;
+    const uint32_t n = (f->bins < roi) ? f->bins : roi;
+    uint8_t flags = (uint8_t)(SL_SCAN_AZ_VALID | extra_flags);
+    if (f->bytes_per_bin == 1U) {
+        memcpy(row, f->bin_data, n);
+    } else {
+        const uint8_t *b = f->bin_data;
+        const unsigned shift = s->cfg.pow16_shift;
+        if (shift == 8U) {
+            for (uint32_t i = 0; i < n; i++) {
+                row[i] = b[2U * i + 1U]; // the high byte: v >> 8 never saturates
+            }
+        } else {
+            uint32_t sat = 0;
+            for (uint32_t i = 0; i < n; i++) {
+                const uint32_t v = ((uint32_t)b[2U * i] | ((uint32_t)b[2U * i + 1U] << 8)) >> shift;
+                sat += (v > 255U) ? 1U : 0U;
+                row[i] = (uint8_t)((v > 255U) ? 255U : v);
+            }
+            s->stats.saturated16 += sat;
+        }
+        flags |= SL_SCAN_AZ_16BIT;
+        fr->stats.wide_azimuths++;
+        s->stats.wide_azimuths++;
+    }
+    if (n < roi) {
+        memset(row + n, 0, roi - n);
+        flags |= SL_SCAN_AZ_SHORT;
+        fr->stats.short_azimuths++;
+        s->stats.short_azimuths++;
+    }
+    fr->flags[idx] = flags;
+    fr->bins[idx] = (uint16_t)n;
+    fr->ticks[idx] = f->azimuth_ticks;
+    fr->sweep[idx] = f->sweep_counter;
+    const uint64_t t = sl_proto_fft_time_us(f);
+    fr->t_us[idx] = t;
+    if (t < fr->t_first_us) {
+        fr->t_first_us = t;
+    }
+    if (t > fr->t_last_us) {
+        fr->t_last_us = t;
+    }
+    fr->stats.valid++;
+    s->stats.azimuths++;
+    if (s->cfg.on_azimuth != NULL) {
+        s->cfg.on_azimuth(s->cfg.ctx, fr, idx);
+    }
+}
+
+static void duplicate(sl_scan_t *s, uint16_t idx)
+{
+    s->fill->flags[idx] |= SL_SCAN_AZ_DUP;
+    s->fill->stats.duplicates++;
+    s->stats.duplicates++;
+}
+
+sl_err_t sl_scan_on_fft(sl_scan_t *s, const sl_proto_fft_t *f)
+{
+    if (s == NULL || f == NULL || (f->bytes_per_bin != 1U && f->bytes_per_bin != 2U) ||
+        (f->bin_data == NULL && f->bins != 0U)) {
+        return SL_ERR_ARG;
+    }
+    s->stats.fft++;
+    if (s->azimuths == 0U) {
+        s->stats.no_config++;
+        return SL_ERR_STATE;
+    }
+    const int32_t sidx = sl_scan_az_index(s->azimuths, s->encoder_size, f->azimuth_ticks);
+    if (sidx < 0) {
+        s->stats.bad_azimuth++;
+        return SL_ERR_RANGE;
+    }
+    const uint16_t idx = (uint16_t)sidx;
+    const uint16_t n = s->azimuths;
+    if (s->have_sweep && f->sweep_counter != (uint16_t)(s->last_sweep + 1U)) {
+        s->stats.sweep_gaps++;
+    }
+    s->have_sweep = true;
+    s->last_sweep = f->sweep_counter;
+
+    if (s->in_frame) {
+        sl_scan_frame_t *fr = s->fill;
+        const uint16_t du = (uint16_t)(f->sweep_counter - fr->head_sweep);
+        const int32_t dsweep = (du < 0x8000U) ? (int32_t)du : (int32_t)du - 0x10000;
+        if (!s->cfg.ignore_sweep && dsweep >= (int32_t)n) {
+            frame_complete(s, SL_SCAN_END_SWEEP_GAP);
+        } else {
+            const uint16_t head = fr->head;
+            const uint32_t fwd = ((uint32_t)idx + n - head) % n;
+            if (fwd == 0U) {
+                duplicate(s, idx);
+                return SL_OK;
+            }
+            if (fwd >= (uint32_t)(n - s->window)) {
+                // A small step backwards: a late message.
+                if (idx > head) {
+                    s->stats.late_dropped++; // its rotation was already completed
+                } else if ((fr->flags[idx] & SL_SCAN_AZ_VALID) != 0U) {
+                    duplicate(s, idx);
+                } else {
+                    fr->stats.out_of_order++;
+                    s->stats.out_of_order++;
+                    store(s, f, idx, SL_SCAN_AZ_LATE);
+                }
+                return SL_OK;
+            }
+            if (idx < head) {
+                frame_complete(s, SL_SCAN_END_WRAP);
+            }
+        }
+    }
+    if (!s->in_frame) {
+        frame_start(s);
+    }
+    s->fill->head = idx;
+    s->fill->head_sweep = f->sweep_counter;
+    store(s, f, idx, 0);
+    return SL_OK;
+}
+
+sl_err_t sl_scan_on_msg(sl_scan_t *s, const sl_proto_msg_t *msg)
+{
+    if (s == NULL || msg == NULL) {
+        return SL_ERR_ARG;
+    }
+    switch (msg->id) {
+    case SL_PROTO_ID_CONFIGURATION: {
+        sl_proto_config_t c;
+        if (sl_proto_parse_config(msg, &c) != SL_OK) {
+            s->stats.malformed++;
+            return SL_ERR_MALFORMED;
+        }
+        return sl_scan_on_config(s, &c);
+    }
+    case SL_PROTO_ID_FFT_DATA:
+    case SL_PROTO_ID_FFT_DATA_16: {
+        sl_proto_fft_t f;
+        if (sl_proto_parse_fft(msg, &f) != SL_OK) {
+            s->stats.malformed++;
+            return SL_ERR_MALFORMED;
+        }
+        return sl_scan_on_fft(s, &f);
+    }
+    default:
+        return SL_OK;
+    }
+}
+
+void sl_scan_proto_sink(void *ctx, const sl_proto_msg_t *msg)
+{
+    (void)sl_scan_on_msg((sl_scan_t *)ctx, msg);
+}
+
+void sl_scan_flush(sl_scan_t *s)
+{
+    if (s != NULL && s->in_frame) {
+        frame_complete(s, SL_SCAN_END_FLUSH);
+    }
+}
+
+const sl_scan_frame_t *sl_scan_last_frame(const sl_scan_t *s)
+{
+    return (s != NULL && s->done_valid) ? s->done : NULL;
+}

@@ -1,0 +1,11 @@
+// port_clock.c: the Linux port's clock (CLOCK_MONOTONIC, microseconds).
+#include "sl_port_linux.h"
+
+#include <time.h>
+
+uint64_t sl_port_now_us(void)
+{
+    struct timespec ts;
+    (void)clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (uint64_t)ts.tv_sec * 1000000U + (uint64_t)ts.tv_nsec / 1000U;
+}

@@ -1,0 +1,36 @@
+#!/bin/sh
+# deps.sh GROUP...: install the Debian packages a group needs, only when missing.
+# Groups: build (host build + tools), test (cross + qemu-user + fuzz + CAN/VM tests), demo.
+# Needs root (or sudo) only when something is missing.
+set -eu
+pkgs=""
+for g in "$@"; do
+    case "$g" in
+    build) pkgs="$pkgs build-essential cmake pkg-config git python3 libcmocka-dev libinih-dev
+             libopencv-dev libpcap-dev libusb-1.0-0-dev nlohmann-json3-dev" ;;
+    test) pkgs="$pkgs valgrind clang libfuzzer-14-dev libclang-rt-14-dev
+             gcc-arm-none-eabi libnewlib-arm-none-eabi gcc-aarch64-linux-gnu gcc-s390x-linux-gnu
+             qemu-user libcmocka-dev:arm64 libcmocka-dev:s390x libc6:arm64 libc6:s390x
+             python3-canmatrix python3-can can-utils user-mode-linux iproute2 kmod
+             qemu-system-x86 busybox-static cpio usbutils" ;;
+    demo) pkgs="$pkgs python3-canmatrix can-utils" ;;
+    *) echo "deps.sh: unknown group '$g'" >&2; exit 2 ;;
+    esac
+done
+missing=""
+for p in $pkgs; do
+    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing="$missing $p"
+done
+[ -z "$missing" ] && exit 0
+echo "deps.sh: installing:$missing"
+SUDO=""
+[ "$(id -u)" -eq 0 ] || SUDO=sudo
+case "$missing" in
+*:arm64*|*:s390x*)
+    $SUDO dpkg --add-architecture arm64
+    $SUDO dpkg --add-architecture s390x ;;
+esac
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -q
+# shellcheck disable=SC2086
+$SUDO apt-get install -y -q --no-install-recommends $missing

@@ -1,0 +1,41 @@
+#!/bin/sh
+# test.sh: the whole test suite, from a fresh Debian machine (installs what is missing).
+#   host       Debug build: unit, build/symbol checks, tables, tools, integration tests
+#   host-asan  ASan + UBSan build of the same tests, plus the bounded fuzz run
+#   aarch64    unit tests cross-built, run under qemu-aarch64
+#   s390x      unit tests cross-built (big-endian), run under qemu-s390x
+#   cortex-m0/m4f  bare-metal core builds with their size
+# Exit status: non-zero when any step fails. Set SL_TEST_ONLY="host aarch64" to run a subset.
+set -eu
+cd "$(dirname "$0")/.."
+sh scripts/deps.sh build test
+STEPS=${SL_TEST_ONLY:-"host host-asan aarch64 s390x cortex-m0 cortex-m4f"}
+JOBS=${SL_JOBS:-2}
+failed=""
+run() { # name, command...
+    name=$1; shift
+    echo "=== [$name] $*"
+    if ! "$@"; then failed="$failed $name"; echo "=== [$name] FAILED"; fi
+}
+configure_build() { # preset
+    cmake --preset "$1" >/dev/null && cmake --build --preset "$1" -j "$JOBS"
+}
+for s in $STEPS; do
+    case "$s" in
+    host) run host-build configure_build host
+          run host-ctest ctest --preset host --output-on-failure ;;
+    host-asan) run asan-build configure_build host-asan
+          run asan-ctest ctest --preset host-asan --output-on-failure -LE "vm|slow" ;;
+    aarch64) run aarch64-build configure_build cross-aarch64
+          run aarch64-ctest ctest --preset cross-aarch64 --output-on-failure ;;
+    s390x) run s390x-build configure_build cross-s390x
+          run s390x-ctest ctest --preset cross-s390x --output-on-failure ;;
+    cortex-m0|cortex-m4f) run "$s" configure_build "cross-$s" ;;
+    *) echo "unknown step $s"; exit 2 ;;
+    esac
+done
+if [ -n "$failed" ]; then
+    echo "test.sh: FAILED:$failed"
+    exit 1
+fi
+echo "test.sh: all steps passed ($STEPS)"
