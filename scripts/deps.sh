@@ -9,7 +9,7 @@ for g in "$@"; do
     build) pkgs="$pkgs build-essential cmake pkg-config git python3 libcmocka-dev libinih-dev
              libopencv-dev libpcap-dev libusb-1.0-0-dev nlohmann-json3-dev" ;;
     test) pkgs="$pkgs valgrind clang libfuzzer-14-dev libclang-rt-14-dev
-             gcc-arm-none-eabi libnewlib-arm-none-eabi gcc-aarch64-linux-gnu gcc-s390x-linux-gnu
+             gcc-arm-none-eabi libnewlib-arm-none-eabi gcc-aarch64-linux-gnu gcc-s390x-linux-gnu libc6-dev-arm64-cross libc6-dev-s390x-cross
              qemu-user libcmocka-dev:arm64 libcmocka-dev:s390x libc6:arm64 libc6:s390x
              python3-canmatrix python3-can can-utils user-mode-linux iproute2 kmod
              qemu-system-x86 busybox-static cpio usbutils" ;;

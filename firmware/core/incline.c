@@ -5,8 +5,9 @@
 //   N, D       Q58 (int64) -> Q27     atan ratio                     UQ2.30 in [0, 1]
 //   angles     bam32 (2^32 / turn)    derivatives K, g               UQ8.24
 //   sigma terms  0.01 deg in Q12 (saturated at 65536 cdeg each)
-// Stack (arm-none-eabi-gcc 12, -mcpu=cortex-m0 -Os, -fstack-usage): see the report in
-// sl_incline.h; no recursion, no arrays on the stack.
+// Stack (arm-none-eabi-gcc, -mcpu=cortex-m0 -Os, -fstack-usage): sl_incline_estimate 88 B,
+// sl_incline_atan2_bam32 32 B, sl_incline_geom_ok 24 B, sl_fx_isqrt64 40 B; plus libgcc's
+// 64-bit division. No recursion, no arrays on the stack. Flash: 2500 B incl. the table.
 #include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>

@@ -268,10 +268,13 @@ void sl_mask_end_rotation(sl_mask_t *m)
     m->stats.rotations++;
 }
 
-bool sl_mask_stable(const sl_mask_t *m, uint16_t az, uint32_t *occ, uint32_t *free_)
+bool sl_mask_stable_prefix(const sl_mask_t *m, uint16_t az, uint32_t words, uint32_t *occ,
+                           uint32_t *free_)
 {
     SL_ASSERT(m != NULL);
-    const uint32_t words = m->words;
+    if (words > m->words) {
+        words = m->words;
+    }
     if (az >= m->azimuths || (m->state[az] & ST_HISTORY) == 0U) {
         for (uint32_t w = 0; w < words; w++) {
             if (occ != NULL) {
@@ -285,8 +288,14 @@ bool sl_mask_stable(const sl_mask_t *m, uint16_t az, uint32_t *occ, uint32_t *fr
     }
     stable_row((const uint32_t(*)[SL_ROI_WORDS])m->planes[az], occ, free_, words,
                m->counter_planes);
-    if (free_ != NULL && (m->bins % 32U) != 0U) {
+    if (free_ != NULL && words == m->words && (m->bins % 32U) != 0U) {
         free_[words - 1U] &= ((uint32_t)1U << (m->bins % 32U)) - 1U;
     }
     return true;
+}
+
+bool sl_mask_stable(const sl_mask_t *m, uint16_t az, uint32_t *occ, uint32_t *free_)
+{
+    SL_ASSERT(m != NULL);
+    return sl_mask_stable_prefix(m, az, m->words, occ, free_);
 }

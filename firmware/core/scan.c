@@ -13,10 +13,11 @@ int32_t sl_scan_az_index(uint16_t azimuths, uint16_t encoder_size, uint16_t tick
     if (azimuths == 0U || encoder_size == 0U || ticks >= encoder_size) {
         return -1;
     }
-    // Nearest azimuth centre, ties upwards; < 2^33 so 64-bit is plenty (and exact).
-    const uint64_t num = (uint64_t)ticks * azimuths + (uint64_t)(encoder_size / 2U);
-    const uint32_t idx = (uint32_t)(num / encoder_size);
-    return (int32_t)(idx % azimuths);
+    // Nearest azimuth centre, ties upwards. Exact in 32 bits: (2^16-1)^2 + 2^15 < 2^32, and
+    // ticks < encoder_size makes the quotient <= azimuths, so the modulo is one compare.
+    const uint32_t num = (uint32_t)ticks * azimuths + (uint32_t)(encoder_size / 2U);
+    const uint32_t idx = num / encoder_size;
+    return (int32_t)((idx >= azimuths) ? idx - azimuths : idx);
 }
 
 static void frame_clear(sl_scan_frame_t *f)
@@ -252,7 +253,7 @@ sl_err_t sl_scan_on_fft(sl_scan_t *s, const sl_proto_fft_t *f)
             frame_complete(s, SL_SCAN_END_SWEEP_GAP);
         } else {
             const uint16_t head = fr->head;
-            const uint32_t fwd = ((uint32_t)idx + n - head) % n;
+            const uint32_t fwd = (idx >= head) ? (uint32_t)idx - head : (uint32_t)idx + n - head;
             if (fwd == 0U) {
                 duplicate(s, idx);
                 return SL_OK;

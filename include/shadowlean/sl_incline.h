@@ -10,10 +10,19 @@
 ///         alpha = atan2(rho cos t - cos b, rho sin t + sin b)
 ///     branch 2 (1/cos((t+b)/2) <= rho < 1/cos(t+b), (b-t)/2 <= alpha < beta):
 ///         alpha = atan2(sqrt(rho^2 - 1), 1) - t
-///     ambiguous (rho < 1/cos((t+b)/2)): two inclinations give the same rho; no number.
+///     ambiguous (rho < 1/cos((t+b)/2)): below the smallest ratio the model produces; no number.
 ///
 /// `alpha > 0` means the top of the pole leans TOWARDS the radar. Its uncertainty is the
 /// first-order propagation of MATH.md s.3, generalised to beta (see sl_incline_estimate).
+///
+/// The fold (read this before trusting negative angles). rho is smallest, rho_amb =
+/// 1/cos((t+b)/2), at alpha = (beta - theta)/2. A pole leaning away by MORE than that is
+/// not flagged: its rho = 1/cos(beta - alpha) is >= rho_amb, so it reads as its mirror image
+/// about (beta - theta)/2, alpha_read = beta - theta - alpha (theta 26, beta 3: a pole at
+/// -14 deg reads -9 deg). Ratios below rho_amb cannot come from the ideal model at all; they
+/// come from noise around the fold point (or a broken assumption), and are reported as
+/// SL_INCLINE_AMBIGUOUS rather than as a number. Only the change of alpha over the vehicle's
+/// motion, or a prior, separates the two sides of the fold.
 ///
 /// Everything here is integer-only (no float anywhere in the core); the host builds the
 /// geometry entries with `sl::make_geom()` (host_tools/common/sl_geom.h), which is the only
@@ -21,18 +30,28 @@
 ///
 /// Units: ranges are plain unsigned integers. The estimator only uses the ratio r2/r1 and
 /// the ratio sigma_r/r1, so any unit works as long as r1, r2 and sigma_r share it; the
-/// names say `_um` because the detection pipeline passes micrometres.
+/// names say `_um` because the detection pipeline passes micrometres (r <= 4294 m).
 ///
-/// Accuracy (measured by tests/unit/test_incline.c against double-precision libm, over
-/// theta 5..34 deg, beta 0..5 deg, rho from the ambiguity bound to 10, both branches and
-/// their seam; and by tests/alpha over the whole supported domain):
-/// - `alpha_bam32` (before the final rounding): |error| <= 1.0e-4 deg (bound asserted by
-///   the test; measured 7.5e-5 deg, dominated by the linear interpolation of the atan table).
-/// - `alpha_cdeg` (rounded half up to 0.01 deg): |error| <= 0.0051 deg (asserted <= 0.01).
-/// - `sigma_cdeg`: |error| <= 0.5 cdeg + 1e-4 x sigma (rounding to 1 cdeg plus <= 1e-5
-///   relative internal error), against the same linearised formula evaluated in double.
-/// - ambiguity: `rho_q28 < geom->rho_amb_q28` exactly; rho_amb_q28 = round(2^28/cos((t+b)/2)),
-///   so the classification matches the real bound to one LSB of rho (3.7e-9).
+/// Accuracy against double-precision libm (the oracle takes the exact theta, beta and r2/r1;
+/// so this includes the rounding of the geometry entry and of rho):
+/// - `alpha_bam32` (before the final rounding): |error| <= 7.3e-5 deg measured, asserted
+///   <= 1e-4 deg; dominated by the linear interpolation of the atan table (1.24e-6 rad).
+/// - `alpha_cdeg` (rounded half up to 0.01 deg): |error| <= 0.00507 deg measured, asserted
+///   <= 0.01 deg.
+/// - `sigma_cdeg`: |error| <= 0.5 cdeg + 1e-4 x sigma, asserted (measured: <= 0.5 cdeg +
+///   1e-4 x sigma - 0.0007 cdeg), against the same linearised formula evaluated in double.
+///   By analysis the error before the rounding to 1 cdeg is ~1e-5 relative + 2^-12 cdeg.
+/// - ambiguity: the test is `rho_q28 < geom->rho_amb_q28`, exact in integers;
+///   rho_amb_q28 = round(2^28/cos((t+b)/2)), so the classification matches the real bound to
+///   one LSB of rho (3.7e-9).
+/// Measured by tests/unit/test_incline.c (201945 points: theta 5..34 deg step 0.5, beta 0..5
+/// step 1, rho from the ambiguity bound to 10 incl. +-8 LSB around the seam; plus 18000
+/// random micrometre pairs over the whole domain), tests/alpha/test_geom.cpp (191461 random
+/// points over the whole domain) and tests/alpha/check_alpha.py (sl-alpha, 5000 lines).
+///
+/// Resources (Cortex-M0, arm-none-eabi-gcc -Os): code + table 2500 bytes of flash (the atan
+/// table is 1028 of them), no RAM; stack <= 200 bytes (sl_incline_estimate's frame 88 B +
+/// sl_incline_atan2_bam32 32 B or sl_fx_isqrt64 40 B + libgcc's 64-bit division).
 #ifndef SHADOWLEAN_SL_INCLINE_H
 #define SHADOWLEAN_SL_INCLINE_H
 
@@ -86,8 +105,9 @@ typedef struct sl_incline_geom {
 /// Outcome of one estimate.
 typedef enum sl_incline_flag {
     SL_INCLINE_VALID = 0,         ///< alpha and sigma are set
-    SL_INCLINE_AMBIGUOUS = 1,     ///< rho < rho_amb: the pole leans away by more than
-                                  ///< (theta - beta)/2, where the model folds; no number
+    SL_INCLINE_AMBIGUOUS = 1,     ///< rho < rho_amb = 1/cos((theta+beta)/2), the model's
+                                  ///< minimum, reached at the fold alpha = (beta-theta)/2
+                                  ///< (see "The fold" above); no number
     SL_INCLINE_INVALID = 2,       ///< r1 == 0 or r1 >= r2 (not a run of bins)
     SL_INCLINE_OUT_OF_DOMAIN = 3, ///< rho > SL_INCLINE_RHO_MAX_Q28, or geometry outside
                                   ///< the supported domain (see SL_INCLINE_THETA_MIN_CDEG)
@@ -140,9 +160,10 @@ typedef struct sl_incline_result {
 /// them to Q27; branch 2 takes sl_fx_isqrt64(rho_q28^2 - 2^56) (Q28); both go through
 /// sl_incline_atan2_bam32(). sigma uses Q56 for Q, Q24 for the derivatives, Q12 cdeg for
 /// the two terms and sl_fx_isqrt64 for the root.
-/// Cost: O(1): 3-4 64-bit divisions, up to 3 sl_fx_isqrt64 calls, ~10 64-bit multiplies;
-/// about 600 host (x86-64) instructions; Cortex-M0 estimate ~3-4k cycles (software 64-bit
-/// division and multiplication). Stack: see firmware/core/incline.c banner (M0 -fstack-usage).
+/// Cost: O(1): 4-5 64-bit divisions, 2 (branch 1) or 3 (branch 2) sl_fx_isqrt64 calls
+/// (the bulk of the time), ~12 64-bit multiplies. Measured with callgrind on x86-64 -O2:
+/// ~700 instructions (branch 1), ~880 (branch 2); on Cortex-M0 (software 64-bit division
+/// and multiplication) an estimate of 4-6k cycles, not measured. Stack: see the file banner.
 /// Pure function: reentrant, no state, callable from any context.
 sl_incline_result_t sl_incline_estimate(uint32_t r1_um, uint32_t r2_um,
                                         const sl_incline_geom_t *geom, uint32_t sigma_r_um,

@@ -146,6 +146,11 @@ void sl_mask_end_rotation(sl_mask_t *m);
 /// @return true when the azimuth has history (its planes mean something). O(words x P).
 bool sl_mask_stable(const sl_mask_t *m, uint16_t az, uint32_t *occ, uint32_t *free_);
 
+/// As sl_mask_stable() for the first `words` words only (clamped to the mask's words):
+/// consumers that need the near range only (detection) skip the rest. O(words x P).
+bool sl_mask_stable_prefix(const sl_mask_t *m, uint16_t az, uint32_t words, uint32_t *occ,
+                           uint32_t *free_);
+
 /// Consecutive rotations azimuth `az` has gone without a row (0 = fresh; 255 saturated; 0
 /// for an out-of-range az). O(1).
 static inline uint8_t sl_mask_missed(const sl_mask_t *m, uint16_t az)

@@ -1,0 +1,607 @@
+// Pole extraction inside the shadow, grouping over azimuths, corrections (sl_detect.h).
+#include <stdint.h>
+#include <string.h>
+
+#include "shadowlean/sl_detect.h"
+#include "shadowlean/sl_fx.h"
+
+#define CF_NEAR 0x01U
+#define CF_SHADOW 0x02U
+#define CF_SPAN 0x04U
+#define CF_WRAPS 0x08U
+
+#define ST_FREE 0U
+#define ST_OPEN 1U
+#define ST_CLOSED 2U
+
+#define EMPTY_LO 0xFFFFU
+#define EMPTY_HI 0U
+
+// 2^32 / (2 pi), rounded: radians -> bam32.
+#define BAM_PER_RAD 683565276ULL
+// pi * 2^16, rounded: r * w_bam * pi / 2^32 = half-angle arc of a bam32 width w at range r.
+#define PI_Q16 205887ULL
+
+void sl_detect_cfg_default(sl_detect_cfg_t *cfg)
+{
+    SL_ASSERT(cfg != NULL);
+    cfg->max_pole_diameter_um = 300000U;
+    cfg->max_radius_um = 150000U;
+    cfg->beam_width_cdeg = 180U;
+    cfg->gap_bins = 2U;
+    cfg->link_bins = 1U;
+    cfg->width_slack_az = 1U;
+    cfg->radius_from_width = true;
+}
+
+// ---- bit scanning (portable: de Bruijn count of trailing zeros)
+
+static unsigned ctz32(uint32_t v)
+{
+    static const uint8_t tab[32] = {0,  1,  28, 2,  29, 14, 24, 3,  30, 22, 20,
+                                    15, 25, 17, 4,  8,  31, 27, 13, 23, 21, 19,
+                                    16, 7,  26, 12, 18, 6,  11, 5,  10, 9};
+    return tab[((v & (0U - v)) * 0x077CB531U) >> 27];
+}
+
+// First set bin in [pos, end), or end.
+static uint32_t next_set(const uint32_t *b, uint32_t pos, uint32_t end)
+{
+    while (pos < end) {
+        const uint32_t w = b[pos >> 5] >> (pos & 31U);
+        if (w != 0U) {
+            pos += ctz32(w);
+            return pos < end ? pos : end;
+        }
+        pos = (pos | 31U) + 1U;
+    }
+    return end;
+}
+
+// First clear bin in [pos, end), or end.
+static uint32_t next_clear(const uint32_t *b, uint32_t pos, uint32_t end)
+{
+    while (pos < end) {
+        const uint32_t w = ~b[pos >> 5] >> (pos & 31U);
+        if (w != 0U) {
+            pos += ctz32(w);
+            return pos < end ? pos : end;
+        }
+        pos = (pos | 31U) + 1U;
+    }
+    return end;
+}
+
+// ---- geometry helpers
+
+int32_t sl_detect_elong_um(const sl_board_t *board, uint32_t r_um)
+{
+    SL_ASSERT(board != NULL);
+    const uint32_t n = board->elong_points;
+    if (n == 0U) {
+        return 0;
+    }
+    const uint32_t *r = board->elong_range_um;
+    const int32_t *dv = board->elong_d_um;
+    const uint32_t last = (n > SL_CFG_MAX_ELONG_POINTS ? SL_CFG_MAX_ELONG_POINTS : n) - 1U;
+    if (r_um <= r[0]) {
+        return dv[0];
+    }
+    if (r_um >= r[last]) {
+        return dv[last];
+    }
+    uint32_t i = 0;
+    while (i + 1U < last && r_um >= r[i + 1U]) {
+        i++;
+    }
+    if (r[i + 1U] <= r[i]) {
+        return dv[i]; // not ascending: no interpolation across a bad segment
+    }
+    const int64_t num = ((int64_t)dv[i + 1U] - (int64_t)dv[i]) * (int64_t)(r_um - r[i]);
+    return sl_fx_sat32((int64_t)dv[i] + num / (int64_t)(r[i + 1U] - r[i]));
+}
+
+uint32_t sl_detect_shadow_slant_um(const sl_board_t *board, uint16_t az)
+{
+    SL_ASSERT(board != NULL);
+    uint64_t rs;
+    if (board->shadow_um != NULL) {
+        rs = board->shadow_um[az];
+    } else if (board->shadow_bins != NULL) {
+        rs = ((uint64_t)board->shadow_bins[az] + 1U) * board->bin_size_um;
+    } else {
+        return 0U;
+    }
+    const uint64_t h = board->radar_height_um;
+    return sl_fx_isqrt64(rs * rs + h * h);
+}
+
+// r * w_bam * pi / 2^32: the half-width arc (small angle) of a bam32 angle w at range r.
+static uint64_t half_arc_um(uint64_t r_um, uint64_t w_bam)
+{
+    // r * w * pi / 2^32 = (r * w) * PI_Q16 / 2^48, split so nothing overflows 64 bits
+    // (r * w < 2^64 for r < 2^32 um and w <= 2^32; the dropped 24 bits are < 1 um).
+    const uint64_t t = r_um * w_bam;
+    return ((t >> 24) * PI_Q16) >> 24;
+}
+
+void sl_detect_correct(const sl_board_t *board, const sl_detect_cfg_t *cfg, uint16_t az,
+                       uint16_t bin_first, uint16_t bin_last, uint16_t az_count,
+                       sl_target_t *t)
+{
+    SL_ASSERT(board != NULL && t != NULL);
+    sl_detect_cfg_t defcfg;
+    if (cfg == NULL) {
+        sl_detect_cfg_default(&defcfg);
+        cfg = &defcfg;
+    }
+    (void)az;
+    const uint64_t b = board->bin_size_um;
+    t->r1_raw_um = sl_fx_usat32((int64_t)((uint64_t)bin_first * b));
+    t->r2_raw_um = sl_fx_usat32((int64_t)(((uint64_t)bin_last + 1U) * b));
+    // Half-bin: the centres of the first and last occupied bins, rounded half up.
+    const uint64_t r1_hb = (((uint64_t)2U * bin_first + 1U) * b + 1U) / 2U;
+    const uint64_t r2_hb = (((uint64_t)2U * bin_last + 1U) * b + 1U) / 2U;
+    const int32_t d = sl_detect_elong_um(board, sl_fx_usat32((int64_t)r2_hb));
+    t->elong_um = d;
+    t->flags = (uint8_t)(t->flags & ~(SL_TARGET_RADIUS_BOARD | SL_TARGET_RADIUS_WIDTH |
+                                      SL_TARGET_RADIUS_CLAMPED | SL_TARGET_ELONG));
+    if (d != 0) {
+        t->flags |= SL_TARGET_ELONG;
+    }
+    int64_t r2 = (int64_t)r2_hb - (int64_t)d;
+    const uint64_t beam_bam = ((uint64_t)cfg->beam_width_cdeg << 32) / 36000U;
+    uint64_t radius;
+    if (board->pole_radius_um != 0U) {
+        radius = board->pole_radius_um;
+        t->flags |= SL_TARGET_RADIUS_BOARD;
+    } else if (!cfg->radius_from_width) {
+        radius = 0U;
+    } else {
+        const uint64_t step = board->azimuths != 0U ? ((uint64_t)1U << 32) / board->azimuths
+                                                   : 0U;
+        const uint64_t width = (az_count > 0U ? (uint64_t)az_count - 1U : 0U) * step;
+        radius = width > beam_bam ? half_arc_um(r1_hb, width - beam_bam) : 0U;
+        t->flags |= SL_TARGET_RADIUS_WIDTH;
+        if (radius > cfg->max_radius_um) {
+            radius = cfg->max_radius_um;
+            t->flags |= SL_TARGET_RADIUS_CLAMPED;
+        }
+    }
+    t->radius_um = (uint32_t)radius;
+    // Front surface -> axis on r1; on r2 only the part of the radius the beam does not see
+    // around the silhouette (L = half footprint of the beam at r1).
+    const uint64_t l = half_arc_um(r1_hb, beam_bam);
+    if (radius > l) {
+        r2 += (int64_t)sl_fx_isqrt64(radius * radius - l * l);
+    }
+    t->r1_um = sl_fx_usat32((int64_t)(r1_hb + radius));
+    t->r2_um = sl_fx_usat32(r2);
+}
+
+// ---- groups
+
+static void ext_union(uint16_t *lo, uint16_t *hi, uint16_t f, uint16_t l)
+{
+    if (f < *lo) {
+        *lo = f;
+    }
+    if (l > *hi) {
+        *hi = l;
+    }
+}
+
+static void entry_add(sl_detect_azrun_t *e, uint16_t f, uint16_t l, uint16_t count)
+{
+    if (e->count == 0U) {
+        e->first = f;
+        e->last = l;
+    } else {
+        e->first = f < e->first ? f : e->first;
+        e->last = l > e->last ? l : e->last;
+    }
+    const uint32_t c = (uint32_t)e->count + count;
+    e->count = (uint16_t)(c > 0xFFFFU ? 0xFFFFU : c);
+}
+
+// Extent of c on azimuth x (x in {az_last - 1, az_last}), or empty.
+static void ext_at(const sl_detect_cand_t *c, uint32_t x, uint16_t *lo, uint16_t *hi)
+{
+    if (x == c->az_last) {
+        *lo = c->last_lo;
+        *hi = c->last_hi;
+    } else if (x + 1U == c->az_last && c->az_first <= x) {
+        *lo = c->prev_lo;
+        *hi = c->prev_hi;
+    } else {
+        *lo = EMPTY_LO;
+        *hi = EMPTY_HI;
+    }
+}
+
+static bool overlaps(uint16_t lo, uint16_t hi, uint32_t f, uint32_t l, uint32_t tol)
+{
+    return lo <= hi && f <= (uint32_t)hi + tol && (uint32_t)lo <= l + tol;
+}
+
+static bool linkable(const sl_detect_t *d, const sl_detect_cand_t *c, uint32_t a, uint32_t f,
+                     uint32_t l)
+{
+    if (c->state != ST_OPEN || a == 0U) {
+        return false;
+    }
+    uint16_t lo, hi;
+    ext_at(c, a - 1U, &lo, &hi);
+    return overlaps(lo, hi, f, l, d->cfg.link_bins);
+}
+
+// Move src's azimuth entries into dst at offset (src first azimuth - dst first azimuth).
+static void entries_merge(sl_detect_cand_t *dst, const sl_detect_cand_t *src, uint32_t offset)
+{
+    const uint32_t span = (uint32_t)src->az_last - src->az_first + 1U;
+    for (uint32_t i = 0; i < span && i < SL_CFG_DETECT_MAX_SPAN; i++) {
+        const sl_detect_azrun_t *e = &src->run[i];
+        if (e->count == 0U) {
+            continue;
+        }
+        if (offset + i < SL_CFG_DETECT_MAX_SPAN) {
+            entry_add(&dst->run[offset + i], e->first, e->last, e->count);
+        } else {
+            dst->flags |= CF_SPAN;
+        }
+    }
+    if (span > SL_CFG_DETECT_MAX_SPAN) {
+        dst->flags |= CF_SPAN;
+    }
+}
+
+// Merge src into dst; both are open and touch azimuth a - 1 or a.
+static void cand_merge(sl_detect_t *d, sl_detect_cand_t *dst, sl_detect_cand_t *src)
+{
+    const uint32_t last = dst->az_last > src->az_last ? dst->az_last : src->az_last;
+    uint16_t llo = EMPTY_LO, lhi = EMPTY_HI, plo = EMPTY_LO, phi = EMPTY_HI, lo, hi;
+    ext_at(dst, last, &lo, &hi);
+    ext_union(&llo, &lhi, lo, hi);
+    ext_at(src, last, &lo, &hi);
+    ext_union(&llo, &lhi, lo, hi);
+    ext_at(dst, last - 1U, &lo, &hi);
+    ext_union(&plo, &phi, lo, hi);
+    ext_at(src, last - 1U, &lo, &hi);
+    ext_union(&plo, &phi, lo, hi);
+    if (src->az_first < dst->az_first) {
+        // Shift dst's entries right to make room in front.
+        const uint32_t sh = (uint32_t)dst->az_first - src->az_first;
+        for (uint32_t i = SL_CFG_DETECT_MAX_SPAN; i-- > 0U;) {
+            if (i >= sh) {
+                dst->run[i] = dst->run[i - sh];
+            } else {
+                dst->run[i].count = 0U;
+            }
+        }
+        // Entries pushed past the end: only possible when the merged span overflows.
+        if ((uint32_t)dst->az_last - src->az_first + 1U > SL_CFG_DETECT_MAX_SPAN) {
+            dst->flags |= CF_SPAN;
+        }
+        dst->az_first = src->az_first;
+    }
+    entries_merge(dst, src, (uint32_t)src->az_first - dst->az_first);
+    dst->flags |= src->flags;
+    dst->az_last = (uint16_t)last;
+    dst->last_lo = llo;
+    dst->last_hi = lhi;
+    dst->prev_lo = plo;
+    dst->prev_hi = phi;
+    src->state = ST_FREE; // src was open
+    d->n_open--;
+}
+
+static void cand_attach(sl_detect_cand_t *c, uint32_t a, uint16_t f, uint16_t l, uint16_t count,
+                        uint8_t rflags)
+{
+    if ((uint32_t)c->az_last + 1U == a) {
+        c->prev_lo = c->last_lo;
+        c->prev_hi = c->last_hi;
+        c->last_lo = f;
+        c->last_hi = l;
+        c->az_last = (uint16_t)a;
+    } else {
+        ext_union(&c->last_lo, &c->last_hi, f, l);
+    }
+    const uint32_t idx = a - c->az_first;
+    if (idx < SL_CFG_DETECT_MAX_SPAN) {
+        entry_add(&c->run[idx], f, l, count);
+    } else {
+        c->flags |= CF_SPAN;
+    }
+    c->flags |= rflags;
+}
+
+static void add_run(sl_detect_t *d, uint32_t a, uint32_t f, uint32_t l, uint32_t count,
+                    uint8_t rflags)
+{
+    d->stats.runs++;
+    sl_detect_cand_t *dst = NULL;
+    for (uint32_t i = 0; i < SL_CFG_DETECT_MAX_CANDIDATES; i++) {
+        sl_detect_cand_t *c = &d->cand[i];
+        if (!linkable(d, c, a, f, l)) {
+            continue;
+        }
+        if (dst == NULL) {
+            dst = c;
+        } else {
+            cand_merge(d, dst, c);
+        }
+    }
+    if (dst == NULL) {
+        for (uint32_t i = 0; i < SL_CFG_DETECT_MAX_CANDIDATES; i++) {
+            if (d->cand[i].state == ST_FREE) {
+                dst = &d->cand[i];
+                break;
+            }
+        }
+        if (dst == NULL) {
+            d->stats.cand_overflow++;
+            return;
+        }
+        memset(dst, 0, sizeof *dst);
+        dst->state = ST_OPEN;
+        d->n_open++;
+        dst->az_first = (uint16_t)a;
+        dst->az_last = (uint16_t)a;
+        dst->last_lo = (uint16_t)f;
+        dst->last_hi = (uint16_t)l;
+        dst->prev_lo = EMPTY_LO;
+        dst->prev_hi = EMPTY_HI;
+    }
+    cand_attach(dst, a, (uint16_t)f, (uint16_t)l, (uint16_t)(count > 0xFFFFU ? 0xFFFFU : count),
+                rflags);
+}
+
+// Width test: most azimuths a pole of diameter D at range r1 can cover.
+static uint32_t allowed_span(const sl_detect_t *d, uint32_t r1_um)
+{
+    if (r1_um == 0U || d->step_bam == 0U) {
+        return 0xFFFFFFFFU;
+    }
+    const uint64_t w = (uint64_t)d->cfg.max_pole_diameter_um * BAM_PER_RAD / r1_um +
+                       d->beam_bam;
+    const uint64_t n = w / d->step_bam + 1U + d->cfg.width_slack_az;
+    return n > 0xFFFFFFFFU ? 0xFFFFFFFFU : (uint32_t)n;
+}
+
+static void finalize(sl_detect_t *d, sl_detect_cand_t *c)
+{
+    d->stats.groups++;
+    const sl_board_t *bd = d->board;
+    const uint32_t span = (uint32_t)c->az_last - c->az_first + 1U;
+    // Representative azimuth: most occupied bins, then nearest the middle, then lowest.
+    uint32_t best = 0, best_cnt = 0, best_dist = 0xFFFFFFFFU;
+    for (uint32_t i = 0; i < span && i < SL_CFG_DETECT_MAX_SPAN; i++) {
+        const uint32_t cnt = c->run[i].count;
+        const uint32_t two_i = 2U * i;
+        const uint32_t dist = two_i > span - 1U ? two_i - (span - 1U) : (span - 1U) - two_i;
+        if (cnt > best_cnt || (cnt == best_cnt && cnt > 0U && dist < best_dist)) {
+            best = i;
+            best_cnt = cnt;
+            best_dist = dist;
+        }
+    }
+    const sl_detect_azrun_t *rep = &c->run[best];
+    const uint16_t az = (uint16_t)(((uint32_t)c->az_first + best) % d->azimuths);
+    sl_target_t t;
+    memset(&t, 0, sizeof t);
+    t.az = az;
+    t.az_first = c->az_first;
+    t.az_count = (uint16_t)(span > 0xFFFFU ? 0xFFFFU : span);
+    t.bin_first = rep->first;
+    t.bin_last = rep->last;
+    t.occupied = rep->count;
+    sl_detect_correct(bd, &d->cfg, az, rep->first, rep->last, t.az_count, &t);
+    t.shadow_slant_um = sl_detect_shadow_slant_um(bd, az);
+    if ((c->flags & CF_WRAPS) != 0U) {
+        t.flags |= SL_TARGET_WRAPS;
+    }
+    const uint32_t r1_hb = t.r1_raw_um + bd->bin_size_um / 2U;
+    int reason = -1;
+    if ((c->flags & CF_NEAR) != 0U) {
+        reason = SL_DETECT_REJ_NEAR;
+    } else if ((c->flags & CF_SHADOW) != 0U || t.r2_um >= t.shadow_slant_um) {
+        reason = SL_DETECT_REJ_SHADOW;
+    } else if ((c->flags & CF_SPAN) != 0U || span > allowed_span(d, r1_hb)) {
+        reason = SL_DETECT_REJ_WIDE;
+    } else if ((uint32_t)rep->count < (uint32_t)rep->last - rep->first + 1U) {
+        reason = SL_DETECT_REJ_BROKEN;
+    }
+    if ((c->flags & CF_SPAN) != 0U) {
+        d->stats.span_overflow++;
+    }
+    c->state = ST_FREE;
+    if (reason >= 0) {
+        d->stats.rejected[reason]++;
+        return;
+    }
+    if (d->n_targets >= d->max_targets) {
+        d->stats.target_overflow++;
+        return;
+    }
+    if (bd->geom != NULL) {
+        const sl_incline_result_t res = sl_incline_estimate(
+            t.r1_um, t.r2_um, &bd->geom[az], bd->range_sigma_um, bd->theta_sigma_cdeg);
+        t.alpha_cdeg = res.alpha_cdeg;
+        t.sigma_cdeg = res.sigma_cdeg;
+        t.incline_flag = res.flag;
+        t.incline_branch = res.branch;
+    } else {
+        t.incline_flag = (uint8_t)SL_INCLINE_OUT_OF_DOMAIN;
+    }
+    d->targets[d->n_targets++] = t;
+    d->stats.targets++;
+}
+
+// Close groups that can no longer grow (no run on a - 1). Groups starting at azimuth 0
+// wait for the wrap merge at the end of the rotation.
+static void close_before(sl_detect_t *d, uint32_t a)
+{
+    if (d->n_open == 0U) {
+        return;
+    }
+    for (uint32_t i = 0; i < SL_CFG_DETECT_MAX_CANDIDATES; i++) {
+        sl_detect_cand_t *c = &d->cand[i];
+        if (c->state != ST_OPEN || (uint32_t)c->az_last + 1U >= a) {
+            continue;
+        }
+        d->n_open--;
+        if (c->az_first == 0U) {
+            c->state = ST_CLOSED;
+        } else {
+            finalize(d, c);
+        }
+    }
+}
+
+sl_err_t sl_detect_init(sl_detect_t *d, const sl_board_t *board, const sl_detect_cfg_t *cfg)
+{
+    if (d == NULL || board == NULL || board->bin_size_um == 0U || board->azimuths == 0U ||
+        board->azimuths > SL_CFG_MAX_AZIMUTHS || board->roi_bins == 0U ||
+        board->roi_bins > SL_CFG_ROI_BINS ||
+        (board->shadow_um == NULL && board->shadow_bins == NULL)) {
+        return SL_ERR_ARG;
+    }
+    memset(d, 0, sizeof *d);
+    d->board = board;
+    if (cfg != NULL) {
+        d->cfg = *cfg;
+    } else {
+        sl_detect_cfg_default(&d->cfg);
+    }
+    d->azimuths = board->azimuths;
+    d->bins = board->roi_bins;
+    d->near_bins = board->near_exclusion_bins;
+    d->step_bam = (uint32_t)(((uint64_t)1U << 32) / board->azimuths);
+    d->beam_bam = (uint32_t)(((uint64_t)d->cfg.beam_width_cdeg << 32) / 36000U);
+    const uint32_t mt = board->max_targets == 0U ? SL_CFG_MAX_TARGETS : board->max_targets;
+    d->max_targets = (uint8_t)(mt > SL_CFG_MAX_TARGETS ? SL_CFG_MAX_TARGETS : mt);
+    const uint64_t b = board->bin_size_um;
+    for (uint16_t a = 0; a < board->azimuths; a++) {
+        const uint64_t s = sl_detect_shadow_slant_um(board, a);
+        const uint64_t win = (s + b - 1U) / b;
+        const int64_t e2 = 2 * ((int64_t)s + sl_detect_elong_um(board, (uint32_t)s)) - (int64_t)b;
+        const uint64_t edge = e2 <= 0 ? 0U : ((uint64_t)e2 + 2U * b - 1U) / (2U * b);
+        d->win_bins[a] = (uint16_t)(win > 0xFFFFU ? 0xFFFFU : win);
+        d->edge_bins[a] = (uint16_t)(edge > 0xFFFFU ? 0xFFFFU : edge);
+    }
+    sl_detect_begin(d);
+    return SL_OK;
+}
+
+void sl_detect_begin(sl_detect_t *d)
+{
+    SL_ASSERT(d != NULL);
+    for (uint32_t i = 0; i < SL_CFG_DETECT_MAX_CANDIDATES; i++) {
+        d->cand[i].state = ST_FREE;
+    }
+    d->n_targets = 0U;
+    d->n_open = 0U;
+    d->last_az = -1;
+}
+
+sl_err_t sl_detect_row(sl_detect_t *d, uint16_t az, const uint32_t *occ, uint32_t words)
+{
+    SL_ASSERT(d != NULL && (occ != NULL || words == 0U));
+    if (az >= d->azimuths || (int32_t)az <= d->last_az) {
+        d->stats.order_errors++;
+        return SL_ERR_RANGE;
+    }
+    d->last_az = az;
+    d->stats.rows++;
+    close_before(d, az);
+    const uint32_t limit = words * 32U < d->bins ? words * 32U : d->bins;
+    const uint32_t win = d->win_bins[az] < limit ? d->win_bins[az] : limit;
+    const uint32_t near = d->near_bins;
+    const uint32_t edge = d->edge_bins[az];
+    const uint32_t gap = d->cfg.gap_bins;
+    uint32_t pos = near;
+    while (pos < win) {
+        const uint32_t s = next_set(occ, pos, win);
+        if (s >= win) {
+            break;
+        }
+        uint8_t rf = 0U;
+        if (s == near && near > 0U && sl_bits_get(occ, near - 1U)) {
+            rf |= CF_NEAR;
+        }
+        uint32_t e = next_clear(occ, s, limit); // one past the last occupied bin
+        uint32_t count = e - s;
+        while (e < limit) {
+            // Bridge gaps of up to `gap` free bins (the run is then broken).
+            const uint32_t stop = (e + gap + 1U) < limit ? (e + gap + 1U) : limit;
+            const uint32_t s2 = next_set(occ, e, stop);
+            if (s2 >= stop) {
+                break;
+            }
+            const uint32_t e2 = next_clear(occ, s2, limit);
+            count += e2 - s2;
+            e = e2;
+        }
+        if (e >= limit || e - 1U >= edge) {
+            rf |= CF_SHADOW;
+        }
+        add_run(d, az, s, e - 1U, count, rf);
+        pos = e;
+    }
+    return SL_OK;
+}
+
+sl_ssize_t sl_detect_end(sl_detect_t *d)
+{
+    SL_ASSERT(d != NULL);
+    const uint32_t n = d->azimuths;
+    // Wrap: groups on the last azimuth continue into groups that started on azimuth 0.
+    for (uint32_t i = 0; i < SL_CFG_DETECT_MAX_CANDIDATES; i++) {
+        sl_detect_cand_t *c = &d->cand[i];
+        if (c->state != ST_OPEN || c->az_last != n - 1U || n < 2U) {
+            continue;
+        }
+        for (uint32_t j = 0; j < SL_CFG_DETECT_MAX_CANDIDATES; j++) {
+            sl_detect_cand_t *c0 = &d->cand[j];
+            if (j == i || c0->state == ST_FREE || c0->az_first != 0U ||
+                !overlaps(c->last_lo, c->last_hi, c0->run[0].first, c0->run[0].last,
+                          d->cfg.link_bins)) {
+                continue;
+            }
+            entries_merge(c, c0, n - c->az_first);
+            const uint32_t last = n + c0->az_last;
+            c->az_last = (uint16_t)(last > 0xFFFFU ? 0xFFFFU : last);
+            c->flags |= (uint8_t)(c0->flags | CF_WRAPS);
+            c0->state = ST_FREE;
+            break;
+        }
+    }
+    for (uint32_t i = 0; i < SL_CFG_DETECT_MAX_CANDIDATES; i++) {
+        if (d->cand[i].state != ST_FREE) {
+            finalize(d, &d->cand[i]);
+        }
+    }
+    d->stats.rotations++;
+    d->last_az = (int32_t)n; // further rows are order errors until sl_detect_begin()
+    return (sl_ssize_t)d->n_targets;
+}
+
+sl_ssize_t sl_detect_rotation_from_mask(sl_detect_t *d, const sl_mask_t *mask)
+{
+    SL_ASSERT(d != NULL && mask != NULL);
+    uint32_t occ[SL_ROI_WORDS];
+    sl_detect_begin(d);
+    const uint32_t n = d->azimuths < mask->azimuths ? d->azimuths : mask->azimuths;
+    for (uint32_t a = 0; a < n; a++) {
+        // Enough words to see a run reach the edge bin (then it is SHADOW anyway).
+        uint32_t words = SL_BITS_WORDS((uint32_t)d->edge_bins[a] + 1U);
+        if (words > mask->words) {
+            words = mask->words;
+        }
+        if (sl_mask_stable_prefix(mask, (uint16_t)a, words, occ, NULL)) {
+            (void)sl_detect_row(d, (uint16_t)a, occ, words);
+        }
+    }
+    return sl_detect_end(d);
+}

@@ -1,0 +1,267 @@
+// Tracks over rotations: gated association, 1-D Kalman on alpha, warning hysteresis.
+#include <stdint.h>
+#include <string.h>
+
+#include "shadowlean/sl_fx.h"
+#include "shadowlean/sl_track.h"
+
+void sl_track_cfg_default(sl_track_cfg_t *cfg)
+{
+    SL_ASSERT(cfg != NULL);
+    cfg->range_gate_um = 300000U;
+    cfg->az_gate = 3U;
+    cfg->q_cdeg = 20U;
+    cfg->min_sigma_cdeg = 50U;
+    cfg->max_sigma_cdeg = 300U;
+    cfg->hysteresis_cdeg = 100U;
+    cfg->confirm = 3U;
+    cfg->caution_abs = true;
+}
+
+sl_err_t sl_track_init(sl_tracker_t *tr, const sl_board_t *board, const sl_track_cfg_t *cfg)
+{
+    if (tr == NULL || board == NULL || board->azimuths == 0U) {
+        return SL_ERR_ARG;
+    }
+    sl_track_cfg_t c;
+    if (cfg != NULL) {
+        c = *cfg;
+    } else {
+        sl_track_cfg_default(&c);
+    }
+    if (c.az_gate == 0U || c.range_gate_um == 0U) {
+        return SL_ERR_ARG;
+    }
+    memset(tr, 0, sizeof *tr);
+    tr->board = board;
+    tr->cfg = c;
+    tr->next_id = 1U;
+    return SL_OK;
+}
+
+static uint32_t az_dist(uint32_t a, uint32_t b, uint32_t n)
+{
+    uint32_t d = (a > b ? a - b : b - a) % n;
+    return (d > n - d) ? n - d : d;
+}
+
+// Raw level of alpha `a` with every threshold lowered by `lower` (cdeg). A threshold <= 0
+// disables its level.
+static uint8_t raw_level(const sl_tracker_t *tr, int32_t a, int32_t lower)
+{
+    const sl_board_t *b = tr->board;
+    if (b->danger_lean_cdeg > 0 && (int64_t)a >= (int64_t)b->danger_lean_cdeg - lower) {
+        return (uint8_t)SL_WARN_DANGER;
+    }
+    const int64_t m = tr->cfg.caution_abs ? (a < 0 ? -(int64_t)a : (int64_t)a) : (int64_t)a;
+    if (b->caution_lean_cdeg > 0 && m >= (int64_t)b->caution_lean_cdeg - lower) {
+        return (uint8_t)SL_WARN_CAUTION;
+    }
+    return (uint8_t)SL_WARN_NONE;
+}
+
+static void filter_update(const sl_tracker_t *tr, sl_track_t *t, int32_t z_cdeg,
+                          uint16_t sigma_cdeg)
+{
+    const uint64_t sz = sigma_cdeg > tr->cfg.min_sigma_cdeg ? sigma_cdeg : tr->cfg.min_sigma_cdeg;
+    const uint64_t r = sz * sz;
+    if (t->valid_hits == 0U) {
+        t->alpha_q8 = sl_fx_sat32((int64_t)z_cdeg * 256);
+        t->var_cdeg2 = sl_fx_usat32((int64_t)(r == 0U ? 1U : r));
+    } else {
+        const uint64_t p = (uint64_t)t->var_cdeg2 + (uint64_t)tr->cfg.q_cdeg * tr->cfg.q_cdeg;
+        const uint64_t k = (p << 16) / (p + r + 0U); // Q16 gain in [0, 65536]
+        const int64_t e = (int64_t)z_cdeg * 256 - t->alpha_q8;
+        t->alpha_q8 = sl_fx_sat32(t->alpha_q8 + sl_fx_rshift_round64((int64_t)k * e, 16U));
+        const uint64_t pn = sl_fx_urshift_round64((65536U - k) * p, 16U);
+        t->var_cdeg2 = sl_fx_usat32((int64_t)(pn == 0U ? 1U : pn));
+    }
+    t->alpha_cdeg = (int32_t)sl_fx_rshift_round64(t->alpha_q8, 8U);
+    const uint32_t s = sl_fx_isqrt64(t->var_cdeg2);
+    t->sigma_cdeg = (uint16_t)(s > 0xFFFFU ? 0xFFFFU : s);
+    if (t->valid_hits < 0xFFFFU) {
+        t->valid_hits++;
+    }
+}
+
+static void level_update(sl_tracker_t *tr, sl_track_t *t)
+{
+    const uint8_t raw = raw_level(tr, t->alpha_cdeg, 0);
+    if (raw > t->level) {
+        if (t->sigma_cdeg <= tr->cfg.max_sigma_cdeg) {
+            if (t->streak < 0xFFU) {
+                t->streak++;
+            }
+            const uint8_t need = tr->cfg.confirm == 0U ? 1U : tr->cfg.confirm;
+            if (t->streak >= need) {
+                t->level = raw;
+                t->streak = 0U;
+                tr->stats.level_changes++;
+            }
+        }
+        return;
+    }
+    t->streak = 0U;
+    const uint8_t keep = raw_level(tr, t->alpha_cdeg, (int32_t)tr->cfg.hysteresis_cdeg);
+    if (keep < t->level) {
+        t->level = keep;
+        tr->stats.level_changes++;
+    }
+}
+
+static void track_take(sl_tracker_t *tr, sl_track_t *t, const sl_target_t *g, uint64_t now_us)
+{
+    t->az = g->az;
+    t->r1_um = g->r1_um;
+    t->r2_um = g->r2_um;
+    t->last_flag = g->incline_flag;
+    if (now_us < t->last_seen_us) {
+        tr->stats.time_backwards++;
+    } else {
+        t->last_seen_us = now_us;
+    }
+    t->updated = 1U;
+    if (t->hits < 0xFFFFU) {
+        t->hits++;
+    }
+    if (g->incline_flag == (uint8_t)SL_INCLINE_VALID) {
+        filter_update(tr, t, g->alpha_cdeg, g->sigma_cdeg);
+        level_update(tr, t);
+    }
+}
+
+static uint16_t new_id(sl_tracker_t *tr)
+{
+    for (;;) {
+        uint16_t id = tr->next_id++;
+        if (id == 0U) {
+            continue;
+        }
+        bool used = false;
+        for (uint32_t i = 0; i < SL_CFG_MAX_TARGETS; i++) {
+            if (tr->tracks[i].live != 0U && tr->tracks[i].id == id) {
+                used = true;
+                break;
+            }
+        }
+        if (!used) {
+            return id;
+        }
+    }
+}
+
+void sl_track_update(sl_tracker_t *tr, const sl_target_t *targets, uint32_t n,
+                     uint64_t now_us)
+{
+    SL_ASSERT(tr != NULL && (targets != NULL || n == 0U));
+    tr->stats.updates++;
+    if (n > SL_CFG_MAX_TARGETS) {
+        tr->stats.full += n - SL_CFG_MAX_TARGETS;
+        n = SL_CFG_MAX_TARGETS;
+    }
+    const uint32_t naz = tr->board->azimuths;
+    const uint64_t ag = tr->cfg.az_gate, rg = tr->cfg.range_gate_um;
+    bool used[SL_CFG_MAX_TARGETS];
+    for (uint32_t i = 0; i < SL_CFG_MAX_TARGETS; i++) {
+        tr->tracks[i].updated = 0U;
+        used[i] = false;
+    }
+    // Greedy global nearest neighbour. Cost |d az| / ag + |d r| / rg, scaled by ag * rg.
+    for (;;) {
+        uint32_t bi = 0, bj = 0;
+        uint64_t best = UINT64_MAX;
+        for (uint32_t i = 0; i < SL_CFG_MAX_TARGETS; i++) {
+            const sl_track_t *t = &tr->tracks[i];
+            if (t->live == 0U || t->updated != 0U) {
+                continue;
+            }
+            for (uint32_t j = 0; j < n; j++) {
+                if (used[j]) {
+                    continue;
+                }
+                const uint32_t da = az_dist(t->az, targets[j].az, naz);
+                const uint32_t dr = t->r1_um > targets[j].r1_um ? t->r1_um - targets[j].r1_um
+                                                                : targets[j].r1_um - t->r1_um;
+                if (da > ag || dr > rg) {
+                    continue;
+                }
+                const uint64_t cost = (uint64_t)da * rg + (uint64_t)dr * ag;
+                if (cost < best) {
+                    best = cost;
+                    bi = i;
+                    bj = j;
+                }
+            }
+        }
+        if (best == UINT64_MAX) {
+            break;
+        }
+        used[bj] = true;
+        track_take(tr, &tr->tracks[bi], &targets[bj], now_us);
+        tr->stats.associated++;
+    }
+    // Tracks not seen for too long are dropped (before opening new ones: frees slots).
+    for (uint32_t i = 0; i < SL_CFG_MAX_TARGETS; i++) {
+        sl_track_t *t = &tr->tracks[i];
+        if (t->live == 0U || t->updated != 0U) {
+            continue;
+        }
+        if (now_us < t->last_seen_us) {
+            tr->stats.time_backwards++;
+            continue;
+        }
+        if (now_us - t->last_seen_us > tr->board->track_timeout_us) {
+            t->live = 0U;
+            tr->live--;
+            tr->stats.dropped++;
+        }
+    }
+    // New tracks for the remaining targets.
+    for (uint32_t j = 0; j < n; j++) {
+        if (used[j]) {
+            continue;
+        }
+        sl_track_t *t = NULL;
+        for (uint32_t i = 0; i < SL_CFG_MAX_TARGETS; i++) {
+            if (tr->tracks[i].live == 0U) {
+                t = &tr->tracks[i];
+                break;
+            }
+        }
+        if (t == NULL) {
+            tr->stats.full++;
+            continue;
+        }
+        memset(t, 0, sizeof *t);
+        t->id = new_id(tr);
+        t->live = 1U;
+        t->first_seen_us = now_us;
+        t->last_seen_us = now_us;
+        tr->live++;
+        tr->stats.created++;
+        track_take(tr, t, &targets[j], now_us);
+    }
+}
+
+sl_warn_level_t sl_track_max_level(const sl_tracker_t *tr)
+{
+    SL_ASSERT(tr != NULL);
+    uint8_t m = (uint8_t)SL_WARN_NONE;
+    for (uint32_t i = 0; i < SL_CFG_MAX_TARGETS; i++) {
+        if (tr->tracks[i].live != 0U && tr->tracks[i].level > m) {
+            m = tr->tracks[i].level;
+        }
+    }
+    return (sl_warn_level_t)m;
+}
+
+const sl_track_t *sl_track_find(const sl_tracker_t *tr, uint16_t id)
+{
+    SL_ASSERT(tr != NULL);
+    for (uint32_t i = 0; i < SL_CFG_MAX_TARGETS; i++) {
+        if (tr->tracks[i].live != 0U && tr->tracks[i].id == id) {
+            return &tr->tracks[i];
+        }
+    }
+    return NULL;
+}

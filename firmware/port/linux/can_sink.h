@@ -1,0 +1,91 @@
+/// @file can_sink.h
+/// @brief A CAN frame sink: a const vtable + context, so the daemon can send every frame
+///        to several outputs (SocketCAN, a candump log file, later gs_usb over libusb).
+///
+/// Contract of every sink:
+/// - `send` never blocks. It returns SL_OK when the frame was written or queued for a
+///   later write, SL_ERR_BUSY when it was dropped because the sink is congested (queue
+///   full, bus-off), SL_ERR_PORT when it was dropped because the medium failed (interface
+///   down or gone, I/O error). Every drop is counted in the sink's stats; the caller never
+///   needs to retry (and must not, or frames would be duplicated).
+/// - `poll` (may be NULL) does deferred work: retries queued frames, reads error reports,
+///   flushes files. Call it at least once per main-loop turn. Never blocks.
+/// - `get_stats` fills the common counters below (a sink may keep more detail).
+/// Time `t_us` is the caller's monotonic clock in microseconds (the core's convention).
+///
+/// Thread safety: none; a sink belongs to one thread.
+#ifndef SHADOWLEAN_CAN_SINK_H
+#define SHADOWLEAN_CAN_SINK_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "shadowlean/sl_can.h"
+#include "shadowlean/sl_err.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/// Counters every sink reports. All totals since open; wrap at 2^32 (not saturating).
+typedef struct sl_can_sink_stats {
+    uint32_t sent;    ///< frames written to the medium
+    uint32_t dropped; ///< frames lost, all reasons
+    uint32_t queued;  ///< frames waiting in the sink right now
+    uint32_t errors;  ///< error reports from the medium (bus errors, I/O errors)
+} sl_can_sink_stats_t;
+
+/// One sink: a vtable and its context. Plain value; the context is borrowed.
+typedef struct sl_can_sink {
+    const char *name; ///< short constant name for logs ("socketcan", "candump")
+    void *ctx;
+    /// Send one frame (see the contract above).
+    sl_err_t (*send)(void *ctx, const sl_can_frame_t *f, uint64_t t_us);
+    /// Deferred work; may be NULL.
+    void (*poll)(void *ctx, uint64_t t_us);
+    /// Common counters.
+    void (*get_stats)(void *ctx, sl_can_sink_stats_t *out);
+} sl_can_sink_t;
+
+/// Send `f` to each of `n` sinks. @return SL_OK when every sink took it, else the first
+/// error (every sink is still tried). O(n).
+static inline sl_err_t sl_can_sinks_send(const sl_can_sink_t *sinks, size_t n,
+                                         const sl_can_frame_t *f, uint64_t t_us)
+{
+    sl_err_t first = SL_OK;
+    for (size_t i = 0; i < n; i++) {
+        const sl_err_t e = sinks[i].send(sinks[i].ctx, f, t_us);
+        if (e != SL_OK && first == SL_OK) {
+            first = e;
+        }
+    }
+    return first;
+}
+
+/// Poll each sink that has a poll function. O(n).
+static inline void sl_can_sinks_poll(const sl_can_sink_t *sinks, size_t n, uint64_t t_us)
+{
+    for (size_t i = 0; i < n; i++) {
+        if (sinks[i].poll != NULL) {
+            sinks[i].poll(sinks[i].ctx, t_us);
+        }
+    }
+}
+
+/// Sum of the sinks' dropped counters (for Status.CanDropped). O(n).
+static inline uint32_t sl_can_sinks_dropped(const sl_can_sink_t *sinks, size_t n)
+{
+    uint32_t sum = 0;
+    for (size_t i = 0; i < n; i++) {
+        sl_can_sink_stats_t st = {0, 0, 0, 0};
+        sinks[i].get_stats(sinks[i].ctx, &st);
+        sum += st.dropped;
+    }
+    return sum;
+}
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif // SHADOWLEAN_CAN_SINK_H

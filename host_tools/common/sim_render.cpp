@@ -1,0 +1,919 @@
+// sim_render.cpp: see sim_render.h.
+#include "sim_render.h"
+
+#include <algorithm>
+#include <atomic>
+#include <condition_variable>
+#include <cstring>
+#include <mutex>
+#include <thread>
+#include <limits>
+
+#include "shadowlean/sl_proto.h"
+#include "sl_geom.h"
+
+namespace sl {
+
+// ------------------------------------------------------------------------------------------
+// random numbers
+
+uint64_t sim_hash(uint64_t a, uint64_t b, uint64_t c, uint64_t d)
+{
+    auto mix = [](uint64_t z) {
+        z += 0x9E3779B97F4A7C15ULL;
+        z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
+        z = (z ^ (z >> 27)) * 0x94D049BB133111EBULL;
+        return z ^ (z >> 31);
+    };
+    uint64_t h = mix(a);
+    h = mix(h ^ b);
+    h = mix(h ^ (c * 0xD1B54A32D192ED03ULL));
+    h = mix(h ^ (d * 0x8CB92BA72F3D8DD7ULL));
+    return h;
+}
+
+double sim_uniform(uint64_t h) { return static_cast<double>(h >> 11) * (1.0 / 9007199254740992.0); }
+
+double sim_normal(uint64_t h)
+{
+    const double u1 = 1.0 - sim_uniform(h);                   // (0, 1]
+    const double u2 = sim_uniform(sim_hash(h, 0x5EED));
+    return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * kSimPi * u2);
+}
+
+void sim_split_time(double unix_s, uint32_t *seconds, uint32_t *split_ns)
+{
+    double sec = std::floor(unix_s);
+    long long ns = std::llround((unix_s - sec) * 1e9);
+    if (ns >= 1000000000LL) {
+        sec += 1;
+        ns -= 1000000000LL;
+    }
+    *seconds = static_cast<uint32_t>(sec);
+    *split_ns = static_cast<uint32_t>(ns);
+}
+
+void SimColumn::reset(int bins)
+{
+    energy.assign(static_cast<size_t>(bins), 0.0);
+    peak.assign(static_cast<size_t>(bins), 0.0F);
+    touched.assign(static_cast<size_t>(bins), 0);
+}
+
+// ------------------------------------------------------------------------------------------
+
+struct Simulator::PoleView {
+    int pole = 0;
+    RadarPose pose;
+    VisibleAxis va;
+};
+
+struct Simulator::RotationGeom {
+    int k = 0;
+    std::vector<std::vector<PoleView>> per_az;
+    std::vector<GtRow> gt;
+};
+
+namespace {
+
+constexpr uint64_t kSaltSpeckle = 0x5BEC1EULL, kSaltPhase = 0x9A5EULL, kSaltNoise = 0x4015EULL,
+                   kSaltLeak = 0x1EA4ULL;
+
+void add_uniform(std::vector<double> &e, double bin, double a, double c, double E)
+{
+    if (E <= 0) {
+        return;
+    }
+    if (c < a) {
+        std::swap(a, c);
+    }
+    const long n = static_cast<long>(e.size());
+    long ia = static_cast<long>(std::floor(a / bin));
+    long ic = static_cast<long>(std::floor(c / bin));
+    if (ic < 0 || ia >= n) {
+        return;
+    }
+    if (ia == ic || c - a < 1e-15) {
+        if (ia >= 0) {
+            e[static_cast<size_t>(ia)] += E;
+        }
+        return;
+    }
+    const double inv = E / (c - a);
+    for (long i = std::max(0L, ia); i <= std::min(ic, n - 1); i++) {
+        const double lo = std::max(a, i * bin), hi = std::min(c, (i + 1) * bin);
+        if (hi > lo) {
+            e[static_cast<size_t>(i)] += (hi - lo) * inv;
+        }
+    }
+}
+
+void touch(SimColumn &col, double bin, double a, double c, float pk)
+{
+    if (c < a) {
+        std::swap(a, c);
+    }
+    const long n = static_cast<long>(col.touched.size());
+    const long ia = std::max(0L, static_cast<long>(std::floor(a / bin)));
+    const long ic = std::min(n - 1, static_cast<long>(std::floor(c / bin)));
+    for (long i = ia; i <= ic; i++) {
+        col.touched[static_cast<size_t>(i)] = 1;
+        col.peak[static_cast<size_t>(i)] = std::max(col.peak[static_cast<size_t>(i)], pk);
+    }
+}
+
+} // namespace
+
+Simulator::Simulator(const Scene &scene) : s_(scene)
+{
+    validate_scene(s_);
+    const BoardSpec &b = s_.board;
+    for (const auto &p : s_.poles) {
+        poles_.push_back(make_pole_geom(p));
+    }
+    for (const auto &x : s_.boxes) {
+        boxes_.push_back(make_box_geom(x));
+    }
+    for (int i = 0; i < b.azimuths; i++) {
+        az_deg_.push_back(b.azimuth_vehicle_deg(i));
+        theta_deg_.push_back(b.theta_deg(i));
+    }
+    sigma_az_ = scene_az_sigma_deg(s_);
+    cut_az_ = scene_az_cutoff_deg(s_);
+
+    // ground: cumulative gain over depression
+    const int nc = static_cast<int>(std::lround(90.0 / ground_cum_step_)) + 1;
+    ground_cum_.assign(static_cast<size_t>(nc), 0.0);
+    auto f = [&](double x) {
+        return elevation_gain(-x) *
+               (s_.ground_ambient + (1.0 - s_.ground_ambient) * std::sin(sim_d2r(x)));
+    };
+    for (int n = 1; n < nc; n++) {
+        const double x0 = (n - 1) * ground_cum_step_, x1 = n * ground_cum_step_;
+        ground_cum_[static_cast<size_t>(n)] =
+            ground_cum_[static_cast<size_t>(n) - 1] +
+            (f(x0) + 4 * f(0.5 * (x0 + x1)) + f(x1)) / 6.0 * ground_cum_step_;
+    }
+    if (s_.ground) {
+        const int ncols = b.chassis_type == "cylinder" ? 1 : b.azimuths;
+        ground_cols_.resize(static_cast<size_t>(ncols));
+        for (int i = 0; i < ncols; i++) {
+            SimColumn c;
+            c.reset(bins());
+            ground_analytic(i, c);
+            ground_cols_[static_cast<size_t>(i)] = c.energy;
+        }
+    }
+
+    // smear kernel: triangular, mode weight 1, front part = mode_frac of the width
+    if (s_.smear) {
+        const int W = std::max(1, static_cast<int>(std::lround(s_.smear_width_bins)));
+        const int F = std::min(W - 1, static_cast<int>(std::lround(W * s_.smear_mode_frac)));
+        smear_front_ = F;
+        for (int j = -F; j < W - F; j++) {
+            smear_kernel_.push_back(j <= 0 ? (j + F + 1.0) / (F + 1.0)
+                                           : 1.0 - static_cast<double>(j) / (W - F));
+        }
+    }
+
+    // pure-noise magnitude: N = round(|n|), n complex Gaussian, sigma per component
+    if (s_.noise) {
+        const double sg = std::max(1e-9, s_.noise_sigma);
+        auto F = [&](double x) { return x <= 0 ? 0.0 : 1.0 - std::exp(-x * x / (2 * sg * sg)); };
+        for (int m = 0;; m++) {
+            noise_cdf_.push_back(F(m + 0.5));
+            const double v = m <= 1 ? 0.0 : std::round(s_.log_db_per_decade * std::log10(m));
+            noise_val_.push_back(static_cast<uint8_t>(std::min(255.0, v)));
+            if (1.0 - noise_cdf_.back() < 1e-15 || m > 100000) {
+                noise_cdf_.back() = 1.0;
+                break;
+            }
+        }
+    }
+
+    // static scene: the geometry never changes; compute it once
+    if (s_.speed_mps == 0.0) {
+        RotationGeom rg;
+        rotation_geom(0, rg);
+        static_cols_.resize(static_cast<size_t>(b.azimuths));
+        for (int i = 0; i < b.azimuths; i++) {
+            column_from(rg, i, static_cols_[static_cast<size_t>(i)]);
+        }
+    }
+}
+
+Simulator::~Simulator() = default;
+
+double Simulator::time_of(int k, int i) const
+{
+    return (k + static_cast<double>(i) / s_.board.azimuths) / s_.rotation_hz;
+}
+
+uint16_t Simulator::ticks_of(int i) const
+{
+    return static_cast<uint16_t>(
+        std::lround(static_cast<double>(i) * s_.board.encoder_size / s_.board.azimuths) %
+        s_.board.encoder_size);
+}
+
+double Simulator::elevation_gain(double e) const
+{
+    if (e > s_.elev_top_deg || e < s_.elev_bottom_deg) {
+        return 0.0;
+    }
+    if (s_.elevation == ElevationProfile::Ideal) {
+        return 1.0;
+    }
+    const double pk = s_.measured_peak_deg;
+    const double u = e >= pk ? (e - pk) / (s_.elev_top_deg - pk) : (pk - e) / (pk - s_.elev_bottom_deg);
+    return std::pow(10.0, -0.1 * s_.measured_edge_db * u * u);
+}
+
+double Simulator::azimuth_gain(double d) const
+{
+    if (std::fabs(d) > cut_az_) {
+        return 0.0;
+    }
+    return std::exp(-0.5 * d * d / (sigma_az_ * sigma_az_));
+}
+
+std::vector<uint8_t> Simulator::config_message() const
+{
+    const BoardSpec &b = s_.board;
+    sl_proto_config_t c;
+    std::memset(&c, 0, sizeof c);
+    c.azimuths = static_cast<uint16_t>(b.azimuths);
+    c.bin_size_100um = static_cast<uint16_t>(std::lround(b.bin_size_m * 1e4));
+    c.range_bins = static_cast<uint16_t>(b.range_bins);
+    c.encoder_size = static_cast<uint16_t>(b.encoder_size);
+    c.rotation_mhz = static_cast<uint16_t>(std::lround(s_.rotation_hz * 1000));
+    c.packet_rate = static_cast<uint16_t>(std::lround(b.azimuths * s_.rotation_hz));
+    const float one = 1.0F, zero = 0.0F, res = static_cast<float>(b.bin_size_m);
+    std::memcpy(&c.range_gain_f32, &one, 4);
+    std::memcpy(&c.range_offset_f32, &zero, 4);
+    c.has_data_width = true;
+    c.data_width = 1;
+    c.has_range_res = true;
+    std::memcpy(&c.range_res_m_f32, &res, 4);
+    std::vector<uint8_t> buf(256);
+    const sl_bytes_t none = {nullptr, 0};
+    const sl_ssize_t n = sl_proto_encode_config(buf.data(), buf.size(), &c, none);
+    if (n <= 0) {
+        throw SceneError("sl_proto_encode_config failed");
+    }
+    buf.resize(static_cast<size_t>(n));
+    return buf;
+}
+
+// ------------------------------------------------------------------------------------------
+// geometry of one rotation: which poles are visible on which azimuths, and the truth
+
+void Simulator::rotation_geom(int k, RotationGeom &rg) const
+{
+    const BoardSpec &b = s_.board;
+    const int N = b.azimuths;
+    const double step = 360.0 / N;
+    rg.k = k;
+    rg.per_az.assign(static_cast<size_t>(N), {});
+    rg.gt.clear();
+    Occluders occ{&poles_, &boxes_};
+    const Wedge w{s_.elev_top_deg, s_.elev_bottom_deg};
+    auto index_of = [&](double az) {
+        long i = std::lround((az - b.radar_yaw_deg) / step);
+        i %= N;
+        if (i < 0) {
+            i += N;
+        }
+        return static_cast<int>(i);
+    };
+    for (size_t p = 0; p < poles_.size(); p++) {
+        const PoleGeom &pg = poles_[p];
+        const int self = static_cast<int>(p);
+        // nominal azimuth: nearest to the midpoint of the wedge-visible axis (2 passes so
+        // the pose is that of the nominal azimuth's own instant)
+        RadarPose pose = radar_pose_at(s_, time_of(k, 0));
+        VisibleAxis va0;
+        int i_nom = -1;
+        for (int pass = 0; pass < 3; pass++) {
+            va0 = visible_axis(b, pose, pg, self, occ, w, 0, -1, 200);
+            if (va0.runs == 0) {
+                break;
+            }
+            const V3 mid = pg.at(0.5 * (va0.s_lo + va0.s_hi));
+            i_nom = index_of(azimuth_of(pose, mid));
+            pose = radar_pose_at(s_, time_of(k, i_nom));
+        }
+        if (va0.runs == 0 || i_nom < 0) {
+            continue;
+        }
+        // angular spread of the visible axis around the nominal azimuth
+        double lo = 0, hi = 0;
+        for (int q = 0; q <= 16; q++) {
+            const V3 P = pg.at(va0.s_lo + (va0.s_hi - va0.s_lo) * q / 16.0);
+            const double d = wrap180(azimuth_of(pose, P) - az_deg_[static_cast<size_t>(i_nom)]);
+            lo = std::min(lo, d);
+            hi = std::max(hi, d);
+        }
+        const double h_min = std::max(1e-3, std::hypot(pg.at(va0.s_lo).x - pose.o.x,
+                                                       pg.at(va0.s_lo).y - pose.o.y) - pg.radius);
+        const double ang_r = sim_r2d(std::asin(std::min(1.0, pg.radius / h_min)));
+        const int m_lo = static_cast<int>(std::ceil((-lo + cut_az_ + ang_r) / step)) + 1;
+        const int m_hi = static_cast<int>(std::ceil((hi + cut_az_ + ang_r) / step)) + 1;
+        for (int m = -std::min(m_lo, N / 2); m <= std::min(m_hi, N / 2 - 1); m++) {
+            const int j = ((i_nom + m) % N + N) % N;
+            PoleView pv;
+            pv.pole = self;
+            pv.pose = radar_pose_at(s_, time_of(k, j));
+            pv.va = visible_axis(b, pv.pose, pg, self, occ, w, az_deg_[static_cast<size_t>(j)],
+                                 cut_az_, 400);
+            if (pv.va.runs == 0) {
+                continue;
+            }
+            GtRow g;
+            g.rotation = k;
+            g.azimuth = j;
+            g.nominal = j == i_nom ? 1 : 0;
+            g.pole = self;
+            g.pole_name = s_.poles[p].name;
+            g.t_s = s_.start_time_s + time_of(k, j);
+            g.radar_x_m = pv.pose.o.x;
+            g.radar_y_m = pv.pose.o.y;
+            g.heading_deg = pv.pose.heading_deg;
+            g.az_center_deg = az_deg_[static_cast<size_t>(j)];
+            const V3 mid = pg.at(0.5 * (pv.va.s_lo + pv.va.s_hi));
+            g.bearing_deg = azimuth_of(pv.pose, mid);
+            g.theta_deg = theta_deg_[static_cast<size_t>(j)];
+            g.beta_deg = s_.elev_top_deg;
+            g.r1_m = pv.va.r1;
+            g.r2_m = pv.va.r2;
+            splat_pole(pv, j, nullptr, &g.r1_surf_m, &g.r2_surf_m);
+            g.r1_end = pv.va.r1_at_foot ? "foot" : seg_end_name(pv.va.r1_end);
+            g.r2_end = seg_end_name(pv.va.r2_end);
+            g.runs = pv.va.runs;
+            g.valid = (pv.va.runs == 1 && (g.r1_end == "top" || g.r1_end == "foot") &&
+                       g.r2_end == "wedge")
+                          ? 1
+                          : 0;
+            const double bw_mid = sim_r2d(std::atan2(mid.y - pv.pose.o.y, mid.x - pv.pose.o.x));
+            g.alpha_deg = inplane_alpha_deg(pg, bw_mid);
+            g.alpha_az_deg = inplane_alpha_deg(pg, pv.pose.heading_deg - g.az_center_deg);
+            int flag = 0;
+            g.alpha_model_deg = alpha_oracle_deg(g.r1_m, g.r2_m, g.theta_deg, g.beta_deg, &flag);
+            g.alpha_paper_deg = paper_alpha_gt_deg(pg, pv.pose);
+            g.psi_deg = s_.poles[p].tilt_deg;
+            g.phi_deg = wrap180(s_.poles[p].lean_deg - pv.pose.heading_deg);
+            const double sh = std::min(pg.length, pv.pose.o.z / pg.v.z);
+            const V3 ph = pg.at(sh);
+            const double hh = sim_d2r(pv.pose.heading_deg);
+            g.offset_m = -(ph.x - pv.pose.o.x) * std::sin(hh) + (ph.y - pv.pose.o.y) * std::cos(hh);
+            g.along_m = (pv.pose.o.x - ph.x) * std::cos(hh) + (pv.pose.o.y - ph.y) * std::sin(hh);
+            g.radius_m = pg.radius;
+            rg.gt.push_back(g);
+            rg.per_az[static_cast<size_t>(j)].push_back(std::move(pv));
+        }
+    }
+}
+
+std::vector<GtRow> Simulator::truth(int k) const
+{
+    RotationGeom rg;
+    rotation_geom(k, rg);
+    return rg.gt;
+}
+
+// ------------------------------------------------------------------------------------------
+// objects -> energies
+
+void Simulator::splat_pole(const PoleView &pv, int i, SimColumn *col, double *r1s,
+                           double *r2s) const
+{
+    const PoleGeom &pg = poles_[static_cast<size_t>(pv.pole)];
+    const RadarPose &r = pv.pose;
+    const double bin = bin_m();
+    const double a_c = az_deg_[static_cast<size_t>(i)];
+    const double s_foot = dot(r.o - pg.base, pg.v);
+    constexpr int K = 8; // cross-section quantiles
+    double q[K];
+    for (int k = 0; k < K; k++) {
+        const double F = (k + 0.5) / K;
+        q[k] = std::sqrt(1.0 - F * F);
+    }
+    double r1 = std::numeric_limits<double>::infinity(), r2 = 0;
+    struct Smp {
+        double r, re, e, eps, g;
+    };
+    std::vector<Smp> sm;
+    std::vector<double> ss;
+    for (const auto &run : pv.va.run) {
+        const double s0 = run.first, s1 = run.second;
+        auto elev = [&](double s) {
+            const V3 d = pg.at(s) - r.o;
+            return sim_r2d(std::atan2(d.z, std::hypot(d.x, d.y)));
+        };
+        const double de = std::fabs(elev(s1) - elev(s0));
+        const int n = std::max(2, static_cast<int>(std::ceil(2.0 * de / s_.pole_step_deg)) + 1);
+        ss.clear();
+        for (int j = 0; j < n; j++) {
+            ss.push_back(s0 + (s1 - s0) * j / (n - 1));
+        }
+        if (s_foot > s0 && s_foot < s1) {
+            ss.push_back(s_foot);
+            std::sort(ss.begin(), ss.end());
+        }
+        sm.clear();
+        for (double s : ss) {
+            const V3 P = pg.at(s);
+            const V3 rel = P - r.o;
+            const double rr = norm(rel);
+            const V3 d = (1.0 / rr) * rel;
+            const double h = std::hypot(rel.x, rel.y);
+            const double e = sim_r2d(std::atan2(rel.z, h));
+            const double bw = std::atan2(rel.y, rel.x);
+            const double az = wrap180(r.heading_deg - sim_r2d(bw) - a_c);
+            const double dv = dot(d, pg.v);
+            const double re = pg.radius / std::sqrt(std::max(1e-12, 1.0 - dv * dv));
+            const double tl = -std::sin(bw) * pg.lean.x + std::cos(bw) * pg.lean.y;
+            const double rt = pg.radius * std::sqrt(1.0 + pg.tan_psi * pg.tan_psi * tl * tl);
+            const double wdeg = sim_r2d(std::asin(std::min(1.0, rt / std::max(h, 1e-9))));
+            const double g = elevation_gain(e) * azimuth_gain(az);
+            sm.push_back({rr, re, e, pg.reflectivity * g * 2.0 * wdeg, pg.reflectivity * g});
+            r1 = std::min(r1, rr - re);
+            r2 = std::max(r2, rr);
+        }
+        if (col == nullptr) {
+            continue;
+        }
+        for (size_t j = 0; j + 1 < sm.size(); j++) {
+            const Smp &A = sm[j], &B = sm[j + 1];
+            const double E = 0.5 * (A.eps + B.eps) * std::fabs(B.e - A.e);
+            const double re = 0.5 * (A.re + B.re);
+            for (int k = 0; k < K; k++) {
+                add_uniform(col->energy, bin, A.r - re * q[k], B.r - re * q[k], E / K);
+            }
+            if (A.g > 0 || B.g > 0) {
+                touch(*col, bin, std::min(A.r, B.r) - re, std::max(A.r, B.r),
+                      static_cast<float>(std::max(A.g, B.g)));
+            }
+        }
+    }
+    if (r1s != nullptr) {
+        *r1s = r1;
+    }
+    if (r2s != nullptr) {
+        *r2s = r2;
+    }
+}
+
+void Simulator::ground_analytic(int i, SimColumn &col) const
+{
+    const BoardSpec &b = s_.board;
+    const double H = b.radar_height_m, bin = bin_m();
+    const int K = s_.ground_az_samples;
+    const int nb = bins();
+    const int last = std::min(nb - 1, static_cast<int>(std::floor(s_.ground_max_range_m / bin)));
+    auto C = [&](double x) {
+        const double u = std::clamp(x, 0.0, 90.0) / ground_cum_step_;
+        const size_t n = std::min(ground_cum_.size() - 2, static_cast<size_t>(u));
+        const double f = u - static_cast<double>(n);
+        return ground_cum_[n] + f * (ground_cum_[n + 1] - ground_cum_[n]);
+    };
+    for (int k = 0; k < K; k++) {
+        const double d = K == 1 ? 0.0 : -cut_az_ + 2.0 * cut_az_ * k / (K - 1);
+        const double wk = K == 1 ? 1.0 : (2.0 * cut_az_ / (K - 1)) * ((k == 0 || k == K - 1) ? 0.5 : 1.0);
+        const double g = azimuth_gain(d) * wk;
+        if (g <= 0) {
+            continue;
+        }
+        const double th = chassis_theta_deg(b, az_deg_[static_cast<size_t>(i)] + d);
+        const double lo_d = std::max(0.0, -s_.elev_top_deg);
+        const double hi_d = std::min(th, -s_.elev_bottom_deg);
+        if (!(hi_d > lo_d)) {
+            continue;
+        }
+        const double r_first = H / std::sin(sim_d2r(hi_d));
+        for (int j = std::max(0, static_cast<int>(std::floor(r_first / bin))); j <= last; j++) {
+            const double ra = j * bin, rb = (j + 1) * bin;
+            if (rb <= H) {
+                continue;
+            }
+            const double x_hi = ra <= H ? 90.0 : sim_r2d(std::asin(H / ra));
+            const double x_lo = sim_r2d(std::asin(H / rb));
+            const double a = std::max(x_lo, lo_d), c = std::min(x_hi, hi_d);
+            if (c <= a) {
+                continue;
+            }
+            const double E = s_.ground_reflectivity * g * (C(c) - C(a));
+            col.energy[static_cast<size_t>(j)] += E;
+            if (E > 0) {
+                col.touched[static_cast<size_t>(j)] = 1;
+                col.peak[static_cast<size_t>(j)] = std::max(
+                    col.peak[static_cast<size_t>(j)],
+                    static_cast<float>(s_.ground_reflectivity * azimuth_gain(d) *
+                                       elevation_gain(-0.5 * (a + c))));
+            }
+        }
+    }
+}
+
+bool Simulator::boxes_in_window(const RadarPose &r, int i) const
+{
+    const double a_c = az_deg_[static_cast<size_t>(i)];
+    for (const auto &bx : boxes_) {
+        double lo = 1e9, hi = -1e9;
+        for (int q = 0; q < 4; q++) {
+            const double u = (q & 1) ? bx.hx : -bx.hx, v = (q & 2) ? bx.hy : -bx.hy;
+            const V3 P{bx.cx + bx.c * u - bx.s * v, bx.cy + bx.s * u + bx.c * v, 0};
+            const double d = wrap180(azimuth_of(r, P) - a_c);
+            lo = std::min(lo, d);
+            hi = std::max(hi, d);
+        }
+        if (hi - lo >= 180.0) {
+            return true; // the radar is inside or beside it: take the slow path
+        }
+        if (hi >= -cut_az_ && lo <= cut_az_) {
+            return true;
+        }
+    }
+    return false;
+}
+
+void Simulator::grid_ground_boxes(const RadarPose &r, int i, SimColumn &col) const
+{
+    const BoardSpec &b = s_.board;
+    const double H = b.radar_height_m, bin = bin_m();
+    const int K = s_.ground_az_samples;
+    const double a_c = az_deg_[static_cast<size_t>(i)];
+    const int ne = std::max(2, static_cast<int>(std::ceil((s_.elev_top_deg - s_.elev_bottom_deg) /
+                                                          s_.box_step_deg)) + 1);
+    struct Hit {
+        int surf; // -2 none, -1 ground, >= 0 box
+        double t, eps, g;
+    };
+    std::vector<Hit> hits(static_cast<size_t>(ne));
+    for (int k = 0; k < K; k++) {
+        const double d = K == 1 ? 0.0 : -cut_az_ + 2.0 * cut_az_ * k / (K - 1);
+        const double wk = K == 1 ? 1.0 : (2.0 * cut_az_ / (K - 1)) * ((k == 0 || k == K - 1) ? 0.5 : 1.0);
+        const double ga = azimuth_gain(d);
+        if (ga <= 0) {
+            continue;
+        }
+        const double th = chassis_theta_deg(b, a_c + d);
+        const double bw = sim_d2r(r.heading_deg - (a_c + d));
+        for (int j = 0; j < ne; j++) {
+            const double e = s_.elev_bottom_deg + (s_.elev_top_deg - s_.elev_bottom_deg) * j / (ne - 1);
+            Hit h{-2, 0, 0, 0};
+            if (e >= -th) {
+                const double ce = std::cos(sim_d2r(e)), se = std::sin(sim_d2r(e));
+                const V3 dir{ce * std::cos(bw), ce * std::sin(bw), se};
+                double tg = std::numeric_limits<double>::infinity();
+                if (se < 0) {
+                    tg = H / -se;
+                    if (tg * ce > s_.ground_max_range_m) {
+                        tg = std::numeric_limits<double>::infinity();
+                    }
+                }
+                double tb = std::min(tg, 1e6);
+                int which = -2;
+                for (size_t q = 0; q < boxes_.size(); q++) {
+                    double t = 0;
+                    if (boxes_[q].hit(r.o, dir, 1e-6, tb, &t)) {
+                        tb = t;
+                        which = static_cast<int>(q);
+                    }
+                }
+                const double gel = elevation_gain(e);
+                if (which >= 0) {
+                    const double g = boxes_[static_cast<size_t>(which)].reflectivity * gel * ga;
+                    h = Hit{which, tb, g * wk, g};
+                } else if (std::isfinite(tg) && s_.ground) {
+                    const double sh = s_.ground_ambient + (1 - s_.ground_ambient) * -se;
+                    const double g = s_.ground_reflectivity * sh * gel * ga;
+                    h = Hit{-1, tg, g * wk, g};
+                }
+            }
+            hits[static_cast<size_t>(j)] = h;
+        }
+        const double de = (s_.elev_top_deg - s_.elev_bottom_deg) / (ne - 1);
+        for (int j = 0; j + 1 < ne; j++) {
+            const Hit &A = hits[static_cast<size_t>(j)], &B = hits[static_cast<size_t>(j) + 1];
+            if (A.surf == -2 || A.surf != B.surf) {
+                continue;
+            }
+            add_uniform(col.energy, bin, A.t, B.t, 0.5 * (A.eps + B.eps) * de);
+            if (A.g > 0 || B.g > 0) {
+                touch(col, bin, A.t, B.t, static_cast<float>(std::max(A.g, B.g)));
+            }
+        }
+    }
+}
+
+void Simulator::column_from(const RotationGeom &rg, int i, SimColumn &col) const
+{
+    col.reset(bins());
+    const RadarPose pose = radar_pose_at(s_, time_of(rg.k, i));
+    if (!boxes_.empty() && boxes_in_window(pose, i)) {
+        grid_ground_boxes(pose, i, col);
+    } else if (s_.ground && !ground_cols_.empty()) {
+        const auto &g = ground_cols_[ground_cols_.size() == 1 ? 0 : static_cast<size_t>(i)];
+        for (size_t j = 0; j < g.size(); j++) {
+            if (g[j] > 0) {
+                col.energy[j] += g[j];
+                col.touched[j] = 1;
+                col.peak[j] = std::max(col.peak[j], static_cast<float>(s_.ground_reflectivity));
+            }
+        }
+    }
+    for (const auto &pv : rg.per_az[static_cast<size_t>(i)]) {
+        splat_pole(pv, i, &col, nullptr, nullptr);
+    }
+}
+
+void Simulator::geometry_column(int k, int i, SimColumn &col) const
+{
+    RotationGeom rg;
+    rotation_geom(k, rg);
+    column_from(rg, i, col);
+}
+
+// ------------------------------------------------------------------------------------------
+// effects and the 8-bit mapping
+
+void Simulator::map_column(int k, int i, const SimColumn &col, uint8_t *out) const
+{
+    const int nb = bins();
+    const double bin = bin_m();
+    const bool frozen = scene_speckle_static(s_);
+    const uint64_t spk_seed = s_.speckle_seed != 0 ? s_.speckle_seed : sim_hash(s_.seed, kSaltSpeckle);
+    const uint64_t spk_k = frozen ? 0 : static_cast<uint64_t>(k) + 1;
+    std::vector<double> E(col.energy);
+    if (s_.amplitude == AmplitudeModel::Peak) {
+        for (int j = 0; j < nb; j++) {
+            E[static_cast<size_t>(j)] = col.peak[static_cast<size_t>(j)];
+        }
+    }
+    if (s_.smear) {
+        std::vector<double> S(static_cast<size_t>(nb), 0.0);
+        const int nk = static_cast<int>(smear_kernel_.size());
+        for (int j = 0; j < nb; j++) {
+            const double v = E[static_cast<size_t>(j)];
+            if (v <= 0) {
+                continue;
+            }
+            for (int q = 0; q < nk; q++) {
+                const int t = j - smear_front_ + q;
+                if (t >= 0 && t < nb) {
+                    S[static_cast<size_t>(t)] += v * smear_kernel_[static_cast<size_t>(q)];
+                }
+            }
+        }
+        E.swap(S);
+    }
+    if (s_.speckle) {
+        for (int j = 0; j < nb; j++) {
+            if (E[static_cast<size_t>(j)] > 0) {
+                const double g = sim_normal(sim_hash(spk_seed, spk_k, static_cast<uint64_t>(i),
+                                                     static_cast<uint64_t>(j)));
+                E[static_cast<size_t>(j)] *= std::pow(10.0, 0.1 * s_.speckle_db * g);
+            }
+        }
+    }
+    if (s_.mapping == OutputMapping::Linear) {
+        double scale = s_.linear_scale;
+        if (s_.normalize == Normalize::Column) {
+            const double mx = *std::max_element(E.begin(), E.end());
+            scale = mx > 0 ? s_.peak_counts / mx : 0.0;
+        }
+        for (int j = 0; j < nb; j++) {
+            long v = std::lround(E[static_cast<size_t>(j)] * scale);
+            if (!s_.smear && col.touched[static_cast<size_t>(j)] != 0 && v < s_.detect_floor) {
+                v = s_.detect_floor;
+            }
+            out[j] = static_cast<uint8_t>(std::clamp(v, 0L, 255L));
+        }
+        return;
+    }
+    // log-magnitude mapping with leakage and noise
+    const double c = s_.log_db_per_decade;
+    const double n_ref = std::pow(10.0, s_.log_ref_value / c);
+    for (int j = 0; j < nb; j++) {
+        const double r = (j + 0.5) * bin;
+        double aL = 0;
+        if (s_.leakage) {
+            double L = 0;
+            if (r <= s_.leak_edge_m) {
+                L = s_.leak_level;
+            } else if (r <= s_.leak_edge_m + 0.2) {
+                L = s_.leak_level + (s_.leak_shoulder - s_.leak_level) * (r - s_.leak_edge_m) / 0.2;
+            } else if (r <= s_.leak_shoulder_end_m) {
+                L = s_.leak_shoulder;
+            } else if (r <= s_.leak_shoulder_end_m + 0.3) {
+                L = s_.leak_shoulder * (1.0 - (r - s_.leak_shoulder_end_m) / 0.3);
+            }
+            if (L > 0) {
+                const double jit = sim_normal(sim_hash(s_.seed, kSaltLeak, static_cast<uint64_t>(i),
+                                                       static_cast<uint64_t>(j)));
+                aL = std::max(0.0, std::pow(10.0, L / c) * (1.0 + s_.leak_jitter * jit));
+            }
+        }
+        const double Ej = E[static_cast<size_t>(j)];
+        const double aS = Ej > 0 ? n_ref * std::sqrt(Ej / s_.log_ref_energy) : 0.0;
+        const uint64_t hn = sim_hash(s_.seed, kSaltNoise ^ (static_cast<uint64_t>(k) << 20),
+                                     static_cast<uint64_t>(i), static_cast<uint64_t>(j));
+        if (aS == 0 && aL == 0) {
+            if (!s_.noise) {
+                out[j] = 0;
+                continue;
+            }
+            const double u = sim_uniform(hn);
+            const size_t m = static_cast<size_t>(
+                std::upper_bound(noise_cdf_.begin(), noise_cdf_.end(), u) - noise_cdf_.begin());
+            out[j] = noise_val_[std::min(m, noise_val_.size() - 1)];
+            continue;
+        }
+        double re = 0, im = 0;
+        if (aS > 0) {
+            const double ph = s_.speckle ? 2 * kSimPi * sim_uniform(sim_hash(spk_seed ^ kSaltPhase, spk_k,
+                                                                              static_cast<uint64_t>(i),
+                                                                              static_cast<uint64_t>(j)))
+                                         : 0.0;
+            re += aS * std::cos(ph);
+            im += aS * std::sin(ph);
+        }
+        if (aL > 0) {
+            const double ph = 2 * kSimPi * sim_uniform(sim_hash(s_.seed, kSaltLeak ^ kSaltPhase,
+                                                                static_cast<uint64_t>(i),
+                                                                static_cast<uint64_t>(j)));
+            re += aL * std::cos(ph);
+            im += aL * std::sin(ph);
+        }
+        if (s_.noise) {
+            re += s_.noise_sigma * sim_normal(hn);
+            im += s_.noise_sigma * sim_normal(sim_hash(hn, 1));
+        }
+        const long nq = std::lround(std::hypot(re, im));
+        const double v = nq <= 1 ? 0.0 : std::round(c * std::log10(static_cast<double>(nq)));
+        out[j] = static_cast<uint8_t>(std::min(255.0, v));
+    }
+}
+
+std::vector<uint8_t> Simulator::render_bins(int k, int i) const
+{
+    std::vector<uint8_t> out(static_cast<size_t>(bins()));
+    if (!static_cols_.empty()) {
+        map_column(k, i, static_cols_[static_cast<size_t>(i)], out.data());
+        return out;
+    }
+    SimColumn col;
+    geometry_column(k, i, col);
+    map_column(k, i, col, out.data());
+    return out;
+}
+
+void Simulator::render_rotation(int k, std::vector<uint8_t> &bytes, std::vector<GtRow> &gt) const
+{
+    RotationGeom rg;
+    rotation_geom(k, rg);
+    gt.insert(gt.end(), rg.gt.begin(), rg.gt.end());
+    const int N = azimuths(), nb = bins();
+    const size_t msg = SL_PROTO_HEADER_BYTES + SL_PROTO_FFT_FIXED_BYTES + static_cast<size_t>(nb);
+    size_t at = bytes.size();
+    bytes.resize(at + msg * static_cast<size_t>(N));
+    SimColumn col;
+    for (int i = 0; i < N; i++) {
+        sl_proto_fft_t f;
+        std::memset(&f, 0, sizeof f);
+        f.id = SL_PROTO_ID_FFT_DATA;
+        f.bytes_per_bin = 1;
+        f.data_offset = SL_PROTO_FFT_FIXED_BYTES;
+        f.sweep_counter = static_cast<uint16_t>((static_cast<long long>(k) * N + i) & 0xFFFF);
+        f.azimuth_ticks = ticks_of(i);
+        sim_split_time(s_.start_time_s + time_of(k, i), &f.seconds, &f.split_ns);
+        f.bins = static_cast<uint32_t>(nb);
+        const sl_ssize_t n = sl_proto_encode_fft_head(bytes.data() + at, msg, &f);
+        if (n != static_cast<sl_ssize_t>(SL_PROTO_HEADER_BYTES + SL_PROTO_FFT_FIXED_BYTES)) {
+            throw SceneError("sl_proto_encode_fft_head failed");
+        }
+        uint8_t *out = bytes.data() + at + static_cast<size_t>(n);
+        if (!static_cols_.empty()) {
+            map_column(k, i, static_cols_[static_cast<size_t>(i)], out);
+        } else {
+            column_from(rg, i, col);
+            map_column(k, i, col, out);
+        }
+        at += msg;
+    }
+}
+
+void sim_run(const Simulator &sim, int first, int count, int threads,
+             const std::function<void(int k, std::vector<uint8_t> &bytes, std::vector<GtRow> &gt)> &sink,
+             const std::function<void(int done, int total)> &progress)
+{
+    if (threads <= 0) {
+        threads = static_cast<int>(std::max(1U, std::thread::hardware_concurrency()));
+    }
+    threads = std::max(1, std::min(threads, count));
+    if (threads == 1) {
+        for (int n = 0; n < count; n++) {
+            std::vector<uint8_t> bytes;
+            std::vector<GtRow> gt;
+            sim.render_rotation(first + n, bytes, gt);
+            sink(first + n, bytes, gt);
+            if (progress) {
+                progress(n + 1, count);
+            }
+        }
+        return;
+    }
+    // A ring of 2 * threads slots; worker w renders rotations n with n % threads == w
+    // (static assignment keeps the ring ordered); the caller consumes in order.
+    const int slots = 2 * threads;
+    struct Slot {
+        int n = -1;
+        bool ready = false;
+        std::vector<uint8_t> bytes;
+        std::vector<GtRow> gt;
+    };
+    std::vector<Slot> ring(static_cast<size_t>(slots));
+    std::mutex mu;
+    std::condition_variable cv;
+    std::atomic<bool> failed{false};
+    std::string error;
+    int consumed = 0;
+    auto worker = [&](int w) {
+        for (int n = w; n < count && !failed; n += threads) {
+            Slot &sl = ring[static_cast<size_t>(n % slots)];
+            {
+                std::unique_lock<std::mutex> lk(mu);
+                cv.wait(lk, [&] { return failed || n < consumed + slots; });
+                if (failed) {
+                    return;
+                }
+            }
+            std::vector<uint8_t> bytes;
+            std::vector<GtRow> gt;
+            try {
+                sim.render_rotation(first + n, bytes, gt);
+            } catch (const std::exception &e) {
+                std::lock_guard<std::mutex> lk(mu);
+                failed = true;
+                error = e.what();
+                cv.notify_all();
+                return;
+            }
+            std::lock_guard<std::mutex> lk(mu);
+            sl.n = n;
+            sl.bytes.swap(bytes);
+            sl.gt.swap(gt);
+            sl.ready = true;
+            cv.notify_all();
+        }
+    };
+    std::vector<std::thread> pool;
+    for (int w = 0; w < threads; w++) {
+        pool.emplace_back(worker, w);
+    }
+    for (int n = 0; n < count; n++) {
+        Slot &sl = ring[static_cast<size_t>(n % slots)];
+        std::vector<uint8_t> bytes;
+        std::vector<GtRow> gt;
+        {
+            std::unique_lock<std::mutex> lk(mu);
+            cv.wait(lk, [&] { return failed || (sl.ready && sl.n == n); });
+            if (failed) {
+                break;
+            }
+            bytes.swap(sl.bytes);
+            gt.swap(sl.gt);
+            sl.ready = false;
+        }
+        try {
+            sink(first + n, bytes, gt);
+        } catch (...) {
+            {
+                std::lock_guard<std::mutex> lk(mu);
+                failed = true;
+                cv.notify_all();
+            }
+            for (auto &t : pool) {
+                t.join();
+            }
+            throw;
+        }
+        {
+            std::lock_guard<std::mutex> lk(mu);
+            consumed = n + 1;
+            cv.notify_all();
+        }
+        if (progress) {
+            progress(n + 1, count);
+        }
+    }
+    for (auto &t : pool) {
+        t.join();
+    }
+    if (failed) {
+        throw SceneError("simulation failed: " + error);
+    }
+}
+
+} // namespace sl

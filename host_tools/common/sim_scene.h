@@ -1,0 +1,135 @@
+// sim_scene.h: the scene a simulation runs (scenes/README.md is the file format's manual).
+//
+// A scene is a board (the vehicle + radar installation, boards/<name>/board.ini), a vehicle
+// path, world objects (poles, boxes, walls, the ground plane), a beam model, the effects of a
+// real sensor (smear, speckle, noise floor, near-field leakage) and how energies become 8-bit
+// bins. It is parsed with inih (ini_parse / ini_parse_string), validated key by key, and can
+// also be built in code (the experiments of sl-eval do that) and then checked with
+// `validate_scene()`.
+//
+// World frame: x, y horizontal, z up, ground at z = 0; angles in the world are degrees
+// counter-clockwise from +x. The vehicle frame is the board's (x forward, y left); the
+// radar's azimuths are clockwise from vehicle forward (BoardSpec::azimuth_vehicle_deg).
+#pragma once
+
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "sl_board_spec.h"
+
+namespace sl {
+
+/// A straight cylinder standing on the ground (its axis starts at z = 0).
+struct ScenePole {
+    std::string name;
+    double x_m = 0, y_m = 0;    ///< world position of the axis point at height `at_height_m`
+    double at_height_m = 0;     ///< 0: (x, y) is the base; e.g. the radar height (paper s.IV-A)
+    double length_m = 4.0;      ///< along the axis, from the ground
+    double radius_m = 0.005;    ///< cylinder radius (1 cm pole: 0.005)
+    double tilt_deg = 0;        ///< psi: angle of the axis from vertical, [0, 60]
+    double lean_deg = 0;        ///< phi: direction the top leans towards, world CCW from +x
+    double reflectivity = 1.0;  ///< energy per unit solid angle (deg^2) of the lit surface
+};
+
+/// An oriented box on (or above) the ground; walls are thin boxes.
+struct SceneBox {
+    std::string name;
+    double cx_m = 0, cy_m = 0;  ///< centre of the footprint, world
+    double size_x_m = 1, size_y_m = 1; ///< footprint along the box's own axes
+    double yaw_deg = 0;         ///< rotation of the box's x axis, world CCW from +x
+    double z0_m = 0, height_m = 1; ///< bottom and height
+    double reflectivity = 0.5;
+};
+
+enum class ElevationProfile { Ideal, Measured };
+enum class AmplitudeModel { Integral, Peak };
+enum class OutputMapping { Linear, Log };
+enum class Normalize { Column, None };
+
+struct Scene {
+    std::string source;         ///< file it came from ("" when built in code)
+    // [scene]
+    std::string board_name = "paper-sim";
+    BoardSpec board;            ///< loaded from board_name, then the overrides below applied
+    double bin_size_override_m = 0;  ///< > 0: replaces the board's bin size
+    int range_bins_override = 0;     ///< > 0: replaces the board's bins per azimuth
+    int rotations = 4;
+    double rotation_hz = 4.0;
+    uint64_t seed = 1;
+    double start_time_s = 1700000000.0; ///< UNIX time of rotation 0, azimuth 0
+    // [vehicle]
+    double vehicle_x_m = 0, vehicle_y_m = 0, heading_deg = 90.0, speed_mps = 0;
+    // objects
+    std::vector<ScenePole> poles;
+    std::vector<SceneBox> boxes;
+    // [ground]
+    bool ground = true;
+    double ground_reflectivity = 0.05;
+    double ground_ambient = 0.0;   ///< shading = ambient + (1 - ambient) sin(grazing)
+    double ground_max_range_m = 40;
+    // [beam]
+    ElevationProfile elevation = ElevationProfile::Ideal;
+    double elev_top_deg = 0;       ///< upper emission bound (ideal 0, measured +3)
+    double elev_bottom_deg = -35;  ///< lower emission bound
+    double measured_edge_db = 5;   ///< measured profile: gain at the bounds, dB below peak
+    double measured_peak_deg = -10;///< measured profile: elevation of the gain peak
+    double az_width_deg = 8.0;     ///< full width of the normal cone (RadaRays beam_width)
+    double az_p_in_cone = 0.8;     ///< fraction of the normal inside +-width/2 (RadaRays)
+    double az_cutoff_deg = 0;      ///< hard window half-width; 0 = 2 sigma
+    double pole_step_deg = 0.05;   ///< elevation step of the pole quadrature
+    int ground_az_samples = 33;    ///< bearing samples across the beam for ground/boxes
+    double box_step_deg = 0.05;    ///< elevation step of the box ray grid
+    // [output]
+    AmplitudeModel amplitude = AmplitudeModel::Integral;
+    OutputMapping mapping = OutputMapping::Linear;
+    Normalize normalize = Normalize::Column;
+    double peak_counts = 250;      ///< Column: the column's maximum energy maps to this
+    double linear_scale = 100;     ///< None + Linear: counts per unit energy
+    int detect_floor = 1;          ///< Linear: a bin touched by an object reads >= this
+    double log_db_per_decade = 19.8; ///< Log: value = round(c log10(N)), N integer magnitude
+    double log_ref_energy = 1.0;   ///< Log: this energy (deg^2) ...
+    double log_ref_value = 100;    ///< ... reads this value (noise-free)
+    // [effects]
+    bool smear = false;
+    double smear_width_bins = 20;  ///< triangular kernel length (RadaRays: 50, MulRan 35)
+    double smear_mode_frac = 0.05; ///< fraction of the kernel in front of the target (RadaRays 0.35)
+    bool speckle = false;
+    double speckle_db = 2.0;       ///< log-normal power fluctuation per bin, 1 sigma
+    int speckle_static = -1;       ///< 1: fixed over time (static scene), 0: per rotation, -1 auto
+    uint64_t speckle_seed = 0;     ///< 0: derived from seed
+    bool noise = false;
+    double noise_sigma = 2.15;     ///< complex Gaussian per component (35 % zeros)
+    bool leakage = false;
+    double leak_level = 38;        ///< output value of the bright band (0 .. leak_edge_m)
+    double leak_shoulder = 19;     ///< value of the shoulder
+    double leak_edge_m = 1.5;      ///< end of the bright band
+    double leak_shoulder_end_m = 2.2; ///< end of the shoulder
+    double leak_jitter = 0.08;     ///< fixed per-pixel relative amplitude variation
+};
+
+struct SceneError : std::runtime_error {
+    using std::runtime_error::runtime_error;
+};
+
+/// Parses a scene file (INI, scenes/README.md). Loads its board. Throws SceneError with
+/// "<file>:<line> ..." or "<file>: <section>.<key>: <problem>" on the first problem.
+Scene load_scene(const std::string &path);
+/// Same from text (tests); `name` is used in messages.
+Scene parse_scene_string(const std::string &text, const std::string &name = "<string>");
+
+/// Loads the board (if `s.board` is empty or its name differs), applies the overrides and
+/// checks every field's range and the combinations. Throws SceneError.
+void validate_scene(Scene &s);
+
+/// The scene's range resolution and bins (board values or the overrides).
+double scene_bin_size_m(const Scene &s);
+int scene_range_bins(const Scene &s);
+/// Hard half-width of the azimuth window (deg) and the normal sigma (deg).
+double scene_az_sigma_deg(const Scene &s);
+double scene_az_cutoff_deg(const Scene &s);
+/// True when speckle is frozen over rotations (static scene or speckle_static = 1).
+bool scene_speckle_static(const Scene &s);
+
+} // namespace sl

@@ -1,0 +1,299 @@
+// sl_dbc.cpp: DBC generation from the core's CAN layout table (see sl_dbc.h).
+#include "sl_dbc.h"
+
+#include <cstdint>
+#include <map>
+#include <set>
+#include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "shadowlean/sl_can.h"
+
+namespace sl {
+namespace {
+
+// Exact decimal text of num/den (den must divide a power of ten <= 10^9): "0.2", "-51.2".
+std::string decimal(int64_t num, int64_t den)
+{
+    int digits = 0;
+    int64_t p = 1;
+    while (p % den != 0) {
+        p *= 10;
+        digits++;
+        if (digits > 9) {
+            throw std::invalid_argument("DBC factor denominator is not a divisor of 10^9");
+        }
+    }
+    const int64_t scaled = num * (p / den); // value x 10^digits, exact
+    const bool neg = scaled < 0;
+    const uint64_t a = static_cast<uint64_t>(neg ? -scaled : scaled);
+    std::string s = std::to_string(a / static_cast<uint64_t>(p));
+    if (digits > 0) {
+        std::string frac = std::to_string(a % static_cast<uint64_t>(p));
+        frac.insert(0, static_cast<size_t>(digits) - frac.size(), '0');
+        while (!frac.empty() && frac.back() == '0') {
+            frac.pop_back();
+        }
+        if (!frac.empty()) {
+            s += "." + frac;
+        }
+    }
+    return neg ? "-" + s : s;
+}
+
+// DBC strings cannot hold a double quote.
+std::string q(const std::string &s)
+{
+    std::string o;
+    for (char c : s) {
+        o += (c == '"') ? '\'' : c;
+    }
+    return "\"" + o + "\"";
+}
+
+std::string hex(unsigned v, int width)
+{
+    std::ostringstream o;
+    o << "0x" << std::hex << std::uppercase;
+    o.width(width);
+    o.fill('0');
+    o << v;
+    return o.str();
+}
+
+const char *kSender = "SHADOWLEAN";
+const char *kVehicle = "VEHICLE";
+
+const char *kNetworkComment =
+    "shadowlean: pole-lean estimation from a vehicle radar's chassis shadow. "
+    "Classic CAN, DLC 8, all signals little-endian (Intel), physical = raw x factor. "
+    "E2E protection (AUTOSAR E2E Profile 1 style) on every message: byte 0 = Crc, "
+    "bits 8..11 = Counter. Crc = CRC-8 SAE J1850 (poly 0x1D, init 0xFF, final XOR 0xFF, "
+    "not reflected; check value of ASCII 123456789 = 0x4B) computed over 8 bytes: the "
+    "message's Data ID (attribute SlE2EDataId, not transmitted) first, then data bytes 1..7. "
+    "Counter counts 0..14 per message and wraps to 0 (modulo 15); 15 is never sent and is "
+    "rejected. A receiver accepts delta (counter - previous) mod 15 = 1, counts delta >= 2 "
+    "as lost frames, rejects delta 0 (repetition). Worked example: Status (Data ID 0x53) "
+    "with Counter 0, LinkState 3, Rotations 2 has bytes 1..7 = 30 02 00 00 00 00 00; CRC "
+    "input 53 30 02 00 00 00 00 00 gives 0x95; frame = 95 30 02 00 00 00 00 00. "
+    "Out-of-range values are clamped to the signal range and flagged (Clamped / Saturated "
+    "bit), never wrapped; azimuths are reduced modulo 360 deg. Reserved bits are 0.";
+
+const std::map<std::string, std::string> kMessageComments = {
+    {"PoleLean",
+     "One frame per target and radar rotation: the in-plane lean of a slender object "
+     "(pole, post, trunk) inside the vehicle's radar shadow. Lean and LeanSigma are "
+     "meaningful only when Quality is VALID or FILTERED."},
+    {"LeanWarning",
+     "Once per rotation: the warning level and the most severe target (largest lean "
+     "towards the vehicle). HasTarget = 0: no target; the target fields are 0."},
+    {"Status", "Module health, nominally once per second. Counters are totals since start "
+               "and stop at their maximum (Saturated = 1)."},
+    {"VehicleMotion", "Input from the vehicle for the motion-aware masks: speed and yaw "
+                      "rate with E2E protection; CRC errors and counter jumps are counted."},
+};
+
+// key "Message.Signal"
+const std::map<std::string, std::string> kSignalComments = {
+    {"*.Crc", "E2E CRC-8 SAE J1850 over [Data ID, bytes 1..7]; see the network comment."},
+    {"*.Counter", "E2E counter 0..14 per message, modulo 15; 15 is invalid."},
+    {"PoleLean.Quality", "Estimate quality."},
+    {"PoleLean.Clamped", "1: at least one value of this frame hit its signal range limit "
+                         "and is sent as that limit (a bound, not a measurement)."},
+    {"PoleLean.TargetId", "Tracker id of the target, stable over rotations, 0..15."},
+    {"PoleLean.Azimuth", "Direction of the target, clockwise from the vehicle's forward "
+                         "axis seen from above."},
+    {"PoleLean.Lean", "In-plane lean from vertical in the target's azimuth plane; positive: "
+                      "the top leans towards the vehicle. Clamped to +-51.1 deg here; "
+                      "LeanWarning carries +-102 deg."},
+    {"PoleLean.LeanSigma", "1-sigma uncertainty of Lean; 6.2 with Clamped = 1 means >= 6.2."},
+    {"PoleLean.RangeInner", "Inner bound r1 of the target's radar return (slant range)."},
+    {"PoleLean.RangeOuter", "Outer bound r2 of the target's radar return (slant range)."},
+    {"LeanWarning.Level", "Warning level with hysteresis, from the board's caution/danger "
+                          "lean thresholds."},
+    {"LeanWarning.Clamped", "1: at least one value hit its range limit."},
+    {"LeanWarning.HasTarget", "1: the target fields describe the most severe target."},
+    {"LeanWarning.TargetId", "Tracker id of the most severe target (as in PoleLean)."},
+    {"LeanWarning.Azimuth", "Direction, clockwise from vehicle forward."},
+    {"LeanWarning.Lean", "Lean of the most severe target; positive: top towards the vehicle."},
+    {"LeanWarning.Range", "Inner bound r1 of the most severe target."},
+    {"LeanWarning.LeanSigma", "1-sigma uncertainty of Lean."},
+    {"LeanWarning.Quality", "Quality of the most severe target's estimate."},
+    {"Status.LinkState", "State of the radar TCP link."},
+    {"Status.Saturated", "1: a counter of this frame is stuck at its maximum."},
+    {"Status.Rotations", "Radar rotations processed since start (saturating)."},
+    {"Status.AzimuthsMissing", "Azimuths lost in gaps of the radar stream (saturating)."},
+    {"Status.DecoderResyncs", "Radar stream decoder resynchronisations (saturating)."},
+    {"Status.CanDropped", "CAN frames the module's CAN outputs dropped (saturating)."},
+    {"VehicleMotion.SpeedValid", "1: Speed is valid."},
+    {"VehicleMotion.YawRateValid", "1: YawRate is valid."},
+    {"VehicleMotion.Speed", "Vehicle speed over ground; positive forward."},
+    {"VehicleMotion.YawRate", "Yaw rate; positive counter-clockwise seen from above (ISO 8855)."},
+};
+
+std::string signal_comment(const std::string &msg, const std::string &sig)
+{
+    auto it = kSignalComments.find(msg + "." + sig);
+    if (it == kSignalComments.end()) {
+        it = kSignalComments.find("*." + sig);
+    }
+    return it == kSignalComments.end() ? std::string() : it->second;
+}
+
+// The layout of one message as a text table, for its CM_ comment.
+std::string layout_table(const sl_can_message_desc_t &m)
+{
+    std::ostringstream o;
+    o << "Layout (start|length, Intel; s = signed; factor; range):";
+    for (unsigned i = 0; i < m.n_signals; i++) {
+        const sl_can_signal_desc_t &s = m.signals[i];
+        o << (i == 0 ? " " : "; ") << s.name << " " << unsigned(s.start) << "|"
+          << unsigned(s.length) << (s.is_signed ? " s" : "") << " x"
+          << decimal(s.factor_num, s.factor_den) << " ["
+          << decimal(int64_t(s.raw_min) * s.factor_num, s.factor_den) << ".."
+          << decimal(int64_t(s.raw_max) * s.factor_num, s.factor_den) << "]"
+          << (s.unit[0] != '\0' ? std::string(" ") + s.unit : std::string());
+    }
+    o << ". E2E Data ID " << hex(m.data_id, 2) << ".";
+    return o.str();
+}
+
+uint32_t board_id(const BoardSpec &b, sl_can_msg_t m)
+{
+    switch (m) {
+    case SL_CAN_MSG_POLE_LEAN:
+        return b.can_id_pole_lean;
+    case SL_CAN_MSG_LEAN_WARNING:
+        return b.can_id_lean_warning;
+    case SL_CAN_MSG_STATUS:
+        return b.can_id_status;
+    case SL_CAN_MSG_VEHICLE_MOTION:
+        return b.can_id_vehicle_motion;
+    case SL_CAN_MSG_COUNT:
+        break;
+    }
+    throw std::invalid_argument("bad message index");
+}
+
+std::string db_name(const std::string &board)
+{
+    std::string n = "shadowlean_";
+    for (char c : board) {
+        n += (std::isalnum(static_cast<unsigned char>(c)) != 0) ? c : '_';
+    }
+    return n;
+}
+
+} // namespace
+
+std::string make_dbc(const BoardSpec &b)
+{
+    // Ids: validated the way the core's sl_can_tx_init() does.
+    sl_can_ids_t ids{};
+    for (unsigned m = 0; m < SL_CAN_MSG_COUNT; m++) {
+        ids.id[m] = board_id(b, static_cast<sl_can_msg_t>(m));
+    }
+    sl_can_tx_t tx;
+    if (sl_can_tx_init(&tx, &ids) != SL_OK) {
+        throw std::invalid_argument("board " + b.name +
+                                    ": CAN ids must be distinct 11-bit ids (or 29-bit ids with "
+                                    "bit 31 set)");
+    }
+    if (b.max_targets > static_cast<int>(SL_CAN_TARGET_ID_MAX) + 1) {
+        throw std::invalid_argument("board " + b.name + ": max_targets " +
+                                    std::to_string(b.max_targets) +
+                                    " exceeds the 16 ids of PoleLean.TargetId");
+    }
+
+    std::ostringstream o;
+    o << "VERSION \"shadowlean " << b.name << " (" << kDbcGeneratorVersion << ")\"\n\n\n";
+    o << "NS_ :\n";
+    for (const char *ns : {"NS_DESC_", "CM_", "BA_DEF_", "BA_", "VAL_", "CAT_DEF_", "CAT_",
+                           "FILTER", "BA_DEF_DEF_", "EV_DATA_", "ENVVAR_DATA_", "SGTYPE_",
+                           "SGTYPE_VAL_", "BA_DEF_SGTYPE_", "BA_SGTYPE_", "SIG_TYPE_REF_",
+                           "VAL_TABLE_", "SIG_GROUP_", "SIG_VALTYPE_", "SIGTYPE_VALTYPE_",
+                           "BO_TX_BU_", "BA_DEF_REL_", "BA_REL_", "BA_DEF_DEF_REL_",
+                           "BU_SG_REL_", "BU_EV_REL_", "BU_BO_REL_", "SG_MUL_VAL_"}) {
+        o << "\t" << ns << "\n";
+    }
+    o << "\nBS_:\n\n";
+    o << "BU_: " << kSender << " " << kVehicle << "\n\n\n";
+
+    for (unsigned mi = 0; mi < SL_CAN_MSG_COUNT; mi++) {
+        const sl_can_message_desc_t &m = *sl_can_layout(static_cast<sl_can_msg_t>(mi));
+        const char *tx_node = m.to_shadowlean ? kVehicle : kSender;
+        const char *rx_node = m.to_shadowlean ? kSender : kVehicle;
+        o << "BO_ " << ids.id[mi] << " " << m.name << ": 8 " << tx_node << "\n";
+        for (unsigned si = 0; si < m.n_signals; si++) {
+            const sl_can_signal_desc_t &s = m.signals[si];
+            o << " SG_ " << s.name << " : " << unsigned(s.start) << "|" << unsigned(s.length)
+              << "@1" << (s.is_signed ? "-" : "+") << " ("
+              << decimal(s.factor_num, s.factor_den) << ",0) ["
+              << decimal(int64_t(s.raw_min) * s.factor_num, s.factor_den) << "|"
+              << decimal(int64_t(s.raw_max) * s.factor_num, s.factor_den) << "] "
+              << q(s.unit) << " " << rx_node << "\n";
+        }
+        o << "\n";
+    }
+    o << "\n";
+
+    o << "CM_ " << q(kNetworkComment) << ";\n";
+    o << "CM_ BU_ " << kSender << " "
+      << q("shadowlean module (radar companion computer), board " + b.name + ": " +
+           b.description)
+      << ";\n";
+    o << "CM_ BU_ " << kVehicle << " "
+      << q("The vehicle: consumes PoleLean, LeanWarning, Status; sends VehicleMotion.")
+      << ";\n";
+    for (unsigned mi = 0; mi < SL_CAN_MSG_COUNT; mi++) {
+        const sl_can_message_desc_t &m = *sl_can_layout(static_cast<sl_can_msg_t>(mi));
+        o << "CM_ BO_ " << ids.id[mi] << " " << q(kMessageComments.at(m.name) + " " + layout_table(m))
+          << ";\n";
+        for (unsigned si = 0; si < m.n_signals; si++) {
+            const std::string c = signal_comment(m.name, m.signals[si].name);
+            if (!c.empty()) {
+                o << "CM_ SG_ " << ids.id[mi] << " " << m.signals[si].name << " " << q(c) << ";\n";
+            }
+        }
+    }
+
+    o << "BA_DEF_  \"BusType\" STRING ;\n";
+    o << "BA_DEF_  \"DBName\" STRING ;\n";
+    o << "BA_DEF_  \"Baudrate\" INT 10000 1000000;\n";
+    o << "BA_DEF_ BO_  \"GenMsgCycleTime\" INT 0 65535;\n";
+    o << "BA_DEF_ BO_  \"SlE2EDataId\" INT 0 255;\n";
+    o << "BA_DEF_DEF_  \"BusType\" \"CAN\";\n";
+    o << "BA_DEF_DEF_  \"DBName\" \"\";\n";
+    o << "BA_DEF_DEF_  \"Baudrate\" 500000;\n";
+    o << "BA_DEF_DEF_  \"GenMsgCycleTime\" 0;\n";
+    o << "BA_DEF_DEF_  \"SlE2EDataId\" 0;\n";
+    o << "BA_ \"BusType\" \"CAN\";\n";
+    o << "BA_ \"DBName\" " << q(db_name(b.name)) << ";\n";
+    o << "BA_ \"Baudrate\" " << b.can_bitrate << ";\n";
+    for (unsigned mi = 0; mi < SL_CAN_MSG_COUNT; mi++) {
+        const sl_can_message_desc_t &m = *sl_can_layout(static_cast<sl_can_msg_t>(mi));
+        o << "BA_ \"GenMsgCycleTime\" BO_ " << ids.id[mi] << " " << m.cycle_ms << ";\n";
+        o << "BA_ \"SlE2EDataId\" BO_ " << ids.id[mi] << " " << unsigned(m.data_id) << ";\n";
+    }
+
+    for (unsigned mi = 0; mi < SL_CAN_MSG_COUNT; mi++) {
+        const sl_can_message_desc_t &m = *sl_can_layout(static_cast<sl_can_msg_t>(mi));
+        for (unsigned si = 0; si < m.n_signals; si++) {
+            const sl_can_signal_desc_t &s = m.signals[si];
+            if (s.values == nullptr) {
+                continue;
+            }
+            o << "VAL_ " << ids.id[mi] << " " << s.name;
+            for (unsigned k = s.n_values; k-- > 0;) {
+                o << " " << s.values[k].value << " " << q(s.values[k].name);
+            }
+            o << " ;\n";
+        }
+    }
+    o << "\n";
+    return o.str();
+}
+
+} // namespace sl

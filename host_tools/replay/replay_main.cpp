@@ -1,0 +1,309 @@
+// sl-replay: radar emulator, recorder and Oxford converter.
+//
+//   sl-replay serve CAPTURE [--port P] [--bind ADDR] [--rate realtime|max] [--loop] ...
+//   sl-replay record --radar HOST:PORT --out FILE [--duration S] [--non-contour]
+//   sl-replay from-oxford DIR --out FILE [--bin-size-m 0.0438]
+#include "replay.h"
+
+#include "capture.h"
+#include "oxford.h"
+
+#include <cinttypes>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <signal.h>
+#include <string>
+
+namespace sl::replay {
+
+volatile std::sig_atomic_t g_stop = 0;
+
+namespace {
+void on_signal(int) { g_stop = 1; }
+} // namespace
+
+void install_signal_handlers()
+{
+    struct sigaction sa {};
+    sa.sa_handler = on_signal;
+    sigemptyset(&sa.sa_mask);
+    sa.sa_flags = 0; // no SA_RESTART: poll() returns EINTR and the loops see g_stop
+    sigaction(SIGINT, &sa, nullptr);
+    sigaction(SIGTERM, &sa, nullptr);
+    signal(SIGPIPE, SIG_IGN);
+}
+
+} // namespace sl::replay
+
+namespace {
+
+using namespace sl::replay;
+
+void usage()
+{
+    std::fprintf(stderr,
+        "usage:\n"
+        "  sl-replay serve CAPTURE [options]   emulate a radar on TCP, replaying CAPTURE\n"
+        "      --port P            TCP port (default 6317; 0 = any free port, printed)\n"
+        "      --bind ADDR         listen address (default 127.0.0.1, loopback only)\n"
+        "      --rate realtime|max pace by the FFT timestamps (default) or as fast as read\n"
+        "      --loop              restart the capture at its end (timestamps and sweep\n"
+        "                          counters shifted to stay monotonic)\n"
+        "      --keepalive-ms N    keep-alive period (default 1000, 0 = none)\n"
+        "      --max-clients N     concurrent connections (default 3; more are closed)\n"
+        "      --queue-bytes N     per-client output queue (default 4194304)\n"
+        "      --max-gap-ms N      realtime: longer timestamp gaps shortened (default 1000)\n"
+        "      --junk-every N      inject junk after every N-th FFT message (3 patterns:\n"
+        "                          7 bytes, a 12-byte partial signature, a 26-byte header\n"
+        "                          with version 2), for decoder tests\n"
+        "      --split K           send every message in K writes (first cut in the header)\n"
+        "      --close-after N     close a connection after N FFT messages (radar restart);\n"
+        "                          the next connection continues where it stopped\n"
+        "      --stall-after N     go silent on a connection after N FFT messages (no data,\n"
+        "                          no keep-alive, socket open); the next connection continues\n"
+        "      --timeout S         exit by itself after S seconds\n"
+        "      -v                  log connections\n"
+        "  sl-replay record --radar HOST:PORT --out FILE [options]\n"
+        "      --duration S        stop after S seconds (default: Ctrl-C)\n"
+        "      --non-contour       start with id 140 instead of 21\n"
+        "      --silence-ms N      reconnect when nothing arrives for N ms (default 3000)\n"
+        "  sl-replay from-oxford DIR --out FILE [--bin-size-m 0.0438]\n"
+        "      DIR/radar/*.png (or DIR/*.png), Oxford Radar RobotCar polar PNGs\n"
+        "      --encoder-size N --rotation-mhz N --packet-rate N (defaults 5600 4000 1600)\n");
+}
+
+bool parse_u64(const char *s, uint64_t &v)
+{
+    char *end = nullptr;
+    errno = 0;
+    const unsigned long long x = std::strtoull(s, &end, 10);
+    if (errno != 0 || end == s || *end != '\0' || s[0] == '-') {
+        return false;
+    }
+    v = x;
+    return true;
+}
+
+bool parse_double(const char *s, double &v)
+{
+    char *end = nullptr;
+    v = std::strtod(s, &end);
+    return end != s && *end == '\0';
+}
+
+// "host:port", "[v6]:port"
+bool split_host_port(const std::string &hp, std::string &host, uint16_t &port)
+{
+    std::string p;
+    if (!hp.empty() && hp[0] == '[') {
+        const auto e = hp.find("]:");
+        if (e == std::string::npos) return false;
+        host = hp.substr(1, e - 1);
+        p = hp.substr(e + 2);
+    } else {
+        const auto e = hp.rfind(':');
+        if (e == std::string::npos) {
+            host = hp;
+            port = 6317;
+            return !host.empty();
+        }
+        host = hp.substr(0, e);
+        p = hp.substr(e + 1);
+    }
+    uint64_t v = 0;
+    if (host.empty() || !parse_u64(p.c_str(), v) || v == 0 || v > 65535) return false;
+    port = static_cast<uint16_t>(v);
+    return true;
+}
+
+#define NEED_ARG()                                                                           \
+    do {                                                                                     \
+        if (i + 1 >= argc) {                                                                 \
+            std::fprintf(stderr, "sl-replay: %s needs a value\n", a.c_str());               \
+            return 2;                                                                        \
+        }                                                                                    \
+    } while (0)
+
+int cmd_serve(int argc, char **argv)
+{
+    ServeOptions o;
+    for (int i = 2; i < argc; ++i) {
+        const std::string a = argv[i];
+        uint64_t v = 0;
+        if (a == "--port") {
+            NEED_ARG();
+            if (!parse_u64(argv[++i], v) || v > 65535) return usage(), 2;
+            o.port = static_cast<int>(v);
+        } else if (a == "--bind") {
+            NEED_ARG();
+            o.bind = argv[++i];
+        } else if (a == "--rate") {
+            NEED_ARG();
+            const std::string r = argv[++i];
+            if (r == "realtime") o.realtime = true;
+            else if (r == "max") o.realtime = false;
+            else return usage(), 2;
+        } else if (a == "--loop") {
+            o.loop = true;
+        } else if (a == "--keepalive-ms") {
+            NEED_ARG();
+            if (!parse_u64(argv[++i], v) || v > 3600000) return usage(), 2;
+            o.keepalive_ms = static_cast<uint32_t>(v);
+        } else if (a == "--max-clients") {
+            NEED_ARG();
+            if (!parse_u64(argv[++i], v) || v == 0 || v > 1000) return usage(), 2;
+            o.max_clients = static_cast<unsigned>(v);
+        } else if (a == "--queue-bytes") {
+            NEED_ARG();
+            if (!parse_u64(argv[++i], v) || v < 65536) return usage(), 2;
+            o.queue_bytes = static_cast<size_t>(v);
+        } else if (a == "--max-gap-ms") {
+            NEED_ARG();
+            if (!parse_u64(argv[++i], v) || v > 3600000) return usage(), 2;
+            o.max_gap_ms = static_cast<uint32_t>(v);
+        } else if (a == "--junk-every") {
+            NEED_ARG();
+            if (!parse_u64(argv[++i], v)) return usage(), 2;
+            o.junk_every = v;
+        } else if (a == "--split") {
+            NEED_ARG();
+            if (!parse_u64(argv[++i], v) || v > 64) return usage(), 2;
+            o.split = static_cast<unsigned>(v);
+        } else if (a == "--close-after") {
+            NEED_ARG();
+            if (!parse_u64(argv[++i], v)) return usage(), 2;
+            o.close_after = v;
+        } else if (a == "--stall-after") {
+            NEED_ARG();
+            if (!parse_u64(argv[++i], v)) return usage(), 2;
+            o.stall_after = v;
+        } else if (a == "--timeout") {
+            NEED_ARG();
+            if (!parse_double(argv[++i], o.timeout_s) || o.timeout_s < 0) return usage(), 2;
+        } else if (a == "-v") {
+            o.verbose = true;
+        } else if (!a.empty() && a[0] == '-') {
+            std::fprintf(stderr, "sl-replay serve: unknown option %s\n", a.c_str());
+            return 2;
+        } else if (o.capture.empty()) {
+            o.capture = a;
+        } else {
+            return usage(), 2;
+        }
+    }
+    if (o.capture.empty()) {
+        return usage(), 2;
+    }
+    install_signal_handlers();
+    return serve(o);
+}
+
+int cmd_record(int argc, char **argv)
+{
+    RecordOptions o;
+    std::string radar;
+    for (int i = 2; i < argc; ++i) {
+        const std::string a = argv[i];
+        uint64_t v = 0;
+        if (a == "--radar") {
+            NEED_ARG();
+            radar = argv[++i];
+        } else if (a == "--out") {
+            NEED_ARG();
+            o.out = argv[++i];
+        } else if (a == "--duration") {
+            NEED_ARG();
+            if (!parse_double(argv[++i], o.duration_s) || o.duration_s < 0) return usage(), 2;
+        } else if (a == "--non-contour") {
+            o.non_contour = true;
+        } else if (a == "--silence-ms") {
+            NEED_ARG();
+            if (!parse_u64(argv[++i], v) || v > 3600000) return usage(), 2;
+            o.silence_ms = static_cast<uint32_t>(v);
+        } else if (a == "-v") {
+            o.verbose = true;
+        } else {
+            std::fprintf(stderr, "sl-replay record: unexpected %s\n", a.c_str());
+            return 2;
+        }
+    }
+    if (radar.empty() || o.out.empty() || !split_host_port(radar, o.host, o.port)) {
+        return usage(), 2;
+    }
+    install_signal_handlers();
+    return record(o);
+}
+
+int cmd_from_oxford(int argc, char **argv)
+{
+    std::string dir, out;
+    sl::OxfordOptions opt;
+    for (int i = 2; i < argc; ++i) {
+        const std::string a = argv[i];
+        uint64_t v = 0;
+        if (a == "--out") {
+            NEED_ARG();
+            out = argv[++i];
+        } else if (a == "--bin-size-m") {
+            NEED_ARG();
+            if (!parse_double(argv[++i], opt.bin_size_m)) return usage(), 2;
+        } else if (a == "--encoder-size" || a == "--rotation-mhz" || a == "--packet-rate") {
+            NEED_ARG();
+            if (!parse_u64(argv[++i], v) || v == 0 || v > 65535) return usage(), 2;
+            (a == "--encoder-size" ? opt.encoder_size : a == "--rotation-mhz" ? opt.rotation_mhz : opt.packet_rate) =
+                static_cast<uint16_t>(v);
+        } else if (!a.empty() && a[0] == '-') {
+            std::fprintf(stderr, "sl-replay from-oxford: unknown option %s\n", a.c_str());
+            return 2;
+        } else if (dir.empty()) {
+            dir = a;
+        } else {
+            return usage(), 2;
+        }
+    }
+    if (dir.empty() || out.empty()) {
+        return usage(), 2;
+    }
+    std::vector<uint8_t> bytes;
+    sl::OxfordReport rep;
+    std::string err;
+    if (!sl::oxford_to_colossus(dir, opt, bytes, rep, err)) {
+        std::fprintf(stderr, "sl-replay from-oxford: %s\n", err.c_str());
+        return 1;
+    }
+    if (!sl::write_raw_capture(out, bytes.data(), bytes.size(), err)) {
+        std::fprintf(stderr, "sl-replay from-oxford: %s\n", err.c_str());
+        return 1;
+    }
+    std::printf("%s: %u scans of %u azimuths x %u bins (bin size %u x 0.1 mm) -> %" PRIu64
+                " FFT messages, %" PRIu64 " bytes in %s\n",
+                rep.png_dir.c_str(), rep.scans, rep.azimuths, rep.range_bins, rep.bin_size_100um, rep.rows,
+                rep.bytes, out.c_str());
+    std::printf("rows with valid != 255: %" PRIu64 "; azimuth >= encoder size: %" PRIu64
+                "; timestamp not increasing: %" PRIu64 "; negative timestamp: %" PRIu64
+                "; time %" PRId64 " .. %" PRId64 " us\n",
+                rep.invalid_rows, rep.azimuth_out_of_range, rep.time_not_increasing, rep.negative_time,
+                rep.first_time_us, rep.last_time_us);
+    return 0;
+}
+
+} // namespace
+
+int main(int argc, char **argv)
+{
+    if (argc < 2) {
+        usage();
+        return 2;
+    }
+    const std::string cmd = argv[1];
+    if (cmd == "serve") return cmd_serve(argc, argv);
+    if (cmd == "record") return cmd_record(argc, argv);
+    if (cmd == "from-oxford") return cmd_from_oxford(argc, argv);
+    if (cmd == "-h" || cmd == "--help") {
+        usage();
+        return 0;
+    }
+    usage();
+    return 2;
+}

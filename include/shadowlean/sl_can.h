@@ -1,0 +1,463 @@
+/// @file sl_can.h
+/// @brief CAN messages of shadowlean: frame type, message layouts, E2E protection,
+///        encoders and decoders (integer only, endian-clean, no allocation).
+///
+/// The wire contract is this header plus the board file's `[can]` section (ids, bit rate).
+/// The DBC file (`sl::make_dbc()`, host_tools/common/sl_dbc.h) is GENERATED from the layout
+/// table below (`sl_can_layout()`), so the encoder, the decoder and the DBC cannot disagree.
+///
+/// Classic CAN, DLC 8, every signal little-endian (Intel, DBC `@1`): a signal with start
+/// bit `s` and length `n` occupies frame bits s..s+n-1, where frame bit k is bit (k % 8) of
+/// data byte k / 8 (so raw value bit 0 is at bit s). `u` = unsigned, `s` = two's complement.
+/// physical = raw x factor (every offset is 0).
+///
+/// ## E2E protection (AUTOSAR E2E Profile 1 style) - every message
+///
+/// | byte/bits | signal  | meaning |
+/// |-----------|---------|---------|
+/// | 0 (0..7)  | Crc     | CRC-8 SAE J1850 of [DataID, data[1], ..., data[7]] |
+/// | 8..11     | Counter | per message type: 0, 1, ..., 14, 0, ... (modulo 15; 15 is never sent) |
+///
+/// CRC-8 SAE J1850: polynomial 0x1D (x^8+x^4+x^3+x^2+1), initial value 0xFF, no
+/// reflection, final XOR 0xFF. Check value: CRC of the ASCII bytes "123456789" = 0x4B.
+/// The per-message Data ID (`SL_CAN_DATA_ID_*`, not transmitted) is the FIRST byte fed
+/// to the CRC, followed by data bytes 1..7 (byte 0, the CRC itself, is skipped): one CRC
+/// run over 8 bytes. A frame of the wrong message type, or a frame copied from another
+/// message id, therefore fails the CRC even when its bytes are otherwise plausible.
+///
+/// Worked example (checked by test_canmsg_crc_worked_example): a Status frame
+/// (Data ID 0x53) whose bytes 1..7 are `30 02 00 00 00 00 00` (Counter 0, LinkState 3 =
+/// STREAMING, Rotations 2). CRC input = `53 30 02 00 00 00 00 00`, CRC = 0x95, so the
+/// frame is `95 30 02 00 00 00 00 00`.
+///
+/// The counter starts at 0 after `sl_can_tx_init()` and advances by one per frame of that
+/// message type (all PoleLean frames of a rotation share one counter). A receiver
+/// (`sl_can_e2e_check()`) accepts delta = (counter - previous) mod 15 of 1, counts
+/// delta >= 2 as a counter jump (delta - 1 frames lost), rejects delta 0 as a repetition
+/// and rejects counter 15 and CRC mismatches as malformed.
+///
+/// ## PoleLean (board `can.id_pole_lean`, SHADOWLEAN -> VEHICLE, one frame per target)
+///
+/// | start | len | signal     | type | factor | range (physical)  | unit | note |
+/// |------:|----:|------------|------|--------|-------------------|------|------|
+/// |  0 | 8  | Crc        | u | 1    | 0..255         |     | E2E, Data ID 0x51 |
+/// |  8 | 4  | Counter    | u | 1    | 0..14          |     | E2E |
+/// | 12 | 3  | Quality    | u | 1    | 0..4           |     | sl_can_quality_t |
+/// | 15 | 1  | Clamped    | u | 1    | 0..1           |     | 1 = a value below hit its range limit |
+/// | 16 | 4  | TargetId   | u | 1    | 0..15          |     | tracker id of the target |
+/// | 20 | 11 | Azimuth    | u | 0.2  | 0..359.8       | deg | clockwise from vehicle forward |
+/// | 31 | 10 | Lean       | s | 0.1  | -51.2..51.1    | deg | > 0: top leans towards the vehicle |
+/// | 41 | 5  | LeanSigma  | u | 0.2  | 0..6.2         | deg | 1-sigma of Lean |
+/// | 46 | 9  | RangeInner | u | 0.02 | 0..10.22       | m   | inner bound r1 of the return |
+/// | 55 | 9  | RangeOuter | u | 0.02 | 0..10.22       | m   | outer bound r2 of the return |
+///
+/// Why these resolutions: the full wish list (0.1 deg 12-bit azimuth, 0.01 m ranges, an
+/// 11-bit lean, a wide sigma) needs 73 bits. The radar's azimuth step is 0.9 deg and its
+/// range bin 4.38 cm (per-bound sigma 1.26 cm), so 0.2 deg and 0.02 m steps stay well below
+/// the sensor's own resolution; 10.22 m covers the ground shadow of every board (<= 6 m
+/// slant range); a lean beyond +-51 deg (a fallen pole) is sent clamped with Clamped = 1,
+/// and the LeanWarning frame carries the most severe lean at 0.05 deg over +-102 deg.
+/// Lean and LeanSigma are meaningful only when Quality is VALID or FILTERED.
+///
+/// ## LeanWarning (board `can.id_lean_warning`, the most severe target of the rotation)
+///
+/// | start | len | signal    | type | factor | range (physical) | unit |
+/// |------:|----:|-----------|------|--------|------------------|------|
+/// |  0 | 8  | Crc       | u | 1    | 0..255          |     | (Data ID 0x52)
+/// |  8 | 4  | Counter   | u | 1    | 0..14           |     |
+/// | 12 | 2  | Level     | u | 1    | 0..2            |     | sl_can_level_t
+/// | 14 | 1  | Clamped   | u | 1    | 0..1            |     |
+/// | 15 | 1  | HasTarget | u | 1    | 0..1            |     | 0: no target; fields below are 0
+/// | 16 | 4  | TargetId  | u | 1    | 0..15           |     |
+/// | 20 | 12 | Azimuth   | u | 0.1  | 0..359.9        | deg |
+/// | 32 | 12 | Lean      | s | 0.05 | -102.4..102.35  | deg |
+/// | 44 | 11 | Range     | u | 0.01 | 0..20.47        | m   | inner bound r1
+/// | 55 | 6  | LeanSigma | u | 0.1  | 0..6.3          | deg |
+/// | 61 | 3  | Quality   | u | 1    | 0..4            |     | sl_can_quality_t
+///
+/// ## Status (board `can.id_status`, SHADOWLEAN -> VEHICLE, nominally 1 Hz)
+///
+/// | start | len | signal          | type | range        | note |
+/// |------:|----:|-----------------|------|--------------|------|
+/// |  0 | 8  | Crc             | u | 0..255       | (Data ID 0x53) |
+/// |  8 | 4  | Counter         | u | 0..14        | |
+/// | 12 | 3  | LinkState       | u | 0..4         | sl_can_link_state_t |
+/// | 15 | 1  | Saturated       | u | 0..1         | 1 = a counter below is stuck at its maximum |
+/// | 16 | 18 | Rotations       | u | 0..262143    | rotations processed (saturating) |
+/// | 34 | 14 | AzimuthsMissing | u | 0..16383     | azimuths lost in gaps (saturating) |
+/// | 48 | 8  | DecoderResyncs  | u | 0..255       | stream decoder resyncs (saturating) |
+/// | 56 | 8  | CanDropped      | u | 0..255       | CAN frames dropped by the sinks (saturating) |
+///
+/// ## VehicleMotion (board `can.id_vehicle_motion`, VEHICLE -> SHADOWLEAN, input)
+///
+/// | start | len | signal       | type | factor | range            | unit  |
+/// |------:|----:|--------------|------|--------|------------------|-------|
+/// |  0 | 8  | Crc          | u | 1    | 0..255           |       | (Data ID 0x54)
+/// |  8 | 4  | Counter      | u | 1    | 0..14            |       |
+/// | 12 | 1  | SpeedValid   | u | 1    | 0..1             |       |
+/// | 13 | 1  | YawRateValid | u | 1    | 0..1             |       |
+/// | 16 | 16 | Speed        | s | 0.01 | -327.68..327.67  | m/s   | > 0 forward
+/// | 32 | 16 | YawRate      | s | 0.01 | -327.68..327.67  | deg/s | > 0 counter-clockwise seen from above (ISO 8855)
+///
+/// Unlisted bits are reserved: sent as 0, ignored by the decoders.
+///
+/// ## Encoding rules (house style: rounding place 3)
+/// raw = physical / factor, rounded half up (towards +infinity at exact halves), then
+/// range-checked: a value outside the signal's range is CLAMPED to the nearest limit and
+/// the frame's Clamped (Status: Saturated) bit is set and `tx->stats.clamped_frames`
+/// counted. Nothing is ever wrapped silently. Azimuths are angles: they are reduced modulo
+/// 360 deg first (370 deg is 10 deg), which is not clamping.
+///
+/// Cost: every encode/decode is O(64) bit operations, no division in loops, < 64 bytes of
+/// stack, no allocation. Reentrant; one `sl_can_tx_t` per sender, one `sl_can_e2e_rx_t`
+/// per received message id. Not ISR-safe on a shared `sl_can_tx_t` without a lock.
+#ifndef SHADOWLEAN_SL_CAN_H
+#define SHADOWLEAN_SL_CAN_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "shadowlean/sl_err.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+struct sl_board;
+
+// ---------------------------------------------------------------------------------------
+// Frame
+
+#define SL_CAN_FLAG_EFF 0x01U ///< 29-bit identifier
+#define SL_CAN_FLAG_RTR 0x02U ///< remote transmission request (no data)
+#define SL_CAN_FLAG_ERR 0x04U ///< error frame (SocketCAN; payload per linux/can/error.h)
+
+#define SL_CAN_SFF_MASK 0x000007FFUL ///< 11-bit id mask
+#define SL_CAN_EFF_MASK 0x1FFFFFFFUL ///< 29-bit id mask
+/// Board/DBC id convention: a 29-bit id is stored with bit 31 set (DBC `BO_` style).
+#define SL_CAN_DBC_EFF_BIT 0x80000000UL
+
+/// One classic CAN frame. `id` is the bare 11- or 29-bit identifier (no flag bits in it);
+/// the kind is in `flags` (SL_CAN_FLAG_*). `dlc` is 0..8; bytes past `dlc` are 0 in frames
+/// the core produces. Plain value type, 16 bytes.
+typedef struct sl_can_frame {
+    uint32_t id;
+    uint8_t dlc;
+    uint8_t flags;
+    uint8_t data[8];
+} sl_can_frame_t;
+
+// ---------------------------------------------------------------------------------------
+// Messages, Data IDs, nominal cycle times
+
+/// The message types of this module.
+typedef enum sl_can_msg {
+    SL_CAN_MSG_POLE_LEAN = 0,
+    SL_CAN_MSG_LEAN_WARNING = 1,
+    SL_CAN_MSG_STATUS = 2,
+    SL_CAN_MSG_VEHICLE_MOTION = 3,
+    SL_CAN_MSG_COUNT = 4,
+} sl_can_msg_t;
+
+#define SL_CAN_DATA_ID_POLE_LEAN 0x51U      ///< E2E Data ID (first CRC byte)
+#define SL_CAN_DATA_ID_LEAN_WARNING 0x52U
+#define SL_CAN_DATA_ID_STATUS 0x53U
+#define SL_CAN_DATA_ID_VEHICLE_MOTION 0x54U
+
+#define SL_CAN_COUNTER_MODULO 15U ///< counters run 0..14; 15 is invalid on the wire
+
+/// Nominal cycle times (DBC GenMsgCycleTime): PoleLean and LeanWarning once per radar
+/// rotation (CTS350-X: 4 Hz), Status 1 Hz, VehicleMotion as expected from the vehicle.
+#define SL_CAN_CYCLE_MS_POLE_LEAN 250U
+#define SL_CAN_CYCLE_MS_LEAN_WARNING 250U
+#define SL_CAN_CYCLE_MS_STATUS 1000U
+#define SL_CAN_CYCLE_MS_VEHICLE_MOTION 20U
+
+// ---------------------------------------------------------------------------------------
+// Value tables
+
+/// PoleLean.Quality / LeanWarning.Quality.
+typedef enum sl_can_quality {
+    SL_CAN_QUALITY_VALID = 0,        ///< Lean is this rotation's estimate, inside the model
+    SL_CAN_QUALITY_AMBIGUOUS = 1,    ///< rho below the ambiguity bound: no lean number
+    SL_CAN_QUALITY_OUT_OF_MODEL = 2, ///< geometry outside the model (pole too short, base
+                                     ///< outside the shadow, rho or theta out of domain)
+    SL_CAN_QUALITY_INVALID = 3,      ///< the return is not a usable run of bins
+    SL_CAN_QUALITY_FILTERED = 4,     ///< Lean/LeanSigma are the tracker's filtered estimate
+                                     ///< over rotations (valid)
+} sl_can_quality_t;
+#define SL_CAN_QUALITY_MAX 4U
+
+/// LeanWarning.Level.
+typedef enum sl_can_level {
+    SL_CAN_LEVEL_NONE = 0,
+    SL_CAN_LEVEL_CAUTION = 1,
+    SL_CAN_LEVEL_DANGER = 2,
+} sl_can_level_t;
+#define SL_CAN_LEVEL_MAX 2U
+
+/// Status.LinkState: state of the radar TCP link.
+typedef enum sl_can_link_state {
+    SL_CAN_LINK_DISCONNECTED = 0, ///< no TCP connection
+    SL_CAN_LINK_CONNECTING = 1,   ///< TCP connect in progress
+    SL_CAN_LINK_WAIT_CONFIG = 2,  ///< connected, waiting for the radar's configuration
+    SL_CAN_LINK_STREAMING = 3,    ///< azimuth data flowing
+    SL_CAN_LINK_SILENT = 4,       ///< connected but no data for longer than the timeout
+} sl_can_link_state_t;
+#define SL_CAN_LINK_STATE_MAX 4U
+
+// ---------------------------------------------------------------------------------------
+// Signal limits (raw values). The layout table and the encoders use these; tests too.
+
+#define SL_CAN_TARGET_ID_MAX 15U
+#define SL_CAN_POLE_AZIMUTH_CDEG_PER_LSB 20  ///< 0.2 deg
+#define SL_CAN_POLE_AZIMUTH_RAW_MAX 1799     ///< 359.8 deg
+#define SL_CAN_POLE_LEAN_CDEG_PER_LSB 10     ///< 0.1 deg
+#define SL_CAN_POLE_LEAN_RAW_MIN (-512)
+#define SL_CAN_POLE_LEAN_RAW_MAX 511
+#define SL_CAN_POLE_SIGMA_CDEG_PER_LSB 20    ///< 0.2 deg
+#define SL_CAN_POLE_SIGMA_RAW_MAX 31
+#define SL_CAN_POLE_RANGE_MM_PER_LSB 20      ///< 0.02 m
+#define SL_CAN_POLE_RANGE_RAW_MAX 511
+
+#define SL_CAN_WARN_AZIMUTH_CDEG_PER_LSB 10  ///< 0.1 deg
+#define SL_CAN_WARN_AZIMUTH_RAW_MAX 3599
+#define SL_CAN_WARN_LEAN_CDEG_PER_LSB 5      ///< 0.05 deg
+#define SL_CAN_WARN_LEAN_RAW_MIN (-2048)
+#define SL_CAN_WARN_LEAN_RAW_MAX 2047
+#define SL_CAN_WARN_RANGE_MM_PER_LSB 10      ///< 0.01 m
+#define SL_CAN_WARN_RANGE_RAW_MAX 2047
+#define SL_CAN_WARN_SIGMA_CDEG_PER_LSB 10    ///< 0.1 deg
+#define SL_CAN_WARN_SIGMA_RAW_MAX 63
+
+#define SL_CAN_STATUS_ROTATIONS_MAX 262143UL ///< 18 bits
+#define SL_CAN_STATUS_AZ_MISSING_MAX 16383UL ///< 14 bits
+#define SL_CAN_STATUS_RESYNCS_MAX 255UL
+#define SL_CAN_STATUS_DROPPED_MAX 255UL
+
+#define SL_CAN_MOTION_SPEED_MM_S_PER_LSB 10  ///< 0.01 m/s
+#define SL_CAN_MOTION_YAW_CDEG_S_PER_LSB 1   ///< 0.01 deg/s
+#define SL_CAN_MOTION_RAW_MIN (-32768)
+#define SL_CAN_MOTION_RAW_MAX 32767
+
+// ---------------------------------------------------------------------------------------
+// Message contents in physical integer units (filled by the pipeline, returned by decoders)
+
+/// One target (PoleLean). Encode reads the fields marked "in"; decode sets all fields.
+typedef struct sl_can_pole_lean {
+    uint8_t target_id;        ///< in: 0..15
+    uint8_t quality;          ///< in: sl_can_quality_t (0..4)
+    int32_t azimuth_cdeg;     ///< in: clockwise from vehicle forward; any value, reduced mod 36000
+    uint32_t range_inner_mm;  ///< in: inner bound r1
+    uint32_t range_outer_mm;  ///< in: outer bound r2
+    int32_t lean_cdeg;        ///< in: > 0 = top towards the vehicle
+    uint32_t lean_sigma_cdeg; ///< in: 1-sigma of lean
+    bool clamped;             ///< decode: Clamped bit (ignored by encode: it is computed)
+    uint8_t counter;          ///< decode: E2E counter (ignored by encode: from sl_can_tx_t)
+} sl_can_pole_lean_t;
+
+/// The most severe target (LeanWarning).
+typedef struct sl_can_lean_warning {
+    uint8_t level;            ///< in: sl_can_level_t
+    bool has_target;          ///< in: false: no target; the target fields are sent as 0
+    uint8_t target_id;        ///< in: 0..15
+    uint8_t quality;          ///< in: sl_can_quality_t of that target
+    int32_t azimuth_cdeg;     ///< in: reduced mod 36000
+    uint32_t range_mm;        ///< in: inner bound r1
+    int32_t lean_cdeg;        ///< in
+    uint32_t lean_sigma_cdeg; ///< in
+    bool clamped;             ///< decode only
+    uint8_t counter;          ///< decode only
+} sl_can_lean_warning_t;
+
+/// Module health (Status). Counters are totals since start; the encoder saturates them.
+typedef struct sl_can_status {
+    uint8_t link_state;        ///< in: sl_can_link_state_t
+    uint32_t rotations;        ///< in: rotations processed
+    uint32_t azimuths_missing; ///< in: azimuths lost in gaps
+    uint32_t decoder_resyncs;  ///< in: Colossus decoder resynchronisations
+    uint32_t can_dropped;      ///< in: CAN frames the sinks dropped
+    bool saturated;            ///< decode only: a counter is at its maximum
+    uint8_t counter;           ///< decode only
+} sl_can_status_t;
+
+/// Vehicle motion (input from the vehicle; encoded here for tests and simulators).
+typedef struct sl_can_vehicle_motion {
+    int32_t speed_mm_s;        ///< > 0 forward
+    int32_t yaw_rate_cdeg_s;   ///< 0.01 deg/s, > 0 counter-clockwise seen from above
+    bool speed_valid;
+    bool yaw_rate_valid;
+    uint8_t counter;           ///< decode only
+} sl_can_vehicle_motion_t;
+
+// ---------------------------------------------------------------------------------------
+// CRC and E2E
+
+/// CRC-8 SAE J1850 (poly 0x1D, init 0xFF, final XOR 0xFF) of `len` bytes. `data` may be
+/// NULL when `len` is 0. Cost: 8 shift/xor steps per byte, no table.
+uint8_t sl_can_crc8_j1850(const uint8_t *data, size_t len);
+
+/// The E2E CRC of a frame payload: CRC-8 SAE J1850 of [data_id, data[1..7]] (data[0] is
+/// the CRC slot and is not read).
+uint8_t sl_can_e2e_crc(uint8_t data_id, const uint8_t data[8]);
+
+/// E2E receiver state for one message id. Zero-initialise or call sl_can_e2e_rx_init().
+/// Fields read-only to the application.
+typedef struct sl_can_e2e_rx {
+    uint8_t last_counter; ///< counter of the last accepted frame
+    bool synced;          ///< false until the first accepted frame (or after a reset)
+    struct {
+        uint32_t accepted;      ///< frames that passed
+        uint32_t crc_errors;    ///< CRC mismatch: rejected
+        uint32_t bad_dlc;       ///< dlc != 8 or RTR/ERR/EFF mismatch: rejected
+        uint32_t bad_counter;   ///< counter 15: rejected
+        uint32_t repeated;      ///< same counter as the previous frame: rejected
+        uint32_t counter_jumps; ///< accepted frames after a gap (delta >= 2)
+        uint32_t lost_frames;   ///< sum of (delta - 1) over the jumps
+    } stats;
+} sl_can_e2e_rx_t;
+
+/// Reset the receiver: the next valid frame is accepted without a sequence check
+/// (use after a reception timeout). Keeps the stats. O(1).
+void sl_can_e2e_rx_reset(sl_can_e2e_rx_t *rx);
+
+/// Zero everything. O(1).
+void sl_can_e2e_rx_init(sl_can_e2e_rx_t *rx);
+
+/// Check one received frame's E2E protection and sequence (the caller has matched the id).
+/// @return SL_OK (accepted; a counter jump is counted but accepted), SL_ERR_MALFORMED
+///         (dlc, flags, counter 15 or CRC: rejected, counted), SL_ERR_STATE (repeated
+///         counter: rejected, counted). Cost: one CRC over 8 bytes.
+sl_err_t sl_can_e2e_check(sl_can_e2e_rx_t *rx, uint8_t data_id, const sl_can_frame_t *f);
+
+// ---------------------------------------------------------------------------------------
+// Transmitter
+
+/// Message ids in board/DBC style: 11-bit ids as is, 29-bit ids with bit 31 set.
+typedef struct sl_can_ids {
+    uint32_t id[SL_CAN_MSG_COUNT]; ///< indexed by sl_can_msg_t
+} sl_can_ids_t;
+
+/// The four ids of a board (`can_id_*` fields). O(1).
+void sl_can_ids_from_board(sl_can_ids_t *ids, const struct sl_board *board);
+
+/// Sender state: ids and one E2E counter per message type. Fields read-only.
+typedef struct sl_can_tx {
+    sl_can_ids_t ids;
+    uint8_t counter[SL_CAN_MSG_COUNT]; ///< counter of the NEXT frame of each type
+    struct {
+        uint32_t frames;         ///< frames encoded
+        uint32_t clamped_frames; ///< frames with a clamped (or saturated) value
+    } stats;
+} sl_can_tx_t;
+
+/// Initialise a sender. @return SL_ERR_ARG when an id is not a valid 11-bit id or 29-bit
+/// id with bit 31 set, or two ids are equal; SL_OK otherwise. O(1).
+sl_err_t sl_can_tx_init(sl_can_tx_t *tx, const sl_can_ids_t *ids);
+
+/// Encode one PoleLean frame into `out` (id, dlc 8, data, E2E) and advance the counter.
+/// Out-of-range values are clamped and flagged (Clamped bit, stats.clamped_frames);
+/// quality > 4 is sent as INVALID (3) with Clamped set; target_id > 15 is sent as 15 with
+/// Clamped set. @return SL_OK, or SL_ERR_ARG for NULL pointers. O(1).
+sl_err_t sl_can_encode_pole_lean(sl_can_tx_t *tx, const sl_can_pole_lean_t *in,
+                                 sl_can_frame_t *out);
+
+/// Encode one LeanWarning frame (same rules; level > 2 is sent as DANGER with Clamped set;
+/// has_target false sends every target field as 0).
+sl_err_t sl_can_encode_lean_warning(sl_can_tx_t *tx, const sl_can_lean_warning_t *in,
+                                    sl_can_frame_t *out);
+
+/// Encode one Status frame. Counters saturate at their field maximum (Saturated bit);
+/// link_state > 4 is sent as DISCONNECTED with Saturated set.
+sl_err_t sl_can_encode_status(sl_can_tx_t *tx, const sl_can_status_t *in, sl_can_frame_t *out);
+
+/// Encode one VehicleMotion frame (for tests, simulators and replay tools). Out-of-range
+/// speed or yaw rate is clamped and counted in stats.clamped_frames (the message has no
+/// Clamped bit: the vehicle owns it).
+sl_err_t sl_can_encode_vehicle_motion(sl_can_tx_t *tx, const sl_can_vehicle_motion_t *in,
+                                      sl_can_frame_t *out);
+
+// ---------------------------------------------------------------------------------------
+// Decoders: check dlc/flags, CRC and counter 15 (not the sequence: use sl_can_e2e_check
+// or sl_can_motion_rx_feed for that) and convert to physical integer units
+// (raw x factor; e.g. Lean raw 123 -> 1230 cdeg). They do not check the id.
+// @return SL_OK or SL_ERR_MALFORMED (nothing useful written) / SL_ERR_ARG (NULL).
+
+sl_err_t sl_can_decode_pole_lean(const sl_can_frame_t *f, sl_can_pole_lean_t *out);
+sl_err_t sl_can_decode_lean_warning(const sl_can_frame_t *f, sl_can_lean_warning_t *out);
+sl_err_t sl_can_decode_status(const sl_can_frame_t *f, sl_can_status_t *out);
+sl_err_t sl_can_decode_vehicle_motion(const sl_can_frame_t *f, sl_can_vehicle_motion_t *out);
+
+/// VehicleMotion receiver for the motion-aware masks: id match, E2E check (CRC errors and
+/// counter jumps counted in `e2e.stats`), latest accepted value with its time.
+/// Fields read-only to the application.
+typedef struct sl_can_motion_rx {
+    uint32_t id_dbc;             ///< expected id, board/DBC style
+    sl_can_e2e_rx_t e2e;
+    sl_can_vehicle_motion_t last;///< last accepted value (valid when have_value)
+    uint64_t last_t_us;          ///< time of the last accepted frame
+    bool have_value;
+    uint64_t timeout_us;         ///< no accepted frame for this long: sequence resets
+    struct {
+        uint32_t other_ids;      ///< frames with another id (ignored, counted)
+        uint32_t timeouts;       ///< sequence resets after a reception gap
+    } stats;
+} sl_can_motion_rx_t;
+
+/// Initialise. `timeout_us` is both the staleness limit of sl_can_motion_rx_get() and
+/// the gap after which the counter sequence restarts. O(1).
+void sl_can_motion_rx_init(sl_can_motion_rx_t *rx, uint32_t id_dbc, uint64_t timeout_us);
+
+/// Feed one received frame at time `t_us`. @return SL_OK (accepted), SL_ERR_ARG (another
+/// id: ignored, counted in stats.other_ids), or the sl_can_e2e_check() error. O(1).
+sl_err_t sl_can_motion_rx_feed(sl_can_motion_rx_t *rx, const sl_can_frame_t *f, uint64_t t_us);
+
+/// The latest accepted motion if it is younger than the timeout at `now_us`. O(1).
+/// @return true and `*out` set, or false (none yet, or stale).
+bool sl_can_motion_rx_get(const sl_can_motion_rx_t *rx, uint64_t now_us,
+                          sl_can_vehicle_motion_t *out);
+
+// ---------------------------------------------------------------------------------------
+// Layout table: the single description the DBC generator (host) reads. Static const data.
+
+/// One entry of a value table.
+typedef struct sl_can_value_name {
+    uint32_t value;
+    const char *name;
+} sl_can_value_name_t;
+
+/// One signal. physical = raw x factor_num / factor_den (offset 0). raw_min/raw_max are the
+/// encoder's clamping limits (the DBC [min|max] is raw_min x factor .. raw_max x factor).
+typedef struct sl_can_signal_desc {
+    const char *name;
+    uint8_t start;            ///< Intel start bit (LSB position)
+    uint8_t length;           ///< bits
+    bool is_signed;           ///< two's complement
+    int32_t factor_num;
+    int32_t factor_den;
+    int32_t raw_min;
+    int32_t raw_max;
+    const char *unit;         ///< "" when none
+    const sl_can_value_name_t *values; ///< value table or NULL
+    uint8_t n_values;
+} sl_can_signal_desc_t;
+
+/// One message.
+typedef struct sl_can_message_desc {
+    const char *name;         ///< DBC message name, e.g. "PoleLean"
+    uint8_t data_id;          ///< E2E Data ID
+    uint16_t cycle_ms;        ///< nominal cycle time
+    bool to_shadowlean;       ///< true: received (VehicleMotion); false: sent
+    const sl_can_signal_desc_t *signals;
+    uint8_t n_signals;
+} sl_can_message_desc_t;
+
+/// Layout of message `m` (NULL when out of range). O(1).
+const sl_can_message_desc_t *sl_can_layout(sl_can_msg_t m);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif // SHADOWLEAN_SL_CAN_H

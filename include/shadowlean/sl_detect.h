@@ -1,0 +1,270 @@
+/// @file sl_detect.h
+/// @brief Pole extraction inside the chassis shadow, corrections of MATH.md s.4, alpha.
+///
+/// Input: per azimuth, the stable-occupied bit row of the consistency mask (sl_mask.h,
+/// layout sl_thresh.h), fed in increasing azimuth order once per rotation. Output: up to
+/// `max_targets` targets per rotation, each with its representative azimuth, raw and
+/// corrected bounds r1/r2 (micrometres) and the inclination estimate (sl_incline.h).
+///
+/// ## Stages (all integer; units in the names)
+/// 1. **Runs** (per azimuth `az`). A run is a maximal set of consecutive occupied bins;
+///    runs separated by at most `cfg.gap_bins` free bins are bridged into one run that is
+///    marked *broken* (its occupied count is below its extent). Only runs that start inside
+///    the search window are considered: first bin >= `near_exclusion_bins` ... or touching
+///    it, see below ... and first bin < `win_bins[az]` = ceil(S(az) / b), where
+///    `S(az) = sqrt(shadow_um[az]^2 + radar_height_um^2)` is the **slant** range of the
+///    ground-shadow edge (the radar measures slant range; the ground at the horizontal
+///    shadow radius R lies at slant sqrt(R^2 + H^2)). Runs entirely inside the near-field
+///    band `[0, near_exclusion_bins)` are ignored (the bright leakage band of REAL_SCANS.md
+///    s.2 is never reported). A run that contains bin near_exclusion_bins - 1 *and*
+///    near_exclusion_bins crosses into the band: flagged NEAR. A run whose last bin is
+///    `>= edge_bins[az]` (the bin whose centre, less the elongation d at S, reaches S) or
+///    reaches the end of the row passed in is flagged SHADOW: its far end is at or beyond
+///    the shadow edge, so its r2 is the ground or the pole's base, not the -theta ray.
+/// 2. **Grouping**. A run on azimuth a joins the group (candidate) that has a run on a - 1
+///    whose extent overlaps it within `cfg.link_bins` bins; a run touching two groups merges
+///    them. Azimuth azimuths-1 links to azimuth 0 at the end of the rotation (wrap). A
+///    group remembers, per azimuth, the union extent [first, last] and the occupied count
+///    of its runs there, for up to SL_CFG_DETECT_MAX_SPAN azimuths (wider: rejected WIDE).
+/// 3. **Representative azimuth**: the azimuth of the group with the most occupied bins
+///    (the strongest return: for a slender pole, the beam centre); ties go to the azimuth
+///    nearest the middle of the group, then to the lower index. Its run gives raw
+///    `bin_first`, `bin_last`.
+/// 4. **Rejections**, counted per reason in `stats.rejected[]`, first match wins:
+///    NEAR (any run of the group crosses into the near-field band);
+///    SHADOW (any run flagged SHADOW, or the corrected r2 of the representative run is
+///    >= S(az): the base is not inside the shadow);
+///    WIDE (the group spans more azimuths than a pole of `cfg.max_pole_diameter_um` at r1
+///    can: allowed = floor((D / r1 [rad] + beam) / step) + 1 + `cfg.width_slack_az`);
+///    BROKEN (the representative run has a gap).
+/// 5. **Corrections** (sl_detect_correct(), MATH.md s.4), b = bin_size_um:
+///    - raw bounds: r1_raw = bin_first * b (near edge of the first occupied bin),
+///      r2_raw = (bin_last + 1) * b (far edge of the last occupied bin);
+///    - half-bin (paper Sec. V-A): r1 = r1_raw + b/2, r2 = r2_raw - b/2. Combined, r1 and r2
+///      are the CENTRES of the first and last occupied bins (a point target in one bin k
+///      gives r1 = r2 = (k + 1/2) b, the mean of a position uniform in the bin: unbiased);
+///      bin k is assumed to span [k b, (k + 1) b) as in the board generator;
+///    - elongation: r2 -= d(r2), d = piecewise-linear interpolation of the board's table
+///      (elong_range_um -> elong_d_um), constant beyond its ends, 0 without a table;
+///    - radius R: the board's pole_radius_um when non-zero (flag RADIUS_BOARD); otherwise,
+///      when cfg.radius_from_width, from the group's azimuthal width, R = r1 * tan(w / 2)
+///      with w = (az_count - 1) * step - beam, the smallest arc consistent with az_count
+///      azimuth samples less the beam's own spread (small angle; clamped to
+///      [0, cfg.max_radius_um]; flags RADIUS_WIDTH and RADIUS_CLAMPED). It is biased low on
+///      purpose: a thin pole seen on 2-3 azimuths gets R = 0 rather than a fake radius;
+///      the azimuth quantisation (0.9 deg = 47 mm at 3 m) makes it coarse. The nearest return is the pole's front surface, so
+///      r1 += R (front surface -> axis). The far end of the return comes from the surface
+///      points the beam still covers near the silhouette: with L = r1 * tan(beam / 2) the
+///      half-footprint of the beam, the deepest covered surface point lies
+///      R - sqrt(max(0, R^2 - L^2)) behind the front, so r2 += sqrt(max(0, R^2 - L^2)).
+///      A wide beam (L >= R, the paper's simulation) leaves r2 alone; a narrow one shifts
+///      both bounds by ~R (rho unchanged to first order).
+/// 6. **Alpha**: sl_incline_estimate(r1, r2, &board->geom[az], board->range_sigma_um,
+///    board->theta_sigma_cdeg); its flag is stored in the target (targets are reported
+///    whatever the flag; consumers use `incline_flag`).
+///
+/// ## Calling sequence (one rotation)
+///     sl_detect_begin(&d);
+///     for (az = 0; az < azimuths; az++)            // increasing; gaps allowed
+///         sl_detect_row(&d, az, occ_row, words);   // e.g. straight after sl_mask_update()
+///     n = sl_detect_end(&d);                       // targets in d.targets[0 .. n)
+/// or `sl_detect_rotation_from_mask()` which does exactly that from a mask.
+///
+/// ## Ownership, memory, cost
+/// Caller-owned `sl_detect_t`, no allocation; it borrows `board` (static const) until
+/// re-init. RAM: sizeof(sl_detect_t) = 4 x SL_CFG_MAX_AZIMUTHS (window tables) +
+/// SL_CFG_DETECT_MAX_CANDIDATES x (16 + 6 x SL_CFG_DETECT_MAX_SPAN) + SL_CFG_MAX_TARGETS x
+/// sizeof(sl_target_t) + ~100 bytes (defaults: about 9.4 KB).
+/// Cost: sl_detect_row O(words of the row up to the shadow edge + runs x candidates),
+/// typically < 60 x86-64 instructions for an azimuth without runs; sl_detect_end O(candidates
+/// x span) plus one sl_incline_estimate (~600 instructions) and one isqrt per target.
+/// sl_detect_init: one isqrt per azimuth. Not reentrant per instance; no callbacks.
+#ifndef SHADOWLEAN_SL_DETECT_H
+#define SHADOWLEAN_SL_DETECT_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "shadowlean/sl_board.h"
+#include "shadowlean/sl_config.h"
+#include "shadowlean/sl_err.h"
+#include "shadowlean/sl_incline.h"
+#include "shadowlean/sl_mask.h"
+#include "shadowlean/sl_thresh.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/// Azimuths one group records per-azimuth runs for; a wider group is rejected WIDE.
+/// At 0.9 deg per azimuth, 24 covers a 0.3 m pole down to 1.3 m plus a 2 deg beam.
+#ifndef SL_CFG_DETECT_MAX_SPAN
+#define SL_CFG_DETECT_MAX_SPAN 24
+#endif
+#if SL_CFG_DETECT_MAX_SPAN < 1 || SL_CFG_DETECT_MAX_SPAN > 255
+#error "SL_CFG_DETECT_MAX_SPAN must be in [1, 255]"
+#endif
+
+/// Groups open at once within a rotation (runs beyond it are dropped and counted).
+#ifndef SL_CFG_DETECT_MAX_CANDIDATES
+#define SL_CFG_DETECT_MAX_CANDIDATES 32
+#endif
+#if SL_CFG_DETECT_MAX_CANDIDATES < 1 || SL_CFG_DETECT_MAX_CANDIDATES > 255
+#error "SL_CFG_DETECT_MAX_CANDIDATES must be in [1, 255]"
+#endif
+
+/// Rejection reasons (index of `sl_detect_stats_t.rejected`).
+typedef enum sl_detect_reject {
+    SL_DETECT_REJ_NEAR = 0,   ///< a run crosses into the near-field exclusion band
+    SL_DETECT_REJ_SHADOW = 1, ///< the return reaches the shadow edge (base not in the shadow)
+    SL_DETECT_REJ_WIDE = 2,   ///< too wide in azimuth for a slender pole at its range
+    SL_DETECT_REJ_BROKEN = 3, ///< a gap inside the run on the representative azimuth
+    SL_DETECT_REJ_COUNT = 4
+} sl_detect_reject_t;
+
+/// `sl_target_t.flags`.
+#define SL_TARGET_RADIUS_BOARD 0x01U   ///< radius from board->pole_radius_um
+#define SL_TARGET_RADIUS_WIDTH 0x02U   ///< radius estimated from the azimuthal width
+#define SL_TARGET_RADIUS_CLAMPED 0x04U ///< ... and clamped to cfg.max_radius_um
+#define SL_TARGET_ELONG 0x08U          ///< the elongation table was applied (d != 0)
+#define SL_TARGET_WRAPS 0x10U          ///< the group crosses azimuth 0
+
+/// Detection parameters that are not (yet) board fields.
+typedef struct sl_detect_cfg {
+    uint32_t max_pole_diameter_um; ///< widest object still called a pole (WIDE test)
+    uint32_t max_radius_um;        ///< clamp of the width-estimated radius
+    uint16_t beam_width_cdeg;      ///< azimuth spread of a point target's return at the
+                                   ///< threshold (sensor beam; simulator cone), 0.01 deg
+    uint8_t gap_bins;              ///< free bins bridged inside a run (marked broken)
+    uint8_t link_bins;             ///< extent overlap tolerance between adjacent azimuths
+    uint8_t width_slack_az;        ///< extra azimuths allowed by the WIDE test
+    bool radius_from_width;        ///< estimate R from the width when the board has none
+} sl_detect_cfg_t;
+
+/// Defaults: D_max 0.3 m, R clamp 0.15 m, beam 1.8 deg (CTS350-X), gap 2 bins, link 1 bin,
+/// slack 1 azimuth, radius from width on.
+void sl_detect_cfg_default(sl_detect_cfg_t *cfg);
+
+/// One detected target (one rotation). Plain value.
+typedef struct sl_target {
+    uint16_t az;            ///< representative azimuth index (0 .. azimuths-1)
+    uint16_t az_first;      ///< first azimuth of the group (clockwise; > az when wrapping)
+    uint16_t az_count;      ///< group width in azimuths
+    uint16_t bin_first;     ///< first occupied bin of the representative run
+    uint16_t bin_last;      ///< last occupied bin of the representative run
+    uint16_t occupied;      ///< occupied bins in the representative run
+    uint32_t r1_raw_um;     ///< bin_first * b
+    uint32_t r2_raw_um;     ///< (bin_last + 1) * b
+    uint32_t r1_um;         ///< corrected inner bound (half-bin, radius)
+    uint32_t r2_um;         ///< corrected outer bound (half-bin, elongation, radius)
+    uint32_t radius_um;     ///< radius used (0 = none)
+    int32_t elong_um;       ///< d(r2) subtracted from r2
+    uint32_t shadow_slant_um; ///< S(az): slant range of the ground-shadow edge
+    int32_t alpha_cdeg;     ///< inclination, 0.01 deg, > 0 = top towards the radar (VALID)
+    uint16_t sigma_cdeg;    ///< 1-sigma of alpha, 0.01 deg (VALID)
+    uint8_t incline_flag;   ///< sl_incline_flag_t
+    uint8_t incline_branch; ///< sl_incline_branch_t
+    uint8_t flags;          ///< SL_TARGET_*
+} sl_target_t;
+
+/// Counters (cumulative since init; never asserted).
+typedef struct sl_detect_stats {
+    uint32_t rotations;        ///< sl_detect_end() calls
+    uint32_t rows;             ///< rows accepted
+    uint32_t runs;             ///< runs started inside the search window
+    uint32_t groups;           ///< groups closed (targets + rejected)
+    uint32_t targets;          ///< targets reported
+    uint32_t rejected[SL_DETECT_REJ_COUNT]; ///< groups rejected, by first reason
+    uint32_t span_overflow;    ///< groups wider than SL_CFG_DETECT_MAX_SPAN (also WIDE)
+    uint32_t cand_overflow;    ///< runs dropped: no free group slot
+    uint32_t target_overflow;  ///< accepted targets dropped: more than max_targets
+    uint32_t order_errors;     ///< rows ignored: azimuth out of range or not increasing
+} sl_detect_stats_t;
+
+/// Per-azimuth summary of a group (internal).
+typedef struct sl_detect_azrun {
+    uint16_t first; ///< union extent of the group's runs on this azimuth
+    uint16_t last;
+    uint16_t count; ///< occupied bins (0 = no run on this azimuth)
+} sl_detect_azrun_t;
+
+/// A group being built (internal).
+typedef struct sl_detect_cand {
+    uint16_t az_first;  ///< first azimuth (feed order; wrap merges append past azimuths-1)
+    uint16_t az_last;   ///< last azimuth with a run (unwrapped)
+    uint16_t last_lo, last_hi; ///< extent on az_last
+    uint16_t prev_lo, prev_hi; ///< extent on az_last - 1 (lo > hi: none)
+    uint8_t state;      ///< 0 free, 1 open, 2 closed (waiting for the wrap merge)
+    uint8_t flags;      ///< internal NEAR / SHADOW / SPAN / WRAPS bits
+    sl_detect_azrun_t run[SL_CFG_DETECT_MAX_SPAN];
+} sl_detect_cand_t;
+
+/// The detector. Caller-owned; fields read-only to the application.
+typedef struct sl_detect {
+    const sl_board_t *board;
+    sl_detect_cfg_t cfg;
+    uint16_t win_bins[SL_CFG_MAX_AZIMUTHS];  ///< runs must start below this bin
+    uint16_t edge_bins[SL_CFG_MAX_AZIMUTHS]; ///< a run reaching this bin touches the edge
+    uint32_t step_bam;      ///< 2^32 / azimuths
+    uint32_t beam_bam;      ///< cfg.beam_width_cdeg as bam32
+    uint16_t azimuths;
+    uint16_t bins;          ///< board->roi_bins
+    uint16_t near_bins;     ///< board->near_exclusion_bins
+    uint8_t max_targets;    ///< min(board->max_targets or SL_CFG_MAX_TARGETS, SL_CFG_MAX_TARGETS)
+    uint8_t n_targets;      ///< targets of the last completed rotation
+    int32_t last_az;        ///< last row's azimuth this rotation (-1: none yet)
+    uint16_t n_open;        ///< groups in state "open" (skips the per-row close scan)
+    sl_detect_cand_t cand[SL_CFG_DETECT_MAX_CANDIDATES];
+    sl_target_t targets[SL_CFG_MAX_TARGETS];
+    sl_detect_stats_t stats;
+} sl_detect_t;
+
+/// Initialise for a board (borrowed until re-init). `cfg` NULL = defaults (copied).
+/// @return SL_OK; SL_ERR_ARG when a pointer is NULL, the board lacks shadow tables
+/// (shadow_um and shadow_bins both NULL), has bin_size_um 0, azimuths outside
+/// 1..SL_CFG_MAX_AZIMUTHS or roi_bins outside 1..SL_CFG_ROI_BINS.
+/// Cost: O(azimuths) with one isqrt and one d(r) lookup each.
+sl_err_t sl_detect_init(sl_detect_t *d, const sl_board_t *board, const sl_detect_cfg_t *cfg);
+
+/// Start a rotation: drops the previous rotation's targets and groups. O(candidates).
+void sl_detect_begin(sl_detect_t *d);
+
+/// Feed the stable-occupied row of azimuth `az` (`words` words, layout sl_thresh.h;
+/// borrowed for the call). Rows must come in increasing azimuth order; a missing azimuth
+/// simply breaks adjacency. Only the first `words` words are read (bins beyond are treated
+/// as unknown: a run reaching the end of the row is flagged SHADOW).
+/// @return SL_OK; SL_ERR_RANGE (az >= azimuths, or az not above the previous row's):
+/// counted in `stats.order_errors`, row ignored.
+sl_err_t sl_detect_row(sl_detect_t *d, uint16_t az, const uint32_t *occ, uint32_t words);
+
+/// Close the rotation: wrap merge (azimuth azimuths-1 with 0), representative azimuth,
+/// rejections, corrections and alpha for every remaining group.
+/// @return the number of targets in `d->targets` (0..max_targets).
+sl_ssize_t sl_detect_end(sl_detect_t *d);
+
+/// begin + one row per azimuth from `mask` (held rows of stale azimuths included; none for
+/// azimuths without history) + end. Reads only the words up to the furthest edge bin.
+/// @return as sl_detect_end(). Cost: O(azimuths x words used x mask planes) + the above.
+sl_ssize_t sl_detect_rotation_from_mask(sl_detect_t *d, const sl_mask_t *mask);
+
+/// Stage 5 alone (MATH.md s.4) for a run `bin_first..bin_last` on azimuth `az` of a group
+/// `az_count` azimuths wide. Fills r1_raw_um, r2_raw_um, r1_um, r2_um, radius_um, elong_um
+/// and the RADIUS_* / ELONG flags of `t` (other fields untouched). Pure; O(elong points).
+void sl_detect_correct(const sl_board_t *board, const sl_detect_cfg_t *cfg, uint16_t az,
+                       uint16_t bin_first, uint16_t bin_last, uint16_t az_count,
+                       sl_target_t *t);
+
+/// The board's elongation d(r) in micrometres (piecewise linear over elong_range_um ->
+/// elong_d_um, constant beyond the ends, 0 with no table; truncated toward zero, <= 1 um).
+/// O(elong_points).
+int32_t sl_detect_elong_um(const sl_board_t *board, uint32_t r_um);
+
+/// Slant range of the ground-shadow edge on azimuth `az`: sqrt(shadow_um^2 + H^2), from
+/// `shadow_um` (or, without it, (shadow_bins + 1) * b as the horizontal radius). O(isqrt).
+uint32_t sl_detect_shadow_slant_um(const sl_board_t *board, uint16_t az);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif // SHADOWLEAN_SL_DETECT_H

@@ -1,0 +1,148 @@
+/// @file sl_track.h
+/// @brief Targets over rotations: association, filtered alpha, warning level with hysteresis.
+///
+/// Once per rotation the caller hands over that rotation's targets (sl_detect.h) and the
+/// time (`now_us`, microseconds, monotonic; the core never reads a clock).
+///
+/// ## Association
+/// A target may continue a live track when both gates hold: circular azimuth distance
+/// `<= cfg.az_gate` azimuths and `|r1 - track r1| <= cfg.range_gate_um`. Pairs are taken
+/// greedily by increasing normalised distance (|d az| / az_gate + |d r1| / range_gate), each
+/// track and target at most once (global nearest neighbour). Unmatched targets open new
+/// tracks while slots are free (`stats.full` otherwise). Tracks not matched for longer than
+/// `board->track_timeout_us` are dropped (0: dropped at the first update without a match).
+/// The gates are for a (nearly) static scene; compensating vehicle motion comes later.
+///
+/// ## Filter (1-D Kalman, fixed point)
+/// State alpha in 1/256 cdeg (Q8 cdeg), variance P in cdeg^2 (uint32). Only targets with
+/// `incline_flag == SL_INCLINE_VALID` update it; other flags refresh the track's position
+/// and time only. Per valid measurement z (cdeg) with sigma_z = max(target sigma,
+/// cfg.min_sigma_cdeg):
+///
+///     first:   alpha = z, P = sigma_z^2
+///     else:    P += q^2 (q = cfg.q_cdeg, the random walk allowed per update)
+///              K = P / (P + sigma_z^2)              (Q16, one 64-bit division)
+///              alpha += K (z - alpha);  P = (1 - K) P   (round half up via sl_fx)
+///
+/// `alpha_cdeg` and `sigma_cdeg` (= isqrt(P)) are the reported values.
+///
+/// ## Warning level
+/// raw level of a filtered alpha a: DANGER when a >= board->danger_lean_cdeg (leaning
+/// towards the vehicle; alpha > 0 = top towards the radar), else CAUTION when
+/// `cfg.caution_abs ? |a| : a` >= board->caution_lean_cdeg (the board header defines
+/// CAUTION on |lean|; set caution_abs = false for "towards only"), else NONE. A board
+/// threshold <= 0 disables its level.
+/// - Raising: `cfg.confirm` consecutive valid updates with a raw level above the current one
+///   and the filtered sigma <= `cfg.max_sigma_cdeg`; the level becomes the raw level of the
+///   last of them.
+/// - Lowering: immediately, to the raw level computed with every threshold lowered by
+///   `cfg.hysteresis_cdeg` (so a lean hovering at a threshold does not toggle).
+/// - Non-valid measurements leave the level unchanged (and do not count as confirmations
+///   nor break a confirmation streak).
+///
+/// ## Ownership, memory, cost
+/// Caller-owned `sl_tracker_t`; borrows `board` until re-init. RAM: SL_CFG_MAX_TARGETS x
+/// sizeof(sl_track_t) (56 bytes) + ~64 bytes (defaults: ~1.9 KB). Cost per update:
+/// O(tracks x targets x min(tracks, targets)) gate tests (worst case 32^3 = 32k simple
+/// steps; a few hundred instructions for a handful of poles) + one 64-bit division and one
+/// isqrt per valid measurement. Not reentrant per instance.
+#ifndef SHADOWLEAN_SL_TRACK_H
+#define SHADOWLEAN_SL_TRACK_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "shadowlean/sl_board.h"
+#include "shadowlean/sl_config.h"
+#include "shadowlean/sl_detect.h"
+#include "shadowlean/sl_err.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/// Warning level of a track.
+typedef enum sl_warn_level {
+    SL_WARN_NONE = 0,
+    SL_WARN_CAUTION = 1,
+    SL_WARN_DANGER = 2,
+} sl_warn_level_t;
+
+/// Tracking parameters that are not board fields.
+typedef struct sl_track_cfg {
+    uint32_t range_gate_um;    ///< max |d r1| to associate (default 0.3 m)
+    uint16_t az_gate;          ///< max circular azimuth distance (default 3)
+    uint16_t q_cdeg;           ///< process noise per valid update (default 20 = 0.2 deg)
+    uint16_t min_sigma_cdeg;   ///< floor of a measurement's sigma (default 50)
+    uint16_t max_sigma_cdeg;   ///< levels are raised only at filtered sigma <= this (300)
+    uint16_t hysteresis_cdeg;  ///< lowering margin below each threshold (default 100 = 1 deg)
+    uint8_t confirm;           ///< consecutive valid updates needed to raise (default 3)
+    bool caution_abs;          ///< CAUTION on |alpha| (default true, as sl_board.h says)
+} sl_track_cfg_t;
+
+/// Defaults as listed on each field.
+void sl_track_cfg_default(sl_track_cfg_t *cfg);
+
+/// One track. Fields read-only to the application.
+typedef struct sl_track {
+    uint64_t first_seen_us;  ///< time of the target that opened it
+    uint64_t last_seen_us;   ///< time of the last associated target
+    uint32_t r1_um;          ///< last target's corrected r1
+    uint32_t r2_um;          ///< last target's corrected r2
+    int32_t alpha_q8;        ///< filter state, 1/256 cdeg
+    uint32_t var_cdeg2;      ///< filter variance, cdeg^2 (0 = no valid measurement yet)
+    int32_t alpha_cdeg;      ///< filtered alpha, 0.01 deg (valid when valid_hits > 0)
+    uint16_t sigma_cdeg;     ///< filtered 1-sigma, 0.01 deg (valid when valid_hits > 0)
+    uint16_t id;             ///< non-zero, unique among live tracks
+    uint16_t az;             ///< last target's representative azimuth
+    uint16_t hits;           ///< targets associated (saturating)
+    uint16_t valid_hits;     ///< valid alpha measurements (saturating)
+    uint8_t level;           ///< sl_warn_level_t
+    uint8_t streak;          ///< consecutive valid updates above the current level
+    uint8_t last_flag;       ///< incline flag of the last associated target
+    uint8_t live;            ///< 1 = slot in use
+    uint8_t updated;         ///< 1 = matched by the last sl_track_update()
+} sl_track_t;
+
+/// Counters (cumulative; never asserted).
+typedef struct sl_track_stats {
+    uint32_t updates;        ///< sl_track_update() calls
+    uint32_t associated;     ///< target -> existing track matches
+    uint32_t created;        ///< tracks opened
+    uint32_t dropped;        ///< tracks dropped after the timeout
+    uint32_t full;           ///< targets without a track: no free slot
+    uint32_t level_changes;  ///< warning level transitions (any direction)
+    uint32_t time_backwards; ///< now_us earlier than a track's last_seen_us (treated as 0 s)
+} sl_track_stats_t;
+
+/// The tracker. Caller-owned; fields read-only to the application.
+typedef struct sl_tracker {
+    const sl_board_t *board;
+    sl_track_cfg_t cfg;
+    uint16_t next_id;
+    uint16_t live;           ///< live tracks
+    sl_track_t tracks[SL_CFG_MAX_TARGETS];
+    sl_track_stats_t stats;
+} sl_tracker_t;
+
+/// Initialise (no tracks). `cfg` NULL = defaults (copied). Borrows `board`.
+/// @return SL_OK; SL_ERR_ARG for NULL tracker/board, board azimuths 0, az_gate 0 or
+/// range_gate_um 0.
+sl_err_t sl_track_init(sl_tracker_t *tr, const sl_board_t *board, const sl_track_cfg_t *cfg);
+
+/// Feed one rotation's targets (`n` of them, borrowed for the call; NULL allowed when n is
+/// 0) at time `now_us`: associate, filter, update levels, open and drop tracks.
+void sl_track_update(sl_tracker_t *tr, const sl_target_t *targets, uint32_t n,
+                     uint64_t now_us);
+
+/// Highest warning level over live tracks (SL_WARN_NONE when none). O(tracks).
+sl_warn_level_t sl_track_max_level(const sl_tracker_t *tr);
+
+/// Live track by id, or NULL. O(tracks).
+const sl_track_t *sl_track_find(const sl_tracker_t *tr, uint16_t id);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif // SHADOWLEAN_SL_TRACK_H

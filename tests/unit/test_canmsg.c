@@ -1,0 +1,664 @@
+// Unit tests for sl_can.h: CRC, E2E, layout table, encoders/decoders, VehicleMotion rx.
+// Byte-level expectations only (the suite also runs on big-endian s390x under qemu).
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+#include <string.h>
+
+#include "shadowlean/sl_can.h"
+
+#define ID_POLE 0x620U
+#define ID_WARN 0x621U
+#define ID_STATUS 0x622U
+#define ID_MOTION 0x300U
+
+static uint64_t rng_state = 0x9E3779B97F4A7C15ull;
+static uint32_t rnd32(void)
+{
+    rng_state ^= rng_state << 13;
+    rng_state ^= rng_state >> 7;
+    rng_state ^= rng_state << 17;
+    return (uint32_t)(rng_state >> 16);
+}
+/// Uniform in [lo, hi] (hi - lo < 2^32).
+static int64_t rnd_range(int64_t lo, int64_t hi)
+{
+    const uint64_t span = (uint64_t)(hi - lo) + 1U;
+    return lo + (int64_t)((((uint64_t)rnd32() << 16) ^ rnd32()) % span);
+}
+
+static void tx_setup(sl_can_tx_t *tx)
+{
+    sl_can_ids_t ids = {{ID_POLE, ID_WARN, ID_STATUS, ID_MOTION}};
+    assert_int_equal(sl_can_tx_init(tx, &ids), SL_OK);
+}
+
+/// round(x / d), halves up, by a different route than the core (double-free integer math).
+static int64_t ref_round(int64_t x, int64_t d)
+{
+    int64_t q = x / d, r = x % d;
+    if (r < 0) {
+        q -= 1;
+        r += d;
+    }
+    return (2 * r >= d) ? q + 1 : q;
+}
+
+static int64_t clamp64(int64_t v, int64_t lo, int64_t hi)
+{
+    return v < lo ? lo : v > hi ? hi : v;
+}
+
+static void test_canmsg_crc8_check_value_is_0x4b(void **state)
+{
+    (void)state;
+    const uint8_t check[] = {'1', '2', '3', '4', '5', '6', '7', '8', '9'};
+    assert_int_equal(sl_can_crc8_j1850(check, sizeof check), 0x4B);
+    assert_int_equal(sl_can_crc8_j1850(NULL, 0), 0x00); // 0xFF ^ 0xFF
+    // AUTOSAR CRC library test vectors for CRC8 SAE J1850.
+    const uint8_t v1[] = {0x00, 0x00, 0x00, 0x00};
+    const uint8_t v2[] = {0xF2, 0x01, 0x83};
+    const uint8_t v3[] = {0x0F, 0xAA, 0x00, 0x55};
+    const uint8_t v4[] = {0xFF, 0xFF, 0xFF, 0xFF};
+    assert_int_equal(sl_can_crc8_j1850(v1, sizeof v1), 0x59);
+    assert_int_equal(sl_can_crc8_j1850(v2, sizeof v2), 0x37);
+    assert_int_equal(sl_can_crc8_j1850(v3, sizeof v3), 0x79);
+    assert_int_equal(sl_can_crc8_j1850(v4, sizeof v4), 0x74);
+}
+
+static void test_canmsg_e2e_crc_mixes_data_id_first(void **state)
+{
+    (void)state;
+    uint8_t d[8] = {0xEE, 0x31, 0x42, 0x53, 0x64, 0x75, 0x86, 0x97};
+    const uint8_t seq[8] = {SL_CAN_DATA_ID_POLE_LEAN, 0x31, 0x42, 0x53, 0x64, 0x75, 0x86, 0x97};
+    assert_int_equal(sl_can_e2e_crc(SL_CAN_DATA_ID_POLE_LEAN, d), sl_can_crc8_j1850(seq, 8));
+    // Byte 0 (the CRC slot) is not part of the CRC.
+    const uint8_t c = sl_can_e2e_crc(SL_CAN_DATA_ID_POLE_LEAN, d);
+    d[0] = 0x00;
+    assert_int_equal(sl_can_e2e_crc(SL_CAN_DATA_ID_POLE_LEAN, d), c);
+    // Every other Data ID gives another CRC for the same bytes (the CRC is a bijection of
+    // its first byte for fixed following bytes).
+    for (unsigned id = 0; id < 256U; id++) {
+        if (id != SL_CAN_DATA_ID_POLE_LEAN) {
+            assert_int_not_equal(sl_can_e2e_crc((uint8_t)id, d), c);
+        }
+    }
+}
+
+static void test_canmsg_crc_worked_example(void **state)
+{
+    (void)state;
+    // The example of the sl_can.h header comment.
+    sl_can_tx_t tx;
+    tx_setup(&tx);
+    sl_can_status_t st = {.link_state = SL_CAN_LINK_STREAMING, .rotations = 2};
+    sl_can_frame_t f;
+    assert_int_equal(sl_can_encode_status(&tx, &st, &f), SL_OK);
+    const uint8_t want[8] = {0x95, 0x30, 0x02, 0x00, 0x00, 0x00, 0x00, 0x00};
+    assert_memory_equal(f.data, want, 8);
+    assert_int_equal(f.id, ID_STATUS);
+    assert_int_equal(f.dlc, 8);
+    assert_int_equal(f.flags, 0);
+}
+
+static void test_canmsg_pole_lean_golden_bytes(void **state)
+{
+    (void)state;
+    // Bytes computed independently (by hand from the layout table of sl_can.h):
+    // Quality 4 @12, Clamped 0, TargetId 9 @16, Azimuth 123.4 deg = raw 617 @20,
+    // Lean -12.3 deg = raw -123 (10-bit 0x385) @31, LeanSigma 1.4 deg = raw 7 @41,
+    // RangeInner 2.46 m = raw 123 @46, RangeOuter 3.00 m = raw 150 @55, Counter 0.
+    sl_can_tx_t tx;
+    tx_setup(&tx);
+    const sl_can_pole_lean_t in = {.target_id = 9, .quality = SL_CAN_QUALITY_FILTERED,
+                                   .azimuth_cdeg = 12340, .range_inner_mm = 2460,
+                                   .range_outer_mm = 3000, .lean_cdeg = -1230,
+                                   .lean_sigma_cdeg = 140};
+    sl_can_frame_t f;
+    assert_int_equal(sl_can_encode_pole_lean(&tx, &in, &f), SL_OK);
+    // value = 4<<12 | 9<<16 | 617<<20 | 0x385<<31 | 7<<41 | 123<<46 | 150<<55
+    const uint64_t v = (4ull << 12) | (9ull << 16) | (617ull << 20) | (0x385ull << 31) |
+                       (7ull << 41) | (123ull << 46) | (150ull << 55);
+    uint8_t want[8];
+    for (unsigned i = 0; i < 8; i++) {
+        want[i] = (uint8_t)(v >> (8 * i));
+    }
+    want[0] = sl_can_e2e_crc(SL_CAN_DATA_ID_POLE_LEAN, want);
+    assert_memory_equal(f.data, want, 8);
+}
+
+static void test_canmsg_layout_table_is_consistent(void **state)
+{
+    (void)state;
+    for (unsigned m = 0; m < SL_CAN_MSG_COUNT; m++) {
+        const sl_can_message_desc_t *md = sl_can_layout((sl_can_msg_t)m);
+        assert_non_null(md);
+        uint64_t used = 0;
+        assert_string_equal(md->signals[0].name, "Crc");
+        assert_int_equal(md->signals[0].start, 0);
+        assert_int_equal(md->signals[0].length, 8);
+        assert_string_equal(md->signals[1].name, "Counter");
+        assert_int_equal(md->signals[1].start, 8);
+        assert_int_equal(md->signals[1].length, 4);
+        for (unsigned i = 0; i < md->n_signals; i++) {
+            const sl_can_signal_desc_t *s = &md->signals[i];
+            assert_true(s->length >= 1 && s->start + s->length <= 64);
+            const uint64_t mask = ((s->length == 64) ? ~0ull : ((1ull << s->length) - 1U))
+                                  << s->start;
+            assert_int_equal(used & mask, 0); // no overlap
+            used |= mask;
+            // raw limits fit the field
+            if (s->is_signed) {
+                assert_true(s->raw_min >= -(1 << (s->length - 1)));
+                assert_true(s->raw_max <= (1 << (s->length - 1)) - 1);
+            } else {
+                assert_true(s->raw_min >= 0);
+                assert_true((uint64_t)s->raw_max <= (1ull << s->length) - 1U);
+            }
+            assert_true(s->factor_num > 0 && s->factor_den > 0);
+            for (unsigned k = 0; k < s->n_values; k++) {
+                assert_true((int64_t)s->values[k].value <= s->raw_max);
+            }
+        }
+    }
+    assert_null(sl_can_layout(SL_CAN_MSG_COUNT));
+    // The DBC factors (physical per LSB) are the documented ones.
+    struct {
+        sl_can_msg_t m;
+        const char *sig;
+        int32_t num, den; // expected factor num/den, compared as fractions
+    } want[] = {
+        {SL_CAN_MSG_POLE_LEAN, "Azimuth", 1, 5},      {SL_CAN_MSG_POLE_LEAN, "Lean", 1, 10},
+        {SL_CAN_MSG_POLE_LEAN, "LeanSigma", 1, 5},    {SL_CAN_MSG_POLE_LEAN, "RangeInner", 1, 50},
+        {SL_CAN_MSG_POLE_LEAN, "RangeOuter", 1, 50},  {SL_CAN_MSG_LEAN_WARNING, "Azimuth", 1, 10},
+        {SL_CAN_MSG_LEAN_WARNING, "Lean", 1, 20},     {SL_CAN_MSG_LEAN_WARNING, "Range", 1, 100},
+        {SL_CAN_MSG_LEAN_WARNING, "LeanSigma", 1, 10}, {SL_CAN_MSG_VEHICLE_MOTION, "Speed", 1, 100},
+        {SL_CAN_MSG_VEHICLE_MOTION, "YawRate", 1, 100},
+    };
+    for (size_t k = 0; k < sizeof want / sizeof want[0]; k++) {
+        const sl_can_message_desc_t *md = sl_can_layout(want[k].m);
+        bool found = false;
+        for (unsigned i = 0; i < md->n_signals; i++) {
+            const sl_can_signal_desc_t *s = &md->signals[i];
+            if (strcmp(s->name, want[k].sig) == 0) {
+                assert_int_equal(s->factor_num * want[k].den, s->factor_den * want[k].num);
+                found = true;
+            }
+        }
+        assert_true(found);
+    }
+}
+
+static void test_canmsg_pole_lean_round_trips_every_raw_value(void **state)
+{
+    (void)state;
+    sl_can_tx_t tx;
+    tx_setup(&tx);
+    sl_can_frame_t f;
+    sl_can_pole_lean_t out;
+    // Each signal exhaustively over its raw range (others random in range).
+    for (int32_t raw = -600; raw <= 2100; raw++) {
+        sl_can_pole_lean_t in = {
+            .target_id = (uint8_t)((raw + 600) % 16),
+            .quality = (uint8_t)((raw + 600) % 5),
+            .azimuth_cdeg = (int32_t)(clamp64(raw, 0, SL_CAN_POLE_AZIMUTH_RAW_MAX) * 20),
+            .lean_cdeg = (int32_t)(clamp64(raw, -512, 511) * 10),
+            .lean_sigma_cdeg = (uint32_t)(clamp64(raw, 0, 31) * 20),
+            .range_inner_mm = (uint32_t)(clamp64(raw, 0, 511) * 20),
+            .range_outer_mm = (uint32_t)(clamp64(2100 - raw, 0, 511) * 20),
+        };
+        assert_int_equal(sl_can_encode_pole_lean(&tx, &in, &f), SL_OK);
+        assert_int_equal(sl_can_decode_pole_lean(&f, &out), SL_OK);
+        assert_int_equal(out.target_id, in.target_id);
+        assert_int_equal(out.quality, in.quality);
+        assert_int_equal(out.azimuth_cdeg, in.azimuth_cdeg);
+        assert_int_equal(out.lean_cdeg, in.lean_cdeg);
+        assert_int_equal(out.lean_sigma_cdeg, in.lean_sigma_cdeg);
+        assert_int_equal(out.range_inner_mm, in.range_inner_mm);
+        assert_int_equal(out.range_outer_mm, in.range_outer_mm);
+        assert_false(out.clamped);
+    }
+    assert_int_equal(tx.stats.clamped_frames, 0);
+}
+
+static void test_canmsg_pole_lean_random_values_within_half_lsb(void **state)
+{
+    (void)state;
+    sl_can_tx_t tx;
+    tx_setup(&tx);
+    sl_can_frame_t f;
+    sl_can_pole_lean_t out;
+    for (int i = 0; i < 200000; i++) {
+        sl_can_pole_lean_t in = {
+            .target_id = (uint8_t)rnd_range(0, 15),
+            .quality = (uint8_t)rnd_range(0, 4),
+            .azimuth_cdeg = (int32_t)rnd_range(-100000, 100000),
+            .lean_cdeg = (int32_t)rnd_range(-5125, 5114),
+            .lean_sigma_cdeg = (uint32_t)rnd_range(0, 629),
+            .range_inner_mm = (uint32_t)rnd_range(0, 10229),
+            .range_outer_mm = (uint32_t)rnd_range(0, 10229),
+        };
+        assert_int_equal(sl_can_encode_pole_lean(&tx, &in, &f), SL_OK);
+        assert_int_equal(sl_can_decode_pole_lean(&f, &out), SL_OK);
+        assert_false(out.clamped);
+        assert_int_equal(out.lean_cdeg, ref_round(in.lean_cdeg, 10) * 10);
+        assert_true(out.lean_cdeg - in.lean_cdeg <= 5 && in.lean_cdeg - out.lean_cdeg <= 5);
+        assert_int_equal(out.lean_sigma_cdeg, ref_round(in.lean_sigma_cdeg, 20) * 20);
+        assert_int_equal(out.range_inner_mm, ref_round(in.range_inner_mm, 20) * 20);
+        assert_int_equal(out.range_outer_mm, ref_round(in.range_outer_mm, 20) * 20);
+        int64_t az = in.azimuth_cdeg % 36000;
+        az += (az < 0) ? 36000 : 0;
+        assert_int_equal(out.azimuth_cdeg, (ref_round(az, 20) % 1800) * 20);
+    }
+}
+
+static void test_canmsg_clamps_and_flags_out_of_range_values(void **state)
+{
+    (void)state;
+    sl_can_tx_t tx;
+    tx_setup(&tx);
+    sl_can_frame_t f;
+    sl_can_pole_lean_t out;
+    struct {
+        int32_t lean;
+        uint32_t sigma, r1, r2;
+        uint8_t id, quality;
+        int32_t want_lean;
+        uint32_t want_sigma, want_r1, want_r2;
+        uint8_t want_id, want_q;
+        bool clamped;
+    } cases[] = {
+        // lean: 51.14 rounds to 51.1 (in range); 51.15 rounds to 51.2: clamped to 51.1
+        {5114, 0, 0, 0, 0, 0, 5110, 0, 0, 0, 0, 0, false},
+        {5115, 0, 0, 0, 0, 0, 5110, 0, 0, 0, 0, 0, true},
+        {9000, 0, 0, 0, 0, 0, 5110, 0, 0, 0, 0, 0, true},
+        {INT32_MAX, 0, 0, 0, 0, 0, 5110, 0, 0, 0, 0, 0, true},
+        // -51.25 rounds half up to -51.2 (in range); -51.26 -> -51.3: clamped to -51.2
+        {-5125, 0, 0, 0, 0, 0, -5120, 0, 0, 0, 0, 0, false},
+        {-5126, 0, 0, 0, 0, 0, -5120, 0, 0, 0, 0, 0, true},
+        {INT32_MIN, 0, 0, 0, 0, 0, -5120, 0, 0, 0, 0, 0, true},
+        // sigma max 6.2 deg
+        {0, 629, 0, 0, 0, 0, 0, 620, 0, 0, 0, 0, false},
+        {0, 630, 0, 0, 0, 0, 0, 620, 0, 0, 0, 0, true},
+        {0, UINT32_MAX, 0, 0, 0, 0, 0, 620, 0, 0, 0, 0, true},
+        // ranges max 10.22 m
+        {0, 0, 10229, 10229, 0, 0, 0, 0, 10220, 10220, 0, 0, false},
+        {0, 0, 10230, 5, 0, 0, 0, 0, 10220, 0, 0, 0, true},
+        {0, 0, 5, UINT32_MAX, 0, 0, 0, 0, 0, 10220, 0, 0, true},
+        // ids and enums
+        {0, 0, 0, 0, 15, 4, 0, 0, 0, 0, 15, 4, false},
+        {0, 0, 0, 0, 16, 0, 0, 0, 0, 0, 15, 0, true},
+        {0, 0, 0, 0, 255, 5, 0, 0, 0, 0, 15, SL_CAN_QUALITY_INVALID, true},
+        {0, 0, 0, 0, 1, 200, 0, 0, 0, 0, 1, SL_CAN_QUALITY_INVALID, true},
+    };
+    uint32_t want_clamped = 0;
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        sl_can_pole_lean_t in = {.target_id = cases[i].id, .quality = cases[i].quality,
+                                 .lean_cdeg = cases[i].lean, .lean_sigma_cdeg = cases[i].sigma,
+                                 .range_inner_mm = cases[i].r1, .range_outer_mm = cases[i].r2};
+        assert_int_equal(sl_can_encode_pole_lean(&tx, &in, &f), SL_OK);
+        assert_int_equal(sl_can_decode_pole_lean(&f, &out), SL_OK);
+        assert_int_equal(out.lean_cdeg, cases[i].want_lean);
+        assert_int_equal(out.lean_sigma_cdeg, cases[i].want_sigma);
+        assert_int_equal(out.range_inner_mm, cases[i].want_r1);
+        assert_int_equal(out.range_outer_mm, cases[i].want_r2);
+        assert_int_equal(out.target_id, cases[i].want_id);
+        assert_int_equal(out.quality, cases[i].want_q);
+        assert_int_equal(out.clamped, cases[i].clamped);
+        want_clamped += cases[i].clamped ? 1U : 0U;
+    }
+    assert_int_equal(tx.stats.clamped_frames, want_clamped);
+}
+
+static void test_canmsg_azimuth_wraps_modulo_a_turn_not_clamped(void **state)
+{
+    (void)state;
+    sl_can_tx_t tx;
+    tx_setup(&tx);
+    sl_can_frame_t f;
+    sl_can_pole_lean_t out;
+    const int32_t in_az[] = {0, 36000, -20, 35990, 35989, 72010, -36000, INT32_MIN, INT32_MAX};
+    for (size_t i = 0; i < sizeof in_az / sizeof in_az[0]; i++) {
+        sl_can_pole_lean_t in = {.azimuth_cdeg = in_az[i]};
+        assert_int_equal(sl_can_encode_pole_lean(&tx, &in, &f), SL_OK);
+        assert_int_equal(sl_can_decode_pole_lean(&f, &out), SL_OK);
+        int64_t a = (int64_t)in_az[i] % 36000;
+        a += (a < 0) ? 36000 : 0;
+        const int64_t want = (ref_round(a, 20) % 1800) * 20;
+        assert_int_equal(out.azimuth_cdeg, want);
+        assert_false(out.clamped);
+    }
+    sl_can_pole_lean_t in = {.azimuth_cdeg = 35990}; // 359.9 deg -> 360.0 -> 0
+    sl_can_encode_pole_lean(&tx, &in, &f);
+    sl_can_decode_pole_lean(&f, &out);
+    assert_int_equal(out.azimuth_cdeg, 0);
+}
+
+static void test_canmsg_lean_warning_round_trips_and_clamps(void **state)
+{
+    (void)state;
+    sl_can_tx_t tx;
+    tx_setup(&tx);
+    sl_can_frame_t f;
+    sl_can_lean_warning_t out;
+    for (int32_t raw = -2048; raw <= 4095; raw++) {
+        sl_can_lean_warning_t in = {
+            .level = (uint8_t)((raw + 2048) % 3), .has_target = true,
+            .target_id = (uint8_t)((raw + 2048) % 16), .quality = (uint8_t)((raw + 2048) % 5),
+            .azimuth_cdeg = (int32_t)(clamp64(raw, 0, 3599) * 10),
+            .lean_cdeg = (int32_t)(clamp64(raw, -2048, 2047) * 5),
+            .range_mm = (uint32_t)(clamp64(raw, 0, 2047) * 10),
+            .lean_sigma_cdeg = (uint32_t)(clamp64(raw, 0, 63) * 10),
+        };
+        assert_int_equal(sl_can_encode_lean_warning(&tx, &in, &f), SL_OK);
+        assert_int_equal(f.id, ID_WARN);
+        assert_int_equal(sl_can_decode_lean_warning(&f, &out), SL_OK);
+        assert_int_equal(out.level, in.level);
+        assert_true(out.has_target);
+        assert_int_equal(out.target_id, in.target_id);
+        assert_int_equal(out.quality, in.quality);
+        assert_int_equal(out.azimuth_cdeg, in.azimuth_cdeg);
+        assert_int_equal(out.lean_cdeg, in.lean_cdeg);
+        assert_int_equal(out.range_mm, in.range_mm);
+        assert_int_equal(out.lean_sigma_cdeg, in.lean_sigma_cdeg);
+        assert_false(out.clamped);
+    }
+    // Out of range: lean 150 deg, level 7 (-> DANGER, never under-reported), range 30 m.
+    sl_can_lean_warning_t in = {.level = 7, .has_target = true, .lean_cdeg = 15000,
+                                .range_mm = 30000, .lean_sigma_cdeg = 100};
+    sl_can_encode_lean_warning(&tx, &in, &f);
+    assert_int_equal(sl_can_decode_lean_warning(&f, &out), SL_OK);
+    assert_int_equal(out.level, SL_CAN_LEVEL_DANGER);
+    assert_int_equal(out.lean_cdeg, 2047 * 5);
+    assert_int_equal(out.range_mm, 20470);
+    assert_true(out.clamped);
+    // No target: every target field is zero whatever the input says.
+    sl_can_lean_warning_t none = {.level = SL_CAN_LEVEL_NONE, .has_target = false,
+                                  .target_id = 3, .lean_cdeg = 999, .range_mm = 77};
+    sl_can_encode_lean_warning(&tx, &none, &f);
+    assert_int_equal(sl_can_decode_lean_warning(&f, &out), SL_OK);
+    assert_false(out.has_target);
+    assert_int_equal(out.target_id, 0);
+    assert_int_equal(out.lean_cdeg, 0);
+    assert_int_equal(out.range_mm, 0);
+    assert_int_equal(f.data[2] | f.data[3] | f.data[4] | f.data[5] | f.data[6] | f.data[7], 0);
+}
+
+static void test_canmsg_status_counters_saturate_and_flag(void **state)
+{
+    (void)state;
+    sl_can_tx_t tx;
+    tx_setup(&tx);
+    sl_can_frame_t f;
+    sl_can_status_t out;
+    for (int i = 0; i < 50000; i++) {
+        sl_can_status_t in = {.link_state = (uint8_t)rnd_range(0, 4),
+                              .rotations = (uint32_t)rnd_range(0, 262143),
+                              .azimuths_missing = (uint32_t)rnd_range(0, 16383),
+                              .decoder_resyncs = (uint32_t)rnd_range(0, 255),
+                              .can_dropped = (uint32_t)rnd_range(0, 255)};
+        sl_can_encode_status(&tx, &in, &f);
+        assert_int_equal(sl_can_decode_status(&f, &out), SL_OK);
+        assert_int_equal(out.link_state, in.link_state);
+        assert_int_equal(out.rotations, in.rotations);
+        assert_int_equal(out.azimuths_missing, in.azimuths_missing);
+        assert_int_equal(out.decoder_resyncs, in.decoder_resyncs);
+        assert_int_equal(out.can_dropped, in.can_dropped);
+        assert_false(out.saturated);
+    }
+    const sl_can_status_t big = {.link_state = SL_CAN_LINK_SILENT, .rotations = 262144,
+                                 .azimuths_missing = UINT32_MAX, .decoder_resyncs = 256,
+                                 .can_dropped = 1000};
+    sl_can_encode_status(&tx, &big, &f);
+    assert_int_equal(sl_can_decode_status(&f, &out), SL_OK);
+    assert_true(out.saturated);
+    assert_int_equal(out.rotations, 262143);
+    assert_int_equal(out.azimuths_missing, 16383);
+    assert_int_equal(out.decoder_resyncs, 255);
+    assert_int_equal(out.can_dropped, 255);
+    assert_int_equal(out.link_state, SL_CAN_LINK_SILENT);
+    const sl_can_status_t bad_link = {.link_state = 9};
+    sl_can_encode_status(&tx, &bad_link, &f);
+    sl_can_decode_status(&f, &out);
+    assert_int_equal(out.link_state, SL_CAN_LINK_DISCONNECTED);
+    assert_true(out.saturated);
+    assert_int_equal(tx.stats.clamped_frames, 2);
+}
+
+static void test_canmsg_vehicle_motion_round_trips_full_range(void **state)
+{
+    (void)state;
+    sl_can_tx_t tx;
+    tx_setup(&tx);
+    sl_can_frame_t f;
+    sl_can_vehicle_motion_t out;
+    for (int32_t raw = -32768; raw <= 32767; raw++) {
+        sl_can_vehicle_motion_t in = {.speed_mm_s = raw * 10, .yaw_rate_cdeg_s = -1 - raw,
+                                      .speed_valid = (raw & 1) != 0,
+                                      .yaw_rate_valid = (raw & 2) != 0};
+        assert_int_equal(sl_can_encode_vehicle_motion(&tx, &in, &f), SL_OK);
+        assert_int_equal(f.id, ID_MOTION);
+        assert_int_equal(sl_can_decode_vehicle_motion(&f, &out), SL_OK);
+        assert_int_equal(out.speed_mm_s, in.speed_mm_s);
+        assert_int_equal(out.yaw_rate_cdeg_s, in.yaw_rate_cdeg_s);
+        assert_int_equal(out.speed_valid, in.speed_valid);
+        assert_int_equal(out.yaw_rate_valid, in.yaw_rate_valid);
+    }
+    assert_int_equal(tx.stats.clamped_frames, 0);
+    const sl_can_vehicle_motion_t fast = {.speed_mm_s = 400000, .yaw_rate_cdeg_s = -40000};
+    sl_can_encode_vehicle_motion(&tx, &fast, &f);
+    sl_can_decode_vehicle_motion(&f, &out);
+    assert_int_equal(out.speed_mm_s, 327670);
+    assert_int_equal(out.yaw_rate_cdeg_s, -32768);
+    assert_int_equal(tx.stats.clamped_frames, 1);
+    // 1.235 m/s = 123.5 LSB rounds half up to 124 -> 1240 mm/s; -1.235 -> -123.5 -> -123
+    const sl_can_vehicle_motion_t half = {.speed_mm_s = 1235};
+    sl_can_encode_vehicle_motion(&tx, &half, &f);
+    sl_can_decode_vehicle_motion(&f, &out);
+    assert_int_equal(out.speed_mm_s, 1240);
+    const sl_can_vehicle_motion_t nhalf = {.speed_mm_s = -1235};
+    sl_can_encode_vehicle_motion(&tx, &nhalf, &f);
+    sl_can_decode_vehicle_motion(&f, &out);
+    assert_int_equal(out.speed_mm_s, -1230);
+}
+
+static void test_canmsg_counter_wraps_modulo_15_per_message(void **state)
+{
+    (void)state;
+    sl_can_tx_t tx;
+    tx_setup(&tx);
+    sl_can_frame_t f;
+    const sl_can_pole_lean_t p = {0};
+    const sl_can_status_t s = {0};
+    for (unsigned i = 0; i < 100U; i++) {
+        sl_can_encode_pole_lean(&tx, &p, &f);
+        assert_int_equal(f.data[1] & 0x0F, i % 15U);
+        assert_int_not_equal(f.data[1] & 0x0F, 15);
+        if (i % 3U == 0U) { // another message type keeps its own counter
+            sl_can_encode_status(&tx, &s, &f);
+            assert_int_equal(f.data[1] & 0x0F, (i / 3U) % 15U);
+        }
+    }
+    assert_int_equal(tx.stats.frames, 100 + 34);
+}
+
+static void test_canmsg_e2e_detects_every_single_bit_error(void **state)
+{
+    (void)state;
+    sl_can_tx_t tx;
+    tx_setup(&tx);
+    sl_can_frame_t f;
+    const sl_can_pole_lean_t p = {.target_id = 3, .lean_cdeg = 456, .range_inner_mm = 3000,
+                                  .range_outer_mm = 3300, .azimuth_cdeg = 9000};
+    sl_can_encode_pole_lean(&tx, &p, &f);
+    sl_can_e2e_rx_t rx;
+    sl_can_e2e_rx_init(&rx);
+    for (unsigned bit = 0; bit < 64U; bit++) {
+        sl_can_frame_t g = f;
+        g.data[bit / 8U] ^= (uint8_t)(1U << (bit % 8U));
+        assert_int_equal(sl_can_e2e_check(&rx, SL_CAN_DATA_ID_POLE_LEAN, &g), SL_ERR_MALFORMED);
+        sl_can_pole_lean_t out;
+        assert_int_equal(sl_can_decode_pole_lean(&g, &out), SL_ERR_MALFORMED);
+    }
+    assert_int_equal(rx.stats.crc_errors, 64);
+    assert_int_equal(rx.stats.accepted, 0);
+    // The right frame under another Data ID (e.g. received on the Status id) is rejected.
+    assert_int_equal(sl_can_e2e_check(&rx, SL_CAN_DATA_ID_STATUS, &f), SL_ERR_MALFORMED);
+    sl_can_status_t st;
+    assert_int_equal(sl_can_decode_status(&f, &st), SL_ERR_MALFORMED);
+    assert_int_equal(sl_can_e2e_check(&rx, SL_CAN_DATA_ID_POLE_LEAN, &f), SL_OK);
+    // Wrong DLC, RTR and error frames.
+    sl_can_frame_t g = f;
+    g.dlc = 7;
+    assert_int_equal(sl_can_e2e_check(&rx, SL_CAN_DATA_ID_POLE_LEAN, &g), SL_ERR_MALFORMED);
+    g = f;
+    g.flags = SL_CAN_FLAG_RTR;
+    assert_int_equal(sl_can_e2e_check(&rx, SL_CAN_DATA_ID_POLE_LEAN, &g), SL_ERR_MALFORMED);
+    assert_int_equal(rx.stats.bad_dlc, 2);
+    // Counter 15 with a correct CRC.
+    g = f;
+    g.data[1] = (uint8_t)((g.data[1] & 0xF0U) | 0x0FU);
+    g.data[0] = sl_can_e2e_crc(SL_CAN_DATA_ID_POLE_LEAN, g.data);
+    assert_int_equal(sl_can_e2e_check(&rx, SL_CAN_DATA_ID_POLE_LEAN, &g), SL_ERR_MALFORMED);
+    assert_int_equal(rx.stats.bad_counter, 1);
+}
+
+static void test_canmsg_e2e_counts_jumps_and_rejects_repeats(void **state)
+{
+    (void)state;
+    sl_can_tx_t tx;
+    tx_setup(&tx);
+    sl_can_e2e_rx_t rx;
+    sl_can_e2e_rx_init(&rx);
+    sl_can_frame_t fr[40];
+    const sl_can_status_t s = {.link_state = SL_CAN_LINK_STREAMING};
+    for (unsigned i = 0; i < 40U; i++) {
+        sl_can_encode_status(&tx, &s, &fr[i]);
+    }
+    assert_int_equal(sl_can_e2e_check(&rx, SL_CAN_DATA_ID_STATUS, &fr[0]), SL_OK);
+    assert_int_equal(sl_can_e2e_check(&rx, SL_CAN_DATA_ID_STATUS, &fr[1]), SL_OK);
+    assert_int_equal(sl_can_e2e_check(&rx, SL_CAN_DATA_ID_STATUS, &fr[1]), SL_ERR_STATE);
+    assert_int_equal(rx.stats.repeated, 1);
+    // Lose 3 frames (2, 3, 4), across no wrap.
+    assert_int_equal(sl_can_e2e_check(&rx, SL_CAN_DATA_ID_STATUS, &fr[5]), SL_OK);
+    assert_int_equal(rx.stats.counter_jumps, 1);
+    assert_int_equal(rx.stats.lost_frames, 3);
+    // In sequence across the 14 -> 0 wrap.
+    for (unsigned i = 6; i < 20U; i++) {
+        assert_int_equal(sl_can_e2e_check(&rx, SL_CAN_DATA_ID_STATUS, &fr[i]), SL_OK);
+    }
+    assert_int_equal(rx.stats.counter_jumps, 1);
+    // Lose 7 frames (20..26), then 5 across the 14 -> 0 wrap (28..32).
+    assert_int_equal(sl_can_e2e_check(&rx, SL_CAN_DATA_ID_STATUS, &fr[27]), SL_OK);
+    assert_int_equal(sl_can_e2e_check(&rx, SL_CAN_DATA_ID_STATUS, &fr[33]), SL_OK);
+    assert_int_equal(rx.stats.counter_jumps, 3);
+    assert_int_equal(rx.stats.lost_frames, 3 + 7 + 5);
+    // After a reset the next frame is accepted whatever its counter (even a repeat).
+    sl_can_e2e_rx_reset(&rx);
+    assert_int_equal(sl_can_e2e_check(&rx, SL_CAN_DATA_ID_STATUS, &fr[33]), SL_OK);
+    assert_int_equal(rx.stats.accepted, 2 + 1 + 14 + 2 + 1);
+}
+
+static void test_canmsg_tx_init_validates_ids(void **state)
+{
+    (void)state;
+    sl_can_tx_t tx;
+    sl_can_ids_t bad = {{0x800U, 1U, 2U, 3U}};
+    assert_int_equal(sl_can_tx_init(&tx, &bad), SL_ERR_ARG);
+    sl_can_ids_t dup = {{5U, 6U, 5U, 7U}};
+    assert_int_equal(sl_can_tx_init(&tx, &dup), SL_ERR_ARG);
+    sl_can_ids_t eff_bad = {{0x80000000UL | 0x20000000UL, 1U, 2U, 3U}};
+    assert_int_equal(sl_can_tx_init(&tx, &eff_bad), SL_ERR_ARG);
+    sl_can_ids_t eff = {{0x80000000UL | 0x18FF1234UL, 0x7FFU, 0U, 0x123U}};
+    assert_int_equal(sl_can_tx_init(&tx, &eff), SL_OK);
+    assert_int_equal(sl_can_tx_init(NULL, &eff), SL_ERR_ARG);
+    sl_can_frame_t f;
+    const sl_can_pole_lean_t p = {0};
+    sl_can_encode_pole_lean(&tx, &p, &f);
+    assert_int_equal(f.id, 0x18FF1234UL);
+    assert_int_equal(f.flags, SL_CAN_FLAG_EFF);
+    const sl_can_status_t s = {0};
+    sl_can_encode_status(&tx, &s, &f);
+    assert_int_equal(f.id, 0);
+    assert_int_equal(f.flags, 0);
+    assert_int_equal(sl_can_encode_status(NULL, &s, &f), SL_ERR_ARG);
+    assert_int_equal(sl_can_decode_status(NULL, NULL), SL_ERR_ARG);
+}
+
+static void test_canmsg_motion_rx_checks_id_sequence_and_age(void **state)
+{
+    (void)state;
+    sl_can_tx_t tx;
+    tx_setup(&tx);
+    sl_can_motion_rx_t rx;
+    sl_can_motion_rx_init(&rx, ID_MOTION, 100000U);
+    sl_can_vehicle_motion_t mv;
+    assert_false(sl_can_motion_rx_get(&rx, 0, &mv));
+    sl_can_frame_t f[10];
+    for (int i = 0; i < 10; i++) {
+        const sl_can_vehicle_motion_t in = {.speed_mm_s = 1000 * i, .yaw_rate_cdeg_s = -50 * i,
+                                            .speed_valid = true, .yaw_rate_valid = true};
+        sl_can_encode_vehicle_motion(&tx, &in, &f[i]);
+    }
+    uint64_t t = 1000000;
+    assert_int_equal(sl_can_motion_rx_feed(&rx, &f[0], t), SL_OK);
+    assert_true(sl_can_motion_rx_get(&rx, t + 100000, &mv));
+    assert_false(sl_can_motion_rx_get(&rx, t + 100001, &mv));
+    // Another id is ignored and counted.
+    sl_can_frame_t other = f[1];
+    other.id = ID_STATUS;
+    assert_int_equal(sl_can_motion_rx_feed(&rx, &other, t), SL_ERR_ARG);
+    assert_int_equal(rx.stats.other_ids, 1);
+    other = f[1];
+    other.flags = SL_CAN_FLAG_EFF; // same number as a 29-bit id is another id
+    assert_int_equal(sl_can_motion_rx_feed(&rx, &other, t), SL_ERR_ARG);
+    // A corrupted frame is rejected and the last good value kept.
+    sl_can_frame_t bad = f[1];
+    bad.data[3] ^= 0x40U;
+    assert_int_equal(sl_can_motion_rx_feed(&rx, &bad, t + 10000), SL_ERR_MALFORMED);
+    assert_int_equal(rx.e2e.stats.crc_errors, 1);
+    assert_true(sl_can_motion_rx_get(&rx, t + 10000, &mv));
+    assert_int_equal(mv.speed_mm_s, 0);
+    // Frames 1 and 2 lost: a jump of 2.
+    assert_int_equal(sl_can_motion_rx_feed(&rx, &f[3], t + 20000), SL_OK);
+    assert_int_equal(rx.e2e.stats.counter_jumps, 1);
+    assert_int_equal(rx.e2e.stats.lost_frames, 2);
+    assert_true(sl_can_motion_rx_get(&rx, t + 20000, &mv));
+    assert_int_equal(mv.speed_mm_s, 3000);
+    assert_int_equal(mv.yaw_rate_cdeg_s, -150);
+    assert_true(mv.speed_valid && mv.yaw_rate_valid);
+    // Repeat rejected.
+    assert_int_equal(sl_can_motion_rx_feed(&rx, &f[3], t + 30000), SL_ERR_STATE);
+    // After a gap longer than the timeout, the sequence restarts: no jump counted.
+    assert_int_equal(sl_can_motion_rx_feed(&rx, &f[9], t + 500000), SL_OK);
+    assert_int_equal(rx.stats.timeouts, 1);
+    assert_int_equal(rx.e2e.stats.counter_jumps, 1);
+    assert_true(sl_can_motion_rx_get(&rx, t + 500000, &mv));
+    assert_int_equal(mv.speed_mm_s, 9000);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_canmsg_crc8_check_value_is_0x4b),
+        cmocka_unit_test(test_canmsg_e2e_crc_mixes_data_id_first),
+        cmocka_unit_test(test_canmsg_crc_worked_example),
+        cmocka_unit_test(test_canmsg_pole_lean_golden_bytes),
+        cmocka_unit_test(test_canmsg_layout_table_is_consistent),
+        cmocka_unit_test(test_canmsg_pole_lean_round_trips_every_raw_value),
+        cmocka_unit_test(test_canmsg_pole_lean_random_values_within_half_lsb),
+        cmocka_unit_test(test_canmsg_clamps_and_flags_out_of_range_values),
+        cmocka_unit_test(test_canmsg_azimuth_wraps_modulo_a_turn_not_clamped),
+        cmocka_unit_test(test_canmsg_lean_warning_round_trips_and_clamps),
+        cmocka_unit_test(test_canmsg_status_counters_saturate_and_flag),
+        cmocka_unit_test(test_canmsg_vehicle_motion_round_trips_full_range),
+        cmocka_unit_test(test_canmsg_counter_wraps_modulo_15_per_message),
+        cmocka_unit_test(test_canmsg_e2e_detects_every_single_bit_error),
+        cmocka_unit_test(test_canmsg_e2e_counts_jumps_and_rejects_repeats),
+        cmocka_unit_test(test_canmsg_tx_init_validates_ids),
+        cmocka_unit_test(test_canmsg_motion_rx_checks_id_sequence_and_age),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

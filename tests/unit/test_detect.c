@@ -1,0 +1,522 @@
+// Unit tests for sl_detect.h: pole extraction on hand-made stable-occupied rows, the
+// rejections, the corrections of MATH.md s.4 and alpha. The board is built here (theta =
+// 26 deg, beta = 0, the paper-sim geometry) with its geometry entry computed with libm.
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <string.h>
+#include <cmocka.h>
+#include <math.h>
+
+#include "shadowlean/sl_detect.h"
+#include "shadowlean/sl_mask.h"
+#include "shadowlean/sl_thresh.h"
+
+#define NAZ 400
+#define NW (SL_ROI_WORDS)
+#define BIN_UM 43800U
+#define H_UM 2580000U
+#define THETA_DEG 26.0
+
+static const double kPi = 3.14159265358979323846;
+
+static sl_incline_geom_t geom[NAZ];
+static uint32_t shadow_um[NAZ];
+static uint16_t shadow_bins[NAZ];
+static int16_t theta_cdeg[NAZ];
+static sl_board_t board;
+static sl_detect_t det;
+static uint32_t rows[NAZ][NW];
+
+static int32_t q30(double v)
+{
+    return (int32_t)llround(v * 1073741824.0);
+}
+
+static uint32_t q28(double v)
+{
+    return (uint32_t)llround(v * 268435456.0);
+}
+
+static void make_board(void)
+{
+    const double t = THETA_DEG * kPi / 180.0, b = 0.0;
+    sl_incline_geom_t g;
+    g.cos_theta_q30 = q30(cos(t));
+    g.sin_theta_q30 = q30(sin(t));
+    g.cos_beta_q30 = q30(cos(b));
+    g.sin_beta_q30 = q30(sin(b));
+    g.cos_tb_q30 = q30(cos(t + b));
+    g.sin_tb_q30 = q30(sin(t + b));
+    g.rho_amb_q28 = q28(1.0 / cos((t + b) / 2.0));
+    g.rho_seam_q28 = q28(1.0 / cos(t + b));
+    g.theta_bam32 = (uint32_t)llround(THETA_DEG / 360.0 * 4294967296.0);
+    g.beta_bam32 = 0U;
+    const double rs_m = 2.58 / tan(t);
+    for (int i = 0; i < NAZ; i++) {
+        geom[i] = g;
+        shadow_um[i] = (uint32_t)llround(rs_m * 1e6);
+        shadow_bins[i] = (uint16_t)(floor(rs_m / 0.0438) - 1.0);
+        theta_cdeg[i] = 2600;
+    }
+    memset(&board, 0, sizeof board);
+    board.name = "test-26";
+    board.radar_height_um = H_UM;
+    board.azimuths = NAZ;
+    board.encoder_size = 5600;
+    board.bin_size_um = BIN_UM;
+    board.range_bins = 3768;
+    board.roi_bins = 512;
+    board.near_exclusion_bins = 39; // 1.7 m
+    board.threshold = 40;
+    board.mask_frames = 16;
+    board.max_targets = 16;
+    board.range_sigma_um = 12640;
+    board.theta_sigma_cdeg = 10;
+    board.caution_lean_cdeg = 500;
+    board.danger_lean_cdeg = 1000;
+    board.track_timeout_us = 2000000;
+    board.geom = geom;
+    board.theta_cdeg = theta_cdeg;
+    board.shadow_um = shadow_um;
+    board.shadow_bins = shadow_bins;
+}
+
+static int setup(void **state)
+{
+    (void)state;
+    make_board();
+    memset(rows, 0, sizeof rows);
+    return 0;
+}
+
+static void set_run(int az, uint32_t first, uint32_t last)
+{
+    for (uint32_t k = first; k <= last; k++) {
+        sl_bits_put(rows[az], k, true);
+    }
+}
+
+static void set_band(uint32_t last_bin)
+{
+    for (int a = 0; a < NAZ; a++) {
+        set_run(a, 0, last_bin);
+    }
+}
+
+static int run_rotation(void)
+{
+    sl_detect_begin(&det);
+    for (int a = 0; a < NAZ; a++) {
+        assert_int_equal(sl_detect_row(&det, (uint16_t)a, rows[a], NW), SL_OK);
+    }
+    return (int)sl_detect_end(&det);
+}
+
+static uint32_t half_bin_um(uint32_t bin)
+{
+    return (uint32_t)(((2ULL * bin + 1U) * BIN_UM + 1U) / 2U);
+}
+
+// Double-precision alpha (beta = 0) from corrected bounds, MATH.md s.2.
+static double alpha_ref_deg(double r1, double r2)
+{
+    const double t = THETA_DEG * kPi / 180.0, rho = r2 / r1;
+    if (rho >= 1.0 / cos(t)) {
+        return atan((rho * cos(t) - 1.0) / (rho * sin(t))) * 180.0 / kPi;
+    }
+    return (acos(1.0 / rho) - t) * 180.0 / kPi;
+}
+
+// A pole leaning alpha_deg towards the radar, crossing radar height at horizontal x0_m:
+// r1 on the horizontal ray (alpha >= 0), r2 on the -theta ray. Returns the bins.
+static void pole_bins(double x0_m, double alpha_deg, uint32_t *first, uint32_t *last,
+                      double *r1_m, double *r2_m)
+{
+    const double t = THETA_DEG * kPi / 180.0, a = alpha_deg * kPi / 180.0;
+    const double s = -x0_m * tan(t) / (cos(a) - sin(a) * tan(t));
+    const double x = x0_m - s * sin(a);
+    *r1_m = x0_m;
+    *r2_m = x / cos(t);
+    *first = (uint32_t)floor(*r1_m / 0.0438);
+    *last = (uint32_t)floor(*r2_m / 0.0438);
+}
+
+static void test_detect_finds_a_slanted_pole_with_corrected_bounds(void **state)
+{
+    (void)state;
+    sl_detect_cfg_t cfg;
+    sl_detect_cfg_default(&cfg);
+    cfg.radius_from_width = false;
+    assert_int_equal(sl_detect_init(&det, &board, &cfg), SL_OK);
+    uint32_t f, l;
+    double r1m, r2m;
+    pole_bins(3.0, 10.0, &f, &l, &r1m, &r2m);
+    assert_int_equal(f, 68);
+    assert_int_equal(l, 83);
+    // Beam-edge azimuths see a shorter run; the strongest is the representative.
+    set_run(100, f + 1, l - 1);
+    set_run(101, f, l);
+    set_run(102, f, l);
+    set_run(103, f + 1, l - 2);
+    assert_int_equal(run_rotation(), 1);
+    const sl_target_t *t = &det.targets[0];
+    assert_int_equal(t->az, 101); // tie 101/102, both as central: lower index
+    assert_int_equal(t->az_first, 100);
+    assert_int_equal(t->az_count, 4);
+    assert_int_equal(t->bin_first, f);
+    assert_int_equal(t->bin_last, l);
+    assert_int_equal(t->r1_raw_um, f * BIN_UM);
+    assert_int_equal(t->r2_raw_um, (l + 1U) * BIN_UM);
+    assert_int_equal(t->r1_um, half_bin_um(f));
+    assert_int_equal(t->r2_um, half_bin_um(l));
+    assert_int_equal(t->radius_um, 0);
+    assert_int_equal(t->incline_flag, SL_INCLINE_VALID);
+    assert_int_equal(t->incline_branch, SL_INCLINE_BRANCH_1);
+    const double want = alpha_ref_deg(t->r1_um, t->r2_um);
+    assert_true(fabs(t->alpha_cdeg / 100.0 - want) < 0.02);
+    assert_true(fabs(t->alpha_cdeg / 100.0 - 10.0) < 1.2); // bin quantisation only
+    assert_true(t->sigma_cdeg > 0);
+    assert_int_equal(det.stats.targets, 1);
+    for (int r = 0; r < SL_DETECT_REJ_COUNT; r++) {
+        assert_int_equal(det.stats.rejected[r], 0);
+    }
+}
+
+static void test_detect_estimates_a_leaning_away_pole_on_branch_two(void **state)
+{
+    (void)state;
+    assert_int_equal(sl_detect_init(&det, &board, NULL), SL_OK);
+    // alpha = -5 deg: r1 = foot of the perpendicular, r2 on the -theta ray.
+    const double t = THETA_DEG * kPi / 180.0, a = -5.0 * kPi / 180.0, p = 3.2;
+    const double r1 = p, r2 = p / cos(a + t);
+    const uint32_t f = (uint32_t)floor(r1 / 0.0438), l = (uint32_t)floor(r2 / 0.0438);
+    set_run(200, f, l);
+    set_run(201, f, l);
+    assert_int_equal(run_rotation(), 1);
+    const sl_target_t *tg = &det.targets[0];
+    assert_int_equal(tg->incline_flag, SL_INCLINE_VALID);
+    assert_int_equal(tg->incline_branch, SL_INCLINE_BRANCH_2);
+    assert_int_equal(tg->radius_um, 0); // 2 azimuths: nothing beyond the beam
+    assert_true((tg->flags & SL_TARGET_RADIUS_WIDTH) != 0U);
+    assert_true(fabs(tg->alpha_cdeg / 100.0 - alpha_ref_deg(tg->r1_um, tg->r2_um)) < 0.02);
+    assert_true(fabs(tg->alpha_cdeg / 100.0 + 5.0) < 1.5);
+}
+
+static void test_detect_never_reports_the_near_field_band(void **state)
+{
+    (void)state;
+    assert_int_equal(sl_detect_init(&det, &board, NULL), SL_OK);
+    set_band(38); // bright band in bins 0..38, all azimuths: ends right below the exclusion
+    set_run(50, 70, 85);
+    set_run(51, 70, 85);
+    assert_int_equal(run_rotation(), 1);
+    assert_int_equal(det.targets[0].az, 50);
+    assert_int_equal(det.stats.rejected[SL_DETECT_REJ_NEAR], 0);
+    // The band leaks past the exclusion on azimuths 10..12: that group is rejected NEAR.
+    set_run(10, 39, 44);
+    set_run(11, 39, 46);
+    set_run(12, 39, 44);
+    // A pole whose run starts right at the exclusion, continuing the band: NEAR too.
+    set_run(300, 39, 60);
+    assert_int_equal(run_rotation(), 1);
+    assert_int_equal(det.targets[0].az, 50);
+    assert_int_equal(det.stats.rejected[SL_DETECT_REJ_NEAR], 2);
+    // A run just past the exclusion with a free bin before it is fine.
+    set_run(150, 40, 60);
+    set_run(151, 40, 60);
+    assert_int_equal(run_rotation(), 2);
+}
+
+static void test_detect_never_reports_ground_outside_the_shadow(void **state)
+{
+    (void)state;
+    assert_int_equal(sl_detect_init(&det, &board, NULL), SL_OK);
+    // Slant range of the shadow edge: sqrt(R^2 + H^2) with R = H / tan(26 deg).
+    const double s_m = 2.58 / sin(THETA_DEG * kPi / 180.0);
+    const uint32_t s_bin = (uint32_t)floor(s_m / 0.0438); // 134
+    assert_int_equal(det.win_bins[0], (uint16_t)ceil(s_m / 0.0438));
+    assert_int_equal(det.edge_bins[0], s_bin);
+    // Ground clutter from the edge outwards on every azimuth.
+    for (int a = 0; a < NAZ; a++) {
+        set_run(a, s_bin, 300);
+    }
+    assert_int_equal(run_rotation(), 0);
+    assert_int_equal(det.stats.rejected[SL_DETECT_REJ_SHADOW], 1); // one group, all around
+    // A pole whose base is outside the shadow: its run joins the ground.
+    set_run(80, 110, 133);
+    set_run(81, 110, 133);
+    assert_int_equal(run_rotation(), 0);
+    assert_int_equal(det.stats.rejected[SL_DETECT_REJ_SHADOW], 2);
+    // Ground clutter that starts beyond the window is not even a run.
+    memset(rows, 0, sizeof rows);
+    for (int a = 0; a < NAZ; a++) {
+        set_run(a, s_bin + 1U, 300);
+    }
+    const uint32_t runs0 = det.stats.runs;
+    assert_int_equal(run_rotation(), 0);
+    assert_int_equal(det.stats.runs, runs0);
+    // A pole ending one bin before the edge bin is inside (ground further than gap_bins).
+    memset(rows, 0, sizeof rows);
+    for (int a = 0; a < NAZ; a++) {
+        set_run(a, s_bin + 3U, 300);
+    }
+    set_run(90, 110, s_bin - 1U);
+    set_run(91, 110, s_bin - 1U);
+    assert_int_equal(run_rotation(), 1);
+    assert_int_equal(det.targets[0].bin_last, s_bin - 1U);
+    assert_true(det.targets[0].r2_um < det.targets[0].shadow_slant_um);
+}
+
+static void test_detect_rejects_wide_and_broken_returns(void **state)
+{
+    (void)state;
+    assert_int_equal(sl_detect_init(&det, &board, NULL), SL_OK);
+    // A car-sized object at 3 m: 20 azimuths (18 deg, ~1 m). Allowed at 3 m for 0.3 m:
+    // floor((0.1 rad + 1.8 deg) / 0.9 deg) + 2 = 10.
+    for (int a = 20; a < 40; a++) {
+        set_run(a, 68, 75);
+    }
+    // Wider than the group storage (SL_CFG_DETECT_MAX_SPAN): WIDE as well.
+    for (int a = 100; a < 100 + SL_CFG_DETECT_MAX_SPAN + 5; a++) {
+        set_run(a, 60, 64);
+    }
+    // A broken run: one free bin inside the run on the representative azimuth.
+    set_run(250, 70, 90);
+    sl_bits_put(rows[250], 80, false);
+    set_run(251, 72, 88);
+    // Gaps wider than gap_bins split runs: two targets on the same azimuths.
+    set_run(320, 60, 66);
+    set_run(320, 70, 80);
+    set_run(321, 60, 66);
+    set_run(321, 70, 80);
+    assert_int_equal(run_rotation(), 2);
+    assert_int_equal(det.stats.rejected[SL_DETECT_REJ_WIDE], 2);
+    assert_int_equal(det.stats.rejected[SL_DETECT_REJ_BROKEN], 1);
+    assert_int_equal(det.stats.span_overflow, 1);
+    assert_int_equal(det.targets[0].az, 320);
+    assert_int_equal(det.targets[1].az, 320);
+    // Ten azimuths at 3 m is still a pole (allowed 10); its width radius is clamped.
+    memset(rows, 0, sizeof rows);
+    for (int a = 20; a < 30; a++) {
+        set_run(a, 68, 75);
+    }
+    assert_int_equal(run_rotation(), 1);
+    assert_int_equal(det.targets[0].az_count, 10);
+    assert_int_equal(det.targets[0].radius_um, 150000);
+    assert_true((det.targets[0].flags & SL_TARGET_RADIUS_CLAMPED) != 0U);
+    // Eight azimuths: R = r1 * tan(w/2), w = 7 * 0.9 - 1.8 = 4.5 deg.
+    memset(rows, 0, sizeof rows);
+    for (int a = 20; a < 28; a++) {
+        set_run(a, 68, 75);
+    }
+    assert_int_equal(run_rotation(), 1);
+    assert_true((det.targets[0].flags & SL_TARGET_RADIUS_WIDTH) != 0U);
+    assert_true((det.targets[0].flags & SL_TARGET_RADIUS_CLAMPED) == 0U);
+    const double r1 = half_bin_um(68) * 1e-6;
+    const double rexp = r1 * tan(4.5 / 2.0 * kPi / 180.0) * 1e6;
+    assert_true(fabs((double)det.targets[0].radius_um - rexp) < rexp * 0.002 + 2.0);
+    assert_int_equal(det.targets[0].r1_um, half_bin_um(68) + det.targets[0].radius_um);
+}
+
+static void test_detect_groups_across_the_azimuth_wrap(void **state)
+{
+    (void)state;
+    assert_int_equal(sl_detect_init(&det, &board, NULL), SL_OK);
+    set_run(398, 70, 80);
+    set_run(399, 69, 82);
+    set_run(0, 69, 82);
+    set_run(1, 71, 80);
+    set_run(200, 60, 70);
+    assert_int_equal(run_rotation(), 2);
+    const sl_target_t *w = det.targets[0].az_count == 4 ? &det.targets[0] : &det.targets[1];
+    assert_int_equal(w->az_count, 4);
+    assert_int_equal(w->az_first, 398);
+    assert_int_equal(w->az, 399);
+    assert_true((w->flags & SL_TARGET_WRAPS) != 0U);
+    assert_int_equal(w->bin_first, 69);
+    assert_int_equal(w->bin_last, 82);
+}
+
+static void test_detect_merges_groups_joined_by_a_later_azimuth(void **state)
+{
+    (void)state;
+    assert_int_equal(sl_detect_init(&det, &board, NULL), SL_OK);
+    // Two runs on azimuth 60 that a long run on 61 joins (a V shape): one group.
+    set_run(60, 60, 65);
+    set_run(60, 75, 80);
+    set_run(61, 60, 80);
+    set_run(62, 62, 78);
+    assert_int_equal(run_rotation(), 1);
+    assert_int_equal(det.targets[0].az, 61);
+    assert_int_equal(det.targets[0].az_first, 60);
+    assert_int_equal(det.targets[0].az_count, 3);
+    assert_int_equal(det.stats.groups, 1);
+}
+
+static void test_detect_handles_empty_saturated_and_misordered_input(void **state)
+{
+    (void)state;
+    assert_int_equal(sl_detect_init(&det, &board, NULL), SL_OK);
+    assert_int_equal(run_rotation(), 0); // empty
+    memset(rows, 0xFF, sizeof rows);     // saturated: one band-connected group, NEAR
+    assert_int_equal(run_rotation(), 0);
+    assert_int_equal(det.stats.rejected[SL_DETECT_REJ_NEAR], 1);
+    memset(rows, 0, sizeof rows);
+    sl_detect_begin(&det);
+    assert_int_equal(sl_detect_row(&det, 5, rows[5], NW), SL_OK);
+    assert_int_equal(sl_detect_row(&det, 5, rows[5], NW), SL_ERR_RANGE);
+    assert_int_equal(sl_detect_row(&det, 4, rows[4], NW), SL_ERR_RANGE);
+    assert_int_equal(sl_detect_row(&det, NAZ, rows[4], NW), SL_ERR_RANGE);
+    assert_int_equal(det.stats.order_errors, 3);
+    assert_int_equal(sl_detect_end(&det), 0);
+    assert_int_equal(sl_detect_row(&det, 6, rows[6], NW), SL_ERR_RANGE); // after end
+    // Too many separate runs on one azimuth (no gap bridging): groups and targets overflow.
+    sl_detect_cfg_t cfg;
+    sl_detect_cfg_default(&cfg);
+    cfg.gap_bins = 0;
+    assert_int_equal(sl_detect_init(&det, &board, &cfg), SL_OK);
+    for (uint32_t k = 40; k <= 132U; k += 2U) {
+        set_run(7, k, k); // 47 one-bin runs
+    }
+    assert_int_equal(run_rotation(), 16);
+    assert_int_equal(det.stats.runs, 47);
+    assert_int_equal(det.stats.cand_overflow, 47 - SL_CFG_DETECT_MAX_CANDIDATES);
+    assert_int_equal(det.stats.target_overflow, SL_CFG_DETECT_MAX_CANDIDATES - 16);
+    assert_int_equal(det.targets[0].incline_flag, SL_INCLINE_INVALID); // r1 == r2
+    // Init rejects boards it cannot use.
+    sl_board_t bad = board;
+    bad.shadow_um = NULL;
+    bad.shadow_bins = NULL;
+    assert_int_equal(sl_detect_init(&det, &bad, NULL), SL_ERR_ARG);
+    bad = board;
+    bad.bin_size_um = 0;
+    assert_int_equal(sl_detect_init(&det, &bad, NULL), SL_ERR_ARG);
+    assert_int_equal(sl_detect_init(NULL, &board, NULL), SL_ERR_ARG);
+}
+
+static void test_detect_correct_half_bin_elongation_and_radius(void **state)
+{
+    (void)state;
+    sl_target_t t;
+    memset(&t, 0, sizeof t);
+    // A point target in one bin: r1 = r2 = the bin centre.
+    sl_detect_correct(&board, NULL, 0, 70, 70, 2, &t);
+    assert_int_equal(t.r1_raw_um, 70U * BIN_UM);
+    assert_int_equal(t.r2_raw_um, 71U * BIN_UM);
+    assert_int_equal(t.r1_um, 70U * BIN_UM + BIN_UM / 2U);
+    assert_int_equal(t.r2_um, t.r1_um);
+    assert_int_equal(t.flags & SL_TARGET_ELONG, 0);
+    // Elongation table of the paper's bench: 1.75:0.806, 2.30:0.806, 2.38:0.741 (m).
+    sl_board_t b = board;
+    b.elong_points = 3;
+    b.elong_range_um[0] = 1750000;
+    b.elong_d_um[0] = 806000;
+    b.elong_range_um[1] = 2300000;
+    b.elong_d_um[1] = 806000;
+    b.elong_range_um[2] = 2380000;
+    b.elong_d_um[2] = 741000;
+    assert_int_equal(sl_detect_elong_um(&b, 1000000), 806000);
+    assert_int_equal(sl_detect_elong_um(&b, 2000000), 806000);
+    assert_int_equal(sl_detect_elong_um(&b, 2340000), 773500);
+    assert_int_equal(sl_detect_elong_um(&b, 2380000), 741000);
+    assert_int_equal(sl_detect_elong_um(&b, 9000000), 741000);
+    assert_int_equal(sl_detect_elong_um(&board, 2000000), 0);
+    sl_detect_correct(&b, NULL, 0, 50, 80, 2, &t); // r2 centre 3.5259 m: d = 0.741 m
+    assert_int_equal(t.elong_um, 741000);
+    assert_int_equal(t.r2_um, half_bin_um(80) - 741000U);
+    assert_int_equal(t.r1_um, half_bin_um(50));
+    assert_true((t.flags & SL_TARGET_ELONG) != 0U);
+    // Board radius 0.1 m: r1 += R; r2 += sqrt(R^2 - L^2), L = r1 tan(0.9 deg).
+    b = board;
+    b.pole_radius_um = 100000;
+    sl_detect_correct(&b, NULL, 0, 60, 80, 3, &t);
+    const double r1 = half_bin_um(60) * 1e-6, L = r1 * tan(0.9 * kPi / 180.0);
+    const double add2 = sqrt(0.1 * 0.1 - L * L);
+    assert_int_equal(t.radius_um, 100000);
+    assert_true((t.flags & SL_TARGET_RADIUS_BOARD) != 0U);
+    assert_int_equal(t.r1_um, half_bin_um(60) + 100000U);
+    assert_true(fabs((double)t.r2_um - (half_bin_um(80) + add2 * 1e6)) < 30.0);
+    // Width estimate clamped.
+    sl_detect_cfg_t cfg;
+    sl_detect_cfg_default(&cfg);
+    cfg.max_radius_um = 20000;
+    sl_detect_correct(&board, &cfg, 0, 60, 80, 12, &t);
+    assert_int_equal(t.radius_um, 20000);
+    assert_true((t.flags & SL_TARGET_RADIUS_CLAMPED) != 0U);
+}
+
+// End to end over threshold + mask + detect: a static scene with a near-field band, a
+// pole, ground beyond the shadow and flickering clutter; the pole appears after n rotations.
+static sl_mask_t mask;
+static void test_detect_from_mask_reports_the_pole_after_n_stable_rotations(void **state)
+{
+    (void)state;
+    assert_int_equal(sl_detect_init(&det, &board, NULL), SL_OK);
+    assert_int_equal(sl_mask_init(&mask, NAZ, 512, 16, 2), SL_OK);
+    static uint8_t power[512];
+    uint32_t bits[NW];
+    uint64_t rng = 12345;
+    uint32_t f, l;
+    double r1m, r2m;
+    pole_bins(3.0, 5.0, &f, &l, &r1m, &r2m);
+    for (int rot = 1; rot <= 20; rot++) {
+        for (int a = 0; a < NAZ; a++) {
+            for (int k = 0; k < 512; k++) {
+                rng ^= rng << 13;
+                rng ^= rng >> 7;
+                rng ^= rng << 17;
+                uint8_t v = (uint8_t)(rng & 31U); // floor below threshold
+                if (k < 36) {
+                    v = 80; // near-field band
+                }
+                if (k >= 134 && (rng >> 20) % 3U == 0U) {
+                    v = 60; // flickering ground clutter beyond the shadow
+                }
+                if (k >= 160 && k < 170) {
+                    v = 90; // a stable wall outside the shadow
+                }
+                if ((a == 120 || a == 121 || a == 122) && k >= (int)f && k <= (int)l) {
+                    v = 100; // the pole
+                }
+                if (a == 300 && k >= 90 && k < 95 && (rng >> 30) % 2U == 0U) {
+                    v = 100; // a flickering object inside the shadow: never stable
+                }
+                power[k] = v;
+            }
+            sl_thresh_u8(power, 512, board.threshold, bits);
+            assert_int_equal(sl_mask_update(&mask, (uint16_t)a, bits, NULL, NULL), SL_OK);
+        }
+        sl_mask_end_rotation(&mask);
+        const sl_ssize_t n = sl_detect_rotation_from_mask(&det, &mask);
+        if (rot < 16) {
+            assert_int_equal(n, 0);
+        } else {
+            assert_int_equal(n, 1);
+            assert_int_equal(det.targets[0].az, 121);
+            assert_int_equal(det.targets[0].bin_first, f);
+            assert_int_equal(det.targets[0].bin_last, l);
+            assert_int_equal(det.targets[0].incline_flag, SL_INCLINE_VALID);
+            assert_true(fabs(det.targets[0].alpha_cdeg / 100.0 - 5.0) < 1.5);
+        }
+    }
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test_setup(test_detect_finds_a_slanted_pole_with_corrected_bounds, setup),
+        cmocka_unit_test_setup(test_detect_estimates_a_leaning_away_pole_on_branch_two, setup),
+        cmocka_unit_test_setup(test_detect_never_reports_the_near_field_band, setup),
+        cmocka_unit_test_setup(test_detect_never_reports_ground_outside_the_shadow, setup),
+        cmocka_unit_test_setup(test_detect_rejects_wide_and_broken_returns, setup),
+        cmocka_unit_test_setup(test_detect_groups_across_the_azimuth_wrap, setup),
+        cmocka_unit_test_setup(test_detect_merges_groups_joined_by_a_later_azimuth, setup),
+        cmocka_unit_test_setup(test_detect_handles_empty_saturated_and_misordered_input, setup),
+        cmocka_unit_test_setup(test_detect_correct_half_bin_elongation_and_radius, setup),
+        cmocka_unit_test_setup(test_detect_from_mask_reports_the_pole_after_n_stable_rotations,
+                               setup),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

@@ -1,0 +1,644 @@
+// Unit tests for sl_scan.h: azimuth index, rotation boundaries, missing / duplicate /
+// out-of-order azimuths, contoured rows, 16-bit reduction, ROI copy, timestamps, double
+// buffering, and the whole chain bytes -> sl_proto -> sl_scan under random chunkings.
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "shadowlean/sl_proto.h"
+#include "shadowlean/sl_scan.h"
+#include "sl_golden.h"
+
+static sl_scan_frame_t g_frames[2];
+
+// ------------------------------------------------------------------------------ recorder
+
+#define MAX_FRAMES 64
+#define MAX_AZ_EVENTS 8192
+
+typedef struct rec {
+    size_t frames;
+    const sl_scan_frame_t *frame_ptr[MAX_FRAMES];
+    uint32_t rotation[MAX_FRAMES];
+    uint8_t end[MAX_FRAMES];
+    sl_scan_frame_stats_t stats[MAX_FRAMES];
+    uint64_t hash[MAX_FRAMES]; // rows + flags + bins + times of the complete frame
+    size_t az;
+    uint16_t az_idx[MAX_AZ_EVENTS];
+    uint64_t az_row_hash[MAX_AZ_EVENTS];
+} rec_t;
+
+static uint64_t frame_hash(const sl_scan_frame_t *f)
+{
+    uint64_t h = SL_GOLDEN_FNV_INIT;
+    for (uint16_t i = 0; i < f->azimuths; i++) {
+        h = sl_golden_fnv1a(f->power[i], f->roi_bins, h);
+        h = sl_golden_fnv1a(&f->flags[i], 1, h);
+        const uint8_t b[10] = {(uint8_t)f->bins[i], (uint8_t)(f->bins[i] >> 8),
+                               (uint8_t)f->t_us[i], (uint8_t)(f->t_us[i] >> 8),
+                               (uint8_t)(f->t_us[i] >> 16), (uint8_t)(f->t_us[i] >> 24),
+                               (uint8_t)(f->t_us[i] >> 32), (uint8_t)(f->t_us[i] >> 40),
+                               (uint8_t)f->ticks[i], (uint8_t)(f->ticks[i] >> 8)};
+        h = sl_golden_fnv1a(b, sizeof b, h);
+    }
+    return h;
+}
+
+static void on_frame(void *ctx, const sl_scan_frame_t *f)
+{
+    rec_t *r = ctx;
+    assert_true(r->frames < MAX_FRAMES);
+    r->frame_ptr[r->frames] = f;
+    r->rotation[r->frames] = f->rotation;
+    r->end[r->frames] = f->end;
+    r->stats[r->frames] = f->stats;
+    r->hash[r->frames] = frame_hash(f);
+    r->frames++;
+}
+
+static void on_azimuth(void *ctx, const sl_scan_frame_t *f, uint16_t idx)
+{
+    rec_t *r = ctx;
+    assert_true(r->az < MAX_AZ_EVENTS);
+    assert_true(idx < f->azimuths);
+    assert_true((f->flags[idx] & SL_SCAN_AZ_VALID) != 0);
+    r->az_idx[r->az] = idx;
+    r->az_row_hash[r->az] = sl_golden_fnv1a(f->power[idx], f->roi_bins, SL_GOLDEN_FNV_INIT);
+    r->az++;
+}
+
+static rec_t g_rec;
+
+static void scan_init(sl_scan_t *s, uint16_t roi, bool double_buffer, uint16_t az, uint16_t enc)
+{
+    memset(&g_rec, 0, sizeof g_rec);
+    sl_scan_cfg_t c = {.roi_bins = roi, .pow16_shift = 8, .azimuths = az, .encoder_size = enc,
+                       .on_azimuth = on_azimuth, .on_frame = on_frame, .ctx = &g_rec};
+    assert_int_equal(sl_scan_init(s, &c, &g_frames[0], double_buffer ? &g_frames[1] : NULL), SL_OK);
+}
+
+// An FFT message built directly (not from bytes); bins from a caller buffer.
+static sl_proto_fft_t fft8(uint16_t ticks, uint16_t sweep, const uint8_t *bins, uint32_t n)
+{
+    sl_proto_fft_t f = {.id = 30, .bytes_per_bin = 1, .data_offset = 14, .sweep_counter = sweep,
+                        .azimuth_ticks = ticks, .seconds = 1000, .split_ns = 0, .bins = n,
+                        .bin_data = bins};
+    return f;
+}
+
+static uint8_t g_bins[8192];
+
+static void fill_bins(uint8_t seed, uint32_t n)
+{
+    for (uint32_t i = 0; i < n; i++) {
+        g_bins[i] = (uint8_t)(seed * 31U + i * 7U + 1U);
+    }
+}
+
+// Feed one azimuth index of a 400 x 5600 radar (ticks 14 * idx), 64 bins of pattern `seed`.
+static void feed_idx(sl_scan_t *s, uint16_t idx, uint16_t sweep, uint8_t seed)
+{
+    fill_bins(seed, 64);
+    sl_proto_fft_t f = fft8((uint16_t)(idx * 14U), sweep, g_bins, 64);
+    assert_int_equal(sl_scan_on_fft(s, &f), SL_OK);
+}
+
+// ---------------------------------------------------------------------------------- tests
+
+static void test_scan_maps_encoder_values_to_the_nearest_azimuth_centre(void **state)
+{
+    (void)state;
+    // Oxford pattern: ticks 13 + 14 i -> index i + 1, the last (5599) wraps to 0.
+    for (uint32_t i = 0; i < 400; i++) {
+        assert_int_equal(sl_scan_az_index(400, 5600, (uint16_t)(13 + 14 * i)), (i + 1) % 400);
+    }
+    // Ties go up: 7 ticks is exactly half-way between azimuths 0 and 1.
+    assert_int_equal(sl_scan_az_index(400, 5600, 6), 0);
+    assert_int_equal(sl_scan_az_index(400, 5600, 7), 1);
+    assert_int_equal(sl_scan_az_index(400, 5600, 0), 0);
+    assert_int_equal(sl_scan_az_index(400, 5600, 5600), -1);
+    assert_int_equal(sl_scan_az_index(0, 5600, 1), -1);
+    assert_int_equal(sl_scan_az_index(400, 0, 0), -1);
+    // Exhaustive against a double reference, including a non-integer tick ratio.
+    static const uint16_t geo[][2] = {{400, 5600}, {360, 5600}, {400, 65535}, {4096, 4096}};
+    for (size_t g = 0; g < 4; g++) {
+        for (uint32_t t = 0; t < geo[g][1]; t++) {
+            const double x = (double)t * geo[g][0] / geo[g][1];
+            const int32_t want = (int32_t)fmod(floor(x + 0.5), geo[g][0]);
+            assert_int_equal(sl_scan_az_index(geo[g][0], geo[g][1], (uint16_t)t), want);
+        }
+    }
+}
+
+static void test_scan_completes_a_frame_when_the_azimuth_index_wraps(void **state)
+{
+    (void)state;
+    sl_scan_t s;
+    scan_init(&s, 64, true, 400, 5600);
+    uint16_t sweep = 0;
+    for (int rot = 0; rot < 2; rot++) {
+        for (uint16_t i = 0; i < 400; i++) {
+            feed_idx(&s, i, sweep++, (uint8_t)i);
+        }
+    }
+    feed_idx(&s, 0, sweep++, 0); // opens rotation 2: completes rotation 1
+    assert_int_equal(g_rec.frames, 2);
+    for (int k = 0; k < 2; k++) {
+        assert_int_equal(g_rec.rotation[k], k);
+        assert_int_equal(g_rec.end[k], SL_SCAN_END_WRAP);
+        assert_int_equal(g_rec.stats[k].valid, 400);
+        assert_int_equal(g_rec.stats[k].missing, 0);
+        assert_int_equal(g_rec.stats[k].duplicates, 0);
+    }
+    assert_int_equal(s.stats.azimuths, 801);
+    assert_int_equal(s.stats.sweep_gaps, 0);
+    assert_int_equal(g_rec.az, 801);
+    for (size_t k = 0; k < 801; k++) {
+        assert_int_equal(g_rec.az_idx[k], k % 400);
+    }
+}
+
+static void test_scan_oxford_rotation_starts_at_the_tick_5599_message(void **state)
+{
+    (void)state;
+    sl_scan_t s;
+    scan_init(&s, 64, true, 400, 5600);
+    uint16_t sweep = 0;
+    for (int rot = 0; rot < 3; rot++) {
+        for (uint16_t i = 0; i < 400; i++) {
+            fill_bins((uint8_t)i, 64);
+            sl_proto_fft_t f = fft8((uint16_t)(13 + 14 * i), sweep++, g_bins, 64);
+            assert_int_equal(sl_scan_on_fft(&s, &f), SL_OK);
+        }
+    }
+    // PNG row i (ticks 13 + 14 i) is index i + 1; row 399 (tick 5599) is index 0 and opens a
+    // new frame. Frame 0 = rows 0..398 of PNG 0 (index 0 missing); frame 1 = row 399 of PNG 0
+    // plus rows 0..398 of PNG 1, complete.
+    assert_int_equal(g_rec.frames, 3);
+    assert_int_equal(g_rec.stats[0].valid, 399);
+    assert_int_equal(g_rec.stats[0].missing, 1);
+    assert_int_equal(g_rec.stats[1].valid, 400);
+    assert_int_equal(g_rec.stats[1].missing, 0);
+    assert_int_equal(g_rec.stats[2].valid, 400);
+    const sl_scan_frame_t *last = sl_scan_last_frame(&s);
+    assert_non_null(last);
+    assert_int_equal(last->ticks[0], 5599);
+    assert_int_equal(last->ticks[1], 13);
+    assert_int_equal(last->power[1][0], (uint8_t)(0 * 31 + 1)); // row 0's pattern at index 1
+}
+
+static void test_scan_counts_and_zero_fills_missing_azimuths(void **state)
+{
+    (void)state;
+    sl_scan_t s;
+    scan_init(&s, 64, false, 400, 5600); // single buffer: rows are reused in place
+    uint16_t sweep = 0;
+    for (uint16_t i = 0; i < 400; i++) {
+        feed_idx(&s, i, sweep++, 0xEE);
+    }
+    for (uint16_t i = 0; i < 400; i++) {
+        if (i == 5 || i == 6 || i == 200) {
+            sweep++;
+            continue;
+        }
+        feed_idx(&s, i, sweep++, 3);
+    }
+    sl_scan_flush(&s);
+    assert_int_equal(g_rec.frames, 2);
+    assert_int_equal(g_rec.end[1], SL_SCAN_END_FLUSH);
+    assert_int_equal(g_rec.stats[1].valid, 397);
+    assert_int_equal(g_rec.stats[1].missing, 3);
+    assert_int_equal(s.stats.missing, 3);
+    assert_int_equal(s.stats.sweep_gaps, 2); // 4->7 and 199->201
+    const sl_scan_frame_t *f = &g_frames[0];
+    static const uint8_t zero[64];
+    assert_int_equal(f->flags[5], 0);
+    assert_int_equal(f->bins[200], 0);
+    assert_int_equal(f->t_us[6], 0);
+    assert_memory_equal(f->power[5], zero, 64); // previous rotation's data is gone
+    assert_memory_equal(f->power[200], zero, 64);
+    assert_int_equal(f->flags[4], SL_SCAN_AZ_VALID);
+    assert_int_equal(f->power[4][0], 3 * 31 + 1);
+}
+
+static void test_scan_drops_duplicates_and_keeps_the_first_row(void **state)
+{
+    (void)state;
+    sl_scan_t s;
+    scan_init(&s, 64, true, 400, 5600);
+    feed_idx(&s, 9, 0, 1);
+    feed_idx(&s, 10, 1, 1);
+    feed_idx(&s, 10, 2, 2); // duplicate of the head, different data
+    feed_idx(&s, 11, 3, 1);
+    feed_idx(&s, 9, 4, 3); // duplicate of an older row (inside the reorder window)
+    sl_scan_flush(&s);
+    assert_int_equal(g_rec.frames, 1);
+    assert_int_equal(g_rec.stats[0].duplicates, 2);
+    assert_int_equal(g_rec.stats[0].valid, 3);
+    assert_int_equal(s.stats.duplicates, 2);
+    const sl_scan_frame_t *f = sl_scan_last_frame(&s);
+    assert_int_equal(f->flags[10], SL_SCAN_AZ_VALID | SL_SCAN_AZ_DUP);
+    assert_int_equal(f->flags[9], SL_SCAN_AZ_VALID | SL_SCAN_AZ_DUP);
+    assert_int_equal(f->power[10][0], 1 * 31 + 1); // the first one
+    assert_int_equal(f->power[9][0], 1 * 31 + 1);
+    assert_int_equal(g_rec.az, 3); // duplicates are not reported as new rows
+}
+
+static void test_scan_stores_late_azimuths_inside_the_reorder_window(void **state)
+{
+    (void)state;
+    sl_scan_t s;
+    scan_init(&s, 64, true, 400, 5600); // window = 400 / 8 = 50
+    uint16_t sweep = 100;
+    for (uint16_t i = 0; i < 400; i++) {
+        if (i == 10) {
+            continue;
+        }
+        feed_idx(&s, i, sweep++, 1);
+        if (i == 12) {
+            feed_idx(&s, 10, 10, 9); // late by 2
+        }
+    }
+    feed_idx(&s, 0, sweep++, 1);
+    feed_idx(&s, 1, sweep++, 1);
+    feed_idx(&s, 399, 7, 9); // late, but its rotation is already complete: dropped
+    feed_idx(&s, 2, sweep++, 1);
+    feed_idx(&s, 300, sweep++, 1); // a forward jump: azimuths 3..299 missing
+    feed_idx(&s, 100, sweep++, 1); // 200 back: far outside the window -> a new rotation
+    assert_int_equal(g_rec.frames, 2);
+    assert_int_equal(g_rec.stats[0].valid, 400);
+    assert_int_equal(g_rec.stats[0].out_of_order, 1);
+    assert_int_equal(s.stats.late_dropped, 1);
+    assert_int_equal(g_rec.end[1], SL_SCAN_END_WRAP);
+    assert_int_equal(g_rec.stats[1].valid, 4);
+    assert_int_equal(g_rec.stats[1].missing, 396);
+    const sl_scan_frame_t *f0 = g_rec.frame_ptr[0];
+    (void)f0; // recycled by now (double buffer): check via the recorded hash instead
+    // The late row was reported to the per-azimuth callback after 11 and 12.
+    assert_int_equal(g_rec.az_idx[10], 11);
+    assert_int_equal(g_rec.az_idx[11], 12);
+    assert_int_equal(g_rec.az_idx[12], 10);
+}
+
+static void test_scan_marks_late_rows_in_the_frame(void **state)
+{
+    (void)state;
+    sl_scan_t s;
+    scan_init(&s, 64, true, 400, 5600);
+    feed_idx(&s, 20, 0, 1);
+    feed_idx(&s, 22, 2, 1);
+    feed_idx(&s, 21, 1, 1);
+    sl_scan_flush(&s);
+    const sl_scan_frame_t *f = sl_scan_last_frame(&s);
+    assert_int_equal(f->flags[21], SL_SCAN_AZ_VALID | SL_SCAN_AZ_LATE);
+    assert_int_equal(f->flags[22], SL_SCAN_AZ_VALID);
+    assert_int_equal(f->stats.out_of_order, 1);
+}
+
+static void test_scan_zero_fills_short_contoured_azimuths(void **state)
+{
+    (void)state;
+    sl_scan_t s;
+    scan_init(&s, 256, false, 400, 5600);
+    memset(g_bins, 0xFF, 256);
+    sl_proto_fft_t f = fft8(0, 0, g_bins, 256);
+    assert_int_equal(sl_scan_on_fft(&s, &f), SL_OK);
+    sl_scan_flush(&s);
+    fill_bins(5, 100);
+    f = fft8(0, 1, g_bins, 100); // contoured: 100 bins only
+    assert_int_equal(sl_scan_on_fft(&s, &f), SL_OK);
+    sl_scan_flush(&s);
+    const sl_scan_frame_t *fr = &g_frames[0];
+    assert_int_equal(fr->bins[0], 100);
+    assert_int_equal(fr->flags[0], SL_SCAN_AZ_VALID | SL_SCAN_AZ_SHORT);
+    assert_memory_equal(fr->power[0], g_bins, 100);
+    for (int i = 100; i < 256; i++) {
+        assert_int_equal(fr->power[0][i], 0);
+    }
+    assert_int_equal(fr->stats.short_azimuths, 1);
+    assert_int_equal(s.stats.short_azimuths, 1);
+    f = fft8(14, 2, g_bins, 0); // an azimuth with no bins at all
+    assert_int_equal(sl_scan_on_fft(&s, &f), SL_OK);
+    assert_int_equal(fr->bins[1], 0);
+}
+
+static void test_scan_copies_only_the_region_of_interest(void **state)
+{
+    (void)state;
+    sl_scan_t s;
+    scan_init(&s, 96, false, 400, 5600);
+    fill_bins(7, 3768);
+    sl_proto_fft_t f = fft8(28, 0, g_bins, 3768);
+    assert_int_equal(sl_scan_on_fft(&s, &f), SL_OK);
+    const sl_scan_frame_t *fr = &g_frames[0];
+    assert_int_equal(fr->bins[2], 96);
+    assert_int_equal(fr->flags[2], SL_SCAN_AZ_VALID);
+    assert_memory_equal(fr->power[2], g_bins, 96);
+    for (int i = 96; i < SL_CFG_ROI_BINS; i++) {
+        assert_int_equal(fr->power[2][i], 0); // beyond the ROI: never written
+    }
+    assert_int_equal(fr->roi_bins, 96);
+}
+
+static void test_scan_reduces_16_bit_power_by_the_configured_shift(void **state)
+{
+    (void)state;
+    // Through the wire: encode 16-bit bins, decode, store.
+    const uint16_t v[6] = {0x0000, 0x00FF, 0x0100, 0x12F0, 0xFFFF, 0x0FF0};
+    uint8_t b[64];
+    sl_proto_fft_t h = {.sweep_counter = 0, .azimuth_ticks = 0, .bins = 6};
+    const sl_ssize_t n = sl_proto_encode_fft16(b, sizeof b, &h, v);
+    assert_true(n > 0);
+    sl_proto_msg_t m = {.id = 31, .payload = {b + 22, (size_t)n - 22}};
+    for (unsigned shift = 8; shift >= 4; shift -= 4) {
+        memset(&g_rec, 0, sizeof g_rec);
+        sl_scan_t s;
+        sl_scan_cfg_t c = {.roi_bins = 32, .pow16_shift = (uint8_t)shift, .azimuths = 400,
+                           .encoder_size = 5600};
+        assert_int_equal(sl_scan_init(&s, &c, &g_frames[0], NULL), SL_OK);
+        assert_int_equal(sl_scan_on_msg(&s, &m), SL_OK);
+        const sl_scan_frame_t *fr = &g_frames[0];
+        assert_int_equal(fr->flags[0], SL_SCAN_AZ_VALID | SL_SCAN_AZ_16BIT | SL_SCAN_AZ_SHORT);
+        assert_int_equal(fr->bins[0], 6);
+        for (int i = 0; i < 6; i++) {
+            const uint32_t want = (uint32_t)v[i] >> shift;
+            assert_int_equal(fr->power[0][i], want > 255 ? 255 : want);
+        }
+        assert_int_equal(s.stats.saturated16, shift == 8 ? 0 : 2); // 0x12F0 and 0xFFFF
+        assert_int_equal(s.stats.wide_azimuths, 1);
+    }
+}
+
+static void test_scan_keeps_a_timestamp_per_azimuth(void **state)
+{
+    (void)state;
+    sl_scan_t s;
+    scan_init(&s, 32, true, 400, 5600);
+    fill_bins(1, 32);
+    sl_proto_fft_t f = fft8(14, 0, g_bins, 32);
+    f.seconds = 1547131046U;
+    f.split_ns = 999999999U;
+    assert_int_equal(sl_scan_on_fft(&s, &f), SL_OK);
+    f.azimuth_ticks = 28;
+    f.sweep_counter = 1;
+    f.seconds = 1547131047U;
+    f.split_ns = 625999U;
+    assert_int_equal(sl_scan_on_fft(&s, &f), SL_OK);
+    sl_scan_flush(&s);
+    const sl_scan_frame_t *fr = sl_scan_last_frame(&s);
+    assert_int_equal(fr->t_us[1], 1547131046ULL * 1000000 + 999999);
+    assert_int_equal(fr->t_us[2], 1547131047ULL * 1000000 + 625);
+    assert_int_equal(fr->t_first_us, fr->t_us[1]);
+    assert_int_equal(fr->t_last_us, fr->t_us[2]);
+    assert_int_equal(fr->sweep[2], 1);
+    assert_int_equal(fr->ticks[2], 28);
+}
+
+static void test_scan_double_buffer_keeps_the_last_frame_intact_for_a_rotation(void **state)
+{
+    (void)state;
+    sl_scan_t s;
+    scan_init(&s, 64, true, 400, 5600);
+    assert_null(sl_scan_last_frame(&s));
+    uint16_t sweep = 0;
+    for (uint16_t i = 0; i < 400; i++) {
+        feed_idx(&s, i, sweep++, (uint8_t)i);
+    }
+    for (uint16_t i = 0; i < 300; i++) {
+        feed_idx(&s, i, sweep++, (uint8_t)(i + 100));
+    }
+    assert_int_equal(g_rec.frames, 1);
+    const sl_scan_frame_t *a = g_rec.frame_ptr[0];
+    assert_ptr_equal(sl_scan_last_frame(&s), a);
+    assert_true(frame_hash(a) == g_rec.hash[0]); // untouched while the next one fills
+    for (uint16_t i = 300; i < 400; i++) {
+        feed_idx(&s, i, sweep++, (uint8_t)(i + 100));
+    }
+    feed_idx(&s, 0, sweep++, 0);
+    assert_int_equal(g_rec.frames, 2);
+    assert_true(g_rec.frame_ptr[1] != a);
+    assert_ptr_equal(sl_scan_last_frame(&s), g_rec.frame_ptr[1]);
+    assert_true(frame_hash(g_rec.frame_ptr[1]) == g_rec.hash[1]);
+}
+
+static void test_scan_completes_the_frame_on_a_geometry_change(void **state)
+{
+    (void)state;
+    sl_scan_t s;
+    scan_init(&s, 64, true, 0, 0);
+    fill_bins(1, 64);
+    sl_proto_fft_t early = fft8(42, 0, g_bins, 64);
+    assert_int_equal(sl_scan_on_fft(&s, &early), SL_ERR_STATE); // no geometry yet
+    assert_int_equal(s.stats.no_config, 1);
+    sl_proto_config_t c = {.azimuths = 400, .encoder_size = 5600};
+    assert_int_equal(sl_scan_on_config(&s, &c), SL_OK);
+    feed_idx(&s, 3, 1, 1);
+    feed_idx(&s, 4, 2, 1);
+    assert_int_equal(sl_scan_on_config(&s, &c), SL_OK); // identical: the frame continues
+    assert_int_equal(g_rec.frames, 0);
+    feed_idx(&s, 5, 3, 1);
+    c.azimuths = 200;
+    c.encoder_size = 2800;
+    assert_int_equal(sl_scan_on_config(&s, &c), SL_OK);
+    assert_int_equal(g_rec.frames, 1);
+    assert_int_equal(g_rec.end[0], SL_SCAN_END_CONFIG);
+    assert_int_equal(g_rec.stats[0].valid, 3);
+    assert_int_equal(s.stats.configs, 3);
+    assert_int_equal(s.stats.config_changes, 1);
+    c.azimuths = SL_CFG_MAX_AZIMUTHS + 1;
+    assert_int_equal(sl_scan_on_config(&s, &c), SL_ERR_RANGE);
+    c.azimuths = 0;
+    assert_int_equal(sl_scan_on_config(&s, &c), SL_ERR_RANGE);
+    c.azimuths = 200;
+    c.encoder_size = 0;
+    assert_int_equal(sl_scan_on_config(&s, &c), SL_ERR_RANGE);
+    assert_int_equal(s.stats.config_rejected, 3);
+    assert_int_equal(s.azimuths, 200); // unchanged
+}
+
+static void test_scan_rejects_unexpected_geometry_and_bad_azimuths(void **state)
+{
+    (void)state;
+    sl_scan_t s;
+    sl_scan_cfg_t cfg = {.roi_bins = 32, .pow16_shift = 8, .expect_azimuths = 400,
+                         .expect_encoder_size = 5600};
+    assert_int_equal(sl_scan_init(&s, &cfg, &g_frames[0], NULL), SL_OK);
+    sl_proto_config_t c = {.azimuths = 360, .encoder_size = 5600};
+    assert_int_equal(sl_scan_on_config(&s, &c), SL_ERR_RANGE);
+    assert_int_equal(sl_scan_set_geometry(&s, 400, 4096), SL_ERR_RANGE);
+    assert_int_equal(s.stats.config_rejected, 2);
+    fill_bins(1, 32);
+    sl_proto_fft_t f = fft8(0, 0, g_bins, 32);
+    assert_int_equal(sl_scan_on_fft(&s, &f), SL_ERR_STATE);
+    assert_int_equal(sl_scan_set_geometry(&s, 400, 5600), SL_OK);
+    f.azimuth_ticks = 5600;
+    assert_int_equal(sl_scan_on_fft(&s, &f), SL_ERR_RANGE);
+    assert_int_equal(s.stats.bad_azimuth, 1);
+    f.azimuth_ticks = 0xFFFF;
+    assert_int_equal(sl_scan_on_fft(&s, &f), SL_ERR_RANGE);
+    assert_int_equal(s.stats.bad_azimuth, 2);
+    // Bad init arguments.
+    cfg.roi_bins = 0;
+    assert_int_equal(sl_scan_init(&s, &cfg, &g_frames[0], NULL), SL_ERR_ARG);
+    cfg.roi_bins = SL_CFG_ROI_BINS + 1;
+    assert_int_equal(sl_scan_init(&s, &cfg, &g_frames[0], NULL), SL_ERR_ARG);
+    cfg.roi_bins = 32;
+    assert_int_equal(sl_scan_init(&s, &cfg, &g_frames[0], &g_frames[0]), SL_ERR_ARG);
+    cfg.pow16_shift = 16;
+    assert_int_equal(sl_scan_init(&s, &cfg, &g_frames[0], NULL), SL_ERR_ARG);
+    // Malformed messages through on_msg are counted.
+    cfg.pow16_shift = 8;
+    assert_int_equal(sl_scan_init(&s, &cfg, &g_frames[0], NULL), SL_OK);
+    uint8_t pl[13] = {0};
+    sl_proto_msg_t m = {.id = 30, .payload = {pl, sizeof pl}};
+    assert_int_equal(sl_scan_on_msg(&s, &m), SL_ERR_MALFORMED);
+    m.id = 10;
+    assert_int_equal(sl_scan_on_msg(&s, &m), SL_ERR_MALFORMED);
+    m.id = 1;
+    assert_int_equal(sl_scan_on_msg(&s, &m), SL_OK);
+    assert_int_equal(s.stats.malformed, 2);
+}
+
+static void test_scan_completes_the_frame_after_a_rotation_of_lost_packets(void **state)
+{
+    (void)state;
+    for (int ignore = 0; ignore < 2; ignore++) {
+        memset(&g_rec, 0, sizeof g_rec);
+        sl_scan_t s;
+        sl_scan_cfg_t c = {.roi_bins = 32, .pow16_shift = 8, .azimuths = 400, .encoder_size = 5600,
+                           .ignore_sweep = ignore != 0, .on_frame = on_frame, .ctx = &g_rec};
+        assert_int_equal(sl_scan_init(&s, &c, &g_frames[0], &g_frames[1]), SL_OK);
+        feed_idx(&s, 10, 1000, 1);
+        feed_idx(&s, 20, 1010, 1);
+        feed_idx(&s, 30, (uint16_t)(1020 + 400), 1); // same index range, a rotation later
+        if (!ignore) {
+            assert_int_equal(g_rec.frames, 1);
+            assert_int_equal(g_rec.end[0], SL_SCAN_END_SWEEP_GAP);
+            assert_int_equal(g_rec.stats[0].valid, 2);
+        } else {
+            assert_int_equal(g_rec.frames, 0);
+        }
+        // A sweep counter that wraps at 65535 is a +1 step, not a gap.
+        feed_idx(&s, 40, 65535, 1);
+        const uint32_t gaps = s.stats.sweep_gaps;
+        feed_idx(&s, 41, 0, 1);
+        assert_int_equal(s.stats.sweep_gaps, gaps);
+    }
+}
+
+// The whole chain: golden bytes -> sl_proto (random chunkings) -> sl_scan. Frames must be
+// identical for every chunking and hold exactly the golden power values.
+typedef struct chain {
+    sl_proto_t p;
+    sl_scan_t s;
+    uint8_t reasm[8192];
+} chain_t;
+
+static void run_chain(chain_t *c, const uint8_t *data, size_t n, uint64_t seed, bool double_buffer)
+{
+    memset(&g_rec, 0, sizeof g_rec);
+    sl_scan_cfg_t sc = {.roi_bins = 200, .pow16_shift = 8, .on_azimuth = on_azimuth,
+                        .on_frame = on_frame, .ctx = &g_rec};
+    assert_int_equal(sl_scan_init(&c->s, &sc, &g_frames[0], double_buffer ? &g_frames[1] : NULL),
+                     SL_OK);
+    sl_proto_cfg_t pc = {.reasm_buf = c->reasm, .reasm_size = sizeof c->reasm,
+                         .max_payload_bytes = 8000, .on_msg = sl_scan_proto_sink, .ctx = &c->s};
+    assert_int_equal(sl_proto_init(&c->p, &pc), SL_OK);
+    uint64_t r = seed * 0x9E3779B97F4A7C15ULL + 3;
+    size_t i = 0;
+    while (i < n) {
+        r ^= r << 13;
+        r ^= r >> 7;
+        r ^= r << 17;
+        size_t k = seed == 0 ? n : 1 + (r % ((seed % 3 == 0) ? 7 : 3000));
+        if (k > n - i) {
+            k = n - i;
+        }
+        assert_int_equal(sl_proto_feed(&c->p, data + i, k, 0), SL_OK);
+        i += k;
+    }
+    assert_int_equal(sl_proto_finish(&c->p), SL_OK);
+    sl_scan_flush(&c->s);
+}
+
+static void test_scan_frames_from_a_byte_stream_match_for_every_chunking(void **state)
+{
+    (void)state;
+    sl_golden_params_t g = sl_golden_defaults();
+    g.azimuths = 40;
+    g.encoder_size = 5600;
+    g.range_bins = 400;
+    g.rotations = 3;
+    g.keep_alive_every = 13;
+    g.contour_bins = 150;
+    for (int width = 1; width <= 2; width++) {
+        g.bytes_per_bin = (uint8_t)width;
+        const size_t n = sl_golden_size(&g);
+        uint8_t *data = malloc(n);
+        assert_int_equal(sl_golden_build(data, n, &g), n);
+        static chain_t c;
+        run_chain(&c, data, n, 0, true);
+        // Tick offset 13 with 140 ticks per azimuth: index = azimuth (13 < 70), so golden
+        // rotation r is frame r exactly.
+        assert_int_equal(g_rec.frames, 3);
+        uint64_t want_hash[3];
+        for (int f = 0; f < 3; f++) {
+            want_hash[f] = g_rec.hash[f];
+            assert_int_equal(g_rec.stats[f].valid, 40);
+            assert_int_equal(g_rec.stats[f].short_azimuths, 20);
+            assert_int_equal(g_rec.end[f], f < 2 ? SL_SCAN_END_WRAP : SL_SCAN_END_FLUSH);
+        }
+        // Content of the last frame (still intact: double buffering) against the generator.
+        const sl_scan_frame_t *fr = sl_scan_last_frame(&c.s);
+        for (uint32_t a = 0; a < 40; a++) {
+            const uint32_t nb = sl_golden_bins(&g, a) < 200 ? sl_golden_bins(&g, a) : 200;
+            assert_int_equal(fr->bins[a], nb);
+            for (uint32_t b = 0; b < 200; b++) {
+                const uint8_t want = b >= nb ? 0
+                                     : width == 1 ? sl_golden_power8(&g, 2, a, b)
+                                                  : (uint8_t)(sl_golden_power16(&g, 2, a, b) >> 8);
+                assert_int_equal(fr->power[a][b], want);
+            }
+            uint32_t sec, ns;
+            sl_golden_time(&g, 80 + a, &sec, &ns);
+            assert_int_equal(fr->t_us[a], (uint64_t)sec * 1000000 + ns / 1000);
+        }
+        for (uint64_t seed = 1; seed <= 12; seed++) {
+            run_chain(&c, data, n, seed, seed % 2 == 0);
+            assert_int_equal(g_rec.frames, 3);
+            for (int f = 0; f < 3; f++) {
+                assert_true(g_rec.hash[f] == want_hash[f]);
+            }
+            assert_int_equal(c.p.stats.bytes_skipped, 0);
+        }
+        free(data);
+    }
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_scan_maps_encoder_values_to_the_nearest_azimuth_centre),
+        cmocka_unit_test(test_scan_completes_a_frame_when_the_azimuth_index_wraps),
+        cmocka_unit_test(test_scan_oxford_rotation_starts_at_the_tick_5599_message),
+        cmocka_unit_test(test_scan_counts_and_zero_fills_missing_azimuths),
+        cmocka_unit_test(test_scan_drops_duplicates_and_keeps_the_first_row),
+        cmocka_unit_test(test_scan_stores_late_azimuths_inside_the_reorder_window),
+        cmocka_unit_test(test_scan_marks_late_rows_in_the_frame),
+        cmocka_unit_test(test_scan_zero_fills_short_contoured_azimuths),
+        cmocka_unit_test(test_scan_copies_only_the_region_of_interest),
+        cmocka_unit_test(test_scan_reduces_16_bit_power_by_the_configured_shift),
+        cmocka_unit_test(test_scan_keeps_a_timestamp_per_azimuth),
+        cmocka_unit_test(test_scan_double_buffer_keeps_the_last_frame_intact_for_a_rotation),
+        cmocka_unit_test(test_scan_completes_the_frame_on_a_geometry_change),
+        cmocka_unit_test(test_scan_rejects_unexpected_geometry_and_bad_azimuths),
+        cmocka_unit_test(test_scan_completes_the_frame_after_a_rotation_of_lost_packets),
+        cmocka_unit_test(test_scan_frames_from_a_byte_stream_match_for_every_chunking),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
