@@ -108,6 +108,83 @@ void add_uniform(std::vector<double> &e, double bin, double a, double c, double 
     }
 }
 
+// Integral of H(t) from 0 to q, where H is the probability that a ray hitting a circle of
+// radius R_e (seen from afar) lands more than q R_e in front of the axis plane... i.e.
+// P(hit range <= r_axis - q R_e) = H(q) = 1 (q <= 0), sqrt(1 - q^2) (0..1), 0 (q >= 1).
+double Phi(double q)
+{
+    if (q <= 0) {
+        return q;
+    }
+    if (q >= 1) {
+        return 0.25 * kSimPi;
+    }
+    return 0.5 * (q * std::sqrt(1 - q * q) + std::asin(q));
+}
+
+} // namespace
+
+void sim_splat_profile(std::vector<double> &e, double bin, double a, double c, double re, double E,
+                       int first_bin)
+{
+    if (E <= 0) {
+        return;
+    }
+    if (re < 1e-9) {
+        // sharp: uniform over [a, c]
+        if (c < a) {
+            std::swap(a, c);
+        }
+        const long n = static_cast<long>(e.size());
+        const long ia = static_cast<long>(std::floor(a / bin)) - first_bin;
+        const long ic = static_cast<long>(std::floor(c / bin)) - first_bin;
+        if (ic < 0 || ia >= n) {
+            return;
+        }
+        if (ia == ic || c - a < 1e-15) {
+            if (ia >= 0) {
+                e[static_cast<size_t>(ia)] += E;
+            }
+            return;
+        }
+        const double inv = E / (c - a);
+        for (long i = std::max(0L, ia); i <= std::min(ic, n - 1); i++) {
+            const double lo = std::max(a, (i + first_bin) * bin), hi = std::min(c, (i + first_bin + 1) * bin);
+            if (hi > lo) {
+                e[static_cast<size_t>(i)] += (hi - lo) * inv;
+            }
+        }
+        return;
+    }
+    if (c < a) {
+        std::swap(a, c);
+    }
+    // P(hit <= x) for an axis point at r: H((r - x) / re). Over r uniform in [a, c]:
+    // mean of H = re / (c - a) * [Phi((c - x)/re) - Phi((a - x)/re)].
+    const bool point = c - a < 1e-12;
+    auto cdf = [&](double x) {
+        if (point) {
+            const double q = (a - x) / re;
+            return q <= 0 ? 1.0 : (q >= 1 ? 0.0 : std::sqrt(1 - q * q));
+        }
+        return re / (c - a) * (Phi((c - x) / re) - Phi((a - x) / re));
+    };
+    const long n = static_cast<long>(e.size());
+    const long ia = static_cast<long>(std::floor((a - re) / bin)) - first_bin;
+    const long ic = static_cast<long>(std::floor(c / bin)) - first_bin;
+    if (ic < 0 || ia >= n) {
+        return;
+    }
+    double prev = cdf((std::max(0L, ia) + first_bin) * bin);
+    for (long i = std::max(0L, ia); i <= std::min(ic, n - 1); i++) {
+        const double next = cdf((i + first_bin + 1) * bin);
+        e[static_cast<size_t>(i)] += E * std::max(0.0, next - prev);
+        prev = next;
+    }
+}
+
+namespace {
+
 void touch(SimColumn &col, double bin, double a, double c, float pk)
 {
     if (c < a) {
@@ -171,8 +248,15 @@ Simulator::Simulator(const Scene &scene) : s_(scene)
         const int F = std::min(W - 1, static_cast<int>(std::lround(W * s_.smear_mode_frac)));
         smear_front_ = F;
         for (int j = -F; j < W - F; j++) {
-            smear_kernel_.push_back(j <= 0 ? (j + F + 1.0) / (F + 1.0)
-                                           : 1.0 - static_cast<double>(j) / (W - F));
+            double k = 0;
+            if (j <= 0) {
+                k = (j + F + 1.0) / (F + 1.0);
+            } else if (s_.smear_shape == 0) {
+                k = 1.0 - static_cast<double>(j) / (W - F);
+            } else {
+                k = std::pow(10.0, -0.1 * s_.smear_decay_db * j);
+            }
+            smear_kernel_.push_back(k);
         }
     }
 
@@ -200,6 +284,27 @@ Simulator::Simulator(const Scene &scene) : s_(scene)
             column_from(rg, i, static_cols_[static_cast<size_t>(i)]);
         }
     }
+    deterministic_ = !s_.noise && (!s_.speckle || scene_speckle_static(s_));
+    if (deterministic_) {
+        out_cache_.resize(static_cast<size_t>(b.azimuths));
+        SimColumn col;
+        for (int i = 0; i < b.azimuths; i++) {
+            auto &o = out_cache_[static_cast<size_t>(i)];
+            o.resize(static_cast<size_t>(bins()));
+            if (!static_cols_.empty()) {
+                map_column(0, i, static_cols_[static_cast<size_t>(i)], o.data());
+            } else {
+                RotationGeom none;
+                none.k = 0;
+                none.per_az.assign(static_cast<size_t>(b.azimuths), {});
+                col.reset(bins());
+                if (s_.ground && !ground_cols_.empty()) {
+                    column_from(none, i, col);
+                }
+                map_column(0, i, col, o.data());
+            }
+        }
+    }
 }
 
 Simulator::~Simulator() = default;
@@ -216,18 +321,20 @@ uint16_t Simulator::ticks_of(int i) const
         s_.board.encoder_size);
 }
 
-double Simulator::elevation_gain(double e) const
+double sim_elevation_gain(const Scene &s, double e)
 {
-    if (e > s_.elev_top_deg || e < s_.elev_bottom_deg) {
+    if (e > s.elev_top_deg || e < s.elev_bottom_deg) {
         return 0.0;
     }
-    if (s_.elevation == ElevationProfile::Ideal) {
+    if (s.elevation == ElevationProfile::Ideal) {
         return 1.0;
     }
-    const double pk = s_.measured_peak_deg;
-    const double u = e >= pk ? (e - pk) / (s_.elev_top_deg - pk) : (pk - e) / (pk - s_.elev_bottom_deg);
-    return std::pow(10.0, -0.1 * s_.measured_edge_db * u * u);
+    const double pk = s.measured_peak_deg;
+    const double u = e >= pk ? (e - pk) / (s.elev_top_deg - pk) : (pk - e) / (pk - s.elev_bottom_deg);
+    return std::pow(10.0, -0.1 * s.measured_edge_db * u * u);
 }
+
+double Simulator::elevation_gain(double e) const { return sim_elevation_gain(s_, e); }
 
 double Simulator::azimuth_gain(double d) const
 {
@@ -392,12 +499,6 @@ void Simulator::splat_pole(const PoleView &pv, int i, SimColumn *col, double *r1
     const double bin = bin_m();
     const double a_c = az_deg_[static_cast<size_t>(i)];
     const double s_foot = dot(r.o - pg.base, pg.v);
-    constexpr int K = 8; // cross-section quantiles
-    double q[K];
-    for (int k = 0; k < K; k++) {
-        const double F = (k + 0.5) / K;
-        q[k] = std::sqrt(1.0 - F * F);
-    }
     double r1 = std::numeric_limits<double>::infinity(), r2 = 0;
     struct Smp {
         double r, re, e, eps, g;
@@ -447,9 +548,7 @@ void Simulator::splat_pole(const PoleView &pv, int i, SimColumn *col, double *r1
             const Smp &A = sm[j], &B = sm[j + 1];
             const double E = 0.5 * (A.eps + B.eps) * std::fabs(B.e - A.e);
             const double re = 0.5 * (A.re + B.re);
-            for (int k = 0; k < K; k++) {
-                add_uniform(col->energy, bin, A.r - re * q[k], B.r - re * q[k], E / K);
-            }
+            sim_splat_profile(col->energy, bin, A.r, B.r, re, E, 0);
             if (A.g > 0 || B.g > 0) {
                 touch(*col, bin, std::min(A.r, B.r) - re, std::max(A.r, B.r),
                       static_cast<float>(std::max(A.g, B.g)));
@@ -794,7 +893,13 @@ void Simulator::render_rotation(int k, std::vector<uint8_t> &bytes, std::vector<
             throw SceneError("sl_proto_encode_fft_head failed");
         }
         uint8_t *out = bytes.data() + at + static_cast<size_t>(n);
-        if (!static_cols_.empty()) {
+        const bool plain = !static_cols_.empty() ||
+                           (rg.per_az[static_cast<size_t>(i)].empty() &&
+                            (boxes_.empty() ||
+                             !boxes_in_window(radar_pose_at(s_, time_of(k, i)), i)));
+        if (deterministic_ && plain) {
+            std::memcpy(out, out_cache_[static_cast<size_t>(i)].data(), static_cast<size_t>(nb));
+        } else if (!static_cols_.empty()) {
             map_column(k, i, static_cols_[static_cast<size_t>(i)], out);
         } else {
             column_from(rg, i, col);

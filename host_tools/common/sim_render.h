@@ -115,6 +115,10 @@ private:
     std::vector<std::vector<double>> ground_cols_; ///< per azimuth (or 1 for a cylinder)
     // static scenes (speed 0): the geometry of every azimuth, computed once
     std::vector<SimColumn> static_cols_;
+    // deterministic output (no noise, no per-rotation speckle): the 8-bit bins of columns
+    // without poles or boxes (moving scenes) or of every column (static scenes)
+    bool deterministic_ = false;
+    std::vector<std::vector<uint8_t>> out_cache_;
     // noise: integer magnitude distribution of pure noise
     std::vector<double> noise_cdf_;
     std::vector<uint8_t> noise_val_;
@@ -129,6 +133,17 @@ private:
 void sim_run(const Simulator &sim, int first, int count, int threads,
              const std::function<void(int k, std::vector<uint8_t> &bytes, std::vector<GtRow> &gt)> &sink,
              const std::function<void(int done, int total)> &progress = {});
+
+/// Adds energy E of a thin cylinder whose axis range runs uniformly over [a, c] (m) to the
+/// bins of `e` (bin `first_bin` at index 0, width `bin` m): each axis point's energy is spread
+/// over its cross-section, from the front surface (axis - re) to the silhouette (axis), with
+/// the exact distribution of a circle's hit ranges (P(hit <= r - q re) = sqrt(1 - q^2)).
+/// re <= 1e-9: sharp (uniform over [a, c]). Exact, closed form (no sampling).
+void sim_splat_profile(std::vector<double> &e, double bin, double a, double c, double re,
+                       double E, int first_bin = 0);
+
+/// Elevation gain (power, peak 1) of a scene's beam at elevation e (deg).
+double sim_elevation_gain(const Scene &s, double e_deg);
 
 /// Splits a unix time in seconds into the FFT timestamp fields (LE on the wire).
 void sim_split_time(double unix_s, uint32_t *seconds, uint32_t *split_ns);

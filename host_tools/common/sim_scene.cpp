@@ -240,12 +240,14 @@ Scene build(const Parsed &p)
     }
     {
         Sec c = sec("effects");
-        c.only({"smear", "smear_width_bins", "smear_mode_frac", "speckle", "speckle_db",
+        c.only({"smear", "smear_shape", "smear_width_bins", "smear_mode_frac", "smear_decay_db", "speckle", "speckle_db",
                 "speckle_static", "speckle_seed", "noise", "noise_sigma", "leakage",
                 "leak_level", "leak_shoulder", "leak_edge_m", "leak_shoulder_end_m",
                 "leak_jitter"});
         s.smear = c.boolean("smear", false);
+        s.smear_shape = c.choice<int>("smear_shape", 0, {{"triangular", 0}, {"exponential", 1}});
         s.smear_width_bins = c.real("smear_width_bins", s.smear_width_bins, 1, 500);
+        s.smear_decay_db = c.real("smear_decay_db", s.smear_decay_db, 0.01, 100);
         s.smear_mode_frac = c.real("smear_mode_frac", s.smear_mode_frac, 0, 1);
         s.speckle = c.boolean("speckle", false);
         s.speckle_db = c.real("speckle_db", s.speckle_db, 0, 20);

@@ -93,8 +93,10 @@ struct Scene {
     double log_ref_value = 100;    ///< ... reads this value (noise-free)
     // [effects]
     bool smear = false;
-    double smear_width_bins = 20;  ///< triangular kernel length (RadaRays: 50, MulRan 35)
-    double smear_mode_frac = 0.05; ///< fraction of the kernel in front of the target (RadaRays 0.35)
+    int smear_shape = 0;           ///< 0 triangular (RadaRays), 1 exponential tail
+    double smear_width_bins = 20;  ///< kernel length (RadaRays triangular: 50, MulRan 35)
+    double smear_mode_frac = 0.0;  ///< fraction of the kernel in front of the target (RadaRays 0.35)
+    double smear_decay_db = 3.0;   ///< exponential: power decay per bin behind the target (dB)
     bool speckle = false;
     double speckle_db = 2.0;       ///< log-normal power fluctuation per bin, 1 sigma
     int speckle_static = -1;       ///< 1: fixed over time (static scene), 0: per rotation, -1 auto

@@ -1,6 +1,7 @@
 // sl_dbc.cpp: DBC generation from the core's CAN layout table (see sl_dbc.h).
 #include "sl_dbc.h"
 
+#include <cctype>
 #include <cstdint>
 #include <map>
 #include <set>

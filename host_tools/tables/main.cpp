@@ -4,7 +4,9 @@
 //   sl-tables --all [--no-png]
 //
 // BOARD is a name under boards/ or a path to a board.ini. By default the tables are written
-// to boards/<name>/sl_board_<c_name>.{c,h} and the plot to boards/<name>/tables.png.
+// to boards/<name>/sl_board_<c_name>.{c,h}, the CAN interface to boards/<name>/shadowlean.dbc
+// (generated from the core's message layout table, sl_can_layout()) and the plot to
+// boards/<name>/tables.png.
 // The output is a pure function of the board file and the generator version, so the
 // check_tables test can regenerate and diff.
 #include <algorithm>
@@ -24,6 +26,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "sl_board_spec.h"
+#include "sl_dbc.h"
 #include "sl_geom.h"
 #include "sl_paths.h"
 
@@ -316,6 +319,14 @@ int generate(const std::string &board, std::string out_dir, std::string png, boo
     const std::string base = out_dir + "/sl_board_" + c_name(b.name);
     write_header(b, base + ".h", ban);
     write_source(b, t, base + ".c", ban);
+    {
+        // The CAN interface of the board: the DBC, from the core's own layout table.
+        std::ofstream dbc(out_dir + "/shadowlean.dbc");
+        dbc << sl::make_dbc(b);
+        if (!dbc) {
+            throw std::runtime_error("cannot write " + out_dir + "/shadowlean.dbc");
+        }
+    }
     if (!no_png) {
         write_png(b, png);
     }
@@ -325,7 +336,7 @@ int generate(const std::string &board, std::string out_dir, std::string png, boo
         tmax = std::max(tmax, b.theta_deg(i));
     }
     std::cout << b.name << ": " << b.azimuths << " azimuths, theta " << tmin << " .. " << tmax
-              << " deg, tables -> " << base << ".{c,h}" << (no_png ? "" : ", plot -> " + png) << "\n";
+              << " deg, tables -> " << base << ".{c,h}, " << out_dir << "/shadowlean.dbc" << (no_png ? "" : ", plot -> " + png) << "\n";
     return 0;
 }
 

@@ -1035,9 +1035,14 @@ int test_client_timeouts(const std::string &work)
         std::unique_ptr<sl_radar_client_t> c;
         if (hold < 0 || !make_client(c, log, static_cast<uint16_t>(bound_port(hold)), reasm)) return 1;
         const uint64_t end = sl_port_now_us() + 10000000u;
-        while (c->stats.connect_attempts < 7 && sl_port_now_us() < end) sl_radar_client_poll(c.get(), 1000);
-        CHECK_EQ(c->stats.connect_failures, c->stats.connect_attempts, "refused: every attempt failed");
+        while (c->stats.connect_failures < 6 && sl_port_now_us() < end) sl_radar_client_poll(c.get(), 1000);
+        CHECK_EQ(c->stats.connect_failures, 6u, "refused: failed attempts");
+        CHECK_EQ(c->stats.connect_attempts, 6u, "refused: attempts");
+        CHECK_EQ(c->stats.connects, 0u, "refused: connections");
         CHECK(log.delays_ms.size() >= 6, "refused: failures seen (%zu)", log.delays_ms.size());
+        std::printf("refused: backoff delays (ms):");
+        for (uint32_t d : log.delays_ms) std::printf(" %u", d);
+        std::printf("\n");
         const uint32_t want[] = {10, 20, 40, 80, 80, 80};
         for (size_t i = 0; i < 6 && i < log.delays_ms.size(); ++i) {
             CHECK(log.delays_ms[i] == want[i], "refused: backoff %zu is %u ms, expected %u", i, log.delays_ms[i], want[i]);

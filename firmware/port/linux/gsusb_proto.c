@@ -1,0 +1,1143 @@
+// gs_usb protocol layer and driver logic (no libusb: see gsusb_proto.h).
+#include "gsusb_proto.h"
+
+#include <stdarg.h>
+#include <stdio.h>
+#include <string.h>
+
+// ---------------------------------------------------------------------------------------
+// Little-endian helpers (byte by byte: endian-clean on s390x)
+
+static void put_le32(uint8_t *p, uint32_t v)
+{
+    p[0] = (uint8_t)(v & 0xFFU);
+    p[1] = (uint8_t)((v >> 8) & 0xFFU);
+    p[2] = (uint8_t)((v >> 16) & 0xFFU);
+    p[3] = (uint8_t)((v >> 24) & 0xFFU);
+}
+
+static uint32_t get_le32(const uint8_t *p)
+{
+    return (uint32_t)p[0] | ((uint32_t)p[1] << 8) | ((uint32_t)p[2] << 16) |
+           ((uint32_t)p[3] << 24);
+}
+
+// ---------------------------------------------------------------------------------------
+// Identity
+
+static const sl_gsusb_usb_id_t known_ids[] = {
+    {0x1d50, 0x606f, "candleLight_fw default / Geschwister Schneider USB2CAN"},
+    {0x1209, 0x2323, "candleLight (pid.codes)"},
+    {0x1cd2, 0x606f, "CES CANext FD"},
+    {0x16d0, 0x10b8, "ABE CANdebugger FD"},
+    {0x16d0, 0x0f30, "Xylanta SAINT3"},
+    {0x1209, 0xca01, "CANnectivity (Zephyr)"},
+};
+
+const sl_gsusb_usb_id_t *sl_gsusb_known_ids(size_t *n)
+{
+    if (n != NULL) {
+        *n = sizeof known_ids / sizeof known_ids[0];
+    }
+    return known_ids;
+}
+
+bool sl_gsusb_is_known_id(uint16_t vid, uint16_t pid)
+{
+    for (size_t i = 0; i < sizeof known_ids / sizeof known_ids[0]; i++) {
+        if (known_ids[i].vid == vid && known_ids[i].pid == pid) {
+            return true;
+        }
+    }
+    return false;
+}
+
+const char *sl_gsusb_breq_name(uint8_t breq)
+{
+    switch (breq) {
+    case SL_GSUSB_BREQ_HOST_FORMAT: return "HOST_FORMAT";
+    case SL_GSUSB_BREQ_BITTIMING: return "BITTIMING";
+    case SL_GSUSB_BREQ_MODE: return "MODE";
+    case SL_GSUSB_BREQ_BERR: return "BERR";
+    case SL_GSUSB_BREQ_BT_CONST: return "BT_CONST";
+    case SL_GSUSB_BREQ_DEVICE_CONFIG: return "DEVICE_CONFIG";
+    case SL_GSUSB_BREQ_TIMESTAMP: return "TIMESTAMP";
+    case SL_GSUSB_BREQ_IDENTIFY: return "IDENTIFY";
+    case SL_GSUSB_BREQ_DATA_BITTIMING: return "DATA_BITTIMING";
+    case SL_GSUSB_BREQ_BT_CONST_EXT: return "BT_CONST_EXT";
+    case SL_GSUSB_BREQ_SET_TERMINATION: return "SET_TERMINATION";
+    case SL_GSUSB_BREQ_GET_TERMINATION: return "GET_TERMINATION";
+    case SL_GSUSB_BREQ_GET_STATE: return "GET_STATE";
+    default: return "REQ?";
+    }
+}
+
+const char *sl_gsusb_io_name(sl_gsusb_io_t io)
+{
+    switch (io) {
+    case SL_GSUSB_IO_OK: return "OK";
+    case SL_GSUSB_IO_TIMEOUT: return "TIMEOUT";
+    case SL_GSUSB_IO_STALL: return "STALL";
+    case SL_GSUSB_IO_NO_DEVICE: return "NO_DEVICE";
+    case SL_GSUSB_IO_OVERFLOW: return "OVERFLOW";
+    case SL_GSUSB_IO_ERROR: return "ERROR";
+    default: return "IO?";
+    }
+}
+
+// ---------------------------------------------------------------------------------------
+// Request payloads
+
+void sl_gsusb_encode_host_format(uint8_t out[SL_GSUSB_HOST_FORMAT_BYTES])
+{
+    put_le32(out, (uint32_t)SL_GSUSB_HOST_FORMAT_WORD);
+}
+
+void sl_gsusb_encode_bittiming(const sl_gsusb_bittiming_t *bt, uint8_t out[SL_GSUSB_BITTIMING_BYTES])
+{
+    put_le32(out + 0, bt->prop_seg);
+    put_le32(out + 4, bt->phase_seg1);
+    put_le32(out + 8, bt->phase_seg2);
+    put_le32(out + 12, bt->sjw);
+    put_le32(out + 16, bt->brp);
+}
+
+void sl_gsusb_encode_mode(uint32_t mode, uint32_t flags, uint8_t out[SL_GSUSB_MODE_BYTES])
+{
+    put_le32(out + 0, mode);
+    put_le32(out + 4, flags);
+}
+
+sl_err_t sl_gsusb_decode_device_config(const uint8_t *buf, size_t len, sl_gsusb_device_config_t *out)
+{
+    if (buf == NULL || out == NULL) {
+        return SL_ERR_ARG;
+    }
+    if (len < SL_GSUSB_DEVICE_CONFIG_BYTES) {
+        return SL_ERR_MALFORMED;
+    }
+    out->icount = buf[3];
+    out->sw_version = get_le32(buf + 4);
+    out->hw_version = get_le32(buf + 8);
+    return SL_OK;
+}
+
+sl_err_t sl_gsusb_decode_bt_const(const uint8_t *buf, size_t len, sl_gsusb_bt_const_t *out)
+{
+    if (buf == NULL || out == NULL) {
+        return SL_ERR_ARG;
+    }
+    if (len < SL_GSUSB_BT_CONST_BYTES) {
+        return SL_ERR_MALFORMED;
+    }
+    out->feature = get_le32(buf + 0);
+    out->fclk_hz = get_le32(buf + 4);
+    out->tseg1_min = get_le32(buf + 8);
+    out->tseg1_max = get_le32(buf + 12);
+    out->tseg2_min = get_le32(buf + 16);
+    out->tseg2_max = get_le32(buf + 20);
+    out->sjw_max = get_le32(buf + 24);
+    out->brp_min = get_le32(buf + 28);
+    out->brp_max = get_le32(buf + 32);
+    out->brp_inc = get_le32(buf + 36);
+    return SL_OK;
+}
+
+sl_err_t sl_gsusb_decode_bittiming(const uint8_t *buf, size_t len, sl_gsusb_bittiming_t *out)
+{
+    if (buf == NULL || out == NULL) {
+        return SL_ERR_ARG;
+    }
+    if (len < SL_GSUSB_BITTIMING_BYTES) {
+        return SL_ERR_MALFORMED;
+    }
+    out->prop_seg = get_le32(buf + 0);
+    out->phase_seg1 = get_le32(buf + 4);
+    out->phase_seg2 = get_le32(buf + 8);
+    out->sjw = get_le32(buf + 12);
+    out->brp = get_le32(buf + 16);
+    return SL_OK;
+}
+
+sl_err_t sl_gsusb_decode_state(const uint8_t *buf, size_t len, sl_gsusb_can_state_t *out)
+{
+    if (buf == NULL || out == NULL) {
+        return SL_ERR_ARG;
+    }
+    if (len < SL_GSUSB_STATE_BYTES) {
+        return SL_ERR_MALFORMED;
+    }
+    out->state = get_le32(buf + 0);
+    out->rxerr = get_le32(buf + 4);
+    out->txerr = get_le32(buf + 8);
+    return SL_OK;
+}
+
+sl_err_t sl_gsusb_bt_const_check(const sl_gsusb_bt_const_t *c)
+{
+    if (c == NULL) {
+        return SL_ERR_ARG;
+    }
+    if (c->fclk_hz == 0U || c->brp_inc == 0U || c->brp_max == 0U || c->tseg2_max == 0U ||
+        c->tseg1_max == 0U || c->tseg1_min > c->tseg1_max || c->tseg2_min > c->tseg2_max ||
+        c->brp_min > c->brp_max || c->tseg1_max > SL_GSUSB_TSEG_LIMIT ||
+        c->tseg2_max > SL_GSUSB_TSEG_LIMIT) {
+        return SL_ERR_MALFORMED;
+    }
+    return SL_OK;
+}
+
+// ---------------------------------------------------------------------------------------
+// Bit timing (Linux can_calc_bittiming(), drivers/net/can/dev/calc_bittiming.c, 6.1)
+
+uint16_t sl_gsusb_default_sample_point(uint32_t bitrate)
+{
+    if (bitrate > 800000U) {
+        return 750U;
+    }
+    if (bitrate > 500000U) {
+        return 800U;
+    }
+    return 875U;
+}
+
+uint32_t sl_gsusb_bittiming_rate(const sl_gsusb_bittiming_t *bt, uint32_t fclk_hz)
+{
+    if (bt == NULL || bt->brp == 0U) {
+        return 0U;
+    }
+    uint64_t tq = 1U + (uint64_t)bt->prop_seg + bt->phase_seg1 + bt->phase_seg2;
+    return (uint32_t)((uint64_t)fclk_hz / ((uint64_t)bt->brp * tq));
+}
+
+static uint64_t absdiff_u64(uint64_t a, uint64_t b)
+{
+    return a > b ? a - b : b - a;
+}
+
+// For `tseg` = tseg1 + tseg2 time quanta (plus the sync quantum), split it so the sample
+// point is as close as possible to, but not above, the nominal one. Returns false when no
+// split fits the limits.
+static bool split_tseg(const sl_gsusb_bt_const_t *c, uint32_t sp_nominal, int64_t tseg,
+                       int64_t *tseg1_out, int64_t *tseg2_out, uint32_t *sp_err_out)
+{
+    uint32_t best_err = UINT32_MAX;
+    int64_t all = tseg + 1;
+    for (int64_t i = 0; i <= 1; i++) {
+        int64_t tseg2 = all - ((int64_t)sp_nominal * all) / 1000 - i;
+        if (tseg2 < (int64_t)c->tseg2_min) {
+            tseg2 = (int64_t)c->tseg2_min;
+        }
+        if (tseg2 > (int64_t)c->tseg2_max) {
+            tseg2 = (int64_t)c->tseg2_max;
+        }
+        int64_t tseg1 = tseg - tseg2;
+        if (tseg1 > (int64_t)c->tseg1_max) {
+            tseg1 = (int64_t)c->tseg1_max;
+            tseg2 = tseg - tseg1;
+        }
+        if (tseg1 < (int64_t)c->tseg1_min || tseg2 < (int64_t)c->tseg2_min ||
+            tseg2 > (int64_t)c->tseg2_max || tseg2 < 1) {
+            continue;
+        }
+        int64_t sp = (1000 * (all - tseg2)) / all;
+        uint32_t err = (uint32_t)(sp > (int64_t)sp_nominal ? sp - (int64_t)sp_nominal
+                                                            : (int64_t)sp_nominal - sp);
+        if (sp <= (int64_t)sp_nominal && err < best_err) {
+            best_err = err;
+            *tseg1_out = tseg1;
+            *tseg2_out = tseg2;
+        }
+    }
+    *sp_err_out = best_err;
+    return best_err != UINT32_MAX;
+}
+
+sl_err_t sl_gsusb_bittiming_calc(const sl_gsusb_bt_const_t *c, uint32_t bitrate,
+                                 uint16_t sample_point_permille, sl_gsusb_bt_result_t *out)
+{
+    if (c == NULL || out == NULL || bitrate == 0U || sample_point_permille >= 1000U) {
+        return SL_ERR_ARG;
+    }
+    memset(out, 0, sizeof *out);
+    uint32_t sp_nominal =
+        sample_point_permille != 0U ? sample_point_permille : sl_gsusb_default_sample_point(bitrate);
+    out->sample_point_nominal = (uint16_t)sp_nominal;
+    if (sl_gsusb_bt_const_check(c) != SL_OK) {
+        return SL_ERR_MALFORMED;
+    }
+
+    uint64_t best_rate_err = UINT64_MAX;
+    uint32_t best_sp_err = UINT32_MAX;
+    int64_t best_tseg1 = 0;
+    int64_t best_tseg2 = 0;
+    uint64_t best_brp = 0;
+    int64_t lo = 2 * ((int64_t)c->tseg1_min + (int64_t)c->tseg2_min);
+    if (lo < 2) {
+        lo = 2; // at least one quantum besides the sync quantum
+    }
+    // tseg even = round the prescaler down, odd = round it up (as Linux).
+    for (int64_t tseg = 2 * ((int64_t)c->tseg1_max + (int64_t)c->tseg2_max) + 1; tseg >= lo; tseg--) {
+        uint64_t tsegall = 1U + (uint64_t)(tseg / 2);
+        uint64_t brp = (uint64_t)c->fclk_hz / (tsegall * bitrate) + (uint64_t)(tseg % 2);
+        brp = (brp / c->brp_inc) * c->brp_inc;
+        if (brp < c->brp_min || brp > c->brp_max || brp == 0U) {
+            continue;
+        }
+        uint64_t rate = (uint64_t)c->fclk_hz / (brp * tsegall);
+        uint64_t rate_err = absdiff_u64(bitrate, rate);
+        if (rate_err > best_rate_err) {
+            continue;
+        }
+        if (rate_err < best_rate_err) {
+            best_sp_err = UINT32_MAX; // a better rate resets the sample-point race
+        }
+        int64_t tseg1 = 0;
+        int64_t tseg2 = 0;
+        uint32_t sp_err = UINT32_MAX;
+        if (!split_tseg(c, sp_nominal, tseg / 2, &tseg1, &tseg2, &sp_err)) {
+            continue;
+        }
+        if (sp_err >= best_sp_err) {
+            continue;
+        }
+        best_sp_err = sp_err;
+        best_rate_err = rate_err;
+        best_tseg1 = tseg1;
+        best_tseg2 = tseg2;
+        best_brp = brp;
+        if (rate_err == 0U && sp_err == 0U) {
+            break;
+        }
+    }
+    if (best_brp == 0U) {
+        return SL_ERR_RANGE; // no prescaler in [brp_min, brp_max] reaches this rate
+    }
+    uint64_t tq = 1U + (uint64_t)best_tseg1 + (uint64_t)best_tseg2;
+    out->bt.prop_seg = (uint32_t)(best_tseg1 / 2);
+    out->bt.phase_seg1 = (uint32_t)best_tseg1 - out->bt.prop_seg;
+    out->bt.phase_seg2 = (uint32_t)best_tseg2;
+    out->bt.sjw = 1U; // Linux 6.1 default; always <= sjw_max (>= 1) and <= phase_seg2
+    out->bt.brp = (uint32_t)best_brp;
+    out->tq_per_bit = (uint16_t)tq;
+    out->bitrate = (uint32_t)((uint64_t)c->fclk_hz / (best_brp * tq));
+    out->error_ppm = (uint32_t)((absdiff_u64(bitrate, out->bitrate) * 1000000U) / bitrate);
+    out->sample_point_permille = (uint16_t)((1000U * (1U + (uint64_t)best_tseg1)) / tq);
+    if (bitrate > SL_GSUSB_MAX_BITRATE || out->error_ppm > SL_GSUSB_MAX_RATE_ERROR_PPM) {
+        return SL_ERR_RANGE;
+    }
+    return SL_OK;
+}
+
+// ---------------------------------------------------------------------------------------
+// Bulk frames
+
+size_t sl_gsusb_frame_size(unsigned fmt)
+{
+    if ((fmt & SL_GSUSB_FMT_TIMESTAMP) != 0U) {
+        return SL_GSUSB_FRAME_TS_BYTES;
+    }
+    if ((fmt & SL_GSUSB_FMT_QUIRK) != 0U) {
+        return SL_GSUSB_FRAME_QUIRK_BYTES;
+    }
+    return SL_GSUSB_FRAME_BYTES;
+}
+
+sl_ssize_t sl_gsusb_frame_encode(const sl_gsusb_host_frame_t *hf, unsigned fmt, uint8_t *buf,
+                                 size_t cap)
+{
+    if (hf == NULL || buf == NULL ||
+        (fmt & (SL_GSUSB_FMT_TIMESTAMP | SL_GSUSB_FMT_QUIRK)) ==
+            (SL_GSUSB_FMT_TIMESTAMP | SL_GSUSB_FMT_QUIRK)) {
+        return SL_ERR_ARG;
+    }
+    size_t n = sl_gsusb_frame_size(fmt);
+    if (cap < n) {
+        return SL_ERR_FULL;
+    }
+    put_le32(buf + 0, hf->echo_id);
+    put_le32(buf + 4, hf->can_id);
+    buf[8] = hf->can_dlc;
+    buf[9] = hf->channel;
+    buf[10] = hf->flags;
+    buf[11] = hf->reserved;
+    memcpy(buf + 12, hf->data, 8);
+    if ((fmt & SL_GSUSB_FMT_TIMESTAMP) != 0U) {
+        put_le32(buf + 20, hf->timestamp_us);
+    } else if ((fmt & SL_GSUSB_FMT_QUIRK) != 0U) {
+        buf[20] = 0U;
+    }
+    return (sl_ssize_t)n;
+}
+
+sl_err_t sl_gsusb_frame_decode(const uint8_t *buf, size_t len, unsigned fmt, sl_gsusb_host_frame_t *out)
+{
+    if (buf == NULL || out == NULL) {
+        return SL_ERR_ARG;
+    }
+    bool ts = (fmt & SL_GSUSB_FMT_TIMESTAMP) != 0U;
+    if (len < (ts ? SL_GSUSB_FRAME_TS_BYTES : SL_GSUSB_FRAME_BYTES)) {
+        return SL_ERR_MALFORMED;
+    }
+    out->echo_id = get_le32(buf + 0);
+    out->can_id = get_le32(buf + 4);
+    out->can_dlc = buf[8];
+    out->channel = buf[9];
+    out->flags = buf[10];
+    out->reserved = buf[11];
+    memcpy(out->data, buf + 12, 8);
+    out->timestamp_us = ts ? get_le32(buf + 20) : 0U;
+    return SL_OK;
+}
+
+sl_err_t sl_gsusb_frame_from_can(const sl_can_frame_t *f, uint32_t echo_id, uint8_t channel,
+                                 sl_gsusb_host_frame_t *out)
+{
+    if (f == NULL || out == NULL || f->dlc > 8U || (f->flags & SL_CAN_FLAG_ERR) != 0U) {
+        return SL_ERR_ARG;
+    }
+    bool eff = (f->flags & SL_CAN_FLAG_EFF) != 0U;
+    bool rtr = (f->flags & SL_CAN_FLAG_RTR) != 0U;
+    if (f->id > (eff ? SL_CAN_EFF_MASK : SL_CAN_SFF_MASK)) {
+        return SL_ERR_ARG;
+    }
+    memset(out, 0, sizeof *out);
+    out->echo_id = echo_id;
+    out->can_id = f->id | (eff ? (uint32_t)SL_GSUSB_CAN_EFF_FLAG : 0U) |
+                  (rtr ? (uint32_t)SL_GSUSB_CAN_RTR_FLAG : 0U);
+    out->can_dlc = f->dlc;
+    out->channel = channel;
+    if (!rtr) {
+        memcpy(out->data, f->data, f->dlc);
+    }
+    return SL_OK;
+}
+
+sl_err_t sl_gsusb_frame_to_can(const sl_gsusb_host_frame_t *hf, sl_can_frame_t *out)
+{
+    if (hf == NULL || out == NULL) {
+        return SL_ERR_ARG;
+    }
+    if ((hf->flags & SL_GSUSB_FRAME_FLAG_FD) != 0U || hf->can_dlc > 8U) {
+        return SL_ERR_MALFORMED;
+    }
+    bool eff = (hf->can_id & SL_GSUSB_CAN_EFF_FLAG) != 0U;
+    bool rtr = (hf->can_id & SL_GSUSB_CAN_RTR_FLAG) != 0U;
+    bool err = (hf->can_id & SL_GSUSB_CAN_ERR_FLAG) != 0U;
+    if (err && rtr) {
+        return SL_ERR_MALFORMED;
+    }
+    memset(out, 0, sizeof *out);
+    out->dlc = hf->can_dlc;
+    if (err) {
+        out->id = hf->can_id & (uint32_t)SL_GSUSB_CAN_ERR_MASK;
+        out->flags = SL_CAN_FLAG_ERR;
+        memcpy(out->data, hf->data, hf->can_dlc);
+        return SL_OK;
+    }
+    out->id = hf->can_id & (uint32_t)(eff ? SL_CAN_EFF_MASK : SL_CAN_SFF_MASK);
+    out->flags = (uint8_t)((eff ? SL_CAN_FLAG_EFF : 0U) | (rtr ? SL_CAN_FLAG_RTR : 0U));
+    if (!rtr) {
+        memcpy(out->data, hf->data, hf->can_dlc);
+    }
+    return SL_OK;
+}
+
+// ---------------------------------------------------------------------------------------
+// Echo ids
+
+sl_err_t sl_gsusb_echo_init(sl_gsusb_echo_t *e, uint8_t capacity)
+{
+    if (e == NULL || capacity > SL_GSUSB_MAX_IN_FLIGHT) {
+        return SL_ERR_ARG;
+    }
+    memset(e, 0, sizeof *e);
+    e->capacity = capacity != 0U ? capacity : (uint8_t)SL_GSUSB_DEFAULT_IN_FLIGHT;
+    return SL_OK;
+}
+
+sl_ssize_t sl_gsusb_echo_alloc(sl_gsusb_echo_t *e, const sl_can_frame_t *frame, uint32_t tag,
+                               uint64_t now_us)
+{
+    if (e == NULL || frame == NULL) {
+        return SL_ERR_ARG;
+    }
+    for (uint8_t k = 0; k < e->capacity; k++) {
+        uint8_t id = (uint8_t)((e->next + k) % e->capacity);
+        sl_gsusb_echo_slot_t *s = &e->slot[id];
+        if (!s->in_use) {
+            s->in_use = true;
+            s->tag = tag;
+            s->sent_us = now_us;
+            s->frame = *frame;
+            e->next = (uint8_t)((id + 1U) % e->capacity);
+            e->in_flight++;
+            e->stats.allocated++;
+            if (e->in_flight > e->stats.max_in_flight) {
+                e->stats.max_in_flight = e->in_flight;
+            }
+            return (sl_ssize_t)id;
+        }
+    }
+    e->stats.full++;
+    return SL_ERR_FULL;
+}
+
+sl_err_t sl_gsusb_echo_release(sl_gsusb_echo_t *e, uint32_t echo_id)
+{
+    if (e == NULL || echo_id >= e->capacity || !e->slot[echo_id].in_use) {
+        return SL_ERR_ARG;
+    }
+    e->slot[echo_id].in_use = false;
+    e->in_flight--;
+    e->stats.allocated--;
+    // Give the id back to the round-robin search first: it was never used on the wire.
+    e->next = (uint8_t)echo_id;
+    return SL_OK;
+}
+
+sl_err_t sl_gsusb_echo_confirm(sl_gsusb_echo_t *e, uint32_t echo_id, sl_gsusb_echo_slot_t *done)
+{
+    if (e == NULL) {
+        return SL_ERR_ARG;
+    }
+    if (echo_id >= e->capacity || !e->slot[echo_id].in_use) {
+        e->stats.unknown++;
+        return SL_ERR_MALFORMED;
+    }
+    if (done != NULL) {
+        *done = e->slot[echo_id];
+    }
+    e->slot[echo_id].in_use = false;
+    e->in_flight--;
+    e->stats.confirmed++;
+    return SL_OK;
+}
+
+size_t sl_gsusb_echo_expire(sl_gsusb_echo_t *e, uint64_t now_us, uint64_t timeout_us,
+                            sl_gsusb_echo_done_fn cb, void *ctx)
+{
+    size_t n = 0;
+    if (e == NULL) {
+        return 0;
+    }
+    for (uint8_t id = 0; id < e->capacity; id++) {
+        sl_gsusb_echo_slot_t *s = &e->slot[id];
+        if (s->in_use && now_us >= s->sent_us && now_us - s->sent_us >= timeout_us) {
+            sl_gsusb_echo_slot_t copy = *s;
+            s->in_use = false;
+            e->in_flight--;
+            e->stats.timeouts++;
+            n++;
+            if (cb != NULL) {
+                cb(ctx, id, &copy, SL_GSUSB_TX_TIMEOUT);
+            }
+        }
+    }
+    return n;
+}
+
+size_t sl_gsusb_echo_drop_all(sl_gsusb_echo_t *e, sl_gsusb_echo_done_fn cb, void *ctx)
+{
+    size_t n = 0;
+    if (e == NULL) {
+        return 0;
+    }
+    for (uint8_t id = 0; id < e->capacity; id++) {
+        sl_gsusb_echo_slot_t *s = &e->slot[id];
+        if (s->in_use) {
+            sl_gsusb_echo_slot_t copy = *s;
+            s->in_use = false;
+            e->in_flight--;
+            e->stats.dropped++;
+            n++;
+            if (cb != NULL) {
+                cb(ctx, id, &copy, SL_GSUSB_TX_DROPPED);
+            }
+        }
+    }
+    return n;
+}
+
+uint64_t sl_gsusb_echo_deadline(const sl_gsusb_echo_t *e, uint64_t timeout_us)
+{
+    uint64_t best = UINT64_MAX;
+    if (e == NULL) {
+        return best;
+    }
+    for (uint8_t id = 0; id < e->capacity; id++) {
+        if (e->slot[id].in_use && e->slot[id].sent_us + timeout_us < best) {
+            best = e->slot[id].sent_us + timeout_us;
+        }
+    }
+    return best;
+}
+
+// ---------------------------------------------------------------------------------------
+// Driver
+
+void sl_gsusb_cfg_defaults(sl_gsusb_cfg_t *cfg)
+{
+    if (cfg == NULL) {
+        return;
+    }
+    memset(cfg, 0, sizeof *cfg);
+    cfg->bitrate = 500000U;
+    cfg->reset_first = true;
+    cfg->max_in_flight = (uint8_t)SL_GSUSB_DEFAULT_IN_FLIGHT;
+    cfg->echo_timeout_ms = 1000U;
+    cfg->control_timeout_ms = 1000U;
+    cfg->bulk_out_timeout_ms = 100U;
+    cfg->rx_budget = 64U;
+    cfg->io_error_limit = 3U;
+}
+
+sl_err_t sl_gsusb_init(sl_gsusb_t *d, const sl_gsusb_cfg_t *cfg, const sl_gsusb_transport_t *tr)
+{
+    if (d == NULL || cfg == NULL || tr == NULL || tr->ops == NULL || tr->ops->control_out == NULL ||
+        tr->ops->control_in == NULL || tr->ops->bulk_out == NULL || tr->ops->bulk_in == NULL ||
+        cfg->bitrate == 0U || cfg->max_in_flight > SL_GSUSB_MAX_IN_FLIGHT ||
+        (cfg->mode_flags & ~(uint32_t)SL_GSUSB_MODE_FLAGS_ALLOWED) != 0U ||
+        cfg->sample_point_permille >= 1000U) {
+        return SL_ERR_ARG;
+    }
+    memset(d, 0, sizeof *d);
+    d->cfg = *cfg;
+    if (d->cfg.max_in_flight == 0U) {
+        d->cfg.max_in_flight = (uint8_t)SL_GSUSB_DEFAULT_IN_FLIGHT;
+    }
+    if (d->cfg.echo_timeout_ms == 0U) {
+        d->cfg.echo_timeout_ms = 1000U;
+    }
+    if (d->cfg.control_timeout_ms == 0U) {
+        d->cfg.control_timeout_ms = 1000U;
+    }
+    if (d->cfg.bulk_out_timeout_ms == 0U) {
+        d->cfg.bulk_out_timeout_ms = 100U;
+    }
+    if (d->cfg.rx_budget == 0U) {
+        d->cfg.rx_budget = 64U;
+    }
+    if (d->cfg.io_error_limit == 0U) {
+        d->cfg.io_error_limit = 3U;
+    }
+    d->tr = *tr;
+    d->state = SL_GSUSB_CLOSED;
+    (void)sl_gsusb_echo_init(&d->echo, d->cfg.max_in_flight);
+    return SL_OK;
+}
+
+void sl_gsusb_set_transport(sl_gsusb_t *d, const sl_gsusb_transport_t *tr)
+{
+    if (d != NULL && tr != NULL) {
+        d->tr = *tr;
+    }
+}
+
+// printf-style into last_error; keeps the first message of a start-up.
+static void set_error(sl_gsusb_t *d, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+static void set_error(sl_gsusb_t *d, const char *fmt, ...)
+{
+    if (d->last_error[0] != '\0') {
+        return;
+    }
+    va_list ap;
+    va_start(ap, fmt);
+    (void)vsnprintf(d->last_error, sizeof d->last_error, fmt, ap);
+    va_end(ap);
+}
+
+static void echo_done_cb(void *ctx, uint32_t echo_id, const sl_gsusb_echo_slot_t *slot,
+                         sl_gsusb_tx_result_t result)
+{
+    sl_gsusb_t *d = ctx;
+    (void)echo_id;
+    if (result == SL_GSUSB_TX_TIMEOUT) {
+        d->stats.tx_unconfirmed++;
+    } else if (result == SL_GSUSB_TX_DROPPED) {
+        d->stats.tx_dropped++;
+    }
+    if (d->cfg.on_tx_done != NULL) {
+        d->cfg.on_tx_done(d->cfg.ctx, &slot->frame, slot->tag, result, 0U);
+    }
+}
+
+void sl_gsusb_mark_down(sl_gsusb_t *d)
+{
+    if (d == NULL) {
+        return;
+    }
+    if (d->state != SL_GSUSB_DOWN) {
+        d->stats.vanished++;
+    }
+    d->state = SL_GSUSB_DOWN;
+    d->io_errors_in_row = 0;
+    (void)sl_gsusb_echo_drop_all(&d->echo, echo_done_cb, d);
+}
+
+// Why a control request failed, for last_error.
+static const char *io_reason(sl_gsusb_io_t io)
+{
+    switch (io) {
+    case SL_GSUSB_IO_STALL: return "refused by the device (control request stalled)";
+    case SL_GSUSB_IO_TIMEOUT: return "timed out";
+    case SL_GSUSB_IO_NO_DEVICE: return "failed: the device vanished";
+    case SL_GSUSB_IO_OVERFLOW: return "failed: answer overflow";
+    case SL_GSUSB_IO_OK:
+    case SL_GSUSB_IO_ERROR:
+    default: return "failed (USB error)";
+    }
+}
+
+static sl_err_t ctrl_fail(sl_gsusb_t *d, uint8_t breq, sl_gsusb_io_t io)
+{
+    if (io == SL_GSUSB_IO_STALL) {
+        d->stats.ctrl_stalls++;
+    } else {
+        d->stats.ctrl_errors++;
+    }
+    set_error(d, "%s %s", sl_gsusb_breq_name(breq), io_reason(io));
+    if (io == SL_GSUSB_IO_NO_DEVICE) {
+        sl_gsusb_mark_down(d);
+    }
+    return SL_ERR_PORT;
+}
+
+static sl_err_t ctrl_out(sl_gsusb_t *d, uint8_t breq, uint16_t wvalue, uint16_t windex,
+                         const uint8_t *data, uint16_t len, sl_gsusb_io_t *io_out)
+{
+    size_t n = 0;
+    sl_gsusb_io_t io = d->tr.ops->control_out(d->tr.ctx, (uint8_t)SL_GSUSB_RT_OUT, breq, wvalue,
+                                              windex, data, len, d->cfg.control_timeout_ms, &n);
+    if (io_out != NULL) {
+        *io_out = io;
+    }
+    if (io == SL_GSUSB_IO_OK && n != len) {
+        io = SL_GSUSB_IO_ERROR;
+    }
+    return io == SL_GSUSB_IO_OK ? SL_OK : ctrl_fail(d, breq, io);
+}
+
+static sl_err_t ctrl_in(sl_gsusb_t *d, uint8_t breq, uint16_t wvalue, uint16_t windex,
+                        uint8_t *data, uint16_t len)
+{
+    size_t n = 0;
+    sl_gsusb_io_t io = d->tr.ops->control_in(d->tr.ctx, (uint8_t)SL_GSUSB_RT_IN, breq, wvalue,
+                                             windex, data, len, d->cfg.control_timeout_ms, &n);
+    if (io != SL_GSUSB_IO_OK) {
+        return ctrl_fail(d, breq, io);
+    }
+    if (n < len) {
+        d->stats.ctrl_errors++;
+        set_error(d, "%s answer too short (%zu of %u bytes)", sl_gsusb_breq_name(breq), n,
+                  (unsigned)len);
+        return SL_ERR_MALFORMED;
+    }
+    return SL_OK;
+}
+
+static sl_err_t start_sequence(sl_gsusb_t *d)
+{
+    uint8_t buf[SL_GSUSB_BT_CONST_BYTES];
+    sl_err_t rc;
+    uint16_t ch = d->cfg.channel;
+
+    // 1. HOST_FORMAT (per device: wValue 1, wIndex = interface number)
+    sl_gsusb_encode_host_format(buf);
+    rc = ctrl_out(d, SL_GSUSB_BREQ_HOST_FORMAT, 1U, SL_GSUSB_INTERFACE, buf,
+                  SL_GSUSB_HOST_FORMAT_BYTES, NULL);
+    if (rc != SL_OK) {
+        return rc;
+    }
+    // 2. DEVICE_CONFIG
+    memset(buf, 0, sizeof buf);
+    rc = ctrl_in(d, SL_GSUSB_BREQ_DEVICE_CONFIG, 1U, SL_GSUSB_INTERFACE, buf,
+                 SL_GSUSB_DEVICE_CONFIG_BYTES);
+    if (rc != SL_OK) {
+        return rc;
+    }
+    (void)sl_gsusb_decode_device_config(buf, SL_GSUSB_DEVICE_CONFIG_BYTES, &d->dev_cfg);
+    if ((unsigned)d->cfg.channel > d->dev_cfg.icount) {
+        set_error(d, "channel %u not present (the device has %u)", (unsigned)d->cfg.channel,
+                  (unsigned)d->dev_cfg.icount + 1U);
+        return SL_ERR_ARG;
+    }
+    // 3. BT_CONST (per channel: wValue = channel, wIndex 0)
+    memset(buf, 0, sizeof buf);
+    rc = ctrl_in(d, SL_GSUSB_BREQ_BT_CONST, ch, 0U, buf, SL_GSUSB_BT_CONST_BYTES);
+    if (rc != SL_OK) {
+        return rc;
+    }
+    (void)sl_gsusb_decode_bt_const(buf, SL_GSUSB_BT_CONST_BYTES, &d->bt_const);
+    const sl_gsusb_bt_const_t *c = &d->bt_const;
+    if (sl_gsusb_bt_const_check(c) != SL_OK) {
+        set_error(d,
+                  "BT_CONST reports implausible limits (fclk %lu Hz, tseg1 %lu..%lu, tseg2 "
+                  "%lu..%lu, brp %lu..%lu step %lu)",
+                  (unsigned long)c->fclk_hz, (unsigned long)c->tseg1_min,
+                  (unsigned long)c->tseg1_max, (unsigned long)c->tseg2_min,
+                  (unsigned long)c->tseg2_max, (unsigned long)c->brp_min,
+                  (unsigned long)c->brp_max, (unsigned long)c->brp_inc);
+        return SL_ERR_MALFORMED;
+    }
+    if ((d->cfg.mode_flags & ~c->feature) != 0U) {
+        set_error(d, "the device does not offer mode flags 0x%lx (features 0x%lx)",
+                  (unsigned long)(d->cfg.mode_flags & ~c->feature), (unsigned long)c->feature);
+        return SL_ERR_ARG;
+    }
+    d->rx_fmt = (d->cfg.hw_timestamp && (c->feature & SL_GSUSB_FEAT_HW_TIMESTAMP) != 0U)
+                    ? SL_GSUSB_FMT_TIMESTAMP
+                    : 0U;
+    d->tx_fmt = (c->feature & SL_GSUSB_FEAT_QUIRK_LPC546XX) != 0U ? SL_GSUSB_FMT_QUIRK : 0U;
+
+    // 4. bit timing from the clock and limits
+    rc = sl_gsusb_bittiming_calc(c, d->cfg.bitrate, d->cfg.sample_point_permille, &d->timing);
+    if (rc != SL_OK) {
+        if (d->timing.tq_per_bit == 0U) {
+            set_error(d,
+                      "bitrate %lu bit/s cannot be produced from the %lu Hz clock: no prescaler "
+                      "in %lu..%lu (step %lu) fits tseg1 %lu..%lu + tseg2 %lu..%lu",
+                      (unsigned long)d->cfg.bitrate, (unsigned long)c->fclk_hz,
+                      (unsigned long)c->brp_min, (unsigned long)c->brp_max,
+                      (unsigned long)c->brp_inc, (unsigned long)c->tseg1_min,
+                      (unsigned long)c->tseg1_max, (unsigned long)c->tseg2_min,
+                      (unsigned long)c->tseg2_max);
+        } else if (d->cfg.bitrate > SL_GSUSB_MAX_BITRATE) {
+            set_error(d, "bitrate %lu bit/s is above the classic CAN maximum of %lu bit/s",
+                      (unsigned long)d->cfg.bitrate, (unsigned long)SL_GSUSB_MAX_BITRATE);
+        } else {
+            set_error(d,
+                      "bitrate %lu bit/s cannot be produced from the %lu Hz clock: closest is "
+                      "%lu bit/s (brp %lu, %u tq), error %lu.%02lu %% > %u.%02u %%",
+                      (unsigned long)d->cfg.bitrate, (unsigned long)c->fclk_hz,
+                      (unsigned long)d->timing.bitrate, (unsigned long)d->timing.bt.brp,
+                      (unsigned)d->timing.tq_per_bit, (unsigned long)(d->timing.error_ppm / 10000U),
+                      (unsigned long)((d->timing.error_ppm / 100U) % 100U),
+                      SL_GSUSB_MAX_RATE_ERROR_PPM / 10000U,
+                      (SL_GSUSB_MAX_RATE_ERROR_PPM / 100U) % 100U);
+        }
+        return rc;
+    }
+
+    // 5. MODE RESET first (a channel left running), tolerated when refused
+    if (d->cfg.reset_first) {
+        sl_gsusb_io_t io = SL_GSUSB_IO_OK;
+        sl_gsusb_encode_mode(SL_GSUSB_MODE_RESET, 0U, buf);
+        rc = ctrl_out(d, SL_GSUSB_BREQ_MODE, ch, 0U, buf, SL_GSUSB_MODE_BYTES, &io);
+        if (rc != SL_OK) {
+            if (io != SL_GSUSB_IO_STALL) {
+                return rc;
+            }
+            d->last_error[0] = '\0'; // a refused RESET of a stopped channel is harmless
+        }
+    }
+    // 6. BITTIMING
+    sl_gsusb_encode_bittiming(&d->timing.bt, buf);
+    rc = ctrl_out(d, SL_GSUSB_BREQ_BITTIMING, ch, 0U, buf, SL_GSUSB_BITTIMING_BYTES, NULL);
+    if (rc != SL_OK) {
+        return rc;
+    }
+    // 7. MODE START
+    d->mode_flags_sent = d->cfg.mode_flags | (d->rx_fmt != 0U ? (uint32_t)SL_GSUSB_FEAT_HW_TIMESTAMP : 0U);
+    sl_gsusb_encode_mode(SL_GSUSB_MODE_START, d->mode_flags_sent, buf);
+    return ctrl_out(d, SL_GSUSB_BREQ_MODE, ch, 0U, buf, SL_GSUSB_MODE_BYTES, NULL);
+}
+
+sl_err_t sl_gsusb_start(sl_gsusb_t *d, uint64_t now_us)
+{
+    (void)now_us;
+    if (d == NULL) {
+        return SL_ERR_ARG;
+    }
+    if (d->state == SL_GSUSB_RUNNING) {
+        return SL_ERR_STATE;
+    }
+    (void)sl_gsusb_echo_drop_all(&d->echo, echo_done_cb, d);
+    d->last_error[0] = '\0';
+    d->io_errors_in_row = 0;
+    sl_gsusb_state_t before = d->state;
+    sl_err_t rc = start_sequence(d);
+    if (rc != SL_OK) {
+        d->stats.start_failures++;
+        if (d->state != SL_GSUSB_DOWN) {
+            d->state = before == SL_GSUSB_DOWN ? SL_GSUSB_DOWN : SL_GSUSB_CLOSED;
+        }
+        return rc;
+    }
+    d->state = SL_GSUSB_RUNNING;
+    d->stats.starts++;
+    return SL_OK;
+}
+
+// Count a transfer error; too many in a row means the device is as good as gone.
+static void io_error(sl_gsusb_t *d)
+{
+    if (++d->io_errors_in_row >= d->cfg.io_error_limit) {
+        sl_gsusb_mark_down(d);
+    }
+}
+
+static bool clear_halt(sl_gsusb_t *d, bool in)
+{
+    if (d->tr.ops->clear_halt == NULL) {
+        d->stats.clear_halt_failures++;
+        return false;
+    }
+    sl_gsusb_io_t io = d->tr.ops->clear_halt(d->tr.ctx, in);
+    if (io == SL_GSUSB_IO_OK) {
+        d->stats.clear_halts++;
+        return true;
+    }
+    d->stats.clear_halt_failures++;
+    if (io == SL_GSUSB_IO_NO_DEVICE) {
+        sl_gsusb_mark_down(d);
+    }
+    return false;
+}
+
+static uint64_t echo_timeout_us(const sl_gsusb_t *d)
+{
+    return (uint64_t)d->cfg.echo_timeout_ms * 1000U;
+}
+
+sl_err_t sl_gsusb_send(sl_gsusb_t *d, const sl_can_frame_t *f, uint32_t tag, uint64_t now_us)
+{
+    if (d == NULL || f == NULL) {
+        return SL_ERR_ARG;
+    }
+    if (d->state != SL_GSUSB_RUNNING) {
+        return SL_ERR_STATE;
+    }
+    sl_gsusb_host_frame_t hf;
+    if (sl_gsusb_frame_from_can(f, 0U, d->cfg.channel, &hf) != SL_OK) {
+        return SL_ERR_ARG;
+    }
+    (void)sl_gsusb_echo_expire(&d->echo, now_us, echo_timeout_us(d), echo_done_cb, d);
+    sl_ssize_t id = sl_gsusb_echo_alloc(&d->echo, f, tag, now_us);
+    if (id < 0) {
+        d->stats.tx_window_full++;
+        return SL_ERR_BUSY;
+    }
+    hf.echo_id = (uint32_t)id;
+    uint8_t buf[SL_GSUSB_FRAME_MAX_BYTES];
+    sl_ssize_t len = sl_gsusb_frame_encode(&hf, d->tx_fmt, buf, sizeof buf);
+    SL_ASSERT(len > 0);
+
+    for (int attempt = 0; attempt < 2; attempt++) {
+        size_t n = 0;
+        sl_gsusb_io_t io = d->tr.ops->bulk_out(d->tr.ctx, buf, (size_t)len,
+                                               d->cfg.bulk_out_timeout_ms, &n);
+        if (n == (size_t)len && (io == SL_GSUSB_IO_OK || io == SL_GSUSB_IO_TIMEOUT)) {
+            d->stats.tx_frames++;
+            d->io_errors_in_row = 0;
+            return SL_OK;
+        }
+        switch (io) {
+        case SL_GSUSB_IO_STALL:
+            d->stats.stalls_out++;
+            if (attempt == 0 && clear_halt(d, false)) {
+                d->stats.tx_retries++;
+                continue;
+            }
+            (void)sl_gsusb_echo_release(&d->echo, (uint32_t)id);
+            d->stats.tx_errors++;
+            return SL_ERR_PORT;
+        case SL_GSUSB_IO_TIMEOUT:
+            (void)sl_gsusb_echo_release(&d->echo, (uint32_t)id);
+            d->stats.tx_timeouts++;
+            return SL_ERR_BUSY;
+        case SL_GSUSB_IO_NO_DEVICE:
+            (void)sl_gsusb_echo_release(&d->echo, (uint32_t)id);
+            d->stats.tx_errors++;
+            sl_gsusb_mark_down(d);
+            return SL_ERR_PORT;
+        case SL_GSUSB_IO_OK: // short write
+        case SL_GSUSB_IO_OVERFLOW:
+        case SL_GSUSB_IO_ERROR:
+        default:
+            (void)sl_gsusb_echo_release(&d->echo, (uint32_t)id);
+            d->stats.tx_errors++;
+            io_error(d);
+            return SL_ERR_PORT;
+        }
+    }
+    // Unreachable: the second attempt returns in every branch.
+    (void)sl_gsusb_echo_release(&d->echo, (uint32_t)id);
+    d->stats.tx_errors++;
+    return SL_ERR_PORT;
+}
+
+static void handle_error_frame(sl_gsusb_t *d, const sl_can_frame_t *f)
+{
+    d->stats.rx_error_frames++;
+    if ((f->id & SL_GSUSB_ERR_BUSOFF) != 0U) {
+        d->stats.bus_off++;
+    }
+    if ((f->id & SL_GSUSB_ERR_CRTL) != 0U && f->dlc >= 2U) {
+        uint8_t st = f->data[1];
+        if ((st & (SL_GSUSB_ERR_CRTL_RX_PASSIVE | SL_GSUSB_ERR_CRTL_TX_PASSIVE)) != 0U) {
+            d->stats.err_passive++;
+        }
+        if ((st & (SL_GSUSB_ERR_CRTL_RX_WARNING | SL_GSUSB_ERR_CRTL_TX_WARNING)) != 0U) {
+            d->stats.err_warning++;
+        }
+    }
+}
+
+static void handle_packet(sl_gsusb_t *d, const uint8_t *pkt, size_t len, uint64_t now_us)
+{
+    sl_gsusb_host_frame_t hf;
+    if (sl_gsusb_frame_decode(pkt, len, d->rx_fmt, &hf) != SL_OK) {
+        d->stats.rx_malformed++;
+        return;
+    }
+    if (hf.echo_id != (uint32_t)SL_GSUSB_ECHO_ID_RX) {
+        sl_gsusb_echo_slot_t done;
+        if (sl_gsusb_echo_confirm(&d->echo, hf.echo_id, &done) != SL_OK) {
+            d->stats.echo_unknown++;
+            return;
+        }
+        sl_gsusb_host_frame_t sent;
+        (void)sl_gsusb_frame_from_can(&done.frame, hf.echo_id, d->cfg.channel, &sent);
+        if (sent.can_id != hf.can_id || sent.can_dlc != hf.can_dlc) {
+            d->stats.echo_mismatch++;
+        }
+        d->stats.tx_confirmed++;
+        if (d->cfg.on_tx_done != NULL) {
+            uint64_t lat = now_us >= done.sent_us ? now_us - done.sent_us : 0U;
+            d->cfg.on_tx_done(d->cfg.ctx, &done.frame, done.tag, SL_GSUSB_TX_CONFIRMED, lat);
+        }
+        return;
+    }
+    if (hf.channel != d->cfg.channel) {
+        d->stats.rx_other_channel++;
+        return;
+    }
+    sl_can_frame_t f;
+    if (sl_gsusb_frame_to_can(&hf, &f) != SL_OK) {
+        d->stats.rx_malformed++;
+        return;
+    }
+    sl_gsusb_rx_info_t info = {
+        .now_us = now_us,
+        .timestamp_us = hf.timestamp_us,
+        .has_timestamp = d->rx_fmt != 0U,
+        .overflow = (hf.flags & SL_GSUSB_FRAME_FLAG_OVERFLOW) != 0U,
+    };
+    if (info.overflow) {
+        d->stats.rx_overflows++;
+    }
+    if ((f.flags & SL_CAN_FLAG_ERR) != 0U) {
+        handle_error_frame(d, &f);
+    } else {
+        d->stats.rx_frames++;
+    }
+    if (d->cfg.on_rx != NULL) {
+        d->cfg.on_rx(d->cfg.ctx, &f, &info);
+    }
+}
+
+sl_ssize_t sl_gsusb_poll(sl_gsusb_t *d, uint32_t timeout_ms, uint64_t now_us)
+{
+    if (d == NULL) {
+        return SL_ERR_ARG;
+    }
+    if (d->state != SL_GSUSB_RUNNING) {
+        return SL_ERR_STATE;
+    }
+    sl_ssize_t handled = 0;
+    uint8_t pkt[512];
+    uint32_t wait = timeout_ms;
+    for (uint16_t k = 0; k < d->cfg.rx_budget; k++) {
+        size_t n = 0;
+        sl_gsusb_io_t io = d->tr.ops->bulk_in(d->tr.ctx, pkt, sizeof pkt, wait, &n);
+        wait = 0;
+        if (io == SL_GSUSB_IO_OK) {
+            d->io_errors_in_row = 0;
+            handle_packet(d, pkt, n, now_us);
+            handled++;
+            continue;
+        }
+        if (io == SL_GSUSB_IO_TIMEOUT) {
+            break;
+        }
+        if (io == SL_GSUSB_IO_STALL) {
+            d->stats.stalls_in++;
+            (void)clear_halt(d, true);
+            break;
+        }
+        if (io == SL_GSUSB_IO_NO_DEVICE) {
+            sl_gsusb_mark_down(d);
+            break;
+        }
+        if (io == SL_GSUSB_IO_OVERFLOW) {
+            d->stats.rx_malformed++;
+            continue;
+        }
+        d->stats.rx_io_errors++;
+        io_error(d);
+        break;
+    }
+    if (d->state != SL_GSUSB_RUNNING) {
+        return SL_ERR_PORT;
+    }
+    (void)sl_gsusb_echo_expire(&d->echo, now_us, echo_timeout_us(d), echo_done_cb, d);
+    return handled;
+}
+
+sl_err_t sl_gsusb_get_state(sl_gsusb_t *d, sl_gsusb_can_state_t *out)
+{
+    if (d == NULL || out == NULL) {
+        return SL_ERR_ARG;
+    }
+    if (d->state != SL_GSUSB_RUNNING || (d->bt_const.feature & SL_GSUSB_FEAT_GET_STATE) == 0U) {
+        return SL_ERR_STATE;
+    }
+    uint8_t buf[SL_GSUSB_STATE_BYTES];
+    sl_err_t rc = ctrl_in(d, SL_GSUSB_BREQ_GET_STATE, d->cfg.channel, 0U, buf, SL_GSUSB_STATE_BYTES);
+    if (rc != SL_OK) {
+        return rc;
+    }
+    return sl_gsusb_decode_state(buf, sizeof buf, out);
+}
+
+void sl_gsusb_stop(sl_gsusb_t *d)
+{
+    if (d == NULL) {
+        return;
+    }
+    if (d->state == SL_GSUSB_RUNNING) {
+        uint8_t buf[SL_GSUSB_MODE_BYTES];
+        size_t n = 0;
+        sl_gsusb_encode_mode(SL_GSUSB_MODE_RESET, 0U, buf);
+        sl_gsusb_io_t io = d->tr.ops->control_out(d->tr.ctx, (uint8_t)SL_GSUSB_RT_OUT,
+                                                  SL_GSUSB_BREQ_MODE, d->cfg.channel, 0U, buf,
+                                                  SL_GSUSB_MODE_BYTES, d->cfg.control_timeout_ms, &n);
+        if (io != SL_GSUSB_IO_OK) {
+            d->stats.ctrl_errors++;
+        }
+    }
+    (void)sl_gsusb_echo_drop_all(&d->echo, echo_done_cb, d);
+    d->state = SL_GSUSB_CLOSED;
+}
+
+uint8_t sl_gsusb_in_flight(const sl_gsusb_t *d)
+{
+    return d != NULL ? d->echo.in_flight : 0U;
+}
+
+int sl_gsusb_next_timeout_ms(const sl_gsusb_t *d, uint64_t now_us)
+{
+    if (d == NULL) {
+        return -1;
+    }
+    uint64_t dl = sl_gsusb_echo_deadline(&d->echo, echo_timeout_us(d));
+    if (dl == UINT64_MAX) {
+        return -1;
+    }
+    if (dl <= now_us) {
+        return 0;
+    }
+    uint64_t ms = (dl - now_us + 999U) / 1000U;
+    return ms > (uint64_t)INT32_MAX ? INT32_MAX : (int)ms;
+}

@@ -1,0 +1,193 @@
+// sim_eval.h: accuracy evaluation of the inclination estimator on simulated captures.
+//
+// Chain: Colossus bytes -> core decoder (sl_proto_feed / sl_proto_parse_fft) -> the bins of
+// the pole's nominal azimuth (from the ground truth) -> bounding-box extraction (first/last
+// bin above threshold of the run that overlaps the true segment, inside the ground shadow;
+// "bbox extraction (detection pipeline not used)") -> corrections (half-bin, sub-bin from the
+// partial-fill amplitude, elongation d, radius) -> core estimator sl_incline_estimate()
+// with the board's theta and a chosen beta (sl::make_geom) -> error against the truth.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "shadowlean/sl_proto.h"
+#include "sim_scene.h"
+#include "sim_truth.h"
+#include "sl_board_spec.h"
+
+namespace sl {
+
+/// Decodes a radar byte stream with the core decoder and hands every FFT row over with its
+/// rotation index (0 = first FFT message; +1 whenever the azimuth index does not increase).
+class CaptureRows {
+public:
+    using RowFn = std::function<void(int rotation, int azimuth, const uint8_t *bins, uint32_t n)>;
+    explicit CaptureRows(RowFn on_row);
+    CaptureRows(const CaptureRows &) = delete;
+    CaptureRows &operator=(const CaptureRows &) = delete;
+    void feed(const uint8_t *data, size_t n);
+    void finish();
+    bool have_config() const { return have_cfg_; }
+    const sl_proto_config_t &config() const { return cfg_; }
+    double bin_m() const { return bin_um_ * 1e-6; }
+    const sl_proto_stats_t &stats() const { return p_.stats; }
+    uint32_t bad_fft() const { return bad_fft_; }
+    int rotations_seen() const { return rot_ + 1; }
+
+private:
+    static void on_msg(void *ctx, const sl_proto_msg_t *m);
+    RowFn on_row_;
+    sl_proto_t p_{};
+    std::vector<uint8_t> reasm_;
+    sl_proto_config_t cfg_{};
+    bool have_cfg_ = false;
+    uint32_t bin_um_ = 0;
+    int rot_ = -1, last_az_ = -1;
+    uint32_t bad_fft_ = 0;
+};
+
+/// A run of bins [i1, i2] (inclusive); found = false when nothing qualifies.
+struct BinRun {
+    bool found = false;
+    int i1 = -1, i2 = -1;
+};
+
+/// Bounding-box extraction on one azimuth: runs of bins with value >= threshold inside
+/// [lo_bin, hi_bin], runs closer than `gap_bins` merged; returns the run with the largest
+/// overlap with [want_lo, want_hi] (the true segment's bins).
+BinRun bbox_run(const double *v, int n, double threshold, int lo_bin, int hi_bin, int want_lo,
+                int want_hi, int gap_bins = 1);
+
+/// Planar pole model for sub-bin bounds: the energy the renderer puts in each bin for a pole
+/// of radius R whose axis spans elevations [-theta, beta] with bounds (r1, r2).
+struct SubbinModel {
+    double theta_deg = 26, beta_deg = 0, radius_m = 0.005, bin_m = 0.0438;
+    std::function<double(double)> gain; ///< elevation gain G(e deg)
+};
+
+/// Sub-bin bounds from the partial-fill amplitudes of the edge bins: solves for the AXIS
+/// r1 in bin i1 (front surface) and r2 in bin i2 such that the model's ratios
+/// E(i1)/E(i1+1) and E(i2)/E(i2-1) match the observed ones (alternating bisections,
+/// starting from the half-bin values). false (r1, r2 untouched) when the run is too short
+/// or the model has no valid inclination. Needs a noise-free linear amplitude.
+bool subbin_bounds(const double *v, int n, int i1, int i2, const SubbinModel &m, double *r1,
+                   double *r2);
+
+/// Energies of bins [lo, hi] predicted by the planar model (relative units).
+std::vector<double> subbin_model_bins(const SubbinModel &m, double r1, double r2, int lo, int hi);
+
+/// How the bounds are formed from a run and passed to the estimator.
+struct Proc {
+    enum class Bounds { Raw, HalfBin, SubBin } bounds = Bounds::HalfBin;
+    double r1_add_m = 0;        ///< radius correction: front surface -> axis (r1 += R)
+    double beta_model_deg = 0;  ///< beta in the estimator's geometry (paper: 0)
+    double d_const_m = 0;       ///< elongation: r2 -= d
+    std::vector<ElongPoint> d_table; ///< elongation table d(r2_obs) (overrides d_const when set)
+};
+
+/// Outcome of one estimate.
+struct Est {
+    bool extracted = false;     ///< a run was found
+    int flag = 0;               ///< sl_incline_flag_t of the core estimator
+    double alpha_deg = 0, sigma_deg = 0, r1_m = 0, r2_m = 0;
+};
+
+/// Runs the core estimator (integer) on bounds in metres with the board's theta.
+Est core_estimate(double r1_m, double r2_m, double theta_deg, double beta_deg,
+                  double sigma_r_m, double sigma_theta_deg);
+
+/// Extraction + corrections + estimator for one row. `v` are the azimuth's bins
+/// (double: 8-bit values or means over frames).
+Est estimate_row(const double *v, int n, const GtRow &gt, const BoardSpec &b, double threshold,
+                 int lo_bin, int hi_bin, const Proc &proc, const SubbinModel *sub);
+
+/// Error statistics of one condition.
+struct ErrStats {
+    std::vector<double> err;    ///< alpha_est - alpha_true (deg), valid estimates
+    int rows = 0, missed = 0, ambiguous = 0, invalid = 0;
+    double mean = 0, std = 0, rmse = 0, maxabs = 0;
+    void add(const Est &e, double truth);
+    void finish();
+};
+
+/// Linear interpolation in an elongation table (clamped at the ends); 0 when empty.
+double elong_at(const std::vector<ElongPoint> &t, double r_m);
+
+/// Simulates `scene` in memory and decodes the bytes with the core decoder. `on_gt` gets
+/// each rotation's ground truth before its bytes are decoded; `on_row` every decoded row.
+void simulate_decode(const Scene &scene, int threads,
+                     const std::function<void(int k, const std::vector<GtRow> &gt)> &on_gt,
+                     const CaptureRows::RowFn &on_row,
+                     const std::function<void(int done, int total)> &progress = {});
+
+// ------------------------------------------------------------------------------------------
+// Experiments (sl-eval table1 / realistic)
+
+struct Table1Options {
+    int rotations = 400;        ///< per pass (vehicle covers 10 m: speed = 10 m / (rot / 4 Hz))
+    int threads = 0;
+    bool progress = true;
+    double lateral_m = 3.0;     ///< axis point at radar height, lateral offset (paper Fig. 7: 3 m)
+};
+
+struct Table1Row {
+    std::string name, paper_label;
+    double paper_mean[3] = {0, 0, 0}, paper_std[3] = {0, 0, 0};
+    ErrStats paper_style[3];    ///< the paper's processing (bbox, half-bin from "corrected" on, beta = 0)
+    ErrStats improved_a[3];     ///< + beta in the model + radius correction r1 += R (half-bin)
+    ErrStats improved_b[3];     ///< + beta + sub-bin bounds from the fill amplitude (R in the model)
+    std::string paper_proc, a_proc, b_proc;
+};
+
+struct CurvePoint {
+    double along_m, truth_deg, paper_deg, improved_deg;
+};
+
+struct Table1Result {
+    std::vector<Table1Row> rows;
+    int angles[3] = {-10, 0, 10};
+    std::vector<CurvePoint> curves[2][3]; ///< [ideal, real corrected][angle]
+    int rotations = 0;
+    double seconds = 0;
+};
+
+Table1Result run_table1(const Table1Options &o);
+void print_table1(std::FILE *f, const Table1Result &r);
+std::string table1_json(const Table1Result &r);
+/// Fig. 7-8 style plot (alpha(y) curves). false + err on failure.
+bool plot_table1(const std::string &png, const Table1Result &r, std::string &err);
+
+struct RealisticOptions {
+    int positions = 11, reps = 4, frames = 16, threads = 0;
+    int calib_positions = 12;   ///< vertical poles over 1.75-3.0 m for d(r)
+    bool progress = true;
+    int range_bins = 512;       ///< bins per azimuth in the simulated stream (contoured data)
+};
+
+struct RealisticResult {
+    int angles[5] = {-10, -5, 0, 5, 10};
+    double paper_mean[5] = {-11.00, -3.80, 3.64, 1.82, 9.45};
+    double paper_std[5] = {2.52, 3.91, 3.30, 3.59, 3.04};
+    ErrStats paper_style[5], improved[5];
+    std::vector<double> est_paper[5], est_improved[5]; ///< the estimates themselves
+    double d_const_m = 0;       ///< paper-style calibration: mean d over 1.75-2.30 m
+    std::vector<ElongPoint> d_table; ///< our calibration: d(r2_obs) table over 1.75-3.0 m
+    std::vector<std::pair<double, double>> calib; ///< (r2_obs, d) samples
+    double seconds = 0;
+    int frames = 16, positions = 11, reps = 4;
+};
+
+RealisticResult run_realistic(const RealisticOptions &o);
+void print_realistic(std::FILE *f, const RealisticResult &r);
+std::string realistic_json(const RealisticResult &r);
+
+/// The realistic bench scene (paper-bench board): pole base `dist_m` ahead on azimuth 0,
+/// tilt `alpha_deg` in the radar's plane (> 0 = towards it).
+Scene realistic_scene(double dist_m, double alpha_deg, uint64_t seed, int frames, int range_bins);
+/// The table-1 pass scene: `cond` 0 ideal, 1 real res, 2 measured emission, 3 10 cm, 4 20 cm.
+Scene table1_scene(int cond, int angle_deg, int rotations, double lateral_m);
+
+} // namespace sl

@@ -1,0 +1,175 @@
+// view_frames.cpp: capture / Oxford folder -> rotations, through sl_proto and sl_scan.
+#include "view_frames.h"
+
+#include <algorithm>
+#include <memory>
+#include <sys/stat.h>
+
+#include "capture.h"
+#include "oxford.h"
+
+namespace sl {
+namespace {
+
+struct DecodeCtx {
+    sl_scan_t scan{};
+    const FrameOptions *opt = nullptr;
+    FrameSet *out = nullptr;
+    bool stop = false;
+    uint32_t config_bin_um = 0;
+};
+
+void on_frame(void *vctx, const sl_scan_frame_t *f)
+{
+    auto *c = static_cast<DecodeCtx *>(vctx);
+    if (c->stop) {
+        return;
+    }
+    const int az = f->azimuths;
+    if (az <= 0 || f->stats.valid < c->opt->min_valid_fraction * az) {
+        c->out->dropped_partial++;
+        return;
+    }
+    RadarFrame fr;
+    fr.rotation = f->rotation;
+    fr.t_first_us = f->t_first_us;
+    fr.t_last_us = f->t_last_us;
+    fr.valid_azimuths = f->stats.valid;
+    fr.power = cv::Mat(az, f->roi_bins, CV_8U);
+    fr.flags.assign(f->flags, f->flags + az);
+    for (int i = 0; i < az; i++) {
+        std::copy(f->power[i], f->power[i] + f->roi_bins, fr.power.ptr<uint8_t>(i));
+    }
+    c->out->azimuths = az;
+    c->out->encoder_size = f->encoder_size;
+    c->out->frames.push_back(std::move(fr));
+    if (c->opt->max_frames > 0 && static_cast<int>(c->out->frames.size()) >= c->opt->max_frames) {
+        c->stop = true;
+    }
+}
+
+void on_msg(void *vctx, const sl_proto_msg_t *m)
+{
+    auto *c = static_cast<DecodeCtx *>(vctx);
+    if (c->stop) {
+        return;
+    }
+    if (m->id == SL_PROTO_ID_CONFIGURATION) {
+        sl_proto_config_t cfg;
+        if (sl_proto_parse_config(m, &cfg) == SL_OK) {
+            const uint32_t um = sl_proto_config_bin_size_um(&cfg);
+            if (um > 0 && c->config_bin_um == 0) {
+                c->config_bin_um = um;
+            }
+        }
+    }
+    (void)sl_scan_on_msg(&c->scan, m);
+}
+
+bool is_dir(const std::string &p)
+{
+    struct stat st {};
+    return ::stat(p.c_str(), &st) == 0 && S_ISDIR(st.st_mode);
+}
+
+bool decode(const Capture &cap, const FrameOptions &opt, FrameSet &out, std::string &err)
+{
+    if (opt.roi_bins < 1 || opt.roi_bins > SL_CFG_ROI_BINS) {
+        err = "roi_bins must be in 1.." + std::to_string(SL_CFG_ROI_BINS);
+        return false;
+    }
+    auto ctx = std::make_unique<DecodeCtx>();
+    auto fill = std::make_unique<sl_scan_frame_t>();
+    auto spare = std::make_unique<sl_scan_frame_t>();
+    ctx->opt = &opt;
+    ctx->out = &out;
+    sl_scan_cfg_t sc{};
+    sc.roi_bins = static_cast<uint16_t>(opt.roi_bins);
+    sc.pow16_shift = 8;
+    sc.azimuths = static_cast<uint16_t>(opt.azimuths);
+    sc.encoder_size = static_cast<uint16_t>(opt.encoder_size);
+    sc.ignore_sweep = opt.ignore_sweep;
+    sc.on_frame = on_frame;
+    sc.ctx = ctx.get();
+    if (sl_scan_init(&ctx->scan, &sc, fill.get(), spare.get()) != SL_OK) {
+        err = "sl_scan_init rejected the geometry (azimuths " + std::to_string(opt.azimuths) +
+              ", encoder " + std::to_string(opt.encoder_size) + ")";
+        return false;
+    }
+    std::vector<uint8_t> reasm(kHostMaxPayloadBytes);
+    sl_proto_t p{};
+    sl_proto_cfg_t pc{};
+    pc.reasm_buf = reasm.data();
+    pc.reasm_size = reasm.size();
+    pc.on_msg = on_msg;
+    pc.ctx = ctx.get();
+    (void)sl_proto_init(&p, &pc);
+    feed_capture(cap, &p);
+    sl_scan_flush(&ctx->scan);
+    out.proto = p.stats;
+    out.scan = ctx->scan.stats;
+    out.roi_bins = opt.roi_bins;
+    if (opt.bin_size_m > 0) {
+        out.bin_size_m = opt.bin_size_m;
+        out.bin_from_config = false;
+    } else if (ctx->config_bin_um > 0) {
+        out.bin_size_m = ctx->config_bin_um * 1e-6;
+        out.bin_from_config = true;
+    }
+    if (out.frames.empty()) {
+        err = "no complete rotation decoded (" + std::to_string(out.proto.fft8 + out.proto.fft16) +
+              " FFT messages, " + std::to_string(out.dropped_partial) + " partial frames)";
+        return false;
+    }
+    if (out.bin_size_m <= 0) {
+        err = "no bin size: the stream has no Configuration; give one (board or --bin-size-m)";
+        return false;
+    }
+    return true;
+}
+
+} // namespace
+
+bool decode_frames(const std::vector<uint8_t> &bytes, const FrameOptions &opt, FrameSet &out,
+                   std::string &err)
+{
+    Capture cap;
+    cap.format = CaptureFormat::Raw;
+    cap.bytes = bytes;
+    if (out.kind.empty()) {
+        out.kind = "raw";
+    }
+    return decode(cap, opt, out, err);
+}
+
+bool load_frames(const std::string &path, const FrameOptions &opt, FrameSet &out,
+                 std::string &err)
+{
+    out = FrameSet{};
+    out.source = path;
+    Capture cap;
+    if (is_dir(path)) {
+        OxfordOptions oo;
+        if (opt.bin_size_m > 0) {
+            oo.bin_size_m = opt.bin_size_m;
+        }
+        OxfordReport rep;
+        cap.format = CaptureFormat::Raw;
+        if (!oxford_to_colossus(path, oo, cap.bytes, rep, err)) {
+            return false;
+        }
+        out.kind = "oxford-png";
+    } else {
+        if (!load_capture(path, cap, err)) {
+            return false;
+        }
+        out.kind = capture_format_name(cap.format);
+    }
+    if (!decode(cap, opt, out, err)) {
+        err = path + ": " + err;
+        return false;
+    }
+    return true;
+}
+
+} // namespace sl

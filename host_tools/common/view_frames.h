@@ -1,0 +1,68 @@
+// view_frames.h: a capture (raw .colossus, pcap/pcapng) or an Oxford PNG folder decoded into
+// whole rotations, for the host tools that look at images (sl-view, sl-calib). Host only.
+//
+// Every byte goes through the core: capture.h reads the file, sl_proto_feed() decodes the
+// Colossus stream (1 MiB reassembly buffer) and sl_scan assembles rotations (double
+// buffering, nearest-azimuth index, the first `roi_bins` bins of each azimuth). An Oxford
+// folder is first converted with oxford.h (the same converter as `sl-replay from-oxford`)
+// into an in-memory Colossus stream, so it is decoded exactly as its converted capture.
+//
+// Frames are copied out as cv::Mat (CV_8U, azimuths x roi_bins, row = azimuth index, column =
+// range bin). Frames with fewer than `min_valid_fraction` of their azimuths stored are dropped
+// and counted (an Oxford sequence ends with a one-row frame: its last row, encoder tick 5599,
+// is azimuth index 0 and opens a frame that never fills).
+//
+// Memory: the capture bytes plus one Mat per kept frame (400 x 512 B = 200 KB each).
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "shadowlean/sl_proto.h"
+#include "shadowlean/sl_scan.h"
+
+namespace sl {
+
+struct RadarFrame {
+    uint32_t rotation = 0;          ///< sl_scan frame number (0 = first in the stream)
+    uint64_t t_first_us = 0, t_last_us = 0;
+    int valid_azimuths = 0;         ///< rows stored
+    cv::Mat power;                  ///< CV_8U, azimuths x roi_bins
+    std::vector<uint8_t> flags;     ///< SL_SCAN_AZ_* per azimuth
+};
+
+struct FrameOptions {
+    int roi_bins = SL_CFG_ROI_BINS;     ///< bins kept per azimuth (1 .. SL_CFG_ROI_BINS)
+    int azimuths = 0, encoder_size = 0; ///< geometry for streams without a Configuration
+    double bin_size_m = 0;          ///< > 0: overrides the stream's bin size; Oxford folders:
+                                    ///< the bin size written into the converted stream
+    double min_valid_fraction = 0.5;///< drop frames with fewer valid azimuths than this
+    int max_frames = 0;             ///< > 0: stop after this many kept frames
+    bool ignore_sweep = false;      ///< sl_scan cfg.ignore_sweep
+};
+
+struct FrameSet {
+    std::string source;             ///< path given
+    std::string kind;               ///< "raw", "pcap", "pcapng", "oxford-png"
+    int azimuths = 0, encoder_size = 0, roi_bins = 0;
+    double bin_size_m = 0;          ///< from the Configuration (or the override / board)
+    bool bin_from_config = false;   ///< true: the stream's Configuration gave the bin size
+    std::vector<RadarFrame> frames;
+    int dropped_partial = 0;        ///< frames dropped by min_valid_fraction
+    sl_proto_stats_t proto{};
+    sl_scan_stats_t scan{};
+};
+
+/// Decodes `path` (a capture file, or a folder of Oxford PNGs: DIR/radar/*.png or DIR/*.png).
+/// false + err on I/O or format errors, or when no frame survives.
+bool load_frames(const std::string &path, const FrameOptions &opt, FrameSet &out,
+                 std::string &err);
+
+/// Decodes an in-memory Colossus byte stream (same rules as load_frames).
+bool decode_frames(const std::vector<uint8_t> &bytes, const FrameOptions &opt, FrameSet &out,
+                   std::string &err);
+
+} // namespace sl
