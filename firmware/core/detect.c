@@ -442,9 +442,6 @@ static void finalize(sl_detect_t *d, sl_detect_cand_t *c)
 // wait for the wrap merge at the end of the rotation.
 static void close_before(sl_detect_t *d, uint32_t a)
 {
-    if (d->n_open == 0U) {
-        return;
-    }
     for (uint32_t i = 0; i < SL_CFG_DETECT_MAX_CANDIDATES; i++) {
         sl_detect_cand_t *c = &d->cand[i];
         if (c->state != ST_OPEN || (uint32_t)c->az_last + 1U >= a) {
@@ -514,10 +511,24 @@ sl_err_t sl_detect_row(sl_detect_t *d, uint16_t az, const uint32_t *occ, uint32_
     }
     d->last_az = az;
     d->stats.rows++;
-    close_before(d, az);
+    if (d->n_open != 0U) {
+        close_before(d, az);
+    }
     const uint32_t limit = words * 32U < d->bins ? words * 32U : d->bins;
     const uint32_t win = d->win_bins[az] < limit ? d->win_bins[az] : limit;
     const uint32_t near = d->near_bins;
+    if (win <= near) {
+        return SL_OK;
+    }
+    // Fast exit for the common azimuth: nothing occupied in [near, win) (the last word is
+    // not trimmed at win: a set bit beyond it only costs the exact scan below).
+    uint32_t any = occ[near >> 5] & (UINT32_MAX << (near & 31U));
+    for (uint32_t w = (near >> 5) + 1U; w <= (win - 1U) >> 5; w++) {
+        any |= occ[w];
+    }
+    if (any == 0U) {
+        return SL_OK;
+    }
     const uint32_t edge = d->edge_bins[az];
     const uint32_t gap = d->cfg.gap_bins;
     uint32_t pos = near;

@@ -1,4 +1,5 @@
 // n-frame consistency mask with bit-sliced count-down run counters (sl_mask.h).
+#include <stdbool.h>
 #include <stdint.h>
 #include <string.h>
 
@@ -6,6 +7,14 @@
 
 #if SL_CFG_MASK_FRAMES_MAX > 255
 #error "frames are stored in uint8_t"
+#endif
+
+// The per-P specialisations below rely on inlining with P constant (then the plane loops
+// unroll and the planes stay in registers); compilers otherwise keep one generic copy.
+#if defined(__GNUC__)
+#define FORCE_INLINE static inline __attribute__((always_inline))
+#else
+#define FORCE_INLINE static inline
 #endif
 
 #define ST_HISTORY 1U
@@ -32,109 +41,160 @@ static inline void st(uint32_t *p, lane_t v)
     memcpy(p, &v, sizeof v);
 }
 
-// One lane: x = new row, *l = last row, c[0..P) = counter planes (k, count-down).
-// Returns the stable mask after the update (k == 0).
-static inline lane_t step(lane_t x, lane_t *l, lane_t *c, unsigned P, uint32_t nm1)
+// Load/store one lane at word w: a full lane (memcpy), or a single word (the odd tail).
+FORCE_INLINE lane_t lane_ld(const uint32_t *p, bool one)
 {
-    const lane_t d = x ^ *l;
-    *l = x;
-    lane_t nz = 0;
-    for (unsigned p = 0; p < P; p++) {
-        nz |= c[p];
+    return one ? (lane_t)p[0] : ld(p);
+}
+
+FORCE_INLINE void lane_st(uint32_t *p, lane_t v, bool one)
+{
+    if (one) {
+        p[0] = (uint32_t)v;
+    } else {
+        st(p, v);
     }
-    // k -= 1 where the bin is unchanged and k > 0: ripple borrow through the planes.
-    lane_t b = nz & ~d;
-    for (unsigned p = 0; p < P; p++) {
-        const lane_t t = ~c[p] & b;
-        c[p] ^= b;
+}
+
+// Update one lane of one azimuth. P (counter planes) and `one` are compile-time constants
+// at every call site, so the plane code below folds to straight-line code on scalars
+// (unused planes are constant 0). k counts down: see sl_mask.h.
+//   d = x ^ L;  k -= 1 where !d && k > 0 (borrow chain);  k = n - 1 where d;  L = x;
+//   stable = (k == 0).
+FORCE_INLINE void lane_update(uint32_t (*pl)[SL_ROI_WORDS], const uint32_t *x, uint32_t *occ,
+                              uint32_t *fr, uint32_t w, unsigned P, const lane_t *rp, bool one,
+                              bool full)
+{
+    const lane_t xv = lane_ld(&x[w], one);
+    const lane_t d = xv ^ lane_ld(&pl[0][w], one);
+    lane_t c0 = 0, c1 = 0, c2 = 0, c3 = 0, c4 = 0, b, t;
+    if (P > 0U) {
+        c0 = lane_ld(&pl[1][w], one);
+    }
+    if (P > 1U) {
+        c1 = lane_ld(&pl[2][w], one);
+    }
+    if (P > 2U) {
+        c2 = lane_ld(&pl[3][w], one);
+    }
+    if (P > 3U) {
+        c3 = lane_ld(&pl[4][w], one);
+    }
+    if (P > 4U) {
+        c4 = lane_ld(&pl[5][w], one);
+    }
+    b = (c0 | c1 | c2 | c3 | c4) & ~d; // decrement: unchanged and k > 0
+    if (P > 0U) {
+        t = ~c0 & b;
+        // Borrow step, then reset to n - 1 where d (n = 2^P: n - 1 is all ones).
+        c0 = full ? ((c0 ^ b) | d) : (((c0 ^ b) & ~d) | (d & rp[0]));
         b = t;
     }
-    // k = n - 1 where the bin changed.
-    lane_t nz2 = 0;
-    for (unsigned p = 0; p < P; p++) {
-        c[p] = (((nm1 >> p) & 1U) != 0U) ? (c[p] | d) : (c[p] & ~d);
-        nz2 |= c[p];
+    if (P > 1U) {
+        t = ~c1 & b;
+        c1 = full ? ((c1 ^ b) | d) : (((c1 ^ b) & ~d) | (d & rp[1]));
+        b = t;
     }
-    return ~nz2;
+    if (P > 2U) {
+        t = ~c2 & b;
+        c2 = full ? ((c2 ^ b) | d) : (((c2 ^ b) & ~d) | (d & rp[2]));
+        b = t;
+    }
+    if (P > 3U) {
+        t = ~c3 & b;
+        c3 = full ? ((c3 ^ b) | d) : (((c3 ^ b) & ~d) | (d & rp[3]));
+        b = t;
+    }
+    if (P > 4U) {
+        c4 = full ? ((c4 ^ b) | d) : (((c4 ^ b) & ~d) | (d & rp[4]));
+    }
+    (void)t;
+    const lane_t s = ~(c0 | c1 | c2 | c3 | c4);
+    lane_st(&pl[0][w], xv, one);
+    if (P > 0U) {
+        lane_st(&pl[1][w], c0, one);
+    }
+    if (P > 1U) {
+        lane_st(&pl[2][w], c1, one);
+    }
+    if (P > 2U) {
+        lane_st(&pl[3][w], c2, one);
+    }
+    if (P > 3U) {
+        lane_st(&pl[4][w], c3, one);
+    }
+    if (P > 4U) {
+        lane_st(&pl[5][w], c4, one);
+    }
+    if (occ != NULL) {
+        lane_st(&occ[w], s & xv, one);
+    }
+    if (fr != NULL) {
+        lane_st(&fr[w], s & ~xv, one);
+    }
 }
 
-// Update `words` words of one azimuth. P is a compile-time constant at every call site
-// (see update_dispatch), so the plane loops unroll and the planes stay in registers.
-static inline void update_row(uint32_t (*pl)[SL_ROI_WORDS], const uint32_t *x, uint32_t *occ,
-                              uint32_t *fr, uint32_t words, unsigned P, uint32_t nm1)
+FORCE_INLINE void update_row(uint32_t (*pl)[SL_ROI_WORDS], const uint32_t *x, uint32_t *occ,
+                             uint32_t *fr, uint32_t words, unsigned P, uint32_t nm1, bool full)
 {
+    lane_t rp[5];
+    for (unsigned p = 0; p < 5U; p++) {
+        rp[p] = (((nm1 >> p) & 1U) != 0U) ? ~(lane_t)0 : (lane_t)0;
+    }
     uint32_t w = 0;
     for (; w + LANE_WORDS <= words; w += LANE_WORDS) {
-        lane_t c[SL_MASK_COUNTER_PLANES + 1];
-        lane_t l = ld(&pl[0][w]);
-        const lane_t xv = ld(&x[w]);
-        for (unsigned p = 0; p < P; p++) {
-            c[p] = ld(&pl[1U + p][w]);
-        }
-        const lane_t s = step(xv, &l, c, P, nm1);
-        st(&pl[0][w], l);
-        for (unsigned p = 0; p < P; p++) {
-            st(&pl[1U + p][w], c[p]);
-        }
-        if (occ != NULL) {
-            st(&occ[w], s & xv);
-        }
-        if (fr != NULL) {
-            st(&fr[w], s & ~xv);
-        }
+        lane_update(pl, x, occ, fr, w, P, rp, false, full);
     }
-    // Odd tail word (64-bit lanes only): same step on a zero-extended word.
     for (; w < words; w++) {
-        lane_t c[SL_MASK_COUNTER_PLANES + 1];
-        lane_t l = pl[0][w];
-        const lane_t xv = x[w];
-        for (unsigned p = 0; p < P; p++) {
-            c[p] = pl[1U + p][w];
-        }
-        const lane_t s = step(xv, &l, c, P, nm1);
-        pl[0][w] = (uint32_t)l;
-        for (unsigned p = 0; p < P; p++) {
-            pl[1U + p][w] = (uint32_t)c[p];
-        }
-        if (occ != NULL) {
-            occ[w] = (uint32_t)(s & xv);
-        }
-        if (fr != NULL) {
-            fr[w] = (uint32_t)(s & ~xv);
-        }
+        lane_update(pl, x, occ, fr, w, P, rp, true, full);
     }
 }
 
+// Specialised on P and on n being a power of two (reset value all ones: one OR per plane).
+#define UPD(P_, F_) update_row(pl, x, occ, fr, words, (P_), nm1, (F_))
 static void update_dispatch(uint32_t (*pl)[SL_ROI_WORDS], const uint32_t *x, uint32_t *occ,
                             uint32_t *fr, uint32_t words, unsigned P, uint32_t nm1)
 {
-    switch (P) {
-    case 0:
-        update_row(pl, x, occ, fr, words, 0U, nm1);
+    const bool full = nm1 == (((uint32_t)1U << P) - 1U);
+    switch (P * 2U + (full ? 1U : 0U)) {
+    case 1: // n = 1
+        UPD(0U, true);
         break;
 #if SL_MASK_COUNTER_PLANES >= 1
-    case 1:
-        update_row(pl, x, occ, fr, words, 1U, nm1);
+    case 3: // n = 2
+        UPD(1U, true);
         break;
 #endif
 #if SL_MASK_COUNTER_PLANES >= 2
-    case 2:
-        update_row(pl, x, occ, fr, words, 2U, nm1);
+    case 4:
+        UPD(2U, false);
+        break;
+    case 5:
+        UPD(2U, true);
         break;
 #endif
 #if SL_MASK_COUNTER_PLANES >= 3
-    case 3:
-        update_row(pl, x, occ, fr, words, 3U, nm1);
+    case 6:
+        UPD(3U, false);
+        break;
+    case 7:
+        UPD(3U, true);
         break;
 #endif
 #if SL_MASK_COUNTER_PLANES >= 4
-    case 4:
-        update_row(pl, x, occ, fr, words, 4U, nm1);
+    case 8:
+        UPD(4U, false);
+        break;
+    case 9:
+        UPD(4U, true);
         break;
 #endif
 #if SL_MASK_COUNTER_PLANES >= 5
-    case 5:
-        update_row(pl, x, occ, fr, words, 5U, nm1);
+    case 10:
+        UPD(5U, false);
+        break;
+    case 11:
+        UPD(5U, true);
         break;
 #endif
     default:
@@ -142,22 +202,60 @@ static void update_dispatch(uint32_t (*pl)[SL_ROI_WORDS], const uint32_t *x, uin
         break;
     }
 }
+#undef UPD
 
-// Read-only view of the stable planes of one azimuth with history.
-static void stable_row(const uint32_t (*pl)[SL_ROI_WORDS], uint32_t *occ, uint32_t *fr,
-                       uint32_t words, unsigned P)
+// Stable planes of one azimuth with history, specialised on P like the update.
+FORCE_INLINE void stable_words(const uint32_t (*pl)[SL_ROI_WORDS], uint32_t *occ, uint32_t *fr,
+                               uint32_t words, unsigned P)
 {
     for (uint32_t w = 0; w < words; w++) {
-        uint32_t nz = 0;
-        for (unsigned p = 0; p < P; p++) {
-            nz |= pl[1U + p][w];
-        }
+        const uint32_t nz = (P > 0U ? pl[1][w] : 0U) | (P > 1U ? pl[2][w] : 0U) |
+                            (P > 2U ? pl[3][w] : 0U) | (P > 3U ? pl[4][w] : 0U) |
+                            (P > 4U ? pl[5][w] : 0U);
         if (occ != NULL) {
             occ[w] = ~nz & pl[0][w];
         }
         if (fr != NULL) {
             fr[w] = ~nz & ~pl[0][w];
         }
+    }
+}
+
+static void stable_row(const uint32_t (*pl)[SL_ROI_WORDS], uint32_t *occ, uint32_t *fr,
+                       uint32_t words, unsigned P)
+{
+    switch (P) {
+    case 0:
+        stable_words(pl, occ, fr, words, 0U);
+        break;
+#if SL_MASK_COUNTER_PLANES >= 1
+    case 1:
+        stable_words(pl, occ, fr, words, 1U);
+        break;
+#endif
+#if SL_MASK_COUNTER_PLANES >= 2
+    case 2:
+        stable_words(pl, occ, fr, words, 2U);
+        break;
+#endif
+#if SL_MASK_COUNTER_PLANES >= 3
+    case 3:
+        stable_words(pl, occ, fr, words, 3U);
+        break;
+#endif
+#if SL_MASK_COUNTER_PLANES >= 4
+    case 4:
+        stable_words(pl, occ, fr, words, 4U);
+        break;
+#endif
+#if SL_MASK_COUNTER_PLANES >= 5
+    case 5:
+        stable_words(pl, occ, fr, words, 5U);
+        break;
+#endif
+    default:
+        SL_ASSERT(0);
+        break;
     }
 }
 

@@ -4,6 +4,13 @@
 #include "shadowlean/sl_err.h"
 #include "shadowlean/sl_thresh.h"
 
+// The SWAR kernels are specialised on `low` (threshold <= 128) by inlining with a constant.
+#if defined(__GNUC__)
+#define FORCE_INLINE static inline __attribute__((always_inline))
+#else
+#define FORCE_INLINE static inline
+#endif
+
 // Lane = the widest integer the target handles natively (a 64-bit multiply on a 32-bit
 // core would be a library call). All lane arithmetic below is per-byte carry-free.
 #if UINTPTR_MAX > 0xFFFFFFFFU
@@ -36,7 +43,7 @@ typedef uint32_t lane_t;
 #define LANE_HALVES (LANE_BYTES / 2U)
 
 // Bytes p[0..LANE_BYTES) with p[i] in bits 8i.. (endian-independent; one load on LE).
-static inline lane_t ld8(const uint8_t *p)
+FORCE_INLINE lane_t ld8(const uint8_t *p)
 {
 #if UINTPTR_MAX > 0xFFFFFFFFU
     return (lane_t)p[0] | ((lane_t)p[1] << 8) | ((lane_t)p[2] << 16) | ((lane_t)p[3] << 24) |
@@ -47,7 +54,7 @@ static inline lane_t ld8(const uint8_t *p)
 #endif
 }
 
-static inline lane_t ld16(const uint16_t *p)
+FORCE_INLINE lane_t ld16(const uint16_t *p)
 {
 #if UINTPTR_MAX > 0xFFFFFFFFU
     return (lane_t)p[0] | ((lane_t)p[1] << 16) | ((lane_t)p[2] << 32) | ((lane_t)p[3] << 48);
@@ -57,12 +64,12 @@ static inline lane_t ld16(const uint16_t *p)
 }
 
 // Flags in the top bit of each byte -> LANE_BYTES bits, byte k -> bit k.
-static inline uint32_t gather8(lane_t msb)
+FORCE_INLINE uint32_t gather8(lane_t msb)
 {
     return (uint32_t)(((msb >> 7) * GATHER8) >> GATHER8_SHIFT);
 }
 
-static inline uint32_t gather16(lane_t msb)
+FORCE_INLINE uint32_t gather16(lane_t msb)
 {
     return (uint32_t)(((msb >> 15) * GATHER16) >> GATHER16_SHIFT);
 }
@@ -70,14 +77,48 @@ static inline uint32_t gather16(lane_t msb)
 // x >= t per byte with one threshold. For 1 <= t <= 128, c = 128 - t: (x & 0x7F) + c
 // stays below 256 and has its top bit set iff (x & 0x7F) >= t; x >= t iff that or x >= 128.
 // For 129 <= t <= 255, c = 256 - t: x >= t iff x >= 128 and (x & 0x7F) >= t - 128.
-static inline lane_t ge8(lane_t x, lane_t c, bool low)
+FORCE_INLINE lane_t ge8(lane_t x, lane_t c, bool low)
 {
     const lane_t s = (x & L8) + c;
     return (low ? (x | s) : (x & s)) & H8;
 }
 
-// One output word: 32 bins, unrolled (compilers keep the loop otherwise).
-static inline uint32_t word8(const uint8_t *p, lane_t c, bool low)
+#if UINTPTR_MAX > 0xFFFFFFFFU
+// 64-bit lanes: 64 bins at a time without multiplies. Lane j (bins 8j..8j+7) contributes
+// its byte flags shifted to bit j of every byte: acc byte k bit j = bin 8j + k. An 8x8 bit
+// transpose (Hacker's Delight 7-3: element (r, c) at bit 8r + c) turns that into byte j
+// bit k = bit 8j + k = bin 8j + k.
+FORCE_INLINE uint64_t transpose8(uint64_t x)
+{
+    uint64_t t = (x ^ (x >> 7)) & 0x00AA00AA00AA00AAU;
+    x = x ^ t ^ (t << 7);
+    t = (x ^ (x >> 14)) & 0x0000CCCC0000CCCCU;
+    x = x ^ t ^ (t << 14);
+    t = (x ^ (x >> 28)) & 0x00000000F0F0F0F0U;
+    return x ^ t ^ (t << 28);
+}
+
+FORCE_INLINE void block64(const uint8_t *p, lane_t c, bool low, uint32_t *out)
+{
+    // Horner: after lane j the earlier lanes moved one bit down; lane j ends at bit j.
+#define H(j) acc = (acc >> 1) | ge8(ld8(p + 8U * (j)), c, low)
+    uint64_t acc = ge8(ld8(p), c, low);
+    H(1U);
+    H(2U);
+    H(3U);
+    H(4U);
+    H(5U);
+    H(6U);
+    H(7U);
+#undef H
+    const uint64_t bitsv = transpose8(acc);
+    out[0] = (uint32_t)bitsv;
+    out[1] = (uint32_t)(bitsv >> 32);
+}
+#endif
+
+// One output word: 32 bins (multiply gather), unrolled.
+FORCE_INLINE uint32_t word8(const uint8_t *p, lane_t c, bool low)
 {
 #define G8(j) (gather8(ge8(ld8(p + (j) * LANE_BYTES), c, low)) << ((j) * LANE_BYTES))
 #if UINTPTR_MAX > 0xFFFFFFFFU
@@ -88,12 +129,18 @@ static inline uint32_t word8(const uint8_t *p, lane_t c, bool low)
 #undef G8
 }
 
-static inline void thresh8_rows(const uint8_t *row, uint32_t bins, uint8_t t, uint32_t *bits,
-                                bool low)
+FORCE_INLINE void thresh8_rows(const uint8_t *row, uint32_t bins, uint8_t t, uint32_t *bits,
+                               bool low)
 {
     const lane_t c = ONES8 * (lane_t)(low ? 128U - t : 256U - t);
     const uint32_t full = bins / 32U;
-    for (uint32_t w = 0; w < full; w++) {
+    uint32_t w = 0;
+#if UINTPTR_MAX > 0xFFFFFFFFU
+    for (; w + 2U <= full; w += 2U) {
+        block64(row + 32U * w, c, low, &bits[w]);
+    }
+#endif
+    for (; w < full; w++) {
         bits[w] = word8(row + 32U * w, c, low);
     }
     const uint32_t rem = bins % 32U;
@@ -166,13 +213,13 @@ void sl_thresh_u8_table(const uint8_t *row, uint32_t bins, const uint8_t *table,
 }
 
 // Same scheme as ge8 on 16-bit lanes.
-static inline lane_t ge16(lane_t x, lane_t c, bool low)
+FORCE_INLINE lane_t ge16(lane_t x, lane_t c, bool low)
 {
     const lane_t s = (x & L16) + c;
     return (low ? (x | s) : (x & s)) & H16;
 }
 
-static inline void thresh16_rows(const uint16_t *row, uint32_t bins, uint32_t t,
+FORCE_INLINE void thresh16_rows(const uint16_t *row, uint32_t bins, uint32_t t,
                                  uint32_t *bits, bool low)
 {
     const lane_t c = ONES16 * (lane_t)(low ? 32768U - t : 65536U - t);

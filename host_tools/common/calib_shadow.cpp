@@ -124,6 +124,7 @@ ShadowCalib calibrate_shadow(const std::vector<cv::Mat> &frames,
     }
     c.mean = cv::Mat(A, K, CV_32F, cv::Scalar(0));
     cv::Mat single(A, K, CV_32F, cv::Scalar(0)); // range-smoothed single-azimuth means
+    cv::Mat raw(A, K, CV_32F, cv::Scalar(0));    // windowed, not range-smoothed
     c.profile = cv::Mat(A, K, CV_32F, cv::Scalar(0));
     std::vector<double> tmp(K);
     for (int a = 0; a < A; a++) {
@@ -143,13 +144,14 @@ ShadowCalib calibrate_shadow(const std::vector<cv::Mat> &frames,
         }
         for (int k = 0; k < K; k++) {
             tmp[k] = n ? tmp[k] / n : 0.0;
+            raw.at<float>(a, k) = static_cast<float>(tmp[k]);
         }
         smooth_row(tmp.data(), c.profile.ptr<float>(a), K, s);
     }
 
     const int kmax = std::min(K - 1, static_cast<int>(opt.search_max_m / b));
     const int knear = std::max(1, std::min(kmax, static_cast<int>(opt.near_search_m / b)));
-    const int persist = std::max(1, static_cast<int>(std::lround(opt.persist_m / b)));
+    const int confirm = std::max(2, static_cast<int>(std::lround(opt.confirm_m / b)));
     const int gwin = std::max(2, static_cast<int>(std::lround(opt.ground_window_m / b)));
     auto to_m = [&](double pos_bins) { return pos_bins * b; };
 
@@ -158,20 +160,17 @@ ShadowCalib calibrate_shadow(const std::vector<cv::Mat> &frames,
         ShadowAz &r = c.az[a];
         r = ShadowAz{};
         r.az = a;
-        r.theta_deg = r.theta_raw_deg = r.ground_start_m = r.ground_radius_m = kNaN;
+        r.theta_deg = r.theta_raw_deg = r.ground_start_m = r.ground_half_m = r.ground_radius_m =
+            kNaN;
         const float *p = c.profile.ptr<float>(a);
+        const float *pr = raw.ptr<float>(a);
         const float *p1 = single.ptr<float>(a);
         int kpk = 1;
         const double P = max_in(p, 1, knear, &kpk);
-        int kmin = kpk;
         double F = 1e30;
         for (int k = kpk; k <= kmax; k++) {
-            if (p[k] < F) {
-                F = p[k];
-                kmin = k;
-            }
+            F = std::min(F, static_cast<double>(p[k]));
         }
-        (void)kmin;
         r.near_peak_level = P;
         r.core_level = F;
         if (P - F < opt.min_ring_contrast) {
@@ -219,33 +218,36 @@ ShadowCalib calibrate_shadow(const std::vector<cv::Mat> &frames,
         }
         // Core: first bin after the band within 15 % of (P - F) of the floor.
         const double core_lvl = F + 0.15 * (P - F);
+        const int core_len = std::max(1, static_cast<int>(std::lround(opt.min_core_m / b)));
         int kc = k;
-        while (kc <= kmax && p[kc] > core_lvl) {
-            kc++;
+        for (; kc <= kmax; kc++) {
+            int n = 0;
+            while (kc + n <= kmax && n < core_len && p[kc + n] <= core_lvl) {
+                n++;
+            }
+            if (n >= core_len) {
+                break;
+            }
         }
-        if (kc > kmax) {
+        if (kc >= kmax) {
             r.reason = "no dark ring";
             continue;
         }
         r.core_m = to_m(kc + 0.5);
-        // Noise of the dark core: std of p over the next 0.5 m of dark bins.
+        // Noise of the dark core: robust sigma of the unsmoothed profile from its first
+        // differences over the next 0.5 m (MAD / 0.6745 / sqrt 2; insensitive to a slope).
         double sigma = 0;
         {
             std::vector<double> v;
-            for (int kk = kc; kk <= std::min(kmax, kc + static_cast<int>(0.5 / b)); kk++) {
-                if (p[kk] <= core_lvl) {
-                    v.push_back(p[kk]);
-                }
+            for (int kk = kc + 1; kk <= std::min(kmax, kc + static_cast<int>(0.5 / b)); kk++) {
+                v.push_back(std::fabs(pr[kk] - pr[kk - 1]));
             }
             if (v.size() > 2) {
-                double m = 0;
-                for (double x : v) m += x;
-                m /= v.size();
-                for (double x : v) sigma += (x - m) * (x - m);
-                sigma = std::sqrt(sigma / (v.size() - 1));
+                sigma = median(v) / 0.6745 / std::sqrt(2.0);
             }
         }
         const double d0 = std::max(opt.min_ground_contrast, 4.0 * sigma);
+        r.rise_level = d0;
         // Inner edge: walking inwards from the core, last bin above Li.
         const double li = F + std::max(opt.min_ground_contrast, 0.1 * (P - F));
         int ki = kc;
@@ -253,89 +255,89 @@ ShadowCalib calibrate_shadow(const std::vector<cv::Mat> &frames,
             ki--;
         }
         r.inner_edge_m = to_m(ki + 1 <= kc ? cross_at(p, ki + 1, li) : kc + 0.5);
-        // Ground: first persistent rise above F + d0 after the core.
-        int k0 = -1;
+        // Ground foot: the first bin after the core whose unsmoothed level reaches F + d0 and
+        // that starts a confirmed rise (>= 90 % of the next confirm_m stays >= F + d0 / 2).
+        // A rise that falls back is a return inside the ring: remembered, skipped.
+        int kf = -1;
         double bright_m = 0, bright_lvl = 0;
         for (int kk = kc + 1; kk <= kmax; kk++) {
-            if (p[kk] < F + d0) {
+            if (pr[kk] < F + d0) {
                 continue;
             }
-            int run = 0;
-            while (kk + run <= kmax && p[kk + run] >= F + 0.5 * d0) {
-                run++;
+            const int end = std::min(kmax, kk + confirm);
+            int up = 0, run = 0;
+            bool in_run = true;
+            for (int j = kk; j <= end; j++) {
+                const bool hi = p[j] >= F + 0.5 * d0;
+                up += hi ? 1 : 0;
+                if (in_run && hi) {
+                    run++;
+                } else {
+                    in_run = false;
+                }
             }
-            if (run >= persist || kk + run > kmax) {
-                k0 = kk;
+            if (up >= 0.9 * (end - kk + 1) && end - kk >= confirm / 2) {
+                kf = kk;
                 break;
             }
-            // Isolated return inside the ring: remember the strongest.
             int at = kk;
-            const double m = max_in(p, kk, kk + run - 1, &at);
-            if (m > bright_lvl) {
-                bright_lvl = m;
+            const double m = max_in(pr, kk, kk + std::max(0, run - 1), &at);
+            if (m - F > bright_lvl) {
+                bright_lvl = m - F;
                 bright_m = to_m(at + 0.5);
             }
-            kk += run;
+            kk += std::max(0, run - 1);
         }
-        if (k0 < 0 || k0 >= kmax) {
+        if (kf < 0) {
             r.reason = "no ground edge";
             continue;
         }
-        {
-            std::vector<double> v;
-            for (int kk = k0; kk <= std::min(kmax, k0 + gwin); kk++) {
-                v.push_back(p[kk]);
-            }
-            r.ground_level = quantile(v, opt.ground_ref_quantile);
-        }
+        // Where ground returns start: the centre of the first ground bin (partly filled bins
+        // count, as the half-bin rule for targets). The half rise uses the ground level G =
+        // max of the smoothed profile over the first ground_window_m after the foot.
+        const double S = to_m(kf + 0.5);
+        r.ground_start_m = S;
+        r.ground_level = max_in(p, kf, std::min(kmax, kf + gwin));
         const double G = r.ground_level;
+        {
+            const double L = F + 0.5 * (G - F);
+            int kh = std::max(kc + 1, kf - 2);
+            while (kh <= kmax && p[kh] < L) {
+                kh++;
+            }
+            r.ground_half_m = kh <= kmax ? to_m(cross_at(p, kh, L)) : kNaN;
+        }
+        const double Suse = opt.edge_half_rise ? r.ground_half_m : S;
+        if (std::isfinite(Suse) && Suse > H) {
+            r.ground_radius_m = std::sqrt(Suse * Suse - H * H);
+            r.theta_raw_deg = std::asin(H / Suse) * 180.0 / kPi;
+        }
         if (G - F < opt.min_ground_contrast) {
             r.reason = "no ground edge";
             continue;
         }
-        const double L = F + opt.edge_fraction * (G - F);
-        int ke = std::max(kc + 1, k0);
-        // Start from the last bin before k0 that is below F + d0 (the foot of the rise).
-        while (ke > kc + 1 && p[ke - 1] >= F + 0.5 * d0) {
-            ke--;
-        }
-        while (ke <= kmax && p[ke] < L) {
-            ke++;
-        }
-        if (ke > kmax) {
-            r.reason = "no ground edge";
-            continue;
-        }
-        const double S = to_m(cross_at(p, std::max(ke, 1), L));
-        r.ground_start_m = S;
-        if (S > H) {
-            r.ground_radius_m = std::sqrt(S * S - H * H);
-            r.theta_raw_deg = std::asin(H / S) * 180.0 / kPi;
-        }
-        // Bright return inside the ring (windowed or single-azimuth profile).
-        const double bright_thr = F + std::max(opt.bright_min, opt.bright_fraction * (G - F));
-        const int kin = std::max(kpk, static_cast<int>(r.inner_edge_m / b + 0.5));
-        const int kout = static_cast<int>(S / b - 0.5) - 1;
-        for (const float *q : {p, p1}) {
-            // Skip the band's own tail: start after the first dark bin past the inner edge.
-            int kk = kin;
-            while (kk < kout && q[kk] > li) {
+        // Bright return inside the ring: the strongest skipped rise, or on the single-azimuth
+        // profile any bin between the first dark bin past the inner edge and the foot.
+        {
+            int kk = std::max(kpk, static_cast<int>(r.inner_edge_m / b));
+            while (kk < kf && p[kk] > li) {
                 kk++;
             }
-            for (; kk <= kout; kk++) {
-                if (q[kk] > bright_thr && q[kk] > bright_lvl) {
-                    bright_lvl = q[kk];
+            for (; kk < kf - 1; kk++) {
+                if (p1[kk] - F > opt.single_az_factor * opt.bright_min &&
+                    p1[kk] - F > bright_lvl) {
+                    bright_lvl = p1[kk] - F;
                     bright_m = to_m(kk + 0.5);
                 }
             }
         }
-        if (bright_lvl > bright_thr) {
-            r.bright_inside_m = bright_m;
-            r.bright_level = bright_lvl;
+        r.bright_inside_m = bright_m;
+        r.bright_level = bright_lvl;
+        if (bright_lvl > opt.bright_min) {
             r.reason = "bright return inside the ring";
             continue;
         }
-        if (!(S > H)) {
+        if (!(Suse > H)) {
             r.reason = "ground start within the radar height";
             continue;
         }

@@ -1,38 +1,43 @@
 // calib_shadow.h: the chassis shadow measured from many rotations (sl-calib shadow).
 //
 // Per azimuth the rotations (and +-az_half_window neighbouring azimuths) are averaged into a
-// mean range profile p(k) of the 8-bit power, smoothed over +-range_smooth_bins bins. On it:
+// mean range profile of the 8-bit power: `raw` (no range smoothing) and p (boxcar of
+// +-range_smooth_bins bins). Bin k spans [k b, (k + 1) b), its centre is (k + 1/2) b.
 //
-//  - near-field band: the brightest bin up to near_search_m is the band's peak P; the band
-//    ends (`near_end_m`) where p falls through F + 0.5 (P - F) (half fall). Its stability in
-//    time is the median over the band's bins of std/mean across rotations (`near_cv`).
-//  - dark core: F = min p over [band peak, search_max_m] (`core_level`); `core_m` is the
-//    first bin after the band that comes within 15 % of (P - F) of F (the ring's first dark
-//    bin, not the global argmin: a return splitting the ring leaves its inner half as core).
-//  - inner edge (`inner_edge_m`): walking inwards from the core, the last bin whose p is
-//    above F + max(min_ground_contrast, 0.1 (P - F)): where the band's tail meets the floor.
-//  - ground start (`ground_start_m`, SLANT range): G = the ground_ref_quantile of p over
-//    [core, core + ground_window_m] (`ground_level`); the first upward crossing of
-//    L = F + edge_fraction (G - F) after the core, interpolated linearly between bin centres
-//    (bin k spans [k b, (k + 1) b), centre (k + 1/2) b). A crossing that does not stay above
-//    F + 0.5 (L - F) for persist_m is an isolated return inside the ring: recorded
-//    (`bright_inside_m`), the search continues beyond it.
+//  - near-field band: the brightest bin of p up to near_search_m is the band's peak P; the
+//    band ends (`near_end_m`) where p falls through F + 0.5 (P - F) (half fall, interpolated).
+//    Its stability in time (`near_cv`) is the median over the band's bins of std/mean across
+//    rotations.
+//  - dark core: F = min p over [band peak, search_max_m] (`core_level`); `core_m` is the first
+//    bin after the band that starts min_core_m of bins within 15 % of (P - F) of F. The noise
+//    sigma of `raw` over the next 0.5 m (robust: MAD of first differences / 0.6745 / sqrt 2)
+//    sets the rise level d0 = max(min_ground_contrast, 4 sigma) (`rise_level`).
+//  - inner edge (`inner_edge_m`): walking inwards from the core, where p rises above
+//    F + max(min_ground_contrast, 0.1 (P - F)): the band's tail meets the floor.
+//  - ground start (`ground_start_m`, SLANT range S): the first bin after the core whose raw
+//    level reaches F + d0 and starts a confirmed rise (>= 90 % of the next confirm_m of p
+//    stays >= F + d0 / 2); S is that bin's centre (a partly lit bin counts, as the half-bin
+//    rule of the targets). A rise that falls back to the floor is a return inside the ring:
+//    skipped, its level remembered. `ground_level` G = max of p over ground_window_m after
+//    the foot; `ground_half_m` = where p crosses F + 0.5 (G - F) (half rise, as REAL_SCANS
+//    s.2 uses). theta uses S, or the half rise with edge_half_rise.
 //  - theta(az) = atan(H / R) with the horizontal radius R = sqrt(S^2 - H^2) of the slant
 //    ground start S (the radar measures slant range): theta = asin(H / S).
 //
 // Unusable azimuths (never given a theta; `reason` says why):
-//  - "no dark ring": P - F < min_ring_contrast (the band never falls to a floor);
-//  - "no ground edge": no persistent rise after the core within search_max_m, or
-//    G - F < min_ground_contrast (platform occludes the sector, or no road return);
-//  - "bright return inside the ring": on the windowed OR the single-azimuth profile, a bin
-//    between the inner edge and the ground start exceeds F + bright_fraction (G - F) and is
-//    separated from the band by dark bins (a platform self-return, or an object in the ring);
+//  - "no dark ring": P - F < min_ring_contrast, or the band never falls to the core level;
+//  - "no ground edge": no confirmed rise after the core within search_max_m, or
+//    G - F < min_ground_contrast (the platform occludes the sector, or no road return);
+//  - "bright return inside the ring": a skipped rise, or a bin of the single-azimuth profile
+//    between the first dark bin past the inner edge and the foot, more than bright_min
+//    (single azimuth: single_az_factor x bright_min) above F: a platform self-return or an
+//    object standing in the ring;
 //  - "ground start within the radar height": S <= H (no real angle);
 //  - "outlier": theta differs from the median of the usable azimuths within
 //    +-outlier_half_window by more than outlier_deg.
 // A sector is a maximal run of consecutive unusable azimuths (wrapping at 0).
 //
-// Cost: O(azimuths x (2 w + 1) x rotations x bins); 400 x 5 x 11 x 230 is ~5 M adds.
+// Cost: O(azimuths x (2 w + 1) x rotations x bins); 400 x 5 x 11 x 512 is ~11 M adds.
 #pragma once
 
 #include <string>
@@ -49,14 +54,14 @@ struct ShadowCalibOptions {
     int range_smooth_bins = 1;     ///< +- bins of the boxcar on the profile
     double near_search_m = 2.5;    ///< the band's peak is searched in [b, this]
     double search_max_m = 10.0;    ///< core and ground are searched up to this slant range
-    double ground_window_m = 2.0;  ///< window after the core for the ground level G
-    double ground_ref_quantile = 0.75;
-    double edge_fraction = 0.5;    ///< L = F + edge_fraction (G - F)
-    double persist_m = 0.3;        ///< a rise must stay up this long to be the ground
+    double ground_window_m = 1.0;  ///< window after the foot for the ground level G
+    double min_core_m = 0.2;       ///< the core is the first run this long of dark bins
+    double confirm_m = 0.8;        ///< a rise must stay up this long to be the ground
+    bool edge_half_rise = false;   ///< theta from the half rise instead of the foot
     double min_ring_contrast = 6;  ///< P - F, power units
     double min_ground_contrast = 3;///< G - F, power units
-    double bright_fraction = 1.0;  ///< bright return inside the ring: p > F + this (G - F)
-    double bright_min = 8;         ///< ... and p > F + this (power units)
+    double bright_min = 8;         ///< bright return inside the ring: > F + this
+    double single_az_factor = 1.5; ///< single-azimuth profile: > F + this x bright_min
     int outlier_half_window = 10;  ///< azimuths each side for the outlier test
     double outlier_deg = 4.0;      ///< |theta - local median| above this: outlier
 };
@@ -67,13 +72,15 @@ struct ShadowAz {
     std::string reason;            ///< empty when usable
     double near_peak_level = 0, near_end_m = 0, near_cv = 0;
     double inner_edge_m = 0, core_m = 0, core_level = 0;
-    double ground_start_m = 0;     ///< slant range S (NaN when not found)
+    double rise_level = 0;         ///< d0
+    double ground_start_m = 0;     ///< slant range S of the foot (NaN when not found)
+    double ground_half_m = 0;      ///< slant range of the half rise (NaN when not found)
     double ground_level = 0;
     double ground_radius_m = 0;    ///< horizontal R = sqrt(S^2 - H^2)
     double theta_deg = 0;          ///< NaN unless usable
     double theta_raw_deg = 0;      ///< from S whenever S > H (also for unusable azimuths)
-    double bright_inside_m = 0;    ///< range of the offending return (0: none)
-    double bright_level = 0;
+    double bright_inside_m = 0;    ///< range of the strongest return inside the ring
+    double bright_level = 0;       ///< its level above F (power units)
 };
 
 struct ShadowSector {

@@ -384,9 +384,8 @@ bool load_pcap(const std::string &path, Capture &out, std::string &err, const Pc
         }
     }
     if (rc == PCAP_ERROR) {
-        err = path + ": " + pcap_geterr(pc);
-        pcap_close(pc);
-        return false;
+        // A capture cut short (tcpdump killed) or corrupt further on: keep what was read.
+        rep.read_error = pcap_geterr(pc);
     }
     pcap_close(pc);
 
@@ -410,7 +409,9 @@ bool load_pcap(const std::string &path, Capture &out, std::string &err, const Pc
     rep.radar_port = static_cast<uint16_t>(radar_port);
     if (!any) {
         err = path + ": no TCP payload from port " + std::to_string(opt.radar_port) +
-              (opt.port_explicit ? "" : " and no flow carrying Colossus radar messages");
+              (opt.port_explicit ? "" : " and no flow carrying Colossus radar messages") +
+              (rep.read_error.empty() ? "" : " (read error after " + std::to_string(rep.packets_total) +
+                                                 " packets: " + rep.read_error + ")");
         for (const auto &f : flows) {
             rep.flows.push_back(f.info);
         }

@@ -9,8 +9,10 @@
 // The format is sniffed from the file's first bytes, never from its extension.
 //
 // Reassembly tolerates retransmissions (full or partial), out-of-order segments, missing
-// segments and packets truncated by the snap length; everything is counted in
-// `PcapReport`. Missing bytes are NOT invented: the stream skips them, and each gap is
+// segments, packets truncated by the snap length and files cut short (the packets before
+// the read error are used); everything is counted in `PcapReport`. Bytes present more than
+// once keep the copy that comes first in sequence order (ties: capture order); copies that
+// differ are counted (`retransmit_mismatch_bytes`). Missing bytes are NOT invented: the stream skips them, and each gap is
 // recorded as a `Discontinuity` at its position in the output so a decoder can be reset
 // there instead of gluing two half messages together. Several sequential TCP sessions to
 // the radar (reconnections) are concatenated in time order, with a discontinuity between
@@ -88,6 +90,8 @@ struct PcapReport {
     uint64_t flows_ignored = 0;     ///< radar-side sessions overlapping a selected one
     bool started_mid_stream = false;///< a selected session has no SYN: the first bytes may
                                     ///< be the tail of a message
+    std::string read_error;         ///< libpcap error that ended reading early (a truncated or
+                                    ///< corrupt file); the packets before it are used
     std::vector<PcapFlow> flows;    ///< every radar-side direction found (selected or not)
     std::vector<Discontinuity> gap_list; ///< gaps only, in output order
 };

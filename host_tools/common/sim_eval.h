@@ -84,6 +84,8 @@ struct Proc {
     enum class Bounds { Raw, HalfBin, SubBin } bounds = Bounds::HalfBin;
     double r1_add_m = 0;        ///< radius correction: front surface -> axis (r1 += R)
     double beta_model_deg = 0;  ///< beta in the estimator's geometry (paper: 0)
+    bool r2_raw = false;        ///< r2 from the raw back edge even with HalfBin (when d was
+                                ///< calibrated against the back edge)
     double d_const_m = 0;       ///< elongation: r2 -= d
     std::vector<ElongPoint> d_table; ///< elongation table d(r2_obs) (overrides d_const when set)
 };

@@ -141,6 +141,7 @@ json pcap_json(const sl::PcapReport &r)
 {
     json j;
     j["link_type"] = r.link_type;
+    j["read_error"] = r.read_error.empty() ? json(nullptr) : json(r.read_error);
     j["radar_port"] = r.radar_port;
     j["port_auto_detected"] = r.port_auto_detected;
     j["packets_total"] = r.packets_total;
@@ -366,6 +367,9 @@ int main(int argc, char **argv)
                     " IP fragments), radar port %u%s\n",
                     r.link_type.c_str(), r.packets_total, r.packets_undecoded, r.ip_fragments,
                     r.radar_port, r.port_auto_detected ? " (auto-detected)" : "");
+        if (!r.read_error.empty()) {
+            std::printf("  read error (file cut short or corrupt; packets before it used): %s\n", r.read_error.c_str());
+        }
         for (const auto &f : r.flows) {
             std::printf("  flow %s -> %s: %" PRIu64 " packets, %" PRIu64 " payload bytes%s%s%s%s\n",
                         f.src.c_str(), f.dst.c_str(), f.packets, f.payload_bytes, f.syn ? ", SYN" : "",

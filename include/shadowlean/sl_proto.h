@@ -38,8 +38,11 @@
 /// - `sl_proto_feed()`: O(len) worst case (junk is scanned bytewise); for well-formed data
 ///   O(messages) when each payload is whole in the chunk (header check + one callback per
 ///   message), plus one memcpy of each payload byte that must be reassembled.
-/// - Stack: < 128 bytes plus the callback's. RAM: `sizeof(sl_proto_t)` (<= 160 bytes) plus the
-///   caller's reassembly buffer. No allocation, no float, no OS.
+/// - Stack: < 128 bytes plus the callback's. RAM: `sizeof(sl_proto_t)` (160 bytes on x86-64,
+///   asserted <= 192) plus the caller's reassembly buffer. No allocation, no float, no OS.
+/// - Measured (host_tools/bench_proto, x86-64 gcc -O2, 3804-byte 8-bit FFT messages):
+///   about 140 instructions per message when fed 64 KiB chunks, about 810 with 1448-byte
+///   chunks (every payload then straddles chunks and is copied to the reassembly buffer).
 /// - Context: task context; one decoder per stream; not reentrant (the callback must not
 ///   call `sl_proto_feed()` / `sl_proto_finish()` / `sl_proto_init()` on the same decoder).
 #ifndef SHADOWLEAN_SL_PROTO_H

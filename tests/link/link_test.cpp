@@ -524,7 +524,8 @@ struct PcapWriter {
         if (!dump) fail("pcap_dump_open %s", path.c_str());
         return dump != nullptr;
     }
-    // One TCP/IPv4 packet.
+    // One TCP/IPv4 packet (checksums left 0: the reader does not verify them, like Wireshark
+// by default).
     void tcp(uint32_t src_ip, uint16_t sport, uint32_t dst_ip, uint16_t dport, uint32_t seq, uint32_t ack,
              uint8_t flags, const uint8_t *payload, size_t len)
     {
@@ -597,7 +598,7 @@ int test_pcap(const std::string &inspect, const std::string &work)
     const uint32_t radar = 0xC0A80001, client = 0xC0A80064; // 192.168.0.1 / .100
     const uint32_t isn_r = 0xFFFF0000u;                      // wraps inside the stream
     const uint32_t isn_c = 1000;
-    const size_t k_retx = 5, k_swap = 10, k_drop = 20;
+    const size_t k_retx = 5, k_swap = 10, k_drop = 20, k_part = 30, k_bad = 40;
     auto seg = [&](PcapWriter &w, size_t k, uint16_t rport, uint32_t isn) {
         const size_t a = k * mss, n = std::min(mss, s.bytes.size() - a);
         w.tcp(radar, rport, client, 40001, static_cast<uint32_t>(isn + 1 + a), isn_c + 23, 0x18, s.bytes.data() + a, n);
@@ -620,6 +621,20 @@ int test_pcap(const std::string &inspect, const std::string &work)
             if (k == 1) w.tcp(client, 40001, radar, 6317, isn_c + 1, isn_r + 1, 0x18, start, sizeof start);
             if (k == k_swap + 1) seg(w, k_swap, 6317, isn_r); // out of order
             if (k == k_retx + 2) seg(w, k_retx, 6317, isn_r); // retransmission
+            if (k == k_part) { // re-segmented retransmission: 748 old bytes + 700 new ones
+                const size_t a = k * mss + 700;
+                w.tcp(radar, 6317, client, 40001, static_cast<uint32_t>(isn_r + 1 + a), isn_c + 23, 0x18,
+                      s.bytes.data() + a, mss);
+            }
+            if (k == k_bad + 1) { // retransmission whose content differs in 3 bytes
+                std::vector<uint8_t> alt(s.bytes.begin() + static_cast<long>(k_bad * mss),
+                                         s.bytes.begin() + static_cast<long>((k_bad + 1) * mss));
+                alt[10] ^= 0xFF;
+                alt[20] ^= 0x01;
+                alt[30] ^= 0x80;
+                w.tcp(radar, 6317, client, 40001, static_cast<uint32_t>(isn_r + 1 + k_bad * mss), isn_c + 23, 0x18,
+                      alt.data(), alt.size());
+            }
         }
         w.tcp(radar, 6317, client, 40001, static_cast<uint32_t>(isn_r + 1 + s.bytes.size()), isn_c + 23, 0x11, nullptr, 0);
         w.close();
@@ -630,9 +645,10 @@ int test_pcap(const std::string &inspect, const std::string &work)
     std::printf("%s\n", r.dump().c_str());
     CHECK(j["format"] == "pcap", "format pcap");
     CHECK_EQ(r["radar_port"].get<int>(), 6317, "radar port");
-    CHECK_EQ(r["retransmitted_segments"].get<long long>(), 1, "retransmitted segments");
-    CHECK_EQ(r["retransmitted_bytes"].get<long long>(), static_cast<long long>(mss), "retransmitted bytes");
-    CHECK_EQ(r["retransmit_mismatch_bytes"].get<long long>(), 0, "retransmitted bytes differing");
+    CHECK_EQ(r["retransmitted_segments"].get<long long>(), 2, "retransmitted segments");
+    CHECK_EQ(r["partial_overlap_segments"].get<long long>(), 2, "partly retransmitted segments");
+    CHECK_EQ(r["retransmitted_bytes"].get<long long>(), static_cast<long long>(2 * mss + mss), "retransmitted bytes");
+    CHECK_EQ(r["retransmit_mismatch_bytes"].get<long long>(), 3, "retransmitted bytes differing (first copy kept)");
     CHECK_EQ(r["out_of_order_segments"].get<long long>(), 1, "out-of-order segments");
     CHECK_EQ(r["gaps"].get<long long>(), 1, "gaps");
     CHECK_EQ(r["gap_bytes"].get<long long>(), static_cast<long long>(mss), "gap bytes");
@@ -665,6 +681,26 @@ int test_pcap(const std::string &inspect, const std::string &work)
     CHECK_EQ(r2["gaps"].get<long long>(), 0, "mid-stream: gaps");
     CHECK_EQ(j2["fft"]["total"].get<long long>(), fft_outside(s, 0, k_first * mss), "mid-stream: FFT messages");
     CHECK(j2["configuration"].is_null(), "mid-stream: no configuration");
+
+    // 3) The first capture cut in the middle of a packet (tcpdump killed): the packets before
+    //    the cut are used and the read error is reported.
+    const std::string p3 = work + "/cut.pcap";
+    {
+        std::FILE *f = std::fopen(p1.c_str(), "rb");
+        std::vector<uint8_t> all;
+        uint8_t b[65536];
+        size_t n;
+        while (f && (n = std::fread(b, 1, sizeof b, f)) > 0) all.insert(all.end(), b, b + n);
+        if (f) std::fclose(f);
+        all.resize(all.size() / 2 + 7);
+        if (!write_file(p3, all)) return 1;
+    }
+    const json j3 = inspect_json(inspect, p3);
+    if (g_failures) return 1;
+    CHECK(j3["pcap"]["read_error"].is_string(), "cut pcap: read error reported");
+    const long long n3 = j3["fft"]["total"].get<long long>();
+    CHECK(n3 > 0 && n3 < want, "cut pcap: %lld FFT messages decoded from the first half", n3);
+    CHECK_EQ(j3["pcap"]["gaps"].get<long long>(), 1, "cut pcap: gaps");
     return g_failures ? 1 : 0;
 }
 

@@ -348,29 +348,52 @@ static void test_scan_copies_only_the_region_of_interest(void **state)
 static void test_scan_reduces_16_bit_power_by_the_configured_shift(void **state)
 {
     (void)state;
-    // Through the wire: encode 16-bit bins, decode, store.
-    const uint16_t v[6] = {0x0000, 0x00FF, 0x0100, 0x12F0, 0xFFFF, 0x0FF0};
-    uint8_t b[64];
-    sl_proto_fft_t h = {.sweep_counter = 0, .azimuth_ticks = 0, .bins = 6};
+    // Through the wire: encode 16-bit bins, decode, store. 77 bins: exercises the 8-bin and
+    // 32-bin block paths and their tails; the first six are hand-picked edge values.
+    uint16_t v[77] = {0x0000, 0x00FF, 0x0100, 0x12F0, 0xFFFF, 0x0FF0};
+    uint32_t x = 12345;
+    for (int i = 6; i < 77; i++) {
+        x = x * 1103515245U + 12345U;
+        v[i] = (uint16_t)(x >> 16);
+    }
+    uint8_t b[256];
+    sl_proto_fft_t h = {.sweep_counter = 0, .azimuth_ticks = 0, .bins = 77};
     const sl_ssize_t n = sl_proto_encode_fft16(b, sizeof b, &h, v);
-    assert_true(n > 0);
+    assert_int_equal(n, 22 + 14 + 2 * 77);
     sl_proto_msg_t m = {.id = 31, .payload = {b + 22, (size_t)n - 22}};
-    for (unsigned shift = 8; shift >= 4; shift -= 4) {
-        memset(&g_rec, 0, sizeof g_rec);
-        sl_scan_t s;
-        sl_scan_cfg_t c = {.roi_bins = 32, .pow16_shift = (uint8_t)shift, .azimuths = 400,
-                           .encoder_size = 5600};
-        assert_int_equal(sl_scan_init(&s, &c, &g_frames[0], NULL), SL_OK);
-        assert_int_equal(sl_scan_on_msg(&s, &m), SL_OK);
-        const sl_scan_frame_t *fr = &g_frames[0];
-        assert_int_equal(fr->flags[0], SL_SCAN_AZ_VALID | SL_SCAN_AZ_16BIT | SL_SCAN_AZ_SHORT);
-        assert_int_equal(fr->bins[0], 6);
-        for (int i = 0; i < 6; i++) {
-            const uint32_t want = (uint32_t)v[i] >> shift;
-            assert_int_equal(fr->power[0][i], want > 255 ? 255 : want);
+    static const unsigned shifts[] = {8, 4, 0, 9, 15};
+    for (size_t t = 0; t < sizeof shifts / sizeof shifts[0]; t++) {
+        const unsigned shift = shifts[t];
+        for (unsigned roi = 32; roi <= 96; roi += 64) { // 77 bins: truncated / short row
+            memset(&g_rec, 0, sizeof g_rec);
+            sl_scan_t s;
+            sl_scan_cfg_t c = {.roi_bins = (uint16_t)roi, .pow16_shift = (uint8_t)shift,
+                               .azimuths = 400, .encoder_size = 5600};
+            assert_int_equal(sl_scan_init(&s, &c, &g_frames[0], NULL), SL_OK);
+            assert_int_equal(sl_scan_on_msg(&s, &m), SL_OK);
+            const sl_scan_frame_t *fr = &g_frames[0];
+            const uint32_t nb = roi < 77 ? roi : 77;
+            assert_int_equal(fr->bins[0], nb);
+            assert_int_equal(fr->flags[0], SL_SCAN_AZ_VALID | SL_SCAN_AZ_16BIT |
+                                               (nb < roi ? SL_SCAN_AZ_SHORT : 0));
+            uint32_t sat = 0;
+            for (uint32_t i = 0; i < nb; i++) {
+                const uint32_t want = (uint32_t)v[i] >> shift;
+                sat += want > 255;
+                assert_int_equal(fr->power[0][i], want > 255 ? 255 : want);
+            }
+            for (uint32_t i = nb; i < roi; i++) {
+                assert_int_equal(fr->power[0][i], 0);
+            }
+            assert_int_equal(s.stats.saturated16, sat);
+            if (shift == 8) {
+                assert_int_equal(sat, 0);
+            }
+            if (shift == 4) {
+                assert_true(sat >= 2); // 0x12F0 and 0xFFFF at least
+            }
+            assert_int_equal(s.stats.wide_azimuths, 1);
         }
-        assert_int_equal(s.stats.saturated16, shift == 8 ? 0 : 2); // 0x12F0 and 0xFFFF
-        assert_int_equal(s.stats.wide_azimuths, 1);
     }
 }
 
@@ -620,6 +643,47 @@ static void test_scan_frames_from_a_byte_stream_match_for_every_chunking(void **
     }
 }
 
+static void test_scan_follows_a_radar_restart_with_a_new_configuration_mid_stream(void **state)
+{
+    (void)state;
+    // Stream A (40 azimuths) then, mid-stream, a restarted radar's stream B (its own
+    // Configuration: 20 azimuths, new sweep counters), then B' = the same radar restarting
+    // again with an unchanged configuration.
+    sl_golden_params_t a = sl_golden_defaults();
+    a.azimuths = 40;
+    a.range_bins = 100;
+    a.rotations = 2;
+    a.keep_alive_every = 9;
+    sl_golden_params_t b = a;
+    b.azimuths = 20;
+    b.seed = 7;
+    sl_golden_params_t b2 = b;
+    b2.seed = 11;
+    const size_t na = sl_golden_size(&a), nb = sl_golden_size(&b), nb2 = sl_golden_size(&b2);
+    uint8_t *data = malloc(na + nb + nb2);
+    assert_int_equal(sl_golden_build(data, na, &a), na);
+    assert_int_equal(sl_golden_build(data + na, nb, &b), nb);
+    assert_int_equal(sl_golden_build(data + na + nb, nb2, &b2), nb2);
+    static chain_t c;
+    for (uint64_t seed = 0; seed <= 6; seed++) {
+        run_chain(&c, data, na + nb + nb2, seed, true);
+        assert_int_equal(g_rec.frames, 6);
+        static const uint8_t ends[6] = {SL_SCAN_END_WRAP, SL_SCAN_END_CONFIG, SL_SCAN_END_WRAP,
+                                        SL_SCAN_END_SWEEP_GAP, SL_SCAN_END_WRAP, SL_SCAN_END_FLUSH};
+        static const uint16_t valid[6] = {40, 40, 20, 20, 20, 20};
+        for (int f = 0; f < 6; f++) {
+            assert_int_equal(g_rec.end[f], ends[f]);
+            assert_int_equal(g_rec.stats[f].valid, valid[f]);
+            assert_int_equal(g_rec.stats[f].missing, 0);
+        }
+        assert_int_equal(c.s.stats.configs, 3);
+        assert_int_equal(c.s.stats.config_changes, 1);
+        assert_int_equal(c.p.stats.configuration, 3);
+        assert_int_equal(c.p.stats.bytes_skipped, 0);
+    }
+    free(data);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -639,6 +703,7 @@ int main(void)
         cmocka_unit_test(test_scan_rejects_unexpected_geometry_and_bad_azimuths),
         cmocka_unit_test(test_scan_completes_the_frame_after_a_rotation_of_lost_packets),
         cmocka_unit_test(test_scan_frames_from_a_byte_stream_match_for_every_chunking),
+        cmocka_unit_test(test_scan_follows_a_radar_restart_with_a_new_configuration_mid_stream),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

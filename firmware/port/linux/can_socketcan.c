@@ -201,8 +201,13 @@ static void read_errors(sl_can_socketcan_t *s, uint64_t t_us)
         struct can_frame cf;
         const ssize_t n = recv(s->fd, &cf, sizeof cf, MSG_DONTWAIT);
         if (n < 0) {
+            // The kernel reports interface events as a pending socket error: NETDEV_DOWN
+            // -> ENETDOWN, NETDEV_UNREGISTER -> ENODEV (and the socket is unbound).
             if (errno == ENODEV || errno == ENXIO) {
                 become_gone(s, t_us);
+            } else if (errno == ENETDOWN && !s->link_down) {
+                s->link_down = true;
+                s->stats.link_down++;
             }
             return; // EAGAIN: nothing more
         }

@@ -28,7 +28,7 @@
 ///
 /// Cost: send/poll are O(queue + error frames read) system calls, bounded by
 /// SL_CAN_SOCKETCAN_QUEUE_MAX + SL_CAN_SOCKETCAN_RX_BURST. RAM: ~sizeof(sl_can_socketcan_t)
-/// (about 1.3 KiB with the default queue). Not thread-safe.
+/// (about 1.7 KiB: the queue array is always SL_CAN_SOCKETCAN_QUEUE_MAX entries). Not thread-safe.
 #ifndef SHADOWLEAN_CAN_SOCKETCAN_H
 #define SHADOWLEAN_CAN_SOCKETCAN_H
 

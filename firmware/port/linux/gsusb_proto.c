@@ -1048,6 +1048,13 @@ sl_ssize_t sl_gsusb_poll(sl_gsusb_t *d, uint32_t timeout_ms, uint64_t now_us)
     sl_ssize_t handled = 0;
     uint8_t pkt[512];
     uint32_t wait = timeout_ms;
+    if (d->tr.ops->out_stalled != NULL && d->tr.ops->out_stalled(d->tr.ctx)) {
+        d->stats.stalls_out++;
+        (void)clear_halt(d, false);
+        if (d->state != SL_GSUSB_RUNNING) {
+            return SL_ERR_PORT;
+        }
+    }
     for (uint16_t k = 0; k < d->cfg.rx_budget; k++) {
         size_t n = 0;
         sl_gsusb_io_t io = d->tr.ops->bulk_in(d->tr.ctx, pkt, sizeof pkt, wait, &n);

@@ -412,6 +412,10 @@ typedef struct sl_gsusb_transport_ops {
                              size_t *transferred);
     /// Clear a halted bulk endpoint (`in`: the IN endpoint) and resume it. May be NULL.
     sl_gsusb_io_t (*clear_halt)(void *ctx, bool in);
+    /// True when an earlier (asynchronous) bulk OUT ended in a stall that is not cleared
+    /// yet; sl_gsusb_poll() then clears it. May be NULL (synchronous transports report the
+    /// stall from bulk_out itself).
+    bool (*out_stalled)(void *ctx);
 } sl_gsusb_transport_ops_t;
 
 /// A transport: operations + their context (borrowed by the driver until deinit).
@@ -554,8 +558,8 @@ sl_err_t sl_gsusb_send(sl_gsusb_t *d, const sl_can_frame_t *f, uint32_t tag, uin
 
 /// Receive: wait at most `timeout_ms` for the first IN packet, then take what is already
 /// there (up to rx_budget packets): echoes confirm frames, RX/error frames go to on_rx.
-/// Then expire echoes older than echo_timeout_ms at `now_us`. A halted IN endpoint is
-/// cleared (counted). @return packets handled (>= 0), SL_ERR_PORT (the device vanished in
+/// Then expire echoes older than echo_timeout_ms at `now_us`. A halted IN endpoint, or an
+/// OUT endpoint the transport reports stalled, is cleared (counted). @return packets handled (>= 0), SL_ERR_PORT (the device vanished in
 /// this call: DOWN) or SL_ERR_STATE (not RUNNING; nothing done).
 sl_ssize_t sl_gsusb_poll(sl_gsusb_t *d, uint32_t timeout_ms, uint64_t now_us);
 

@@ -1,0 +1,33 @@
+// calib_cmds.h: the subcommands of sl-calib (main.cpp parses the arguments).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "calib_shadow.h"
+
+namespace sl::calib {
+
+struct ShadowArgs {
+    std::string input;      ///< capture file or Oxford folder
+    std::string board;
+    std::string out_ini, png, csv;
+    double bin_size_m = 0;  ///< > 0: override the capture's / board's bin size
+    double height_m = 0;    ///< > 0: override the board's radar height
+    ShadowCalibOptions opt; ///< estimator knobs (H and b are filled in)
+};
+int cmd_shadow(const ShadowArgs &a);
+
+struct ElongArgs {
+    std::vector<std::string> captures;
+    std::vector<std::string> truth;   ///< one list file, or one sl-sim truth per capture
+    std::string board;
+    std::string out_ini, png, csv;
+    double bin_size_m = 0;
+    int points = 0;                   ///< table points (0 = automatic)
+    int mask_frames = 0;              ///< consistency window (0 = board's, capped by frames)
+    int threshold = -1;               ///< occupancy threshold (-1 = board's)
+};
+int cmd_elongation(const ElongArgs &a);
+
+} // namespace sl::calib

@@ -1,0 +1,156 @@
+// sl-calib: calibration of a board from recorded (or simulated) radar data.
+//
+//   sl-calib shadow CAPTURE|OXFORD_DIR --board NAME [--out-ini FILE] [--png FILE] [--csv FILE]
+//        [--bin-size-m M] [--height-m M] [--az-window N] [--search-max-m M]
+//        [--edge foot|half] [--ground-window-m M]
+//     The chassis shadow per azimuth from many rotations: near-field band, inner edge and
+//     dark core of the ring, ground start; theta(az) = asin(H / ground start) (slant), i.e.
+//     atan(H / R) with R the horizontal radius. Sectors without a clean shadow are reported
+//     as unusable, never given a theta. --out-ini writes the [calib] fragment
+//     (host_tools/calib/README.md), --png the comparison with the board's geometric theta,
+//     --csv every per-azimuth number.
+//
+//   sl-calib elongation CAPTURE... --truth FILE [--truth FILE ...] [--board NAME]
+//        [--out-ini FILE] [--png FILE] [--csv FILE] [--points N] [--mask-frames N]
+//        [--threshold T] [--bin-size-m M]
+//     The elongation bias d = r2_observed - r2_true (paper Sec. V-B: a target at many known
+//     distances) as a table over the observed r2 (the core looks d up at the half-bin r2),
+//     with its spread; --out-ini writes the board line `elongation = r:d, ...` under
+//     [detect]. Truth: a list CSV (capture,range_m[,r2_m]) or one sl-sim truth CSV per
+//     capture (README.md).
+//
+// Exit status: 0 done, 1 error (I/O, bad data), 2 usage.
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <string>
+
+#include "calib_cmds.h"
+
+namespace {
+
+void usage()
+{
+    std::fputs(
+        "usage:\n"
+        "  sl-calib shadow CAPTURE|OXFORD_DIR --board NAME [--out-ini FILE] [--png FILE]\n"
+        "      [--csv FILE] [--bin-size-m M] [--height-m M] [--az-window N]\n"
+        "      [--search-max-m M] [--edge foot|half] [--ground-window-m M]\n"
+        "  sl-calib elongation CAPTURE... --truth FILE [--truth FILE...] [--board NAME]\n"
+        "      [--out-ini FILE] [--png FILE] [--csv FILE] [--points N] [--mask-frames N]\n"
+        "      [--threshold T] [--bin-size-m M]\n",
+        stderr);
+}
+
+bool num(const char *s, double &v)
+{
+    char *e = nullptr;
+    v = std::strtod(s, &e);
+    return e != s && *e == '\0';
+}
+
+} // namespace
+
+int main(int argc, char **argv)
+{
+    if (argc < 2) {
+        usage();
+        return 2;
+    }
+    const std::string cmd = argv[1];
+    if (cmd == "shadow") {
+        sl::calib::ShadowArgs a;
+        for (int i = 2; i < argc; i++) {
+            const std::string o = argv[i];
+            const bool has = i + 1 < argc;
+            double v = 0;
+            if (o == "--board" && has) {
+                a.board = argv[++i];
+            } else if (o == "--out-ini" && has) {
+                a.out_ini = argv[++i];
+            } else if (o == "--png" && has) {
+                a.png = argv[++i];
+            } else if (o == "--csv" && has) {
+                a.csv = argv[++i];
+            } else if (o == "--bin-size-m" && has && num(argv[i + 1], v) && v > 0) {
+                a.bin_size_m = v;
+                i++;
+            } else if (o == "--height-m" && has && num(argv[i + 1], v) && v > 0) {
+                a.height_m = v;
+                i++;
+            } else if (o == "--az-window" && has && num(argv[i + 1], v) && v >= 0 && v <= 20) {
+                a.opt.az_half_window = static_cast<int>(v);
+                i++;
+            } else if (o == "--search-max-m" && has && num(argv[i + 1], v) && v > 1) {
+                a.opt.search_max_m = v;
+                i++;
+            } else if (o == "--edge" && has && (std::strcmp(argv[i + 1], "foot") == 0 ||
+                                                 std::strcmp(argv[i + 1], "half") == 0)) {
+                a.opt.edge_half_rise = std::strcmp(argv[++i], "half") == 0;
+            } else if (o == "--ground-window-m" && has && num(argv[i + 1], v) && v > 0) {
+                a.opt.ground_window_m = v;
+                i++;
+            } else if (o[0] != '-' && a.input.empty()) {
+                a.input = o;
+            } else {
+                std::fprintf(stderr, "sl-calib: bad argument '%s'\n", o.c_str());
+                usage();
+                return 2;
+            }
+        }
+        if (a.input.empty() || a.board.empty()) {
+            usage();
+            return 2;
+        }
+        return sl::calib::cmd_shadow(a);
+    }
+#ifdef SL_CALIB_ELONG
+    if (cmd == "elongation") {
+        sl::calib::ElongArgs a;
+        for (int i = 2; i < argc; i++) {
+            const std::string o = argv[i];
+            const bool has = i + 1 < argc;
+            double v = 0;
+            if (o == "--board" && has) {
+                a.board = argv[++i];
+            } else if (o == "--truth" && has) {
+                a.truth.push_back(argv[++i]);
+            } else if (o == "--out-ini" && has) {
+                a.out_ini = argv[++i];
+            } else if (o == "--png" && has) {
+                a.png = argv[++i];
+            } else if (o == "--csv" && has) {
+                a.csv = argv[++i];
+            } else if (o == "--bin-size-m" && has && num(argv[i + 1], v) && v > 0) {
+                a.bin_size_m = v;
+                i++;
+            } else if (o == "--points" && has && num(argv[i + 1], v) && v >= 1 && v <= 16) {
+                a.points = static_cast<int>(v);
+                i++;
+            } else if (o == "--mask-frames" && has && num(argv[i + 1], v) && v >= 1 && v <= 32) {
+                a.mask_frames = static_cast<int>(v);
+                i++;
+            } else if (o == "--threshold" && has && num(argv[i + 1], v) && v >= 0 && v <= 255) {
+                a.threshold = static_cast<int>(v);
+                i++;
+            } else if (o[0] != '-') {
+                a.captures.push_back(o);
+            } else {
+                std::fprintf(stderr, "sl-calib: bad argument '%s'\n", o.c_str());
+                usage();
+                return 2;
+            }
+        }
+        if (a.captures.empty() || a.truth.empty()) {
+            usage();
+            return 2;
+        }
+        if (a.board.empty()) {
+            a.board = "paper-bench";
+        }
+        return sl::calib::cmd_elongation(a);
+    }
+#endif
+    usage();
+    return 2;
+}

@@ -1,0 +1,182 @@
+// can-utils text frames and candump -L lines (see candump_text.h).
+#include "candump_text.h"
+
+#include <ctype.h>
+#include <stdbool.h>
+#include <stdio.h>
+#include <string.h>
+
+#define CAN_ERR_FLAG_BIT 0x20000000UL
+
+static int hexval(char c)
+{
+    if (c >= '0' && c <= '9') {
+        return c - '0';
+    }
+    if (c >= 'a' && c <= 'f') {
+        return c - 'a' + 10;
+    }
+    if (c >= 'A' && c <= 'F') {
+        return c - 'A' + 10;
+    }
+    return -1;
+}
+
+sl_err_t sl_candump_parse_frame(const char *s, sl_can_frame_t *out, const char **why)
+{
+    const char *dummy = NULL;
+    if (why == NULL) {
+        why = &dummy;
+    }
+    memset(out, 0, sizeof *out);
+    size_t idlen = 0;
+    uint32_t id = 0;
+    while (s[idlen] != '\0' && s[idlen] != '#') {
+        int v = hexval(s[idlen]);
+        if (v < 0 || idlen >= 8) {
+            *why = "identifier: 3 or 8 hex digits expected before '#'";
+            return SL_ERR_MALFORMED;
+        }
+        id = (id << 4) | (uint32_t)v;
+        idlen++;
+    }
+    if (s[idlen] != '#' || (idlen != 3 && idlen != 8)) {
+        *why = "identifier: 3 or 8 hex digits expected before '#'";
+        return SL_ERR_MALFORMED;
+    }
+    if (idlen == 3) {
+        if (id > SL_CAN_SFF_MASK) {
+            *why = "11-bit identifier above 7FF";
+            return SL_ERR_MALFORMED;
+        }
+    } else if ((id & CAN_ERR_FLAG_BIT) != 0U) {
+        out->flags = SL_CAN_FLAG_ERR;
+        id &= (uint32_t)SL_CAN_EFF_MASK;
+    } else {
+        if (id > SL_CAN_EFF_MASK) {
+            *why = "29-bit identifier above 1FFFFFFF";
+            return SL_ERR_MALFORMED;
+        }
+        out->flags = SL_CAN_FLAG_EFF;
+    }
+    out->id = id;
+    const char *p = s + idlen + 1;
+    if (*p == '#') {
+        *why = "CAN FD frames are not supported";
+        return SL_ERR_MALFORMED;
+    }
+    if (*p == 'R' || *p == 'r') {
+        if ((out->flags & SL_CAN_FLAG_ERR) != 0U) {
+            *why = "an error frame cannot be a remote request";
+            return SL_ERR_MALFORMED;
+        }
+        out->flags |= SL_CAN_FLAG_RTR;
+        p++;
+        if (*p >= '0' && *p <= '8') {
+            out->dlc = (uint8_t)(*p - '0');
+            p++;
+        }
+        if (*p != '\0') {
+            *why = "junk after R";
+            return SL_ERR_MALFORMED;
+        }
+        return SL_OK;
+    }
+    uint8_t n = 0;
+    while (*p != '\0') {
+        if (*p == '.') {
+            p++;
+            continue;
+        }
+        int hi = hexval(p[0]);
+        int lo = hi < 0 ? -1 : hexval(p[1]);
+        if (hi < 0 || lo < 0) {
+            *why = "data: hex byte pairs expected";
+            return SL_ERR_MALFORMED;
+        }
+        if (n >= 8U) {
+            *why = "more than 8 data bytes";
+            return SL_ERR_MALFORMED;
+        }
+        out->data[n++] = (uint8_t)((hi << 4) | lo);
+        p += 2;
+    }
+    out->dlc = n;
+    return SL_OK;
+}
+
+sl_err_t sl_candump_parse_line(const char *line, sl_can_frame_t *out, const char **why)
+{
+    char buf[256];
+    const char *dummy = NULL;
+    if (why == NULL) {
+        why = &dummy;
+    }
+    size_t n = strlen(line);
+    if (n >= sizeof buf) {
+        *why = "line too long";
+        return SL_ERR_MALFORMED;
+    }
+    memcpy(buf, line, n + 1U);
+    while (n > 0U && isspace((unsigned char)buf[n - 1U])) {
+        buf[--n] = '\0';
+    }
+    char *p = buf;
+    while (isspace((unsigned char)*p)) {
+        p++;
+    }
+    if (*p == '\0') {
+        return SL_ERR_NEED_MORE;
+    }
+    // The frame is the last blank-separated field ("(ts) iface frame" or a bare frame),
+    // unless python-can appended " R"/" T" (rx/tx marker): then the one before it.
+    char *last = strrchr(p, ' ');
+    char *frame = last != NULL ? last + 1 : p;
+    if (last != NULL && (strcmp(frame, "R") == 0 || strcmp(frame, "T") == 0)) {
+        *last = '\0';
+        last = strrchr(p, ' ');
+        frame = last != NULL ? last + 1 : p;
+    }
+    if (frame != p && *p != '(') {
+        *why = "expected '(timestamp) interface frame'";
+        return SL_ERR_MALFORMED;
+    }
+    return sl_candump_parse_frame(frame, out, why);
+}
+
+char *sl_candump_format_frame(const sl_can_frame_t *f, char *buf, size_t cap)
+{
+    int k;
+    if ((f->flags & SL_CAN_FLAG_ERR) != 0U) {
+        k = snprintf(buf, cap, "%08lX#",
+                     (unsigned long)((f->id & SL_CAN_EFF_MASK) | CAN_ERR_FLAG_BIT));
+    } else if ((f->flags & SL_CAN_FLAG_EFF) != 0U) {
+        k = snprintf(buf, cap, "%08lX#", (unsigned long)(f->id & SL_CAN_EFF_MASK));
+    } else {
+        k = snprintf(buf, cap, "%03lX#", (unsigned long)(f->id & SL_CAN_SFF_MASK));
+    }
+    if (k < 0 || (size_t)k >= cap) {
+        return buf;
+    }
+    if ((f->flags & SL_CAN_FLAG_RTR) != 0U) {
+        if (f->dlc > 0U && f->dlc <= 8U) {
+            (void)snprintf(buf + k, cap - (size_t)k, "R%u", (unsigned)f->dlc);
+        } else {
+            (void)snprintf(buf + k, cap - (size_t)k, "R");
+        }
+        return buf;
+    }
+    for (uint8_t i = 0; i < f->dlc && i < 8U && (size_t)k + 3U <= cap; i++) {
+        k += snprintf(buf + k, cap - (size_t)k, "%02X", (unsigned)f->data[i]);
+    }
+    return buf;
+}
+
+char *sl_candump_format_line(const sl_can_frame_t *f, uint64_t t_us, const char *iface, char *buf,
+                             size_t cap)
+{
+    char fr[40];
+    (void)snprintf(buf, cap, "(%010lu.%06lu) %s %s", (unsigned long)(t_us / 1000000U),
+                   (unsigned long)(t_us % 1000000U), iface, sl_candump_format_frame(f, fr, sizeof fr));
+    return buf;
+}

@@ -1,0 +1,619 @@
+// sl-view: what the module sees, as pictures.
+//
+//   sl-view CAPTURE|OXFORD_DIR --board NAME --out FILE.png|FILE.mp4|FILE.avi
+//           [--rotation K | --all] [--truth GT.csv] [--calib CALIB.ini] [--roi-m M]
+//           [--mask-frames N] [--threshold T] [--vmax V] [--fps F] [--bin-size-m M]
+//
+// One picture per rotation: on the left the polar image (slant range across, azimuth down,
+// the region of interest), on the right the top view around the vehicle (forward up), both
+// with
+//   - the 8-bit power in grey (display stretch fixed for the whole capture),
+//   - the core's n-frame consistency mask (sl_thresh_u8 + sl_mask, board threshold and n;
+//     stable-occupied bins tinted green),
+//   - the chassis outline from the board file (top view),
+//   - the board's theoretical shadow edge (amber): the slant range sqrt(R^2 + H^2) at which
+//     the ground at the board's shadow radius R(az) = H / tan(theta(az)) appears,
+//   - the near-field exclusion (blue, dashed),
+//   - the calibrated shadow edge from `sl-calib shadow --out-ini` (magenta, --calib),
+//   - the core's detections (sl_detect on the mask, red) with their alpha labels,
+//   - the simulator's ground truth (cyan, --truth: the sl-sim CSV),
+//   - a legend, a scale bar, and a line of numbers under the panels.
+// Captures are read with capture.h (raw .colossus or pcap) and decoded by the core
+// (sl_proto_feed + sl_scan); an Oxford folder is converted in memory by oxford.h first.
+//
+// --rotation K picks rotation K of the decoded frames (0-based; negative counts from the
+// end; default: the last one, where the mask has the most history). --all renders every
+// rotation into a video (.mp4 through OpenCV's FFmpeg backend, codec mp4v; when that
+// writer cannot be opened, the same frames go to .avi with MJPG and a note says so) or, with
+// a .png output, into FILE_0000.png, FILE_0001.png, ...
+//
+// Exit status: 0 done, 1 error, 2 usage.
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/videoio.hpp>
+
+#include "calib_shadow.h"
+#include "shadowlean/sl_board.h"
+#include "shadowlean/sl_detect.h"
+#include "shadowlean/sl_mask.h"
+#include "shadowlean/sl_thresh.h"
+#include "sl_board_spec.h"
+#include "view_draw.h"
+#include "view_frames.h"
+#ifdef SL_HAVE_SIM_TRUTH
+#include "sim_truth.h"
+#endif
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+struct Args {
+    std::string input, board, out, truth, calib;
+    int rotation = -1;
+    bool all = false;
+    double roi_m = 0, vmax = 0, fps = 4, bin_size_m = 0;
+    int mask_frames = 0, threshold = -1;
+};
+
+void usage()
+{
+    std::fputs(
+        "usage: sl-view CAPTURE|OXFORD_DIR --board NAME --out FILE.png|FILE.mp4|FILE.avi\n"
+        "               [--rotation K | --all] [--truth GT.csv] [--calib CALIB.ini]\n"
+        "               [--roi-m M] [--mask-frames N] [--threshold T] [--vmax V] [--fps F]\n"
+        "               [--bin-size-m M]\n",
+        stderr);
+}
+
+std::string fmt(const char *f, double v)
+{
+    char b[64];
+    std::snprintf(b, sizeof b, f, v);
+    return b;
+}
+
+bool ends_with(const std::string &s, const std::string &e)
+{
+    return s.size() >= e.size() && s.compare(s.size() - e.size(), e.size(), e) == 0;
+}
+
+/// Truth of one pole on one rotation (the nominal azimuth's row).
+struct TruthMark {
+    std::string name;
+    int az = 0;
+    double r1_m = 0, r2_m = 0, alpha_deg = 0;
+    bool valid = false;
+};
+
+/// Everything drawn on one rotation.
+struct RotationView {
+    const sl::RadarFrame *frame = nullptr;
+    int index = 0, count = 0;
+    std::vector<std::vector<uint32_t>> occ; ///< stable-occupied rows (empty: no history)
+    std::vector<sl_target_t> targets;
+    std::vector<TruthMark> truth;
+};
+
+struct Scene {
+    sl::BoardSpec board;
+    const sl_board_t *core_board = nullptr;
+    const sl::FrameSet *fs = nullptr;
+    double roi_m = 10, vmax = 60;
+    int mask_n = 16, threshold = 40;
+    std::string mask_note, detect_note, truth_note;
+    std::vector<double> board_slant_m, near_m;
+    std::vector<double> calib_slant_m;
+    bool have_calib = false;
+    double theta_min = 0, theta_max = 0;
+    std::string title;
+};
+
+const char *flag_name(int f)
+{
+    switch (f) {
+    case SL_INCLINE_AMBIGUOUS:
+        return "ambiguous";
+    case SL_INCLINE_INVALID:
+        return "invalid";
+    case SL_INCLINE_OUT_OF_DOMAIN:
+        return "out of domain";
+    default:
+        return "";
+    }
+}
+
+std::string target_label(const sl_target_t &t)
+{
+    if (t.incline_flag == SL_INCLINE_VALID) {
+        char b[64];
+        std::snprintf(b, sizeof b, "%+.1f deg", t.alpha_cdeg / 100.0);
+        return b;
+    }
+    return flag_name(t.incline_flag);
+}
+
+/// Greedy label placement: each label goes to the first candidate offset around its anchor
+/// whose box overlaps no label placed before (readability when poles are close).
+struct Labels {
+    std::vector<cv::Rect> used;
+    void put(cv::Mat &img, const std::string &s, cv::Point2d anchor, const cv::Scalar &c,
+             double scale = 0.52)
+    {
+        int base = 0;
+        const cv::Size sz = cv::getTextSize(s, cv::FONT_HERSHEY_SIMPLEX, scale, 1, &base);
+        const cv::Point a(static_cast<int>(anchor.x), static_cast<int>(anchor.y));
+        const cv::Point offs[] = {{14, -10}, {14, sz.height + 12}, {-sz.width - 14, -10},
+                                  {-sz.width - 14, sz.height + 12}, {14, -sz.height - 26},
+                                  {14, 2 * sz.height + 30}, {-sz.width - 14, -sz.height - 26}};
+        cv::Point org = a + offs[0];
+        for (const auto &o : offs) {
+            const cv::Rect r(a.x + o.x - 2, a.y + o.y - sz.height - 3, sz.width + 4, sz.height + 7);
+            bool clash = false;
+            for (const auto &u : used) {
+                if ((u & r).area() > 0) {
+                    clash = true;
+                    break;
+                }
+            }
+            if (!clash) {
+                org = a + o;
+                break;
+            }
+        }
+        used.emplace_back(org.x - 2, org.y - sz.height - 3, sz.width + 4, sz.height + 7);
+        sl::draw_text(img, s, org, scale, c);
+    }
+};
+
+cv::Mat render(const Scene &sc, const RotationView &rv)
+{
+    Labels labels;
+    const sl::FrameSet &fs = *sc.fs;
+    const int A = fs.azimuths;
+    const double bin = fs.bin_size_m;
+    const cv::Mat &pw = rv.frame->power;
+    const double yaw = sc.board.radar_yaw_deg;
+    // Polar BGR image with the mask tint.
+    cv::Mat polar = sl::power_to_grey(pw, sc.vmax, 0.7);
+    for (int a = 0; a < A && a < static_cast<int>(rv.occ.size()); a++) {
+        if (rv.occ[a].empty()) {
+            continue;
+        }
+        cv::Vec3b *row = polar.ptr<cv::Vec3b>(a);
+        for (int k = 0; k < pw.cols; k++) {
+            if (sl_bits_get(rv.occ[a].data(), static_cast<uint32_t>(k))) {
+                const cv::Vec3b g = row[k];
+                row[k] = cv::Vec3b(static_cast<uint8_t>(g[0] * 0.3),
+                                   static_cast<uint8_t>(std::min(255.0, 90 + g[1] * 0.65)),
+                                   static_cast<uint8_t>(g[2] * 0.3));
+            }
+        }
+    }
+    const int W = 1600, Ht = 1010;
+    cv::Mat img(Ht, W, CV_8UC3, cv::Scalar(28, 28, 28));
+    sl::draw_text(img, sc.title, cv::Point(20, 30), 0.62);
+    {
+        char b[256];
+        const double t = rv.frame->t_first_us * 1e-6;
+        std::snprintf(b, sizeof b, "rotation %d of %d (frame #%u, t = %.3f s)", rv.index + 1,
+                      rv.count, rv.frame->rotation, t);
+        sl::draw_text(img, b, cv::Point(20, 55), 0.5, cv::Scalar(200, 200, 200));
+    }
+    sl::PolarAxes pa;
+    pa.rect = cv::Rect(70, 75, 640, 800);
+    pa.azimuths = A;
+    pa.range_max_m = sc.roi_m;
+    pa.yaw_deg = yaw;
+    pa.draw_image(img, polar, bin);
+    sl::CartAxes ca;
+    ca.rect = cv::Rect(770, 75, 800, 800);
+    ca.roi_m = sc.roi_m;
+    ca.draw_image(img, polar, bin, yaw);
+    // --- overlays: polar
+    pa.curve(img, sc.near_m, sl::col::kNearField, 2, true);
+    pa.curve(img, sc.board_slant_m, sl::col::kBoardShadow, 2);
+    if (sc.have_calib) {
+        pa.curve(img, sc.calib_slant_m, sl::col::kCalibShadow, 2);
+    }
+    pa.draw_axes(img);
+    sl::draw_text(img, "azimuth (deg)", cv::Point(8, 70), 0.45);
+    // --- overlays: top view
+    ca.draw_axes(img);
+    {
+        cv::Mat sub = img(ca.rect);
+        const cv::Point2d off(ca.rect.x, ca.rect.y);
+        const auto &b = sc.board;
+        if (b.chassis_type == "cylinder") {
+            cv::circle(sub, ca.centre() - off, static_cast<int>(b.cylinder_radius_m * ca.scale()),
+                       sl::col::kChassis, 2, cv::LINE_AA);
+        } else {
+            std::vector<cv::Point> poly;
+            for (const auto &v : b.polygon) {
+                const cv::Point2d p = ca.px_xy(v.x_m - b.radar_x_m, v.y_m - b.radar_y_m) - off;
+                poly.emplace_back(static_cast<int>(std::lround(p.x)), static_cast<int>(std::lround(p.y)));
+            }
+            cv::polylines(sub, poly, true, sl::col::kChassis, 2, cv::LINE_AA);
+        }
+        cv::drawMarker(sub, ca.centre() - off, sl::col::kChassis, cv::MARKER_TILTED_CROSS, 10, 2);
+    }
+    ca.curve(img, sc.near_m, yaw, sl::col::kNearField, 2, true);
+    ca.curve(img, sc.board_slant_m, yaw, sl::col::kBoardShadow, 2);
+    if (sc.have_calib) {
+        ca.curve(img, sc.calib_slant_m, yaw, sl::col::kCalibShadow, 2);
+    }
+    // --- detections (boxes and circles first, labels after the truth marks)
+    for (size_t i = 0; i < rv.targets.size(); i++) {
+        const sl_target_t &t = rv.targets[i];
+        const double r1 = t.r1_raw_um * 1e-6, r2 = t.r2_raw_um * 1e-6;
+        const cv::Point2d p0 = pa.px(t.az_first, r1), p1 = pa.px(t.az_first + t.az_count, r2);
+        cv::rectangle(img, cv::Rect(cv::Point(static_cast<int>(p0.x) - 2, static_cast<int>(p0.y) - 2),
+                                    cv::Point(static_cast<int>(p1.x) + 2, static_cast<int>(p1.y) + 2)),
+                      sl::col::kDetect, 2);
+        const double az_deg = yaw + 360.0 * (t.az + 0.5) / A;
+        cv::circle(img, ca.px_ra(0.5 * (r1 + r2), az_deg), 12, sl::col::kDetect, 2, cv::LINE_AA);
+    }
+    // --- truth: the visible axis r1..r2 on the nominal azimuth
+    for (const auto &t : rv.truth) {
+        const double az_deg = yaw + 360.0 * (t.az + 0.5) / A;
+        const cv::Point2d a = pa.px(t.az + 0.5, t.r1_m), b2 = pa.px(t.az + 0.5, t.r2_m);
+        cv::line(img, a, b2, sl::col::kTruth, 2, cv::LINE_AA);
+        cv::drawMarker(img, a, sl::col::kTruth, cv::MARKER_CROSS, 10, 2);
+        cv::line(img, ca.px_ra(t.r1_m, az_deg), ca.px_ra(t.r2_m, az_deg), sl::col::kTruth, 2, cv::LINE_AA);
+        cv::drawMarker(img, ca.px_ra(t.r1_m, az_deg), sl::col::kTruth, cv::MARKER_CROSS, 14, 2);
+    }
+    for (size_t i = 0; i < rv.targets.size(); i++) {
+        const sl_target_t &t = rv.targets[i];
+        const double r1 = t.r1_raw_um * 1e-6, r2 = t.r2_raw_um * 1e-6;
+        const std::string lab = std::string(1, static_cast<char>('A' + i % 26)) + " " + target_label(t);
+        labels.put(img, lab, pa.px(t.az_first + t.az_count, r2), sl::col::kDetect, 0.5);
+        const double az_deg = yaw + 360.0 * (t.az + 0.5) / A;
+        labels.put(img, lab, ca.px_ra(0.5 * (r1 + r2), az_deg), sl::col::kDetect, 0.55);
+    }
+    for (const auto &t : rv.truth) {
+        const double az_deg = yaw + 360.0 * (t.az + 0.5) / A;
+        const std::string lab = "truth " + t.name + " " +
+                                (t.valid ? fmt("%+.1f deg", t.alpha_deg) : std::string("(not valid)"));
+        labels.put(img, lab, ca.px_ra(t.r1_m, az_deg), sl::col::kTruth, 0.5);
+        labels.put(img, t.name, pa.px(t.az + 0.5, t.r2_m), sl::col::kTruth, 0.45);
+    }
+    ca.scale_bar(img, sc.roi_m > 12 ? 5.0 : (sc.roi_m > 5 ? 2.0 : 1.0));
+    // --- legend (top view, top-right)
+    std::vector<sl::LegendItem> items = {
+        {cv::Scalar(60, 200, 60), "stable-occupied (mask, n = " + std::to_string(sc.mask_n) + ")", 2},
+        {sl::col::kChassis, "chassis outline (board file)", 0},
+        {sl::col::kBoardShadow, "board shadow edge (slant range)", 0},
+        {sl::col::kNearField, "near-field exclusion", 1},
+    };
+    if (sc.have_calib) {
+        items.push_back({sl::col::kCalibShadow, "calibrated shadow edge (sl-calib)", 0});
+    }
+    items.push_back({sl::col::kDetect, "detection (core), alpha", 3});
+    if (!rv.truth.empty() || !sc.truth_note.empty()) {
+        items.push_back({sl::col::kTruth, "ground truth (sl-sim), alpha", 4});
+    }
+    sl::draw_legend(img, items, cv::Point(ca.rect.x + ca.rect.width - 330, ca.rect.y + 6), 326);
+    // --- numbers
+    int y = 930;
+    auto line = [&](const std::string &s, const cv::Scalar &c = sl::col::kText) {
+        sl::draw_text(img, s, cv::Point(20, y), 0.5, c);
+        y += 22;
+    };
+    {
+        char b[400];
+        std::snprintf(b, sizeof b,
+                      "board %s: H %.2f m, theta %.1f-%.1f deg, bin %.4f m (%s), threshold %d, "
+                      "mask n = %d%s",
+                      sc.board.name.c_str(), sc.board.radar_height_m, sc.theta_min, sc.theta_max,
+                      bin, fs.bin_from_config ? "capture" : "board/option", sc.threshold, sc.mask_n,
+                      sc.mask_note.c_str());
+        line(b);
+    }
+    {
+        std::string s;
+        if (!sc.detect_note.empty()) {
+            s = sc.detect_note;
+        } else {
+            s = "detections: " + std::to_string(rv.targets.size());
+            for (size_t i = 0; i < rv.targets.size() && i < 6; i++) {
+                const sl_target_t &t = rv.targets[i];
+                char b[160];
+                std::snprintf(b, sizeof b, "  %c: az %.1f deg r1 %.2f r2 %.2f m %s", 'A' + static_cast<int>(i % 26),
+                              std::fmod(yaw + 360.0 * t.az / A + 360.0, 360.0), t.r1_um * 1e-6,
+                              t.r2_um * 1e-6, target_label(t).c_str());
+                s += b;
+            }
+        }
+        line(s, sl::col::kDetect);
+    }
+    if (!sc.truth_note.empty()) {
+        line(sc.truth_note, sl::col::kTruth);
+    }
+    return img;
+}
+
+} // namespace
+
+int main(int argc, char **argv)
+{
+    Args a;
+    for (int i = 1; i < argc; i++) {
+        const std::string o = argv[i];
+        const bool has = i + 1 < argc;
+        auto numv = [&](double &v) {
+            if (!has) return false;
+            char *e = nullptr;
+            v = std::strtod(argv[i + 1], &e);
+            if (e == argv[i + 1] || *e != '\0') return false;
+            i++;
+            return true;
+        };
+        double v = 0;
+        if (o == "--board" && has) {
+            a.board = argv[++i];
+        } else if (o == "--out" && has) {
+            a.out = argv[++i];
+        } else if (o == "--truth" && has) {
+            a.truth = argv[++i];
+        } else if (o == "--calib" && has) {
+            a.calib = argv[++i];
+        } else if (o == "--all") {
+            a.all = true;
+        } else if (o == "--rotation" && numv(v)) {
+            a.rotation = static_cast<int>(v);
+        } else if (o == "--roi-m" && numv(v) && v > 0.5) {
+            a.roi_m = v;
+        } else if (o == "--vmax" && numv(v) && v > 0) {
+            a.vmax = v;
+        } else if (o == "--fps" && numv(v) && v > 0) {
+            a.fps = v;
+        } else if (o == "--bin-size-m" && numv(v) && v > 0) {
+            a.bin_size_m = v;
+        } else if (o == "--mask-frames" && numv(v) && v >= 1 && v <= SL_CFG_MASK_FRAMES_MAX) {
+            a.mask_frames = static_cast<int>(v);
+        } else if (o == "--threshold" && numv(v) && v >= 0 && v <= 255) {
+            a.threshold = static_cast<int>(v);
+        } else if (o[0] != '-' && a.input.empty()) {
+            a.input = o;
+        } else {
+            std::fprintf(stderr, "sl-view: bad argument '%s'\n", o.c_str());
+            usage();
+            return 2;
+        }
+    }
+    if (a.input.empty() || a.board.empty() || a.out.empty()) {
+        usage();
+        return 2;
+    }
+    Scene sc;
+    try {
+        sc.board = sl::load_board(a.board);
+    } catch (const std::exception &e) {
+        std::fprintf(stderr, "sl-view: %s\n", e.what());
+        return 1;
+    }
+    sc.core_board = sl_board_find(sc.board.name.c_str());
+    // Frames.
+    sl::FrameOptions fo;
+    fo.azimuths = sc.board.azimuths;
+    fo.encoder_size = sc.board.encoder_size;
+    fo.roi_bins = std::min(sc.board.roi_bins, SL_CFG_ROI_BINS);
+    fo.bin_size_m = a.bin_size_m;
+    sl::FrameSet fs;
+    std::string err;
+    {
+        // An Oxford folder has no bin size of its own: the board's (or --bin-size-m).
+        sl::FrameOptions f2 = fo;
+        const bool dir = [&] {
+            FILE *f = std::fopen((a.input + "/.").c_str(), "r");
+            if (f) std::fclose(f);
+            return f != nullptr;
+        }();
+        if (dir && f2.bin_size_m <= 0) {
+            f2.bin_size_m = sc.board.bin_size_m;
+        }
+        if (!sl::load_frames(a.input, f2, fs, err)) {
+            std::fprintf(stderr, "sl-view: %s\n", err.c_str());
+            return 1;
+        }
+    }
+    if (fs.azimuths != sc.board.azimuths) {
+        std::fprintf(stderr, "sl-view: capture has %d azimuths, board %s has %d\n", fs.azimuths,
+                     sc.board.name.c_str(), sc.board.azimuths);
+        return 1;
+    }
+    sc.fs = &fs;
+    const int A = fs.azimuths, N = static_cast<int>(fs.frames.size());
+    // Shadow curves.
+    sc.board_slant_m.resize(A);
+    sc.near_m.assign(A, sc.board.near_exclusion_m);
+    double smax = 0;
+    sc.theta_min = 1e9;
+    sc.theta_max = -1e9;
+    for (int i = 0; i < A; i++) {
+        sc.theta_min = std::min(sc.theta_min, sc.board.theta_deg(i));
+        sc.theta_max = std::max(sc.theta_max, sc.board.theta_deg(i));
+        const double R = sc.board.shadow_radius_m(i);
+        sc.board_slant_m[i] = std::isfinite(R) ? std::hypot(R, sc.board.radar_height_m) : kNaN;
+        if (std::isfinite(sc.board_slant_m[i])) smax = std::max(smax, sc.board_slant_m[i]);
+    }
+    if (!a.calib.empty()) {
+        sl::ShadowCalibFile cf;
+        if (!sl::read_shadow_calib(a.calib, cf, err)) {
+            std::fprintf(stderr, "sl-view: %s\n", err.c_str());
+            return 1;
+        }
+        if (cf.azimuths != A) {
+            std::fprintf(stderr, "sl-view: %s has %d azimuths, the capture %d\n", a.calib.c_str(),
+                         cf.azimuths, A);
+            return 1;
+        }
+        sc.calib_slant_m.assign(A, kNaN);
+        for (int i = 0; i < A; i++) {
+            if (std::isfinite(cf.theta_deg[i])) {
+                sc.calib_slant_m[i] = cf.ground_start_m[i];
+            }
+        }
+        sc.have_calib = true;
+    }
+    sc.roi_m = a.roi_m > 0 ? a.roi_m : std::max(6.0, std::ceil(1.6 * smax));
+    sc.roi_m = std::min(sc.roi_m, fs.roi_bins * fs.bin_size_m);
+    sc.vmax = a.vmax > 0 ? a.vmax : sl::display_max(fs.frames[0].power, 0.995);
+    sc.threshold = a.threshold >= 0 ? a.threshold : sc.board.threshold;
+    sc.mask_n = a.mask_frames > 0 ? a.mask_frames : sc.board.mask_frames;
+    if (a.mask_frames <= 0 && N < sc.mask_n) {
+        sc.mask_note = " (board n = " + std::to_string(sc.board.mask_frames) + "; the capture has " +
+                       std::to_string(N) + " rotations)";
+        sc.mask_n = std::max(1, N);
+    }
+    sc.title = "sl-view  " + a.input;
+    // Truth.
+    std::vector<std::vector<TruthMark>> truth_by_rot;
+    if (!a.truth.empty()) {
+#ifdef SL_HAVE_SIM_TRUTH
+        std::vector<sl::GtRow> rows;
+        if (!sl::gt_read(a.truth, rows, err)) {
+            std::fprintf(stderr, "sl-view: %s\n", err.c_str());
+            return 1;
+        }
+        for (const auto &r : rows) {
+            if (!r.nominal || r.rotation < 0) continue;
+            if (static_cast<int>(truth_by_rot.size()) <= r.rotation) truth_by_rot.resize(r.rotation + 1);
+            TruthMark t;
+            t.name = r.pole_name;
+            t.az = r.azimuth;
+            t.r1_m = r.r1_m;
+            t.r2_m = r.r2_m;
+            t.alpha_deg = r.alpha_deg;
+            t.valid = r.valid != 0;
+            truth_by_rot[r.rotation].push_back(t);
+        }
+        sc.truth_note = "truth: " + a.truth + " (nominal azimuth per pole; alpha = in-plane inclination, > 0 towards the radar)";
+#else
+        std::fprintf(stderr, "sl-view: this build has no simulator truth reader (sim_truth.cpp)\n");
+        return 1;
+#endif
+    }
+    // Core mask + detection over all rotations in order.
+    auto mask = std::make_unique<sl_mask_t>();
+    const int bins = fs.roi_bins;
+    if (sl_mask_init(mask.get(), static_cast<uint16_t>(A), static_cast<uint16_t>(bins),
+                     static_cast<uint8_t>(sc.mask_n), SL_MASK_MAX_MISSED_DEFAULT) != SL_OK) {
+        std::fprintf(stderr, "sl-view: sl_mask_init failed (azimuths %d, bins %d, n %d)\n", A, bins,
+                     sc.mask_n);
+        return 1;
+    }
+    auto det = std::make_unique<sl_detect_t>();
+    bool have_det = false;
+    if (sc.core_board == nullptr) {
+        sc.detect_note = "detections: none drawn (board " + sc.board.name + " is not linked into the core)";
+    } else if (std::fabs(sc.core_board->bin_size_um * 1e-6 - fs.bin_size_m) > 1e-6 ||
+               sc.core_board->roi_bins != bins) {
+        sc.detect_note = "detections: none drawn (capture bin " + fmt("%.4f", fs.bin_size_m) +
+                         " m / ROI differ from the board's tables)";
+    } else if (sl_detect_init(det.get(), sc.core_board, nullptr) == SL_OK) {
+        have_det = true;
+    } else {
+        sc.detect_note = "detections: sl_detect_init rejected the board";
+    }
+    std::vector<int> todo;
+    if (a.all) {
+        for (int k = 0; k < N; k++) todo.push_back(k);
+    } else {
+        int k = a.rotation < 0 ? N + a.rotation : a.rotation;
+        if (k < 0 || k >= N) {
+            std::fprintf(stderr, "sl-view: rotation %d out of range (0..%d)\n", a.rotation, N - 1);
+            return 1;
+        }
+        todo.push_back(k);
+    }
+    cv::VideoWriter vw;
+    std::string video_path, video_note;
+    const bool video = a.all && !ends_with(a.out, ".png");
+    std::vector<uint32_t> bits(SL_ROI_WORDS);
+    int written = 0;
+    size_t next = 0;
+    for (int k = 0; k < N && next < todo.size(); k++) {
+        const auto &fr = fs.frames[k];
+        for (int az = 0; az < A; az++) {
+            if (!(fr.flags[az] & SL_SCAN_AZ_VALID)) continue;
+            sl_thresh_u8(fr.power.ptr<uint8_t>(az), static_cast<uint32_t>(bins),
+                         static_cast<uint16_t>(sc.threshold), bits.data());
+            (void)sl_mask_update(mask.get(), static_cast<uint16_t>(az), bits.data(), nullptr, nullptr);
+        }
+        sl_mask_end_rotation(mask.get());
+        RotationView rv;
+        rv.frame = &fr;
+        rv.index = k;
+        rv.count = N;
+        if (have_det) {
+            const sl_ssize_t n = sl_detect_rotation_from_mask(det.get(), mask.get());
+            for (sl_ssize_t i = 0; i < n; i++) rv.targets.push_back(det->targets[i]);
+        }
+        if (todo[next] != k) continue;
+        next++;
+        rv.occ.resize(A);
+        for (int az = 0; az < A; az++) {
+            std::vector<uint32_t> occ(SL_ROI_WORDS);
+            if (sl_mask_stable(mask.get(), static_cast<uint16_t>(az), occ.data(), nullptr)) {
+                rv.occ[az] = occ;
+            }
+        }
+        if (static_cast<int>(fr.rotation) < static_cast<int>(truth_by_rot.size())) {
+            rv.truth = truth_by_rot[fr.rotation];
+        }
+        cv::Mat img = render(sc, rv);
+        if (video) {
+            if (!vw.isOpened()) {
+                video_path = a.out;
+                if (ends_with(a.out, ".mp4")) {
+                    vw.open(video_path, cv::VideoWriter::fourcc('m', 'p', '4', 'v'), a.fps, img.size());
+                }
+                if (!vw.isOpened()) {
+                    const std::string base = a.out.substr(0, a.out.rfind('.'));
+                    video_path = base + ".avi";
+                    vw.open(video_path, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), a.fps, img.size());
+                    if (ends_with(a.out, ".mp4")) {
+                        video_note = " (mp4 writer unavailable in this OpenCV build: wrote MJPG .avi)";
+                    }
+                }
+                if (!vw.isOpened()) {
+                    std::fprintf(stderr, "sl-view: cannot open a video writer for %s\n", a.out.c_str());
+                    return 1;
+                }
+            }
+            vw.write(img);
+            written++;
+        } else {
+            std::string path = a.out;
+            if (a.all) {
+                char b[32];
+                std::snprintf(b, sizeof b, "_%04d.png", k);
+                path = a.out.substr(0, a.out.size() - 4) + b;
+            }
+            if (!cv::imwrite(path, img)) {
+                std::fprintf(stderr, "sl-view: cannot write %s\n", path.c_str());
+                return 1;
+            }
+            written++;
+            if (!a.all) std::printf("sl-view: wrote %s (rotation %d of %d, %zu detections)\n", path.c_str(), k, N, rv.targets.size());
+        }
+    }
+    if (video) {
+        vw.release();
+        std::printf("sl-view: wrote %s (%d frames at %.1f fps)%s\n", video_path.c_str(), written, a.fps,
+                    video_note.c_str());
+    } else if (a.all) {
+        std::printf("sl-view: wrote %d PNGs %s_NNNN.png\n", written, a.out.substr(0, a.out.size() - 4).c_str());
+    }
+    if (!sc.detect_note.empty()) std::printf("sl-view: note: %s\n", sc.detect_note.c_str());
+    if (!sc.mask_note.empty()) std::printf("sl-view: note: mask n = %d%s\n", sc.mask_n, sc.mask_note.c_str());
+    return 0;
+}

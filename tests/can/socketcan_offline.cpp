@@ -1,0 +1,64 @@
+// socketcan_offline: the SocketCAN sink's paths that need no CAN interface (runs on any
+// host, also one whose kernel has no CAN at all): argument checks, an interface that does
+// not exist (every frame dropped and counted as "down", SL_ERR_PORT, never blocking,
+// reopen attempts on schedule), the generic sink vtable and close() idempotence.
+#include <cstdio>
+#include <cstring>
+#include <iostream>
+
+#include "can_sink.h"
+#include "can_socketcan.h"
+
+namespace {
+int failures = 0;
+#define CHECK(cond)                                                                          \
+    do {                                                                                     \
+        if (!(cond)) {                                                                       \
+            std::cerr << __FILE__ << ":" << __LINE__ << ": CHECK failed: " #cond "\n";       \
+            failures++;                                                                      \
+        }                                                                                    \
+    } while (0)
+} // namespace
+
+int main()
+{
+    sl_can_socketcan_t s;
+    CHECK(sl_can_socketcan_open(nullptr, "vcan0", nullptr) == SL_ERR_ARG);
+    CHECK(sl_can_socketcan_open(&s, nullptr, nullptr) == SL_ERR_ARG);
+    CHECK(sl_can_socketcan_open(&s, "", nullptr) == SL_ERR_ARG);
+    CHECK(sl_can_socketcan_open(&s, "a-name-longer-than-15", nullptr) == SL_ERR_ARG);
+    sl_can_socketcan_cfg_t big = sl_can_socketcan_default_cfg();
+    big.queue_cap = SL_CAN_SOCKETCAN_QUEUE_MAX + 1;
+    CHECK(sl_can_socketcan_open(&s, "vcan0", &big) == SL_ERR_ARG);
+    sl_can_socketcan_close(&s);
+
+    // An interface that does not exist (or no CAN in this kernel: EAFNOSUPPORT).
+    sl_can_socketcan_cfg_t cfg = sl_can_socketcan_default_cfg();
+    CHECK(sl_can_socketcan_open(&s, "slnone0", &cfg) == SL_ERR_PORT);
+    CHECK(s.gone && s.fd < 0 && s.last_errno != 0);
+    std::printf("open slnone0: %s (expected: no such device, or no CAN support)\n",
+                std::strerror(s.last_errno));
+    const sl_can_sink_t k = sl_can_socketcan_sink(&s);
+    CHECK(std::strcmp(k.name, "socketcan") == 0);
+    sl_can_frame_t f{};
+    f.id = 0x620;
+    f.dlc = 8;
+    uint64_t t = 5000000;
+    for (int i = 0; i < 100; i++) {
+        CHECK(k.send(k.ctx, &f, t) == SL_ERR_PORT);
+        t += 100000; // 0.1 s: a reopen is attempted every 1 s
+    }
+    CHECK(s.stats.dropped_down == 100);
+    CHECK(s.stats.sent == 0 && s.stats.reopens == 0);
+    sl_can_sink_stats_t st{};
+    k.get_stats(k.ctx, &st);
+    CHECK(st.dropped == 100 && st.sent == 0 && st.queued == 0);
+    CHECK(sl_can_sinks_dropped(&k, 1) == 100);
+    CHECK(sl_can_sinks_send(&k, 1, &f, t) == SL_ERR_PORT);
+    sl_can_sinks_poll(&k, 1, t);
+    CHECK(sl_can_socketcan_send(&s, nullptr, t) == SL_ERR_ARG);
+    sl_can_socketcan_close(&s);
+    sl_can_socketcan_close(&s);
+    std::printf("socketcan_offline: %d failures\n", failures);
+    return failures == 0 ? 0 : 1;
+}

@@ -1,0 +1,28 @@
+#!/bin/sh
+# uml_sink_guest.sh EXE OUTDIR: runs INSIDE user-mode Linux (via uml_run.sh, vcan0 up).
+# Records the bus with `candump -L any` (survives the interface being deleted and
+# re-created in phase G) while vcan_sink_check drives the SocketCAN sink. Marker frames
+# (7FF#53594E43 "SYNC" before, 7FF#454E4400 "END" after) make sure candump records from
+# the first frame to the last without timing assumptions; the host comparison skips them.
+set -u
+exe=$1; out=$2
+M=/usr/lib/uml/modules/$(uname -r)/kernel
+insmod "$M/net/sched/sch_plug.ko" || { echo "cannot load sch_plug"; exit 1; }
+candump -L -r 8000000 any > "$out/candump.log" 2> "$out/candump.err" &
+cdpid=$!
+wait_for() { # pattern frame
+    i=0
+    while ! grep -q "$1" "$out/candump.log" 2>/dev/null; do
+        i=$((i + 1))
+        if [ $i -gt 200 ]; then echo "candump did not record $2"; return 1; fi
+        cansend vcan0 "$2"
+        sleep 0.05
+    done
+}
+wait_for '7FF#53594E43' '7FF#53594E43' || exit 1
+"$exe" --out "$out" --iface vcan0 --n "${SL_SINK_N:-500}"
+rc=$?
+wait_for '7FF#454E4400' '7FF#454E4400' || rc=1
+kill -INT $cdpid
+wait $cdpid
+exit $rc

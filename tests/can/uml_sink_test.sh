@@ -1,0 +1,12 @@
+#!/bin/sh
+# uml_sink_test.sh UML_RUN EXE PYTHON SRC_DIR OUT_DIR
+# The SocketCAN sink inside user-mode Linux (uml_sink_guest.sh), then the host-side
+# comparison of candump's recording with the sink's logs. Exit 77 (skip) without linux.uml.
+set -u
+uml_run=$1; exe=$2; py=$3; src=$4; out=$5
+rm -rf "$out"
+mkdir -p "$out"
+sh "$uml_run" "$out" sh "$src/uml_sink_guest.sh" "$exe" "$out"
+rc=$?
+[ $rc -eq 0 ] || exit $rc
+"$py" "$src/uml_sink_compare.py" "$out/candump.log" "$out/sent.log" "$out/produced_a.log"
