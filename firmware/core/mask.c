@@ -22,7 +22,7 @@
 
 // Lanes: pairs of words on 64-bit targets. Every operation below is bitwise, so a pair of
 // uint32 words loaded into a uint64 (memcpy) maps back bit for bit on either endianness.
-#if UINTPTR_MAX > 0xFFFFFFFFU
+#if SL_CFG_SWAR_BITS == 64
 typedef uint64_t lane_t;
 #else
 typedef uint32_t lane_t;
@@ -396,4 +396,16 @@ bool sl_mask_stable(const sl_mask_t *m, uint16_t az, uint32_t *occ, uint32_t *fr
 {
     SL_ASSERT(m != NULL);
     return sl_mask_stable_prefix(m, az, m->words, occ, free_);
+}
+
+uint8_t sl_mask_missed(const sl_mask_t *m, uint16_t az)
+{
+    SL_ASSERT(m != NULL);
+    return (az < m->azimuths) ? m->missed[az] : 0U;
+}
+
+bool sl_mask_has_history(const sl_mask_t *m, uint16_t az)
+{
+    SL_ASSERT(m != NULL);
+    return (az < m->azimuths) && ((m->state[az] & ST_HISTORY) != 0U);
 }

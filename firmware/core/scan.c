@@ -13,11 +13,10 @@ int32_t sl_scan_az_index(uint16_t azimuths, uint16_t encoder_size, uint16_t tick
     if (azimuths == 0U || encoder_size == 0U || ticks >= encoder_size) {
         return -1;
     }
-    // Nearest azimuth centre, ties upwards. Exact in 32 bits: (2^16-1)^2 + 2^15 < 2^32, and
-    // ticks < encoder_size makes the quotient <= azimuths, so the modulo is one compare.
-    const uint32_t num = (uint32_t)ticks * azimuths + (uint32_t)(encoder_size / 2U);
-    const uint32_t idx = num / encoder_size;
-    return (int32_t)((idx >= azimuths) ? idx - azimuths : idx);
+    // The cell containing the encoder value (round down). Exact in 32 bits:
+    // (2^16-1)^2 < 2^32, and ticks < encoder_size makes the quotient < azimuths.
+    const uint32_t idx = ((uint32_t)ticks * azimuths) / encoder_size;
+    return (int32_t)idx;
 }
 
 static void frame_clear(sl_scan_frame_t *f)

@@ -13,7 +13,7 @@
 
 // Lane = the widest integer the target handles natively (a 64-bit multiply on a 32-bit
 // core would be a library call). All lane arithmetic below is per-byte carry-free.
-#if UINTPTR_MAX > 0xFFFFFFFFU
+#if SL_CFG_SWAR_BITS == 64
 typedef uint64_t lane_t;
 #define LANE_BYTES 8U
 #define ONES8 ((lane_t)0x0101010101010101U)
@@ -45,7 +45,7 @@ typedef uint32_t lane_t;
 // Bytes p[0..LANE_BYTES) with p[i] in bits 8i.. (endian-independent; one load on LE).
 FORCE_INLINE lane_t ld8(const uint8_t *p)
 {
-#if UINTPTR_MAX > 0xFFFFFFFFU
+#if SL_CFG_SWAR_BITS == 64
     return (lane_t)p[0] | ((lane_t)p[1] << 8) | ((lane_t)p[2] << 16) | ((lane_t)p[3] << 24) |
            ((lane_t)p[4] << 32) | ((lane_t)p[5] << 40) | ((lane_t)p[6] << 48) |
            ((lane_t)p[7] << 56);
@@ -56,7 +56,7 @@ FORCE_INLINE lane_t ld8(const uint8_t *p)
 
 FORCE_INLINE lane_t ld16(const uint16_t *p)
 {
-#if UINTPTR_MAX > 0xFFFFFFFFU
+#if SL_CFG_SWAR_BITS == 64
     return (lane_t)p[0] | ((lane_t)p[1] << 16) | ((lane_t)p[2] << 32) | ((lane_t)p[3] << 48);
 #else
     return (lane_t)p[0] | ((lane_t)p[1] << 16);
@@ -83,7 +83,7 @@ FORCE_INLINE lane_t ge8(lane_t x, lane_t c, bool low)
     return (low ? (x | s) : (x & s)) & H8;
 }
 
-#if UINTPTR_MAX > 0xFFFFFFFFU
+#if SL_CFG_SWAR_BITS == 64
 // 64-bit lanes: 64 bins at a time without multiplies. Lane j (bins 8j..8j+7) contributes
 // its byte flags shifted to bit j of every byte: acc byte k bit j = bin 8j + k. An 8x8 bit
 // transpose (Hacker's Delight 7-3: element (r, c) at bit 8r + c) turns that into byte j
@@ -121,7 +121,7 @@ FORCE_INLINE void block64(const uint8_t *p, lane_t c, bool low, uint32_t *out)
 FORCE_INLINE uint32_t word8(const uint8_t *p, lane_t c, bool low)
 {
 #define G8(j) (gather8(ge8(ld8(p + (j) * LANE_BYTES), c, low)) << ((j) * LANE_BYTES))
-#if UINTPTR_MAX > 0xFFFFFFFFU
+#if SL_CFG_SWAR_BITS == 64
     return G8(0U) | G8(1U) | G8(2U) | G8(3U);
 #else
     return G8(0U) | G8(1U) | G8(2U) | G8(3U) | G8(4U) | G8(5U) | G8(6U) | G8(7U);
@@ -135,7 +135,7 @@ FORCE_INLINE void thresh8_rows(const uint8_t *row, uint32_t bins, uint8_t t, uin
     const lane_t c = ONES8 * (lane_t)(low ? 128U - t : 256U - t);
     const uint32_t full = bins / 32U;
     uint32_t w = 0;
-#if UINTPTR_MAX > 0xFFFFFFFFU
+#if SL_CFG_SWAR_BITS == 64
     for (; w + 2U <= full; w += 2U) {
         block64(row + 32U * w, c, low, &bits[w]);
     }

@@ -292,6 +292,30 @@ ShadowCalib calibrate_shadow(const std::vector<cv::Mat> &frames,
             r.reason = "no ground edge";
             continue;
         }
+        // Per-azimuth refinement: the window's foot is the earliest foot of the neighbouring
+        // azimuths (biased short where S changes fast with azimuth); look again on this
+        // azimuth's own mean within +-refine_bins of it.
+        if (opt.refine_bins > 0) {
+            const float *m1 = c.mean.ptr<float>(a);
+            const int lo = std::max(kc + 1, kf - opt.refine_bins);
+            const int hi = std::min(kmax - 1, kf + opt.refine_bins);
+            std::vector<double> dv, fl;
+            for (int kk = kc + 1; kk < lo && kk <= kc + static_cast<int>(0.5 / b); kk++) {
+                dv.push_back(std::fabs(m1[kk] - m1[kk - 1]));
+                fl.push_back(m1[kk]);
+            }
+            if (dv.size() > 4) {
+                const double s1 = median(dv) / 0.6745 / std::sqrt(2.0);
+                const double f1 = median(fl);
+                const double d1 = std::max(opt.min_ground_contrast, 4.0 * s1);
+                for (int kk = lo; kk <= hi; kk++) {
+                    if (m1[kk] >= f1 + d1 && m1[kk + 1] >= f1 + 0.5 * d1) {
+                        kf = kk;
+                        break;
+                    }
+                }
+            }
+        }
         // Where ground returns start: the centre of the first ground bin (partly filled bins
         // count, as the half-bin rule for targets). The half rise uses the ground level G =
         // max of the smoothed profile over the first ground_window_m after the foot.

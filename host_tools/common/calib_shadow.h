@@ -17,7 +17,10 @@
 //  - ground start (`ground_start_m`, SLANT range S): the first bin after the core whose raw
 //    level reaches F + d0 and starts a confirmed rise (>= 90 % of the next confirm_m of p
 //    stays >= F + d0 / 2); S is that bin's centre (a partly lit bin counts, as the half-bin
-//    rule of the targets). A rise that falls back to the floor is a return inside the ring:
+//    rule of the targets). The window's foot is then refined on the azimuth's own mean
+//    profile within +-refine_bins (first bin >= f1 + d1 followed by one >= f1 + d1 / 2, f1
+//    and d1 from that profile's dark core): the window alone returns the EARLIEST foot of
+//    its azimuths, biased short where S changes fast with azimuth. A rise that falls back to the floor is a return inside the ring:
 //    skipped, its level remembered. `ground_level` G = max of p over ground_window_m after
 //    the foot; `ground_half_m` = where p crosses F + 0.5 (G - F) (half rise, as REAL_SCANS
 //    s.2 uses). theta uses S, or the half rise with edge_half_rise.
@@ -56,6 +59,7 @@ struct ShadowCalibOptions {
     double search_max_m = 10.0;    ///< core and ground are searched up to this slant range
     double ground_window_m = 1.0;  ///< window after the foot for the ground level G
     double min_core_m = 0.2;       ///< the core is the first run this long of dark bins
+    int refine_bins = 6;           ///< per-azimuth refinement of the foot (0 = off)
     double confirm_m = 0.8;        ///< a rise must stay up this long to be the ground
     bool edge_half_rise = false;   ///< theta from the half rise instead of the foot
     double min_ring_contrast = 6;  ///< P - F, power units

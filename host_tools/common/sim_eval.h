@@ -71,8 +71,11 @@ struct SubbinModel {
 /// Sub-bin bounds from the partial-fill amplitudes of the edge bins: solves for the AXIS
 /// r1 in bin i1 (front surface) and r2 in bin i2 such that the model's ratios
 /// E(i1)/E(i1+1) and E(i2)/E(i2-1) match the observed ones (alternating bisections,
-/// starting from the half-bin values). false (r1, r2 untouched) when the run is too short
-/// or the model has no valid inclination. Needs a noise-free linear amplitude.
+/// starting from the half-bin values). false (r1, r2 untouched) when the run is too short,
+/// the pole is not thin (R > bin/4: its cross-section spreads the edge over several bins;
+/// the caller falls back to half-bin + r1 += R) or the model has no valid inclination.
+/// Needs a noise-free linear amplitude (simulation only: a real sensor's 8-bit log output,
+/// noise and smear destroy this information).
 bool subbin_bounds(const double *v, int n, int i1, int i2, const SubbinModel &m, double *r1,
                    double *r2);
 

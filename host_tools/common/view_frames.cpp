@@ -39,6 +39,9 @@ void on_frame(void *vctx, const sl_scan_frame_t *f)
     fr.flags.assign(f->flags, f->flags + az);
     for (int i = 0; i < az; i++) {
         std::copy(f->power[i], f->power[i] + f->roi_bins, fr.power.ptr<uint8_t>(i));
+        if (f->flags[i] & SL_SCAN_AZ_VALID) {
+            fr.widest_row = std::max(fr.widest_row, static_cast<int>(f->bins[i]));
+        }
     }
     c->out->azimuths = az;
     c->out->encoder_size = f->encoder_size;
@@ -115,6 +118,20 @@ bool decode(const Capture &cap, const FrameOptions &opt, FrameSet &out, std::str
     } else if (ctx->config_bin_um > 0) {
         out.bin_size_m = ctx->config_bin_um * 1e-6;
         out.bin_from_config = true;
+    }
+    // Rows shorter than the ROI (contoured data, captures with fewer bins) are zero-filled
+    // by sl_scan: crop every frame to the longest row actually received.
+    {
+        int widest = 0;
+        for (const auto &f : out.frames) {
+            widest = std::max(widest, f.widest_row);
+        }
+        if (widest > 0 && widest < out.roi_bins) {
+            for (auto &f : out.frames) {
+                f.power = f.power(cv::Rect(0, 0, widest, f.power.rows)).clone();
+            }
+            out.roi_bins = widest;
+        }
     }
     if (out.frames.empty()) {
         err = "no complete rotation decoded (" + std::to_string(out.proto.fft8 + out.proto.fft16) +

@@ -8,7 +8,9 @@
 // into an in-memory Colossus stream, so it is decoded exactly as its converted capture.
 //
 // Frames are copied out as cv::Mat (CV_8U, azimuths x roi_bins, row = azimuth index, column =
-// range bin). Frames with fewer than `min_valid_fraction` of their azimuths stored are dropped
+// range bin). When no row of the stream holds `roi_bins` bins (a capture with short rows),
+// every frame is cropped to the longest row received (FrameSet::roi_bins says how many), so
+// sl_scan's zero fill never looks like data. Frames with fewer than `min_valid_fraction` of their azimuths stored are dropped
 // and counted (an Oxford sequence ends with a one-row frame: its last row, encoder tick 5599,
 // is azimuth index 0 and opens a frame that never fills).
 //
@@ -30,7 +32,8 @@ struct RadarFrame {
     uint32_t rotation = 0;          ///< sl_scan frame number (0 = first in the stream)
     uint64_t t_first_us = 0, t_last_us = 0;
     int valid_azimuths = 0;         ///< rows stored
-    cv::Mat power;                  ///< CV_8U, azimuths x roi_bins
+    cv::Mat power;                  ///< CV_8U, azimuths x roi_bins (FrameSet::roi_bins)
+    int widest_row = 0;             ///< most bins any stored row of this frame held
     std::vector<uint8_t> flags;     ///< SL_SCAN_AZ_* per azimuth
 };
 
@@ -47,7 +50,8 @@ struct FrameOptions {
 struct FrameSet {
     std::string source;             ///< path given
     std::string kind;               ///< "raw", "pcap", "pcapng", "oxford-png"
-    int azimuths = 0, encoder_size = 0, roi_bins = 0;
+    int azimuths = 0, encoder_size = 0;
+    int roi_bins = 0;               ///< columns of every frame (<= FrameOptions::roi_bins)
     double bin_size_m = 0;          ///< from the Configuration (or the override / board)
     bool bin_from_config = false;   ///< true: the stream's Configuration gave the bin size
     std::vector<RadarFrame> frames;

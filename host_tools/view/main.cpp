@@ -503,7 +503,10 @@ int main(int argc, char **argv)
     }
     // Core mask + detection over all rotations in order.
     auto mask = std::make_unique<sl_mask_t>();
-    const int bins = fs.roi_bins;
+    // The mask spans the board's region of interest (the detector's rows); captures with
+    // shorter rows are padded with free bins.
+    const int bins = sc.core_board ? std::min<int>(sc.core_board->roi_bins, SL_CFG_ROI_BINS) : fs.roi_bins;
+    std::vector<uint8_t> padded(static_cast<size_t>(std::max(bins, fs.roi_bins)), 0);
     if (sl_mask_init(mask.get(), static_cast<uint16_t>(A), static_cast<uint16_t>(bins),
                      static_cast<uint8_t>(sc.mask_n), SL_MASK_MAX_MISSED_DEFAULT) != SL_OK) {
         std::fprintf(stderr, "sl-view: sl_mask_init failed (azimuths %d, bins %d, n %d)\n", A, bins,
@@ -514,8 +517,7 @@ int main(int argc, char **argv)
     bool have_det = false;
     if (sc.core_board == nullptr) {
         sc.detect_note = "detections: none drawn (board " + sc.board.name + " is not linked into the core)";
-    } else if (std::fabs(sc.core_board->bin_size_um * 1e-6 - fs.bin_size_m) > 1e-6 ||
-               sc.core_board->roi_bins != bins) {
+    } else if (std::fabs(sc.core_board->bin_size_um * 1e-6 - fs.bin_size_m) > 1e-6) {
         sc.detect_note = "detections: none drawn (capture bin " + fmt("%.4f", fs.bin_size_m) +
                          " m / ROI differ from the board's tables)";
     } else if (sl_detect_init(det.get(), sc.core_board, nullptr) == SL_OK) {
@@ -544,7 +546,10 @@ int main(int argc, char **argv)
         const auto &fr = fs.frames[k];
         for (int az = 0; az < A; az++) {
             if (!(fr.flags[az] & SL_SCAN_AZ_VALID)) continue;
-            sl_thresh_u8(fr.power.ptr<uint8_t>(az), static_cast<uint32_t>(bins),
+            const int w = std::min(bins, fs.roi_bins);
+            std::copy(fr.power.ptr<uint8_t>(az), fr.power.ptr<uint8_t>(az) + w, padded.begin());
+            std::fill(padded.begin() + w, padded.end(), 0);
+            sl_thresh_u8(padded.data(), static_cast<uint32_t>(bins),
                          static_cast<uint16_t>(sc.threshold), bits.data());
             (void)sl_mask_update(mask.get(), static_cast<uint16_t>(az), bits.data(), nullptr, nullptr);
         }

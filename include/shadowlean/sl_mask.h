@@ -153,16 +153,10 @@ bool sl_mask_stable_prefix(const sl_mask_t *m, uint16_t az, uint32_t words, uint
 
 /// Consecutive rotations azimuth `az` has gone without a row (0 = fresh; 255 saturated; 0
 /// for an out-of-range az). O(1).
-static inline uint8_t sl_mask_missed(const sl_mask_t *m, uint16_t az)
-{
-    return (az < m->azimuths) ? m->missed[az] : 0U;
-}
+uint8_t sl_mask_missed(const sl_mask_t *m, uint16_t az);
 
 /// True when azimuth `az` has history (its stable planes are meaningful). O(1).
-static inline bool sl_mask_has_history(const sl_mask_t *m, uint16_t az)
-{
-    return (az < m->azimuths) && ((m->state[az] & 1U) != 0U);
-}
+bool sl_mask_has_history(const sl_mask_t *m, uint16_t az);
 
 #ifdef __cplusplus
 }

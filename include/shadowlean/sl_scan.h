@@ -7,15 +7,18 @@
 /// a per-azimuth callback as each row is stored (so a pipeline can threshold it at once)
 /// and a per-rotation callback when the frame is complete.
 ///
-/// ## Azimuth index (nearest azimuth centre)
-/// Azimuth index i is centred on encoder tick i * encoder_size / azimuths (sl_board.h).
-/// An FFT message's encoder value is mapped to the NEAREST centre, ties upwards:
-///     idx = ((ticks * azimuths + encoder_size / 2) / encoder_size) mod azimuths
-/// (exact integer arithmetic, 64-bit intermediate). Ticks >= encoder_size are rejected
-/// (`stats.bad_azimuth`). Example, CTS350-X (400 azimuths, 5600 ticks): the Oxford data's
-/// ticks 13, 27, ..., 5599 (= 14 i + 13) land on indices 1, 2, ..., 399, 0: the last
-/// message of an Oxford PNG (tick 5599, 0.13 deg before north) is index 0 and therefore
-/// OPENS the next frame. Frames always span indices 0..azimuths-1 of one rotation.
+/// ## Azimuth index (the azimuth cell containing the encoder value)
+/// Azimuth index i covers the encoder ticks [i * encoder_size / azimuths,
+/// (i + 1) * encoder_size / azimuths): an FFT message's encoder value is mapped to the cell
+/// it falls in (round down):
+///     idx = (ticks * azimuths) / encoder_size
+/// (exact integer arithmetic). Ticks >= encoder_size are rejected (`stats.bad_azimuth`).
+/// Example, CTS350-X (400 azimuths, 5600 ticks, 14 ticks per cell): the Oxford data's
+/// ticks 13, 27, ..., 5599 (= 14 i + 13, the END of each cell) land on indices 0, 1, ...,
+/// 399, so one Oxford PNG is exactly one frame; a radar reporting the start of each cell
+/// (0, 14, 28, ...) maps the same way. Frames always span indices 0..azimuths-1 of one
+/// rotation. (Nearest-centre rounding was rejected: it moves the Oxford data's last row,
+/// tick 5599, into index 0 of the NEXT rotation.)
 ///
 /// ## Rotation boundaries, gaps, duplicates, reordering
 /// Let `head` be the highest index stored in the current frame and W the reorder window

@@ -35,6 +35,20 @@
 extern "C" {
 #endif
 
+/// SWAR lane width used by the core's bit kernels (thresholds, mask): 64 on targets with
+/// 64-bit pointers, else 32 (a 64-bit multiply or shift would be a library call there).
+/// Override with -DSL_CFG_SWAR_BITS=32 to test the 32-bit kernels on a 64-bit host.
+#ifndef SL_CFG_SWAR_BITS
+#if UINTPTR_MAX > 0xFFFFFFFFU
+#define SL_CFG_SWAR_BITS 64
+#else
+#define SL_CFG_SWAR_BITS 32
+#endif
+#endif
+#if SL_CFG_SWAR_BITS != 32 && SL_CFG_SWAR_BITS != 64
+#error "SL_CFG_SWAR_BITS must be 32 or 64"
+#endif
+
 /// Words of a bit row holding `nbins` bins (rounded up).
 #define SL_BITS_WORDS(nbins) (((uint32_t)(nbins) + 31U) / 32U)
 

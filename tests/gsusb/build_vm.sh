@@ -13,6 +13,7 @@ set -eu
 CACHE=${1:?usage: build_vm.sh CACHE_DIR [SOURCE_DIR]}
 SRC=${2:-$(cd "$(dirname "$0")/../.." && pwd)}
 mkdir -p "$CACHE"
+CACHE=$(cd "$CACHE" && pwd)
 cd "$CACHE"
 
 need=""
@@ -82,10 +83,10 @@ for m in virtio_ring virtio virtio_pci_modern_dev virtio_pci_legacy_dev virtio_p
          9pnet 9pnet_virtio 9p; do insmod /mods/$m.ko; done
 arg() { sed -n "s/.* $1=\([^ ]*\).*/\1/p" /proc/cmdline; }
 OUT=$(arg sl_out); SCRIPT=$(arg sl_guest)
-mount -t 9p -o trans=virtio,version=9p2000.L,ro,msize=512000 hostroot /host
+mount -t 9p -o trans=virtio,version=9p2000.L,ro,msize=512000,cache=loose hostroot /host
 mount -t 9p -o trans=virtio,version=9p2000.L,rw,msize=512000 out /host$OUT
 mount -t proc proc /host/proc; mount -t sysfs sysfs /host/sys; mount -o bind /dev /host/dev
-mount -t tmpfs tmpfs /host/run; mount -t tmpfs tmpfs /host/tmp
+mount -t tmpfs tmpfs /host/run
 mkdir -p /host/dev/pts; mount -t devpts devpts /host/dev/pts
 echo "[init] host root mounted at t=$(cut -d' ' -f1 /proc/uptime)s"
 chroot /host /usr/bin/env -i PATH=/usr/sbin:/usr/bin:/sbin:/bin HOME=/root OUT=$OUT \

@@ -4,12 +4,12 @@
 # exit codes and logs in $OUT; check_results.py judges them on the host afterwards.
 # Settings come from $OUT/vm.env (written by run_vm_test.sh): SL_SEND, SL_DIR.
 . "$OUT/vm.env"
-t() { echo "[guest t=$(cut -d' ' -f1 /proc/uptime)s] $*"; }
+t() { read -r up _ < /proc/uptime; echo "[guest t=${up}s] $*"; }
 rc_of() { echo "$2" > "$OUT/rc_$1"; }
 scenario() { # name mode: switch the fake device's behaviour (atomically)
     printf 'scenario=%s\nmode=%s\n' "$1" "$2" > "$OUT/ctl.tmp" && mv "$OUT/ctl.tmp" "$OUT/ctl"
 }
-wait_for() { # tenths-of-a-second test...
+wait_for() { # TRIES command...: run command every 0.1 s until it succeeds
     n=$1; shift
     while [ "$n" -gt 0 ]; do "$@" && return 0; sleep 0.1; n=$((n - 1)); done
     return 1
@@ -35,30 +35,35 @@ mkdir functions/ffs.gs && ln -s functions/ffs.gs configs/c.1/
 mkdir -p /run/ffs-gs && mount -t functionfs gs /run/ffs-gs
 cd "$OUT" || exit 1
 scenario kernel normal
-python3 -u "$SL_DIR/fake_candlelight.py" /run/ffs-gs "$OUT" "$OUT/ctl" $G/UDC dummy_udc.0 \
+python3 -S -u "$SL_DIR/fake_candlelight.py" /run/ffs-gs "$OUT" "$OUT/ctl" $G/UDC dummy_udc.0 \
     > gadget.log 2>&1 &
 wait_for 100 test -e /run/ffs-gs/ep2 || t "gadget did not start"
 echo dummy_udc.0 > $G/UDC
 wait_for 100 test -e /sys/class/net/can0 || t "can0 did not appear"
 t "gadget bound; net devices: $(ls /sys/class/net | tr '\n' ' ')"
-lsusb -d 1d50:606f; lsusb -t | grep -i gs_usb
 BUSPORT=$(for d in /sys/bus/usb/devices/*-*; do
     case "$d" in *:*) continue ;; esac
     [ "$(cat "$d/idVendor" 2>/dev/null)" = 1d50 ] && basename "$d"; done | head -1)
 echo "$BUSPORT" > busport
-t "fake candleLight at bus-port $BUSPORT"
+t "fake candleLight at bus-port $BUSPORT, driver: $(basename "$(readlink /sys/bus/usb/devices/$BUSPORT:1.0/driver)")"
 
 # (a) The kernel's gs_usb driver: SocketCAN can0, frames sent with cansend.
 t "== (a) kernel gs_usb + SocketCAN"
 ip link set can0 type can bitrate 500000 && ip link set can0 up
 ip -details link show can0 > kernel_iplink.txt 2>&1
 candump -L can0 > candump_kernel.log 2>&1 & CPID=$!
-sleep 0.3
+# candump is listening once a marker frame (7E0#SYNC) shows up in its log; the end marker's
+# reply (7E1#END) arrives after every earlier echo and reply. check_results.py drops markers.
+n=0
+until grep -q "7E0#53594E43" candump_kernel.log || [ $n -ge 40 ]; do
+    cansend can0 7E0#53594E43; sleep 0.2; n=$((n + 1))
+done
 while read -r ts ifc frame; do
     [ -n "$frame" ] && cansend can0 "$frame"
 done < "$SL_DIR/frames_kernel.log"
-wait_for 30 sh -c "[ \$(wc -l < candump_kernel.log) -ge $(($(wc -l < "$SL_DIR/frames_kernel.log") * 2)) ]"
-sleep 0.2; kill $CPID
+cansend can0 7E0#454E44
+wait_for 100 grep -q "7E1#454E44" candump_kernel.log
+kill $CPID
 ip -s link show can0 > kernel_stats.txt 2>&1
 ip link set can0 down
 rc_of kernel 0
@@ -100,7 +105,7 @@ rc_of dropecho $?
 t "== (c4) device vanishes mid-stream and comes back"
 wait_for 50 test -e /sys/class/net/can0
 scenario vanish vanish:8:500
-timeout 30 "$SL_SEND" 1d50:606f --count 60 --interval-ms 40 --reopen-ms 200 \
+timeout 30 "$SL_SEND" 1d50:606f --count 80 --interval-ms 40 --reopen-ms 200 \
     --tx-log tx_vanish.log --summary sum_vanish.txt > out_vanish.txt 2>&1
 rc_of vanish $?
 t "all scenarios done"

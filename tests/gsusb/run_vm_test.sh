@@ -34,7 +34,7 @@ timeout -k 5 150 qemu-system-x86_64 -accel tcg,thread=multi -cpu max -m 1024 -sm
     -nographic -no-reboot -nic none \
     -kernel "$KERNEL" -initrd "$CACHE/initrd.gz" \
     -append "console=ttyS0 quiet panic=-1 sl_out=$OUT sl_guest=$HERE/guest.sh sl_kmod=$KMOD" \
-    -virtfs local,path=/,mount_tag=hostroot,security_model=none,readonly=on \
+    -virtfs local,path=/,mount_tag=hostroot,security_model=none,readonly=on,multidevs=remap \
     -virtfs local,path="$OUT",mount_tag=out,security_model=none \
     < /dev/null > "$OUT/console.log" 2>&1
 QRC=$?

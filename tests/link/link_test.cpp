@@ -445,10 +445,9 @@ int test_oxford(const std::string &replay, const std::string &inspect, const std
     CHECK_EQ(j["rotations"]["missing_azimuths"].get<long long>(), 0, "missing azimuths (all frames)");
     if (g_failures) {
         std::fprintf(stderr,
-                     "note: the Oxford rows carry encoder ticks 13 + 14 i. sl_scan maps ticks to the\n"
-                     "NEAREST azimuth centre, so tick 5599 (the last row of each PNG) becomes index 0\n"
-                     "and opens the next frame: 11 PNGs then give 10 complete frames plus two partial\n"
-                     "ones (399 + 1 azimuths). See the list above.\n");
+                     "note: the Oxford rows carry encoder ticks 13 + 14 i; sl_scan maps each to the\n"
+                     "azimuth cell containing it (index i), so each PNG should be one complete frame.\n"
+                     "See the list above.\n");
     }
     return g_failures ? 1 : 0;
 }

@@ -110,16 +110,19 @@ static void feed_idx(sl_scan_t *s, uint16_t idx, uint16_t sweep, uint8_t seed)
 
 // ---------------------------------------------------------------------------------- tests
 
-static void test_scan_maps_encoder_values_to_the_nearest_azimuth_centre(void **state)
+static void test_scan_maps_encoder_values_to_the_azimuth_cell_containing_them(void **state)
 {
     (void)state;
-    // Oxford pattern: ticks 13 + 14 i -> index i + 1, the last (5599) wraps to 0.
+    // Oxford pattern: ticks 13 + 14 i (the end of cell i) -> index i.
     for (uint32_t i = 0; i < 400; i++) {
-        assert_int_equal(sl_scan_az_index(400, 5600, (uint16_t)(13 + 14 * i)), (i + 1) % 400);
+        assert_int_equal(sl_scan_az_index(400, 5600, (uint16_t)(13 + 14 * i)), i);
+        assert_int_equal(sl_scan_az_index(400, 5600, (uint16_t)(14 * i)), i);
     }
-    // Ties go up: 7 ticks is exactly half-way between azimuths 0 and 1.
-    assert_int_equal(sl_scan_az_index(400, 5600, 6), 0);
-    assert_int_equal(sl_scan_az_index(400, 5600, 7), 1);
+    // Cell 0 is ticks [0, 14), cell 1 starts at 14.
+    assert_int_equal(sl_scan_az_index(400, 5600, 7), 0);
+    assert_int_equal(sl_scan_az_index(400, 5600, 13), 0);
+    assert_int_equal(sl_scan_az_index(400, 5600, 14), 1);
+    assert_int_equal(sl_scan_az_index(400, 5600, 5599), 399);
     assert_int_equal(sl_scan_az_index(400, 5600, 0), 0);
     assert_int_equal(sl_scan_az_index(400, 5600, 5600), -1);
     assert_int_equal(sl_scan_az_index(0, 5600, 1), -1);
@@ -129,7 +132,7 @@ static void test_scan_maps_encoder_values_to_the_nearest_azimuth_centre(void **s
     for (size_t g = 0; g < 4; g++) {
         for (uint32_t t = 0; t < geo[g][1]; t++) {
             const double x = (double)t * geo[g][0] / geo[g][1];
-            const int32_t want = (int32_t)fmod(floor(x + 0.5), geo[g][0]);
+            const int32_t want = (int32_t)floor(x + 1e-9);
             assert_int_equal(sl_scan_az_index(geo[g][0], geo[g][1], (uint16_t)t), want);
         }
     }
@@ -163,7 +166,7 @@ static void test_scan_completes_a_frame_when_the_azimuth_index_wraps(void **stat
     }
 }
 
-static void test_scan_oxford_rotation_starts_at_the_tick_5599_message(void **state)
+static void test_scan_oxford_png_rows_fill_exactly_one_frame(void **state)
 {
     (void)state;
     sl_scan_t s;
@@ -176,20 +179,19 @@ static void test_scan_oxford_rotation_starts_at_the_tick_5599_message(void **sta
             assert_int_equal(sl_scan_on_fft(&s, &f), SL_OK);
         }
     }
-    // PNG row i (ticks 13 + 14 i) is index i + 1; row 399 (tick 5599) is index 0 and opens a
-    // new frame. Frame 0 = rows 0..398 of PNG 0 (index 0 missing); frame 1 = row 399 of PNG 0
-    // plus rows 0..398 of PNG 1, complete.
-    assert_int_equal(g_rec.frames, 3);
-    assert_int_equal(g_rec.stats[0].valid, 399);
-    assert_int_equal(g_rec.stats[0].missing, 1);
-    assert_int_equal(g_rec.stats[1].valid, 400);
-    assert_int_equal(g_rec.stats[1].missing, 0);
-    assert_int_equal(g_rec.stats[2].valid, 400);
+    // PNG row i (ticks 13 + 14 i) is index i: each PNG is one complete frame, completed by
+    // the next PNG's row 0 (the third stays open until a flush).
+    assert_int_equal(g_rec.frames, 2);
+    for (int k = 0; k < 2; k++) {
+        assert_int_equal(g_rec.stats[k].valid, 400);
+        assert_int_equal(g_rec.stats[k].missing, 0);
+        assert_int_equal(g_rec.end[k], SL_SCAN_END_WRAP);
+    }
     const sl_scan_frame_t *last = sl_scan_last_frame(&s);
     assert_non_null(last);
-    assert_int_equal(last->ticks[0], 5599);
-    assert_int_equal(last->ticks[1], 13);
-    assert_int_equal(last->power[1][0], (uint8_t)(0 * 31 + 1)); // row 0's pattern at index 1
+    assert_int_equal(last->ticks[0], 13);
+    assert_int_equal(last->ticks[399], 5599);
+    assert_int_equal(last->power[0][0], (uint8_t)(0 * 31 + 1)); // row 0's pattern at index 0
 }
 
 static void test_scan_counts_and_zero_fills_missing_azimuths(void **state)
@@ -687,9 +689,9 @@ static void test_scan_follows_a_radar_restart_with_a_new_configuration_mid_strea
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_scan_maps_encoder_values_to_the_nearest_azimuth_centre),
+        cmocka_unit_test(test_scan_maps_encoder_values_to_the_azimuth_cell_containing_them),
         cmocka_unit_test(test_scan_completes_a_frame_when_the_azimuth_index_wraps),
-        cmocka_unit_test(test_scan_oxford_rotation_starts_at_the_tick_5599_message),
+        cmocka_unit_test(test_scan_oxford_png_rows_fill_exactly_one_frame),
         cmocka_unit_test(test_scan_counts_and_zero_fills_missing_azimuths),
         cmocka_unit_test(test_scan_drops_duplicates_and_keeps_the_first_row),
         cmocka_unit_test(test_scan_stores_late_azimuths_inside_the_reorder_window),

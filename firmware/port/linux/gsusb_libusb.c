@@ -379,7 +379,7 @@ sl_err_t sl_gsusb_usb_open(sl_gsusb_usb_t *u, const sl_gsusb_usb_sel_t *sel)
     if (u == NULL || sel == NULL) {
         return SL_ERR_ARG;
     }
-    if (u->ctx == NULL) {
+    if (u->ctx == NULL && u->open_attempts == 0U) {
         set_err(u, "libusb not initialised");
         return SL_ERR_STATE;
     }
@@ -387,6 +387,22 @@ sl_err_t sl_gsusb_usb_open(sl_gsusb_usb_t *u, const sl_gsusb_usb_sel_t *sel)
         return SL_ERR_STATE;
     }
     u->err[0] = '\0';
+    if (u->open_attempts++ > 0U) {
+        // A fresh context rescans the bus. The old one's device list is only updated by
+        // hotplug events, which never come where no udev daemon runs (containers, the test
+        // VM): a device that re-enumerated after an unplug would stay invisible.
+        if (u->ctx != NULL) {
+            libusb_exit(u->ctx);
+        }
+        u->ctx = NULL;
+        int r = libusb_init(&u->ctx);
+        if (r != 0) {
+            u->ctx = NULL;
+            set_err(u, "libusb_init failed: %s", libusb_error_name(r));
+            u->stats.open_failures++;
+            return SL_ERR_PORT;
+        }
+    }
     u->sel = *sel;
     u->gone = false;
     u->in_halted = false;

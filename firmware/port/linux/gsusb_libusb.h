@@ -123,6 +123,7 @@ typedef struct sl_gsusb_usb {
     bool in_halted;
     bool out_halted;
     uint32_t out_seq;
+    uint32_t open_attempts;        ///< every attempt after the first uses a fresh libusb context
     sl_gsusb_usb_in_t in[SL_GSUSB_USB_IN_XFERS];
     uint8_t done_q[SL_GSUSB_USB_IN_XFERS]; ///< completed IN transfers, oldest first
     uint8_t done_head, done_count;
@@ -136,7 +137,8 @@ typedef struct sl_gsusb_usb {
 sl_err_t sl_gsusb_usb_init(sl_gsusb_usb_t *u);
 
 /// Find, open, detach the kernel driver, claim interface 0, find the endpoints, queue the
-/// IN transfers. @return SL_OK; SL_ERR_PORT (no matching device, permission denied,
+/// IN transfers. Every call after the first re-creates the libusb context first, so the
+/// bus is rescanned even where no udev daemon delivers hotplug events. @return SL_OK; SL_ERR_PORT (no matching device, permission denied,
 /// interface busy, ...: `err` says which, with the device); SL_ERR_STATE (already open);
 /// SL_ERR_ARG. Cost: one bus scan plus a few descriptor reads.
 sl_err_t sl_gsusb_usb_open(sl_gsusb_usb_t *u, const sl_gsusb_usb_sel_t *sel);
@@ -155,7 +157,8 @@ void sl_gsusb_usb_deinit(sl_gsusb_usb_t *u);
 sl_gsusb_transport_t sl_gsusb_usb_transport(sl_gsusb_usb_t *u);
 
 /// File descriptors libusb wants polled (for a caller's poll() loop): up to `cap` entries
-/// written to `fds`. When one is ready, call the driver's poll. @return how many. O(fds).
+/// written to `fds`. When one is ready, call the driver's poll. They belong to the current
+/// libusb context: ask again after every (re)open. @return how many. O(fds).
 size_t sl_gsusb_usb_pollfds(sl_gsusb_usb_t *u, struct pollfd *fds, size_t cap);
 
 /// Print every USB device with a known gs_usb id ("1d50:606f at 1-1 (bound to gs_usb)")
