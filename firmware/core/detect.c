@@ -616,3 +616,14 @@ sl_ssize_t sl_detect_rotation_from_mask(sl_detect_t *d, const sl_mask_t *mask)
     }
     return sl_detect_end(d);
 }
+
+uint16_t sl_detect_bins_needed(const sl_detect_t *d)
+{
+    SL_ASSERT(d != NULL);
+    uint32_t m = 0;
+    for (uint32_t a = 0; a < d->azimuths; a++) {
+        const uint32_t e = (uint32_t)d->edge_bins[a] + 1U;
+        m = e > m ? e : m;
+    }
+    return (uint16_t)(m < d->bins ? m : d->bins);
+}

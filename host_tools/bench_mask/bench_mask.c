@@ -44,6 +44,7 @@ static sl_tracker_t trk;
 static uint32_t bits[NAZ][NW];
 static uint8_t *power; // rotations x NAZ x NBINS
 static const sl_board_t *board;
+static uint32_t nbins = NBINS; // bins thresholded and masked (--detect-bins: only those read)
 
 enum { C_NONE, C_THRESH, C_MASK, C_DETECT, C_TRACK, C_ALL };
 
@@ -111,7 +112,7 @@ void bench_thresh(uint32_t r)
 {
     const uint8_t *rot = power + (size_t)r * NAZ * NBINS;
     for (uint32_t a = 0; a < NAZ; a++) {
-        sl_thresh_u8(rot + (size_t)a * NBINS, NBINS, board->threshold, bits[a]);
+        sl_thresh_u8(rot + (size_t)a * NBINS, nbins, board->threshold, bits[a]);
     }
 }
 
@@ -145,11 +146,14 @@ int main(int argc, char **argv)
     const char *board_name = "paper-sim";
     int collect = C_NONE;
     uint32_t measured = 16;
+    int detect_bins = 0;
     for (int i = 1; i < argc; i++) {
         if (strcmp(argv[i], "--board") == 0 && i + 1 < argc) {
             board_name = argv[++i];
         } else if (strcmp(argv[i], "--rotations") == 0 && i + 1 < argc) {
             measured = (uint32_t)strtoul(argv[++i], NULL, 10);
+        } else if (strcmp(argv[i], "--detect-bins") == 0) {
+            detect_bins = 1;
         } else if (strcmp(argv[i], "--collect") == 0 && i + 1 < argc) {
             const char *s = argv[++i];
             collect = strcmp(s, "thresh") == 0   ? C_THRESH
@@ -163,7 +167,7 @@ int main(int argc, char **argv)
                 return 2;
             }
         } else {
-            fprintf(stderr, "usage: %s [--board NAME] [--rotations MEASURED] "
+            fprintf(stderr, "usage: %s [--board NAME] [--rotations MEASURED] [--detect-bins] "
                             "[--collect thresh|mask|detect|track|all]\n", argv[0]);
             return 2;
         }
@@ -177,9 +181,15 @@ int main(int argc, char **argv)
     const uint32_t warmup = n + 4U;
     const uint32_t rotations = warmup + measured;
     make_scene(rotations);
-    if (sl_mask_init(&mask, NAZ, NBINS, n, SL_MASK_MAX_MISSED_DEFAULT) != SL_OK ||
-        sl_detect_init(&det, board, NULL) != SL_OK || sl_track_init(&trk, board, NULL) != SL_OK) {
+    if (sl_detect_init(&det, board, NULL) != SL_OK || sl_track_init(&trk, board, NULL) != SL_OK) {
         fprintf(stderr, "sl-bench-mask: init failed\n");
+        return 2;
+    }
+    if (detect_bins) {
+        nbins = SL_BITS_WORDS(sl_detect_bins_needed(&det)) * 32U;
+    }
+    if (sl_mask_init(&mask, NAZ, (uint16_t)nbins, n, SL_MASK_MAX_MISSED_DEFAULT) != SL_OK) {
+        fprintf(stderr, "sl-bench-mask: mask init failed\n");
         return 2;
     }
     double t_th = 0, t_mk = 0, t_dt = 0, t_tr = 0;
@@ -230,9 +240,9 @@ int main(int argc, char **argv)
     }
     const double az = (double)measured * NAZ;
     printf("sl-bench-mask: n=%u (SL_CFG_MASK_FRAMES_MAX=%d, %d counter planes + 1), board %s, "
-           "%u x %u bins, %u warm-up + %u measured rotations\n",
+           "%u x %u bins (%u thresholded and masked), %u warm-up + %u measured rotations\n",
            (unsigned)n, SL_CFG_MASK_FRAMES_MAX, SL_MASK_COUNTER_PLANES, board->name,
-           (unsigned)NAZ, (unsigned)NBINS, (unsigned)warmup, (unsigned)measured);
+           (unsigned)NAZ, (unsigned)NBINS, (unsigned)nbins, (unsigned)warmup, (unsigned)measured);
     printf("sizeof: sl_mask_t %zu  sl_detect_t %zu  sl_tracker_t %zu  (naive %u planes: %zu)\n",
            sizeof(sl_mask_t), sizeof(sl_detect_t), sizeof(sl_tracker_t), (unsigned)n,
            (size_t)n * SL_CFG_MAX_AZIMUTHS * SL_ROI_WORDS * 4U);

@@ -17,14 +17,19 @@ command -v valgrind >/dev/null || { echo "callgrind.sh: valgrind not installed" 
 tmp=$(mktemp -d "${TMPDIR:-/tmp}/sl_cgm.XXXXXX")
 trap 'rm -rf "$tmp"' EXIT INT TERM
 printf '%-4s %-8s %14s %8s %12s %14s\n' n stage instructions azimuths instr/az instr/rotation
-for n in 4 16 32; do
+# Full 512-bin ROI for n = 4, 16, 32; then n = 16 thresholding and masking only the bins
+# detection reads (--detect-bins).
+for run in 4 16 32 16d; do
+    n=${run%d}
+    extra=""
+    [ "$run" = 16d ] && extra="--detect-bins"
     bench="$build/host_tools/bench_mask/sl-bench-mask-n$n"
     [ -x "$bench" ] || { echo "callgrind.sh: $bench not built" >&2; exit 2; }
-    "$bench" "$@" | sed -n '1,2p' | sed "s/^/# /"
+    "$bench" $extra "$@" | sed -n '1,2p' | sed "s/^/# /"
     for stage in thresh mask detect track all; do
         valgrind --tool=callgrind --collect-atstart=no \
             --callgrind-out-file="$tmp/cg.$n.$stage" \
-            "$bench" --collect "$stage" "$@" >"$tmp/log.$n.$stage" 2>"$tmp/err.$n.$stage" || {
+            "$bench" $extra --collect "$stage" "$@" >"$tmp/log.$n.$stage" 2>"$tmp/err.$n.$stage" || {
                 cat "$tmp/log.$n.$stage" "$tmp/err.$n.$stage" >&2; exit 1; }
         ir=$(awk '/^(summary|totals):/ {print $2; exit}' "$tmp/cg.$n.$stage")
         az=$(awk '/^azimuths:/ {print $2; exit}' "$tmp/log.$n.$stage")
@@ -32,6 +37,6 @@ for n in 4 16 32; do
             echo "callgrind.sh: could not parse totals ($ir) or azimuths ($az)" >&2; exit 1; }
         per=$(awk -v a="$ir" -v b="$az" 'BEGIN {printf "%.0f", a / b}')
         rot=$(awk -v a="$ir" -v b="$az" 'BEGIN {printf "%.0f", a / b * 400}')
-        printf '%-4s %-8s %14s %8s %12s %14s\n' "$n" "$stage" "$ir" "$az" "$per" "$rot"
+        printf '%-4s %-8s %14s %8s %12s %14s\n' "$run" "$stage" "$ir" "$az" "$per" "$rot"
     done
 done

@@ -105,7 +105,7 @@ std::string f3(double v)
 cv::Mat elong_png(const std::vector<ElongMeasurement> &m, const ElongTable &t,
                   const std::string &title)
 {
-    cv::Mat img(720, 1100, CV_8UC3, cv::Scalar(28, 28, 28));
+    cv::Mat img(760, 1100, CV_8UC3, cv::Scalar(28, 28, 28));
     draw_text(img, title, cv::Point(70, 30), 0.6);
     PlotAxes pa;
     pa.rect = cv::Rect(90, 80, 960, 500);
@@ -155,8 +155,8 @@ cv::Mat elong_png(const std::vector<ElongMeasurement> &m, const ElongTable &t,
         {col::kCalibShadow, "table points: group mean, +-1 std, r2 span", 0},
         {col::kBoardShadow, "least squares d = a + b r2", 0},
     };
-    draw_legend(img, items, cv::Point(90, 620), 420);
-    int y = 640;
+    draw_legend(img, items, cv::Point(90, 660), 420);
+    int y = 680;
     auto line = [&](const std::string &s) {
         draw_text(img, s, cv::Point(540, y), 0.5);
         y += 22;
@@ -343,7 +343,7 @@ int cmd_elongation(const ElongArgs &a)
     if (!a.png.empty()) {
         cv::Mat img = elong_png(all, t, "sl-calib elongation: " + board.name + ", " +
                                             std::to_string(t.n) + " positions");
-        if (!cv::imwrite(a.png, img)) {
+        if (!cv::imwrite(a.png, img, {cv::IMWRITE_PNG_COMPRESSION, 9})) {
             std::fprintf(stderr, "sl-calib: cannot write %s\n", a.png.c_str());
             return 1;
         }

@@ -45,7 +45,7 @@ cv::Mat shadow_png(const ShadowCalib &c, const BoardSpec &b, const std::string &
 {
     const int A = c.azimuths;
     const int W = 1360, L = 80, PW = 1200;
-    const int H = 1080;
+    const int H = 1110;
     cv::Mat img(H, W, CV_8UC3, cv::Scalar(28, 28, 28));
     draw_text(img, title, cv::Point(L, 30), 0.65);
     // --- panel A: mean image
@@ -59,7 +59,7 @@ cv::Mat shadow_png(const ShadowCalib &c, const BoardSpec &b, const std::string &
         const double bin = c.opt.bin_size_m;
         const int bins = std::min(c.bins, static_cast<int>(std::ceil(range_max_m / bin)));
         cv::Mat m = c.mean(cv::Rect(0, 0, bins, A)).clone();
-        cv::Mat grey = power_to_grey(m, std::max(20.0, display_max(m, 0.98)), 0.6);
+        cv::Mat grey = power_to_grey(m, std::max(20.0, display_max(m, 0.99)), 0.6);
         // Rows are azimuth index (at yaw + 360 i / A); roll so that x = vehicle azimuth.
         cv::Mat t;
         cv::transpose(grey, t);  // bins x A
@@ -106,7 +106,7 @@ cv::Mat shadow_png(const ShadowCalib &c, const BoardSpec &b, const std::string &
     for (const auto &sct : c.unusable) {
         for (int j = 0; j < sct.az_count; j++) {
             const int i = (sct.az_first + j) % A;
-            pa.band(img, x[i], x[i] + 360.0 / A, col::kUnusable, 0.45);
+            pa.band(img, x[i], x[i] + 360.0 / A, col::kUnusable, 0.3);
         }
     }
     {
@@ -118,6 +118,12 @@ cv::Mat shadow_png(const ShadowCalib &c, const BoardSpec &b, const std::string &
         pa.dots(img, xs, ys, cv::Scalar(200, 200, 200), 1);
         std::tie(xs, ys) = by_x(gs);
         pa.dots(img, xs, ys, col::kCalibShadow, 2);
+    }
+    // Where the beam's lower emission bound reaches the ground: nothing nearer is lit.
+    const cv::Scalar kBeam(140, 220, 140);
+    const double s_beam = c.opt.radar_height_m / std::sin(b.lower_bound_deg * 3.14159265358979 / 180.0);
+    for (double x0 = 0; x0 < 360; x0 += 4) {
+        pa.line(img, {x0, x0 + 2}, {s_beam, s_beam}, kBeam, 1);
     }
     pa.draw(img, 45, 1, "azimuth (deg, vehicle frame, clockwise from forward)",
             "mean power over " + std::to_string(c.frames) + " rotations; slant range (m)");
@@ -140,11 +146,11 @@ cv::Mat shadow_png(const ShadowCalib &c, const BoardSpec &b, const std::string &
         hi = 45;
     }
     pb.y0 = std::floor(lo / 5) * 5 - 5;
-    pb.y1 = std::ceil(hi / 5) * 5 + 5;
+    pb.y1 = std::max(std::ceil(hi / 5) * 5 + 5, b.lower_bound_deg + 5);
     for (const auto &sct : c.unusable) {
         for (int j = 0; j < sct.az_count; j++) {
             const int i = (sct.az_first + j) % A;
-            pb.band(img, x[i], x[i] + 360.0 / A, col::kUnusable, 0.45);
+            pb.band(img, x[i], x[i] + 360.0 / A, col::kUnusable, 0.3);
         }
     }
     {
@@ -154,6 +160,9 @@ cv::Mat shadow_png(const ShadowCalib &c, const BoardSpec &b, const std::string &
         pb.dots(img, xs, ys, cv::Scalar(120, 120, 120), 2);
         std::tie(xs, ys) = by_x(th);
         pb.dots(img, xs, ys, col::kCalibShadow, 2);
+    }
+    for (double x0 = 0; x0 < 360; x0 += 4) {
+        pb.line(img, {x0, x0 + 2}, {b.lower_bound_deg, b.lower_bound_deg}, kBeam, 1);
     }
     pb.draw(img, 45, (pb.y1 - pb.y0) > 30 ? 10 : 5,
             "azimuth (deg, vehicle frame, clockwise from forward)",
@@ -167,6 +176,8 @@ cv::Mat shadow_png(const ShadowCalib &c, const BoardSpec &b, const std::string &
         {cv::Scalar(200, 200, 200), "inner edge of the dark ring", 4},
         {cv::Scalar(120, 120, 120), "theta of unusable azimuths (not kept)", 4},
         {col::kUnusable, "unusable azimuths", 2},
+        {kBeam, "beam's lower bound (-" + f2(b.lower_bound_deg, 0) + " deg): H / sin = " +
+                    f2(s_beam) + " m", 1},
     };
     draw_legend(img, items, cv::Point(L, 930), 420);
     std::vector<double> dth, mth, mbt, mgs, mne;
@@ -261,6 +272,7 @@ int cmd_shadow(const ShadowArgs &a)
     ShadowCalibOptions so = a.opt;
     so.radar_height_m = a.height_m > 0 ? a.height_m : board.radar_height_m;
     so.bin_size_m = fs.bin_size_m;
+    so.max_theta_deg = board.lower_bound_deg + 3.0;
     ShadowCalib c;
     try {
         c = calibrate_shadow(frames, valid, so);
@@ -273,11 +285,12 @@ int cmd_shadow(const ShadowArgs &a)
         bth[i] = board.theta_deg(i);
     }
     // Text report.
-    std::vector<double> th, dth, gs, ne, cvs;
+    std::vector<double> th, dth, gs, gh, ne, cvs;
     for (const auto &r : c.az) {
         if (r.usable) {
             th.push_back(r.theta_deg);
-            gs.push_back(r.ground_start_m);
+            gs.push_back(r.ground_foot_m);
+            gh.push_back(r.ground_half_m);
             if (std::isfinite(bth[r.az])) {
                 dth.push_back(r.theta_deg - bth[r.az]);
             }
@@ -295,7 +308,9 @@ int cmd_shadow(const ShadowArgs &a)
     std::printf("  near-field band end (median): %.2f m; band std/mean over time (median): "
                 "%.3f\n",
                 median_of(ne), median_of(cvs));
-    std::printf("  ground start (slant, median over usable): %.3f m\n", median_of(gs));
+    std::printf("  ground start (slant, median over usable): foot %.3f m, half rise %.3f m; "
+                "theta from the %s\n",
+                median_of(gs), median_of(gh), so.edge_half_rise ? "half rise" : "foot");
     std::printf("  theta (median over usable): %.2f deg; board median over the same azimuths: "
                 "%.2f deg; median(measured - board) %.2f deg\n",
                 median_of(th), median_of([&] {
@@ -347,14 +362,14 @@ int cmd_shadow(const ShadowArgs &a)
             return 1;
         }
         std::fprintf(f, "az,az_vehicle_deg,usable,reason,near_peak,near_end_m,near_cv,"
-                        "inner_edge_m,core_m,core_level,rise_level,ground_start_m,ground_level,"
+                        "inner_edge_m,core_m,core_level,rise_level,ground_start_m,ground_foot_m,ground_level,"
                         "ground_half_m,ground_radius_m,theta_deg,theta_raw_deg,board_theta_deg,"
                         "bright_inside_m,bright_level\n");
         for (const auto &r : c.az) {
-            std::fprintf(f, "%d,%.2f,%d,%s,%.2f,%.3f,%.3f,%.3f,%.3f,%.2f,%.2f,%.3f,%.2f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.2f\n",
+            std::fprintf(f, "%d,%.2f,%d,%s,%.2f,%.3f,%.3f,%.3f,%.3f,%.2f,%.2f,%.3f,%.3f,%.2f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.2f\n",
                          r.az, std::fmod(board.azimuth_vehicle_deg(r.az) + 360.0, 360.0),
                          r.usable ? 1 : 0, r.reason.c_str(), r.near_peak_level, r.near_end_m,
-                         r.near_cv, r.inner_edge_m, r.core_m, r.core_level, r.rise_level, r.ground_start_m,
+                         r.near_cv, r.inner_edge_m, r.core_m, r.core_level, r.rise_level, r.ground_start_m, r.ground_foot_m,
                          r.ground_level, r.ground_half_m, r.ground_radius_m, r.theta_deg, r.theta_raw_deg,
                          bth[r.az], r.bright_inside_m, r.bright_level);
         }
@@ -368,7 +383,7 @@ int cmd_shadow(const ShadowArgs &a)
         if (!std::isfinite(rmax)) rmax = 8;
         rmax = std::clamp(std::ceil(rmax), 4.0, so.search_max_m);
         cv::Mat img = shadow_png(c, board, title, rmax);
-        if (!cv::imwrite(a.png, img)) {
+        if (!cv::imwrite(a.png, img, {cv::IMWRITE_PNG_COMPRESSION, 9})) {
             std::fprintf(stderr, "sl-calib: cannot write %s\n", a.png.c_str());
             return 1;
         }

@@ -160,8 +160,8 @@ ShadowCalib calibrate_shadow(const std::vector<cv::Mat> &frames,
         ShadowAz &r = c.az[a];
         r = ShadowAz{};
         r.az = a;
-        r.theta_deg = r.theta_raw_deg = r.ground_start_m = r.ground_half_m = r.ground_radius_m =
-            kNaN;
+        r.theta_deg = r.theta_raw_deg = r.ground_start_m = r.ground_foot_m = r.ground_half_m =
+            r.ground_radius_m = kNaN;
         const float *p = c.profile.ptr<float>(a);
         const float *pr = raw.ptr<float>(a);
         const float *p1 = single.ptr<float>(a);
@@ -320,6 +320,7 @@ ShadowCalib calibrate_shadow(const std::vector<cv::Mat> &frames,
         // count, as the half-bin rule for targets). The half rise uses the ground level G =
         // max of the smoothed profile over the first ground_window_m after the foot.
         const double S = to_m(kf + 0.5);
+        r.ground_foot_m = S;
         r.ground_start_m = S;
         r.ground_level = max_in(p, kf, std::min(kmax, kf + gwin));
         const double G = r.ground_level;
@@ -332,6 +333,7 @@ ShadowCalib calibrate_shadow(const std::vector<cv::Mat> &frames,
             r.ground_half_m = kh <= kmax ? to_m(cross_at(p, kh, L)) : kNaN;
         }
         const double Suse = opt.edge_half_rise ? r.ground_half_m : S;
+        r.ground_start_m = Suse;
         if (std::isfinite(Suse) && Suse > H) {
             r.ground_radius_m = std::sqrt(Suse * Suse - H * H);
             r.theta_raw_deg = std::asin(H / Suse) * 180.0 / kPi;
@@ -363,6 +365,10 @@ ShadowCalib calibrate_shadow(const std::vector<cv::Mat> &frames,
         }
         if (!(Suse > H)) {
             r.reason = "ground start within the radar height";
+            continue;
+        }
+        if (r.theta_raw_deg > opt.max_theta_deg) {
+            r.reason = "steeper than the beam's lower bound";
             continue;
         }
         r.usable = true;

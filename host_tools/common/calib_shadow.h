@@ -36,6 +36,8 @@
 //    (single azimuth: single_az_factor x bright_min) above F: a platform self-return or an
 //    object standing in the ring;
 //  - "ground start within the radar height": S <= H (no real angle);
+//  - "steeper than the beam's lower bound": theta > max_theta_deg (the board's lower emission
+//    bound plus a margin: ground that close is not lit, so the rise is not the ground's);
 //  - "outlier": theta differs from the median of the usable azimuths within
 //    +-outlier_half_window by more than outlier_deg.
 // A sector is a maximal run of consecutive unusable azimuths (wrapping at 0).
@@ -66,6 +68,7 @@ struct ShadowCalibOptions {
     double min_ground_contrast = 3;///< G - F, power units
     double bright_min = 8;         ///< bright return inside the ring: > F + this
     double single_az_factor = 1.5; ///< single-azimuth profile: > F + this x bright_min
+    double max_theta_deg = 38;     ///< the board's lower emission bound + 3 deg (sl-calib)
     int outlier_half_window = 10;  ///< azimuths each side for the outlier test
     double outlier_deg = 4.0;      ///< |theta - local median| above this: outlier
 };
@@ -77,7 +80,8 @@ struct ShadowAz {
     double near_peak_level = 0, near_end_m = 0, near_cv = 0;
     double inner_edge_m = 0, core_m = 0, core_level = 0;
     double rise_level = 0;         ///< d0
-    double ground_start_m = 0;     ///< slant range S of the foot (NaN when not found)
+    double ground_start_m = 0;     ///< slant range S theta is computed from (foot or half)
+    double ground_foot_m = 0;      ///< slant range of the foot (NaN when not found)
     double ground_half_m = 0;      ///< slant range of the half rise (NaN when not found)
     double ground_level = 0;
     double ground_radius_m = 0;    ///< horizontal R = sqrt(S^2 - H^2)

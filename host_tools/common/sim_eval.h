@@ -91,6 +91,7 @@ struct Proc {
                                 ///< calibrated against the back edge)
     double d_const_m = 0;       ///< elongation: r2 -= d
     std::vector<ElongPoint> d_table; ///< elongation table d(r2_obs) (overrides d_const when set)
+    int gap_bins = 1;           ///< bbox: runs separated by at most this many bins are merged
 };
 
 /// Outcome of one estimate.
@@ -98,6 +99,7 @@ struct Est {
     bool extracted = false;     ///< a run was found
     int flag = 0;               ///< sl_incline_flag_t of the core estimator
     double alpha_deg = 0, sigma_deg = 0, r1_m = 0, r2_m = 0;
+    double amb_bound_deg = 0;   ///< (beta - theta) / 2: the model's lower limit
 };
 
 /// Runs the core estimator (integer) on bounds in metres with the board's theta.
@@ -111,8 +113,11 @@ Est estimate_row(const double *v, int n, const GtRow &gt, const BoardSpec &b, do
 
 /// Error statistics of one condition.
 struct ErrStats {
-    std::vector<double> err;    ///< alpha_est - alpha_true (deg), valid estimates
+    std::vector<double> err;    ///< alpha_est - alpha_true (deg), valid estimates (and clipped
+                                ///< ambiguous ones when clip_ambiguous)
     int rows = 0, missed = 0, ambiguous = 0, invalid = 0;
+    bool clip_ambiguous = true; ///< count AMBIGUOUS as the bound (beta - theta)/2, like the
+                                ///< paper's Table II ("clips at the theoretical limit")
     double mean = 0, std = 0, rmse = 0, maxabs = 0;
     void add(const Est &e, double truth);
     void finish();
@@ -136,6 +141,9 @@ struct Table1Options {
     int threads = 0;
     bool progress = true;
     double lateral_m = 3.0;     ///< axis point at radar height, lateral offset (paper Fig. 7: 3 m)
+    int range_bins = 0;         ///< > 0: bins per azimuth in the stream (contoured data; faster)
+    unsigned captures = 0x1F;   ///< bit c: simulate capture c (0 ideal, 1 real res, 2 emission,
+                                ///< 3 10 cm, 4 20 cm); rows of skipped captures stay empty
 };
 
 struct Table1Row {
@@ -179,7 +187,10 @@ struct RealisticResult {
     ErrStats paper_style[5], improved[5];
     std::vector<double> est_paper[5], est_improved[5]; ///< the estimates themselves
     double d_const_m = 0;       ///< paper-style calibration: mean d over 1.75-2.30 m
-    std::vector<ElongPoint> d_table; ///< our calibration: d(r2_obs) table over 1.75-3.0 m
+    std::vector<ElongPoint> d_table; ///< linear d(r2_obs) fit over 1.75-2.85 m (reference only)
+    double tail_slope = 0;      ///< calibrated smear tail: values per bin
+    double kernel_a = 0;        ///< per-bin power ratio of the exponential kernel
+    double d_resid_m = 0;       ///< residual r2 offset after deconvolution (calibrated)
     std::vector<std::pair<double, double>> calib; ///< (r2_obs, d) samples
     double seconds = 0;
     int frames = 16, positions = 11, reps = 4;
@@ -193,6 +204,6 @@ std::string realistic_json(const RealisticResult &r);
 /// tilt `alpha_deg` in the radar's plane (> 0 = towards it).
 Scene realistic_scene(double dist_m, double alpha_deg, uint64_t seed, int frames, int range_bins);
 /// The table-1 pass scene: `cond` 0 ideal, 1 real res, 2 measured emission, 3 10 cm, 4 20 cm.
-Scene table1_scene(int cond, int angle_deg, int rotations, double lateral_m);
+Scene table1_scene(int cond, int angle_deg, int rotations, double lateral_m, int range_bins = 0);
 
 } // namespace sl

@@ -750,6 +750,17 @@ void Simulator::map_column(int k, int i, const SimColumn &col, uint8_t *out) con
             E[static_cast<size_t>(j)] = col.peak[static_cast<size_t>(j)];
         }
     }
+    // speckle belongs to the scatterers (interference inside a resolution cell); the smear
+    // is the sensor's deterministic range response applied to what they return
+    if (s_.speckle) {
+        for (int j = 0; j < nb; j++) {
+            if (E[static_cast<size_t>(j)] > 0) {
+                const double g = sim_normal(sim_hash(spk_seed, spk_k, static_cast<uint64_t>(i),
+                                                     static_cast<uint64_t>(j)));
+                E[static_cast<size_t>(j)] *= std::pow(10.0, 0.1 * s_.speckle_db * g);
+            }
+        }
+    }
     if (s_.smear) {
         std::vector<double> S(static_cast<size_t>(nb), 0.0);
         const int nk = static_cast<int>(smear_kernel_.size());
@@ -766,15 +777,6 @@ void Simulator::map_column(int k, int i, const SimColumn &col, uint8_t *out) con
             }
         }
         E.swap(S);
-    }
-    if (s_.speckle) {
-        for (int j = 0; j < nb; j++) {
-            if (E[static_cast<size_t>(j)] > 0) {
-                const double g = sim_normal(sim_hash(spk_seed, spk_k, static_cast<uint64_t>(i),
-                                                     static_cast<uint64_t>(j)));
-                E[static_cast<size_t>(j)] *= std::pow(10.0, 0.1 * s_.speckle_db * g);
-            }
-        }
     }
     if (s_.mapping == OutputMapping::Linear) {
         double scale = s_.linear_scale;

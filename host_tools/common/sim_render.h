@@ -23,8 +23,9 @@
 //   boxes and ground; azimuths with a box in the window render their ground this way too.
 //   Poles are hidden by boxes and by other poles; poles do not hide ground or boxes
 //   (slender: negligible).
-// - Effects (optional): triangular range smear on energy (RadaRays' kernel, mode weight 1),
-//   log-normal speckle (frozen for a static scene), near-field leakage (fixed pattern),
+// - Effects (optional): log-normal speckle on the scatterers' energy (frozen for a static
+//   scene), then the range smear kernel on energy (RadaRays' triangular kernel with mode
+//   weight 1, or an exponential tail in dB per bin), near-field leakage (fixed pattern),
 //   complex Gaussian noise, and the sensor's log-magnitude 8-bit mapping
 //   value = round(c log10 N) with N an integer magnitude (Oxford: 0, 6, 9, 12, 14, 15, 17,
 //   18 ...; 35 % zeros with the default noise sigma).

@@ -102,7 +102,7 @@ struct Scene {
     int speckle_static = -1;       ///< 1: fixed over time (static scene), 0: per rotation, -1 auto
     uint64_t speckle_seed = 0;     ///< 0: derived from seed
     bool noise = false;
-    double noise_sigma = 2.15;     ///< complex Gaussian per component (35 % zeros)
+    double noise_sigma = 1.62;     ///< complex Gaussian per component: P(round|n| <= 1) = 35 %
     bool leakage = false;
     double leak_level = 38;        ///< output value of the bright band (0 .. leak_edge_m)
     double leak_shoulder = 19;     ///< value of the shoulder

@@ -273,12 +273,12 @@ void PlotAxes::draw(cv::Mat &canvas, double xstep, double ystep, const std::stri
     for (double x = std::ceil(x0 / xstep) * xstep; x <= x1 + 1e-9; x += xstep) {
         const cv::Point2d a = px(x, y0), b = px(x, y1);
         cv::line(canvas, a, b, col::kGrid, 1);
-        draw_text(canvas, num(x, xstep < 1 ? 1 : 0), cv::Point(static_cast<int>(a.x) - 10, static_cast<int>(a.y) + 18), 0.45);
+        draw_text(canvas, num(x, xstep < 0.1 ? 2 : (xstep < 1 ? 1 : 0)), cv::Point(static_cast<int>(a.x) - 10, static_cast<int>(a.y) + 18), 0.45);
     }
     for (double y = std::ceil(y0 / ystep) * ystep; y <= y1 + 1e-9; y += ystep) {
         const cv::Point2d a = px(x0, y), b = px(x1, y);
         cv::line(canvas, a, b, col::kGrid, 1);
-        draw_text(canvas, num(y, ystep < 1 ? 1 : 0), cv::Point(rect.x - 42, static_cast<int>(a.y) + 5), 0.45);
+        draw_text(canvas, num(y, ystep < 0.1 ? 2 : (ystep < 1 ? 1 : 0)), cv::Point(rect.x - 42, static_cast<int>(a.y) + 5), 0.45);
     }
     cv::rectangle(canvas, rect, cv::Scalar(160, 160, 160), 1);
     draw_text(canvas, xlabel, cv::Point(rect.x + rect.width / 2 - 80, rect.y + rect.height + 38), 0.5);

@@ -18,9 +18,11 @@ void usage()
     std::fprintf(stderr,
                  "usage:\n"
                  "  sl-eval table1 [--rotations N] [--quick] [--json] [--plot FILE.png] [--threads N]\n"
+                 "                [--range-bins N]\n"
                  "      The six conditions of the paper's Table I at -10/0/+10 deg, the paper's\n"
                  "      numbers beside ours, then the same captures with our improvements.\n"
                  "  sl-eval realistic [--quick] [--json] [--positions N] [--reps N] [--frames N]\n"
+                 "                   [--calib N] [--range-bins N] [--threads N]\n"
                  "      Smear, speckle, noise floor, leakage, measured emission, n-frame\n"
                  "      segmentation, poles at 2.2-2.6 m: beside the paper's Table II.\n"
                  "  sl-eval run CAPTURE.colossus GT.csv [--board NAME] [--scene SCENE.ini]\n"
@@ -40,6 +42,8 @@ int cmd_table1(int argc, char **argv)
             o.rotations = std::atoi(argv[++i]);
         } else if (a == "--quick") {
             o.rotations = 40;
+        } else if (a == "--range-bins" && i + 1 < argc) {
+            o.range_bins = std::atoi(argv[++i]);
         } else if (a == "--json") {
             json = true;
         } else if (a == "--plot" && i + 1 < argc) {
@@ -84,6 +88,10 @@ int cmd_realistic(int argc, char **argv)
             o.positions = std::atoi(argv[++i]);
         } else if (a == "--reps" && i + 1 < argc) {
             o.reps = std::atoi(argv[++i]);
+        } else if (a == "--calib" && i + 1 < argc) {
+            o.calib_positions = std::atoi(argv[++i]);
+        } else if (a == "--range-bins" && i + 1 < argc) {
+            o.range_bins = std::atoi(argv[++i]);
         } else if (a == "--frames" && i + 1 < argc) {
             o.frames = std::atoi(argv[++i]);
         } else if (a == "--threads" && i + 1 < argc) {

@@ -51,6 +51,8 @@ static void usage(FILE *to)
             "  --max-in-flight N     echo window (default 10)\n"
             "  --echo-timeout-ms T   no echo this long: frame unconfirmed (default 1000)\n"
             "  --linger-ms T         after the last frame, wait this long for echoes (default echo timeout + 500)\n"
+            "  --drain-ms T          then keep receiving bus frames this long (default 100)\n"
+            "  --expect-rx N         ... or until N frames were received from the bus\n"
             "  --reopen-ms T         retry period while the adapter is gone (default 1000)\n"
             "  --tx-log FILE         write every confirmed frame as a candump -L line\n"
             "  --rx-log FILE         write every frame received from the bus as a candump -L line\n"
@@ -179,6 +181,7 @@ static void write_summary(FILE *to, const app_t *a, size_t frames)
             "stalls_in=%u\nclear_halts=%u\nclear_halt_failures=%u\ntx_retries=%u\n"
             "out_resubmits=%u\nusb_out_stalls=%u\nusb_in_stalls=%u\nvanished=%u\nbus_off=%u\n"
             "err_passive=%u\nerr_warning=%u\nkernel_detaches=%u\nkernel_reattaches=%u\n"
+            "echo_mismatch=%u\necho_unknown=%u\ntx_timeouts=%u\nusb_out_timeouts=%u\n"
             "eps_from_descriptor=%d\nep_in=0x%02x\nep_out=0x%02x\nfclk=%u\nbitrate=%u\nbrp=%u\n"
             "prop_seg=%u\nphase_seg1=%u\nphase_seg2=%u\nsjw=%u\nsample_point=%u\n",
             frames, s->offered, s->submitted, s->confirmed, s->unconfirmed, s->dropped_in_flight,
@@ -188,7 +191,8 @@ static void write_summary(FILE *to, const app_t *a, size_t frames)
             (unsigned)a->sink.drv.echo.stats.max_in_flight, d->stalls_out, d->stalls_in,
             d->clear_halts, d->clear_halt_failures, d->tx_retries, u->out_resubmits, u->out_stalls,
             u->in_stalls, d->vanished, d->bus_off, d->err_passive, d->err_warning, u->kernel_detaches,
-            u->kernel_reattaches, a->sink.usb.eps_from_descriptor ? 1 : 0, (unsigned)a->sink.usb.ep_in,
+            u->kernel_reattaches, d->echo_mismatch, d->echo_unknown, d->tx_timeouts, u->out_timeouts,
+            a->sink.usb.eps_from_descriptor ? 1 : 0, (unsigned)a->sink.usb.ep_in,
             (unsigned)a->sink.usb.ep_out, (unsigned)a->sink.drv.bt_const.fclk_hz, t->bitrate,
             t->bt.brp, t->bt.prop_seg, t->bt.phase_seg1, t->bt.phase_seg2, t->bt.sjw,
             (unsigned)t->sample_point_permille);
@@ -202,6 +206,8 @@ int main(int argc, char **argv)
     uint32_t interval_ms = 0;
     uint32_t linger_ms = 0;
     bool linger_given = false;
+    uint32_t drain_ms = 100;
+    uint32_t expect_rx = UINT32_MAX;
     uint32_t v = 0;
     const char *log_path = NULL;
     const char *tx_path = NULL;
@@ -210,7 +216,7 @@ int main(int argc, char **argv)
     bool list = false;
     enum {
         O_BITRATE = 256, O_COUNT, O_LOG, O_INTERVAL, O_WINDOW, O_ECHO, O_LINGER, O_REOPEN, O_TX,
-        O_RX, O_SUMMARY, O_LOOP, O_LISTEN, O_LIST, O_QUIET, O_SP, O_HELP
+        O_RX, O_SUMMARY, O_LOOP, O_LISTEN, O_LIST, O_QUIET, O_SP, O_DRAIN, O_EXPECT_RX, O_HELP
     };
     static const struct option opts[] = {
         {"bitrate", required_argument, NULL, O_BITRATE},
@@ -229,6 +235,8 @@ int main(int argc, char **argv)
         {"list", no_argument, NULL, O_LIST},
         {"quiet", no_argument, NULL, O_QUIET},
         {"sample-point", required_argument, NULL, O_SP},
+        {"drain-ms", required_argument, NULL, O_DRAIN},
+        {"expect-rx", required_argument, NULL, O_EXPECT_RX},
         {"help", no_argument, NULL, O_HELP},
         {NULL, 0, NULL, 0},
     };
@@ -261,6 +269,8 @@ int main(int argc, char **argv)
             ok = parse_u32(optarg, &v) && v > 0U && v < 1000U;
             cfg.can.sample_point_permille = (uint16_t)v;
             break;
+        case O_DRAIN: ok = parse_u32(optarg, &drain_ms); break;
+        case O_EXPECT_RX: ok = parse_u32(optarg, &expect_rx); break;
         case 'h':
         case O_HELP: usage(stdout); return 0;
         default: usage(stderr); return 2;
@@ -366,6 +376,12 @@ int main(int argc, char **argv)
             app.sink.stats.down_events == 0U) {
             break;
         }
+    }
+    // Bus frames can trail the last echo (a reply to the last frame, say).
+    until = sl_port_now_us() + (uint64_t)drain_ms * 1000U;
+    while (stop_flag == 0 && sl_gsusb_sink_is_up(&app.sink) && app.rx_replies < expect_rx &&
+           sl_port_now_us() < until) {
+        sl_gsusb_sink_wait(&app.sink, 10);
     }
     bool was_up = sl_gsusb_sink_is_up(&app.sink);
     sl_gsusb_sink_close(&app.sink);

@@ -3,6 +3,7 @@
 //   sl-view CAPTURE|OXFORD_DIR --board NAME --out FILE.png|FILE.mp4|FILE.avi
 //           [--rotation K | --all] [--truth GT.csv] [--calib CALIB.ini] [--roi-m M]
 //           [--mask-frames N] [--threshold T] [--vmax V] [--fps F] [--bin-size-m M]
+//           [--elongation D.ini] [--title TEXT]
 //
 // One picture per rotation: on the left the polar image (slant range across, azimuth down,
 // the region of interest), on the right the top view around the vehicle (forward up), both
@@ -18,6 +19,10 @@
 //   - the core's detections (sl_detect on the mask, red) with their alpha labels,
 //   - the simulator's ground truth (cyan, --truth: the sl-sim CSV),
 //   - a legend, a scale bar, and a line of numbers under the panels.
+// --elongation D.ini runs the detector on a copy of the linked board whose d(r) table is the
+// `elongation = r:d, ...` line of D.ini (sl-calib elongation --out-ini): the calibration loop
+// without regenerating the board tables. --mask-frames / --threshold override the board's
+// n and threshold; with fewer rotations than n, n becomes the rotation count (noted).
 // Captures are read with capture.h (raw .colossus or pcap) and decoded by the core
 // (sl_proto_feed + sl_scan); an Oxford folder is converted in memory by oxford.h first.
 //
@@ -56,7 +61,7 @@ namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 struct Args {
-    std::string input, board, out, truth, calib;
+    std::string input, board, out, truth, calib, elongation, title;
     int rotation = -1;
     bool all = false;
     double roi_m = 0, vmax = 0, fps = 4, bin_size_m = 0;
@@ -69,7 +74,7 @@ void usage()
         "usage: sl-view CAPTURE|OXFORD_DIR --board NAME --out FILE.png|FILE.mp4|FILE.avi\n"
         "               [--rotation K | --all] [--truth GT.csv] [--calib CALIB.ini]\n"
         "               [--roi-m M] [--mask-frames N] [--threshold T] [--vmax V] [--fps F]\n"
-        "               [--bin-size-m M]\n",
+        "               [--bin-size-m M] [--elongation D.ini] [--title TEXT]\n",
         stderr);
 }
 
@@ -112,6 +117,7 @@ struct Scene {
     std::vector<double> board_slant_m, near_m;
     std::vector<double> calib_slant_m;
     bool have_calib = false;
+    std::string elong_note;
     double theta_min = 0, theta_max = 0;
     std::string title;
 };
@@ -173,6 +179,54 @@ struct Labels {
     }
 };
 
+/// The `elongation = r:d, ...` line of an INI fragment (sl-calib elongation --out-ini) into
+/// a board's table (micrometres). false + err when absent or malformed.
+bool read_elongation(const std::string &path, sl_board_t &b, std::string &err)
+{
+    std::FILE *f = std::fopen(path.c_str(), "r");
+    if (!f) {
+        err = path + ": cannot open";
+        return false;
+    }
+    char line[1024];
+    std::string val;
+    while (std::fgets(line, sizeof line, f)) {
+        std::string l = line;
+        const size_t p = l.find_first_not_of(" \t");
+        if (p != std::string::npos && l.compare(p, 10, "elongation") == 0 && l.find('=') != std::string::npos) {
+            val = l.substr(l.find('=') + 1);
+        }
+    }
+    std::fclose(f);
+    if (val.empty()) {
+        err = path + ": no 'elongation =' line";
+        return false;
+    }
+    int n = 0;
+    const char *c = val.c_str();
+    while (*c) {
+        double r = 0, d = 0;
+        int used = 0;
+        if (std::sscanf(c, " %lf : %lf%n", &r, &d, &used) != 2) break;
+        if (n >= SL_CFG_MAX_ELONG_POINTS || r <= 0 || (n > 0 && r * 1e6 <= b.elong_range_um[n - 1])) {
+            err = path + ": elongation points must ascend, at most " + std::to_string(SL_CFG_MAX_ELONG_POINTS);
+            return false;
+        }
+        b.elong_range_um[n] = static_cast<uint32_t>(std::lround(r * 1e6));
+        b.elong_d_um[n] = static_cast<int32_t>(std::lround(d * 1e6));
+        n++;
+        c += used;
+        while (*c == ' ' || *c == ',' || *c == '\t') c++;
+        if (*c == '\n' || *c == '\r' || *c == ';') break;
+    }
+    if (n == 0) {
+        err = path + ": no r:d pair in the elongation line";
+        return false;
+    }
+    b.elong_points = static_cast<uint8_t>(n);
+    return true;
+}
+
 cv::Mat render(const Scene &sc, const RotationView &rv)
 {
     Labels labels;
@@ -232,14 +286,16 @@ cv::Mat render(const Scene &sc, const RotationView &rv)
         const cv::Point2d off(ca.rect.x, ca.rect.y);
         const auto &b = sc.board;
         if (b.chassis_type == "cylinder") {
-            cv::circle(sub, ca.centre() - off, static_cast<int>(b.cylinder_radius_m * ca.scale()),
-                       sl::col::kChassis, 2, cv::LINE_AA);
+            const int rad = static_cast<int>(b.cylinder_radius_m * ca.scale());
+            cv::circle(sub, ca.centre() - off, rad, cv::Scalar(0, 0, 0), 5, cv::LINE_AA);
+            cv::circle(sub, ca.centre() - off, rad, sl::col::kChassis, 2, cv::LINE_AA);
         } else {
             std::vector<cv::Point> poly;
             for (const auto &v : b.polygon) {
                 const cv::Point2d p = ca.px_xy(v.x_m - b.radar_x_m, v.y_m - b.radar_y_m) - off;
                 poly.emplace_back(static_cast<int>(std::lround(p.x)), static_cast<int>(std::lround(p.y)));
             }
+            cv::polylines(sub, poly, true, cv::Scalar(0, 0, 0), 5, cv::LINE_AA);
             cv::polylines(sub, poly, true, sl::col::kChassis, 2, cv::LINE_AA);
         }
         cv::drawMarker(sub, ca.centre() - off, sl::col::kChassis, cv::MARKER_TILTED_CROSS, 10, 2);
@@ -316,19 +372,22 @@ cv::Mat render(const Scene &sc, const RotationView &rv)
                       sc.mask_note.c_str());
         line(b);
     }
-    {
-        std::string s;
-        if (!sc.detect_note.empty()) {
-            s = sc.detect_note;
-        } else {
-            s = "detections: " + std::to_string(rv.targets.size());
-            for (size_t i = 0; i < rv.targets.size() && i < 6; i++) {
-                const sl_target_t &t = rv.targets[i];
-                char b[160];
-                std::snprintf(b, sizeof b, "  %c: az %.1f deg r1 %.2f r2 %.2f m %s", 'A' + static_cast<int>(i % 26),
-                              std::fmod(yaw + 360.0 * t.az / A + 360.0, 360.0), t.r1_um * 1e-6,
-                              t.r2_um * 1e-6, target_label(t).c_str());
-                s += b;
+    if (!sc.detect_note.empty()) {
+        line(sc.detect_note, sl::col::kDetect);
+    } else {
+        // Three targets per line so the numbers stay inside the picture.
+        std::string s = "detections" + sc.elong_note + ": " + std::to_string(rv.targets.size());
+        for (size_t i = 0; i < rv.targets.size() && i < 6; i++) {
+            const sl_target_t &t = rv.targets[i];
+            char b[160];
+            std::snprintf(b, sizeof b, "   %c: az %.1f deg r1 %.2f r2 %.2f m %s",
+                          'A' + static_cast<int>(i % 26),
+                          std::fmod(yaw + 360.0 * t.az / A + 360.0, 360.0), t.r1_um * 1e-6,
+                          t.r2_um * 1e-6, target_label(t).c_str());
+            s += b;
+            if (i % 3 == 2 && i + 1 < rv.targets.size()) {
+                line(s, sl::col::kDetect);
+                s = "    ";
             }
         }
         line(s, sl::col::kDetect);
@@ -364,6 +423,10 @@ int main(int argc, char **argv)
             a.truth = argv[++i];
         } else if (o == "--calib" && has) {
             a.calib = argv[++i];
+        } else if (o == "--elongation" && has) {
+            a.elongation = argv[++i];
+        } else if (o == "--title" && has) {
+            a.title = argv[++i];
         } else if (o == "--all") {
             a.all = true;
         } else if (o == "--rotation" && numv(v)) {
@@ -400,6 +463,23 @@ int main(int argc, char **argv)
         return 1;
     }
     sc.core_board = sl_board_find(sc.board.name.c_str());
+    // --elongation: the detector runs on a copy of the linked board with this d(r) table
+    // (the calibration loop without regenerating the board tables).
+    sl_board_t board_copy{};
+    if (!a.elongation.empty()) {
+        if (sc.core_board == nullptr) {
+            std::fprintf(stderr, "sl-view: --elongation needs a board linked into the core\n");
+            return 1;
+        }
+        board_copy = *sc.core_board;
+        std::string e;
+        if (!read_elongation(a.elongation, board_copy, e)) {
+            std::fprintf(stderr, "sl-view: %s\n", e.c_str());
+            return 1;
+        }
+        sc.core_board = &board_copy;
+        sc.elong_note = " (d from " + a.elongation.substr(a.elongation.find_last_of('/') + 1) + ")";
+    }
     // Frames.
     sl::FrameOptions fo;
     fo.azimuths = sc.board.azimuths;
@@ -473,7 +553,7 @@ int main(int argc, char **argv)
                        std::to_string(N) + " rotations)";
         sc.mask_n = std::max(1, N);
     }
-    sc.title = "sl-view  " + a.input;
+    sc.title = a.title.empty() ? "sl-view  " + a.input : a.title;
     // Truth.
     std::vector<std::vector<TruthMark>> truth_by_rot;
     if (!a.truth.empty()) {
@@ -495,7 +575,7 @@ int main(int argc, char **argv)
             t.valid = r.valid != 0;
             truth_by_rot[r.rotation].push_back(t);
         }
-        sc.truth_note = "truth: " + a.truth + " (nominal azimuth per pole; alpha = in-plane inclination, > 0 towards the radar)";
+        sc.truth_note = "truth: " + a.truth.substr(a.truth.find_last_of('/') + 1) + " (nominal azimuth per pole; alpha = in-plane inclination, > 0 towards the radar)";
 #else
         std::fprintf(stderr, "sl-view: this build has no simulator truth reader (sim_truth.cpp)\n");
         return 1;
@@ -603,7 +683,7 @@ int main(int argc, char **argv)
                 std::snprintf(b, sizeof b, "_%04d.png", k);
                 path = a.out.substr(0, a.out.size() - 4) + b;
             }
-            if (!cv::imwrite(path, img)) {
+            if (!cv::imwrite(path, img, {cv::IMWRITE_PNG_COMPRESSION, 9})) {
                 std::fprintf(stderr, "sl-view: cannot write %s\n", path.c_str());
                 return 1;
             }

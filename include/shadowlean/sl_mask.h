@@ -44,17 +44,19 @@
 /// The caller owns `sl_mask_t` (static or on a large stack; no allocation). Storage is
 /// sized by SL_CFG_MAX_AZIMUTHS x SL_CFG_ROI_BINS x (1 + SL_MASK_COUNTER_PLANES) bits:
 ///
-/// | SL_CFG_MASK_FRAMES_MAX | planes | sizeof(sl_mask_t), 400 az x 512 bins | naive n planes |
+/// | SL_CFG_MASK_FRAMES_MAX | planes | sizeof(sl_mask_t), 400 az x 512 bins | n full planes |
 /// |---|---|---|---|
-/// | 4  | 1 + 2 | 76,8xx B  | 409,600 B for n = 16 |
-/// | 16 | 1 + 4 | 128,0xx B | 819,200 B for n = 32 |
-/// | 32 | 1 + 5 | 153,6xx B | |
+/// | 4  | 1 + 2 | 77,636 B  | 102,400 B |
+/// | 16 | 1 + 4 | 128,836 B | 409,600 B |
+/// | 32 | 1 + 5 | 154,436 B | 819,200 B |
 ///
-/// (exact values: `host_tools/bench_mask`, which prints sizeof for each configuration). A
-/// board may use any n <= SL_CFG_MASK_FRAMES_MAX; the per-row cost follows its own P.
+/// (printed by `host_tools/bench_mask` for each configuration). A board may use any
+/// n <= SL_CFG_MASK_FRAMES_MAX; the per-row cost follows its own P.
 ///
-/// Per row: O(words x P) word operations; x86-64 -O2 measured by host_tools/bench_mask:
-/// about 350-450 instructions for a 512-bin row at n = 16 (see the bench for 4/16/32).
+/// Per row: O(words x P) word operations, specialised per P and for n = 2^P (then the reset
+/// to n - 1 is one OR per plane). x86-64 -O2, 512-bin rows, measured by
+/// host_tools/bench_mask under callgrind (per azimuth, sl_mask_update plus its share of
+/// sl_mask_end_rotation): n = 4: ~340, n = 16: ~490, n = 32: ~565 instructions.
 /// sl_mask_end_rotation(): O(azimuths), a few instructions per azimuth.
 /// sl_mask_stable(): O(words x P). Stack: a few words. Not reentrant on the same instance;
 /// distinct instances are independent. Fields are read-only to the application.

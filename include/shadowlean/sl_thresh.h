@@ -11,16 +11,18 @@
 /// **Occupied** means `power >= threshold`. With the board's `threshold` (8-bit scale):
 /// 0 marks every bin occupied, 256 or more marks none (8-bit rows).
 ///
-/// Implementation: SWAR, portable C11 (no intrinsics). On targets with 64-bit pointers
-/// eight 8-bit bins (four 16-bit bins) are compared per 64-bit word with a carry-free
-/// byte compare and gathered into bits with one multiply; on 32-bit targets four (two)
-/// per 32-bit word. Loads are assembled byte by byte (compilers turn that into one load),
-/// so the result is endian-independent.
+/// Implementation: SWAR, portable C11 (no intrinsics). A carry-free byte compare on
+/// 8 (64-bit lanes, SL_CFG_SWAR_BITS = 64) or 4 bytes at a time: for t <= 128,
+/// x >= t == top bit of (x | ((x & 0x7F) + 128 - t)); for t > 128, of
+/// (x & ((x & 0x7F) + 256 - t)). 64-bit lanes gather 64 flags with shifts and one 8x8 bit
+/// transpose; 32-bit lanes gather 4 flags with one 32-bit multiply. Loads are assembled
+/// byte by byte (compilers turn that into one load), so the result is endian-independent.
 ///
-/// Cost (x86-64 -O2, measured by host_tools/bench_mask): sl_thresh_u8 about 1.3
-/// instructions per bin (about 690 per 512-bin row); the table variant about 1.7 per bin;
-/// tails (bins % 8) are done one bin at a time. Stack: a few words. No state: reentrant,
-/// callable from any context. RAM: none (the caller owns the input and output rows).
+/// Cost (measured by host_tools/bench_mask under callgrind, x86-64 -O2, threshold 40):
+/// sl_thresh_u8 ~800 instructions per 512-bin row (1.56 per bin, including the call);
+/// sl_thresh_u8_table 3.3 per bin; sl_thresh_u16 4.2 per bin; tails (bins % 32) one bin at
+/// a time. Stack: a few words. No state: reentrant, callable from any context. RAM: none
+/// (the caller owns the input and output rows).
 ///
 /// Errors: none at run time; NULL pointers with `bins > 0` are caller bugs (SL_ASSERT).
 #ifndef SHADOWLEAN_SL_THRESH_H
@@ -85,7 +87,7 @@ void sl_thresh_u8_table(const uint8_t *row, uint32_t bins, const uint8_t *table,
 
 /// Threshold a 16-bit row (radars configured for 16-bit power): bit k = (row[k] >=
 /// threshold). `row` holds host-order `uint16_t` values (the decoder assembles wire bytes).
-/// threshold 0 = every bin occupied, >= 65536 = none. Cost about 2 instructions per bin.
+/// threshold 0 = every bin occupied, >= 65536 = none. Cost about 4 instructions per bin.
 void sl_thresh_u16(const uint16_t *row, uint32_t bins, uint32_t threshold, uint32_t *bits);
 
 #ifdef __cplusplus

@@ -233,6 +233,8 @@ check(s.get("reopens", 0) >= 1 and s.get("confirmed_after_reopen", 0) >= 1,
 check(s.get("kernel_detaches", 0) >= 2, "the re-probed kernel driver was detached again")
 check(all(f in allgen for f in dev) and all(tx.count(f) <= dev.count(f) for f in tx),
       "every confirmed frame was received by the device")
+print("       late/bogus echoes ignored: %s, unknown echo ids: %s, OUT transfers the device did not take: %s" % (
+    s.get("echo_mismatch"), s.get("echo_unknown"), s.get("usb_out_timeouts")))
 check(accounting(s) and s.get("offered") == 80, "every frame accounted for (offered %s, confirmed %s)" % (
     s.get("offered"), s.get("confirmed")))
 

@@ -72,7 +72,7 @@ rc_of kernel 0
 t "== (b1) libusb: frames from a candump log, VID:PID selector, one error frame"
 scenario libusb_log normal+err
 timeout 20 "$SL_SEND" 1d50:606f --bitrate 500000 --log "$SL_DIR/frames_libusb.log" \
-    --tx-log tx_libusb_log.log --rx-log rx_libusb_log.log --summary sum_libusb_log.txt \
+    --expect-rx 12 --drain-ms 3000 --tx-log tx_libusb_log.log --rx-log rx_libusb_log.log --summary sum_libusb_log.txt \
     > out_libusb_log.txt 2>&1
 rc_of libusb_log $?
 wait_for 50 test -e /sys/class/net/can0 && echo 1 > can0_back_after_b1 || echo 0 > can0_back_after_b1
@@ -80,7 +80,7 @@ t "can0 back after release: $(cat can0_back_after_b1)"
 
 t "== (b2) libusb: generated frames, bus-port selector"
 scenario libusb_gen normal
-timeout 20 "$SL_SEND" "$BUSPORT" --count 40 --tx-log tx_libusb_gen.log \
+timeout 20 "$SL_SEND" "$BUSPORT" --count 40 --expect-rx 40 --drain-ms 3000 --tx-log tx_libusb_gen.log \
     --rx-log rx_libusb_gen.log --summary sum_libusb_gen.txt --quiet > out_libusb_gen.txt 2>&1
 rc_of libusb_gen $?
 
@@ -105,7 +105,7 @@ rc_of dropecho $?
 t "== (c4) device vanishes mid-stream and comes back"
 wait_for 50 test -e /sys/class/net/can0
 scenario vanish vanish:8:500
-timeout 30 "$SL_SEND" 1d50:606f --count 80 --interval-ms 40 --reopen-ms 200 \
+timeout 30 "$SL_SEND" 1d50:606f --count 80 --interval-ms 50 --reopen-ms 200 \
     --tx-log tx_vanish.log --summary sum_vanish.txt > out_vanish.txt 2>&1
 rc_of vanish $?
 t "all scenarios done"

@@ -5,6 +5,7 @@
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
+#include <stdlib.h>
 #include <string.h>
 #include <cmocka.h>
 #include <math.h>
@@ -238,6 +239,7 @@ static void test_detect_never_reports_ground_outside_the_shadow(void **state)
     const uint32_t s_bin = (uint32_t)floor(s_m / 0.0438); // 134
     assert_int_equal(det.win_bins[0], (uint16_t)ceil(s_m / 0.0438));
     assert_int_equal(det.edge_bins[0], s_bin);
+    assert_int_equal(sl_detect_bins_needed(&det), s_bin + 1U);
     // Ground clutter from the edge outwards on every azimuth.
     for (int a = 0; a < NAZ; a++) {
         set_run(a, s_bin, 300);
@@ -503,6 +505,34 @@ static void test_detect_from_mask_reports_the_pole_after_n_stable_rotations(void
     }
 }
 
+// The generated paper-sim board (when linked) gives the same geometry as the one built here.
+static void test_detect_agrees_with_the_generated_paper_sim_board(void **state)
+{
+    (void)state;
+    const sl_board_t *ps = sl_board_find("paper-sim");
+    if (ps == NULL) {
+        skip();
+    }
+    assert_int_equal(sl_detect_init(&det, ps, NULL), SL_OK);
+    const double s_m = sqrt(pow(ps->shadow_um[0] * 1e-6, 2) + pow(ps->radar_height_um * 1e-6, 2));
+    assert_int_equal(det.win_bins[0], (uint16_t)ceil(s_m / (ps->bin_size_um * 1e-6)));
+    assert_int_equal(det.near_bins, ps->near_exclusion_bins);
+    uint32_t f, l;
+    double r1m, r2m;
+    pole_bins(3.0, 10.0, &f, &l, &r1m, &r2m);
+    set_run(10, f, l);
+    set_run(11, f, l);
+    set_run(12, f, l);
+    assert_int_equal(run_rotation(), 1);
+    const sl_target_t got = det.targets[0];
+    assert_int_equal(sl_detect_init(&det, &board, NULL), SL_OK);
+    assert_int_equal(run_rotation(), 1);
+    assert_int_equal(got.r1_um, det.targets[0].r1_um);
+    assert_int_equal(got.r2_um, det.targets[0].r2_um);
+    assert_int_equal(got.incline_flag, SL_INCLINE_VALID);
+    assert_true(abs(got.alpha_cdeg - det.targets[0].alpha_cdeg) <= 1);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -517,6 +547,7 @@ int main(void)
         cmocka_unit_test_setup(test_detect_correct_half_bin_elongation_and_radius, setup),
         cmocka_unit_test_setup(test_detect_from_mask_reports_the_pole_after_n_stable_rotations,
                                setup),
+        cmocka_unit_test_setup(test_detect_agrees_with_the_generated_paper_sim_board, setup),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

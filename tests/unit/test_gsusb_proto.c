@@ -854,18 +854,68 @@ static void test_gsusb_malformed_unknown_and_mismatched_packets_are_counted(void
     assert_int_equal(drv.stats.echo_unknown, 1);
     assert_int_equal(ev.n_rx, 0);
 
-    // An echo with our id but another can_id still confirms, and is counted.
+    // An echo with our id but another can_id, dlc or data confirms nothing.
     fake.echo_limit = 0;
     sl_can_frame_t f = mkframe(0x42, false, 1, 1);
     assert_int_equal(sl_gsusb_send(&drv, &f, 5, 0), SL_OK);
     hf.echo_id = 0;
     hf.can_id = 0x43;
     hf.can_dlc = 1;
+    hf.data[0] = f.data[0];
+    (void)sl_gsusb_frame_encode(&hf, 0, buf, sizeof buf);
+    gsusb_fake_push_in(&fake, buf, 20);
+    hf.can_id = 0x42;
+    hf.can_dlc = 2;
+    (void)sl_gsusb_frame_encode(&hf, 0, buf, sizeof buf);
+    gsusb_fake_push_in(&fake, buf, 20);
+    hf.can_dlc = 1;
+    hf.data[0] = (uint8_t)(f.data[0] + 1U);
+    (void)sl_gsusb_frame_encode(&hf, 0, buf, sizeof buf);
+    gsusb_fake_push_in(&fake, buf, 20);
+    assert_int_equal(sl_gsusb_poll(&drv, 0, 0), 3);
+    assert_int_equal(drv.stats.echo_mismatch, 3);
+    assert_int_equal(ev.n_confirmed, 0);
+    assert_int_equal(sl_gsusb_in_flight(&drv), 1);
+    // The true echo confirms it.
+    hf.data[0] = f.data[0];
     (void)sl_gsusb_frame_encode(&hf, 0, buf, sizeof buf);
     gsusb_fake_push_in(&fake, buf, 20);
     assert_int_equal(sl_gsusb_poll(&drv, 0, 0), 1);
-    assert_int_equal(drv.stats.echo_mismatch, 1);
     assert_int_equal(ev.n_confirmed, 1);
+    assert_int_equal(ev.done_tag[0], 5);
+}
+
+// A frame's echo comes after the frame timed out and its id went to another frame: the
+// late echo must not confirm the new frame (seen in the VM with a slow device).
+static void test_gsusb_late_echo_never_confirms_the_next_user_of_its_id(void **state)
+{
+    (void)state;
+    sl_gsusb_cfg_t c = base_cfg();
+    c.max_in_flight = 1; // every frame uses echo id 0
+    c.echo_timeout_ms = 100;
+    init_with(&c);
+    assert_int_equal(sl_gsusb_start(&drv, 0), SL_OK);
+    fake.echo_limit = 0; // hold the echoes back; the test delivers them late
+    sl_can_frame_t a = mkframe(0x621, false, 8, 1);
+    sl_can_frame_t b = mkframe(0x621, false, 8, 2); // same id, other data (E2E counter)
+    assert_int_equal(sl_gsusb_send(&drv, &a, 1, 0), SL_OK);
+    assert_int_equal(sl_gsusb_poll(&drv, 0, 100000), 0); // a times out
+    assert_int_equal(ev.n_timeout, 1);
+    assert_int_equal(sl_gsusb_send(&drv, &b, 2, 100000), SL_OK);
+    assert_int_equal(fake.frames[1].echo_id, 0);
+    uint8_t buf[24];
+    sl_gsusb_host_frame_t late = fake.frames[0];
+    (void)sl_gsusb_frame_encode(&late, 0, buf, sizeof buf);
+    gsusb_fake_push_in(&fake, buf, 20); // a's echo, late
+    assert_int_equal(sl_gsusb_poll(&drv, 0, 110000), 1);
+    assert_int_equal(ev.n_confirmed, 0);
+    assert_int_equal(drv.stats.echo_mismatch, 1);
+    sl_gsusb_host_frame_t good = fake.frames[1];
+    (void)sl_gsusb_frame_encode(&good, 0, buf, sizeof buf);
+    gsusb_fake_push_in(&fake, buf, 20); // b's own echo
+    assert_int_equal(sl_gsusb_poll(&drv, 0, 120000), 1);
+    assert_int_equal(ev.n_confirmed, 1);
+    assert_int_equal(ev.done_tag[1], 2); // done[0] was a's timeout
 }
 
 static void test_gsusb_window_full_returns_busy_until_echoes_time_out(void **state)
@@ -1113,6 +1163,7 @@ int main(void)
         cmocka_unit_test_setup(test_gsusb_frames_are_confirmed_by_their_echo, setup),
         cmocka_unit_test_setup(test_gsusb_rx_frames_error_frames_and_overflow_reach_the_callback, setup),
         cmocka_unit_test_setup(test_gsusb_malformed_unknown_and_mismatched_packets_are_counted, setup),
+        cmocka_unit_test_setup(test_gsusb_late_echo_never_confirms_the_next_user_of_its_id, setup),
         cmocka_unit_test_setup(test_gsusb_window_full_returns_busy_until_echoes_time_out, setup),
         cmocka_unit_test_setup(test_gsusb_lost_echoes_are_counted_as_unconfirmed_without_hanging, setup),
         cmocka_unit_test_setup(test_gsusb_out_stall_is_cleared_and_the_frame_retried_once, setup),

@@ -496,6 +496,14 @@ sl_err_t sl_gsusb_echo_release(sl_gsusb_echo_t *e, uint32_t echo_id)
     return SL_OK;
 }
 
+const sl_gsusb_echo_slot_t *sl_gsusb_echo_peek(const sl_gsusb_echo_t *e, uint32_t echo_id)
+{
+    if (e == NULL || echo_id >= e->capacity || !e->slot[echo_id].in_use) {
+        return NULL;
+    }
+    return &e->slot[echo_id];
+}
+
 sl_err_t sl_gsusb_echo_confirm(sl_gsusb_echo_t *e, uint32_t echo_id, sl_gsusb_echo_slot_t *done)
 {
     if (e == NULL) {
@@ -992,16 +1000,22 @@ static void handle_packet(sl_gsusb_t *d, const uint8_t *pkt, size_t len, uint64_
         return;
     }
     if (hf.echo_id != (uint32_t)SL_GSUSB_ECHO_ID_RX) {
-        sl_gsusb_echo_slot_t done;
-        if (sl_gsusb_echo_confirm(&d->echo, hf.echo_id, &done) != SL_OK) {
+        const sl_gsusb_echo_slot_t *slot = sl_gsusb_echo_peek(&d->echo, hf.echo_id);
+        if (slot == NULL) {
+            d->echo.stats.unknown++;
             d->stats.echo_unknown++;
             return;
         }
         sl_gsusb_host_frame_t sent;
-        (void)sl_gsusb_frame_from_can(&done.frame, hf.echo_id, d->cfg.channel, &sent);
-        if (sent.can_id != hf.can_id || sent.can_dlc != hf.can_dlc) {
-            d->stats.echo_mismatch++;
+        (void)sl_gsusb_frame_from_can(&slot->frame, hf.echo_id, d->cfg.channel, &sent);
+        bool rtr = (sent.can_id & SL_GSUSB_CAN_RTR_FLAG) != 0U;
+        if (sent.can_id != hf.can_id || sent.can_dlc != hf.can_dlc ||
+            (!rtr && memcmp(sent.data, hf.data, sent.can_dlc) != 0)) {
+            d->stats.echo_mismatch++; // late echo of an earlier user of this id, or bogus
+            return;
         }
+        sl_gsusb_echo_slot_t done;
+        (void)sl_gsusb_echo_confirm(&d->echo, hf.echo_id, &done);
         d->stats.tx_confirmed++;
         if (d->cfg.on_tx_done != NULL) {
             uint64_t lat = now_us >= done.sent_us ? now_us - done.sent_us : 0U;

@@ -362,6 +362,9 @@ sl_ssize_t sl_gsusb_echo_alloc(sl_gsusb_echo_t *e, const sl_can_frame_t *frame, 
 /// @return SL_OK or SL_ERR_ARG (not in flight). O(1).
 sl_err_t sl_gsusb_echo_release(sl_gsusb_echo_t *e, uint32_t echo_id);
 
+/// The slot of `echo_id` when it is in flight, else NULL (never counted). O(1).
+const sl_gsusb_echo_slot_t *sl_gsusb_echo_peek(const sl_gsusb_echo_t *e, uint32_t echo_id);
+
 /// An echo arrived: free its id and copy the slot to `*done` (may be NULL).
 /// @return SL_OK, or SL_ERR_MALFORMED for an id not in flight (counted in stats.unknown). O(1).
 sl_err_t sl_gsusb_echo_confirm(sl_gsusb_echo_t *e, uint32_t echo_id, sl_gsusb_echo_slot_t *done);
@@ -501,7 +504,10 @@ typedef struct sl_gsusb_stats {
     uint32_t rx_other_channel;  ///< frames of another channel: dropped
     uint32_t rx_io_errors;      ///< bulk IN failures (not stalls)
     uint32_t echo_unknown;      ///< echoes with an id not in flight
-    uint32_t echo_mismatch;     ///< echoes whose id/dlc differ from the frame sent (confirmed)
+    uint32_t echo_mismatch;     ///< echoes whose can_id/dlc/data differ from the frame in
+                                ///< flight under that id: a late echo of an earlier frame
+                                ///< (its id timed out and was reused) or a bogus one. Not a
+                                ///< confirmation: the frame in flight keeps waiting
     uint32_t bus_off;           ///< error frames with the BUSOFF class
     uint32_t err_passive;       ///< error frames reporting RX/TX error-passive
     uint32_t err_warning;       ///< error frames reporting RX/TX warning
@@ -557,7 +563,9 @@ sl_err_t sl_gsusb_start(sl_gsusb_t *d, uint64_t now_us);
 sl_err_t sl_gsusb_send(sl_gsusb_t *d, const sl_can_frame_t *f, uint32_t tag, uint64_t now_us);
 
 /// Receive: wait at most `timeout_ms` for the first IN packet, then take what is already
-/// there (up to rx_budget packets): echoes confirm frames, RX/error frames go to on_rx.
+/// there (up to rx_budget packets): echoes confirm frames (only when the echoed can_id,
+/// dlc and data equal the frame in flight under that echo id, so a late echo can never
+/// confirm the wrong frame), RX/error frames go to on_rx.
 /// Then expire echoes older than echo_timeout_ms at `now_us`. A halted IN endpoint, or an
 /// OUT endpoint the transport reports stalled, is cleared (counted). @return packets handled (>= 0), SL_ERR_PORT (the device vanished in
 /// this call: DOWN) or SL_ERR_STATE (not RUNNING; nothing done).
