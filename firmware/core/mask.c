@@ -61,9 +61,55 @@ FORCE_INLINE void lane_st(uint32_t *p, lane_t v, bool one)
 // (unused planes are constant 0). k counts down: see sl_mask.h.
 //   d = x ^ L;  k -= 1 where !d && k > 0 (borrow chain);  k = n - 1 where d;  L = x;
 //   stable = (k == 0).
-FORCE_INLINE void lane_update(uint32_t (*pl)[SL_ROI_WORDS], const uint32_t *x, uint32_t *occ,
+// Window test k < t for a constant t (bit-sliced, MSB plane first): tp[p] = bit p of t as
+// a lane mask, allm = all ones when t >= 2^P (every bin stable). See sl_mask.h.
+FORCE_INLINE lane_t lane_lt(lane_t c0, lane_t c1, lane_t c2, lane_t c3, lane_t c4, unsigned P,
+                            const lane_t *tp, lane_t allm)
+{
+    lane_t lt = 0, eq = ~(lane_t)0;
+    if (P > 4U) {
+        lt |= eq & ~c4 & tp[4];
+        eq &= ~(c4 ^ tp[4]);
+    }
+    if (P > 3U) {
+        lt |= eq & ~c3 & tp[3];
+        eq &= ~(c3 ^ tp[3]);
+    }
+    if (P > 2U) {
+        lt |= eq & ~c2 & tp[2];
+        eq &= ~(c2 ^ tp[2]);
+    }
+    if (P > 1U) {
+        lt |= eq & ~c1 & tp[1];
+        eq &= ~(c1 ^ tp[1]);
+    }
+    if (P > 0U) {
+        lt |= eq & ~c0 & tp[0];
+    }
+    (void)eq;
+    return lt | allm;
+}
+
+// Per-row constants of the window test: t = n - w + 1 (k < t <=> k <= n - w).
+typedef struct win {
+    bool on;      // w < n (else the plain k == 0 test)
+    lane_t allm;  // t >= 2^P
+    lane_t tp[5];
+} win_t;
+
+static void win_make(win_t *wn, unsigned P, uint32_t n, uint32_t w)
+{
+    const uint32_t t = n - w + 1U;
+    wn->on = w < n;
+    wn->allm = (t >= ((uint32_t)1U << P)) ? ~(lane_t)0 : (lane_t)0;
+    for (unsigned p = 0; p < 5U; p++) {
+        wn->tp[p] = (((t >> p) & 1U) != 0U) ? ~(lane_t)0 : (lane_t)0;
+    }
+}
+
+FORCE_INLINE void lane_update(uint32_t (*pl)[SL_MASK_WORDS], const uint32_t *x, uint32_t *occ,
                               uint32_t *fr, uint32_t w, unsigned P, const lane_t *rp, bool one,
-                              bool full)
+                              bool full, const win_t *wn)
 {
     const lane_t xv = lane_ld(&x[w], one);
     const lane_t d = xv ^ lane_ld(&pl[0][w], one);
@@ -109,7 +155,8 @@ FORCE_INLINE void lane_update(uint32_t (*pl)[SL_ROI_WORDS], const uint32_t *x, u
         c4 = full ? ((c4 ^ b) | d) : (((c4 ^ b) & ~d) | (d & rp[4]));
     }
     (void)t;
-    const lane_t s = ~(c0 | c1 | c2 | c3 | c4);
+    const lane_t s = wn->on ? lane_lt(c0, c1, c2, c3, c4, P, wn->tp, wn->allm)
+                            : ~(c0 | c1 | c2 | c3 | c4);
     lane_st(&pl[0][w], xv, one);
     if (P > 0U) {
         lane_st(&pl[1][w], c0, one);
@@ -134,8 +181,9 @@ FORCE_INLINE void lane_update(uint32_t (*pl)[SL_ROI_WORDS], const uint32_t *x, u
     }
 }
 
-FORCE_INLINE void update_row(uint32_t (*pl)[SL_ROI_WORDS], const uint32_t *x, uint32_t *occ,
-                             uint32_t *fr, uint32_t words, unsigned P, uint32_t nm1, bool full)
+FORCE_INLINE void update_row(uint32_t (*pl)[SL_MASK_WORDS], const uint32_t *x, uint32_t *occ,
+                             uint32_t *fr, uint32_t words, unsigned P, uint32_t nm1, bool full,
+                             const win_t *wn)
 {
     lane_t rp[5];
     for (unsigned p = 0; p < 5U; p++) {
@@ -143,17 +191,18 @@ FORCE_INLINE void update_row(uint32_t (*pl)[SL_ROI_WORDS], const uint32_t *x, ui
     }
     uint32_t w = 0;
     for (; w + LANE_WORDS <= words; w += LANE_WORDS) {
-        lane_update(pl, x, occ, fr, w, P, rp, false, full);
+        lane_update(pl, x, occ, fr, w, P, rp, false, full, wn);
     }
     for (; w < words; w++) {
-        lane_update(pl, x, occ, fr, w, P, rp, true, full);
+        lane_update(pl, x, occ, fr, w, P, rp, true, full, wn);
     }
 }
 
 // Specialised on P and on n being a power of two (reset value all ones: one OR per plane).
-#define UPD(P_, F_) update_row(pl, x, occ, fr, words, (P_), nm1, (F_))
-static void update_dispatch(uint32_t (*pl)[SL_ROI_WORDS], const uint32_t *x, uint32_t *occ,
-                            uint32_t *fr, uint32_t words, unsigned P, uint32_t nm1)
+#define UPD(P_, F_) update_row(pl, x, occ, fr, words, (P_), nm1, (F_), wn)
+static void update_dispatch(uint32_t (*pl)[SL_MASK_WORDS], const uint32_t *x, uint32_t *occ,
+                            uint32_t *fr, uint32_t words, unsigned P, uint32_t nm1,
+                            const win_t *wn)
 {
     const bool full = nm1 == (((uint32_t)1U << P) - 1U);
     switch (P * 2U + (full ? 1U : 0U)) {
@@ -205,52 +254,58 @@ static void update_dispatch(uint32_t (*pl)[SL_ROI_WORDS], const uint32_t *x, uin
 #undef UPD
 
 // Stable planes of one azimuth with history, specialised on P like the update.
-FORCE_INLINE void stable_words(const uint32_t (*pl)[SL_ROI_WORDS], uint32_t *occ, uint32_t *fr,
-                               uint32_t words, unsigned P)
+FORCE_INLINE void stable_words(const uint32_t (*pl)[SL_MASK_WORDS], uint32_t *occ, uint32_t *fr,
+                               uint32_t words, unsigned P, const win_t *wn)
 {
     for (uint32_t w = 0; w < words; w++) {
-        const uint32_t nz = (P > 0U ? pl[1][w] : 0U) | (P > 1U ? pl[2][w] : 0U) |
-                            (P > 2U ? pl[3][w] : 0U) | (P > 3U ? pl[4][w] : 0U) |
-                            (P > 4U ? pl[5][w] : 0U);
+        const uint32_t c0 = P > 0U ? pl[1][w] : 0U, c1 = P > 1U ? pl[2][w] : 0U;
+        const uint32_t c2 = P > 2U ? pl[3][w] : 0U, c3 = P > 3U ? pl[4][w] : 0U;
+        const uint32_t c4 = P > 4U ? pl[5][w] : 0U;
+        uint32_t s;
+        if (wn->on) {
+            s = (uint32_t)lane_lt(c0, c1, c2, c3, c4, P, wn->tp, wn->allm);
+        } else {
+            s = ~(c0 | c1 | c2 | c3 | c4);
+        }
         if (occ != NULL) {
-            occ[w] = ~nz & pl[0][w];
+            occ[w] = s & pl[0][w];
         }
         if (fr != NULL) {
-            fr[w] = ~nz & ~pl[0][w];
+            fr[w] = s & ~pl[0][w];
         }
     }
 }
 
-static void stable_row(const uint32_t (*pl)[SL_ROI_WORDS], uint32_t *occ, uint32_t *fr,
-                       uint32_t words, unsigned P)
+static void stable_row(const uint32_t (*pl)[SL_MASK_WORDS], uint32_t *occ, uint32_t *fr,
+                       uint32_t words, unsigned P, const win_t *wn)
 {
     switch (P) {
     case 0:
-        stable_words(pl, occ, fr, words, 0U);
+        stable_words(pl, occ, fr, words, 0U, wn);
         break;
 #if SL_MASK_COUNTER_PLANES >= 1
     case 1:
-        stable_words(pl, occ, fr, words, 1U);
+        stable_words(pl, occ, fr, words, 1U, wn);
         break;
 #endif
 #if SL_MASK_COUNTER_PLANES >= 2
     case 2:
-        stable_words(pl, occ, fr, words, 2U);
+        stable_words(pl, occ, fr, words, 2U, wn);
         break;
 #endif
 #if SL_MASK_COUNTER_PLANES >= 3
     case 3:
-        stable_words(pl, occ, fr, words, 3U);
+        stable_words(pl, occ, fr, words, 3U, wn);
         break;
 #endif
 #if SL_MASK_COUNTER_PLANES >= 4
     case 4:
-        stable_words(pl, occ, fr, words, 4U);
+        stable_words(pl, occ, fr, words, 4U, wn);
         break;
 #endif
 #if SL_MASK_COUNTER_PLANES >= 5
     case 5:
-        stable_words(pl, occ, fr, words, 5U);
+        stable_words(pl, occ, fr, words, 5U, wn);
         break;
 #endif
     default:
@@ -263,7 +318,7 @@ sl_err_t sl_mask_init(sl_mask_t *m, uint16_t azimuths, uint16_t bins, uint8_t fr
                       uint8_t max_missed)
 {
     if (m == NULL || azimuths == 0U || azimuths > SL_CFG_MAX_AZIMUTHS || bins == 0U ||
-        bins > SL_CFG_ROI_BINS || frames == 0U || frames > SL_CFG_MASK_FRAMES_MAX ||
+        bins > SL_CFG_MASK_BINS || frames == 0U || frames > SL_CFG_MASK_FRAMES_MAX ||
         max_missed == 255U) {
         return SL_ERR_ARG;
     }
@@ -274,6 +329,17 @@ sl_err_t sl_mask_init(sl_mask_t *m, uint16_t azimuths, uint16_t bins, uint8_t fr
     m->frames = frames;
     m->counter_planes = (uint8_t)SL_MASK_PLANES_FOR(frames);
     m->max_missed = max_missed;
+    m->window = frames;
+    return SL_OK;
+}
+
+sl_err_t sl_mask_set_window(sl_mask_t *m, uint8_t w)
+{
+    SL_ASSERT(m != NULL);
+    if (w == 0U || w > m->frames) {
+        return SL_ERR_ARG;
+    }
+    m->window = w;
     return SL_OK;
 }
 
@@ -299,7 +365,7 @@ sl_err_t sl_mask_update(sl_mask_t *m, uint16_t az, const uint32_t *bits, uint32_
         (void)sl_mask_stable(m, az, occ, free_);
         return SL_ERR_STATE;
     }
-    uint32_t(*pl)[SL_ROI_WORDS] = m->planes[az];
+    uint32_t(*pl)[SL_MASK_WORDS] = m->planes[az];
     const uint32_t words = m->words;
     const unsigned P = m->counter_planes;
     const uint32_t nm1 = (uint32_t)m->frames - 1U;
@@ -307,13 +373,17 @@ sl_err_t sl_mask_update(sl_mask_t *m, uint16_t az, const uint32_t *bits, uint32_
     const uint32_t tail = (m->bins % 32U) != 0U ? (((uint32_t)1U << (m->bins % 32U)) - 1U)
                                                 : UINT32_MAX;
     const uint32_t *x = bits;
-    uint32_t xbuf[SL_ROI_WORDS];
+    uint32_t xbuf[SL_MASK_WORDS];
     if (tail != UINT32_MAX) {
         // Rare configuration (bins not a multiple of 32): mask a private copy.
         memcpy(xbuf, bits, words * sizeof(uint32_t));
         xbuf[words - 1U] &= tail;
         x = xbuf;
     }
+    win_t wn;
+    win_make(&wn, P, m->frames, m->window);
+    // The first row of a run (k = n - 1) is stable only for a window of 1.
+    const bool first_stable = m->window == 1U;
     if ((m->state[az] & ST_HISTORY) == 0U) {
         // First row of a run: L = X, k = n - 1 everywhere.
         for (uint32_t w = 0; w < words; w++) {
@@ -322,14 +392,14 @@ sl_err_t sl_mask_update(sl_mask_t *m, uint16_t az, const uint32_t *bits, uint32_
                 pl[1U + p][w] = (((nm1 >> p) & 1U) != 0U) ? UINT32_MAX : 0U;
             }
             if (occ != NULL) {
-                occ[w] = (P == 0U) ? x[w] : 0U;
+                occ[w] = first_stable ? x[w] : 0U;
             }
             if (free_ != NULL) {
-                free_[w] = (P == 0U) ? (~x[w] & (w + 1U == words ? tail : UINT32_MAX)) : 0U;
+                free_[w] = first_stable ? (~x[w] & (w + 1U == words ? tail : UINT32_MAX)) : 0U;
             }
         }
     } else {
-        update_dispatch(pl, x, occ, free_, words, P, nm1);
+        update_dispatch(pl, x, occ, free_, words, P, nm1, &wn);
         if (free_ != NULL) {
             free_[words - 1U] &= tail;
         }
@@ -384,8 +454,10 @@ bool sl_mask_stable_prefix(const sl_mask_t *m, uint16_t az, uint32_t words, uint
         }
         return false;
     }
-    stable_row((const uint32_t(*)[SL_ROI_WORDS])m->planes[az], occ, free_, words,
-               m->counter_planes);
+    win_t wn;
+    win_make(&wn, m->counter_planes, m->frames, m->window);
+    stable_row((const uint32_t(*)[SL_MASK_WORDS])m->planes[az], occ, free_, words,
+               m->counter_planes, &wn);
     if (free_ != NULL && words == m->words && (m->bins % 32U) != 0U) {
         free_[words - 1U] &= ((uint32_t)1U << (m->bins % 32U)) - 1U;
     }

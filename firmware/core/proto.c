@@ -105,17 +105,24 @@ static int check_header(sl_proto_t *p, const uint8_t *tail)
         p->stats.oversize++;
         return HDR_OVERSIZE;
     }
-    if ((uint64_t)len > (uint64_t)p->cfg.reasm_size) {
+    if ((uint64_t)len > (uint64_t)p->cfg.reasm_size && !p->cfg.truncate_long) {
         p->stats.too_big++;
         return HDR_TOO_BIG;
     }
     return HDR_OK;
 }
 
-static void deliver(sl_proto_t *p, uint8_t id, const uint8_t *data, uint32_t size, bool zc,
+// `wire` = the payload length field; only its first reasm_size bytes are delivered when it
+// is longer (truncate_long: check_header rejects it otherwise).
+static void deliver(sl_proto_t *p, uint8_t id, const uint8_t *data, uint32_t wire, bool zc,
                     uint64_t now_us)
 {
     sl_proto_stats_t *st = &p->stats;
+    const bool cut = (uint64_t)wire > (uint64_t)p->cfg.reasm_size;
+    const uint32_t size = cut ? (uint32_t)p->cfg.reasm_size : wire;
+    if (cut) {
+        st->cut++;
+    }
     st->messages++;
     switch (id) {
     case SL_PROTO_ID_KEEP_ALIVE: st->keep_alive++; break;
@@ -130,7 +137,7 @@ static void deliver(sl_proto_t *p, uint8_t id, const uint8_t *data, uint32_t siz
     } else {
         st->reassembled++;
     }
-    st->bytes_delivered += (uint64_t)SL_PROTO_HEADER_BYTES + size;
+    st->bytes_delivered += (uint64_t)SL_PROTO_HEADER_BYTES + wire;
     p->state = ST_SIG;
     p->sig_got = 0;
     p->hdr_got = 0;
@@ -142,6 +149,8 @@ static void deliver(sl_proto_t *p, uint8_t id, const uint8_t *data, uint32_t siz
     m.payload.size = size;
     m.stream_offset = p->msg_offset;
     m.rx_us = now_us;
+    m.truncated = cut;
+    m.wire_bytes = wire;
     p->cfg.on_msg(p->cfg.ctx, &m);
 }
 
@@ -153,7 +162,7 @@ sl_err_t sl_proto_init(sl_proto_t *p, const sl_proto_cfg_t *cfg)
     }
     memset(p, 0, sizeof *p);
     p->cfg = *cfg;
-    uint64_t lim = (uint64_t)cfg->reasm_size;
+    uint64_t lim = cfg->truncate_long ? (uint64_t)UINT32_MAX : (uint64_t)cfg->reasm_size;
     if (cfg->max_payload_bytes != 0U && cfg->max_payload_bytes < lim) {
         lim = cfg->max_payload_bytes;
     }
@@ -273,7 +282,12 @@ sl_err_t sl_proto_feed(sl_proto_t *p, const uint8_t *data, size_t len, uint64_t 
             const uint32_t need = p->payload_bytes - p->payload_got;
             const size_t avail = len - i;
             const uint32_t n = (avail < need) ? (uint32_t)avail : need;
-            memcpy(p->cfg.reasm_buf + p->payload_got, data + i, n);
+            if ((uint64_t)p->payload_got < (uint64_t)p->cfg.reasm_size) {
+                // Only the part that fits is kept (all of it unless truncate_long).
+                const uint64_t room = (uint64_t)p->cfg.reasm_size - p->payload_got;
+                const uint32_t c = ((uint64_t)n < room) ? n : (uint32_t)room;
+                memcpy(p->cfg.reasm_buf + p->payload_got, data + i, c);
+            }
             p->payload_got += n;
             i += n;
             if (p->payload_got == p->payload_bytes) {

@@ -24,52 +24,86 @@ static void frame_clear(sl_scan_frame_t *f)
     memset(f, 0, sizeof *f);
 }
 
+// Frame mode: copy the bookkeeping header into the filling frame (its per-azimuth arrays
+// are written as rows arrive).
+static void frame_sync(sl_scan_frame_t *f, const sl_scan_rot_t *r)
+{
+    f->rotation = r->rotation;
+    f->azimuths = r->azimuths;
+    f->encoder_size = r->encoder_size;
+    f->roi_bins = r->roi_bins;
+    f->end = r->end;
+    f->head = r->head;
+    f->head_sweep = r->head_sweep;
+    f->t_first_us = r->t_first_us;
+    f->t_last_us = r->t_last_us;
+    f->stats = r->stats;
+}
+
 static void frame_start(sl_scan_t *s)
 {
-    sl_scan_frame_t *f = s->fill;
+    sl_scan_rot_t *r = &s->rot;
     const uint16_t n = s->azimuths;
-    f->rotation = s->rotation;
-    f->azimuths = n;
-    f->encoder_size = s->encoder_size;
-    f->roi_bins = s->cfg.roi_bins;
-    f->end = SL_SCAN_END_WRAP;
-    f->head = 0;
-    f->head_sweep = 0;
-    f->t_first_us = UINT64_MAX;
-    f->t_last_us = 0;
-    memset(&f->stats, 0, sizeof f->stats);
-    memset(f->flags, 0, n);
+    r->rotation = s->rotation;
+    r->azimuths = n;
+    r->encoder_size = s->encoder_size;
+    r->roi_bins = s->cfg.roi_bins;
+    r->end = SL_SCAN_END_WRAP;
+    r->head = 0;
+    r->head_sweep = 0;
+    r->t_first_us = UINT64_MAX;
+    r->t_last_us = 0;
+    memset(&r->stats, 0, sizeof r->stats);
+    memset(r->flags, 0, n);
+    if (s->fill != NULL) {
+        frame_sync(s->fill, r);
+        memset(s->fill->flags, 0, n);
+    }
     s->in_frame = true;
 }
 
 static void frame_complete(sl_scan_t *s, sl_scan_end_t why)
 {
+    sl_scan_rot_t *r = &s->rot;
     sl_scan_frame_t *f = s->fill;
-    const uint16_t n = f->azimuths;
-    const size_t roi = f->roi_bins;
-    for (uint16_t i = 0; i < n; i++) {
-        if ((f->flags[i] & SL_SCAN_AZ_VALID) == 0U) {
-            memset(f->power[i], 0, roi);
-            f->flags[i] = 0;
-            f->bins[i] = 0;
-            f->ticks[i] = 0;
-            f->sweep[i] = 0;
-            f->t_us[i] = 0;
+    const uint16_t n = r->azimuths;
+    if (f != NULL) {
+        const size_t roi = r->roi_bins;
+        for (uint16_t i = 0; i < n; i++) {
+            if ((r->flags[i] & SL_SCAN_AZ_VALID) == 0U) {
+                memset(f->power[i], 0, roi);
+                f->flags[i] = 0;
+                f->bins[i] = 0;
+                f->ticks[i] = 0;
+                f->sweep[i] = 0;
+                f->t_us[i] = 0;
+            }
         }
     }
-    if (f->stats.valid == 0U) {
-        f->t_first_us = 0;
+    for (uint16_t i = 0; i < n; i++) {
+        if ((r->flags[i] & SL_SCAN_AZ_VALID) == 0U) {
+            r->flags[i] = 0; // a missing row keeps no DUP/LATE marks
+        }
     }
-    f->stats.missing = (uint16_t)(n - f->stats.valid);
-    f->end = (uint8_t)why;
+    if (r->stats.valid == 0U) {
+        r->t_first_us = 0;
+    }
+    r->stats.missing = (uint16_t)(n - r->stats.valid);
+    r->end = (uint8_t)why;
     s->stats.frames++;
-    s->stats.missing += f->stats.missing;
+    s->stats.missing += r->stats.missing;
     s->rotation++;
     s->in_frame = false;
-    if (s->cfg.on_frame != NULL) {
-        s->cfg.on_frame(s->cfg.ctx, f);
+    if (f != NULL) {
+        frame_sync(f, r);
+        if (s->cfg.on_frame != NULL) {
+            s->cfg.on_frame(s->cfg.ctx, f);
+        }
     }
-    if (s->done != NULL) {
+    if (s->cfg.on_rot != NULL) {
+        s->cfg.on_rot(s->cfg.ctx, r);
+    }
+    if (f != NULL && s->done != NULL) {
         s->fill = s->done;
         s->done = f;
         s->done_valid = true;
@@ -110,15 +144,19 @@ static void apply_geometry(sl_scan_t *s, uint16_t azimuths, uint16_t encoder_siz
 sl_err_t sl_scan_init(sl_scan_t *s, const sl_scan_cfg_t *cfg, sl_scan_frame_t *fill,
                       sl_scan_frame_t *spare)
 {
-    if (s == NULL || cfg == NULL || fill == NULL || fill == spare || cfg->roi_bins == 0U ||
-        cfg->roi_bins > SL_CFG_ROI_BINS || cfg->pow16_shift > 15U) {
+    if (s == NULL || cfg == NULL || (fill != NULL && fill == spare) || cfg->roi_bins == 0U ||
+        cfg->roi_bins > SL_CFG_ROI_BINS || cfg->pow16_shift > 15U ||
+        (fill == NULL && (spare != NULL || cfg->row_buf == NULL ||
+                          cfg->row_buf_size < cfg->roi_bins))) {
         return SL_ERR_ARG;
     }
     memset(s, 0, sizeof *s);
     s->cfg = *cfg;
     s->fill = fill;
     s->done = spare;
-    frame_clear(fill);
+    if (fill != NULL) {
+        frame_clear(fill);
+    }
     if (spare != NULL) {
         frame_clear(spare);
     }
@@ -222,52 +260,78 @@ static void reduce16(uint8_t *restrict row, const uint8_t *restrict b, uint32_t 
     *saturated += sat;
 }
 
-// Copy the ROI of one message into row idx of the filling frame and report it.
+// Store one message as row idx (frame mode: copy into the frame; frame-less: a view of the
+// message or of the row buffer) and report it.
 static void store(sl_scan_t *s, const sl_proto_fft_t *f, uint16_t idx, uint8_t extra_flags)
 {
+    sl_scan_rot_t *r = &s->rot;
     sl_scan_frame_t *fr = s->fill;
-    uint8_t *row = fr->power[idx];
     const uint32_t roi = s->cfg.roi_bins;
     const uint32_t n = (f->bins < roi) ? f->bins : roi;
     uint8_t flags = (uint8_t)(SL_SCAN_AZ_VALID | extra_flags);
-    if (f->bytes_per_bin == 1U) {
-        memcpy(row, f->bin_data, n);
+    const uint8_t *view;
+    if (fr == NULL && f->bytes_per_bin == 1U && n == roi) {
+        view = f->bin_data; // frame-less, complete 8-bit row: no copy at all
     } else {
-        reduce16(row, f->bin_data, n, s->cfg.pow16_shift, &s->stats.saturated16);
+        uint8_t *row = (fr != NULL) ? fr->power[idx] : s->cfg.row_buf;
+        if (f->bytes_per_bin == 1U) {
+            memcpy(row, f->bin_data, n);
+        } else {
+            reduce16(row, f->bin_data, n, s->cfg.pow16_shift, &s->stats.saturated16);
+        }
+        if (n < roi) {
+            memset(row + n, 0, roi - n);
+        }
+        view = row;
+    }
+    if (f->bytes_per_bin != 1U) {
         flags |= SL_SCAN_AZ_16BIT;
-        fr->stats.wide_azimuths++;
+        r->stats.wide_azimuths++;
         s->stats.wide_azimuths++;
     }
     if (n < roi) {
-        memset(row + n, 0, roi - n);
         flags |= SL_SCAN_AZ_SHORT;
-        fr->stats.short_azimuths++;
+        r->stats.short_azimuths++;
         s->stats.short_azimuths++;
     }
-    fr->flags[idx] = flags;
-    fr->bins[idx] = (uint16_t)n;
-    fr->ticks[idx] = f->azimuth_ticks;
-    fr->sweep[idx] = f->sweep_counter;
+    r->flags[idx] = flags;
     const uint64_t t = sl_proto_fft_time_us(f);
-    fr->t_us[idx] = t;
-    if (t < fr->t_first_us) {
-        fr->t_first_us = t;
+    if (t < r->t_first_us) {
+        r->t_first_us = t;
     }
-    if (t > fr->t_last_us) {
-        fr->t_last_us = t;
+    if (t > r->t_last_us) {
+        r->t_last_us = t;
     }
-    fr->stats.valid++;
+    r->stats.valid++;
     s->stats.azimuths++;
-    if (s->cfg.on_azimuth != NULL) {
-        s->cfg.on_azimuth(s->cfg.ctx, fr, idx);
+    if (fr != NULL) {
+        fr->flags[idx] = flags;
+        fr->bins[idx] = (uint16_t)n;
+        fr->ticks[idx] = f->azimuth_ticks;
+        fr->sweep[idx] = f->sweep_counter;
+        fr->t_us[idx] = t;
+        frame_sync(fr, r);
+        if (s->cfg.on_azimuth != NULL) {
+            s->cfg.on_azimuth(s->cfg.ctx, fr, idx);
+        }
+    }
+    if (s->cfg.on_row != NULL) {
+        const sl_scan_row_t row = {.rotation = r->rotation, .idx = idx, .bins = (uint16_t)n,
+                                   .ticks = f->azimuth_ticks, .sweep = f->sweep_counter,
+                                   .flags = flags, .t_us = t, .power = view};
+        s->cfg.on_row(s->cfg.ctx, &row);
     }
 }
 
 static void duplicate(sl_scan_t *s, uint16_t idx)
 {
-    s->fill->flags[idx] |= SL_SCAN_AZ_DUP;
-    s->fill->stats.duplicates++;
+    s->rot.flags[idx] |= SL_SCAN_AZ_DUP;
+    s->rot.stats.duplicates++;
     s->stats.duplicates++;
+    if (s->fill != NULL) {
+        s->fill->flags[idx] |= SL_SCAN_AZ_DUP;
+        s->fill->stats = s->rot.stats;
+    }
 }
 
 sl_err_t sl_scan_on_fft(sl_scan_t *s, const sl_proto_fft_t *f)
@@ -295,7 +359,7 @@ sl_err_t sl_scan_on_fft(sl_scan_t *s, const sl_proto_fft_t *f)
     s->last_sweep = f->sweep_counter;
 
     if (s->in_frame) {
-        sl_scan_frame_t *fr = s->fill;
+        sl_scan_rot_t *fr = &s->rot;
         const uint16_t du = (uint16_t)(f->sweep_counter - fr->head_sweep);
         const int32_t dsweep = (du < 0x8000U) ? (int32_t)du : (int32_t)du - 0x10000;
         if (!s->cfg.ignore_sweep && dsweep >= (int32_t)n) {
@@ -316,7 +380,7 @@ sl_err_t sl_scan_on_fft(sl_scan_t *s, const sl_proto_fft_t *f)
                 } else {
                     fr->stats.out_of_order++;
                     s->stats.out_of_order++;
-                    store(s, f, idx, SL_SCAN_AZ_LATE);
+                    store(s, f, idx, SL_SCAN_AZ_LATE); // syncs the frame's stats
                 }
                 return SL_OK;
             }
@@ -328,8 +392,8 @@ sl_err_t sl_scan_on_fft(sl_scan_t *s, const sl_proto_fft_t *f)
     if (!s->in_frame) {
         frame_start(s);
     }
-    s->fill->head = idx;
-    s->fill->head_sweep = f->sweep_counter;
+    s->rot.head = idx;
+    s->rot.head_sweep = f->sweep_counter;
     store(s, f, idx, 0);
     return SL_OK;
 }

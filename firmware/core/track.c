@@ -160,7 +160,9 @@ void sl_track_update(sl_tracker_t *tr, const sl_target_t *targets, uint32_t n,
         n = SL_CFG_MAX_TARGETS;
     }
     const uint32_t naz = tr->board->azimuths;
-    const uint64_t ag = tr->cfg.az_gate, rg = tr->cfg.range_gate_um;
+    const uint64_t ag0 = tr->cfg.az_gate, rg = (uint64_t)tr->cfg.range_gate_um + tr->motion_um;
+    // Yaw per update in azimuth steps (rounded up).
+    const uint64_t yaw_az = ((uint64_t)tr->motion_yaw_bam * naz + 0xFFFFFFFFULL) >> 32;
     bool used[SL_CFG_MAX_TARGETS];
     for (uint32_t i = 0; i < SL_CFG_MAX_TARGETS; i++) {
         tr->tracks[i].updated = 0U;
@@ -174,6 +176,13 @@ void sl_track_update(sl_tracker_t *tr, const sl_target_t *targets, uint32_t n,
             const sl_track_t *t = &tr->tracks[i];
             if (t->live == 0U || t->updated != 0U) {
                 continue;
+            }
+            // Azimuth gate widened by the angle the ego displacement subtends at r1:
+            // d / r1 rad = d * naz / (2 pi r1) azimuth steps (710/113 ~ 2 pi, rounded up).
+            uint64_t ag = ag0 + yaw_az;
+            if (tr->motion_um != 0U) {
+                const uint64_t r1 = t->r1_um > 100000U ? t->r1_um : 100000U; // >= 0.1 m
+                ag += ((uint64_t)tr->motion_um * naz * 113U + r1 * 710U - 1U) / (r1 * 710U);
             }
             for (uint32_t j = 0; j < n; j++) {
                 if (used[j]) {
@@ -241,6 +250,13 @@ void sl_track_update(sl_tracker_t *tr, const sl_target_t *targets, uint32_t n,
         tr->stats.created++;
         track_take(tr, t, &targets[j], now_us);
     }
+}
+
+void sl_track_set_motion(sl_tracker_t *tr, uint32_t disp_um, uint32_t yaw_bam32)
+{
+    SL_ASSERT(tr != NULL);
+    tr->motion_um = disp_um;
+    tr->motion_yaw_bam = yaw_bam32;
 }
 
 sl_warn_level_t sl_track_max_level(const sl_tracker_t *tr)

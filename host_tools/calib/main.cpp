@@ -17,7 +17,7 @@
 //     distances) as a table over the observed r2 (the core looks d up at the half-bin r2),
 //     with its spread; --out-ini writes the board line `elongation = r:d, ...` under
 //     [detect]. Truth: a list CSV (capture,range_m[,r2_m]) or one sl-sim truth CSV per
-//     capture (README.md).
+//     capture (README.md). Without --board: paper-bench (the paper's calibration set-up).
 //
 // Exit status: 0 done, 1 error (I/O, bad data), 2 usage.
 #include <cstdio>
@@ -38,7 +38,7 @@ void usage()
         "      [--search-max-m M] [--edge foot|half] [--ground-window-m M]\n"
         "  sl-calib elongation CAPTURE... --truth FILE [--truth FILE...] [--board NAME]\n"
         "      [--out-ini FILE] [--png FILE] [--csv FILE] [--points N] [--mask-frames N]\n"
-        "      [--threshold T] [--bin-size-m M]\n",
+        "      [--threshold T] [--bin-size-m M]      (default board: paper-bench)\n",
         stderr);
 }
 

@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include <sys/stat.h>
+
 #include <opencv2/imgcodecs.hpp>
 
 #include "calib_shadow.h"
@@ -227,23 +229,15 @@ int cmd_shadow(const ShadowArgs &a)
     fo.bin_size_m = a.bin_size_m;
     FrameSet fs;
     std::string err;
-    // An Oxford folder carries no bin size: it is the board's unless given.
-    if (fo.bin_size_m <= 0) {
-        FrameOptions probe = fo;
-        probe.bin_size_m = board.bin_size_m;
-        probe.max_frames = 0;
-        if (!load_frames(a.input, probe, fs, err)) {
-            std::fprintf(stderr, "sl-calib: %s\n", err.c_str());
-            return 1;
+    // An Oxford folder carries no bin size: it is the board's unless given; a capture's
+    // Configuration gives its own.
+    {
+        struct stat st {};
+        if (fo.bin_size_m <= 0 && ::stat(a.input.c_str(), &st) == 0 && S_ISDIR(st.st_mode)) {
+            fo.bin_size_m = board.bin_size_m;
         }
-        if (fs.kind != "oxford-png") {
-            // A capture: reload to take the stream's own bin size.
-            if (!load_frames(a.input, fo, fs, err)) {
-                std::fprintf(stderr, "sl-calib: %s\n", err.c_str());
-                return 1;
-            }
-        }
-    } else if (!load_frames(a.input, fo, fs, err)) {
+    }
+    if (!load_frames(a.input, fo, fs, err)) {
         std::fprintf(stderr, "sl-calib: %s\n", err.c_str());
         return 1;
     }

@@ -20,6 +20,8 @@ struct ChassisVertex {
     double edge_height_m = 0;  // height above ground of the occluding edge at this vertex
 };
 
+/// One point of the elongation table d(r): `range_m` is the OBSERVED outer bound r2 (slant,
+/// after the half-bin correction, d not yet removed), `d_m` the outward bias there.
 struct ElongPoint {
     double range_m = 0;
     double d_m = 0;

@@ -181,9 +181,10 @@ void CartAxes::draw_axes(cv::Mat &canvas) const
     cv::rectangle(canvas, rect, col::kGrid, 1);
     const cv::Point2d c = centre();
     const double step = roi_m > 12 ? 5.0 : (roi_m > 6 ? 2.0 : 1.0);
-    cv::Mat layer = canvas(rect);
+    cv::Mat layer = canvas(rect); // circles clipped to the panel
+    const cv::Point2d off(rect.x, rect.y);
     for (double r = step; r <= roi_m * 1.42; r += step) {
-        cv::circle(canvas, c, static_cast<int>(r * scale()), col::kGrid, 1, cv::LINE_AA);
+        cv::circle(layer, c - off, static_cast<int>(r * scale()), col::kGrid, 1, cv::LINE_AA);
         const cv::Point2d t = px_ra(r, 135);
         if (t.x < rect.x + rect.width - 40 && t.y < rect.y + rect.height - 10) {
             draw_text(canvas, num(r, 0) + " m", cv::Point(static_cast<int>(t.x) + 3, static_cast<int>(t.y)), 0.4,

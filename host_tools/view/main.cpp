@@ -688,7 +688,31 @@ int main(int argc, char **argv)
                 return 1;
             }
             written++;
-            if (!a.all) std::printf("sl-view: wrote %s (rotation %d of %d, %zu detections)\n", path.c_str(), k, N, rv.targets.size());
+            if (!a.all) {
+                std::printf("sl-view: wrote %s (rotation %d of %d = --rotation %d, %zu detections)\n",
+                            path.c_str(), k + 1, N, k, rv.targets.size());
+                // One line per target, with the truth of the nearest pole (within 3 azimuths).
+                for (size_t i = 0; i < rv.targets.size(); i++) {
+                    const sl_target_t &t = rv.targets[i];
+                    const TruthMark *best = nullptr;
+                    int best_d = 4;
+                    for (const auto &m : rv.truth) {
+                        const int d = std::abs(((m.az - t.az) % A + A + A / 2) % A - A / 2);
+                        if (d < best_d) {
+                            best_d = d;
+                            best = &m;
+                        }
+                    }
+                    std::printf("sl-view: target %c az %u r1 %.3f r2 %.3f m alpha %s", 'A' + static_cast<int>(i % 26),
+                                t.az, t.r1_um * 1e-6, t.r2_um * 1e-6,
+                                t.incline_flag == SL_INCLINE_VALID ? fmt("%+.2f", t.alpha_cdeg / 100.0).c_str()
+                                                                   : flag_name(t.incline_flag));
+                    if (best) {
+                        std::printf(" truth %s %+.2f", best->name.c_str(), best->alpha_deg);
+                    }
+                    std::printf("\n");
+                }
+            }
         }
     }
     if (video) {

@@ -52,8 +52,11 @@ typedef struct sl_board {
     int32_t danger_lean_cdeg;      ///< warning level DANGER at lean towards >= this
     uint32_t track_timeout_us;     ///< drop a track not seen for this long
     uint8_t elong_points;          ///< entries in the elongation table (0 = no correction)
-    uint32_t elong_range_um[SL_CFG_MAX_ELONG_POINTS]; ///< ascending ranges
-    int32_t elong_d_um[SL_CFG_MAX_ELONG_POINTS];      ///< outward bias d at each range
+    /// Elongation table d(r), keyed by the OBSERVED outer bound r2 (slant range after the
+    /// half-bin correction, before removing d): detection looks d up with what it measures.
+    /// Piecewise linear between points, constant beyond the ends.
+    uint32_t elong_range_um[SL_CFG_MAX_ELONG_POINTS]; ///< ascending observed r2
+    int32_t elong_d_um[SL_CFG_MAX_ELONG_POINTS];      ///< outward bias d at each r2
     // --- CAN
     uint32_t can_bitrate;          ///< bit/s
     uint32_t can_id_pole_lean;     ///< 11-bit ids (or 29-bit with bit 31 set, DBC style)

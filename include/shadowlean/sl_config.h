@@ -29,6 +29,20 @@
 #error "SL_CFG_ROI_BINS must be a multiple of 32 in [32, 4096]"
 #endif
 
+/// Bins per row the consistency mask can hold (its planes are sized by this), a multiple of
+/// 32, <= SL_CFG_ROI_BINS. The detection pipeline thresholds and masks only the bins
+/// detection reads (sl_detect_bins_needed(): the farthest shadow edge, 119..141 bins on the
+/// boards carried today) and rejects a board that needs more at init (SL_ERR_RANGE).
+/// Default: the whole ROI (host tools mask whole rows). A firmware build sets 160 (or
+/// 192): the mask then takes 400 x 5 x 160 / 8 = 40,000 bytes at n <= 16 instead of
+/// 128,000, which is what keeps sizeof(sl_pipeline_t) under 64 KiB.
+#ifndef SL_CFG_MASK_BINS
+#define SL_CFG_MASK_BINS SL_CFG_ROI_BINS
+#endif
+#if SL_CFG_MASK_BINS < 32 || SL_CFG_MASK_BINS > SL_CFG_ROI_BINS || (SL_CFG_MASK_BINS % 32) != 0
+#error "SL_CFG_MASK_BINS must be a multiple of 32 in [32, SL_CFG_ROI_BINS]"
+#endif
+
 /// Largest consistency window n (frames) the mask supports; the board picks n <= this.
 #ifndef SL_CFG_MASK_FRAMES_MAX
 #define SL_CFG_MASK_FRAMES_MAX 32

@@ -7,6 +7,13 @@
 /// - **stable-free**: the bin was free in each of the azimuth's last `n` rows.
 /// A bin that changed within the last `n` rows is in neither.
 ///
+/// **Shorter windows at run time** (`sl_mask_set_window()`, used while the vehicle moves):
+/// the counters always run with the full `n`, so after a bin's last change `k = n - m`
+/// (m = rows since and including the change, k floored at 0). "Equal in the last w rows"
+/// is therefore `k <= n - w`, a bit-sliced compare against a constant (2-3 operations per
+/// plane). The stable planes are computed for the current window w (1..n); changing w
+/// loses no history (a vehicle that stops gets its full-n mask back without waiting).
+///
 /// ## How (bit-sliced run counters instead of n stored planes)
 /// Per azimuth the mask stores the last row `L` (1 plane) and, per bin, the number of rows
 /// still needed before the bin counts as stable, `k` in `0..n-1`, bit-sliced over
@@ -42,7 +49,9 @@
 ///
 /// ## Ownership, memory, cost
 /// The caller owns `sl_mask_t` (static or on a large stack; no allocation). Storage is
-/// sized by SL_CFG_MAX_AZIMUTHS x SL_CFG_ROI_BINS x (1 + SL_MASK_COUNTER_PLANES) bits:
+/// sized by SL_CFG_MAX_AZIMUTHS x SL_CFG_MASK_BINS x (1 + SL_MASK_COUNTER_PLANES) bits
+/// (the table is for SL_CFG_MASK_BINS = 512; a firmware build with 160 bins and n <= 16
+/// needs 40,836 bytes):
 ///
 /// | SL_CFG_MASK_FRAMES_MAX | planes | sizeof(sl_mask_t), 400 az x 512 bins | n full planes |
 /// |---|---|---|---|
@@ -78,6 +87,9 @@ extern "C" {
 #define SL_MASK_PLANES_FOR(n)                                                                \
     ((n) <= 1 ? 0 : (n) <= 2 ? 1 : (n) <= 4 ? 2 : (n) <= 8 ? 3 : (n) <= 16 ? 4 : 5)
 
+/// Words per mask row (SL_CFG_MASK_BINS is a multiple of 32).
+#define SL_MASK_WORDS (SL_CFG_MASK_BINS / 32)
+
 /// Counter planes stored per azimuth (for SL_CFG_MASK_FRAMES_MAX).
 #define SL_MASK_COUNTER_PLANES SL_MASK_PLANES_FOR(SL_CFG_MASK_FRAMES_MAX)
 
@@ -101,7 +113,7 @@ typedef struct sl_mask_stats {
 typedef struct sl_mask {
     /// planes[az][0] = last row L; planes[az][1 + p] = bit p of the per-bin counter k.
     /// Layout of each row: sl_thresh.h (bin 32w + b = bit b of word w).
-    uint32_t planes[SL_CFG_MAX_AZIMUTHS][SL_MASK_PLANES][SL_ROI_WORDS];
+    uint32_t planes[SL_CFG_MAX_AZIMUTHS][SL_MASK_PLANES][SL_MASK_WORDS];
     uint8_t missed[SL_CFG_MAX_AZIMUTHS]; ///< consecutive rotations without a row (sat. 255)
     uint8_t state[SL_CFG_MAX_AZIMUTHS];  ///< bit 0: has history; bit 1: row this rotation
     uint16_t azimuths;                   ///< azimuths in use
@@ -110,18 +122,25 @@ typedef struct sl_mask {
     uint8_t frames;                      ///< n
     uint8_t counter_planes;              ///< P = SL_MASK_PLANES_FOR(n)
     uint8_t max_missed;                  ///< see "Frames and missing azimuths"
+    uint8_t window;                      ///< w: stable = equal in the last w rows (1..n)
     sl_mask_stats_t stats;
 } sl_mask_t;
 
 /// Initialise (or re-initialise) a mask: no azimuth has history.
 /// @param azimuths   1..SL_CFG_MAX_AZIMUTHS
-/// @param bins       1..SL_CFG_ROI_BINS (bins per row; usually the board's roi_bins)
+/// @param bins       1..SL_CFG_MASK_BINS (bins per row: the board's roi_bins, or only the
+///                   bins detection reads, sl_detect_bins_needed())
 /// @param frames     n, 1..SL_CFG_MASK_FRAMES_MAX (usually the board's mask_frames)
 /// @param max_missed consecutive missed rotations an azimuth is held through (0..254)
 /// @return SL_OK, or SL_ERR_ARG (NULL or a value out of range; the mask is then unusable).
 /// Cost: clears the whole struct (memset of sizeof(sl_mask_t)).
 sl_err_t sl_mask_init(sl_mask_t *m, uint16_t azimuths, uint16_t bins, uint8_t frames,
                       uint8_t max_missed);
+
+/// Set the window w used for the stable planes from now on (1..n; see "Shorter windows").
+/// Counters and history are unchanged. @return SL_OK, or SL_ERR_ARG (w out of range:
+/// ignored). O(1).
+sl_err_t sl_mask_set_window(sl_mask_t *m, uint8_t w);
 
 /// Drop every azimuth's history (e.g. after a radar restart). Stats are kept. O(azimuths).
 void sl_mask_reset(sl_mask_t *m);

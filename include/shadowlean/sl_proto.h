@@ -21,6 +21,14 @@
 ///   on it): version must be 1; payload length must be <= `max_payload_bytes` (the board's
 ///   `max_message_bytes`); payload length must be <= `reasm_size` (a message that could
 ///   not be reassembled is rejected even when it happens to arrive in one piece).
+/// - **Truncation** (`cfg.truncate_long`, for consumers that read only the start of a
+///   payload, e.g. a detection pipeline that needs the first few hundred range bins of a
+///   3.8 KB FFT message): a payload longer than `reasm_size` (but within
+///   `max_payload_bytes`) is accepted; only its first `reasm_size` bytes are kept and
+///   delivered (`msg->truncated`, `msg->wire_bytes` = the length field), the rest is
+///   consumed without being copied, and the message is delivered once its last byte has
+///   been consumed (so events stay independent of the chunking). Counted in `stats.cut`;
+///   the whole message counts as delivered in the accounting invariant.
 /// - **Resync**: on junk or a rejected header the decoder discards bytes one at a time and
 ///   looks for the signature again starting at the byte after the rejected signature's first
 ///   byte (true byte-wise resync; a signature split across chunks or preceded by a partial
@@ -99,6 +107,8 @@ typedef struct sl_proto_msg {
     uint64_t stream_offset;    ///< offset of the signature's first byte in the fed bytes
                                ///< (counts every byte fed since sl_proto_init, all streams)
     uint64_t rx_us;            ///< `now_us` of the sl_proto_feed() call that completed it
+    bool truncated;            ///< payload cut to reasm_size (cfg.truncate_long)
+    uint32_t wire_bytes;       ///< payload length on the wire (== payload.size unless truncated)
 } sl_proto_msg_t;
 
 /// Message callback. `ctx` is `cfg.ctx`. Must not re-enter the decoder.
@@ -109,6 +119,8 @@ typedef struct sl_proto_cfg {
     uint8_t *reasm_buf;         ///< caller-owned reassembly buffer (may be NULL if size 0)
     size_t reasm_size;          ///< its size in bytes: the largest payload that is accepted
     uint32_t max_payload_bytes; ///< board's max_message_bytes; 0 = use reasm_size
+                                ///< (with truncate_long: 0 = no limit)
+    bool truncate_long;         ///< deliver longer payloads cut to reasm_size (see above)
     sl_proto_on_msg_fn on_msg;  ///< required
     void *ctx;                  ///< passed to on_msg
 } sl_proto_cfg_t;
@@ -122,6 +134,7 @@ typedef struct sl_proto_stats {
     uint32_t bad_version;     ///< headers rejected: version != 1
     uint32_t oversize;        ///< headers rejected: payload > max_payload_bytes
     uint32_t too_big;         ///< headers rejected: payload > reasm_size (<= max_payload_bytes)
+    uint32_t cut;             ///< messages delivered truncated to reasm_size (truncate_long)
     uint32_t truncated;       ///< sl_proto_finish() with a partial message (or signature) held
     uint32_t messages;        ///< messages delivered (all ids)
     uint32_t keep_alive;      ///< ... of which id 1
@@ -138,7 +151,8 @@ typedef struct sl_proto_stats {
 /// except `stats`, which it may read at any time.
 typedef struct sl_proto {
     sl_proto_cfg_t cfg;         ///< copy of the configuration
-    uint32_t max_payload;       ///< effective limit: min(max_payload_bytes, reasm_size)
+    uint32_t max_payload;       ///< effective limit: min(max_payload_bytes, reasm_size), or
+                                ///< max_payload_bytes (0: none) with truncate_long
     uint32_t payload_bytes;     ///< length field of the message being received
     uint32_t payload_got;       ///< payload bytes already copied to the reassembly buffer
     uint64_t msg_offset;        ///< stream offset of the message being received

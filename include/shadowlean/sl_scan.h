@@ -62,6 +62,20 @@
 ///   completes the current frame (`SL_SCAN_END_CONFIG`); an identical one is only counted.
 ///   Call `sl_scan_flush()` on EOF / reconnect to emit a partial frame (`SL_SCAN_END_FLUSH`).
 ///
+/// ## Frame-less mode (fill == NULL: no rows stored; what a small-RAM pipeline uses)
+/// `sl_scan_init(s, cfg, NULL, NULL)`: the rotation bookkeeping above (index, wrap, gaps,
+/// duplicates, reordering, sweep gaps, timestamps, statistics) is unchanged, but no row is
+/// kept. Each stored azimuth is reported through `cfg.on_row` with an `sl_scan_row_t` whose
+/// `power` is a view of `roi_bins` bytes:
+/// - into the message itself when it is 8-bit and holds at least roi_bins bins (no copy);
+/// - into the caller's row buffer (`cfg.row_buf`, >= roi_bins bytes, borrowed like the
+///   frames) for 16-bit data (reduced as above) and for short rows (zero-filled).
+/// The view is valid until `on_row` returns. A completed rotation is reported through
+/// `cfg.on_rot` (`sl_scan_rot_t`: the frame's header, statistics and per-azimuth flags).
+/// `on_row` and `on_rot` are also called in frame mode (there `power` points into the
+/// frame row); `on_azimuth` / `on_frame` only in frame mode. In frame-less mode
+/// `sl_scan_last_frame()` is NULL.
+///
 /// ## Cost
 /// Per FFT message: O(roi_bins) (one memcpy of the ROI bytes; for 16-bit data a SWAR / block
 /// loop) plus O(1) bookkeeping. Per rotation: O(azimuths) flag clearing plus zero-filling missing
@@ -132,6 +146,41 @@ typedef struct sl_scan_frame {
     uint8_t power[SL_CFG_MAX_AZIMUTHS][SL_CFG_ROI_BINS]; ///< uint8 power, row per azimuth
 } sl_scan_frame_t;
 
+/// Bookkeeping of the rotation being assembled / just completed (both modes). Fields as in
+/// sl_scan_frame_t. Read-only to the application.
+typedef struct sl_scan_rot {
+    uint32_t rotation;        ///< sequence number since sl_scan_init (0, 1, ...)
+    uint16_t azimuths;        ///< azimuths per rotation
+    uint16_t encoder_size;    ///< encoder ticks per rotation
+    uint16_t roi_bins;        ///< bins per row
+    uint8_t end;              ///< sl_scan_end_t, valid once complete
+    uint16_t head;            ///< highest index stored (internal while filling)
+    uint16_t head_sweep;      ///< sweep counter of the head's message (internal)
+    uint64_t t_first_us;      ///< earliest azimuth timestamp (UNIX us; 0 when none)
+    uint64_t t_last_us;       ///< latest azimuth timestamp (UNIX us)
+    sl_scan_frame_stats_t stats;
+    uint8_t flags[SL_CFG_MAX_AZIMUTHS]; ///< SL_SCAN_AZ_* per azimuth index
+} sl_scan_rot_t;
+
+/// One stored azimuth (both modes). Lifetime: until the callback returns.
+typedef struct sl_scan_row {
+    uint32_t rotation;        ///< rotation it belongs to
+    uint16_t idx;             ///< azimuth index 0 .. azimuths-1
+    uint16_t bins;            ///< bins taken from the message (<= roi_bins; rest zero)
+    uint16_t ticks;           ///< raw encoder value
+    uint16_t sweep;           ///< sweep counter
+    uint8_t flags;            ///< SL_SCAN_AZ_*
+    uint64_t t_us;            ///< timestamp, UNIX us
+    const uint8_t *power;     ///< roi_bins uint8 power values (see "Frame-less mode")
+} sl_scan_row_t;
+
+/// Row callback (both modes).
+typedef void (*sl_scan_on_row_fn)(void *ctx, const sl_scan_row_t *row);
+
+/// Rotation-complete callback (both modes): `rot->stats`, `rot->end` and `rot->flags` are
+/// final. Valid until the callback returns.
+typedef void (*sl_scan_on_rot_fn)(void *ctx, const sl_scan_rot_t *rot);
+
 /// Per-azimuth callback: row `idx` of `frame` has just been stored (`frame->power[idx]`,
 /// `frame->bins[idx]`, `frame->flags[idx]`). The frame is the one being filled; valid as
 /// described in the file comment.
@@ -154,7 +203,11 @@ typedef struct sl_scan_cfg {
                                 ///< (sources whose sweep counter is meaningless)
     sl_scan_on_azimuth_fn on_azimuth; ///< optional
     sl_scan_on_frame_fn on_frame;     ///< optional
-    void *ctx;                  ///< passed to both callbacks
+    sl_scan_on_row_fn on_row;         ///< optional (both modes)
+    sl_scan_on_rot_fn on_rot;         ///< optional (both modes)
+    uint8_t *row_buf;           ///< frame-less mode: row buffer (>= roi_bins bytes), borrowed
+    uint16_t row_buf_size;      ///< its size in bytes
+    void *ctx;                  ///< passed to every callback
 } sl_scan_cfg_t;
 
 /// Cumulative counters since sl_scan_init.
@@ -192,18 +245,22 @@ typedef struct sl_scan {
     uint16_t last_sweep;      ///< sweep counter of the previous FFT message
     uint32_t rotation;        ///< next frame's sequence number
     sl_scan_stats_t stats;
+    sl_scan_rot_t rot;        ///< bookkeeping of the rotation being assembled (both modes)
 } sl_scan_t;
 
 #if defined(__cplusplus)
-static_assert(sizeof(sl_scan_t) <= 256, "sl_scan_t RAM budget (frames are separate)");
+static_assert(sizeof(sl_scan_t) <= 320 + SL_CFG_MAX_AZIMUTHS,
+              "sl_scan_t RAM budget (frames are separate)");
 #else
-_Static_assert(sizeof(sl_scan_t) <= 256, "sl_scan_t RAM budget (frames are separate)");
+_Static_assert(sizeof(sl_scan_t) <= 320 + SL_CFG_MAX_AZIMUTHS,
+               "sl_scan_t RAM budget (frames are separate)");
 #endif
 
-/// Initialise. `fill` is required; `spare` (the second frame for double buffering) is
-/// optional. Both are cleared once here (O(sizeof frame)).
-/// @return SL_OK; SL_ERR_ARG (NULL, roi_bins 0 or > SL_CFG_ROI_BINS, shift > 15, same frame
-/// twice); SL_ERR_RANGE (initial geometry unusable: azimuths > SL_CFG_MAX_AZIMUTHS, ...).
+/// Initialise. `fill` NULL selects the frame-less mode (then `spare` must be NULL and
+/// `cfg.row_buf` hold >= roi_bins bytes); `spare` (the second frame for double buffering)
+/// is optional. Frames are cleared once here (O(sizeof frame)).
+/// @return SL_OK; SL_ERR_ARG (NULL s/cfg, roi_bins 0 or > SL_CFG_ROI_BINS, shift > 15, same
+/// frame twice, spare without fill, frame-less without a large enough row_buf); SL_ERR_RANGE (initial geometry unusable: azimuths > SL_CFG_MAX_AZIMUTHS, ...).
 sl_err_t sl_scan_init(sl_scan_t *s, const sl_scan_cfg_t *cfg, sl_scan_frame_t *fill,
                       sl_scan_frame_t *spare);
 

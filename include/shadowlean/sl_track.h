@@ -11,7 +11,11 @@
 /// track and target at most once (global nearest neighbour). Unmatched targets open new
 /// tracks while slots are free (`stats.full` otherwise). Tracks not matched for longer than
 /// `board->track_timeout_us` are dropped (0: dropped at the first update without a match).
-/// The gates are for a (nearly) static scene; compensating vehicle motion comes later.
+/// The gates are for a (nearly) static scene. While the vehicle moves, the caller widens them
+/// by the ego displacement per rotation (`sl_track_set_motion()`): the range gate by `d`,
+/// the azimuth gate, per track, by the angle `d` subtends at the track's r1 plus the yaw
+/// per rotation (no prediction: a static point moves by at most that much between
+/// rotations, in any direction).
 ///
 /// ## Filter (1-D Kalman, fixed point)
 /// State alpha in 1/256 cdeg (Q8 cdeg), variance P in cdeg^2 (uint32). Only targets with
@@ -123,6 +127,8 @@ typedef struct sl_tracker {
     uint16_t live;           ///< live tracks
     sl_track_t tracks[SL_CFG_MAX_TARGETS];
     sl_track_stats_t stats;
+    uint32_t motion_um;      ///< ego displacement per update (sl_track_set_motion), um
+    uint32_t motion_yaw_bam; ///< |yaw| per update, bam32 (2^32 = one turn)
 } sl_tracker_t;
 
 /// Initialise (no tracks). `cfg` NULL = defaults (copied). Borrows `board`.
@@ -134,6 +140,11 @@ sl_err_t sl_track_init(sl_tracker_t *tr, const sl_board_t *board, const sl_track
 /// 0) at time `now_us`: associate, filter, update levels, open and drop tracks.
 void sl_track_update(sl_tracker_t *tr, const sl_target_t *targets, uint32_t n,
                      uint64_t now_us);
+
+/// Ego motion between consecutive updates, for the gates (see "Association"): translation
+/// `disp_um` (>= 0) and |yaw| `yaw_bam32` (2^32 = one turn). Stays in effect until changed;
+/// 0, 0 = static. O(1).
+void sl_track_set_motion(sl_tracker_t *tr, uint32_t disp_um, uint32_t yaw_bam32);
 
 /// Highest warning level over live tracks (SL_WARN_NONE when none). O(tracks).
 sl_warn_level_t sl_track_max_level(const sl_tracker_t *tr);

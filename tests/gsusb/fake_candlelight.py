@@ -20,6 +20,7 @@ re-read whenever it changes, so one gadget process serves every scenario of one 
                     re-bind it MS milliseconds later
 Per scenario it writes OUT_DIR/dev_NAME.log (every frame received, candump -L format) and
 OUT_DIR/ctl_NAME.log (every vendor request, decoded)."""
+import errno
 import os
 import queue
 import struct
@@ -135,10 +136,17 @@ def bulk_in_loop():
     while True:
         pkt = to_host.get()
         if pkt is HALT_IN:
-            try:
-                os.read(ep_in, 1)  # wrong direction on an IN endpoint = set halt
-            except OSError as e:
-                log("bulk IN halted (%s)" % e.strerror)
+            # Wrong direction on an IN endpoint = set halt. dummy_hcd refuses (EAGAIN) while
+            # a request is still queued on the endpoint: try again shortly.
+            for attempt in range(100):
+                try:
+                    os.read(ep_in, 1)
+                except OSError as e:
+                    if e.errno == errno.EAGAIN:
+                        time.sleep(0.01)
+                        continue
+                    log("bulk IN halted (%s) after %d attempt(s)" % (e.strerror, attempt + 1))
+                break
             continue
         try:
             os.write(ep_in, pkt)

@@ -71,7 +71,9 @@ rc_of kernel 0
 # (b) our libusb driver: sl-gsusb-send, the kernel driver detached meanwhile.
 t "== (b1) libusb: frames from a candump log, VID:PID selector, one error frame"
 scenario libusb_log normal+err
-timeout 20 "$SL_SEND" 1d50:606f --bitrate 500000 --log "$SL_DIR/frames_libusb.log" \
+# The fake device (Python under TCG) can be slow: generous echo timeouts where every frame
+# must be confirmed.
+timeout 20 "$SL_SEND" 1d50:606f --bitrate 500000 --echo-timeout-ms 5000 --log "$SL_DIR/frames_libusb.log" \
     --expect-rx 12 --drain-ms 3000 --tx-log tx_libusb_log.log --rx-log rx_libusb_log.log --summary sum_libusb_log.txt \
     > out_libusb_log.txt 2>&1
 rc_of libusb_log $?
@@ -80,7 +82,7 @@ t "can0 back after release: $(cat can0_back_after_b1)"
 
 t "== (b2) libusb: generated frames, bus-port selector"
 scenario libusb_gen normal
-timeout 20 "$SL_SEND" "$BUSPORT" --count 40 --expect-rx 40 --drain-ms 3000 --tx-log tx_libusb_gen.log \
+timeout 20 "$SL_SEND" "$BUSPORT" --count 40 --echo-timeout-ms 5000 --expect-rx 40 --drain-ms 3000 --tx-log tx_libusb_gen.log \
     --rx-log rx_libusb_gen.log --summary sum_libusb_gen.txt --quiet > out_libusb_gen.txt 2>&1
 rc_of libusb_gen $?
 
@@ -92,13 +94,13 @@ rc_of refuse $?
 
 t "== (c2) stalled bulk endpoints"
 scenario stall stall
-timeout 20 "$SL_SEND" 1d50:606f --count 12 --tx-log tx_stall.log --summary sum_stall.txt \
+timeout 20 "$SL_SEND" 1d50:606f --count 12 --echo-timeout-ms 5000 --tx-log tx_stall.log --summary sum_stall.txt \
     > out_stall.txt 2>&1
 rc_of stall $?
 
 t "== (c3) lost echoes"
 scenario dropecho drop-echo:2
-timeout 20 "$SL_SEND" 1d50:606f --count 15 --echo-timeout-ms 400 --tx-log tx_dropecho.log \
+timeout 20 "$SL_SEND" 1d50:606f --count 15 --echo-timeout-ms 1000 --tx-log tx_dropecho.log \
     --summary sum_dropecho.txt > out_dropecho.txt 2>&1
 rc_of dropecho $?
 

@@ -10,13 +10,12 @@ SRC=${1:?usage: run_vm_test.sh SOURCE_DIR CACHE_DIR SENDER}
 CACHE=${2:?}
 SEND=${3:?}
 HERE="$SRC/tests/gsusb"
-T0=$(date +%s.%N)
-el() { awk -v a="$T0" -v b="$(date +%s.%N)" 'BEGIN { printf "%.1f", b - a }'; }
-
 if ! command -v qemu-system-x86_64 >/dev/null 2>&1; then
     echo "SKIP: qemu-system-x86_64 is not installed (sh scripts/deps.sh test installs it)"
     exit 77
 fi
+T0=$(date +%s.%N)
+el() { awk -v a="$T0" -v b="$(date +%s.%N)" 'BEGIN { printf "%.1f", b - a }'; }
 [ -x "$SEND" ] || { echo "FAIL: sender $SEND not built"; exit 1; }
 
 sh "$HERE/build_vm.sh" "$CACHE" "$SRC"

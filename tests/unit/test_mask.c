@@ -2,6 +2,7 @@
 // the last n rows of every azimuth and intersects them, for every n in 1..32.
 #include <setjmp.h>
 #include <stdarg.h>
+#include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
 #include <string.h>
@@ -22,14 +23,14 @@ static uint32_t rnd32(void)
 
 // ---- naive reference: a ring of the last n received rows per azimuth
 #define RAZ 12
-#define RWORDS (SL_ROI_WORDS)
+#define RWORDS (SL_MASK_WORDS)
 typedef struct {
     uint32_t hist[RAZ][32][RWORDS];
     uint32_t count[RAZ]; // rows in the current run of history (saturates at 32)
     uint32_t head[RAZ];
     uint32_t missed[RAZ];
     int seen[RAZ];
-    uint32_t n, words, bins, max_missed;
+    uint32_t n, w, words, bins, max_missed; // w: current window (sl_mask_set_window)
 } ref_t;
 static ref_t ref;
 
@@ -45,6 +46,7 @@ static void ref_init(uint32_t n, uint32_t bins, uint32_t max_missed)
 {
     memset(&ref, 0, sizeof ref);
     ref.n = n;
+    ref.w = n;
     ref.bins = bins;
     ref.words = SL_BITS_WORDS(bins);
     ref.max_missed = max_missed;
@@ -83,13 +85,13 @@ static void ref_end_rotation(void)
 static void ref_stable(uint32_t az, uint32_t *occ, uint32_t *fr)
 {
     for (uint32_t w = 0; w < ref.words; w++) {
-        if (ref.count[az] < ref.n) {
+        if (ref.count[az] < ref.w) {
             occ[w] = 0;
             fr[w] = 0;
             continue;
         }
         uint32_t all1 = UINT32_MAX, all0 = UINT32_MAX;
-        for (uint32_t i = 0; i < ref.n; i++) {
+        for (uint32_t i = 0; i < ref.w; i++) {
             const uint32_t v = ref.hist[az][(ref.head[az] + 32U - i) % 32U][w];
             all1 &= v;
             all0 &= ~v;
@@ -139,8 +141,9 @@ static void make_row(uint32_t az, uint32_t *bits, uint32_t flip_shift)
     }
 }
 
-static void run_random(uint32_t n, uint32_t bins, uint32_t max_missed, uint32_t rotations,
-                       uint32_t miss_per_256)
+// `vary_window`: before each rotation, a random window 1..n (sl_mask_set_window) for both.
+static void run_random_w(uint32_t n, uint32_t bins, uint32_t max_missed, uint32_t rotations,
+                         uint32_t miss_per_256, bool vary_window)
 {
     assert_int_equal(sl_mask_init(&mask, RAZ, (uint16_t)bins, (uint8_t)n, (uint8_t)max_missed),
                      SL_OK);
@@ -154,6 +157,11 @@ static void run_random(uint32_t n, uint32_t bins, uint32_t max_missed, uint32_t 
     for (uint32_t r = 0; r < rotations; r++) {
         // A few rotations lose a burst of consecutive rows, others lose single rows.
         const int burst = (rnd32() % 16U) == 0U;
+        if (vary_window) {
+            const uint32_t w = 1U + rnd32() % n;
+            assert_int_equal(sl_mask_set_window(&mask, (uint8_t)w), SL_OK);
+            ref.w = w;
+        }
         for (uint32_t a = 0; a < RAZ; a++) {
             if ((rnd32() % 256U) < miss_per_256 || (burst && a < RAZ / 2U)) {
                 continue;
@@ -182,13 +190,19 @@ static void run_random(uint32_t n, uint32_t bins, uint32_t max_missed, uint32_t 
     }
 }
 
+static void run_random(uint32_t n, uint32_t bins, uint32_t max_missed, uint32_t rotations,
+                       uint32_t miss_per_256)
+{
+    run_random_w(n, bins, max_missed, rotations, miss_per_256, false);
+}
+
 static void test_mask_equals_naive_n_plane_reference_for_every_n(void **state)
 {
     (void)state;
     for (uint32_t n = 1; n <= SL_CFG_MASK_FRAMES_MAX; n++) {
         run_random(n, 96, 2, 3U * n + 20U, 8); // 3 words: a pair and an odd tail word
         run_random(n, 70, 0, 2U * n + 10U, 4); // bins not a multiple of 32
-        run_random(n, 512, 3, 2U * n + 10U, 20);
+        run_random(n, SL_CFG_MASK_BINS, 3, 2U * n + 10U, 20);
     }
 }
 
@@ -270,6 +284,45 @@ static void test_mask_holds_a_missing_azimuth_then_resets_it(void **state)
     }
 }
 
+// sl_mask_set_window(): a random window 1..n per rotation equals the reference's "equal in
+// the last w received rows", for every n, with missing rows and history resets.
+static void test_mask_shorter_window_equals_reference_for_every_n(void **state)
+{
+    (void)state;
+    for (uint32_t n = 1; n <= SL_CFG_MASK_FRAMES_MAX; n++) {
+        run_random_w(n, 96, 2, 3U * n + 20U, 8, true);
+        run_random_w(n, 70, 1, 2U * n + 10U, 4, true);
+    }
+}
+
+// A window change keeps the counters: after a stop (w back to n) a bin equal for n rows is
+// stable at once; w = 1 is the plain current row; out-of-range windows are refused.
+static void test_mask_window_change_keeps_history(void **state)
+{
+    (void)state;
+    const uint8_t n = 16;
+    assert_int_equal(sl_mask_init(&mask, 4, 32, n, 2), SL_OK);
+    uint32_t row[1] = {0x0000F00FU}, occ[1], fr[1];
+    assert_int_equal(sl_mask_set_window(&mask, 1), SL_OK);
+    assert_int_equal(sl_mask_update(&mask, 2, row, occ, fr), SL_OK); // first row of a run
+    assert_int_equal(occ[0], 0x0000F00FU);
+    assert_int_equal(fr[0], ~0x0000F00FU);
+    sl_mask_end_rotation(&mask);
+    assert_int_equal(sl_mask_set_window(&mask, 3), SL_OK);
+    for (int i = 2; i <= 16; i++) {
+        assert_int_equal(sl_mask_update(&mask, 2, row, occ, fr), SL_OK);
+        sl_mask_end_rotation(&mask);
+        assert_int_equal(occ[0], i >= 3 ? 0x0000F00FU : 0U);
+    }
+    // 16 equal rows: stable for the full window too, without new rows.
+    assert_int_equal(sl_mask_set_window(&mask, 16), SL_OK);
+    assert_true(sl_mask_stable(&mask, 2, occ, fr));
+    assert_int_equal(occ[0], 0x0000F00FU);
+    assert_int_equal(sl_mask_set_window(&mask, 0), SL_ERR_ARG);
+    assert_int_equal(sl_mask_set_window(&mask, 17), SL_ERR_ARG);
+    assert_int_equal(mask.window, 16);
+}
+
 static void test_mask_rejects_bad_arguments_and_azimuths(void **state)
 {
     (void)state;
@@ -278,6 +331,7 @@ static void test_mask_rejects_bad_arguments_and_azimuths(void **state)
     assert_int_equal(sl_mask_init(&mask, SL_CFG_MAX_AZIMUTHS + 1, 32, 4, 1), SL_ERR_ARG);
     assert_int_equal(sl_mask_init(&mask, 8, 0, 4, 1), SL_ERR_ARG);
     assert_int_equal(sl_mask_init(&mask, 8, SL_CFG_ROI_BINS + 1, 4, 1), SL_ERR_ARG);
+    assert_int_equal(sl_mask_init(&mask, 8, SL_CFG_MASK_BINS + 1, 4, 1), SL_ERR_ARG);
     assert_int_equal(sl_mask_init(&mask, 8, 32, 0, 1), SL_ERR_ARG);
     assert_int_equal(sl_mask_init(&mask, 8, 32, SL_CFG_MASK_FRAMES_MAX + 1, 1), SL_ERR_ARG);
     assert_int_equal(sl_mask_init(&mask, 8, 32, 4, 1), SL_OK);
@@ -296,6 +350,8 @@ int main(void)
         cmocka_unit_test(test_mask_equals_naive_n_plane_reference_for_every_n),
         cmocka_unit_test(test_mask_is_stable_after_exactly_n_equal_rows),
         cmocka_unit_test(test_mask_holds_a_missing_azimuth_then_resets_it),
+        cmocka_unit_test(test_mask_shorter_window_equals_reference_for_every_n),
+        cmocka_unit_test(test_mask_window_change_keeps_history),
         cmocka_unit_test(test_mask_rejects_bad_arguments_and_azimuths),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

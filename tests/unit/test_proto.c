@@ -649,6 +649,102 @@ static void test_proto_rejects_payloads_beyond_the_reassembly_buffer_even_when_w
     dec_free(&d);
 }
 
+// truncate_long: a decoder with a 100-byte buffer delivers the first 100 payload bytes of
+// every longer message (same events for every chunking), consumes the rest uncopied, keeps
+// the accounting invariant and still rejects what exceeds max_payload_bytes.
+static void dec_init_cut(dec_t *d, size_t reasm, uint32_t max_payload)
+{
+    memset(d, 0, sizeof *d);
+    d->buf = malloc(reasm ? reasm : 1);
+    d->size = reasm;
+    d->rec.reasm_lo = d->buf;
+    d->rec.reasm_hi = d->buf + reasm;
+    sl_proto_cfg_t c = {.reasm_buf = d->buf, .reasm_size = reasm, .max_payload_bytes = max_payload,
+                        .truncate_long = true, .on_msg = rec_on_msg, .ctx = &d->rec};
+    assert_int_equal(sl_proto_init(&d->p, &c), SL_OK);
+}
+
+static uint32_t cut_seen, cut_wire_ok;
+static void cut_on_msg(void *ctx, const sl_proto_msg_t *m)
+{
+    rec_on_msg(ctx, m);
+    if (m->truncated) {
+        cut_seen++;
+    }
+    if ((m->truncated && m->payload.size == 100U && m->wire_bytes > 100U) ||
+        (!m->truncated && m->payload.size == m->wire_bytes)) {
+        cut_wire_ok++;
+    }
+}
+
+static void test_proto_truncates_long_payloads_to_the_buffer_for_every_chunking(void **state)
+{
+    (void)state;
+    sl_golden_params_t g = small_params(); // FFT payloads 14 + 300 or 14 + 120 bytes
+    size_t n;
+    uint8_t *s = build(&g, &n);
+    ev_t *want = calloc(4096, sizeof *want);
+    const size_t nw = expected_events(&g, s, want);
+    // The expected events: sizes capped at 100, hashes of the first 100 bytes.
+    size_t o = 0;
+    uint32_t n_long = 0;
+    for (size_t i = 0; i < nw; i++) {
+        if (want[i].size > 100U) {
+            want[i].hash = sl_golden_fnv1a(s + o + 22, 100, SL_GOLDEN_FNV_INIT);
+            want[i].size = 100;
+            n_long++;
+        }
+        o += 22U + (((uint32_t)s[o + 18] << 24) | ((uint32_t)s[o + 19] << 16) |
+                    ((uint32_t)s[o + 20] << 8) | s[o + 21]);
+    }
+    assert_true(n_long >= 32U);
+    for (uint64_t seed = 0; seed <= 60; seed++) {
+        dec_t d;
+        dec_init_cut(&d, 100, 0);
+        d.p.cfg.on_msg = cut_on_msg;
+        cut_seen = cut_wire_ok = 0;
+        if (seed == 0) {
+            feed(&d, s, n);
+            assert_int_equal(d.p.stats.reassembled, 0); // whole: views, even when cut
+        } else if (seed == 1) {
+            for (size_t i = 0; i < n; i++) {
+                feed(&d, s + i, 1);
+            }
+        } else {
+            feed_random_chunks(&d, s, n, seed);
+        }
+        assert_int_equal(d.rec.n, nw);
+        for (size_t i = 0; i < nw; i++) {
+            assert_int_equal(d.rec.ev[i].id, want[i].id);
+            assert_int_equal(d.rec.ev[i].size, want[i].size);
+            assert_int_equal(d.rec.ev[i].offset, want[i].offset);
+            assert_true(d.rec.ev[i].hash == want[i].hash);
+        }
+        assert_int_equal(d.p.stats.cut, n_long);
+        assert_int_equal(cut_seen, n_long);
+        assert_int_equal(cut_wire_ok, nw);
+        assert_int_equal(d.p.stats.bytes_delivered, n); // whole messages consumed
+        assert_int_equal(d.p.stats.bytes_skipped, 0);
+        assert_int_equal(d.p.stats.too_big, 0);
+        assert_int_equal(d.rec.bad_view, 0);
+        dec_free(&d);
+    }
+    // max_payload_bytes still rejects; without truncate_long the same message is too_big.
+    dec_t d;
+    dec_init_cut(&d, 100, 200);
+    feed(&d, s, n);
+    assert_int_equal(d.p.stats.oversize, 16); // the 16 full-length (314-byte) FFT messages
+    assert_int_equal(d.p.stats.cut, n_long - 16);
+    dec_free(&d);
+    dec_init(&d, 100, 0);
+    feed(&d, s, n);
+    assert_int_equal(d.p.stats.cut, 0);
+    assert_int_equal(d.p.stats.too_big, n_long);
+    dec_free(&d);
+    free(want);
+    free(s);
+}
+
 static void test_proto_counts_a_message_truncated_at_eof_and_restarts_cleanly(void **state)
 {
     (void)state;
@@ -1022,6 +1118,7 @@ int main(void)
         cmocka_unit_test(test_proto_rejects_a_wrong_version_and_finds_a_message_inside_its_header),
         cmocka_unit_test(test_proto_rejects_payloads_above_the_configured_maximum),
         cmocka_unit_test(test_proto_rejects_payloads_beyond_the_reassembly_buffer_even_when_whole),
+        cmocka_unit_test(test_proto_truncates_long_payloads_to_the_buffer_for_every_chunking),
         cmocka_unit_test(test_proto_counts_a_message_truncated_at_eof_and_restarts_cleanly),
         cmocka_unit_test(test_proto_recovers_after_a_message_cut_short_mid_stream),
         cmocka_unit_test(test_proto_delivers_interleaved_keep_alives_and_unknown_ids),

@@ -3,6 +3,7 @@
 // buffering, and the whole chain bytes -> sl_proto -> sl_scan under random chunkings.
 #include <setjmp.h>
 #include <stdarg.h>
+#include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
 #include <cmocka.h>
@@ -686,6 +687,226 @@ static void test_scan_follows_a_radar_restart_with_a_new_configuration_mid_strea
     free(data);
 }
 
+// ------------------------------------------------------------------ frame-less mode
+
+// Row and rotation events (on_row / on_rot), comparable across modes.
+#define MAX_ROWS 4096
+typedef struct rowrec {
+    size_t rows, rots;
+    uint64_t row_hash[MAX_ROWS]; // idx, flags, bins, ticks, sweep, t_us, rotation, power
+    uint64_t rot_hash[MAX_FRAMES]; // header, stats, flags
+    unsigned in_buf, in_other;   // frame-less views: row buffer vs. elsewhere (the message)
+    unsigned bad_view;           // a view that is neither where it should be
+    const uint8_t *row_buf;
+    uint16_t roi;
+} rowrec_t;
+static rowrec_t g_rows;
+
+static void on_row(void *ctx, const sl_scan_row_t *r)
+{
+    rowrec_t *w = ctx;
+    assert_true(w->rows < MAX_ROWS);
+    uint64_t h = SL_GOLDEN_FNV_INIT;
+    const uint8_t b[17] = {(uint8_t)r->idx, (uint8_t)(r->idx >> 8), r->flags, (uint8_t)r->bins,
+                           (uint8_t)(r->bins >> 8), (uint8_t)r->ticks, (uint8_t)(r->ticks >> 8),
+                           (uint8_t)r->sweep, (uint8_t)(r->sweep >> 8), (uint8_t)r->t_us,
+                           (uint8_t)(r->t_us >> 8), (uint8_t)(r->t_us >> 16),
+                           (uint8_t)(r->t_us >> 24), (uint8_t)(r->t_us >> 32),
+                           (uint8_t)r->rotation, (uint8_t)(r->rotation >> 8), 0};
+    h = sl_golden_fnv1a(b, sizeof b, h);
+    h = sl_golden_fnv1a(r->power, w->roi, h);
+    w->row_hash[w->rows++] = h;
+    if (w->row_buf != NULL) {
+        const bool in_buf = r->power == w->row_buf;
+        const bool must_copy = (r->flags & (SL_SCAN_AZ_SHORT | SL_SCAN_AZ_16BIT)) != 0U;
+        if (in_buf != must_copy) {
+            w->bad_view++;
+        }
+        if (in_buf) {
+            w->in_buf++;
+        } else {
+            w->in_other++;
+        }
+    }
+}
+
+static void on_rot(void *ctx, const sl_scan_rot_t *r)
+{
+    rowrec_t *w = ctx;
+    assert_true(w->rots < MAX_FRAMES);
+    uint64_t h = SL_GOLDEN_FNV_INIT;
+    const uint8_t b[13] = {(uint8_t)r->rotation, (uint8_t)r->azimuths, (uint8_t)(r->azimuths >> 8),
+                           (uint8_t)r->roi_bins, r->end, (uint8_t)r->stats.valid,
+                           (uint8_t)(r->stats.valid >> 8), (uint8_t)r->stats.missing,
+                           (uint8_t)r->stats.duplicates, (uint8_t)r->stats.out_of_order,
+                           (uint8_t)r->stats.short_azimuths, (uint8_t)r->stats.wide_azimuths,
+                           (uint8_t)(r->t_last_us - r->t_first_us)};
+    h = sl_golden_fnv1a(b, sizeof b, h);
+    h = sl_golden_fnv1a(r->flags, r->azimuths, h);
+    w->rot_hash[w->rots++] = h;
+}
+
+// Frame mode also reports rows and rotations (on_row / on_rot) and they equal its frames.
+static void on_azimuth_and_row_agree(void *ctx, const sl_scan_frame_t *f, uint16_t idx)
+{
+    on_azimuth(ctx, f, idx);
+}
+
+// Chain bytes -> decoder -> scan in frame mode (whole-message decoder) or frame-less mode
+// (decoder truncating payloads to the ROI: what the pipeline runs).
+typedef struct chain2 {
+    sl_proto_t p;
+    sl_scan_t s;
+    uint8_t reasm[8192];
+    uint8_t row[SL_CFG_ROI_BINS];
+} chain2_t;
+
+static void run_chain2(chain2_t *c, const uint8_t *data, size_t n, uint64_t seed, bool frameless,
+                       uint16_t roi)
+{
+    memset(&g_rec, 0, sizeof g_rec);
+    memset(&g_rows, 0, sizeof g_rows);
+    g_rows.roi = roi;
+    g_rows.row_buf = frameless ? c->row : NULL;
+    sl_scan_cfg_t sc = {.roi_bins = roi, .pow16_shift = 8, .on_row = on_row, .on_rot = on_rot,
+                        .row_buf = c->row, .row_buf_size = sizeof c->row, .ctx = &g_rows};
+    if (frameless) {
+        assert_int_equal(sl_scan_init(&c->s, &sc, NULL, NULL), SL_OK);
+        assert_null(sl_scan_last_frame(&c->s));
+    } else {
+        assert_int_equal(sl_scan_init(&c->s, &sc, &g_frames[0], &g_frames[1]), SL_OK);
+    }
+    // Frame-less: the decoder keeps only what the scan reads (16-bit ROI + fixed part).
+    sl_proto_cfg_t pc = {.reasm_buf = c->reasm,
+                         .reasm_size = frameless ? (size_t)(14U + 2U * roi) : sizeof c->reasm,
+                         .truncate_long = frameless, .on_msg = sl_scan_proto_sink, .ctx = &c->s};
+    assert_int_equal(sl_proto_init(&c->p, &pc), SL_OK);
+    uint64_t r = seed * 0x9E3779B97F4A7C15ULL + 5;
+    size_t i = 0;
+    while (i < n) {
+        r ^= r << 13;
+        r ^= r >> 7;
+        r ^= r << 17;
+        size_t k = seed == 0 ? n : 1 + (r % ((seed % 3 == 0) ? 7 : 3000));
+        if (k > n - i) {
+            k = n - i;
+        }
+        assert_int_equal(sl_proto_feed(&c->p, data + i, k, 0), SL_OK);
+        i += k;
+    }
+    assert_int_equal(sl_proto_finish(&c->p), SL_OK);
+    sl_scan_flush(&c->s);
+}
+
+static void test_scan_frameless_reports_the_rows_and_rotations_of_frame_mode(void **state)
+{
+    (void)state;
+    sl_golden_params_t g = sl_golden_defaults();
+    g.azimuths = 40;
+    g.range_bins = 400;
+    g.rotations = 3;
+    g.keep_alive_every = 11;
+    g.health_every = 7;
+    g.contour_bins = 150; // odd azimuths short of a 160-bin ROI
+    for (int width = 1; width <= 2; width++) {
+        g.bytes_per_bin = (uint8_t)width;
+        const size_t n = sl_golden_size(&g);
+        uint8_t *data = malloc(n);
+        assert_int_equal(sl_golden_build(data, n, &g), n);
+        static chain2_t c;
+        static rowrec_t want;
+        run_chain2(&c, data, n, 0, false, 160);
+        want = g_rows;
+        assert_int_equal(want.rows, 120);
+        assert_int_equal(want.rots, 3);
+        for (uint64_t seed = 0; seed <= 10; seed++) {
+            run_chain2(&c, data, n, seed, true, 160);
+            assert_int_equal(g_rows.rows, want.rows);
+            assert_int_equal(g_rows.rots, want.rots);
+            for (size_t k = 0; k < want.rows; k++) {
+                assert_true(g_rows.row_hash[k] == want.row_hash[k]);
+            }
+            for (size_t k = 0; k < want.rots; k++) {
+                assert_true(g_rows.rot_hash[k] == want.rot_hash[k]);
+            }
+            assert_int_equal(g_rows.bad_view, 0);
+            // 8-bit complete rows are views of the message; short and 16-bit ones are copies.
+            assert_int_equal(g_rows.in_buf, width == 1 ? 60 : 120);
+            assert_int_equal(c.p.stats.bytes_skipped, 0);
+            assert_int_equal(c.p.stats.too_big, 0);
+            assert_true(c.p.stats.cut >= 60U); // whole FFT payloads are longer than 14 + 320
+        }
+        free(data);
+    }
+}
+
+// Gaps, duplicates, late rows and a lost rotation: the frame-less bookkeeping equals frame
+// mode's (row events, rotation flags and statistics).
+static void feed_script(sl_scan_t *s)
+{
+    static const int16_t script[] = {0, 1, 2, 4, 3, 3, 5, 9, 8, 10, 399, 0, 1, 1, 390, 2, 3, -1};
+    uint16_t sweep = 0;
+    for (size_t k = 0; script[k] >= 0; k++) {
+        if (script[k] == 390) {
+            sweep = (uint16_t)(sweep + 500); // a rotation of lost packets
+        }
+        feed_idx(s, (uint16_t)script[k], sweep++, (uint8_t)k);
+    }
+    sl_scan_flush(s);
+}
+
+static void test_scan_frameless_bookkeeping_equals_frame_mode_with_gaps(void **state)
+{
+    (void)state;
+    static uint8_t row[64];
+    static rowrec_t want;
+    for (int frameless = 0; frameless < 2; frameless++) {
+        memset(&g_rows, 0, sizeof g_rows);
+        memset(&g_rec, 0, sizeof g_rec);
+        g_rows.roi = 64;
+        sl_scan_t s;
+        sl_scan_cfg_t c = {.roi_bins = 64, .pow16_shift = 8, .azimuths = 400,
+                           .encoder_size = 5600, .on_row = on_row, .on_rot = on_rot,
+                           .row_buf = row, .row_buf_size = sizeof row, .ctx = &g_rows};
+        if (frameless) {
+            assert_int_equal(sl_scan_init(&s, &c, NULL, NULL), SL_OK);
+        } else {
+            assert_int_equal(sl_scan_init(&s, &c, &g_frames[0], NULL), SL_OK);
+        }
+        feed_script(&s);
+        static sl_scan_stats_t want_stats;
+        if (!frameless) {
+            want = g_rows;
+            want_stats = s.stats;
+            assert_true(want.rots >= 3);
+            assert_true(s.stats.duplicates >= 2);
+            assert_true(s.stats.out_of_order >= 2);
+            assert_true(s.stats.late_dropped >= 1);
+            assert_true(s.stats.missing >= 300);
+            continue;
+        }
+        assert_memory_equal(&s.stats, &want_stats, sizeof want_stats);
+        assert_int_equal(g_rows.rows, want.rows);
+        assert_int_equal(g_rows.rots, want.rots);
+        for (size_t k = 0; k < want.rows; k++) {
+            assert_true(g_rows.row_hash[k] == want.row_hash[k]);
+        }
+        for (size_t k = 0; k < want.rots; k++) {
+            assert_true(g_rows.rot_hash[k] == want.rot_hash[k]);
+        }
+
+    }
+    // Frame-less init needs a row buffer of roi_bins bytes and no spare frame.
+    sl_scan_t s;
+    sl_scan_cfg_t c = {.roi_bins = 64, .pow16_shift = 8, .row_buf = row, .row_buf_size = 63};
+    assert_int_equal(sl_scan_init(&s, &c, NULL, NULL), SL_ERR_ARG);
+    c.row_buf_size = 64;
+    assert_int_equal(sl_scan_init(&s, &c, NULL, &g_frames[1]), SL_ERR_ARG);
+    c.row_buf = NULL;
+    assert_int_equal(sl_scan_init(&s, &c, NULL, NULL), SL_ERR_ARG);
+    (void)on_azimuth_and_row_agree;
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -706,6 +927,8 @@ int main(void)
         cmocka_unit_test(test_scan_completes_the_frame_after_a_rotation_of_lost_packets),
         cmocka_unit_test(test_scan_frames_from_a_byte_stream_match_for_every_chunking),
         cmocka_unit_test(test_scan_follows_a_radar_restart_with_a_new_configuration_mid_stream),
+        cmocka_unit_test(test_scan_frameless_reports_the_rows_and_rotations_of_frame_mode),
+        cmocka_unit_test(test_scan_frameless_bookkeeping_equals_frame_mode_with_gaps),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -1,0 +1,520 @@
+// The detection pipeline (sl_pipeline.h): decoder -> frame-less scan -> threshold -> mask
+// (window shortened with speed) -> streaming detection -> tracker -> CAN frames.
+//
+// Detection is fed while the rotation arrives, one row per azimuth in increasing order:
+// the stable row straight out of sl_mask_update(). Azimuths the stream skipped get their
+// held stable row from the mask (as sl_detect_rotation_from_mask() would); a late
+// (out-of-order) row still updates the mask but detection has already passed it, so this
+// rotation uses that azimuth's held row. At the rotation's end only sl_detect_end(), the
+// tracker and the CAN encoding remain, which keeps the latency short.
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <string.h>
+
+#include "shadowlean/sl_pipeline.h"
+
+#define ROTATION_US_MIN 50000U   // plausible radar rotation periods for the measured T
+#define ROTATION_US_MAX 2000000U
+
+static void set_err(sl_pipeline_t *p, sl_err_t e, uint8_t reason, const char *msg)
+{
+    p->reason = reason;
+    if (p->last_err == SL_OK) {
+        p->last_err = e;
+        p->last_err_msg = msg;
+    }
+}
+
+void sl_pipeline_cfg_default(sl_pipeline_cfg_t *cfg, const sl_board_t *board)
+{
+    SL_ASSERT(cfg != NULL);
+    memset(cfg, 0, sizeof *cfg);
+    sl_detect_cfg_default(&cfg->detect);
+    sl_track_cfg_default(&cfg->track);
+    cfg->threshold = board != NULL ? board->threshold : 40U;
+    cfg->mask_frames = board != NULL ? board->mask_frames : 16U;
+    if (cfg->mask_frames == 0U || cfg->mask_frames > SL_CFG_MASK_FRAMES_MAX) {
+        cfg->mask_frames = SL_CFG_MASK_FRAMES_MAX < 16 ? SL_CFG_MASK_FRAMES_MAX : 16U;
+    }
+    cfg->max_missed = SL_MASK_MAX_MISSED_DEFAULT;
+    cfg->pow16_shift = 8U;
+    cfg->confirm_hits = 3U;
+    cfg->motion_adapt = true;
+    cfg->min_frames = 1U;
+    cfg->motion_budget_um = board != NULL ? board->bin_size_um : 43800U;
+    cfg->motion_timeout_us = 500000U;
+    cfg->rotation_us = 250000U;
+}
+
+uint8_t sl_pipeline_window(uint8_t n, uint8_t min_frames, int32_t speed_mm_s,
+                           int32_t yaw_rate_cdeg_s, uint32_t rotation_us, uint32_t budget_um,
+                           uint32_t r_max_um)
+{
+    if (n == 0U) {
+        return 0U;
+    }
+    const uint8_t lo = min_frames == 0U ? 1U : (min_frames > n ? n : min_frames);
+    const uint64_t v = (uint64_t)(speed_mm_s < 0 ? -(int64_t)speed_mm_s : (int64_t)speed_mm_s);
+    const uint64_t w = (uint64_t)(yaw_rate_cdeg_s < 0 ? -(int64_t)yaw_rate_cdeg_s
+                                                      : (int64_t)yaw_rate_cdeg_s);
+    // Translation per rotation: v [mm/s] x T [us] / 1000 = um (rounded up).
+    uint64_t disp = (v * rotation_us + 999U) / 1000U;
+    // Rotation per rotation: w [cdeg/s] x T [us] -> urad = w T pi / (18000 x 1e6) x 1e6,
+    // pi ~ 355/113; the farthest point of interest moves r_max x angle.
+    uint64_t urad = (w * rotation_us * 355U + 113U * 18000U - 1U) / (113U * 18000U);
+    if (urad > 7000000U) {
+        urad = 7000000U; // more than a turn per rotation: anything moves anywhere
+    }
+    disp += ((uint64_t)r_max_um * urad + 999999U) / 1000000U;
+    if (disp == 0U) {
+        return n;
+    }
+    // (n_eff - 1) x disp <= D.
+    const uint64_t ne = (uint64_t)budget_um / disp + 1U;
+    if (ne >= n) {
+        return n;
+    }
+    return (uint8_t)(ne < lo ? lo : ne);
+}
+
+// ------------------------------------------------------------------------------- motion
+
+// The newest fresh motion (setter or CAN). False: none, or older than the timeout.
+static bool motion_now(const sl_pipeline_t *p, uint64_t now_us, sl_can_vehicle_motion_t *out)
+{
+    sl_can_vehicle_motion_t can;
+    const bool have_can = sl_can_motion_rx_get(&p->motion_rx, now_us, &can);
+    const bool have_set = p->motion_set && now_us >= p->motion_t_us &&
+                          now_us - p->motion_t_us <= p->cfg.motion_timeout_us;
+    if (have_set && (!have_can || p->motion_t_us >= p->motion_rx.last_t_us)) {
+        *out = p->motion;
+        return true;
+    }
+    if (have_can) {
+        *out = can;
+        return true;
+    }
+    return false;
+}
+
+// ------------------------------------------------------------------------------- output
+
+static void can_send(sl_pipeline_t *p, const sl_can_frame_t *f)
+{
+    if (p->cfg.port.can_tx == NULL) {
+        return;
+    }
+    if (p->cfg.port.can_tx(p->cfg.port.ctx, f) == SL_OK) {
+        p->stats.can_frames++;
+    } else {
+        p->stats.can_dropped++; // SL_ERR_BUSY or a port error: never retried, never blocks
+    }
+}
+
+static int32_t vehicle_az_cdeg(const sl_pipeline_t *p, uint16_t az)
+{
+    const int64_t a = (int64_t)az * 36000 / (int64_t)p->board->azimuths;
+    return (int32_t)(a + p->board->radar_yaw_cdeg);
+}
+
+static uint8_t quality_of(const sl_track_t *t)
+{
+    if (t->valid_hits > 0U) {
+        return (uint8_t)SL_CAN_QUALITY_FILTERED;
+    }
+    switch (t->last_flag) {
+    case SL_INCLINE_AMBIGUOUS: return (uint8_t)SL_CAN_QUALITY_AMBIGUOUS;
+    case SL_INCLINE_OUT_OF_DOMAIN: return (uint8_t)SL_CAN_QUALITY_OUT_OF_MODEL;
+    default: return (uint8_t)SL_CAN_QUALITY_INVALID;
+    }
+}
+
+static uint32_t um_to_mm(uint32_t um)
+{
+    return (uint32_t)(((uint64_t)um + 500U) / 1000U);
+}
+
+static void emit_can(sl_pipeline_t *p)
+{
+    const sl_tracker_t *tr = &p->tracker;
+    const uint16_t confirm = p->cfg.confirm_hits == 0U ? 1U : p->cfg.confirm_hits;
+    sl_can_frame_t f;
+    const sl_track_t *worst = NULL;
+    for (uint32_t i = 0; i < SL_CFG_MAX_TARGETS; i++) {
+        const sl_track_t *t = &tr->tracks[i];
+        if (t->live == 0U || t->hits < confirm) {
+            continue;
+        }
+        // The most severe confirmed track: level, then |filtered alpha| (valid ones first).
+        if (worst == NULL || t->level > worst->level ||
+            (t->level == worst->level &&
+             ((t->valid_hits > 0U && worst->valid_hits == 0U) ||
+              (t->valid_hits > 0U && sl_fx_abs32(t->alpha_cdeg) > sl_fx_abs32(worst->alpha_cdeg))))) {
+            worst = t;
+        }
+        if (t->updated == 0U) {
+            continue; // PoleLean only for tracks seen this rotation
+        }
+        const uint8_t q = quality_of(t);
+        const bool has_lean = q == (uint8_t)SL_CAN_QUALITY_FILTERED;
+        const sl_can_pole_lean_t pl = {
+            .target_id = (uint8_t)(t->id & 15U),
+            .quality = q,
+            .azimuth_cdeg = vehicle_az_cdeg(p, t->az),
+            .range_inner_mm = um_to_mm(t->r1_um),
+            .range_outer_mm = um_to_mm(t->r2_um),
+            .lean_cdeg = has_lean ? t->alpha_cdeg : 0,
+            .lean_sigma_cdeg = has_lean ? t->sigma_cdeg : 0U,
+        };
+        if (sl_can_encode_pole_lean(&p->can, &pl, &f) == SL_OK) {
+            can_send(p, &f);
+        }
+    }
+    sl_can_lean_warning_t lw;
+    memset(&lw, 0, sizeof lw);
+    if (worst != NULL) {
+        const uint8_t q = quality_of(worst);
+        const bool has_lean = q == (uint8_t)SL_CAN_QUALITY_FILTERED;
+        lw.level = worst->level;
+        lw.has_target = true;
+        lw.target_id = (uint8_t)(worst->id & 15U);
+        lw.quality = q;
+        lw.azimuth_cdeg = vehicle_az_cdeg(p, worst->az);
+        lw.range_mm = um_to_mm(worst->r1_um);
+        lw.lean_cdeg = has_lean ? worst->alpha_cdeg : 0;
+        lw.lean_sigma_cdeg = has_lean ? worst->sigma_cdeg : 0U;
+    }
+    if (sl_can_encode_lean_warning(&p->can, &lw, &f) == SL_OK) {
+        can_send(p, &f);
+    }
+    // Status last: it reports the drops of this rotation's frames too.
+    const sl_can_status_t st = {
+        .link_state = p->link_state,
+        .rotations = p->stats.rotations,
+        .azimuths_missing = p->stats.azimuths_missing,
+        .decoder_resyncs = p->proto.stats.resyncs,
+        .can_dropped = p->stats.can_dropped,
+    };
+    if (sl_can_encode_status(&p->can, &st, &f) == SL_OK) {
+        can_send(p, &f);
+    }
+}
+
+// ------------------------------------------------------------------------------- rotation
+
+static void begin_rotation(sl_pipeline_t *p)
+{
+    sl_can_vehicle_motion_t m;
+    uint8_t w = p->cfg.mask_frames;
+    p->motion_valid = false;
+    p->speed_mm_s = 0;
+    p->yaw_cdeg_s = 0;
+    if (motion_now(p, p->now_us, &m)) {
+        p->motion_valid = m.speed_valid || m.yaw_rate_valid;
+        p->speed_mm_s = m.speed_valid ? m.speed_mm_s : 0;
+        p->yaw_cdeg_s = m.yaw_rate_valid ? m.yaw_rate_cdeg_s : 0;
+    }
+    if (p->motion_valid && p->cfg.motion_adapt) {
+        w = sl_pipeline_window(p->cfg.mask_frames, p->cfg.min_frames, p->speed_mm_s,
+                               p->yaw_cdeg_s, p->rotation_us, p->cfg.motion_budget_um,
+                               p->r_max_um);
+    }
+    p->frames_eff = w;
+    (void)sl_mask_set_window(&p->mask, w);
+    sl_detect_begin(&p->detect);
+    p->next_az = 0U;
+    p->in_rotation = 1U;
+}
+
+// Detection rows for azimuths [from, to) that got no row (yet) this rotation: their held
+// stable rows, unless the mask will drop their history at the end of this rotation.
+static void feed_held(sl_pipeline_t *p, uint32_t from, uint32_t to)
+{
+    for (uint32_t a = from; a < to; a++) {
+        if (!sl_mask_has_history(&p->mask, (uint16_t)a) ||
+            (uint32_t)sl_mask_missed(&p->mask, (uint16_t)a) + 1U > p->mask.max_missed) {
+            continue;
+        }
+        (void)sl_mask_stable_prefix(&p->mask, (uint16_t)a, p->mask_words, p->occ, NULL);
+        (void)sl_detect_row(&p->detect, (uint16_t)a, p->occ, p->mask_words);
+    }
+}
+
+static void on_row(void *ctx, const sl_scan_row_t *row)
+{
+    sl_pipeline_t *p = ctx;
+    if (p->in_rotation == 0U) {
+        begin_rotation(p);
+    }
+    p->stats.azimuths++;
+    sl_thresh_u8(row->power, p->mask_bins, p->cfg.threshold, p->bits);
+    if (row->idx >= p->next_az) {
+        if (row->idx > p->next_az) {
+            feed_held(p, p->next_az, row->idx);
+        }
+        if (sl_mask_update(&p->mask, row->idx, p->bits, p->occ, NULL) == SL_OK) {
+            (void)sl_detect_row(&p->detect, row->idx, p->occ, p->mask_words);
+        }
+        p->next_az = (uint16_t)(row->idx + 1U);
+    } else {
+        // Late row: counts for the mask; detection of this rotation used the held row.
+        (void)sl_mask_update(&p->mask, row->idx, p->bits, NULL, NULL);
+    }
+}
+
+static void measure_period(sl_pipeline_t *p, const sl_scan_rot_t *rot)
+{
+    if (rot->end == (uint8_t)SL_SCAN_END_WRAP && p->last_t_last_us != 0U &&
+        rot->t_last_us > p->last_t_last_us) {
+        const uint64_t d = rot->t_last_us - p->last_t_last_us;
+        if (d >= ROTATION_US_MIN && d <= ROTATION_US_MAX) {
+            p->rotation_us = (uint32_t)d;
+        }
+    }
+    p->last_t_last_us = rot->stats.valid != 0U ? rot->t_last_us : 0U;
+}
+
+static void on_rot(void *ctx, const sl_scan_rot_t *rot)
+{
+    sl_pipeline_t *p = ctx;
+    if (p->in_rotation == 0U) {
+        begin_rotation(p); // cannot happen (a rotation has a row); keeps the state sane
+    }
+    feed_held(p, p->next_az, rot->azimuths < p->mask.azimuths ? rot->azimuths
+                                                              : p->mask.azimuths);
+    sl_mask_end_rotation(&p->mask);
+    const sl_ssize_t nt = sl_detect_end(&p->detect);
+    const uint32_t n_targets = nt > 0 ? (uint32_t)nt : 0U;
+    measure_period(p, rot);
+    // Tracker gates follow the ego motion of one rotation.
+    uint32_t disp_um = 0, yaw_bam = 0;
+    if (p->motion_valid) {
+        const uint64_t v = (uint64_t)(p->speed_mm_s < 0 ? -(int64_t)p->speed_mm_s
+                                                        : (int64_t)p->speed_mm_s);
+        const uint64_t w = (uint64_t)(p->yaw_cdeg_s < 0 ? -(int64_t)p->yaw_cdeg_s
+                                                        : (int64_t)p->yaw_cdeg_s);
+        const uint64_t d = (v * p->rotation_us + 999U) / 1000U;
+        // w [cdeg/s] x T [us] / 1e6 = cdeg per rotation; x 2^32 / 36000 (~119305) = bam32.
+        const uint64_t cd_e6 = w * p->rotation_us; // cdeg x 1e6, < 2^37
+        const uint64_t bam = (cd_e6 * 119305U + 999999U) / 1000000U;
+        disp_um = d > UINT32_MAX ? UINT32_MAX : (uint32_t)d;
+        yaw_bam = bam > UINT32_MAX ? UINT32_MAX : (uint32_t)bam;
+    }
+    sl_track_set_motion(&p->tracker, disp_um, yaw_bam);
+    sl_track_update(&p->tracker, p->detect.targets, n_targets, p->now_us);
+    p->stats.rotations++;
+    p->stats.azimuths_missing += rot->stats.missing;
+    p->stats.targets += n_targets;
+    if (p->cfg.port.on_rotation != NULL) {
+        const sl_pipeline_rotation_t r = {
+            .rotation = p->stats.rotations - 1U,
+            .now_us = p->now_us,
+            .t_first_us = rot->t_first_us,
+            .t_last_us = rot->t_last_us,
+            .azimuths = rot->azimuths,
+            .valid = rot->stats.valid,
+            .missing = rot->stats.missing,
+            .end = rot->end,
+            .frames_eff = p->frames_eff,
+            .motion_valid = p->motion_valid,
+            .speed_mm_s = p->speed_mm_s,
+            .yaw_rate_cdeg_s = p->yaw_cdeg_s,
+            .targets = p->detect.targets,
+            .n_targets = (uint16_t)n_targets,
+            .tracks = p->tracker.tracks,
+            .n_track_slots = SL_CFG_MAX_TARGETS,
+            .level = (uint8_t)sl_track_max_level(&p->tracker),
+        };
+        p->cfg.port.on_rotation(p->cfg.port.ctx, &r);
+    }
+    emit_can(p);
+    p->in_rotation = 0U;
+}
+
+static void on_msg(void *ctx, const sl_proto_msg_t *m)
+{
+    sl_pipeline_t *p = ctx;
+    if (m->id == (uint8_t)SL_PROTO_ID_CONFIGURATION && p->scan.stats.azimuths != 0U) {
+        p->stats.restarts++; // a radar (re)start announces itself with a Configuration
+    }
+    const uint32_t rejected = p->scan.stats.config_rejected;
+    (void)sl_scan_on_msg(&p->scan, m);
+    if (p->scan.stats.config_rejected != rejected) {
+        p->stats.geometry_rejected++;
+        set_err(p, SL_ERR_RANGE, (uint8_t)SL_PIPELINE_OK,
+                "radar configuration does not match the board (azimuths / encoder size)");
+    }
+}
+
+// ------------------------------------------------------------------------------- API
+
+sl_err_t sl_pipeline_init(sl_pipeline_t *p, const sl_board_t *board,
+                          const sl_pipeline_cfg_t *cfg)
+{
+    if (p == NULL) {
+        return SL_ERR_ARG;
+    }
+    memset(p, 0, sizeof *p);
+    if (board == NULL) {
+        set_err(p, SL_ERR_ARG, (uint8_t)SL_PIPELINE_BAD_ARG, "NULL board");
+        return SL_ERR_ARG;
+    }
+    if (cfg != NULL) {
+        p->cfg = *cfg;
+    } else {
+        sl_pipeline_cfg_default(&p->cfg, board);
+    }
+    p->board = board;
+    const sl_pipeline_cfg_t *c = &p->cfg;
+    if (c->pow16_shift > 15U || c->max_missed == 255U || c->mask_frames == 0U) {
+        set_err(p, SL_ERR_ARG, (uint8_t)SL_PIPELINE_BAD_ARG, "configuration value out of range");
+        return SL_ERR_ARG;
+    }
+    if (c->mask_frames > SL_CFG_MASK_FRAMES_MAX) {
+        set_err(p, SL_ERR_RANGE, (uint8_t)SL_PIPELINE_MASK_FRAMES,
+                "mask_frames exceeds SL_CFG_MASK_FRAMES_MAX");
+        return SL_ERR_RANGE;
+    }
+    if (board->azimuths == 0U || board->azimuths > SL_CFG_MAX_AZIMUTHS ||
+        board->encoder_size == 0U) {
+        set_err(p, SL_ERR_RANGE, (uint8_t)SL_PIPELINE_BOARD_AZIMUTHS,
+                "board azimuths exceed SL_CFG_MAX_AZIMUTHS");
+        return SL_ERR_RANGE;
+    }
+    if (board->roi_bins == 0U || board->roi_bins > SL_CFG_ROI_BINS) {
+        set_err(p, SL_ERR_RANGE, (uint8_t)SL_PIPELINE_BOARD_ROI,
+                "board roi_bins exceed SL_CFG_ROI_BINS");
+        return SL_ERR_RANGE;
+    }
+    sl_err_t e = sl_detect_init(&p->detect, board, &c->detect);
+    if (e != SL_OK) {
+        set_err(p, e, (uint8_t)SL_PIPELINE_STAGE_INIT, "sl_detect_init rejected the board");
+        return e;
+    }
+    // Threshold and mask only what detection reads, in whole words.
+    const uint32_t need = sl_detect_bins_needed(&p->detect);
+    uint32_t bins = (need + 31U) & ~31U;
+    if (bins > board->roi_bins) {
+        bins = board->roi_bins;
+    }
+    if (bins == 0U) {
+        bins = 32U <= board->roi_bins ? 32U : board->roi_bins;
+    }
+    if (bins > SL_CFG_MASK_BINS) {
+        set_err(p, SL_ERR_RANGE, (uint8_t)SL_PIPELINE_MASK_BINS,
+                "detection needs more bins than SL_CFG_MASK_BINS");
+        return SL_ERR_RANGE;
+    }
+    p->mask_bins = (uint16_t)bins;
+    p->mask_words = (uint16_t)SL_BITS_WORDS(bins);
+    p->r_max_um = (uint32_t)(((uint64_t)need * board->bin_size_um > UINT32_MAX)
+                                 ? UINT32_MAX
+                                 : (uint64_t)need * board->bin_size_um);
+    e = sl_mask_init(&p->mask, board->azimuths, (uint16_t)bins, c->mask_frames, c->max_missed);
+    if (e == SL_OK) {
+        e = sl_track_init(&p->tracker, board, &c->track);
+    }
+    sl_can_ids_t ids;
+    if (e == SL_OK) {
+        sl_can_ids_from_board(&ids, board);
+        e = sl_can_tx_init(&p->can, &ids);
+    }
+    if (e != SL_OK) {
+        set_err(p, e, (uint8_t)SL_PIPELINE_STAGE_INIT, "a stage rejected the board or cfg");
+        return e;
+    }
+    sl_can_motion_rx_init(&p->motion_rx, board->can_id_vehicle_motion, c->motion_timeout_us);
+    const sl_scan_cfg_t sc = {
+        .roi_bins = (uint16_t)bins,
+        .pow16_shift = c->pow16_shift,
+        .expect_azimuths = board->azimuths,
+        .expect_encoder_size = board->encoder_size,
+        .azimuths = board->azimuths,
+        .encoder_size = board->encoder_size,
+        .ignore_sweep = c->ignore_sweep,
+        .on_row = on_row,
+        .on_rot = on_rot,
+        .row_buf = p->row8,
+        .row_buf_size = (uint16_t)sizeof p->row8,
+        .ctx = p,
+    };
+    e = sl_scan_init(&p->scan, &sc, NULL, NULL);
+    if (e != SL_OK) {
+        set_err(p, e, (uint8_t)SL_PIPELINE_STAGE_INIT, "sl_scan_init rejected the board");
+        return e;
+    }
+    const sl_proto_cfg_t pc = {
+        .reasm_buf = p->reasm,
+        .reasm_size = sizeof p->reasm,
+        .max_payload_bytes = board->max_message_bytes,
+        .truncate_long = true,
+        .on_msg = on_msg,
+        .ctx = p,
+    };
+    e = sl_proto_init(&p->proto, &pc);
+    if (e != SL_OK) {
+        set_err(p, e, (uint8_t)SL_PIPELINE_STAGE_INIT, "sl_proto_init failed");
+        return e;
+    }
+    p->rotation_us = c->rotation_us != 0U ? c->rotation_us : 250000U;
+    p->frames_eff = c->mask_frames;
+    p->link_state = (uint8_t)SL_CAN_LINK_DISCONNECTED;
+    p->ready = true;
+    return SL_OK;
+}
+
+sl_err_t sl_pipeline_feed(sl_pipeline_t *p, const uint8_t *data, size_t len, uint64_t now_us)
+{
+    if (p == NULL || (data == NULL && len != 0U) || !p->ready) {
+        return SL_ERR_ARG;
+    }
+    p->now_us = now_us;
+    return sl_proto_feed(&p->proto, data, len, now_us);
+}
+
+sl_err_t sl_pipeline_finish(sl_pipeline_t *p, uint64_t now_us)
+{
+    if (p == NULL || !p->ready) {
+        return SL_ERR_ARG;
+    }
+    p->now_us = now_us;
+    (void)sl_proto_finish(&p->proto);
+    sl_scan_flush(&p->scan);
+    p->last_t_last_us = 0U; // the next stream's clock may differ
+    return SL_OK;
+}
+
+sl_err_t sl_pipeline_on_can_rx(sl_pipeline_t *p, const sl_can_frame_t *f, uint64_t now_us)
+{
+    if (p == NULL || f == NULL || !p->ready) {
+        return SL_ERR_ARG;
+    }
+    p->stats.can_rx++;
+    const sl_err_t e = sl_can_motion_rx_feed(&p->motion_rx, f, now_us);
+    if (e == SL_OK) {
+        p->stats.motion_accepted++;
+    } else if (e != SL_ERR_ARG) {
+        p->stats.motion_rejected++;
+    }
+    return e;
+}
+
+void sl_pipeline_set_motion(sl_pipeline_t *p, int32_t speed_mm_s, bool speed_valid,
+                            int32_t yaw_rate_cdeg_s, bool yaw_rate_valid, uint64_t now_us)
+{
+    SL_ASSERT(p != NULL);
+    p->motion.speed_mm_s = speed_mm_s;
+    p->motion.speed_valid = speed_valid;
+    p->motion.yaw_rate_cdeg_s = yaw_rate_cdeg_s;
+    p->motion.yaw_rate_valid = yaw_rate_valid;
+    p->motion_t_us = now_us;
+    p->motion_set = true;
+    p->stats.motion_accepted++;
+}
+
+void sl_pipeline_set_link_state(sl_pipeline_t *p, uint8_t link_state)
+{
+    SL_ASSERT(p != NULL);
+    p->link_state = link_state;
+}

@@ -1,0 +1,905 @@
+// shadowleand.c: the shadowlean daemon. Radar TCP stream or capture file in, pole-lean
+// CAN frames out (SocketCAN, candump log, gs_usb), one sl_pipeline_t in between.
+//
+// One thread, one poll() loop. Every turn: signals (signalfd), VehicleMotion frames, the
+// input (radar client I/O and timers, or the next due part of the capture), the sinks'
+// deferred work, the idle Status frame, the periodic stats line, the exit conditions.
+// Options: daemon_opts.h (also `shadowleand --help`).
+//
+// Clocks. The sinks, timers and the radar input use CLOCK_MONOTONIC. With a capture file
+// the pipeline is driven by the radar's own FFT timestamps (the "data clock"), so the
+// output does not depend on how fast the machine replays (--fast and --realtime give the
+// same frames; track timeouts behave as they did on the road). The candump log writes the
+// data clock for captures and the wall clock (CLOCK_REALTIME) for a live radar, unless
+// --log-time says otherwise.
+#include <errno.h>
+#include <grp.h>
+#include <inttypes.h>
+#include <poll.h>
+#include <pwd.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/signalfd.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "can_sink.h"
+#include "can_socketcan.h"
+#include "daemon_candump.h"
+#include "daemon_capture.h"
+#include "daemon_log.h"
+#include "daemon_motion.h"
+#include "daemon_opts.h"
+#include "daemon_targets.h"
+#include "gsusb_libusb.h"
+#include "gsusb_sink.h"
+#include "radar_client.h"
+#include "shadowlean/sl_board.h"
+#include "shadowlean/sl_can.h"
+#include "shadowlean/sl_pipeline.h"
+#include "shadowlean/sl_proto.h"
+#include "sl_port_linux.h"
+
+#define FAST_MSGS_PER_TURN 512U   // capture messages fed per loop turn in --fast mode
+#define MAX_PLAY_GAP_US 5000000U  // --realtime: longer timestamp gaps are shortened to this
+#define DRAIN_MS 500U             // at exit: wait at most this long for queued frames
+#define PIPE_REASM_HOST (1U << 20) // pacer decoder limit (host captures)
+
+/// One capture message: where it ends and its FFT timestamp (0 = not FFT data).
+typedef struct msg_ix {
+    uint64_t end;
+    uint64_t t_us;
+} msg_ix_t;
+
+typedef struct daemon {
+    sld_opts_t o;
+    const sl_board_t *board;
+    sl_pipeline_cfg_t pcfg;
+    uint32_t status_id; // bare id of the Status frames
+    uint8_t status_eff; // SL_CAN_FLAG_EFF or 0
+
+    // sinks
+    sl_can_socketcan_t sc;
+    bool sc_on;
+    sld_candump_t log;
+    bool log_on;
+    sl_gsusb_sink_t gs;
+    bool gs_on;
+    sl_can_sink_t sinks[3];
+    size_t n_sinks;
+    sld_log_time_t log_time;
+
+    // motion input
+    sld_motion_t motion;
+    bool motion_on;
+
+    // input: radar
+    bool is_radar;
+    sl_radar_client_t radar;
+    uint8_t *radar_reasm;
+    bool fed_since_finish;
+    uint64_t stream_start_mono; // Configuration received (start of streaming)
+    uint64_t last_fft_mono;
+    bool had_fft;               // any FFT data since start
+    sl_radar_state_t last_radar_state;
+
+    // input: capture
+    sld_capture_t cap;
+    msg_ix_t *ix;
+    size_t n_ix, next_ix, next_break;
+    uint64_t fed;               // bytes of cap fed to the pipeline
+    bool cap_done;
+    uint64_t play_wall0, play_us, play_prev_t;
+    bool play_started;
+
+    // clocks
+    uint64_t mono_us;
+    uint64_t data_us;           // latest FFT timestamp fed (capture input)
+
+    // status / stats
+    uint8_t link_state;
+    uint64_t last_status_mono;
+    bool idle_status;           // send Status frames when no rotation does
+    uint32_t status_frames, idle_status_frames, frames_out, rotations_seen;
+    uint64_t next_stats_mono;
+    uint64_t start_mono;
+
+    // --targets-out
+    FILE *targets;
+    bool targets_own;
+    bool targets_failed;
+
+    int sfd;
+    bool stop;
+    const char *stop_why;
+} daemon_t;
+
+// The pipeline is ~250 KB with the default capacities, the radar client ~70 KB: static.
+static sl_pipeline_t g_pipe;
+static daemon_t g_d;
+
+static uint64_t pipe_now(const daemon_t *d)
+{
+    return d->is_radar ? d->mono_us : d->data_us;
+}
+
+static uint64_t realtime_us(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_REALTIME, &ts);
+    return (uint64_t)ts.tv_sec * 1000000U + (uint64_t)ts.tv_nsec / 1000U;
+}
+
+// ---------------------------------------------------------------------------------------
+// Output: the pipeline's port
+
+static sl_err_t send_frame(daemon_t *d, const sl_can_frame_t *f)
+{
+    if (d->log_on) {
+        const bool data = d->log_time == SLD_LOG_TIME_DATA;
+        d->log.stamp_us = data ? d->data_us : realtime_us();
+    }
+    if (f->id == d->status_id && (f->flags & SL_CAN_FLAG_EFF) == d->status_eff) {
+        d->status_frames++;
+        d->last_status_mono = d->mono_us;
+    }
+    d->frames_out++;
+    if (d->n_sinks == 0) {
+        return SL_OK;
+    }
+    const sl_err_t e = sl_can_sinks_send(d->sinks, d->n_sinks, f, d->mono_us);
+    if (d->log_on && d->log.broken_pipe && !d->stop) {
+        d->stop = true;
+        d->stop_why = "the reader of the CAN log (stdout) went away";
+    }
+    return e;
+}
+
+static sl_err_t port_can_tx(void *ctx, const sl_can_frame_t *f)
+{
+    return send_frame(ctx, f);
+}
+
+static void port_on_rotation(void *ctx, const sl_pipeline_rotation_t *r)
+{
+    daemon_t *d = ctx;
+    d->rotations_seen++;
+    if (d->targets != NULL && !d->targets_failed && sld_targets_write_rotation(d->targets, r) != 0) {
+        d->targets_failed = true;
+        sld_log(SLD_LOG_ERR, "--targets-out: write failed: %s", strerror(errno));
+    }
+    unsigned live = 0;
+    for (uint16_t i = 0; i < r->n_track_slots; i++) {
+        live += r->tracks[i].live ? 1U : 0U;
+    }
+    sld_log(SLD_LOG_DEBUG, "rotation %" PRIu32 ": %u/%u azimuths, %u targets, %u tracks, level %u, n_eff %u",
+            r->rotation, (unsigned)r->valid, (unsigned)r->azimuths, (unsigned)r->n_targets, live,
+            (unsigned)r->level, (unsigned)r->frames_eff);
+}
+
+/// Status frame outside the rotations (no data). Filled like the pipeline's own, encoded
+/// with the pipeline's sender so the E2E counter sequence of the Status id stays intact.
+static void send_idle_status(daemon_t *d)
+{
+    sl_can_status_t st;
+    memset(&st, 0, sizeof st);
+    st.link_state = d->link_state;
+    st.rotations = g_pipe.stats.rotations;
+    st.azimuths_missing = g_pipe.stats.azimuths_missing;
+    st.decoder_resyncs = g_pipe.proto.stats.resyncs;
+    st.can_dropped = g_pipe.stats.can_dropped;
+    sl_can_frame_t f;
+    if (sl_can_encode_status(&g_pipe.can, &st, &f) != SL_OK) {
+        return;
+    }
+    d->idle_status_frames++;
+    if (send_frame(d, &f) != SL_OK) {
+        g_pipe.stats.can_dropped++; // reported in the next Status, as the pipeline does
+    }
+}
+
+// ---------------------------------------------------------------------------------------
+// Input: radar
+
+static void radar_on_bytes(void *ctx, const uint8_t *data, size_t len, uint64_t now_us)
+{
+    daemon_t *d = ctx;
+    d->fed_since_finish = true;
+    sl_pipeline_feed(&g_pipe, data, len, now_us);
+}
+
+static void radar_on_msg(void *ctx, const sl_proto_msg_t *msg, uint64_t now_us)
+{
+    daemon_t *d = ctx;
+    if (msg->id == SL_PROTO_ID_FFT_DATA || msg->id == SL_PROTO_ID_FFT_DATA_16) {
+        d->last_fft_mono = now_us;
+        d->had_fft = true;
+    } else if (msg->id == SL_PROTO_ID_CONFIGURATION) {
+        sl_proto_config_t c;
+        if (sl_proto_parse_config(msg, &c) == SL_OK) {
+            sld_log(SLD_LOG_INFO, "radar configuration: %u azimuths, %u bins of %" PRIu32 " um, %u.%03u Hz",
+                    (unsigned)c.azimuths, (unsigned)c.range_bins, sl_proto_config_bin_size_um(&c),
+                    (unsigned)(c.rotation_mhz / 1000U), (unsigned)(c.rotation_mhz % 1000U));
+            if (c.azimuths != d->board->azimuths || c.encoder_size != d->board->encoder_size) {
+                sld_log(SLD_LOG_WARN, "radar geometry (%u azimuths, %u ticks) differs from board %s (%u, %u)",
+                        (unsigned)c.azimuths, (unsigned)c.encoder_size, d->board->name,
+                        (unsigned)d->board->azimuths, (unsigned)d->board->encoder_size);
+            }
+        }
+    }
+}
+
+static void radar_finish(daemon_t *d, uint64_t now_us)
+{
+    if (d->fed_since_finish) {
+        d->fed_since_finish = false;
+        sl_pipeline_finish(&g_pipe, now_us);
+    }
+}
+
+static void radar_on_event(void *ctx, sl_radar_event_t ev, sl_radar_reason_t reason, uint64_t now_us)
+{
+    daemon_t *d = ctx;
+    const sl_radar_client_t *c = &d->radar;
+    switch (ev) {
+    case SL_RADAR_EV_CONNECTED:
+        sld_log(SLD_LOG_INFO, "radar %s:%u connected", d->o.radar_host, (unsigned)d->o.radar_port);
+        break;
+    case SL_RADAR_EV_CONFIG:
+        d->stream_start_mono = now_us;
+        break;
+    case SL_RADAR_EV_DISCONNECTED:
+        sld_log(SLD_LOG_WARN, "radar disconnected (%s%s%s); reconnecting in %" PRIu32 " ms",
+                sl_radar_reason_str(reason), c->stats.last_errno != 0 ? ": " : "",
+                c->stats.last_errno != 0 ? strerror(c->stats.last_errno) : "", c->stats.backoff_ms);
+        radar_finish(d, now_us);
+        break;
+    case SL_RADAR_EV_CONNECT_FAILED:
+        // Logged once per failure streak at warning level, then at debug level.
+        sld_log(c->stats.connect_failures + c->stats.connect_timeouts <= 1 ? SLD_LOG_WARN : SLD_LOG_DEBUG,
+                "radar %s:%u: connect failed (%s%s%s); retrying", d->o.radar_host,
+                (unsigned)d->o.radar_port, sl_radar_reason_str(reason),
+                c->stats.last_errno != 0 ? ": " : "",
+                c->stats.last_errno != 0 ? strerror(c->stats.last_errno) : "");
+        radar_finish(d, now_us);
+        break;
+    case SL_RADAR_EV_STOPPED:
+        radar_finish(d, now_us);
+        break;
+    }
+}
+
+static uint8_t radar_link_state(daemon_t *d)
+{
+    switch (d->radar.state) {
+    case SL_RADAR_IDLE:
+    case SL_RADAR_BACKOFF:
+        return SL_CAN_LINK_DISCONNECTED;
+    case SL_RADAR_CONNECTING:
+        return SL_CAN_LINK_CONNECTING;
+    case SL_RADAR_WAIT_CONFIG:
+        return SL_CAN_LINK_WAIT_CONFIG;
+    case SL_RADAR_STREAMING: {
+        uint64_t ref = d->stream_start_mono;
+        if (d->had_fft && d->last_fft_mono > ref) {
+            ref = d->last_fft_mono;
+        }
+        return d->mono_us >= ref + (uint64_t)d->o.silent_ms * 1000U ? SL_CAN_LINK_SILENT
+                                                                     : SL_CAN_LINK_STREAMING;
+    }
+    }
+    return SL_CAN_LINK_DISCONNECTED;
+}
+
+static int radar_setup(daemon_t *d)
+{
+    size_t reasm = d->board->max_message_bytes;
+    if (reasm < 65536U) {
+        reasm = 65536U;
+    }
+    d->radar_reasm = malloc(reasm);
+    if (d->radar_reasm == NULL) {
+        sld_log(SLD_LOG_ERR, "out of memory");
+        return -1;
+    }
+    sl_radar_client_cfg_t cfg;
+    sl_radar_client_cfg_defaults(&cfg);
+    cfg.host = d->o.radar_host;
+    cfg.port = d->o.radar_port;
+    cfg.connect_timeout_ms = d->o.connect_timeout_ms;
+    cfg.silence_timeout_ms = d->o.silence_timeout_ms;
+    cfg.non_contour = d->o.non_contour;
+    cfg.reasm_buf = d->radar_reasm;
+    cfg.reasm_size = reasm;
+    cfg.max_payload_bytes = (uint32_t)reasm;
+    cfg.on_msg = radar_on_msg;
+    cfg.on_bytes = radar_on_bytes;
+    cfg.on_event = radar_on_event;
+    cfg.ctx = d;
+    const sl_err_t e = sl_radar_client_init(&d->radar, &cfg);
+    if (e != SL_OK) {
+        sld_log(SLD_LOG_ERR, "radar %s:%u: %s", d->o.radar_host, (unsigned)d->o.radar_port,
+                e == SL_ERR_PORT ? "cannot resolve the name" : sl_err_str(e));
+        return -1;
+    }
+    return 0;
+}
+
+// ---------------------------------------------------------------------------------------
+// Input: capture file
+
+typedef struct index_ctx {
+    msg_ix_t *ix;
+    size_t n, cap;
+    bool oom;
+} index_ctx_t;
+
+static void index_on_msg(void *ctx, const sl_proto_msg_t *msg)
+{
+    index_ctx_t *c = ctx;
+    if (c->n == c->cap) {
+        const size_t ncap = c->cap != 0 ? 2 * c->cap : 4096;
+        msg_ix_t *p = realloc(c->ix, ncap * sizeof *p);
+        if (p == NULL) {
+            c->oom = true;
+            return;
+        }
+        c->ix = p;
+        c->cap = ncap;
+    }
+    msg_ix_t m = {msg->stream_offset + SL_PROTO_HEADER_BYTES + msg->payload.size, 0};
+    sl_proto_fft_t fft;
+    if ((msg->id == SL_PROTO_ID_FFT_DATA || msg->id == SL_PROTO_ID_FFT_DATA_16) &&
+        sl_proto_parse_fft(msg, &fft) == SL_OK) {
+        m.t_us = sl_proto_fft_time_us(&fft);
+    }
+    c->ix[c->n++] = m;
+}
+
+/// Index the capture's messages (ends and FFT timestamps) for pacing and the data clock.
+static int capture_setup(daemon_t *d)
+{
+    char err[512];
+    if (sld_capture_load(d->o.capture, &d->cap, err, sizeof err) != 0) {
+        sld_log(SLD_LOG_ERR, "--input: %s", err);
+        return -1;
+    }
+    uint8_t *reasm = malloc(PIPE_REASM_HOST);
+    if (reasm == NULL) {
+        sld_log(SLD_LOG_ERR, "out of memory");
+        return -1;
+    }
+    index_ctx_t ic = {NULL, 0, 0, false};
+    sl_proto_t p;
+    const sl_proto_cfg_t pc = {.reasm_buf = reasm, .reasm_size = PIPE_REASM_HOST,
+                              .max_payload_bytes = PIPE_REASM_HOST, .truncate_long = false,
+                              .on_msg = index_on_msg, .ctx = &ic};
+    sl_proto_init(&p, &pc);
+    uint64_t off = 0;
+    for (size_t b = 0; b <= d->cap.n_breaks; b++) {
+        const uint64_t end = b < d->cap.n_breaks ? d->cap.breaks[b] : d->cap.size;
+        if (end > off) {
+            sl_proto_feed(&p, d->cap.bytes + off, (size_t)(end - off), 0);
+            off = end;
+        }
+        sl_proto_finish(&p);
+    }
+    free(reasm);
+    if (ic.oom) {
+        free(ic.ix);
+        sld_log(SLD_LOG_ERR, "out of memory indexing the capture");
+        return -1;
+    }
+    d->ix = ic.ix;
+    d->n_ix = ic.n;
+    size_t n_fft = 0;
+    for (size_t i = 0; i < d->n_ix; i++) {
+        if (d->ix[i].t_us != 0) {
+            if (n_fft == 0) {
+                d->data_us = d->ix[i].t_us; // the data clock starts at the first FFT message
+            }
+            n_fft++;
+        }
+    }
+    if (n_fft == 0) {
+        d->data_us = realtime_us();
+    }
+    sld_log(SLD_LOG_INFO, "input %s (%s): %zu bytes, %zu messages, %zu FFT, %zu discontinuities%s%s",
+            d->o.capture, d->cap.format, d->cap.size, d->n_ix, n_fft, d->cap.n_breaks,
+            d->cap.report[0] != '\0' ? "; " : "", d->cap.report);
+    if (p.stats.resyncs != 0 || p.stats.truncated != 0) {
+        sld_log(SLD_LOG_WARN, "input: %" PRIu32 " decoder resyncs, %" PRIu32 " truncated messages, %" PRIu64
+                " bytes skipped", p.stats.resyncs, p.stats.truncated, p.stats.bytes_skipped);
+    }
+    return 0;
+}
+
+static void capture_feed_to(daemon_t *d, uint64_t end)
+{
+    if (end > d->fed) {
+        sl_pipeline_feed(&g_pipe, d->cap.bytes + d->fed, (size_t)(end - d->fed), pipe_now(d));
+        d->fed = end;
+    }
+}
+
+/// Feed what is due. @return the monotonic time of the next due message (0 = now / done).
+static uint64_t capture_step(daemon_t *d)
+{
+    unsigned budget = FAST_MSGS_PER_TURN;
+    while (!d->cap_done && !d->stop && budget-- > 0) {
+        // A discontinuity before the next message's end: feed up to it, end the stream.
+        const uint64_t next_end = d->next_ix < d->n_ix ? d->ix[d->next_ix].end : d->cap.size;
+        if (d->next_break < d->cap.n_breaks && d->cap.breaks[d->next_break] <= next_end) {
+            capture_feed_to(d, d->cap.breaks[d->next_break]);
+            sl_pipeline_finish(&g_pipe, pipe_now(d));
+            d->next_break++;
+            continue;
+        }
+        if (d->next_ix >= d->n_ix) {
+            capture_feed_to(d, d->cap.size); // trailing junk or a partial message
+            sl_pipeline_finish(&g_pipe, pipe_now(d));
+            d->cap_done = true;
+            break;
+        }
+        const msg_ix_t *m = &d->ix[d->next_ix];
+        if (m->t_us != 0) {
+            if (d->o.realtime) {
+                if (!d->play_started) {
+                    d->play_started = true;
+                    d->play_wall0 = d->mono_us;
+                    d->play_prev_t = m->t_us;
+                } else {
+                    uint64_t dt = m->t_us > d->play_prev_t ? m->t_us - d->play_prev_t : 0;
+                    if (dt > MAX_PLAY_GAP_US) {
+                        dt = MAX_PLAY_GAP_US;
+                    }
+                    const uint64_t due = d->play_wall0 + d->play_us + dt;
+                    if (due > d->mono_us) {
+                        return due; // not yet (play_us/prev_t unchanged until it is fed)
+                    }
+                    d->play_us += dt;
+                    d->play_prev_t = m->t_us;
+                }
+            }
+            if (m->t_us > d->data_us) {
+                d->data_us = m->t_us;
+            }
+        }
+        capture_feed_to(d, m->end);
+        d->next_ix++;
+    }
+    return 0;
+}
+
+// ---------------------------------------------------------------------------------------
+// Motion input
+
+static void on_motion_frame(void *ctx, const sl_can_frame_t *f)
+{
+    daemon_t *d = ctx;
+    const sl_err_t e = sl_pipeline_on_can_rx(&g_pipe, f, pipe_now(d));
+    if (e != SL_OK) {
+        sld_log(SLD_LOG_DEBUG, "VehicleMotion frame rejected: %s", sl_err_str(e));
+    }
+}
+
+// ---------------------------------------------------------------------------------------
+// Set-up, privileges, stats
+
+static int open_sinks(daemon_t *d)
+{
+    const uint64_t now = d->mono_us;
+    if (d->o.can_iface[0] != '\0') {
+        const sl_err_t e = sl_can_socketcan_open(&d->sc, d->o.can_iface, NULL);
+        if (e == SL_ERR_ARG) {
+            sld_log(SLD_LOG_ERR, "--can %s: bad interface name", d->o.can_iface);
+            return -1;
+        }
+        if (e != SL_OK) {
+            // Usable anyway: frames are dropped and counted, the socket is reopened later.
+            sld_log(SLD_LOG_WARN, "--can %s: %s (frames are dropped until it appears)", d->o.can_iface,
+                    strerror(d->sc.last_errno));
+        }
+        d->sc_on = true;
+        d->sinks[d->n_sinks++] = sl_can_socketcan_sink(&d->sc);
+    }
+    if (d->o.can_log[0] != '\0') {
+        const char *iface = d->o.can_log_iface[0] != '\0' ? d->o.can_log_iface
+                            : d->o.can_iface[0] != '\0' ? d->o.can_iface
+                                                        : "can0";
+        const sl_err_t e = sld_candump_open(&d->log, d->o.can_log, iface);
+        if (e != SL_OK) {
+            sld_log(SLD_LOG_ERR, "--can-log %s: %s", d->o.can_log,
+                    e == SL_ERR_ARG ? "bad interface name" : strerror(d->log.last_errno));
+            return -1;
+        }
+        d->log_on = true;
+        d->sinks[d->n_sinks++] = sld_candump_sink(&d->log);
+    }
+    if (d->o.gs_usb) {
+        sl_gsusb_sink_cfg_t cfg = sl_gsusb_sink_default_cfg();
+        cfg.selector = d->o.gs_usb_sel[0] != '\0' ? d->o.gs_usb_sel : NULL;
+        cfg.can.bitrate = d->o.bitrate != 0 ? d->o.bitrate : d->board->can_bitrate;
+        const sl_err_t e = sl_gsusb_sink_open(&d->gs, &cfg, now);
+        if (e == SL_ERR_ARG) {
+            sld_log(SLD_LOG_ERR, "--gs-usb %s: %s", d->o.gs_usb_sel, sl_gsusb_sink_last_error(&d->gs));
+            return -1;
+        }
+        if (e != SL_OK) {
+            sld_log(SLD_LOG_WARN, "--gs-usb %s: %s (frames are dropped; retrying every second)",
+                    d->o.gs_usb_sel[0] != '\0' ? d->o.gs_usb_sel : "(any)", sl_gsusb_sink_last_error(&d->gs));
+        } else {
+            sld_log(SLD_LOG_INFO, "gs_usb adapter up at %" PRIu32 " bit/s", cfg.can.bitrate);
+        }
+        d->gs_on = true;
+        d->sinks[d->n_sinks++] = sl_gsusb_sink_as_sink(&d->gs);
+    }
+    if (d->n_sinks == 0) {
+        sld_log(SLD_LOG_WARN, "no CAN output (--can, --can-log, --gs-usb): frames are only counted");
+    }
+    return 0;
+}
+
+static int drop_privileges(const char *user)
+{
+    errno = 0;
+    const struct passwd *pw = getpwnam(user);
+    if (pw == NULL) {
+        sld_log(SLD_LOG_ERR, "--user %s: no such user%s%s", user, errno != 0 ? ": " : "",
+                errno != 0 ? strerror(errno) : "");
+        return -1;
+    }
+    if (geteuid() != 0) {
+        if (pw->pw_uid == geteuid()) {
+            return 0; // already that user
+        }
+        sld_log(SLD_LOG_ERR, "--user %s: only root can change user (running as uid %u)", user,
+                (unsigned)geteuid());
+        return -1;
+    }
+    if (initgroups(pw->pw_name, pw->pw_gid) != 0 || setgid(pw->pw_gid) != 0 || setuid(pw->pw_uid) != 0) {
+        sld_log(SLD_LOG_ERR, "--user %s: cannot drop privileges: %s", user, strerror(errno));
+        return -1;
+    }
+    if (pw->pw_uid != 0 && (setuid(0) == 0 || seteuid(0) == 0)) {
+        sld_log(SLD_LOG_ERR, "--user %s: root privileges could be regained", user);
+        return -1;
+    }
+    sld_log(SLD_LOG_INFO, "running as %s (uid %u, gid %u)", user, (unsigned)pw->pw_uid, (unsigned)pw->pw_gid);
+    return 0;
+}
+
+static void log_stats(daemon_t *d, int level, const char *what)
+{
+    const sl_pipeline_stats_t *s = &g_pipe.stats;
+    sld_log(level,
+            "%s: %" PRIu32 " rotations, %" PRIu32 " azimuths (%" PRIu32 " missing), %" PRIu32
+            " targets, level %u, decoder: %" PRIu32 " messages %" PRIu32 " resyncs; CAN: %" PRIu32
+            " frames (%" PRIu32 " Status, %" PRIu32 " idle Status), %" PRIu32 " dropped; motion: %" PRIu32
+            " accepted %" PRIu32 " rejected",
+            what, s->rotations, s->azimuths, s->azimuths_missing, s->targets,
+            (unsigned)sl_track_max_level(&g_pipe.tracker), g_pipe.proto.stats.messages,
+            g_pipe.proto.stats.resyncs, d->frames_out, d->status_frames, d->idle_status_frames,
+            s->can_dropped, s->motion_accepted, s->motion_rejected);
+    for (size_t i = 0; i < d->n_sinks; i++) {
+        sl_can_sink_stats_t st = {0, 0, 0, 0};
+        d->sinks[i].get_stats(d->sinks[i].ctx, &st);
+        sld_log(level, "%s: sink %s: %" PRIu32 " sent, %" PRIu32 " dropped, %" PRIu32 " queued, %" PRIu32 " errors",
+                what, d->sinks[i].name, st.sent, st.dropped, st.queued, st.errors);
+    }
+    if (d->sc_on) {
+        const sl_can_socketcan_stats_t *c = &d->sc.stats;
+        sld_log(level + (c->retries + c->bus_off + c->link_down == 0 ? 1 : 0),
+                "%s: socketcan %s: %" PRIu32 " retries (%" PRIu32 " ENOBUFS), bus-off %" PRIu32
+                ", link down %" PRIu32 ", dropped full/stale/down/bus-off/error %" PRIu32 "/%" PRIu32
+                "/%" PRIu32 "/%" PRIu32 "/%" PRIu32,
+                what, d->sc.ifname, c->retries, c->enobufs, c->bus_off, c->link_down, c->dropped_full,
+                c->dropped_stale, c->dropped_down, c->dropped_bus_off, c->dropped_error);
+    }
+    if (d->is_radar) {
+        const sl_radar_client_stats_t *r = &d->radar.stats;
+        sld_log(level,
+                "%s: radar %s: %" PRIu32 " connects (%" PRIu32 " reconnects), %" PRIu32 " failures, %" PRIu32
+                " silence timeouts, %" PRIu32 " FFT messages, %" PRIu64 " bytes",
+                what, sl_radar_state_str(d->radar.state), r->connects, r->reconnects,
+                r->connect_failures + r->connect_timeouts, r->silence_timeouts, r->fft_messages, r->bytes_rx);
+    }
+}
+
+static int setup_signals(daemon_t *d)
+{
+    sigset_t set;
+    sigemptyset(&set);
+    sigaddset(&set, SIGINT);
+    sigaddset(&set, SIGTERM);
+    sigaddset(&set, SIGHUP);
+    if (sigprocmask(SIG_BLOCK, &set, NULL) != 0) {
+        return -1;
+    }
+    d->sfd = signalfd(-1, &set, SFD_NONBLOCK | SFD_CLOEXEC);
+    signal(SIGPIPE, SIG_IGN); // a closed stdout is an EPIPE write error, counted
+    return d->sfd < 0 ? -1 : 0;
+}
+
+static void read_signals(daemon_t *d)
+{
+    struct signalfd_siginfo si;
+    while (read(d->sfd, &si, sizeof si) == (ssize_t)sizeof si) {
+        if (si.ssi_signo == SIGHUP) {
+            sld_log(SLD_LOG_INFO, "SIGHUP ignored (no reload; restart to apply a new config)");
+            continue;
+        }
+        if (!d->stop) {
+            d->stop = true;
+            d->stop_why = si.ssi_signo == SIGINT ? "SIGINT" : "SIGTERM";
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------------------
+
+static void shutdown_all(daemon_t *d)
+{
+    d->mono_us = sl_port_now_us();
+    if (d->is_radar) {
+        sl_radar_client_stop(&d->radar, 200); // Stop FFT when streaming; STOPPED -> finish
+        radar_finish(d, d->mono_us);
+    } else if (!d->cap_done) {
+        sl_pipeline_finish(&g_pipe, pipe_now(d)); // interrupted: flush the partial rotation
+    }
+    // Drain what the sinks still hold (SocketCAN retry queue, gs_usb echo window).
+    const uint64_t until = d->mono_us + DRAIN_MS * 1000U;
+    for (;;) {
+        d->mono_us = sl_port_now_us();
+        sl_can_sinks_poll(d->sinks, d->n_sinks, d->mono_us);
+        uint32_t queued = 0;
+        for (size_t i = 0; i < d->n_sinks; i++) {
+            sl_can_sink_stats_t st = {0, 0, 0, 0};
+            d->sinks[i].get_stats(d->sinks[i].ctx, &st);
+            queued += st.queued;
+        }
+        if (queued == 0 || d->mono_us >= until) {
+            if (queued != 0) {
+                sld_log(SLD_LOG_WARN, "exit: %" PRIu32 " frames still queued after %u ms, dropped", queued, DRAIN_MS);
+            }
+            break;
+        }
+        struct timespec ts = {0, 2000000};
+        nanosleep(&ts, NULL);
+    }
+    log_stats(d, SLD_LOG_INFO, "exit");
+    if (d->is_radar) {
+        sl_radar_client_deinit(&d->radar);
+    }
+    if (d->sc_on) {
+        sl_can_socketcan_close(&d->sc);
+    }
+    if (d->log_on) {
+        sld_candump_close(&d->log);
+    }
+    if (d->gs_on) {
+        sl_gsusb_sink_close(&d->gs);
+    }
+    if (d->motion_on) {
+        sld_motion_close(&d->motion);
+    }
+    if (d->targets != NULL) {
+        if ((fflush(d->targets) != 0 || (d->targets_own && fclose(d->targets) != 0)) && !d->targets_failed) {
+            sld_log(SLD_LOG_ERR, "--targets-out: write failed: %s", strerror(errno));
+        }
+        d->targets = NULL;
+    }
+}
+
+int main(int argc, char **argv)
+{
+    daemon_t *d = &g_d;
+    sld_opts_defaults(&d->o);
+    char err[1024];
+    const int pr = sld_opts_parse(&d->o, argc, argv, err, sizeof err);
+    if (pr > 0) {
+        return 0;
+    }
+    if (pr < 0 || sld_opts_validate(&d->o, err, sizeof err) != 0) {
+        fprintf(stderr, "shadowleand: %s\n", err);
+        return 2;
+    }
+    sld_log_setup(d->o.verbosity, d->o.use_syslog);
+    d->board = sl_board_find(d->o.board);
+    d->is_radar = d->o.radar_host[0] != '\0';
+    d->log_time = d->o.log_time != SLD_LOG_TIME_AUTO ? d->o.log_time
+                  : d->is_radar                     ? SLD_LOG_TIME_WALL
+                                                    : SLD_LOG_TIME_DATA;
+    d->idle_status = d->is_radar || d->o.realtime;
+    d->sfd = -1;
+    d->mono_us = sl_port_now_us();
+    d->start_mono = d->mono_us;
+    sl_can_ids_t ids;
+    sl_can_ids_from_board(&ids, d->board);
+    d->status_id = ids.id[SL_CAN_MSG_STATUS] & SL_CAN_EFF_MASK;
+    d->status_eff = (uint8_t)((ids.id[SL_CAN_MSG_STATUS] & SL_CAN_DBC_EFF_BIT) != 0 ? SL_CAN_FLAG_EFF : 0U);
+
+    if (setup_signals(d) != 0) {
+        sld_log(SLD_LOG_ERR, "signals: %s", strerror(errno));
+        return 1;
+    }
+    // Pipeline.
+    sl_pipeline_cfg_default(&d->pcfg, d->board);
+    d->pcfg.port.can_tx = port_can_tx;
+    d->pcfg.port.on_rotation = port_on_rotation;
+    d->pcfg.port.ctx = d;
+    if (sl_pipeline_init(&g_pipe, d->board, &d->pcfg) != SL_OK) {
+        sld_log(SLD_LOG_ERR, "pipeline for board %s: %s", d->board->name,
+                g_pipe.last_err_msg != NULL ? g_pipe.last_err_msg : "init failed");
+        return 1;
+    }
+    // Input, outputs, motion: everything that may need privileges is opened here.
+    if ((d->is_radar ? radar_setup(d) : capture_setup(d)) != 0 || open_sinks(d) != 0) {
+        shutdown_all(d);
+        return 1;
+    }
+    if (d->o.targets_out[0] != '\0') {
+        const bool out = strcmp(d->o.targets_out, "-") == 0;
+        d->targets = out ? stdout : fopen(d->o.targets_out, "w");
+        d->targets_own = !out;
+        if (d->targets == NULL || sld_targets_write_header(d->targets, d->board, &d->pcfg) != 0) {
+            sld_log(SLD_LOG_ERR, "--targets-out %s: %s", d->o.targets_out, strerror(errno));
+            shutdown_all(d);
+            return 1;
+        }
+    }
+    const char *miface = sld_opts_motion_iface(&d->o);
+    if (miface[0] != '\0') {
+        d->motion_on = true;
+        if (sld_motion_open(&d->motion, miface, d->board->can_id_vehicle_motion, d->mono_us) != SL_OK) {
+            sld_log(SLD_LOG_WARN, "--motion-can %s: %s (retrying every second)", miface,
+                    strerror(d->motion.last_errno));
+        }
+    }
+    if (d->o.user[0] != '\0' && drop_privileges(d->o.user) != 0) {
+        shutdown_all(d);
+        return 1;
+    }
+    sld_log(SLD_LOG_INFO, "board %s, input %s%s%s, %zu CAN output(s)%s%s", d->board->name,
+            d->is_radar ? "radar " : "capture ", d->is_radar ? d->o.radar_host : d->o.capture,
+            d->is_radar ? "" : (d->o.realtime ? " (real time)" : " (as fast as possible)"), d->n_sinks,
+            d->motion_on ? ", VehicleMotion from " : "", d->motion_on ? miface : "");
+
+    if (d->is_radar) {
+        sl_radar_client_start(&d->radar);
+    }
+    d->link_state = d->is_radar ? SL_CAN_LINK_CONNECTING : SL_CAN_LINK_STREAMING;
+    sl_pipeline_set_link_state(&g_pipe, d->link_state);
+    d->last_status_mono = d->mono_us - (uint64_t)d->o.status_period_ms * 1000U; // first one now
+    d->next_stats_mono = d->o.stats_every_ms != 0 ? d->mono_us + (uint64_t)d->o.stats_every_ms * 1000U : UINT64_MAX;
+    const uint64_t end_mono = d->o.duration_ms != 0 ? d->mono_us + (uint64_t)d->o.duration_ms * 1000U : UINT64_MAX;
+
+    struct pollfd fds[4 + 8];
+    while (!d->stop) {
+        // --- wait
+        d->mono_us = sl_port_now_us();
+        uint64_t wake = end_mono;
+        if (d->idle_status) {
+            const uint64_t due = d->last_status_mono + (uint64_t)d->o.status_period_ms * 1000U;
+            wake = due < wake ? due : wake;
+        }
+        wake = d->next_stats_mono < wake ? d->next_stats_mono : wake;
+        uint64_t cap_due = 0;
+        nfds_t n = 0;
+        fds[n++] = (struct pollfd){d->sfd, POLLIN, 0};
+        const nfds_t i_motion = n;
+        if (d->motion_on) {
+            fds[n++] = (struct pollfd){sld_motion_fd(&d->motion), POLLIN, 0}; // fd -1 is ignored
+            if (sld_motion_fd(&d->motion) < 0) {
+                const uint64_t due = d->motion.next_open_us;
+                wake = due < wake ? due : wake;
+            }
+        }
+        const nfds_t i_radar = n;
+        if (d->is_radar) {
+            fds[n++] = (struct pollfd){sl_radar_client_fd(&d->radar), sl_radar_client_events(&d->radar), 0};
+            const int t = sl_radar_client_timeout_ms(&d->radar, d->mono_us);
+            if (t >= 0) {
+                const uint64_t due = d->mono_us + (uint64_t)t * 1000U;
+                wake = due < wake ? due : wake;
+            }
+            if (d->o.exit_idle_ms != 0 && d->had_fft) {
+                const uint64_t due = d->last_fft_mono + (uint64_t)d->o.exit_idle_ms * 1000U;
+                wake = due < wake ? due : wake;
+            }
+            // Recompute SILENT on time.
+            if (d->radar.state == SL_RADAR_STREAMING) {
+                uint64_t ref = d->stream_start_mono > d->last_fft_mono ? d->stream_start_mono : d->last_fft_mono;
+                const uint64_t due = ref + (uint64_t)d->o.silent_ms * 1000U;
+                if (due > d->mono_us && due < wake) {
+                    wake = due;
+                }
+            }
+        } else if (!d->cap_done) {
+            cap_due = capture_step(d);
+            if (cap_due == 0) {
+                wake = d->mono_us; // more to feed now: just look at the fds
+            } else {
+                wake = cap_due < wake ? cap_due : wake;
+            }
+        }
+        if (d->gs_on && sl_gsusb_sink_is_up(&d->gs)) {
+            n += (nfds_t)sl_gsusb_usb_pollfds(&d->gs.usb, &fds[n], 8);
+            const uint64_t due = d->mono_us + 50000U; // echo timeouts, reopen
+            wake = due < wake ? due : wake;
+        } else if (d->gs_on || d->sc_on) {
+            const uint64_t due = d->mono_us + 200000U; // retries, reopen
+            wake = due < wake ? due : wake;
+        }
+        int timeout_ms = -1;
+        if (wake != UINT64_MAX) {
+            timeout_ms = wake <= d->mono_us ? 0 : (int)((wake - d->mono_us + 999U) / 1000U);
+        }
+        if (d->cap_done && !d->is_radar) {
+            break; // capture fed completely (finish already called)
+        }
+        const int rc = poll(fds, n, timeout_ms);
+        if (rc < 0 && errno != EINTR) {
+            sld_log(SLD_LOG_ERR, "poll: %s", strerror(errno));
+            break;
+        }
+        d->mono_us = sl_port_now_us();
+        // --- work
+        if (rc > 0 && (fds[0].revents & POLLIN) != 0) {
+            read_signals(d);
+        }
+        if (d->motion_on) {
+            sld_motion_read(&d->motion, d->mono_us, on_motion_frame, d);
+            (void)i_motion;
+        }
+        if (d->is_radar) {
+            const short rev = rc > 0 ? fds[i_radar].revents : 0;
+            sl_radar_client_handle(&d->radar, rev, d->mono_us);
+            if (d->radar.state != d->last_radar_state) {
+                sld_log(SLD_LOG_DEBUG, "radar state %s", sl_radar_state_str(d->radar.state));
+                d->last_radar_state = d->radar.state;
+            }
+            const uint8_t ls = radar_link_state(d);
+            if (ls != d->link_state) {
+                if (ls == SL_CAN_LINK_SILENT || d->link_state == SL_CAN_LINK_SILENT) {
+                    sld_log(SLD_LOG_WARN, "radar link %s", ls == SL_CAN_LINK_SILENT ? "SILENT (no FFT data)" : "streaming again");
+                }
+                d->link_state = ls;
+                sl_pipeline_set_link_state(&g_pipe, ls);
+            }
+            if (d->o.exit_idle_ms != 0 && d->had_fft &&
+                d->mono_us >= d->last_fft_mono + (uint64_t)d->o.exit_idle_ms * 1000U) {
+                d->stop = true;
+                d->stop_why = "--exit-idle";
+            }
+        }
+        sl_can_sinks_poll(d->sinks, d->n_sinks, d->mono_us);
+        if (d->idle_status && d->mono_us >= d->last_status_mono + (uint64_t)d->o.status_period_ms * 1000U) {
+            send_idle_status(d);
+        }
+        if (d->mono_us >= d->next_stats_mono) {
+            log_stats(d, SLD_LOG_INFO, "stats");
+            d->next_stats_mono = d->mono_us + (uint64_t)d->o.stats_every_ms * 1000U;
+        }
+        if (d->targets != NULL && d->targets_own) {
+            fflush(d->targets);
+        }
+        if (d->mono_us >= end_mono && !d->stop) {
+            d->stop = true;
+            d->stop_why = "--duration";
+        }
+    }
+    if (d->stop) {
+        sld_log(SLD_LOG_INFO, "stopping (%s)", d->stop_why != NULL ? d->stop_why : "?");
+    } else if (!d->is_radar) {
+        sld_log(SLD_LOG_INFO, "end of capture");
+    }
+    shutdown_all(d);
+    sld_capture_free(&d->cap);
+    free(d->ix);
+    free(d->radar_reasm);
+    sld_log_close();
+    return 0;
+}

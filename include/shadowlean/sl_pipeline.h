@@ -1,0 +1,306 @@
+/// @file sl_pipeline.h
+/// @brief The detection pipeline: radar bytes in, targets, tracks and CAN frames out.
+///
+/// One `sl_pipeline_t` owns one of each core stage, all inside the struct (no allocation,
+/// nothing borrowed except the board and the port's context):
+///
+///     bytes -> sl_proto (decoder, reassembly buffer inside, long payloads truncated to
+///              the bytes the pipeline reads) -> sl_scan (frame-less: one row view per
+///              azimuth) -> sl_thresh (first `mask_bins` bins only) -> sl_mask (n-frame
+///              consistency, window shortened with vehicle speed) -> sl_detect (runs in
+///              the shadow, corrections, alpha) -> sl_track -> CAN (sl_can_tx_t)
+///
+/// so `sizeof(sl_pipeline_t)` is the whole RAM of the module (see the budget below).
+///
+/// ## Inputs (all push-driven; time is passed in, the core never reads a clock)
+/// - `sl_pipeline_feed()`: any chunking of the radar's TCP stream (or a capture file).
+/// - `sl_pipeline_on_can_rx()`: frames from the vehicle bus; VehicleMotion (board id) is
+///   E2E-checked and used, other ids are counted and ignored.
+/// - `sl_pipeline_set_motion()`: the same motion input without CAN (direct setter).
+/// - `sl_pipeline_set_link_state()`: the TCP link state (the port knows it, the core does
+///   not) reported in the Status frame.
+/// - `sl_pipeline_finish()`: end of stream (EOF, peer closed, before a reconnect).
+///
+/// ## Outputs (house style s.6: a const vtable + context, copied at init)
+/// For every completed rotation, in this order, from inside the feed/finish call that
+/// completed it:
+/// 1. `port.on_rotation(ctx, r)` (optional): this rotation's targets (raw and corrected
+///    r1/r2, alpha, sigma, flags, representative azimuth: `sl_target_t`) and the tracker's
+///    tracks (filtered alpha, sigma, warning level: `sl_track_t`, live slots only matter).
+/// 2. `port.can_tx(ctx, f)` (optional) for: one PoleLean per *confirmed* track (live,
+///    matched this rotation, `hits >= cfg.confirm_hits`), in slot order; one LeanWarning
+///    (the most severe confirmed track: highest level, then largest |filtered alpha|;
+///    HasTarget = 0 when there is none); one Status (link state, rotations, missing
+///    azimuths, decoder resyncs, CAN drops). `can_tx` must not block: SL_ERR_BUSY (or any
+///    other error) counts the frame as dropped (`stats.can_dropped`, reported in the next
+///    Status frame) and the pipeline moves on.
+/// Callbacks must not call back into the same pipeline (not reentrant).
+///
+/// ## Mapping to CAN (sl_can.h)
+/// Azimuth = az x 36000 / azimuths + board->radar_yaw_cdeg (vehicle frame, clockwise).
+/// TargetId = track id mod 16. Quality = FILTERED when the track has a valid alpha
+/// (Lean/LeanSigma = the filtered values), else the mapping of the last target's incline
+/// flag (AMBIGUOUS, OUT_OF_MODEL, INVALID). Ranges: the track's last corrected r1 / r2.
+///
+/// ## Motion (the paper assumed a static vehicle; see `sl_pipeline_window()`)
+/// The consistency mask needs the same (azimuth, bin) cell occupied in the last n rotations.
+/// A static point seen from a vehicle moving at speed v with yaw rate w moves, per
+/// rotation of period T, by at most v T + r_max |w| T (r_max = the farthest shadow edge),
+/// radially and tangentially. It stays in its cell over n_eff rotations only if
+/// (n_eff - 1) x that <= D (the cell size budget, `cfg.motion_budget_um`, default one range
+/// bin, which is also about one azimuth step x 2.8 m), so
+///
+///     n_eff = clamp(floor(D / (v T + r_max |w| T)) + 1, cfg.min_frames, n)
+///
+/// computed once per rotation in 64-bit integers, with T the measured rotation period
+/// (radar timestamps; default 250 ms). The mask keeps counting with the full n; only the
+/// stable test changes (k <= n - n_eff instead of k == 0: sl_mask_set_window()), so no
+/// history is lost when the vehicle stops again. Without a (fresh) motion input the board's
+/// n is used. Limits: above D / T (0.175 m/s for 4.38 cm bins at 4 Hz) n_eff is 1, i.e.
+/// single-frame thresholding; rejecting transient returns is then up to the tracker (a
+/// PoleLean is only sent for a track seen `confirm_hits` times), whose gates are widened by
+/// the ego displacement per rotation (v T radially, v T / r + |w| T in azimuth).
+///
+/// ## RAM budget (sizeof(sl_pipeline_t)); asserted below for the firmware configuration
+/// Dominated by the mask: SL_CFG_MAX_AZIMUTHS x (1 + ceil(log2 SL_CFG_MASK_FRAMES_MAX)) x
+/// SL_CFG_MASK_BINS / 8 bytes; then detection (~8.4 KB), the tracker (~1.9 KB), the
+/// reassembly buffer (SL_PIPELINE_REASM_BYTES) and a row buffer. Measured sizes are in the
+/// project report (host default vs. firmware configuration).
+///
+/// ## Cost
+/// Per FFT message: header check + ROI threshold of `mask_bins` bins + one mask row update
+/// + one detection row (O(mask words x planes)); per rotation: detection end (one
+/// sl_incline_estimate per target), tracker update, CAN encoding. Measured by
+/// host_tools/bench (sl-bench). Stack: < 1 KB plus the port callbacks'. Task context only.
+#ifndef SHADOWLEAN_SL_PIPELINE_H
+#define SHADOWLEAN_SL_PIPELINE_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "shadowlean/sl_board.h"
+#include "shadowlean/sl_can.h"
+#include "shadowlean/sl_config.h"
+#include "shadowlean/sl_detect.h"
+#include "shadowlean/sl_err.h"
+#include "shadowlean/sl_mask.h"
+#include "shadowlean/sl_proto.h"
+#include "shadowlean/sl_scan.h"
+#include "shadowlean/sl_thresh.h"
+#include "shadowlean/sl_track.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/// Reassembly buffer of the decoder: the largest payload prefix the pipeline reads (an FFT
+/// message's fixed part plus the masked bins as 16-bit values; at least 256 bytes so that a
+/// Configuration's protobuf fits). Longer payloads (a whole 3768-bin FFT message) are
+/// truncated to this and the rest is consumed uncopied (sl_proto `truncate_long`), never
+/// rejected.
+#ifndef SL_PIPELINE_REASM_BYTES
+#define SL_PIPELINE_REASM_BYTES                                                              \
+    ((SL_PROTO_FFT_FIXED_BYTES + 2U * SL_CFG_MASK_BINS) > 256U                               \
+         ? (SL_PROTO_FFT_FIXED_BYTES + 2U * SL_CFG_MASK_BINS)                                \
+         : 256U)
+#endif
+
+/// Why init failed (in addition to the return code). ROM strings in `last_err_msg`.
+typedef enum sl_pipeline_reason {
+    SL_PIPELINE_OK = 0,
+    SL_PIPELINE_BAD_ARG = 1,          ///< NULL pointer or cfg value out of range
+    SL_PIPELINE_BOARD_AZIMUTHS = 2,   ///< board azimuths > SL_CFG_MAX_AZIMUTHS
+    SL_PIPELINE_BOARD_ROI = 3,        ///< board roi_bins > SL_CFG_ROI_BINS
+    SL_PIPELINE_MASK_BINS = 4,        ///< detection needs more bins than SL_CFG_MASK_BINS
+    SL_PIPELINE_MASK_FRAMES = 5,      ///< n > SL_CFG_MASK_FRAMES_MAX
+    SL_PIPELINE_STAGE_INIT = 6,       ///< a stage's init rejected the board (see err)
+} sl_pipeline_reason_t;
+
+/// Output port: a const vtable + context (copied at init). Both callbacks are optional.
+typedef struct sl_pipeline_rotation sl_pipeline_rotation_t;
+typedef struct sl_port {
+    /// Send one CAN frame (borrowed for the call). Must not block: return SL_ERR_BUSY when
+    /// the bus/queue cannot take it (counted as a drop); SL_OK when queued/sent.
+    sl_err_t (*can_tx)(void *ctx, const sl_can_frame_t *f);
+    /// One completed rotation (borrowed for the call; every pointer in it is valid only
+    /// until the callback returns).
+    void (*on_rotation)(void *ctx, const sl_pipeline_rotation_t *r);
+    void *ctx;
+} sl_port_t;
+
+/// Pipeline configuration. Get defaults from sl_pipeline_cfg_default(), change fields,
+/// pass to sl_pipeline_init() (copied).
+typedef struct sl_pipeline_cfg {
+    sl_port_t port;              ///< outputs
+    sl_detect_cfg_t detect;      ///< detection parameters (beam width, gaps, ...): set
+                                 ///< beam_width_cdeg to the simulator's cone when evaluating
+    sl_track_cfg_t track;        ///< tracker parameters
+    uint16_t threshold;          ///< occupied = power >= this (8-bit scale); default board's
+    uint8_t mask_frames;         ///< n, 1..SL_CFG_MASK_FRAMES_MAX; default board's
+    uint8_t max_missed;          ///< mask: rotations an azimuth is held through (default 2)
+    uint8_t pow16_shift;         ///< 16-bit power -> 8-bit: v >> shift (default 8)
+    bool ignore_sweep;           ///< scan: do not use sweep counters (captures without them)
+    uint8_t confirm_hits;        ///< track hits before PoleLean frames are sent (default 3)
+    // --- motion (see "Motion" above)
+    bool motion_adapt;           ///< shorten the window with speed (default true)
+    uint8_t min_frames;          ///< floor of n_eff (default 1)
+    uint32_t motion_budget_um;   ///< D: displacement allowed over the window (default: bin)
+    uint32_t motion_timeout_us;  ///< motion older than this is ignored (default 500 ms)
+    uint32_t rotation_us;        ///< rotation period when timestamps are unusable (250000)
+} sl_pipeline_cfg_t;
+
+/// Defaults for `board` (threshold, n from the board; detection and tracker defaults;
+/// everything else as documented per field). `board` NULL: board-independent defaults
+/// (threshold 40, n 16). O(1).
+void sl_pipeline_cfg_default(sl_pipeline_cfg_t *cfg, const sl_board_t *board);
+
+/// One completed rotation, handed to `port.on_rotation`. All pointers are borrowed for
+/// the duration of the callback.
+struct sl_pipeline_rotation {
+    uint32_t rotation;           ///< sequence number since init (0, 1, ...)
+    uint64_t now_us;             ///< `now_us` of the call that completed it
+    uint64_t t_first_us;         ///< radar timestamps (UNIX us) of the earliest / latest
+    uint64_t t_last_us;          ///< azimuth in the rotation (0 when unknown)
+    uint16_t azimuths;           ///< azimuths per rotation (radar geometry)
+    uint16_t valid;              ///< azimuths received this rotation
+    uint16_t missing;            ///< azimuths missing this rotation
+    uint8_t end;                 ///< sl_scan_end_t: why the rotation ended
+    uint8_t frames_eff;          ///< consistency window used for this rotation (n_eff)
+    bool motion_valid;           ///< a fresh motion input was used
+    int32_t speed_mm_s;          ///< motion used (0 when !motion_valid)
+    int32_t yaw_rate_cdeg_s;
+    const sl_target_t *targets;  ///< this rotation's targets (sl_detect.h)
+    uint16_t n_targets;
+    const sl_track_t *tracks;    ///< tracker slots (sl_track.h); use those with `live`
+    uint16_t n_track_slots;      ///< SL_CFG_MAX_TARGETS
+    uint8_t level;               ///< sl_warn_level_t: highest level over live tracks
+};
+
+/// Counters (cumulative since init; never asserted). The stage stats are in the stages
+/// themselves (`p->proto.stats`, `p->scan.stats`, `p->mask.stats`, `p->detect.stats`, ...).
+typedef struct sl_pipeline_stats {
+    uint32_t rotations;          ///< rotations processed (on_rotation calls)
+    uint32_t azimuths;           ///< azimuth rows processed
+    uint32_t azimuths_missing;   ///< sum of missing azimuths over rotations
+    uint32_t targets;            ///< targets reported
+    uint32_t can_frames;         ///< frames accepted by can_tx
+    uint32_t can_dropped;        ///< frames can_tx refused (BUSY or error)
+    uint32_t can_rx;             ///< frames given to sl_pipeline_on_can_rx
+    uint32_t motion_accepted;    ///< VehicleMotion frames accepted (or set_motion calls)
+    uint32_t motion_rejected;    ///< VehicleMotion frames failing E2E / dlc
+    uint32_t geometry_rejected;  ///< radar geometry not matching the board (rows dropped)
+    uint32_t restarts;           ///< radar restarts seen (geometry change, finish)
+} sl_pipeline_stats_t;
+
+/// The pipeline. Caller-allocated (static); fields read-only to the application. Stage
+/// members are public for inspection (stats, mask, last targets) but must not be changed.
+typedef struct sl_pipeline {
+    const sl_board_t *board;     ///< borrowed until re-init
+    sl_pipeline_cfg_t cfg;
+    uint8_t reason;              ///< sl_pipeline_reason_t of the last failed init
+    const char *last_err_msg;    ///< ROM string for the first error, or NULL
+    sl_err_t last_err;           ///< first error code seen (SL_OK when none)
+    uint16_t mask_bins;          ///< bins thresholded and masked (sl_detect_bins_needed)
+    uint16_t mask_words;         ///< SL_BITS_WORDS(mask_bins)
+    uint8_t link_state;          ///< sl_can_link_state_t for Status
+    uint8_t frames_eff;          ///< current n_eff
+    uint8_t in_rotation;         ///< internal: a rotation is being assembled
+    bool ready;                  ///< init succeeded
+    uint16_t next_az;            ///< internal: next azimuth detection expects
+    uint32_t r_max_um;           ///< farthest range detection reads (for the yaw term)
+    uint32_t rotation_us;        ///< last measured rotation period
+    bool motion_valid;           ///< motion used for the current rotation
+    int32_t speed_mm_s;          ///< ... its speed (0 when invalid)
+    int32_t yaw_cdeg_s;          ///< ... its yaw rate (0 when invalid)
+    uint64_t last_t_last_us;     ///< previous rotation's t_last_us (0 = none)
+    uint64_t now_us;             ///< now_us of the current call
+    // motion input
+    sl_can_motion_rx_t motion_rx; ///< CAN VehicleMotion receiver (E2E)
+    sl_can_vehicle_motion_t motion; ///< last motion from the setter
+    uint64_t motion_t_us;        ///< time of the setter's value
+    bool motion_set;             ///< the setter was used
+    // stages
+    sl_proto_t proto;
+    sl_scan_t scan;
+    sl_mask_t mask;
+    sl_detect_t detect;
+    sl_tracker_t tracker;
+    sl_can_tx_t can;
+    sl_pipeline_stats_t stats;
+    uint32_t bits[SL_MASK_WORDS]; ///< thresholded row (internal)
+    uint32_t occ[SL_MASK_WORDS];  ///< stable-occupied row (internal)
+    uint8_t row8[SL_CFG_MASK_BINS]; ///< scan's row buffer (16-bit reduction, short rows)
+    uint8_t reasm[SL_PIPELINE_REASM_BYTES]; ///< decoder reassembly buffer
+} sl_pipeline_t;
+
+/// RAM budget of the firmware configuration (CTS350-X: 400 azimuths, n <= 16, masked bins
+/// <= 192, the default target/candidate capacities): the whole pipeline in 64 KiB.
+#if SL_CFG_MAX_AZIMUTHS <= 400 && SL_CFG_MASK_FRAMES_MAX <= 16 && SL_CFG_MASK_BINS <= 192 &&   \
+    SL_CFG_MAX_TARGETS <= 32 && SL_CFG_DETECT_MAX_CANDIDATES <= 32 &&                          \
+    SL_CFG_DETECT_MAX_SPAN <= 24
+#if defined(__cplusplus)
+static_assert(sizeof(sl_pipeline_t) <= 65536U, "sl_pipeline_t: 64 KiB RAM budget");
+#else
+_Static_assert(sizeof(sl_pipeline_t) <= 65536U, "sl_pipeline_t: 64 KiB RAM budget");
+#endif
+#endif
+/// Any azimuth count, bins and n with the default target/candidate capacities: the mask
+/// dominates; everything else stays under 16 KiB.
+#if SL_CFG_MAX_TARGETS <= 32 && SL_CFG_DETECT_MAX_CANDIDATES <= 32 && SL_CFG_DETECT_MAX_SPAN <= 24 \
+    && SL_CFG_MAX_AZIMUTHS <= 400
+#if defined(__cplusplus)
+static_assert(sizeof(sl_pipeline_t) <= sizeof(sl_mask_t) + 16384U, "sl_pipeline_t budget");
+#else
+_Static_assert(sizeof(sl_pipeline_t) <= sizeof(sl_mask_t) + 16384U, "sl_pipeline_t budget");
+#endif
+#endif
+
+/// Initialise (or completely reset) for `board` (borrowed, usually static const) with
+/// `cfg` (copied; NULL = sl_pipeline_cfg_default(board)).
+/// @return SL_OK; SL_ERR_ARG (NULL, cfg out of range); SL_ERR_RANGE when the board does
+/// not fit the compile-time capacities, in particular when detection needs more bins than
+/// SL_CFG_MASK_BINS (the reason is in `p->reason` / `p->last_err_msg`, e.g. "detection
+/// needs more bins than SL_CFG_MASK_BINS"). The pipeline is unusable after an error.
+/// Cost: O(sizeof(sl_pipeline_t)) clearing + O(azimuths) detection tables.
+sl_err_t sl_pipeline_init(sl_pipeline_t *p, const sl_board_t *board,
+                          const sl_pipeline_cfg_t *cfg);
+
+/// Feed `len` bytes of the radar stream (any chunking). Rotations completed by these bytes
+/// are processed and reported (port callbacks) before it returns.
+/// @return SL_OK, or SL_ERR_ARG (NULL p, NULL data with len > 0). Stream errors are
+/// counted in the stage stats, never returned.
+sl_err_t sl_pipeline_feed(sl_pipeline_t *p, const uint8_t *data, size_t len, uint64_t now_us);
+
+/// End of stream (EOF, connection lost, before reconnecting): drops a partial message,
+/// completes and reports the partial rotation if any. The next byte fed starts a new
+/// stream; mask history is kept (a radar restart is handled like a gap). O(azimuths).
+sl_err_t sl_pipeline_finish(sl_pipeline_t *p, uint64_t now_us);
+
+/// One frame from the vehicle bus. VehicleMotion (board id): E2E-checked, then used.
+/// @return SL_OK (accepted), SL_ERR_ARG (NULL or another id: ignored), or the E2E error
+/// (SL_ERR_MALFORMED / SL_ERR_STATE: rejected, counted). O(1).
+sl_err_t sl_pipeline_on_can_rx(sl_pipeline_t *p, const sl_can_frame_t *f, uint64_t now_us);
+
+/// Direct motion input (no CAN): speed in mm/s (> 0 forward), yaw rate in 0.01 deg/s
+/// (> 0 counter-clockwise from above), valid flags as in VehicleMotion. Overrides older
+/// CAN values; the newest input of either kind is used. O(1).
+void sl_pipeline_set_motion(sl_pipeline_t *p, int32_t speed_mm_s, bool speed_valid,
+                            int32_t yaw_rate_cdeg_s, bool yaw_rate_valid, uint64_t now_us);
+
+/// Link state for the Status frame (sl_can_link_state_t, set by the port). O(1).
+void sl_pipeline_set_link_state(sl_pipeline_t *p, uint8_t link_state);
+
+/// The consistency window n_eff for a motion (formula in the file comment): pure, for
+/// tests and tools. `speed_mm_s`/`yaw_rate_cdeg_s` signed (magnitudes are used);
+/// `rotation_us` the period; `budget_um` D; `r_max_um` the farthest range of interest.
+/// O(1), 64-bit integer arithmetic.
+uint8_t sl_pipeline_window(uint8_t n, uint8_t min_frames, int32_t speed_mm_s,
+                           int32_t yaw_rate_cdeg_s, uint32_t rotation_us, uint32_t budget_um,
+                           uint32_t r_max_um);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif // SHADOWLEAN_SL_PIPELINE_H
