@@ -1,52 +1,107 @@
 #!/bin/sh
-# demo.sh: the main job, from a fresh Debian machine (installs what is missing).
+# demo.sh: the whole chain on this machine, from a fresh Debian (installs what is missing):
 #
-# Today's demo (foundation): the table generator turns each board file into the C tables
-# the firmware links and a plot of its chassis shadow; then a pole passing the paper-sim
-# vehicle at -10 / 0 / +10 deg (and a few hard cases) goes through the fixed-point
-# estimator of the core (sl-alpha), next to the truth. Outputs land in out/demo/.
+#   sl-sim (a bundled scene) -> capture + truth
+#   sl-replay serve (a radar emulator on 127.0.0.1, real time, free port)
+#   shadowleand --radar 127.0.0.1:PORT --can-log out/demo/can.log (the daemon: TCP in, CAN out)
+#   python3-canmatrix decodes the candump log with the board's generated DBC -> warning table,
+#   decoded leans next to the simulator's truth, and a picture (sl-view) when it is built.
+#
+# Scene: scenes/demo_three_poles.ini when present, else tests/daemon/scenes/static_four_poles.ini
+# (or the scene given as the first argument). Outputs land in out/demo/. About 10 s plus the
+# build (host-release preset, only the targets needed).
 set -eu
 cd "$(dirname "$0")/.."
+ROOT=$(pwd)
 sh scripts/deps.sh build demo
 cmake --preset host-release >/dev/null
-cmake --build --preset host-release -j 2 --target sl-tables sl-alpha
+cmake --build --preset host-release -j 2 --target shadowleand sl-sim sl-replay
 BIN=build/host-release/host_tools
+VIEW=""
+if [ -f host_tools/view/CMakeLists.txt ] &&
+    cmake --build --preset host-release -j 2 --target sl-view >/dev/null 2>&1; then
+    VIEW=$BIN/view/sl-view
+fi
+PY=/usr/bin/python3
+[ -x "$PY" ] || PY=python3
 OUT=out/demo
+rm -rf "$OUT"
 mkdir -p "$OUT"
 
-echo
-echo "== 1. Board tables (boards/<name>/board.ini -> C tables + shadow plot)"
-for b in paper-sim paper-bench robotcar-leaf; do
-    "$BIN/tables/sl-tables" "$b" --out "$OUT/$b"
-done
+SCENE=${1:-}
+if [ -z "$SCENE" ]; then
+    SCENE=scenes/demo_three_poles.ini
+    [ -f "$SCENE" ] || SCENE=tests/daemon/scenes/static_four_poles.ini
+fi
+BOARD=$(sed -n 's/^[[:space:]]*board[[:space:]]*=[[:space:]]*\([A-Za-z0-9_-]*\).*/\1/p' "$SCENE" | head -1)
+DBC=boards/$BOARD/shadowlean.dbc
+[ -f "$DBC" ] || { echo "demo: board '$BOARD' of $SCENE has no boards/$BOARD/shadowlean.dbc"; exit 1; }
+
+REPLAY_PID=""
+cleanup() {
+    if [ -n "$REPLAY_PID" ]; then
+        kill "$REPLAY_PID" 2>/dev/null || true
+        wait "$REPLAY_PID" 2>/dev/null || true
+    fi
+}
+trap cleanup EXIT INT TERM
 
 echo
-echo "== 2. Inclination from the run [r1, r2] of a pole 2.5 m away (core fixed point)"
-# The forward model of MATH.md s.2 makes (r1, r2) from a true lean; sl-alpha inverts it.
-python3 - "$BIN/alpha/sl-alpha" <<'PY'
-import math, subprocess, sys
-def rho_of(alpha, theta, beta):
-    a, t, b = (math.radians(v) for v in (alpha, theta, beta))
-    if a >= b:
-        return math.cos(a - b) / math.cos(a + t)
-    if a >= (b - t) / 2:
-        return 1 / math.cos(a + t)
-    return 1 / math.cos(b - a)
-cases = [(-10, 26, 0), (0, 26, 0), (10, 26, 0), (10, 26, 3), (-5, 26, 3), (20, 20, 3)]
-lines, truth = [], []
-for a, t, b in cases:
-    r1 = 2.5
-    lines.append(f"{r1:.6f} {r1 * rho_of(a, t, b):.6f} {t} {b}")
-    truth.append(f"{a:+.3f}")
-# hard cases: a run too short for the model (ambiguous), an inverted run (invalid)
-lines += ["2.5 2.55 26 0", "2.5 2.4 26 0"]
-truth += ["(fold)", "(bad run)"]
-out = subprocess.run([sys.argv[1]], input="\n".join(lines) + "\n", capture_output=True,
-                     text=True, check=True).stdout.split("\n")
-print(f"{'r1 [m]':>8} {'r2 [m]':>9} {'theta':>6} {'beta':>5} {'truth [deg]':>12} {'sl-alpha':>10}")
-for line, t, o in zip(lines, truth, out):
-    r1, r2, th, be = line.split()
-    print(f"{float(r1):8.3f} {float(r2):9.4f} {th:>6} {be:>5} {t:>12} {o:>10}")
-PY
+echo "== 1. Simulate $SCENE (board $BOARD) with sl-sim"
+"$BIN/sim/sl-sim" "$SCENE" -o "$OUT/scene.colossus" --quiet
+ROTS=$(awk -F, 'NR > 1 { if ($1 > m) m = $1 } END { print m + 1 }' "$OUT/scene.gt.csv")
+echo "   $OUT/scene.colossus ($(wc -c < "$OUT/scene.colossus") bytes, $ROTS rotations) + truth $OUT/scene.gt.csv"
+
 echo
-echo "demo: tables and plots in $OUT/<board>/ (tables.png)"
+echo "== 2. Serve it as a radar on 127.0.0.1 (sl-replay serve, real time, any free port)"
+"$BIN/replay/sl-replay" serve "$OUT/scene.colossus" --port 0 > "$OUT/replay.out" 2> "$OUT/replay.err" &
+REPLAY_PID=$!
+PORT=""
+i=0
+while [ -z "$PORT" ]; do
+    PORT=$(sed -n 's/^sl-replay: listening on 127\.0\.0\.1:\([0-9][0-9]*\)$/\1/p' "$OUT/replay.out")
+    [ -n "$PORT" ] && break
+    i=$((i + 1))
+    if [ $i -gt 100 ] || ! kill -0 "$REPLAY_PID" 2>/dev/null; then
+        echo "demo: sl-replay did not start:"; cat "$OUT/replay.err"; exit 1
+    fi
+    sleep 0.1
+done
+echo "   listening on 127.0.0.1:$PORT"
+
+echo
+echo "== 3. shadowleand --board $BOARD --radar 127.0.0.1:$PORT --can-log $OUT/can.log"
+echo "   (stops 1.5 s after the last FFT message: --exit-idle 1.5)"
+"$BIN/daemon/shadowleand" --board "$BOARD" --radar "127.0.0.1:$PORT" --can-log "$OUT/can.log" \
+    --targets-out "$OUT/targets.jsonl" --exit-idle 1.5 --duration 300 --stats-every 2 2>&1 |
+    sed 's/^/   /'
+kill "$REPLAY_PID" 2>/dev/null || true
+wait "$REPLAY_PID" 2>/dev/null || true
+REPLAY_PID=""
+echo "   $(wc -l < "$OUT/can.log") CAN frames in $OUT/can.log (candump -L format), e.g.:"
+head -3 "$OUT/can.log" | sed 's/^/     /'
+
+echo
+echo "== 4. The CAN log decoded with $DBC (python3-canmatrix)"
+echo "   Every Status frame (collapsed), with the rotation's LeanWarning:"
+"$PY" tests/daemon/sl_can_decode.py "$DBC" "$OUT/can.log" --summary | sed 's/^/   /'
+echo
+echo "   The PoleLean frames of the last rotation (warning = the LeanWarning's target):"
+"$PY" tests/daemon/sl_can_decode.py "$DBC" "$OUT/can.log" --table --last 1 | sed 's/^/   /'
+
+echo
+echo "== 5. Decoded leans against the simulator's truth (last rotation, nominal azimuth)"
+"$PY" tests/daemon/lean_vs_truth.py "$DBC" "$OUT/can.log" "$OUT/scene.gt.csv" --tol 0.5 |
+    sed 's/^/   /' || true
+
+echo
+if [ -n "$VIEW" ]; then
+    echo "== 6. Picture of the last rotation (sl-view): $OUT/view.png"
+    "$VIEW" "$OUT/scene.colossus" --board "$BOARD" --out "$OUT/view.png" --rotation $((ROTS - 1)) \
+        --truth "$OUT/scene.gt.csv" --title "shadowlean demo: $(basename "$SCENE")" > "$OUT/view.log" 2>&1 ||
+        echo "   (sl-view failed: see $OUT/view.log)"
+else
+    echo "== 6. (no picture: sl-view is not built)"
+fi
+echo
+echo "demo: outputs in $ROOT/$OUT (can.log, targets.jsonl, scene.colossus, scene.gt.csv${VIEW:+, view.png})"

@@ -228,12 +228,17 @@ static void begin_rotation(sl_pipeline_t *p)
 }
 
 // Detection rows for azimuths [from, to) that got no row (yet) this rotation: their held
-// stable rows, unless the mask will drop their history at the end of this rotation.
+// stable rows, unless the mask will drop their history at the end of this rotation, or the
+// vehicle moved too far since the row was taken. A row m + 1 rotations old (m = missed so
+// far) shows the scene displaced by up to (m + 1) x disp, and (n_eff - 1) x disp <= D, so
+// it is still within the cell budget D only when m + 2 <= n_eff. While moving faster than
+// D / T (n_eff = 1) a lost azimuth is simply absent, never a stale ghost.
 static void feed_held(sl_pipeline_t *p, uint32_t from, uint32_t to)
 {
     for (uint32_t a = from; a < to; a++) {
-        if (!sl_mask_has_history(&p->mask, (uint16_t)a) ||
-            (uint32_t)sl_mask_missed(&p->mask, (uint16_t)a) + 1U > p->mask.max_missed) {
+        const uint32_t missed = sl_mask_missed(&p->mask, (uint16_t)a);
+        if (!sl_mask_has_history(&p->mask, (uint16_t)a) || missed + 1U > p->mask.max_missed ||
+            missed + 2U > p->frames_eff) {
             continue;
         }
         (void)sl_mask_stable_prefix(&p->mask, (uint16_t)a, p->mask_words, p->occ, NULL);

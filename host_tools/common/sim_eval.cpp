@@ -8,6 +8,9 @@
 #include <map>
 #include <sstream>
 
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
 #include "shadowlean/sl_incline.h"
 #include "sim_geom.h"
 #include "sim_render.h"
@@ -507,6 +510,16 @@ Table1Result run_table1(const Table1Options &o)
     if (o.progress) {
         std::fprintf(stderr, "\n");
     }
+    for (int c = 0; c < 5; c++) {
+        for (int a = 0; a < 3; a++) {
+            double sm = 0;
+            for (const auto &x : samples[c][a]) {
+                sm += x.gt.alpha_model_deg - x.gt.alpha_deg;
+            }
+            res.model_err[c][a] = samples[c][a].empty() ? std::nan("") : sm / samples[c][a].size();
+            res.boundary[c][a] = n_boundary[c][a];
+        }
+    }
     // processing per table row
     struct RowSpec {
         int cap;
@@ -645,6 +658,15 @@ void print_table1(std::FILE *f, const Table1Result &r)
                      cell(row.improved_b[0]).c_str(), cell(row.improved_b[1]).c_str(),
                      cell(row.improved_b[2]).c_str());
     }
+    std::fprintf(f, "\nThe closed form's own error on the exact axis bounds, mean(alpha_model - alpha), part\n"
+                    "of every cell above (an oblique pole is not in one vertical plane):\n");
+    const char *cap[5] = {"ideal", "real res.", "emission", "10 cm", "20 cm"};
+    for (int c = 0; c < 5; c++) {
+        if (std::isfinite(r.model_err[c][0])) {
+            std::fprintf(f, "  %-10s %+.3f %+.3f %+.3f deg\n", cap[c], r.model_err[c][0], r.model_err[c][1],
+                         r.model_err[c][2]);
+        }
+    }
     std::fprintf(f, "\nrows per angle: ");
     for (int a = 0; a < 3; a++) {
         const auto &e = r.rows[1].paper_style[a];
@@ -680,15 +702,17 @@ std::string table1_json(const Table1Result &r)
         }
         o << "]}" << (i + 1 < r.rows.size() ? "," : "") << "\n";
     }
-    o << "  ],\n  \"seconds\": " << jnum(r.seconds) << "\n}\n";
+    o << "  ],\n  \"model_error_deg\": [";
+    for (int c = 0; c < 5; c++) {
+        o << (c ? ", " : "") << "[" << jnum(r.model_err[c][0]) << ", " << jnum(r.model_err[c][1]) << ", "
+          << jnum(r.model_err[c][2]) << "]";
+    }
+    o << "],\n  \"seconds\": " << jnum(r.seconds) << "\n}\n";
     return o.str();
 }
 
 } // namespace sl
 
-
-#include <opencv2/imgcodecs.hpp>
-#include <opencv2/imgproc.hpp>
 
 namespace sl {
 

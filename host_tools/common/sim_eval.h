@@ -163,6 +163,9 @@ struct Table1Result {
     std::vector<Table1Row> rows;
     int angles[3] = {-10, 0, 10};
     std::vector<CurvePoint> curves[2][3]; ///< [ideal, real corrected][angle]
+    double model_err[5][3] = {};  ///< per capture and angle: mean(alpha_model - alpha), the
+                                  ///< closed form's own error on the exact bounds (oblique poles)
+    int boundary[5][3] = {};      ///< valid rows dropped: r2 within a bin of the ground's first bin
     int rotations = 0;
     double seconds = 0;
 };

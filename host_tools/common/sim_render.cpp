@@ -402,7 +402,7 @@ void Simulator::rotation_geom(int k, RotationGeom &rg) const
         VisibleAxis va0;
         int i_nom = -1;
         for (int pass = 0; pass < 3; pass++) {
-            va0 = visible_axis(b, pose, pg, self, occ, w, 0, -1, 200);
+            va0 = visible_axis(b, pose, pg, self, occ, w, 0, -1, 96);
             if (va0.runs == 0) {
                 break;
             }
@@ -432,7 +432,7 @@ void Simulator::rotation_geom(int k, RotationGeom &rg) const
             pv.pole = self;
             pv.pose = radar_pose_at(s_, time_of(k, j));
             pv.va = visible_axis(b, pv.pose, pg, self, occ, w, az_deg_[static_cast<size_t>(j)],
-                                 cut_az_, 400);
+                                 cut_az_, 128);
             if (pv.va.runs == 0) {
                 continue;
             }

@@ -9,7 +9,9 @@ Library (imported by the daemon tests and scripts/demo.sh):
     check_e2e(...)                         # CRC-8 SAE J1850 over [SlE2EDataId, data[1..7]]
 
 Command line:
-    sl_can_decode.py BOARD.dbc LOG [--table]   decoded frames, or the warning table
+    sl_can_decode.py BOARD.dbc LOG              every frame, decoded
+    sl_can_decode.py BOARD.dbc LOG --summary    one line per Status frame (link, LeanWarning)
+    sl_can_decode.py BOARD.dbc LOG --table [--last K]   PoleLean rows per rotation
 """
 import contextlib
 import io
@@ -110,13 +112,10 @@ def decode_log(dbc_path, log_path):
     return [(f, decode(db, f[2], f[3], f[4])) for f in read_candump(log_path)]
 
 
-def print_table(decoded, out=sys.stdout):
-    """The warnings as a table: one row per rotation (Status frame) with targets."""
-    out.write(f"{'rot':>4} {'link':<12} {'warning':<8} {'id':>3} {'azimuth':>8} {'lean':>8} "
-              f"{'sigma':>6} {'r1 [m]':>7} {'r2 [m]':>7} {'quality':<9}\n")
-    poles = []
-    warn = None
-    for f, d in decoded:
+def groups(decoded):
+    """Rotation groups: (status, warning, [poles]) per Status frame (idle ones: no warning)."""
+    out, poles, warn = [], [], None
+    for _, d in decoded:
         if d is None:
             continue
         if d.name == "PoleLean":
@@ -124,19 +123,55 @@ def print_table(decoded, out=sys.stdout):
         elif d.name == "LeanWarning":
             warn = d
         elif d.name == "Status":
-            rot = d.raw["Rotations"]
-            link = LINK.get(d.raw["LinkState"], "?")
-            level = LEVEL.get(warn.raw["Level"], "?") if warn else "-"
-            wid = warn.raw["TargetId"] if warn and warn.raw["HasTarget"] else None
-            if not poles:
-                out.write(f"{rot:>4} {link:<12} {level:<8} {'-':>3}\n")
-            for p in poles:
-                mark = level if p.raw["TargetId"] == wid else ""
-                out.write(f"{rot:>4} {link:<12} {mark:<8} {p.raw['TargetId']:>3} "
-                          f"{p.phys['Azimuth']:>7.1f}° {p.phys['Lean']:>+7.1f}° {p.phys['LeanSigma']:>5.1f}° "
-                          f"{p.phys['RangeInner']:>7.2f} {p.phys['RangeOuter']:>7.2f} "
-                          f"{QUALITY.get(p.raw['Quality'], '?'):<9}\n")
+            out.append((d, warn, poles))
             poles, warn = [], None
+    return out
+
+
+def print_summary(decoded, out=sys.stdout):
+    """One line per Status frame (E2E counter, link state, Rotations, the LeanWarning of the
+    rotation, PoleLean count); runs of identical lines are collapsed."""
+    out.write(f"{'ctr':>3} {'link':<12} {'rot':>4}  {'LeanWarning':<44} {'PoleLean':>8}\n")
+    prev, same = None, 0
+    for st, warn, poles in groups(decoded):
+        if warn is None:
+            w = "(idle Status: no rotation)"
+        elif not warn.raw["HasTarget"]:
+            w = f"{LEVEL.get(warn.raw['Level'], '?'):<8} no confirmed target"
+        else:
+            w = (f"{LEVEL.get(warn.raw['Level'], '?'):<8} target {warn.raw['TargetId']:>2} "
+                 f"az {warn.phys['Azimuth']:>5.1f}° lean {warn.phys['Lean']:>+6.2f}°")
+        key = (st.raw["LinkState"], w, len(poles))
+        if key == prev and warn is not None:
+            same += 1
+            continue
+        if same:
+            out.write(f"{'':>3} {'':<12} {'':>4}  ... {same} more rotation(s) alike\n")
+        prev, same = key, 0
+        out.write(f"{st.raw['Counter']:>3} {LINK.get(st.raw['LinkState'], '?'):<12} {st.raw['Rotations']:>4}  "
+                  f"{w:<44} {len(poles):>8}\n")
+    if same:
+        out.write(f"{'':>3} {'':<12} {'':>4}  ... {same} more rotation(s) alike\n")
+
+
+def print_table(decoded, out=sys.stdout, last=None):
+    """The warnings as a table: one row per PoleLean frame, grouped by rotation."""
+    out.write(f"{'rot':>4} {'link':<12} {'warning':<8} {'id':>3} {'azimuth':>8} {'lean':>8} "
+              f"{'sigma':>6} {'r1 [m]':>7} {'r2 [m]':>7} {'quality':<9}\n")
+    g = [x for x in groups(decoded) if x[1] is not None]
+    for st, warn, poles in (g if last is None else g[-last:]):
+        rot = st.raw["Rotations"]
+        link = LINK.get(st.raw["LinkState"], "?")
+        level = LEVEL.get(warn.raw["Level"], "?")
+        wid = warn.raw["TargetId"] if warn.raw["HasTarget"] else None
+        if not poles:
+            out.write(f"{rot:>4} {link:<12} {level:<8} {'-':>3}\n")
+        for p in poles:
+            mark = level if p.raw["TargetId"] == wid else ""
+            out.write(f"{rot:>4} {link:<12} {mark:<8} {p.raw['TargetId']:>3} "
+                      f"{p.phys['Azimuth']:>7.1f}° {p.phys['Lean']:>+7.1f}° {p.phys['LeanSigma']:>5.1f}° "
+                      f"{p.phys['RangeInner']:>7.2f} {p.phys['RangeOuter']:>7.2f} "
+                      f"{QUALITY.get(p.raw['Quality'], '?'):<9}\n")
 
 
 def main(argv):
@@ -144,8 +179,12 @@ def main(argv):
         print(__doc__)
         return 2
     decoded = decode_log(argv[1], argv[2])
+    if "--summary" in argv[3:]:
+        print_summary(decoded)
+        return 0
     if "--table" in argv[3:]:
-        print_table(decoded)
+        last = int(argv[argv.index("--last") + 1]) if "--last" in argv else None
+        print_table(decoded, last=last)
         return 0
     for f, d in decoded:
         if d is None:

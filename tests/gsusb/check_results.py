@@ -10,7 +10,9 @@ import sys
 
 OUT, HERE = sys.argv[1], sys.argv[2]
 failures = []
+failed_scenarios = []
 passes = 0
+scenario = None
 
 
 def check(cond, what, detail=""):
@@ -20,6 +22,8 @@ def check(cond, what, detail=""):
         print("  ok   %s" % what)
     else:
         failures.append(what)
+        if scenario not in failed_scenarios:
+            failed_scenarios.append(scenario)
         print("  FAIL %s%s" % (what, (": " + detail) if detail else ""))
 
 
@@ -115,6 +119,7 @@ if "guest script exit" not in console:
     check(False, "the guest script ran to its end")
 
 # ---------------------------------------------------------------------------------------
+scenario = "kernel"
 print("(a) kernel gs_usb driver + SocketCAN (cansend through the fake device)")
 MARKERS = {("SFF", 0x7E0, 4, b"SYNC"), ("SFF", 0x7E0, 3, b"END"), ("SFF", 0x7E1, 4, b"SYNC"),
            ("SFF", 0x7E1, 3, b"END")}
@@ -131,6 +136,7 @@ check("BITTIMING OUT wValue=0 wIndex=0 prop_seg=6 phase_seg1=7 phase_seg2=2 sjw=
 check("mode=START" in ctl, "the kernel started the channel")
 
 # ---------------------------------------------------------------------------------------
+scenario = "libusb_log"
 print("(b1) libusb driver: candump log in, VID:PID selector, one error frame")
 sent = frames_of(open(os.path.join(HERE, "frames_libusb.log")).read())
 dev = frames_of(read("dev_libusb_log.log"))
@@ -164,6 +170,7 @@ check(seq[:len(want)] == want, "control sequence: HOST_FORMAT, DEVICE_CONFIG, BT
 check(any("byte_order=0x0000beef" in l for l in lines[:1]), "HOST_FORMAT carried 0x0000beef")
 
 # ---------------------------------------------------------------------------------------
+scenario = "libusb_gen"
 print("(b2) libusb driver: 40 generated frames, bus-port selector")
 s = summary("libusb_gen")
 expect = [gen(k) for k in range(40)]
@@ -178,6 +185,7 @@ check(accounting(s) and s.get("confirmed") == 40, "40 confirmed, all accounted f
 print("       max frames in flight: %s" % s.get("max_in_flight"))
 
 # ---------------------------------------------------------------------------------------
+scenario = "refuse"
 print("(c1) the device refuses BITTIMING")
 out = read("out_refuse.txt", "")
 check(rc("refuse") == 2, "sl-gsusb-send exit 2 (could not start)", "rc=%s" % rc("refuse"))
@@ -189,6 +197,7 @@ check("BITTIMING OUT wValue=0 wIndex=0 STALL" in ctl and "mode=START" not in ctl
 print("       message: %s" % out.strip().splitlines()[-1] if out.strip() else "")
 
 # ---------------------------------------------------------------------------------------
+scenario = "stall"
 print("(c2) the device halts bulk OUT (after frame 3) and bulk IN (after frame 6)")
 s = summary("stall")
 expect = [gen(k) for k in range(12)]
@@ -204,6 +213,7 @@ check(s.get("clear_halts", 0) >= 2 and s.get("clear_halt_failures") == 0,
 print("       OUT transfers resent after the clear: %s" % s.get("out_resubmits"))
 
 # ---------------------------------------------------------------------------------------
+scenario = "dropecho"
 print("(c3) the device drops echoes after frame 2")
 s = summary("dropecho")
 dev = frames_of(read("dev_dropecho.log"))
@@ -217,6 +227,7 @@ check(s.get("max_in_flight") == 10, "the in-flight limit (10) was reached", "max
 check(accounting(s), "every frame accounted for")
 
 # ---------------------------------------------------------------------------------------
+scenario = "vanish"
 print("(c4) the device vanishes after frame 8 (UDC unbound) and comes back 0.5 s later")
 s = summary("vanish")
 dev = frames_of(read("dev_vanish.log"))
@@ -237,6 +248,20 @@ print("       late/bogus echoes ignored: %s, unknown echo ids: %s, OUT transfers
     s.get("echo_mismatch"), s.get("echo_unknown"), s.get("usb_out_timeouts")))
 check(accounting(s) and s.get("offered") == 80, "every frame accounted for (offered %s, confirmed %s)" % (
     s.get("offered"), s.get("confirmed")))
+
+for name in failed_scenarios:
+    if name is None:
+        continue
+    print("---- context of the failed scenario '%s'" % name)
+    for f in ("out_%s.txt" % name, "sum_%s.txt" % name):
+        text = read(f)
+        if text:
+            print("-- %s (last 25 lines)" % f)
+            print("\n".join(text.splitlines()[-25:]))
+    glog = (read("gadget.log", "") or "").splitlines()
+    start = max([i for i, l in enumerate(glog) if "scenario %s " % name in l] or [0])
+    print("-- gadget.log from the scenario start (40 lines)")
+    print("\n".join(glog[start:start + 40]))
 
 print("%d checks passed, %d failed%s" % (passes, len(failures), (": " + "; ".join(failures)) if failures else ""))
 sys.exit(1 if failures else 0)

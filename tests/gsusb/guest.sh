@@ -100,7 +100,7 @@ rc_of stall $?
 
 t "== (c3) lost echoes"
 scenario dropecho drop-echo:2
-timeout 20 "$SL_SEND" 1d50:606f --count 15 --echo-timeout-ms 1000 --tx-log tx_dropecho.log \
+timeout 20 "$SL_SEND" 1d50:606f --count 15 --echo-timeout-ms 1500 --tx-log tx_dropecho.log \
     --summary sum_dropecho.txt > out_dropecho.txt 2>&1
 rc_of dropecho $?
 

@@ -213,6 +213,49 @@ static void test_track_keeps_poles_apart_by_azimuth_and_range_gates(void **state
     assert_int_equal(trk.stats.created, 5);
 }
 
+// Ego motion widens the gates: a pole 2.8 m away that moves 7 azimuths and 0.4 m between
+// rotations (3 m/s) opens a new track without it, continues its track with it; the azimuth
+// slack follows 1 / r1 (a far pole gets less) and the yaw adds its own steps.
+static void test_track_motion_widens_the_gates(void **state)
+{
+    (void)state;
+    for (int moving = 0; moving < 2; moving++) {
+        assert_int_equal(sl_track_init(&trk, &board, NULL), SL_OK);
+        if (moving) {
+            sl_track_set_motion(&trk, 750000U, 0U); // 3 m/s x 0.25 s
+        }
+        sl_target_t t = tgt(100, 2800000U, 500, 80, SL_INCLINE_VALID);
+        sl_track_update(&trk, &t, 1, 1000000);
+        t = tgt(107, 3200000U, 520, 80, SL_INCLINE_VALID);
+        sl_track_update(&trk, &t, 1, 1250000);
+        assert_int_equal(trk.stats.created, moving ? 1U : 2U);
+        assert_int_equal(trk.stats.associated, moving ? 1U : 0U);
+    }
+    // Slack at r1 = 2.8 m for 0.75 m: 0.268 rad = 17.1 azimuths -> gate 3 + 18 = 21.
+    assert_int_equal(sl_track_init(&trk, &board, NULL), SL_OK);
+    sl_track_set_motion(&trk, 750000U, 0U);
+    sl_target_t t = tgt(100, 2800000U, 500, 80, SL_INCLINE_VALID);
+    sl_track_update(&trk, &t, 1, 1000000);
+    t = tgt(121, 2800000U, 500, 80, SL_INCLINE_VALID);
+    sl_track_update(&trk, &t, 1, 1250000);
+    assert_int_equal(trk.stats.associated, 1U);
+    t = tgt(143, 2800000U, 500, 80, SL_INCLINE_VALID); // 22 steps: outside
+    sl_track_update(&trk, &t, 1, 1500000);
+    assert_int_equal(trk.stats.associated, 1U);
+    assert_int_equal(trk.stats.created, 2U);
+    // Yaw only: 9 deg per update = 10 azimuths (rounded up) on top of the gate of 3.
+    assert_int_equal(sl_track_init(&trk, &board, NULL), SL_OK);
+    sl_track_set_motion(&trk, 0U, (uint32_t)(9.0 / 360.0 * 4294967296.0));
+    t = tgt(200, 2800000U, 500, 80, SL_INCLINE_VALID);
+    sl_track_update(&trk, &t, 1, 1000000);
+    t = tgt(187, 2800000U, 500, 80, SL_INCLINE_VALID);
+    sl_track_update(&trk, &t, 1, 1250000);
+    assert_int_equal(trk.stats.associated, 1U);
+    t = tgt(173, 2800000U, 500, 80, SL_INCLINE_VALID); // 14 steps: outside
+    sl_track_update(&trk, &t, 1, 1500000);
+    assert_int_equal(trk.stats.associated, 1U);
+}
+
 static void test_track_counts_targets_beyond_its_capacity(void **state)
 {
     (void)state;
@@ -241,6 +284,7 @@ int main(void)
         cmocka_unit_test_setup(test_track_needs_a_small_sigma_to_raise, setup),
         cmocka_unit_test_setup(test_track_drops_a_vanished_target_after_the_timeout, setup),
         cmocka_unit_test_setup(test_track_keeps_poles_apart_by_azimuth_and_range_gates, setup),
+        cmocka_unit_test_setup(test_track_motion_widens_the_gates, setup),
         cmocka_unit_test_setup(test_track_counts_targets_beyond_its_capacity, setup),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -306,6 +306,7 @@ static const cli_opt_t k_cli[] = {
     {"--motion-can", "can", "motion_interface", 1, NULL},
     {"--targets-out", "output", "targets", 1, NULL},
     {"--config", NULL, "config", 1, NULL},
+    {"--print-config", NULL, "print", 0, NULL},
 };
 
 void sld_opts_usage(void *fpv)
@@ -343,6 +344,7 @@ void sld_opts_usage(void *fpv)
         "  --duration S             [daemon] duration         stop after S seconds (0 = never)\n"
         "  --exit-idle S            [daemon] exit_idle        radar: stop after S s without FFT data (once data came)\n"
         "  --list-boards                                      print the boards linked in\n"
+        "  --print-config                                     print the effective settings as a config file, exit\n"
         "  -h | --help, --version\n"
         "Signals: SIGINT/SIGTERM stop cleanly (Stop FFT, last rotation flushed, sinks drained).\n");
 }
@@ -430,6 +432,9 @@ int sld_opts_parse(sld_opts_t *o, int argc, char **argv, char *err, size_t err_s
             val = argv[++i];
         }
         if (c->section == NULL) {
+            if (strcmp(c->key, "print") == 0) {
+                o->print_config = true;
+            }
             continue; // --config: pass 1
         }
         if (strcmp(c->key, "radar") == 0 || strcmp(c->key, "capture") == 0) {
@@ -486,4 +491,54 @@ const char *sld_opts_motion_iface(const sld_opts_t *o)
         return o->motion_iface;
     }
     return o->can_iface;
+}
+
+void sld_opts_print(const sld_opts_t *o, void *fpv)
+{
+    FILE *fp = fpv;
+    static const char *const lvl[] = {"error", "warning", "info", "debug"};
+    static const char *const lt[] = {"auto", "wall", "data"};
+    fprintf(fp, "; shadowleand effective settings%s%s%s\n", o->config[0] != '\0' ? " (config file " : "",
+            o->config, o->config[0] != '\0' ? " + command line)" : "");
+    fprintf(fp, "[daemon]\nboard = %s\n", o->board);
+    if (o->user[0] != '\0') {
+        fprintf(fp, "user = %s\n", o->user);
+    }
+    fprintf(fp, "syslog = %s\nverbosity = %s\nstats_every = %.3f\nstatus_period_ms = %u\n",
+            o->use_syslog ? "true" : "false", lvl[o->verbosity < 0 ? 0 : o->verbosity > 3 ? 3 : o->verbosity],
+            (double)o->stats_every_ms / 1000.0, (unsigned)o->status_period_ms);
+    fprintf(fp, "duration = %.3f\nexit_idle = %.3f\n", (double)o->duration_ms / 1000.0,
+            (double)o->exit_idle_ms / 1000.0);
+    fprintf(fp, "\n[input]\n");
+    if (o->radar_host[0] != '\0') {
+        const bool v6 = strchr(o->radar_host, ':') != NULL;
+        fprintf(fp, "radar = %s%s%s:%u\n", v6 ? "[" : "", o->radar_host, v6 ? "]" : "", (unsigned)o->radar_port);
+    }
+    if (o->capture[0] != '\0') {
+        fprintf(fp, "capture = %s\n", o->capture);
+    }
+    fprintf(fp, "realtime = %s\nnon_contour = %s\nconnect_timeout_ms = %u\nsilence_timeout_ms = %u\nsilent_ms = %u\n",
+            o->realtime ? "true" : "false", o->non_contour ? "true" : "false", (unsigned)o->connect_timeout_ms,
+            (unsigned)o->silence_timeout_ms, (unsigned)o->silent_ms);
+    fprintf(fp, "\n[can]\n");
+    if (o->can_iface[0] != '\0') {
+        fprintf(fp, "interface = %s\n", o->can_iface);
+    }
+    if (o->can_log[0] != '\0') {
+        fprintf(fp, "log = %s\n", o->can_log);
+    }
+    if (o->can_log_iface[0] != '\0') {
+        fprintf(fp, "log_iface = %s\n", o->can_log_iface);
+    }
+    fprintf(fp, "log_time = %s\n", lt[o->log_time]);
+    fprintf(fp, "gs_usb = %s\n", !o->gs_usb ? "false" : o->gs_usb_sel[0] != '\0' ? o->gs_usb_sel : "any");
+    fprintf(fp, "bitrate = %u\n", (unsigned)o->bitrate);
+    if (o->motion_off) {
+        fprintf(fp, "motion_interface = none\n");
+    } else if (o->motion_iface[0] != '\0') {
+        fprintf(fp, "motion_interface = %s\n", o->motion_iface);
+    }
+    if (o->targets_out[0] != '\0') {
+        fprintf(fp, "\n[output]\ntargets = %s\n", o->targets_out);
+    }
 }

@@ -44,6 +44,7 @@ typedef enum sld_log_time {
 /// All settings.
 typedef struct sld_opts {
     char config[SLD_PATH_CHARS];       ///< --config FILE ("" = none)
+    bool print_config;                 ///< --print-config: print the settings and exit
     char board[SLD_NAME_CHARS];        ///< --board NAME                      [daemon] board
     char radar_host[256];              ///< --radar HOST[:PORT]               [input] radar
     uint16_t radar_port;               ///< default 6317
@@ -80,8 +81,8 @@ void sld_opts_defaults(sld_opts_t *o);
 int sld_opts_load_file(sld_opts_t *o, const char *path, char *err, size_t err_size);
 
 /// Parse the command line: first loads `--config FILE` if present, then applies every
-/// option (command line wins). @return 0 = run, 1 = exit 0 (--help/--version/--list-boards
-/// printed), -1 = error (message in `err`).
+/// option (command line wins). @return 0 = run (or print, see `print_config`), 1 = exit 0
+/// (--help/--version/--list-boards printed), -1 = error (message in `err`).
 int sld_opts_parse(sld_opts_t *o, int argc, char **argv, char *err, size_t err_size);
 
 /// Checks that need the whole picture (exactly one input, a board, ...).
@@ -93,6 +94,10 @@ const char *sld_opts_motion_iface(const sld_opts_t *o);
 
 /// Print the usage text to `fp` (a FILE *; void * keeps stdio out of this header).
 void sld_opts_usage(void *fp);
+
+/// Print the effective settings as a config file that sld_opts_load_file() reads back to
+/// the same settings (`shadowleand --print-config`). `fp` is a FILE *.
+void sld_opts_print(const sld_opts_t *o, void *fp);
 
 /// Split "HOST:PORT", "[V6ADDR]:PORT" or "HOST" (port 6317). @return 0 or -1.
 int sld_parse_host_port(const char *s, char *host, size_t host_size, uint16_t *port);

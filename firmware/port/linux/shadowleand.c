@@ -583,6 +583,15 @@ static void log_stats(daemon_t *d, int level, const char *what)
             (unsigned)sl_track_max_level(&g_pipe.tracker), g_pipe.proto.stats.messages,
             g_pipe.proto.stats.resyncs, d->frames_out, d->status_frames, d->idle_status_frames,
             s->can_dropped, s->motion_accepted, s->motion_rejected);
+    const sl_detect_stats_t *ds = &g_pipe.detect.stats;
+    sld_log(SLD_LOG_DEBUG,
+            "%s: detection: %" PRIu32 " runs, %" PRIu32 " groups, %" PRIu32 " targets; rejected near %" PRIu32
+            " shadow %" PRIu32 " wide %" PRIu32 " broken %" PRIu32 "; overflows cand %" PRIu32 " target %" PRIu32
+            "; tracks: %" PRIu32 " created %" PRIu32 " dropped; mask bins %u",
+            what, ds->runs, ds->groups, ds->targets, ds->rejected[SL_DETECT_REJ_NEAR],
+            ds->rejected[SL_DETECT_REJ_SHADOW], ds->rejected[SL_DETECT_REJ_WIDE],
+            ds->rejected[SL_DETECT_REJ_BROKEN], ds->cand_overflow, ds->target_overflow,
+            g_pipe.tracker.stats.created, g_pipe.tracker.stats.dropped, (unsigned)g_pipe.mask_bins);
     for (size_t i = 0; i < d->n_sinks; i++) {
         sl_can_sink_stats_t st = {0, 0, 0, 0};
         d->sinks[i].get_stats(d->sinks[i].ctx, &st);
@@ -706,6 +715,10 @@ int main(int argc, char **argv)
         fprintf(stderr, "shadowleand: %s\n", err);
         return 2;
     }
+    if (d->o.print_config) {
+        sld_opts_print(&d->o, stdout);
+        return 0;
+    }
     sld_log_setup(d->o.verbosity, d->o.use_syslog);
     d->board = sl_board_find(d->o.board);
     d->is_radar = d->o.radar_host[0] != '\0';
@@ -762,8 +775,12 @@ int main(int argc, char **argv)
         shutdown_all(d);
         return 1;
     }
-    sld_log(SLD_LOG_INFO, "board %s, input %s%s%s, %zu CAN output(s)%s%s", d->board->name,
-            d->is_radar ? "radar " : "capture ", d->is_radar ? d->o.radar_host : d->o.capture,
+    char port_txt[8] = "";
+    if (d->is_radar) {
+        snprintf(port_txt, sizeof port_txt, ":%u", (unsigned)d->o.radar_port);
+    }
+    sld_log(SLD_LOG_INFO, "board %s, input %s%s%s%s, %zu CAN output(s)%s%s", d->board->name,
+            d->is_radar ? "radar " : "capture ", d->is_radar ? d->o.radar_host : d->o.capture, port_txt,
             d->is_radar ? "" : (d->o.realtime ? " (real time)" : " (as fast as possible)"), d->n_sinks,
             d->motion_on ? ", VehicleMotion from " : "", d->motion_on ? miface : "");
 
@@ -772,7 +789,9 @@ int main(int argc, char **argv)
     }
     d->link_state = d->is_radar ? SL_CAN_LINK_CONNECTING : SL_CAN_LINK_STREAMING;
     sl_pipeline_set_link_state(&g_pipe, d->link_state);
-    d->last_status_mono = d->mono_us - (uint64_t)d->o.status_period_ms * 1000U; // first one now
+    // A live radar gets a Status frame at once (CONNECTING); a capture replayed in real time
+    // only when a rotation is late, so --realtime and --fast write the same frames.
+    d->last_status_mono = d->is_radar ? d->mono_us - (uint64_t)d->o.status_period_ms * 1000U : d->mono_us;
     d->next_stats_mono = d->o.stats_every_ms != 0 ? d->mono_us + (uint64_t)d->o.stats_every_ms * 1000U : UINT64_MAX;
     const uint64_t end_mono = d->o.duration_ms != 0 ? d->mono_us + (uint64_t)d->o.duration_ms * 1000U : UINT64_MAX;
 
@@ -863,8 +882,10 @@ int main(int argc, char **argv)
             }
             const uint8_t ls = radar_link_state(d);
             if (ls != d->link_state) {
-                if (ls == SL_CAN_LINK_SILENT || d->link_state == SL_CAN_LINK_SILENT) {
-                    sld_log(SLD_LOG_WARN, "radar link %s", ls == SL_CAN_LINK_SILENT ? "SILENT (no FFT data)" : "streaming again");
+                if (ls == SL_CAN_LINK_SILENT) {
+                    sld_log(SLD_LOG_WARN, "radar link SILENT: no FFT data for %" PRIu32 " ms", d->o.silent_ms);
+                } else if (d->link_state == SL_CAN_LINK_SILENT && ls == SL_CAN_LINK_STREAMING) {
+                    sld_log(SLD_LOG_INFO, "radar link streaming again");
                 }
                 d->link_state = ls;
                 sl_pipeline_set_link_state(&g_pipe, ls);

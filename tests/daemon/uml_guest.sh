@@ -1,0 +1,46 @@
+#!/bin/sh
+# uml_guest.sh DAEMON CAPTURE SHORT_CAPTURE MOTION_FRAMES OUTDIR: runs INSIDE user-mode Linux
+# (tests/can/uml_run.sh, vcan0 up). `candump -L vcan0` records the bus while:
+#   run 1: shadowleand --input CAPTURE --can vcan0 --can-log daemon_fast.log (as fast as
+#          possible; --motion-can none);
+#   run 2: shadowleand --input SHORT_CAPTURE --realtime --can vcan0 --can-log daemon_rt.log
+#          while VehicleMotion frames (MOTION_FRAMES: one cansend argument per line, E2E
+#          counters 0..14) go onto vcan0 every 50 ms; VehicleMotion is read from vcan0 (the
+#          default: the --can interface).
+# Marker frames 7FF#... (SYNC / MID / END) delimit the runs in candump's recording without
+# timing assumptions (the same trick as tests/can/uml_sink_guest.sh).
+set -u
+daemon=$1; cap=$2; short=$3; motion=$4; out=$5
+candump -L -r 8000000 vcan0 > "$out/candump.log" 2> "$out/candump.err" &
+cdpid=$!
+wait_for() { # hex-marker: resend until candump has recorded it
+    i=0
+    while ! grep -q "7FF#$1" "$out/candump.log" 2>/dev/null; do
+        i=$((i + 1))
+        if [ $i -gt 200 ]; then echo "candump did not record 7FF#$1"; return 1; fi
+        cansend vcan0 "7FF#$1"
+        sleep 0.05
+    done
+}
+wait_for 53594E43 || exit 1                                   # "SYNC"
+"$daemon" --board paper-sim --input "$cap" --can vcan0 --can-log "$out/daemon_fast.log" \
+    --targets-out "$out/targets_fast.jsonl" --motion-can none --stats-every 0 \
+    2> "$out/daemon_fast.err"
+rc=$?
+echo "run 1 (fast): exit $rc"; cat "$out/daemon_fast.err"
+[ $rc -eq 0 ] || exit 1
+wait_for 4D4944 || exit 1                                     # "MID"
+( while :; do
+      while read -r f; do cansend vcan0 "$f"; sleep 0.05; done < "$motion"
+  done ) &
+sender=$!
+"$daemon" --board paper-sim --input "$short" --realtime --can vcan0 --can-log "$out/daemon_rt.log" \
+    --targets-out "$out/targets_rt.jsonl" 2> "$out/daemon_rt.err"
+rc=$?
+kill $sender; wait $sender 2>/dev/null
+echo "run 2 (realtime, VehicleMotion on vcan0): exit $rc"; cat "$out/daemon_rt.err"
+[ $rc -eq 0 ] || exit 1
+wait_for 454E44 || exit 1                                     # "END"
+kill -INT $cdpid
+wait $cdpid
+exit 0
