@@ -109,7 +109,7 @@ static void win_make(win_t *wn, unsigned P, uint32_t n, uint32_t w)
 
 FORCE_INLINE void lane_update(uint32_t (*pl)[SL_MASK_WORDS], const uint32_t *x, uint32_t *occ,
                               uint32_t *fr, uint32_t w, unsigned P, const lane_t *rp, bool one,
-                              bool full, const win_t *wn)
+                              bool full)
 {
     const lane_t xv = lane_ld(&x[w], one);
     const lane_t d = xv ^ lane_ld(&pl[0][w], one);
@@ -155,8 +155,7 @@ FORCE_INLINE void lane_update(uint32_t (*pl)[SL_MASK_WORDS], const uint32_t *x, 
         c4 = full ? ((c4 ^ b) | d) : (((c4 ^ b) & ~d) | (d & rp[4]));
     }
     (void)t;
-    const lane_t s = wn->on ? lane_lt(c0, c1, c2, c3, c4, P, wn->tp, wn->allm)
-                            : ~(c0 | c1 | c2 | c3 | c4);
+    const lane_t s = ~(c0 | c1 | c2 | c3 | c4);
     lane_st(&pl[0][w], xv, one);
     if (P > 0U) {
         lane_st(&pl[1][w], c0, one);
@@ -182,8 +181,7 @@ FORCE_INLINE void lane_update(uint32_t (*pl)[SL_MASK_WORDS], const uint32_t *x, 
 }
 
 FORCE_INLINE void update_row(uint32_t (*pl)[SL_MASK_WORDS], const uint32_t *x, uint32_t *occ,
-                             uint32_t *fr, uint32_t words, unsigned P, uint32_t nm1, bool full,
-                             const win_t *wn)
+                             uint32_t *fr, uint32_t words, unsigned P, uint32_t nm1, bool full)
 {
     lane_t rp[5];
     for (unsigned p = 0; p < 5U; p++) {
@@ -191,18 +189,17 @@ FORCE_INLINE void update_row(uint32_t (*pl)[SL_MASK_WORDS], const uint32_t *x, u
     }
     uint32_t w = 0;
     for (; w + LANE_WORDS <= words; w += LANE_WORDS) {
-        lane_update(pl, x, occ, fr, w, P, rp, false, full, wn);
+        lane_update(pl, x, occ, fr, w, P, rp, false, full);
     }
     for (; w < words; w++) {
-        lane_update(pl, x, occ, fr, w, P, rp, true, full, wn);
+        lane_update(pl, x, occ, fr, w, P, rp, true, full);
     }
 }
 
 // Specialised on P and on n being a power of two (reset value all ones: one OR per plane).
-#define UPD(P_, F_) update_row(pl, x, occ, fr, words, (P_), nm1, (F_), wn)
+#define UPD(P_, F_) update_row(pl, x, occ, fr, words, (P_), nm1, (F_))
 static void update_dispatch(uint32_t (*pl)[SL_MASK_WORDS], const uint32_t *x, uint32_t *occ,
-                            uint32_t *fr, uint32_t words, unsigned P, uint32_t nm1,
-                            const win_t *wn)
+                            uint32_t *fr, uint32_t words, unsigned P, uint32_t nm1)
 {
     const bool full = nm1 == (((uint32_t)1U << P) - 1U);
     switch (P * 2U + (full ? 1U : 0U)) {
@@ -380,8 +377,6 @@ sl_err_t sl_mask_update(sl_mask_t *m, uint16_t az, const uint32_t *bits, uint32_
         xbuf[words - 1U] &= tail;
         x = xbuf;
     }
-    win_t wn;
-    win_make(&wn, P, m->frames, m->window);
     // The first row of a run (k = n - 1) is stable only for a window of 1.
     const bool first_stable = m->window == 1U;
     if ((m->state[az] & ST_HISTORY) == 0U) {
@@ -399,7 +394,16 @@ sl_err_t sl_mask_update(sl_mask_t *m, uint16_t az, const uint32_t *bits, uint32_
             }
         }
     } else {
-        update_dispatch(pl, x, occ, free_, words, P, nm1, &wn);
+        if (m->window == m->frames) {
+            update_dispatch(pl, x, occ, free_, words, P, nm1);
+        } else {
+            // Shorter window (moving): update the state, then the windowed stable test in
+            // a second pass (keeps the window logic out of the static hot path).
+            update_dispatch(pl, x, NULL, NULL, words, P, nm1);
+            win_t wn;
+            win_make(&wn, P, m->frames, m->window);
+            stable_row((const uint32_t(*)[SL_MASK_WORDS])pl, occ, free_, words, P, &wn);
+        }
         if (free_ != NULL) {
             free_[words - 1U] &= tail;
         }

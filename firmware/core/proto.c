@@ -62,6 +62,35 @@ static void put_le32(uint8_t *b, uint32_t v)
 
 // ---------------------------------------------------------------------------------- decoder
 
+// Cache prefetch hint (a compiler builtin, no library call; a no-op elsewhere). Large
+// captures and fast streams are memory-bound: each message's header and the prefix a
+// consumer reads sit ~3.8 KB apart, a stride hardware prefetchers do not follow.
+#if defined(__GNUC__) || defined(__clang__)
+#define SL_PREFETCH(a) __builtin_prefetch(a)
+#else
+#define SL_PREFETCH(a) ((void)(a))
+#endif
+
+// Messages ahead to prefetch, assuming they have the length of the current one.
+#define PREFETCH_MSGS 3U
+
+// With truncate_long the consumer reads at most the header and reasm_size payload bytes of
+// each message: hint the CPU to fetch those of the next PREFETCH_MSGS messages (only the
+// lines inside the caller's buffer). Pure performance; no effect on behaviour.
+static inline void prefetch_ahead(const sl_proto_t *p, const uint8_t *data, size_t len,
+                                  size_t next, uint32_t plen)
+{
+    if (!p->cfg.truncate_long || p->cfg.reasm_size > 1024U) {
+        return;
+    }
+    // Only the message PREFETCH_MSGS ahead: the nearer ones were hinted by earlier calls.
+    const size_t keep = SL_PROTO_HEADER_BYTES + p->cfg.reasm_size;
+    const size_t at = next + (PREFETCH_MSGS - 1U) * (SL_PROTO_HEADER_BYTES + (size_t)plen);
+    for (size_t o = 0; o < keep && at + o < len; o += 64U) {
+        SL_PREFETCH(data + at + o);
+    }
+}
+
 static void skip(sl_proto_t *p, uint64_t n)
 {
     if (n != 0U) {
@@ -233,6 +262,7 @@ sl_err_t sl_proto_feed(sl_proto_t *p, const uint8_t *data, size_t len, uint64_t 
                 p->payload_bytes = plen;
                 i += SL_PROTO_HEADER_BYTES;
                 if (len - i >= plen) {
+                    prefetch_ahead(p, data, len, i + plen, plen);
                     deliver(p, tail[1], data + i, plen, true, now_us);
                     i += plen;
                 } else {

@@ -324,7 +324,9 @@ int main(int argc, char **argv)
         }
         for (size_t i = 0; i < n; i += o.chunk) {
             const size_t k = n - i < o.chunk ? n - i : o.chunk;
-            (void)sl_pipeline_feed(&g_pl, data + i, k, now_for(i, n, rot_est));
+            const uint64_t now = now_for(i, n, rot_est);
+            set_motion(&o, now); // the vehicle bus refreshes it (VehicleMotion: 50 Hz)
+            (void)sl_pipeline_feed(&g_pl, data + i, k, now);
         }
         (void)sl_pipeline_finish(&g_pl, now_for(n, n, rot_est));
         if (cg_run) {
@@ -341,6 +343,19 @@ int main(int argc, char **argv)
         printf("missing: %" PRIu32 " resyncs: %" PRIu32 " cut: %" PRIu32 " mask_bins: %u n: %u\n",
                g_pl.stats.azimuths_missing, g_pl.proto.stats.resyncs, g_pl.proto.stats.cut,
                (unsigned)g_pl.mask_bins, (unsigned)g_pl.mask.frames);
+        const sl_detect_stats_t *ds = &g_pl.detect.stats;
+        printf("detect: runs %" PRIu32 " groups %" PRIu32 " targets %" PRIu32
+               " rejected near %" PRIu32 " shadow %" PRIu32 " wide %" PRIu32 " broken %" PRIu32
+               "\n",
+               ds->runs, ds->groups, ds->targets, ds->rejected[SL_DETECT_REJ_NEAR],
+               ds->rejected[SL_DETECT_REJ_SHADOW], ds->rejected[SL_DETECT_REJ_WIDE],
+               ds->rejected[SL_DETECT_REJ_BROKEN]);
+        uint32_t win_max = 0;
+        for (uint32_t a = 0; a < g_pl.detect.azimuths; a++) {
+            win_max = g_pl.detect.win_bins[a] > win_max ? g_pl.detect.win_bins[a] : win_max;
+        }
+        printf("detect_window: near %u win_max %u\n", (unsigned)g_pl.detect.near_bins,
+               (unsigned)win_max);
         printf("wall_s: %.6f\n", best);
         printf("MB_per_s: %.1f\n", (double)n / best / 1e6);
         printf("us_per_azimuth: %.4f\n",
@@ -362,8 +377,9 @@ int main(int argc, char **argv)
     set_motion(&o, 1000000U);
     for (size_t m = 0; m < msgs; m++) {
         g_b.cur_msg = m;
-        (void)sl_pipeline_feed(&g_pl, data + offs[m], offs[m + 1] - offs[m],
-                               now_for(offs[m], n, rot_est));
+        const uint64_t now = now_for(offs[m], n, rot_est);
+        set_motion(&o, now);
+        (void)sl_pipeline_feed(&g_pl, data + offs[m], offs[m + 1] - offs[m], now);
     }
     // (the last rotation completes at EOF, not on a message: not a latency sample)
     uint64_t *done = g_b.complete_msg;
@@ -380,6 +396,8 @@ int main(int argc, char **argv)
         uint64_t next = 0;
         for (size_t m = 0; m < msgs; m++) {
             const bool arm = next < nd && keep[next] == m;
+            const uint64_t now = now_for(offs[m], n, rot_est);
+            set_motion(&o, now);
             if (arm) {
                 next++;
                 g_b.armed = true;
@@ -388,8 +406,7 @@ int main(int argc, char **argv)
                 }
                 clock_gettime(CLOCK_MONOTONIC, &g_b.t0);
             }
-            (void)sl_pipeline_feed(&g_pl, data + offs[m], offs[m + 1] - offs[m],
-                                   now_for(offs[m], n, rot_est));
+            (void)sl_pipeline_feed(&g_pl, data + offs[m], offs[m + 1] - offs[m], now);
             if (g_b.armed) { // no rotation after all (cannot happen: same input, same state)
                 g_b.armed = false;
                 if (cg_lat) {

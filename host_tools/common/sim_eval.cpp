@@ -186,7 +186,7 @@ bool subbin_bounds(const double *v, int n, int i1, int i2, const SubbinModel &m,
     const double v1 = v[i1] <= 1.0 ? 0.75 : v[i1], v2 = v[i2] <= 1.0 ? 0.75 : v[i2];
     const double obs1 = v1 / v[i1 + 1], obs2 = v2 / v[i2 - 1];
     double r1 = (i1 + 0.5) * b + R, r2 = (i2 + 0.5) * b;
-    for (int it = 0; it < 4; it++) {
+    for (int it = 0; it < 3; it++) {
         // r1: the front edge (axis - R_e) lies in bin i1; E(i1)/E(i1+1) falls as r1 grows
         {
             int flag = 0;
@@ -197,7 +197,7 @@ bool subbin_bounds(const double *v, int n, int i1, int i2, const SubbinModel &m,
             const double e1 = a >= m.beta_deg ? m.beta_deg : a;
             const double re = R / std::cos(sim_d2r(e1 - a));
             double lo = i1 * b + re, hi = (i1 + 1) * b + re;
-            for (int k = 0; k < 40; k++) {
+            for (int k = 0; k < 26; k++) { // 1 bin / 2^26: < 1 nm
                 const double mid = 0.5 * (lo + hi);
                 const auto e = model_bins(m, mid, r2, i1, i1 + 1);
                 if (e.empty() || e[1] <= 0) {
@@ -215,7 +215,7 @@ bool subbin_bounds(const double *v, int n, int i1, int i2, const SubbinModel &m,
         // r2: the silhouette (axis) lies in bin i2; E(i2)/E(i2-1) grows with r2
         {
             double lo = i2 * b, hi = (i2 + 1) * b;
-            for (int k = 0; k < 40; k++) {
+            for (int k = 0; k < 26; k++) {
                 const double mid = 0.5 * (lo + hi);
                 const auto e = model_bins(m, r1, mid, i2 - 1, i2);
                 if (e.empty() || e[0] <= 0) {
@@ -723,8 +723,8 @@ bool plot_table1(const std::string &png, const Table1Result &r, std::string &err
     cv::Mat img(Hh, W, CV_8UC3, cv::Scalar(255, 255, 255));
     const char *rowname[2] = {"Ideal (2 mm bins)", "Real resolution 0.0438 m, corrected"};
     const cv::Scalar cTruth(40, 150, 40), cPaper(40, 40, 220), cImp(200, 90, 20), cGrid(225, 225, 225);
-    cv::putText(img, "alpha(y) as the vehicle passes the pole (cf. paper Figs. 7-8): truth (green line), "
-                     "paper processing (red), improved B (blue)",
+    cv::putText(img, "alpha (deg) vs y (m) as the vehicle passes the pole (cf. paper Figs. 7-8): truth "
+                     "(green line), paper processing (red), improved B (blue)",
                 cv::Point(10, 24), cv::FONT_HERSHEY_SIMPLEX, 0.55, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
     for (int row = 0; row < 2; row++) {
         for (int a = 0; a < 3; a++) {
@@ -766,7 +766,6 @@ bool plot_table1(const std::string &png, const Table1Result &r, std::string &err
             std::snprintf(title, sizeof title, "%s, pole %+d deg", rowname[row], r.angles[a]);
             cv::putText(img, title, {x0, y0 - 8}, cv::FONT_HERSHEY_SIMPLEX, 0.45, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
             cv::putText(img, "y (m)", {x0 + w - 40, y0 + h + 34}, cv::FONT_HERSHEY_SIMPLEX, 0.4, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
-            cv::putText(img, "alpha (deg)", {x0 - 55, y0 - 22 + (row == 0 ? 0 : 0)}, cv::FONT_HERSHEY_SIMPLEX, 0.35, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
             std::vector<CurvePoint> sorted(pts);
             std::sort(sorted.begin(), sorted.end(), [](const CurvePoint &p, const CurvePoint &q) { return p.along_m < q.along_m; });
             for (size_t i = 1; i < sorted.size(); i++) {

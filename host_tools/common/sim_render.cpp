@@ -512,7 +512,7 @@ void Simulator::splat_pole(const PoleView &pv, int i, SimColumn *col, double *r1
             return sim_r2d(std::atan2(d.z, std::hypot(d.x, d.y)));
         };
         const double de = std::fabs(elev(s1) - elev(s0));
-        const int n = std::max(2, static_cast<int>(std::ceil(2.0 * de / s_.pole_step_deg)) + 1);
+        const int n = std::max(2, static_cast<int>(std::ceil(de / s_.pole_step_deg)) + 1);
         ss.clear();
         for (int j = 0; j < n; j++) {
             ss.push_back(s0 + (s1 - s0) * j / (n - 1));

@@ -17,11 +17,11 @@ void usage()
 {
     std::fprintf(stderr,
                  "usage:\n"
-                 "  sl-eval table1 [--rotations N] [--quick] [--json] [--plot FILE.png] [--threads N]\n"
-                 "                [--range-bins N]\n"
+                 "  sl-eval table1 [--rotations N] [--quick] [--json] [--json-out FILE] [--plot FILE.png]\n"
+                 "                [--threads N] [--range-bins N]\n"
                  "      The six conditions of the paper's Table I at -10/0/+10 deg, the paper's\n"
                  "      numbers beside ours, then the same captures with our improvements.\n"
-                 "  sl-eval realistic [--quick] [--json] [--positions N] [--reps N] [--frames N]\n"
+                 "  sl-eval realistic [--quick] [--json] [--json-out FILE] [--positions N] [--reps N] [--frames N]\n"
                  "                   [--calib N] [--range-bins N] [--threads N]\n"
                  "      Smear, speckle, noise floor, leakage, measured emission, n-frame\n"
                  "      segmentation, poles at 2.2-2.6 m: beside the paper's Table II.\n"
@@ -31,11 +31,21 @@ void usage()
                  "--quiet silences the progress lines on stderr.\n");
 }
 
+bool write_text(const std::string &path, const std::string &text)
+{
+    std::FILE *f = std::fopen(path.c_str(), "w");
+    if (f == nullptr || std::fputs(text.c_str(), f) < 0 || std::fclose(f) != 0) {
+        std::fprintf(stderr, "sl-eval: cannot write %s\n", path.c_str());
+        return false;
+    }
+    return true;
+}
+
 int cmd_table1(int argc, char **argv)
 {
     sl::Table1Options o;
     bool json = false;
-    std::string plot;
+    std::string plot, json_out;
     for (int i = 0; i < argc; i++) {
         const std::string a = argv[i];
         if (a == "--rotations" && i + 1 < argc) {
@@ -46,6 +56,8 @@ int cmd_table1(int argc, char **argv)
             o.range_bins = std::atoi(argv[++i]);
         } else if (a == "--json") {
             json = true;
+        } else if (a == "--json-out" && i + 1 < argc) {
+            json_out = argv[++i];
         } else if (a == "--plot" && i + 1 < argc) {
             plot = argv[++i];
         } else if (a == "--threads" && i + 1 < argc) {
@@ -58,6 +70,9 @@ int cmd_table1(int argc, char **argv)
         }
     }
     const sl::Table1Result r = sl::run_table1(o);
+    if (!json_out.empty() && !write_text(json_out, sl::table1_json(r))) {
+        return 1;
+    }
     if (json) {
         std::fputs(sl::table1_json(r).c_str(), stdout);
     } else {
@@ -78,6 +93,7 @@ int cmd_realistic(int argc, char **argv)
 {
     sl::RealisticOptions o;
     bool json = false;
+    std::string json_out;
     for (int i = 0; i < argc; i++) {
         const std::string a = argv[i];
         if (a == "--quick") {
@@ -98,6 +114,8 @@ int cmd_realistic(int argc, char **argv)
             o.threads = std::atoi(argv[++i]);
         } else if (a == "--json") {
             json = true;
+        } else if (a == "--json-out" && i + 1 < argc) {
+            json_out = argv[++i];
         } else if (a == "--quiet") {
             o.progress = false;
         } else {
@@ -106,6 +124,9 @@ int cmd_realistic(int argc, char **argv)
         }
     }
     const sl::RealisticResult r = sl::run_realistic(o);
+    if (!json_out.empty() && !write_text(json_out, sl::realistic_json(r))) {
+        return 1;
+    }
     if (json) {
         std::fputs(sl::realistic_json(r).c_str(), stdout);
     } else {

@@ -60,18 +60,56 @@
 /// single-frame thresholding; rejecting transient returns is then up to the tracker (a
 /// PoleLean is only sent for a track seen `confirm_hits` times), whose gates are widened by
 /// the ego displacement per rotation (v T radially, v T / r + |w| T in azimuth).
+/// Why not shift the consistency test by the ego motion instead: a polar bit cell moves to
+/// a different (azimuth, bin) per rotation as a function of its own range and bearing, so
+/// the shift is a per-cell resampling of every stored plane (not a word operation), and the
+/// azimuth quantisation (0.9 deg = 4.4 cm at 2.8 m) would smear the planes anyway.
+///
+/// Derivation of the bound: a static point at range r and bearing b (from the direction of
+/// travel) changes range by -v T cos b and bearing by v T sin b / r - w T per rotation; both
+/// components are bounded by v T (+ r |w| T), so |d range| and r |d bearing| <= v T + r |w| T.
+/// The cells are one bin (b = 43.8 mm) deep and one azimuth step (r x 15.7 mrad, 44 mm at
+/// 2.8 m) wide, hence D = one bin. Limits: the bound is conservative (a point straight ahead
+/// or abeam moves in one direction only), it ignores the pole's own extent (a long return
+/// moves as a whole), and a yaw rate enters with the farthest range of interest.
+///
+/// Missing azimuths while moving: a lost row is not a frame (the mask holds the azimuth's
+/// state); for detection its held stable row is used only while it is still within the
+/// budget, i.e. when (missed + 1) x disp <= D <=> missed + 2 <= n_eff. At n_eff = 1 a lost
+/// azimuth is simply absent from that rotation (never a ghost at the old position).
+///
+/// Detection runs while the rotation arrives (one row per azimuth, increasing order); a late
+/// (out-of-order) row updates the mask but this rotation's detection used the azimuth's
+/// held row.
 ///
 /// ## RAM budget (sizeof(sl_pipeline_t)); asserted below for the firmware configuration
 /// Dominated by the mask: SL_CFG_MAX_AZIMUTHS x (1 + ceil(log2 SL_CFG_MASK_FRAMES_MAX)) x
-/// SL_CFG_MASK_BINS / 8 bytes; then detection (~8.4 KB), the tracker (~1.9 KB), the
-/// reassembly buffer (SL_PIPELINE_REASM_BYTES) and a row buffer. Measured sizes are in the
-/// project report (host default vs. firmware configuration).
+/// SL_CFG_MASK_BINS / 8 bytes; then detection (8,424 B), the tracker (1,864 B), the scan
+/// bookkeeping (624 B), the reassembly buffer (SL_PIPELINE_REASM_BYTES) and a row buffer.
 ///
-/// ## Cost
-/// Per FFT message: header check + ROI threshold of `mask_bins` bins + one mask row update
-/// + one detection row (O(mask words x planes)); per rotation: detection end (one
-/// sl_incline_estimate per target), tracker update, CAN encoding. Measured by
-/// host_tools/bench (sl-bench). Stack: < 1 KB plus the port callbacks'. Task context only.
+/// | configuration (400 azimuths, 32 targets)              | x86-64    | Cortex-M0 |
+/// |--------------------------------------------------------|-----------|-----------|
+/// | firmware: SL_CFG_MASK_BINS 160, SL_CFG_MASK_FRAMES_MAX 16 | 52,800 B  | 52,696 B  |
+/// | SL_CFG_MASK_BINS 192, SL_CFG_MASK_FRAMES_MAX 16          | 60,904 B  | 60,800 B  |
+/// | host default: mask bins 512 (whole ROI), n <= 32          | 167,544 B | 167,440 B |
+///
+/// The boards carried today need 135 (paper-sim), 119 (paper-bench) and 141 (robotcar-leaf)
+/// masked bins (sl_detect_bins_needed(), rounded up to 160).
+///
+/// ## Cost (measured by host_tools/bench: sl-bench + callgrind.sh, x86-64 gcc -O2, firmware
+/// configuration, 64 KiB chunks of whole 3768-bin CTS350-X messages)
+/// - Per azimuth ~1,110 instructions on the Oxford RobotCar capture (n = 16, no target):
+///   threshold of 160 bins ~290, mask update ~310, decoder ~230, scan ~170, detection row
+///   ~70; ~445 k per rotation. Moving (n_eff = 1, simulated pass with a pole, 31 targets)
+///   ~1,940 per azimuth, ~780 k per rotation (the windowed stable test is a second pass).
+/// - Latency (the feed of the message completing a rotation -> on_rotation with its
+///   targets): ~6.8 k instructions static, ~8.9 k with targets (sl_detect_end, tracker).
+///   The rotation is complete when the next rotation's first azimuth arrives (one azimuth
+///   period, 0.625 ms at 1600 Hz, on top).
+/// - Throughput (wall clock, one core, capture in RAM): 13-16 GB/s of capture for a 535 MB
+///   capture (memory-bound; the decoder prefetches the prefix of the messages ahead),
+///   30-50 GB/s when it fits the L3 cache.
+/// Stack: < 1 KB plus the port callbacks'. Task context only; not reentrant.
 #ifndef SHADOWLEAN_SL_PIPELINE_H
 #define SHADOWLEAN_SL_PIPELINE_H
 
@@ -133,8 +171,14 @@ typedef struct sl_port {
 /// pass to sl_pipeline_init() (copied).
 typedef struct sl_pipeline_cfg {
     sl_port_t port;              ///< outputs
-    sl_detect_cfg_t detect;      ///< detection parameters (beam width, gaps, ...): set
-                                 ///< beam_width_cdeg to the simulator's cone when evaluating
+    sl_detect_cfg_t detect;      ///< detection parameters (beam width, gaps, ...). Default:
+                                 ///< sl_detect_cfg_default (CTS350-X, 1.8 deg beam). For the
+                                 ///< simulator (host_tools/sim: an 8 deg cone, RadaRays style,
+                                 ///< column-normalised) set beam_width_cdeg to the return's
+                                 ///< azimuth spread at the threshold: a 1 cm pole at ~3 m
+                                 ///< spans ~14 azimuths (12.6 deg) in scenes/paper_pass_*.ini,
+                                 ///< so ~1200; else groups are rejected WIDE and the
+                                 ///< width-based radius is biased (radius_from_width)
     sl_track_cfg_t track;        ///< tracker parameters
     uint16_t threshold;          ///< occupied = power >= this (8-bit scale); default board's
     uint8_t mask_frames;         ///< n, 1..SL_CFG_MASK_FRAMES_MAX; default board's

@@ -79,11 +79,14 @@
 /// ## Cost
 /// Per FFT message: O(roi_bins) (one memcpy of the ROI bytes; for 16-bit data a SWAR / block
 /// loop) plus O(1) bookkeeping. Per rotation: O(azimuths) flag clearing plus zero-filling missing
-/// rows. Stack < 128 bytes plus the callbacks'. RAM: sizeof(sl_scan_t) (144 bytes on x86-64)
-/// plus the caller's frame(s) (sizeof(sl_scan_frame_t) each: 210,848 bytes with the default
+/// rows. Stack < 128 bytes plus the callbacks'. RAM: sizeof(sl_scan_t) (624 bytes on x86-64
+/// with 400 azimuths: the rotation bookkeeping keeps one flag byte per azimuth) plus the
+/// caller's frame(s) (sizeof(sl_scan_frame_t) each: 210,848 bytes with the default
 /// 400 azimuths x 512 ROI bins). Measured (host_tools/bench_proto, x86-64 gcc -O2, 512-bin
 /// ROI): 8-bit about 340 instructions per azimuth on top of the decoder's (of which the ROI
 /// memcpy is ~80); 16-bit with the default shift 8 about 1,900 (64-bit SWAR, ~3 per bin).
+/// Frame-less with complete 8-bit rows (no copy): ~170 instructions per azimuth including
+/// the message parse (measured inside sl-bench, host_tools/bench).
 /// Task context, not reentrant; callbacks must not feed the same instance.
 #ifndef SHADOWLEAN_SL_SCAN_H
 #define SHADOWLEAN_SL_SCAN_H

@@ -58,6 +58,11 @@ rejects "no input" "no input" --board paper-sim
 rejects "--realtime with a radar" "--realtime applies to --input only" --board paper-sim --radar 1.2.3.4 --realtime
 rejects "a bad port" "expected HOST:PORT" --board paper-sim --radar 1.2.3.4:99999
 rejects "an unknown option" "unknown option" --board paper-sim --input x --frobnicate
+rejects "two motion inputs" "exclusive" --board paper-sim --input x --motion 1.0 --motion-can vcan0
+rejects "a bad motion" "SPEED_M_S" --board paper-sim --input x --motion fast
+"$D" --board paper-sim --input x --can can0 --motion 2.5,-3 --print-config > "$OUT/motion.ini" || fail "--motion"
+has "$OUT/motion.ini" "motion = 2.500,-3.00"
+hasnt "$OUT/motion.ini" "motion_interface"
 rejects "two stdout outputs" "cannot both be stdout" --board paper-sim --input x --can-log - --targets-out -
 "$D" --list-boards > "$OUT/boards.txt" && has "$OUT/boards.txt" "robotcar-leaf" && has "$OUT/boards.txt" "paper-sim"
 "$D" --help | grep -q -- "--gs-usb" || fail "--help"

@@ -63,6 +63,10 @@ s=$(states "$OUT/stall.log"); echo "stalling radar: LinkState per Status frame: 
 echo "${s% |*}" | tr ' ' '\n' | grep -q '^4$' || { echo "FAIL: no SILENT Status frame"; exit 1; }
 grep -q "radar disconnected (SILENCE" "$OUT/stall.err" || { echo "FAIL: no silence timeout"; exit 1; }
 grep -q "1 reconnects" "$OUT/stall.err" || { echo "FAIL: no reconnection"; exit 1; }
+grep -q "Stop FFT sent to the radar" "$OUT/stall.err" || { echo "FAIL: no Stop FFT at exit"; exit 1; }
+# ... and the radar emulator received it on the second connection (its own count).
+grep -q "client 2 .* starts 1, stops 1," "$OUT/replay.out.err" || {
+    cat "$OUT/replay.out.err"; echo "FAIL: sl-replay did not see Start + Stop FFT"; exit 1; }
 rot=${s#*| }
 [ "$rot" -eq 8 ] || { echo "FAIL: $rot rotations, want 8 (5 before the stall, 3 after the reconnection)"; exit 1; }
 "$PY" "$SRC/check_can_vs_targets.py" "$DBC" "$OUT/stall.log" "$OUT/stall.jsonl" --idle-ok --link 0,1,2,3,4 \

@@ -163,6 +163,29 @@ static int apply(sld_opts_t *o, const char *section, const char *key, const char
         if (parse_u32(val, &o->silence_timeout_ms) != 0) BAD("expected ms");
     } else if (IS("input", "silent_ms")) {
         if (parse_u32(val, &o->silent_ms) != 0 || o->silent_ms == 0) BAD("expected ms > 0");
+    } else if (IS("input", "motion")) {
+        if (strcmp(val, "none") == 0 || strcmp(val, "off") == 0) {
+            o->fixed_motion = false;
+        } else {
+            char *end = NULL;
+            errno = 0;
+            const double v = strtod(val, &end);
+            double w = 0.0;
+            if (errno == 0 && end != val && *end == ',') {
+                const char *y = end + 1;
+                w = strtod(y, &end);
+                if (end == y) {
+                    BAD("expected SPEED_M_S[,YAW_DEG_S]");
+                }
+            }
+            if (errno != 0 || end == val || *end != '\0' || !(v >= -300.0 && v <= 300.0) ||
+                !(w >= -300.0 && w <= 300.0)) {
+                BAD("expected SPEED_M_S[,YAW_DEG_S] within +-300");
+            }
+            o->fixed_motion = true;
+            o->fixed_speed_mm_s = (int32_t)lround(v * 1000.0);
+            o->fixed_yaw_cdeg_s = (int32_t)lround(w * 100.0);
+        }
     } else if (IS("can", "interface")) {
         if (val[0] == '\0' || set_str(o->can_iface, sizeof o->can_iface, val) != 0) BAD("bad interface name");
     } else if (IS("can", "log")) {
@@ -297,6 +320,7 @@ static const cli_opt_t k_cli[] = {
     {"--connect-timeout-ms", "input", "connect_timeout_ms", 1, NULL},
     {"--silence-timeout-ms", "input", "silence_timeout_ms", 1, NULL},
     {"--silent-ms", "input", "silent_ms", 1, NULL},
+    {"--motion", "input", "motion", 1, NULL},
     {"--can", "can", "interface", 1, NULL},
     {"--can-log", "can", "log", 1, NULL},
     {"--can-log-iface", "can", "log_iface", 1, NULL},
@@ -327,6 +351,8 @@ void sld_opts_usage(void *fpv)
         "  --connect-timeout-ms N   [input] connect_timeout_ms  radar connect timeout (2000)\n"
         "  --silence-timeout-ms N   [input] silence_timeout_ms  reconnect after N ms without a byte (3000)\n"
         "  --silent-ms N            [input] silent_ms         Status LinkState SILENT after N ms without FFT data (1000)\n"
+        "  --motion V[,W]           [input] motion            constant vehicle motion instead of VehicleMotion frames:\n"
+        "                                                     V m/s (> 0 forward), W deg/s (> 0 counter-clockwise); none = off\n"
         "  --can IFACE              [can] interface           SocketCAN raw output (can0, vcan0)\n"
         "  --can-log FILE           [can] log                 candump -L log output ('-' = stdout)\n"
         "  --can-log-iface NAME     [can] log_iface           interface name in log lines (default: --can or can0)\n"
@@ -475,6 +501,10 @@ int sld_opts_validate(const sld_opts_t *o, char *err, size_t err_size)
         snprintf(err, err_size, "--realtime applies to --input only");
         return -1;
     }
+    if (o->fixed_motion && o->motion_iface[0] != '\0' && !o->motion_off) {
+        snprintf(err, err_size, "--motion and --motion-can are exclusive (one motion input)");
+        return -1;
+    }
     if (strcmp(o->can_log, "-") == 0 && strcmp(o->targets_out, "-") == 0) {
         snprintf(err, err_size, "--can-log and --targets-out cannot both be stdout");
         return -1;
@@ -484,7 +514,7 @@ int sld_opts_validate(const sld_opts_t *o, char *err, size_t err_size)
 
 const char *sld_opts_motion_iface(const sld_opts_t *o)
 {
-    if (o->motion_off) {
+    if (o->motion_off || o->fixed_motion) {
         return "";
     }
     if (o->motion_iface[0] != '\0') {
@@ -516,6 +546,9 @@ void sld_opts_print(const sld_opts_t *o, void *fpv)
     }
     if (o->capture[0] != '\0') {
         fprintf(fp, "capture = %s\n", o->capture);
+    }
+    if (o->fixed_motion) {
+        fprintf(fp, "motion = %.3f,%.2f\n", (double)o->fixed_speed_mm_s / 1000.0, (double)o->fixed_yaw_cdeg_s / 100.0);
     }
     fprintf(fp, "realtime = %s\nnon_contour = %s\nconnect_timeout_ms = %u\nsilence_timeout_ms = %u\nsilent_ms = %u\n",
             o->realtime ? "true" : "false", o->non_contour ? "true" : "false", (unsigned)o->connect_timeout_ms,

@@ -8,7 +8,7 @@
 ///     [daemon]   board, user, syslog, verbosity, stats_every, duration, exit_idle,
 ///                status_period_ms
 ///     [input]    radar (HOST:PORT) | capture (FILE), realtime, non_contour,
-///                connect_timeout_ms, silence_timeout_ms, silent_ms
+///                connect_timeout_ms, silence_timeout_ms, silent_ms, motion
 ///     [can]      interface, log, log_iface, log_time, gs_usb, bitrate, motion_interface
 ///     [output]   targets
 ///
@@ -63,6 +63,9 @@ typedef struct sld_opts {
     uint32_t bitrate;                  ///< --bitrate B (0 = board's)         [can] bitrate
     char motion_iface[SLD_IFACE_CHARS];///< --motion-can IFACE|none           [can] motion_interface
     bool motion_off;                   ///< motion input disabled ("none")
+    bool fixed_motion;                 ///< --motion SPEED[,YAW]: constant motion [input] motion
+    int32_t fixed_speed_mm_s;          ///< its speed, mm/s (> 0 forward)
+    int32_t fixed_yaw_cdeg_s;          ///< its yaw rate, 0.01 deg/s (> 0 counter-clockwise)
     char targets_out[SLD_PATH_CHARS];  ///< --targets-out FILE ("-" stdout)   [output] targets
     char user[SLD_NAME_CHARS];         ///< --user NAME                       [daemon] user
     bool use_syslog;                   ///< --syslog / --stderr               [daemon] syslog

@@ -17,7 +17,8 @@
 ///   makes the next `bulk_out` return STALL (and `out_stalled` true); `clear_halt(OUT)`
 ///   then clears the endpoint and resubmits the stalled frames in their original order,
 ///   so nothing is lost or reordered. A device that does not take a frame within
-///   `out_timeout_ms` loses it (counted; the driver's echo timeout reports it unconfirmed);
+///   `out_timeout_ms` loses it (counted in out_timeouts; the driver's echo timeout reports
+///   it unconfirmed);
 /// - a vanished device (unplug, reset, gadget unbound): every call returns NO_DEVICE.
 ///   Close it and open again (sl_gsusb_sink does that periodically).
 ///
@@ -111,7 +112,8 @@ typedef struct sl_gsusb_usb {
     struct libusb_context *ctx;
     struct libusb_device_handle *h;
     sl_gsusb_usb_sel_t sel;
-    uint32_t out_timeout_ms;       ///< per bulk OUT transfer (default 1000)
+    uint32_t out_timeout_ms;       ///< per bulk OUT transfer (default 1000; gsusb_sink sets
+                                   ///< it to the echo timeout)
     uint16_t vid, pid;             ///< of the opened device
     char where[32];                ///< "bus-port" of the opened device, e.g. "1-1"
     uint8_t ep_in, ep_out;

@@ -137,6 +137,9 @@ sl_err_t sl_gsusb_sink_open(sl_gsusb_sink_t *s, const sl_gsusb_sink_cfg_t *cfg, 
         (void)snprintf(s->last_error, sizeof s->last_error, "%s", s->usb.err);
         return SL_ERR_PORT;
     }
+    // A frame may wait in the USB queue behind a full echo window on a slow adapter: give
+    // up on the transfer no earlier than on its echo.
+    s->usb.out_timeout_ms = s->drv.cfg.echo_timeout_ms;
     s->opened = true;
     return bring_up(s, t_us);
 }

@@ -203,10 +203,19 @@ static void send_idle_status(daemon_t *d)
 // ---------------------------------------------------------------------------------------
 // Input: radar
 
+/// --motion: the constant motion, refreshed before every feed so it never goes stale.
+static void fixed_motion(const daemon_t *d, uint64_t now_us)
+{
+    if (d->o.fixed_motion) {
+        sl_pipeline_set_motion(&g_pipe, d->o.fixed_speed_mm_s, true, d->o.fixed_yaw_cdeg_s, true, now_us);
+    }
+}
+
 static void radar_on_bytes(void *ctx, const uint8_t *data, size_t len, uint64_t now_us)
 {
     daemon_t *d = ctx;
     d->fed_since_finish = true;
+    fixed_motion(d, now_us);
     sl_pipeline_feed(&g_pipe, data, len, now_us);
 }
 
@@ -419,6 +428,7 @@ static int capture_setup(daemon_t *d)
 static void capture_feed_to(daemon_t *d, uint64_t end)
 {
     if (end > d->fed) {
+        fixed_motion(d, pipe_now(d));
         sl_pipeline_feed(&g_pipe, d->cap.bytes + d->fed, (size_t)(end - d->fed), pipe_now(d));
         d->fed = end;
     }
@@ -653,7 +663,11 @@ static void shutdown_all(daemon_t *d)
 {
     d->mono_us = sl_port_now_us();
     if (d->is_radar) {
+        const uint32_t stops = d->radar.stats.stops_sent;
         sl_radar_client_stop(&d->radar, 200); // Stop FFT when streaming; STOPPED -> finish
+        if (d->radar.stats.stops_sent != stops) {
+            sld_log(SLD_LOG_INFO, "Stop FFT sent to the radar");
+        }
         radar_finish(d, d->mono_us);
     } else if (!d->cap_done) {
         sl_pipeline_finish(&g_pipe, pipe_now(d)); // interrupted: flush the partial rotation
@@ -779,6 +793,10 @@ int main(int argc, char **argv)
     if (d->is_radar) {
         snprintf(port_txt, sizeof port_txt, ":%u", (unsigned)d->o.radar_port);
     }
+    if (d->o.fixed_motion) {
+        sld_log(SLD_LOG_INFO, "constant motion: %.3f m/s, %.2f deg/s (--motion)",
+                (double)d->o.fixed_speed_mm_s / 1000.0, (double)d->o.fixed_yaw_cdeg_s / 100.0);
+    }
     sld_log(SLD_LOG_INFO, "board %s, input %s%s%s%s, %zu CAN output(s)%s%s", d->board->name,
             d->is_radar ? "radar " : "capture ", d->is_radar ? d->o.radar_host : d->o.capture, port_txt,
             d->is_radar ? "" : (d->o.realtime ? " (real time)" : " (as fast as possible)"), d->n_sinks,
@@ -805,10 +823,8 @@ int main(int argc, char **argv)
             wake = due < wake ? due : wake;
         }
         wake = d->next_stats_mono < wake ? d->next_stats_mono : wake;
-        uint64_t cap_due = 0;
         nfds_t n = 0;
         fds[n++] = (struct pollfd){d->sfd, POLLIN, 0};
-        const nfds_t i_motion = n;
         if (d->motion_on) {
             fds[n++] = (struct pollfd){sld_motion_fd(&d->motion), POLLIN, 0}; // fd -1 is ignored
             if (sld_motion_fd(&d->motion) < 0) {
@@ -837,7 +853,7 @@ int main(int argc, char **argv)
                 }
             }
         } else if (!d->cap_done) {
-            cap_due = capture_step(d);
+            const uint64_t cap_due = capture_step(d);
             if (cap_due == 0) {
                 wake = d->mono_us; // more to feed now: just look at the fds
             } else {
@@ -854,7 +870,8 @@ int main(int argc, char **argv)
         }
         int timeout_ms = -1;
         if (wake != UINT64_MAX) {
-            timeout_ms = wake <= d->mono_us ? 0 : (int)((wake - d->mono_us + 999U) / 1000U);
+            const uint64_t ms = wake <= d->mono_us ? 0 : (wake - d->mono_us + 999U) / 1000U;
+            timeout_ms = ms > 60000U ? 60000 : (int)ms;
         }
         if (d->cap_done && !d->is_radar) {
             break; // capture fed completely (finish already called)
@@ -871,7 +888,6 @@ int main(int argc, char **argv)
         }
         if (d->motion_on) {
             sld_motion_read(&d->motion, d->mono_us, on_motion_frame, d);
-            (void)i_motion;
         }
         if (d->is_radar) {
             const short rev = rc > 0 ? fds[i_radar].revents : 0;
