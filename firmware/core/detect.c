@@ -255,6 +255,23 @@ static void entries_merge(sl_detect_cand_t *dst, const sl_detect_cand_t *src, ui
     }
 }
 
+// Open groups are also kept in a bitmap so that the per-row loops visit only them (a long
+// rotation can keep one group open across many azimuths, e.g. ground at the shadow edge
+// while moving).
+#define OPEN_WORDS ((SL_CFG_DETECT_MAX_CANDIDATES + 31) / 32)
+
+static void open_set(sl_detect_t *d, const sl_detect_cand_t *c)
+{
+    const uint32_t i = (uint32_t)(c - d->cand);
+    d->open_bits[i >> 5] |= (uint32_t)1U << (i & 31U);
+}
+
+static void open_clr(sl_detect_t *d, const sl_detect_cand_t *c)
+{
+    const uint32_t i = (uint32_t)(c - d->cand);
+    d->open_bits[i >> 5] &= ~((uint32_t)1U << (i & 31U));
+}
+
 // Merge src into dst; both are open and touch azimuth a - 1 or a.
 static void cand_merge(sl_detect_t *d, sl_detect_cand_t *dst, sl_detect_cand_t *src)
 {
@@ -292,6 +309,7 @@ static void cand_merge(sl_detect_t *d, sl_detect_cand_t *dst, sl_detect_cand_t *
     dst->prev_lo = plo;
     dst->prev_hi = phi;
     src->state = ST_FREE; // src was open
+    open_clr(d, src);
     d->n_open--;
 }
 
@@ -321,15 +339,20 @@ static void add_run(sl_detect_t *d, uint32_t a, uint32_t f, uint32_t l, uint32_t
 {
     d->stats.runs++;
     sl_detect_cand_t *dst = NULL;
-    for (uint32_t i = 0; i < SL_CFG_DETECT_MAX_CANDIDATES; i++) {
-        sl_detect_cand_t *c = &d->cand[i];
-        if (!linkable(d, c, a, f, l)) {
-            continue;
-        }
-        if (dst == NULL) {
-            dst = c;
-        } else {
-            cand_merge(d, dst, c);
+    for (uint32_t w = 0; w < OPEN_WORDS; w++) {
+        uint32_t bits = d->open_bits[w]; // snapshot: merges only clear bits
+        while (bits != 0U) {
+            const uint32_t i = w * 32U + ctz32(bits);
+            bits &= bits - 1U;
+            sl_detect_cand_t *c = &d->cand[i];
+            if (!linkable(d, c, a, f, l)) {
+                continue;
+            }
+            if (dst == NULL) {
+                dst = c;
+            } else {
+                cand_merge(d, dst, c);
+            }
         }
     }
     if (dst == NULL) {
@@ -345,6 +368,7 @@ static void add_run(sl_detect_t *d, uint32_t a, uint32_t f, uint32_t l, uint32_t
         }
         memset(dst, 0, sizeof *dst);
         dst->state = ST_OPEN;
+        open_set(d, dst);
         d->n_open++;
         dst->az_first = (uint16_t)a;
         dst->az_last = (uint16_t)a;
@@ -416,6 +440,7 @@ static void finalize(sl_detect_t *d, sl_detect_cand_t *c)
         d->stats.span_overflow++;
     }
     c->state = ST_FREE;
+    open_clr(d, c);
     if (reason >= 0) {
         d->stats.rejected[reason]++;
         return;
@@ -442,16 +467,22 @@ static void finalize(sl_detect_t *d, sl_detect_cand_t *c)
 // wait for the wrap merge at the end of the rotation.
 static void close_before(sl_detect_t *d, uint32_t a)
 {
-    for (uint32_t i = 0; i < SL_CFG_DETECT_MAX_CANDIDATES; i++) {
-        sl_detect_cand_t *c = &d->cand[i];
-        if (c->state != ST_OPEN || (uint32_t)c->az_last + 1U >= a) {
-            continue;
-        }
-        d->n_open--;
-        if (c->az_first == 0U) {
-            c->state = ST_CLOSED;
-        } else {
-            finalize(d, c);
+    for (uint32_t w = 0; w < OPEN_WORDS; w++) {
+        uint32_t bits = d->open_bits[w];
+        while (bits != 0U) {
+            const uint32_t i = w * 32U + ctz32(bits);
+            bits &= bits - 1U;
+            sl_detect_cand_t *c = &d->cand[i];
+            if ((uint32_t)c->az_last + 1U >= a) {
+                continue;
+            }
+            d->n_open--;
+            open_clr(d, c);
+            if (c->az_first == 0U) {
+                c->state = ST_CLOSED;
+            } else {
+                finalize(d, c);
+            }
         }
     }
 }
@@ -497,6 +528,7 @@ void sl_detect_begin(sl_detect_t *d)
     for (uint32_t i = 0; i < SL_CFG_DETECT_MAX_CANDIDATES; i++) {
         d->cand[i].state = ST_FREE;
     }
+    memset(d->open_bits, 0, sizeof d->open_bits);
     d->n_targets = 0U;
     d->n_open = 0U;
     d->last_az = -1;
@@ -584,7 +616,11 @@ sl_ssize_t sl_detect_end(sl_detect_t *d)
             const uint32_t last = n + c0->az_last;
             c->az_last = (uint16_t)(last > 0xFFFFU ? 0xFFFFU : last);
             c->flags |= (uint8_t)(c0->flags | CF_WRAPS);
+            if (c0->state == ST_OPEN) {
+                d->n_open--;
+            }
             c0->state = ST_FREE;
+            open_clr(d, c0);
             break;
         }
     }

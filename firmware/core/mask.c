@@ -396,6 +396,17 @@ sl_err_t sl_mask_update(sl_mask_t *m, uint16_t az, const uint32_t *bits, uint32_
     } else {
         if (m->window == m->frames) {
             update_dispatch(pl, x, occ, free_, words, P, nm1);
+        } else if (m->window == 1U) {
+            // A window of one row (moving fast): the stable planes are the row itself.
+            update_dispatch(pl, x, NULL, NULL, words, P, nm1);
+            for (uint32_t w = 0; w < words; w++) {
+                if (occ != NULL) {
+                    occ[w] = x[w];
+                }
+                if (free_ != NULL) {
+                    free_[w] = ~x[w];
+                }
+            }
         } else {
             // Shorter window (moving): update the state, then the windowed stable test in
             // a second pass (keeps the window logic out of the static hot path).

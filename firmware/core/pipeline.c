@@ -249,6 +249,10 @@ static void feed_held(sl_pipeline_t *p, uint32_t from, uint32_t to)
 static void on_row(void *ctx, const sl_scan_row_t *row)
 {
     sl_pipeline_t *p = ctx;
+    if (p->geometry_bad) {
+        p->stats.rows_dropped++; // the radar announced another geometry than the board's
+        return;
+    }
     if (p->in_rotation == 0U) {
         begin_rotation(p);
     }
@@ -344,11 +348,17 @@ static void on_msg(void *ctx, const sl_proto_msg_t *m)
         p->stats.restarts++; // a radar (re)start announces itself with a Configuration
     }
     const uint32_t rejected = p->scan.stats.config_rejected;
+    const uint32_t accepted = p->scan.stats.configs;
     (void)sl_scan_on_msg(&p->scan, m);
     if (p->scan.stats.config_rejected != rejected) {
+        // Rows of this radar would be mapped with the board's geometry: drop them until a
+        // matching Configuration arrives.
+        p->geometry_bad = true;
         p->stats.geometry_rejected++;
         set_err(p, SL_ERR_RANGE, (uint8_t)SL_PIPELINE_OK,
                 "radar configuration does not match the board (azimuths / encoder size)");
+    } else if (p->scan.stats.configs != accepted) {
+        p->geometry_bad = false;
     }
 }
 

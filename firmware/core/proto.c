@@ -62,9 +62,10 @@ static void put_le32(uint8_t *b, uint32_t v)
 
 // ---------------------------------------------------------------------------------- decoder
 
-// Cache prefetch hint (a compiler builtin, no library call; a no-op elsewhere). Large
-// captures and fast streams are memory-bound: each message's header and the prefix a
-// consumer reads sit ~3.8 KB apart, a stride hardware prefetchers do not follow.
+// Cache prefetch hint (a compiler builtin, no library call; a no-op elsewhere). A consumer
+// that reads only a prefix of each message touches a few lines every ~3.8 KB; hinting them
+// a few messages ahead measured ~1.4x faster on an L3-resident capture (sl-bench, x86-64),
+// and no change on a 535 MB one.
 #if defined(__GNUC__) || defined(__clang__)
 #define SL_PREFETCH(a) __builtin_prefetch(a)
 #else

@@ -221,6 +221,7 @@ typedef struct sl_detect {
     uint8_t n_targets;      ///< targets of the last completed rotation
     int32_t last_az;        ///< last row's azimuth this rotation (-1: none yet)
     uint16_t n_open;        ///< groups in state "open" (skips the per-row close scan)
+    uint32_t open_bits[(SL_CFG_DETECT_MAX_CANDIDATES + 31) / 32]; ///< open groups (bitmap)
     sl_detect_cand_t cand[SL_CFG_DETECT_MAX_CANDIDATES];
     sl_target_t targets[SL_CFG_MAX_TARGETS];
     sl_detect_stats_t stats;

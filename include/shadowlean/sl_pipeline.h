@@ -89,9 +89,9 @@
 ///
 /// | configuration (400 azimuths, 32 targets)              | x86-64    | Cortex-M0 |
 /// |--------------------------------------------------------|-----------|-----------|
-/// | firmware: SL_CFG_MASK_BINS 160, SL_CFG_MASK_FRAMES_MAX 16 | 52,800 B  | 52,696 B  |
-/// | SL_CFG_MASK_BINS 192, SL_CFG_MASK_FRAMES_MAX 16          | 60,904 B  | 60,800 B  |
-/// | host default: mask bins 512 (whole ROI), n <= 32          | 167,544 B | 167,440 B |
+/// | firmware: SL_CFG_MASK_BINS 160, SL_CFG_MASK_FRAMES_MAX 16 | 52,808 B  | 52,712 B  |
+/// | SL_CFG_MASK_BINS 192, SL_CFG_MASK_FRAMES_MAX 16          | 60,912 B  | 60,816 B  |
+/// | host default: mask bins 512 (whole ROI), n <= 32          | 167,552 B | 167,456 B |
 ///
 /// The boards carried today need 135 (paper-sim), 119 (paper-bench) and 141 (robotcar-leaf)
 /// masked bins (sl_detect_bins_needed(), rounded up to 160).
@@ -100,15 +100,16 @@
 /// configuration, 64 KiB chunks of whole 3768-bin CTS350-X messages)
 /// - Per azimuth ~1,110 instructions on the Oxford RobotCar capture (n = 16, no target):
 ///   threshold of 160 bins ~290, mask update ~310, decoder ~230, scan ~170, detection row
-///   ~70; ~445 k per rotation. Moving (n_eff = 1, simulated pass with a pole, 31 targets)
-///   ~1,940 per azimuth, ~780 k per rotation (the windowed stable test is a second pass).
+///   ~70; ~445 k per rotation. Moving (n_eff = 1: every occupied run counts; simulated
+///   1 m/s pass, 31 targets in 36 rotations) ~1,410 per azimuth, ~560 k per rotation.
 /// - Latency (the feed of the message completing a rotation -> on_rotation with its
 ///   targets): ~6.8 k instructions static, ~8.9 k with targets (sl_detect_end, tracker).
 ///   The rotation is complete when the next rotation's first azimuth arrives (one azimuth
 ///   period, 0.625 ms at 1600 Hz, on top).
-/// - Throughput (wall clock, one core, capture in RAM): 13-16 GB/s of capture for a 535 MB
-///   capture (memory-bound; the decoder prefetches the prefix of the messages ahead),
-///   30-50 GB/s when it fits the L3 cache.
+/// - Throughput (wall clock, one core, capture in RAM, shared 2-core VM, noisy): 13-16 GB/s
+///   of capture for a 535 MB capture (Oxford x32), 30-50 GB/s when it fits the L3 cache;
+///   a NumPy implementation of the front end (host_tools/bench/reference_numpy.py) does
+///   ~1.2-1.3 GB/s on the same data (compare.sh: 10-12x).
 /// Stack: < 1 KB plus the port callbacks'. Task context only; not reentrant.
 #ifndef SHADOWLEAN_SL_PIPELINE_H
 #define SHADOWLEAN_SL_PIPELINE_H
@@ -233,7 +234,8 @@ typedef struct sl_pipeline_stats {
     uint32_t can_rx;             ///< frames given to sl_pipeline_on_can_rx
     uint32_t motion_accepted;    ///< VehicleMotion frames accepted (or set_motion calls)
     uint32_t motion_rejected;    ///< VehicleMotion frames failing E2E / dlc
-    uint32_t geometry_rejected;  ///< radar geometry not matching the board (rows dropped)
+    uint32_t geometry_rejected;  ///< Configurations whose geometry does not match the board
+    uint32_t rows_dropped;       ///< rows ignored after such a Configuration (until one matches)
     uint32_t restarts;           ///< radar restarts seen (geometry change, finish)
 } sl_pipeline_stats_t;
 
@@ -251,6 +253,7 @@ typedef struct sl_pipeline {
     uint8_t frames_eff;          ///< current n_eff
     uint8_t in_rotation;         ///< internal: a rotation is being assembled
     bool ready;                  ///< init succeeded
+    bool geometry_bad;           ///< the radar's last Configuration did not match the board
     uint16_t next_az;            ///< internal: next azimuth detection expects
     uint32_t r_max_um;           ///< farthest range detection reads (for the yaw term)
     uint32_t rotation_us;        ///< last measured rotation period

@@ -1178,11 +1178,29 @@ static void test_pipeline_rejects_boards_that_need_more_mask_bins(void **state)
     // A radar whose configuration does not match the board: rows dropped, counted.
     assert_int_equal(sl_pipeline_init(&pl, B, NULL), SL_OK);
     stream_t st;
-    st_init(&st, 4096);
+    st_init(&st, 400U * 500U * 3U);
     st_config(&st, 360, 400);
+    static uint8_t row[400];
+    memset(row, 200, sizeof row);
+    for (uint32_t a = 0; a < 400; a++) {
+        st_fft(&st, a, row, 400, 1, 8);
+    }
+    st_config(&st, 400, 400); // the radar is reconfigured to the board's geometry
+    for (int r = 0; r < 2; r++) {
+        for (uint32_t a = 0; a < 400; a++) {
+            st_fft(&st, a, row, 400, 1, 8);
+        }
+    }
+    rec_reset(0);
+    c = cfg_for(B);
+    assert_int_equal(sl_pipeline_init(&pl, B, &c), SL_OK);
     assert_int_equal(sl_pipeline_feed(&pl, st.buf, st.n, 0), SL_OK);
+    assert_int_equal(sl_pipeline_finish(&pl, 0), SL_OK);
     assert_int_equal(pl.stats.geometry_rejected, 1);
+    assert_int_equal(pl.stats.rows_dropped, 400);
+    assert_int_equal(pl.stats.azimuths, 800);
     assert_int_equal(pl.last_err, SL_ERR_RANGE);
+    assert_non_null(pl.last_err_msg);
     st_free(&st);
 }
 
