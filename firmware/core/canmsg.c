@@ -302,8 +302,8 @@ sl_err_t sl_can_encode_pole_lean(sl_can_tx_t *tx, const sl_can_pole_lean_t *in,
     put_azimuth(d, &s[P_AZ], in->azimuth_cdeg, SL_CAN_POLE_AZIMUTH_CDEG_PER_LSB);
     put_phys(d, &s[P_LEAN], in->lean_cdeg, SL_CAN_POLE_LEAN_CDEG_PER_LSB, &cl);
     put_phys(d, &s[P_SIGMA], in->lean_sigma_cdeg, SL_CAN_POLE_SIGMA_CDEG_PER_LSB, &cl);
-    put_phys(d, &s[P_R1], in->range_inner_mm, SL_CAN_POLE_RANGE_MM_PER_LSB, &cl);
-    put_phys(d, &s[P_R2], in->range_outer_mm, SL_CAN_POLE_RANGE_MM_PER_LSB, &cl);
+    put_phys(d, &s[P_R1], in->range_inner_um, SL_CAN_POLE_RANGE_UM_PER_LSB, &cl); // um: one rounding
+    put_phys(d, &s[P_R2], in->range_outer_um, SL_CAN_POLE_RANGE_UM_PER_LSB, &cl);
     put_sig(d, &s[P_CLAMPED], cl ? 1 : 0);
     finish(tx, SL_CAN_MSG_POLE_LEAN, d, cl, out);
     return SL_OK;
@@ -335,7 +335,7 @@ sl_err_t sl_can_encode_lean_warning(sl_can_tx_t *tx, const sl_can_lean_warning_t
         put_sig(d, &s[W_TARGET], clamp_raw(&s[W_TARGET], in->target_id, &cl));
         put_azimuth(d, &s[W_AZ], in->azimuth_cdeg, SL_CAN_WARN_AZIMUTH_CDEG_PER_LSB);
         put_phys(d, &s[W_LEAN], in->lean_cdeg, SL_CAN_WARN_LEAN_CDEG_PER_LSB, &cl);
-        put_phys(d, &s[W_RANGE], in->range_mm, SL_CAN_WARN_RANGE_MM_PER_LSB, &cl);
+        put_phys(d, &s[W_RANGE], in->range_um, SL_CAN_WARN_RANGE_UM_PER_LSB, &cl); // um: one rounding
         put_phys(d, &s[W_SIGMA], in->lean_sigma_cdeg, SL_CAN_WARN_SIGMA_CDEG_PER_LSB, &cl);
     }
     put_sig(d, &s[W_CLAMPED], cl ? 1 : 0);
@@ -473,8 +473,8 @@ sl_err_t sl_can_decode_pole_lean(const sl_can_frame_t *f, sl_can_pole_lean_t *ou
     out->azimuth_cdeg = (int32_t)(get_sig(d, &s[P_AZ]) * SL_CAN_POLE_AZIMUTH_CDEG_PER_LSB);
     out->lean_cdeg = (int32_t)(get_sig(d, &s[P_LEAN]) * SL_CAN_POLE_LEAN_CDEG_PER_LSB);
     out->lean_sigma_cdeg = (uint32_t)(get_sig(d, &s[P_SIGMA]) * SL_CAN_POLE_SIGMA_CDEG_PER_LSB);
-    out->range_inner_mm = (uint32_t)(get_sig(d, &s[P_R1]) * SL_CAN_POLE_RANGE_MM_PER_LSB);
-    out->range_outer_mm = (uint32_t)(get_sig(d, &s[P_R2]) * SL_CAN_POLE_RANGE_MM_PER_LSB);
+    out->range_inner_um = (uint32_t)(get_sig(d, &s[P_R1]) * SL_CAN_POLE_RANGE_UM_PER_LSB);
+    out->range_outer_um = (uint32_t)(get_sig(d, &s[P_R2]) * SL_CAN_POLE_RANGE_UM_PER_LSB);
     return SL_OK;
 }
 
@@ -494,7 +494,7 @@ sl_err_t sl_can_decode_lean_warning(const sl_can_frame_t *f, sl_can_lean_warning
     out->quality = (uint8_t)get_sig(d, &s[W_QUALITY]);
     out->azimuth_cdeg = (int32_t)(get_sig(d, &s[W_AZ]) * SL_CAN_WARN_AZIMUTH_CDEG_PER_LSB);
     out->lean_cdeg = (int32_t)(get_sig(d, &s[W_LEAN]) * SL_CAN_WARN_LEAN_CDEG_PER_LSB);
-    out->range_mm = (uint32_t)(get_sig(d, &s[W_RANGE]) * SL_CAN_WARN_RANGE_MM_PER_LSB);
+    out->range_um = (uint32_t)(get_sig(d, &s[W_RANGE]) * SL_CAN_WARN_RANGE_UM_PER_LSB);
     out->lean_sigma_cdeg = (uint32_t)(get_sig(d, &s[W_SIGMA]) * SL_CAN_WARN_SIGMA_CDEG_PER_LSB);
     return SL_OK;
 }

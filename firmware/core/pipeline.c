@@ -130,9 +130,20 @@ static uint8_t quality_of(const sl_track_t *t)
     }
 }
 
-static uint32_t um_to_mm(uint32_t um)
+// One Status frame with the current counters and link state (rotation or idle).
+static void emit_status(sl_pipeline_t *p)
 {
-    return (uint32_t)(((uint64_t)um + 500U) / 1000U);
+    const sl_can_status_t st = {
+        .link_state = p->link_state,
+        .rotations = p->stats.rotations,
+        .azimuths_missing = p->stats.azimuths_missing,
+        .decoder_resyncs = p->proto.stats.resyncs,
+        .can_dropped = p->stats.can_dropped,
+    };
+    sl_can_frame_t f;
+    if (sl_can_encode_status(&p->can, &st, &f) == SL_OK) {
+        can_send(p, &f);
+    }
 }
 
 static void emit_can(sl_pipeline_t *p)
@@ -162,8 +173,8 @@ static void emit_can(sl_pipeline_t *p)
             .target_id = (uint8_t)(t->id & 15U),
             .quality = q,
             .azimuth_cdeg = vehicle_az_cdeg(p, t->az),
-            .range_inner_mm = um_to_mm(t->r1_um),
-            .range_outer_mm = um_to_mm(t->r2_um),
+            .range_inner_um = t->r1_um, // rounded once, by the encoder
+            .range_outer_um = t->r2_um,
             .lean_cdeg = has_lean ? t->alpha_cdeg : 0,
             .lean_sigma_cdeg = has_lean ? t->sigma_cdeg : 0U,
         };
@@ -181,7 +192,7 @@ static void emit_can(sl_pipeline_t *p)
         lw.target_id = (uint8_t)(worst->id & 15U);
         lw.quality = q;
         lw.azimuth_cdeg = vehicle_az_cdeg(p, worst->az);
-        lw.range_mm = um_to_mm(worst->r1_um);
+        lw.range_um = worst->r1_um;
         lw.lean_cdeg = has_lean ? worst->alpha_cdeg : 0;
         lw.lean_sigma_cdeg = has_lean ? worst->sigma_cdeg : 0U;
     }
@@ -189,16 +200,7 @@ static void emit_can(sl_pipeline_t *p)
         can_send(p, &f);
     }
     // Status last: it reports the drops of this rotation's frames too.
-    const sl_can_status_t st = {
-        .link_state = p->link_state,
-        .rotations = p->stats.rotations,
-        .azimuths_missing = p->stats.azimuths_missing,
-        .decoder_resyncs = p->proto.stats.resyncs,
-        .can_dropped = p->stats.can_dropped,
-    };
-    if (sl_can_encode_status(&p->can, &st, &f) == SL_OK) {
-        can_send(p, &f);
-    }
+    emit_status(p);
 }
 
 // ------------------------------------------------------------------------------- rotation
@@ -525,11 +527,28 @@ void sl_pipeline_set_motion(sl_pipeline_t *p, int32_t speed_mm_s, bool speed_val
     p->motion.yaw_rate_valid = yaw_rate_valid;
     p->motion_t_us = now_us;
     p->motion_set = true;
-    p->stats.motion_accepted++;
+    p->stats.motion_set_calls++;
 }
 
 void sl_pipeline_set_link_state(sl_pipeline_t *p, uint8_t link_state)
 {
     SL_ASSERT(p != NULL);
     p->link_state = link_state;
+}
+
+sl_err_t sl_pipeline_send_status(sl_pipeline_t *p, uint64_t now_us)
+{
+    if (p == NULL || !p->ready) {
+        return SL_ERR_ARG;
+    }
+    p->now_us = now_us;
+    emit_status(p);
+    return SL_OK;
+}
+
+void sl_pipeline_add_can_dropped(sl_pipeline_t *p, uint32_t n)
+{
+    SL_ASSERT(p != NULL);
+    p->stats.can_dropped = (n > UINT32_MAX - p->stats.can_dropped) ? UINT32_MAX
+                                                                   : p->stats.can_dropped + n;
 }

@@ -102,7 +102,9 @@
 /// Unlisted bits are reserved: sent as 0, ignored by the decoders.
 ///
 /// ## Encoding rules (house style: rounding place 3)
-/// raw = physical / factor, rounded half up (towards +infinity at exact halves), then
+/// raw = physical / factor, rounded half up (towards +infinity at exact halves), exactly
+/// once from the finest integer unit available (ranges from um: r1 = 2.6499 m -> raw 132
+/// = 2.64 m; never pre-rounded to mm first), then
 /// range-checked: a value outside the signal's range is CLAMPED to the nearest limit and
 /// the frame's Clamped (Status: Saturated) bit is set and `tx->stats.clamped_frames`
 /// counted. Nothing is ever wrapped silently. Azimuths are angles: they are reduced modulo
@@ -222,7 +224,8 @@ typedef enum sl_can_link_state {
 #define SL_CAN_POLE_LEAN_RAW_MAX 511
 #define SL_CAN_POLE_SIGMA_CDEG_PER_LSB 20    ///< 0.2 deg
 #define SL_CAN_POLE_SIGMA_RAW_MAX 31
-#define SL_CAN_POLE_RANGE_MM_PER_LSB 20      ///< 0.02 m
+#define SL_CAN_POLE_RANGE_MM_PER_LSB 20      ///< 0.02 m (layout/DBC factor 20/1000)
+#define SL_CAN_POLE_RANGE_UM_PER_LSB 20000L  ///< 0.02 m: the encoder's step for um inputs
 #define SL_CAN_POLE_RANGE_RAW_MAX 511
 
 #define SL_CAN_WARN_AZIMUTH_CDEG_PER_LSB 10  ///< 0.1 deg
@@ -230,7 +233,8 @@ typedef enum sl_can_link_state {
 #define SL_CAN_WARN_LEAN_CDEG_PER_LSB 5      ///< 0.05 deg
 #define SL_CAN_WARN_LEAN_RAW_MIN (-2048)
 #define SL_CAN_WARN_LEAN_RAW_MAX 2047
-#define SL_CAN_WARN_RANGE_MM_PER_LSB 10      ///< 0.01 m
+#define SL_CAN_WARN_RANGE_MM_PER_LSB 10      ///< 0.01 m (layout/DBC factor 10/1000)
+#define SL_CAN_WARN_RANGE_UM_PER_LSB 10000L  ///< 0.01 m: the encoder's step for um inputs
 #define SL_CAN_WARN_RANGE_RAW_MAX 2047
 #define SL_CAN_WARN_SIGMA_CDEG_PER_LSB 10    ///< 0.1 deg
 #define SL_CAN_WARN_SIGMA_RAW_MAX 63
@@ -246,15 +250,19 @@ typedef enum sl_can_link_state {
 #define SL_CAN_MOTION_RAW_MAX 32767
 
 // ---------------------------------------------------------------------------------------
-// Message contents in physical integer units (filled by the pipeline, returned by decoders)
+// Message contents in physical integer units (filled by the pipeline, returned by decoders).
+// Ranges are in micrometres, the finest unit the pipeline has, so that each range is
+// rounded exactly once on its way to the wire: um -> the signal's step, in the encoder
+// (house style rounding place 3). Decoders return raw x step in um (e.g. RangeInner raw
+// 132 -> 2,640,000 um).
 
 /// One target (PoleLean). Encode reads the fields marked "in"; decode sets all fields.
 typedef struct sl_can_pole_lean {
     uint8_t target_id;        ///< in: 0..15
     uint8_t quality;          ///< in: sl_can_quality_t (0..4)
     int32_t azimuth_cdeg;     ///< in: clockwise from vehicle forward; any value, reduced mod 36000
-    uint32_t range_inner_mm;  ///< in: inner bound r1
-    uint32_t range_outer_mm;  ///< in: outer bound r2
+    uint32_t range_inner_um;  ///< in: inner bound r1, micrometres (rounded once, to 0.02 m)
+    uint32_t range_outer_um;  ///< in: outer bound r2, micrometres (rounded once, to 0.02 m)
     int32_t lean_cdeg;        ///< in: > 0 = top towards the vehicle
     uint32_t lean_sigma_cdeg; ///< in: 1-sigma of lean
     bool clamped;             ///< decode: Clamped bit (ignored by encode: it is computed)
@@ -268,7 +276,7 @@ typedef struct sl_can_lean_warning {
     uint8_t target_id;        ///< in: 0..15
     uint8_t quality;          ///< in: sl_can_quality_t of that target
     int32_t azimuth_cdeg;     ///< in: reduced mod 36000
-    uint32_t range_mm;        ///< in: inner bound r1
+    uint32_t range_um;        ///< in: inner bound r1, micrometres (rounded once, to 0.01 m)
     int32_t lean_cdeg;        ///< in
     uint32_t lean_sigma_cdeg; ///< in
     bool clamped;             ///< decode only
@@ -385,7 +393,8 @@ sl_err_t sl_can_encode_vehicle_motion(sl_can_tx_t *tx, const sl_can_vehicle_moti
 // ---------------------------------------------------------------------------------------
 // Decoders: check dlc/flags, CRC and counter 15 (not the sequence: use sl_can_e2e_check
 // or sl_can_motion_rx_feed for that) and convert to physical integer units
-// (raw x factor; e.g. Lean raw 123 -> 1230 cdeg). They do not check the id.
+// (raw x factor; e.g. Lean raw 123 -> 1230 cdeg, RangeInner raw 132 -> 2640000 um).
+// They do not check the id.
 // @return SL_OK or SL_ERR_MALFORMED (nothing useful written) / SL_ERR_ARG (NULL).
 
 sl_err_t sl_can_decode_pole_lean(const sl_can_frame_t *f, sl_can_pole_lean_t *out);

@@ -33,7 +33,9 @@
 ///    HasTarget = 0 when there is none); one Status (link state, rotations, missing
 ///    azimuths, decoder resyncs, CAN drops). `can_tx` must not block: SL_ERR_BUSY (or any
 ///    other error) counts the frame as dropped (`stats.can_dropped`, reported in the next
-///    Status frame) and the pipeline moves on.
+///    Status frame) and the pipeline moves on. Drops the port notices later (after can_tx
+///    returned SL_OK) are added with `sl_pipeline_add_can_dropped()`. Between rotations
+///    the port sends Status frames with `sl_pipeline_send_status()` (same E2E sequence).
 /// Callbacks must not call back into the same pipeline (not reentrant).
 ///
 /// ## Mapping to CAN (sl_can.h)
@@ -230,9 +232,12 @@ typedef struct sl_pipeline_stats {
     uint32_t azimuths_missing;   ///< sum of missing azimuths over rotations
     uint32_t targets;            ///< targets reported
     uint32_t can_frames;         ///< frames accepted by can_tx
-    uint32_t can_dropped;        ///< frames can_tx refused (BUSY or error)
+    uint32_t can_dropped;        ///< frames can_tx refused (BUSY or error), plus drops the
+                                 ///< port reported later (sl_pipeline_add_can_dropped);
+                                 ///< saturates at UINT32_MAX
     uint32_t can_rx;             ///< frames given to sl_pipeline_on_can_rx
-    uint32_t motion_accepted;    ///< VehicleMotion frames accepted (or set_motion calls)
+    uint32_t motion_accepted;    ///< VehicleMotion frames accepted from CAN (E2E passed)
+    uint32_t motion_set_calls;   ///< sl_pipeline_set_motion() calls (not counted above)
     uint32_t motion_rejected;    ///< VehicleMotion frames failing E2E / dlc
     uint32_t geometry_rejected;  ///< Configurations whose geometry does not match the board
     uint32_t rows_dropped;       ///< rows ignored after such a Configuration (until one matches)
@@ -331,12 +336,27 @@ sl_err_t sl_pipeline_on_can_rx(sl_pipeline_t *p, const sl_can_frame_t *f, uint64
 
 /// Direct motion input (no CAN): speed in mm/s (> 0 forward), yaw rate in 0.01 deg/s
 /// (> 0 counter-clockwise from above), valid flags as in VehicleMotion. Overrides older
-/// CAN values; the newest input of either kind is used. O(1).
+/// CAN values; the newest input of either kind is used. Counted in
+/// `stats.motion_set_calls` (not in `motion_accepted`, which counts CAN frames). O(1).
 void sl_pipeline_set_motion(sl_pipeline_t *p, int32_t speed_mm_s, bool speed_valid,
                             int32_t yaw_rate_cdeg_s, bool yaw_rate_valid, uint64_t now_us);
 
 /// Link state for the Status frame (sl_can_link_state_t, set by the port). O(1).
 void sl_pipeline_set_link_state(sl_pipeline_t *p, uint8_t link_state);
+
+/// One Status frame now, between rotations (e.g. the port's 1 Hz idle Status while no
+/// rotation completes): the current link state and counters, encoded with the pipeline's
+/// own sender so the Status E2E counter continues the rotations' sequence, sent through
+/// `port.can_tx` (a refusal is counted in `stats.can_dropped` like any frame; no can_tx:
+/// nothing is sent). `now_us` is the port's clock (stored as the call's time only).
+/// @return SL_OK, or SL_ERR_ARG (NULL or not initialised). O(1).
+sl_err_t sl_pipeline_send_status(sl_pipeline_t *p, uint64_t now_us);
+
+/// Add `n` frames the port lost AFTER `can_tx` accepted them (a sink's stale or bus-off
+/// drops, gs_usb frames never confirmed) to `stats.can_dropped` (saturating at UINT32_MAX),
+/// so that the next Status frame's CanDropped includes them. Drops `can_tx` reported by
+/// its return value are already counted: do not add those again. O(1).
+void sl_pipeline_add_can_dropped(sl_pipeline_t *p, uint32_t n);
 
 /// The consistency window n_eff for a motion (formula in the file comment): pure, for
 /// tests and tools. `speed_mm_s`/`yaw_rate_cdeg_s` signed (magnitudes are used);

@@ -959,7 +959,8 @@ static void test_pipeline_takes_motion_from_can_and_the_setter(void **state)
     for (int k = 0; k < 10; k++) {
         assert_int_equal(rec.frames_eff[k], want[k]);
     }
-    assert_int_equal(pl.stats.motion_accepted, 4);
+    assert_int_equal(pl.stats.motion_accepted, 2);   // CAN frames only
+    assert_int_equal(pl.stats.motion_set_calls, 2);  // the two setter calls
     assert_int_equal(pl.stats.motion_rejected, 1);
     assert_int_equal(pl.motion_rx.stats.other_ids, 1);
     // A shorter window during rotations 2..5 does not lose history: the static poles are
