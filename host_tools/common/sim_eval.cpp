@@ -4,14 +4,17 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <map>
+#include <memory>
 #include <sstream>
 
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "shadowlean/sl_incline.h"
+#include "shadowlean/sl_pipeline.h"
 #include "sim_geom.h"
 #include "sim_render.h"
 #include "sl_geom.h"
@@ -359,17 +362,24 @@ void ErrStats::finish()
 void simulate_decode(const Scene &scene, int threads,
                      const std::function<void(int k, const std::vector<GtRow> &gt)> &on_gt,
                      const CaptureRows::RowFn &on_row,
-                     const std::function<void(int done, int total)> &progress)
+                     const std::function<void(int done, int total)> &progress,
+                     const std::function<void(int k, const uint8_t *bytes, size_t n)> &on_bytes)
 {
     const Simulator sim(scene);
     CaptureRows dec(on_row);
     const auto cfg = sim.config_message();
     dec.feed(cfg.data(), cfg.size());
+    if (on_bytes) {
+        on_bytes(0, cfg.data(), cfg.size());
+    }
     sim_run(
         sim, 0, scene.rotations, threads,
         [&](int k, std::vector<uint8_t> &bytes, std::vector<GtRow> &gt) {
             on_gt(k, gt);
             dec.feed(bytes.data(), bytes.size());
+            if (on_bytes) {
+                on_bytes(k, bytes.data(), bytes.size());
+            }
         },
         progress);
     dec.finish();
@@ -380,6 +390,215 @@ void simulate_decode(const Scene &scene, int threads,
                                  std::to_string(dec.bad_fft()) + ", rotations " +
                                  std::to_string(dec.rotations_seen()) + ")");
     }
+}
+
+// ------------------------------------------------------------------------------------------
+// core pipeline
+
+const char *const kPipelineLabel =
+    "core pipeline (sl_pipeline: mask + detection + corrections + alpha; n_eff from motion)";
+
+PipeCfg pipe_cfg_for_scene(const Scene &s)
+{
+    PipeCfg c;
+    c.board = s.board.name.empty() ? s.board_name : s.board.name;
+    c.beam_deg = 2.0 * scene_az_cutoff_deg(s);
+    c.threshold = s.mapping == OutputMapping::Linear ? std::max(1, s.detect_floor) : -1;
+    c.speed_mps = s.speed_mps;
+    c.rotation_hz = s.rotation_hz;
+    return c;
+}
+
+struct PipelineEval::Impl {
+    PipeCfg cfg;
+    std::unique_ptr<sl_pipeline_t> p{new sl_pipeline_t()};
+    std::map<int, std::vector<sl_target_t>> targets; // by rotation
+    std::map<int, int> frames_eff;                    // by rotation
+    std::vector<GtRow> truth;
+    uint64_t period_us = 250000;
+
+    static void on_rotation(void *ctx, const sl_pipeline_rotation_t *r)
+    {
+        auto *self = static_cast<Impl *>(ctx);
+        auto &v = self->targets[static_cast<int>(r->rotation)];
+        v.assign(r->targets, r->targets + r->n_targets);
+        self->frames_eff[static_cast<int>(r->rotation)] = r->frames_eff;
+    }
+    uint64_t now_for(int rotation) const
+    {
+        return 1000000U + static_cast<uint64_t>(std::max(0, rotation)) * period_us;
+    }
+};
+
+PipelineEval::PipelineEval(const PipeCfg &c) : m_(new Impl)
+{
+    m_->cfg = c;
+    m_->period_us = static_cast<uint64_t>(std::llround(1e6 / (c.rotation_hz > 0 ? c.rotation_hz : 4.0)));
+    const sl_board_t *b = sl_board_find(c.board.c_str());
+    if (b == nullptr) {
+        delete m_;
+        throw std::runtime_error("board " + c.board + " is not linked into the core (sl_board_find)");
+    }
+    sl_pipeline_cfg_t pc;
+    sl_pipeline_cfg_default(&pc, b);
+    pc.port.on_rotation = &Impl::on_rotation;
+    pc.port.ctx = m_;
+    if (c.beam_deg > 0) {
+        pc.detect.beam_width_cdeg = static_cast<uint16_t>(std::clamp(std::lround(c.beam_deg * 100), 1L, 36000L));
+    }
+    if (c.threshold >= 0) {
+        pc.threshold = static_cast<uint16_t>(c.threshold);
+    }
+    if (c.radius_from_width >= 0) {
+        pc.detect.radius_from_width = c.radius_from_width != 0;
+    }
+    if (c.mask_frames > 0) {
+        pc.mask_frames = static_cast<uint8_t>(c.mask_frames);
+    }
+    const sl_err_t e = sl_pipeline_init(m_->p.get(), b, &pc);
+    if (e != SL_OK) {
+        const std::string msg = m_->p->last_err_msg != nullptr ? m_->p->last_err_msg : "?";
+        delete m_;
+        throw std::runtime_error("sl_pipeline_init(" + c.board + "): " + sl_err_str(e) + " (" + msg + ")");
+    }
+}
+
+PipelineEval::~PipelineEval() { delete m_; }
+
+void PipelineEval::add_truth(const GtRow &g) { m_->truth.push_back(g); }
+
+void PipelineEval::feed(int rotation, const uint8_t *data, size_t n)
+{
+    const uint64_t now = m_->now_for(rotation);
+    if (m_->cfg.motion) {
+        sl_pipeline_set_motion(m_->p.get(), static_cast<int32_t>(std::lround(m_->cfg.speed_mps * 1000)), true,
+                               0, true, now);
+    }
+    sl_pipeline_feed(m_->p.get(), data, n, now + m_->period_us / 2);
+}
+
+void PipelineEval::finish()
+{
+    int last = m_->targets.empty() ? 0 : m_->targets.rbegin()->first + 1;
+    const uint64_t now = m_->now_for(last);
+    if (m_->cfg.motion) {
+        sl_pipeline_set_motion(m_->p.get(), static_cast<int32_t>(std::lround(m_->cfg.speed_mps * 1000)), true,
+                               0, true, now);
+    }
+    sl_pipeline_finish(m_->p.get(), now + m_->period_us / 2);
+}
+
+std::map<int, PipeEval> PipelineEval::result() const
+{
+    const sl_pipeline_t &p = *m_->p;
+    std::map<int, PipeEval> out;
+    PipeEval base;
+    base.rotations = static_cast<int>(p.stats.rotations);
+    base.targets = static_cast<int>(p.stats.targets);
+    for (int i = 0; i < 4; i++) {
+        base.rejected[i] = p.detect.stats.rejected[i];
+    }
+    base.geometry_rejected = p.stats.geometry_rejected;
+    base.beam_cdeg = p.cfg.detect.beam_width_cdeg;
+    base.threshold = p.cfg.threshold;
+    base.frames_eff_min = 255;
+    for (const auto &kv : m_->frames_eff) {
+        base.frames_eff_min = std::min(base.frames_eff_min, kv.second);
+        base.frames_eff_max = std::max(base.frames_eff_max, kv.second);
+    }
+    if (m_->frames_eff.empty()) {
+        base.frames_eff_min = 0;
+    }
+    const int az_n = std::max<int>(1, p.board->azimuths);
+    std::map<int, std::vector<bool>> used;
+    for (const auto &kv : m_->targets) {
+        used[kv.first].assign(kv.second.size(), false);
+    }
+    for (const auto &g : m_->truth) {
+        PipeEval &pe = out.emplace(g.pole, base).first->second;
+        pe.err.clip_ambiguous = m_->cfg.clip_ambiguous;
+        pe.truth_rows++;
+        auto it = m_->targets.find(g.rotation);
+        if (it == m_->targets.end()) {
+            continue;
+        }
+        int best = -1, best_d = m_->cfg.assoc_az + 1;
+        for (size_t j = 0; j < it->second.size(); j++) {
+            if (used[g.rotation][j]) {
+                continue;
+            }
+            int d = std::abs(static_cast<int>(it->second[j].az) - g.azimuth) % az_n;
+            d = std::min(d, az_n - d);
+            if (d < best_d) {
+                best_d = d;
+                best = static_cast<int>(j);
+            }
+        }
+        if (best < 0) {
+            continue;
+        }
+        used[g.rotation][static_cast<size_t>(best)] = true;
+        const sl_target_t &t = it->second[static_cast<size_t>(best)];
+        pe.detected++;
+        Est e;
+        e.extracted = true;
+        e.flag = t.incline_flag;
+        e.alpha_deg = t.alpha_cdeg / 100.0;
+        e.sigma_deg = t.sigma_cdeg / 100.0;
+        e.r1_m = t.r1_um * 1e-6;
+        e.r2_m = t.r2_um * 1e-6;
+        e.amb_bound_deg = 0.5 * (g.beta_deg - g.theta_deg);
+        pe.err.add(e, g.alpha_deg);
+        if (std::getenv("SL_EVAL_PIPE_DEBUG") != nullptr) {
+            std::fprintf(stderr, "rot %d az %d/%d n %u bins %u-%u r1 %.4f/%.4f r2 %.4f/%.4f R %u alpha %.2f truth %.2f model %.2f flag %d\n",
+                         g.rotation, t.az, g.azimuth, t.az_count, t.bin_first, t.bin_last, e.r1_m, g.r1_m, e.r2_m, g.r2_m,
+                         t.radius_um, e.alpha_deg, g.alpha_deg, g.alpha_model_deg, e.flag);
+        }
+    }
+    int unmatched = 0;
+    for (const auto &kv : used) {
+        for (bool u : kv.second) {
+            unmatched += u ? 0 : 1;
+        }
+    }
+    for (auto &kv : out) {
+        kv.second.unmatched = unmatched;
+        kv.second.err.finish();
+    }
+    return out;
+}
+
+std::map<int, PipeEval> simulate_pipeline(const Scene &scene, const PipeCfg &c, int threads, int *boundary,
+                                          const std::function<void(int done, int total)> &progress)
+{
+    const Simulator sim(scene);
+    PipelineEval pe(c);
+    const auto cfg = sim.config_message();
+    pe.feed(0, cfg.data(), cfg.size());
+    const double bin = scene.board.bin_size_m;
+    const int ground_bin = static_cast<int>(
+        std::floor(scene.board.radar_height_m / std::sin(sim_d2r(scene.board.theta_deg(0))) / bin));
+    int nb = 0;
+    sim_run(
+        sim, 0, scene.rotations, threads,
+        [&](int k, std::vector<uint8_t> &bytes, std::vector<GtRow> &gt) {
+            for (const auto &g : gt) {
+                if (g.nominal == 1 && g.valid == 1) {
+                    if (static_cast<int>(std::floor(g.r2_m / bin)) >= ground_bin - 1) {
+                        nb++;
+                        continue;
+                    }
+                    pe.add_truth(g);
+                }
+            }
+            pe.feed(k, bytes.data(), bytes.size());
+        },
+        progress);
+    pe.finish();
+    if (boundary != nullptr) {
+        *boundary = nb;
+    }
+    return pe.result();
 }
 
 // ------------------------------------------------------------------------------------------
@@ -473,6 +692,14 @@ Table1Result run_table1(const Table1Options &o)
             std::map<std::pair<int, int>, GtRow> want;
             auto &out = samples[c][a];
             int &nb = n_boundary[c][a];
+            std::unique_ptr<PipelineEval> pipe, pipe_nr;
+            if (o.extract == Extract::Pipeline && c != 0) {
+                res.pipe_cfg[c] = pipe_cfg_for_scene(s);
+                pipe.reset(new PipelineEval(res.pipe_cfg[c]));
+                PipeCfg nr = res.pipe_cfg[c];
+                nr.radius_from_width = 0;
+                pipe_nr.reset(new PipelineEval(nr));
+            }
             simulate_decode(
                 s, o.threads,
                 [&](int, const std::vector<GtRow> &gt) {
@@ -483,6 +710,10 @@ Table1Result run_table1(const Table1Options &o)
                                 continue;
                             }
                             want[{g.rotation, g.azimuth}] = g;
+                            if (pipe) {
+                                pipe->add_truth(g); // the same rows as the bbox path
+                                pipe_nr->add_truth(g);
+                            }
                         }
                     }
                 },
@@ -504,9 +735,29 @@ Table1Result run_table1(const Table1Options &o)
                                      cap_i, 3 * ncap, c == 0 ? "ideal" : c == 1 ? "real res" : c == 2 ? "emission" : c == 3 ? "10 cm" : "20 cm",
                                      res.angles[a], done, total);
                     }
+                },
+                [&](int k, const uint8_t *bytes, size_t n) {
+                    if (pipe) {
+                        pipe->feed(k, bytes, n);
+                        pipe_nr->feed(k, bytes, n);
+                    }
                 });
+            if (pipe) {
+                pipe->finish();
+                pipe_nr->finish();
+                const auto pr = pipe->result();
+                if (!pr.empty()) {
+                    res.pipe[0][c][a] = pr.begin()->second;
+                }
+                const auto pn = pipe_nr->result();
+                if (!pn.empty()) {
+                    res.pipe[1][c][a] = pn.begin()->second;
+                }
+                res.have_pipe = true;
+            }
         }
     }
+    res.bbox_table = o.bbox_table;
     if (o.progress) {
         std::fprintf(stderr, "\n");
     }
@@ -625,8 +876,74 @@ std::string jstats(const ErrStats &e)
 
 } // namespace
 
+namespace {
+
+void print_table1_pipeline(std::FILE *f, const Table1Result &r)
+{
+    std::fprintf(f,
+                 "Table I captures through the %s.\n"
+                 "Capture bytes -> sl_pipeline_feed (board paper-sim, sl_board_find); speed of the pass\n"
+                 "given with sl_pipeline_set_motion (consistency window n_eff adapted); detection beam\n"
+                 "width = the simulated azimuth window (2 x cutoff), threshold = the linear mapping's\n"
+                 "detect floor. Per rotation, the raw target list (not the tracks): the target nearest\n"
+                 "the truth's nominal azimuth (within 3 azimuths) is the pole's; its alpha is compared\n"
+                 "with that rotation's truth. Same truth rows as the bbox table (pole in the shadow,\n"
+                 "valid, r2 not touching the ground's first bin). The pipeline always applies its\n"
+                 "own corrections (half-bin; radius from the azimuthal width; beta from the board =\n"
+                 "0). The ideal capture (2 mm bins) is not run: the pipeline uses the board's bins.\n"
+                 "Cells: error mean / std (deg), detection rate = rotations with the pole detected /\n"
+                 "rotations the truth has it in the shadow; amb/inv = AMBIGUOUS / other non-VALID\n"
+                 "flags among the detections (not in mean/std).\n\n",
+                 kPipelineLabel);
+    const char *cap[5] = {"Ideal", "Real res.", "Emission model", "10 cm pole", "20 cm pole"};
+    const char *var[2] = {"A: detection defaults (radius from the azimuthal width, r1 += R)",
+                          "B: radius_from_width off (R = 0: the front surface is taken as the axis)"};
+    for (int v = 0; v < 2; v++) {
+        std::fprintf(f, "%s\n", var[v]);
+        std::fprintf(f, "%-15s |", "condition");
+        for (int a = 0; a < 3; a++) {
+            std::fprintf(f, " %+3d deg: mean / std   det.rate  amb/inv |", r.angles[a]);
+        }
+        std::fprintf(f, " n_eff beam\n");
+        for (int c = 1; c < 5; c++) {
+            const auto &pc = r.pipe[v][c];
+            if (pc[0].truth_rows == 0 && pc[1].truth_rows == 0 && pc[2].truth_rows == 0) {
+                continue;
+            }
+            std::fprintf(f, "%-15s |", cap[c]);
+            for (int a = 0; a < 3; a++) {
+                const PipeEval &e = pc[a];
+                std::fprintf(f, " %6.3f / %5.3f  %3d/%-3d=%3.0f%%  %2d/%-2d |", e.err.mean, e.err.std, e.detected,
+                             e.truth_rows, 100.0 * e.rate(), e.err.ambiguous, e.err.invalid);
+            }
+            std::fprintf(f, " %d-%d  %.2f deg\n", pc[1].frames_eff_min, pc[1].frames_eff_max, pc[1].beam_cdeg / 100.0);
+        }
+        std::fprintf(f, "\n");
+    }
+    std::fprintf(f, "per pass (variant A): rotations, targets, unmatched targets, rejected NEAR/SHADOW/WIDE/BROKEN\n");
+    for (int c = 1; c < 5; c++) {
+        for (int a = 0; a < 3; a++) {
+            const PipeEval &e = r.pipe[0][c][a];
+            if (e.truth_rows == 0) {
+                continue;
+            }
+            std::fprintf(f, "  %-15s %+3d deg: rotations %d, targets %d, unmatched %d, rejected %u/%u/%u/%u, "
+                            "speed %.3f m/s, threshold %u\n",
+                         cap[c], r.angles[a], e.rotations, e.targets, e.unmatched, e.rejected[0], e.rejected[1],
+                         e.rejected[2], e.rejected[3], r.pipe_cfg[c].speed_mps, e.threshold);
+        }
+    }
+}
+
+} // namespace
+
 void print_table1(std::FILE *f, const Table1Result &r)
 {
+    if (!r.bbox_table) {
+        print_table1_pipeline(f, r);
+        std::fprintf(f, "run time %.1f s\n", r.seconds);
+        return;
+    }
     std::fprintf(f,
                  "Table I reproduction -- bbox extraction (detection pipeline not used): first/last\n"
                  "bin above threshold on the pole's ground-truth azimuth, inside the ground shadow;\n"
@@ -673,6 +990,10 @@ void print_table1(std::FILE *f, const Table1Result &r)
         std::fprintf(f, "%+d deg: %d (missed %d, ambiguous %d, invalid %d)  ", r.angles[a], e.rows,
                      e.missed, e.ambiguous, e.invalid);
     }
+    if (r.have_pipe) {
+        std::fprintf(f, "\n\n");
+        print_table1_pipeline(f, r);
+    }
     std::fprintf(f, "\nrun time %.1f s\n", r.seconds);
 }
 
@@ -707,7 +1028,33 @@ std::string table1_json(const Table1Result &r)
         o << (c ? ", " : "") << "[" << jnum(r.model_err[c][0]) << ", " << jnum(r.model_err[c][1]) << ", "
           << jnum(r.model_err[c][2]) << "]";
     }
-    o << "],\n  \"seconds\": " << jnum(r.seconds) << "\n}\n";
+    o << "],\n";
+    if (r.have_pipe) {
+        const char *cap[5] = {"ideal", "real_res", "emission", "10cm", "20cm"};
+        o << "  \"pipeline\": {\"extraction\": \"" << kPipelineLabel << "\", \"captures\": [\n";
+        bool first = true;
+        for (int v = 0; v < 2; v++)
+        for (int c = 1; c < 5; c++) {
+            if (r.pipe[v][c][1].truth_rows == 0) {
+                continue;
+            }
+            o << (first ? "" : ",\n") << "    {\"capture\": \"" << cap[c] << "\", \"radius_from_width\": "
+              << (v == 0 ? "true" : "false") << ", \"beam_deg\": "
+              << jnum(r.pipe[v][c][1].beam_cdeg / 100.0) << ", \"speed_mps\": " << jnum(r.pipe_cfg[c].speed_mps)
+              << ", \"angles\": [";
+            first = false;
+            for (int a = 0; a < 3; a++) {
+                const PipeEval &e = r.pipe[v][c][a];
+                o << (a ? ", " : "") << "{\"error\": " << jstats(e.err) << ", \"truth_rows\": " << e.truth_rows
+                  << ", \"detected\": " << e.detected << ", \"detection_rate\": " << jnum(e.rate())
+                  << ", \"targets\": " << e.targets << ", \"unmatched\": " << e.unmatched
+                  << ", \"frames_eff\": [" << e.frames_eff_min << ", " << e.frames_eff_max << "]}";
+            }
+            o << "]}";
+        }
+        o << "\n  ]},\n";
+    }
+    o << "  \"seconds\": " << jnum(r.seconds) << "\n}\n";
     return o.str();
 }
 

@@ -9,7 +9,9 @@
 #pragma once
 
 #include <cstdint>
+#include <cmath>
 #include <functional>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -127,11 +129,88 @@ struct ErrStats {
 double elong_at(const std::vector<ElongPoint> &t, double r_m);
 
 /// Simulates `scene` in memory and decodes the bytes with the core decoder. `on_gt` gets
-/// each rotation's ground truth before its bytes are decoded; `on_row` every decoded row.
+/// each rotation's ground truth before its bytes are decoded; `on_row` every decoded row;
+/// `on_bytes` (optional) the same bytes (the configuration message first, as k = 0).
 void simulate_decode(const Scene &scene, int threads,
                      const std::function<void(int k, const std::vector<GtRow> &gt)> &on_gt,
                      const CaptureRows::RowFn &on_row,
-                     const std::function<void(int done, int total)> &progress = {});
+                     const std::function<void(int done, int total)> &progress = {},
+                     const std::function<void(int k, const uint8_t *bytes, size_t n)> &on_bytes = {});
+
+// ------------------------------------------------------------------------------------------
+// Core detection pipeline on simulated captures ("--extract pipeline")
+
+/// How alpha is obtained: a bounding box on the pole's ground-truth azimuth (the paper's
+/// processing, "bbox extraction (detection pipeline not used)") or the core pipeline
+/// (sl_pipeline: threshold, n-frame consistency mask with the motion-adapted window,
+/// detection in the shadow, corrections, alpha), targets associated with the truth by azimuth.
+enum class Extract { BBox, Pipeline };
+
+/// The label printed wherever pipeline results appear.
+extern const char *const kPipelineLabel;
+
+/// Configuration of one pipeline evaluation.
+struct PipeCfg {
+    std::string board;          ///< core board (sl_board_find), e.g. "paper-sim"
+    double beam_deg = 0;        ///< detection beam width (cfg.detect.beam_width_cdeg); 0 = default 1.8
+    int threshold = -1;         ///< occupied = value >= this; < 0 = the board's
+    double speed_mps = 0;       ///< vehicle speed given to sl_pipeline_set_motion
+    bool motion = true;         ///< pass the speed (false: no motion input, board's n)
+    int mask_frames = 0;        ///< > 0: overrides the board's n
+    int radius_from_width = -1; ///< cfg.detect.radius_from_width: -1 default (on), 0 off, 1 on
+    int assoc_az = 3;           ///< a target is the pole's when |az - truth azimuth| <= this
+    bool clip_ambiguous = false; ///< ErrStats: count AMBIGUOUS as the model's bound
+    double rotation_hz = 4;     ///< for now_us (the pipeline measures the period itself)
+};
+
+/// Pipeline defaults for a simulated scene: its board, the simulated azimuth window as the
+/// beam (2 x scene_az_cutoff_deg: a touched bin reads >= detect_floor, so the return spans
+/// the whole window), threshold = detect_floor for the linear mapping (else the board's),
+/// speed = the scene's.
+PipeCfg pipe_cfg_for_scene(const Scene &s);
+
+/// Result for one pole.
+struct PipeEval {
+    ErrStats err;               ///< alpha errors of the associated targets vs that rotation's truth
+    int truth_rows = 0;         ///< rotations whose truth has the pole in the shadow (valid)
+    int detected = 0;           ///< ... of which with an associated target
+    int rotations = 0;          ///< rotations the pipeline reported
+    int targets = 0;            ///< targets reported (all poles, all rotations)
+    int unmatched = 0;          ///< targets associated with no truth row
+    int frames_eff_min = 0, frames_eff_max = 0; ///< n_eff used
+    uint32_t rejected[4] = {};  ///< sl_detect rejections (NEAR, SHADOW, WIDE, BROKEN)
+    uint32_t geometry_rejected = 0;
+    unsigned beam_cdeg = 0, threshold = 0;
+    double rate() const { return truth_rows > 0 ? static_cast<double>(detected) / truth_rows : std::nan(""); }
+};
+
+/// Feeds a byte stream to a core pipeline and associates its per-rotation targets (raw
+/// alpha per rotation, not the tracks) with ground-truth rows.
+class PipelineEval {
+public:
+    explicit PipelineEval(const PipeCfg &c); ///< throws std::runtime_error (board, init)
+    ~PipelineEval();
+    PipelineEval(const PipelineEval &) = delete;
+    PipelineEval &operator=(const PipelineEval &) = delete;
+    /// A truth row to score (normally nominal == 1 && valid == 1). Rotation = capture rotation.
+    void add_truth(const GtRow &g);
+    /// Bytes of capture rotation `rotation` (any chunking; motion is set before them).
+    void feed(int rotation, const uint8_t *data, size_t n);
+    void finish();
+    /// Association and statistics, per pole index.
+    std::map<int, PipeEval> result() const;
+
+private:
+    struct Impl;
+    Impl *m_;
+};
+
+/// Simulates `scene` in memory and runs the pipeline on its bytes; truth rows are the
+/// nominal valid ones whose r2 is not within a bin of the ground's first bin (the rows the
+/// bbox path scores). `boundary` (optional) gets the count of rows left out that way.
+std::map<int, PipeEval> simulate_pipeline(const Scene &scene, const PipeCfg &c, int threads,
+                                          int *boundary = nullptr,
+                                          const std::function<void(int done, int total)> &progress = {});
 
 // ------------------------------------------------------------------------------------------
 // Experiments (sl-eval table1 / realistic)
@@ -144,6 +223,10 @@ struct Table1Options {
     int range_bins = 0;         ///< > 0: bins per azimuth in the stream (contoured data; faster)
     unsigned captures = 0x1F;   ///< bit c: simulate capture c (0 ideal, 1 real res, 2 emission,
                                 ///< 3 10 cm, 4 20 cm); rows of skipped captures stay empty
+    Extract extract = Extract::BBox; ///< Pipeline: also run the core pipeline on every
+                                ///< capture except the ideal one (its 2 mm bins are not the
+                                ///< board's: the pipeline maps rows with the board's geometry)
+    bool bbox_table = true;     ///< print the bbox table (false with --extract pipeline)
 };
 
 struct Table1Row {
@@ -168,6 +251,13 @@ struct Table1Result {
     int boundary[5][3] = {};      ///< valid rows dropped: r2 within a bin of the ground's first bin
     int rotations = 0;
     double seconds = 0;
+    bool have_pipe = false, bbox_table = true;
+    /// core pipeline per variant, capture and angle (capture 0: not run). Variant 0: the
+    /// detection defaults (radius from the azimuthal width); 1: radius_from_width off (the
+    /// simulated 12.5 deg azimuth window makes the width measure the leaning pole's bearing
+    /// extent, not its diameter).
+    PipeEval pipe[2][5][3];
+    PipeCfg pipe_cfg[5];          ///< variant 0's configuration per capture
 };
 
 Table1Result run_table1(const Table1Options &o);

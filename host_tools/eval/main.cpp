@@ -18,9 +18,12 @@ void usage()
     std::fprintf(stderr,
                  "usage:\n"
                  "  sl-eval table1 [--rotations N] [--quick] [--json] [--json-out FILE] [--plot FILE.png]\n"
-                 "                [--threads N] [--range-bins N]\n"
+                 "                [--threads N] [--range-bins N] [--extract bbox|pipeline|both]\n"
                  "      The six conditions of the paper's Table I at -10/0/+10 deg, the paper's\n"
                  "      numbers beside ours, then the same captures with our improvements.\n"
+                 "      --extract bbox (default): bounding box on the true azimuth (paper columns);\n"
+                 "      pipeline: only the core pipeline (sl_pipeline: mask + detection + corrections +\n"
+                 "      alpha; n_eff from motion) on the real-resolution captures; both: the two.\n"
                  "  sl-eval realistic [--quick] [--json] [--json-out FILE] [--positions N] [--reps N] [--frames N]\n"
                  "                   [--calib N] [--range-bins N] [--threads N]\n"
                  "      Smear, speckle, noise floor, leakage, measured emission, n-frame\n"
@@ -64,10 +67,28 @@ int cmd_table1(int argc, char **argv)
             o.threads = std::atoi(argv[++i]);
         } else if (a == "--quiet") {
             o.progress = false;
+        } else if (a == "--extract" && i + 1 < argc) {
+            const std::string m = argv[++i];
+            if (m == "bbox") {
+                o.extract = sl::Extract::BBox;
+                o.bbox_table = true;
+            } else if (m == "pipeline") {
+                o.extract = sl::Extract::Pipeline;
+                o.bbox_table = false;
+            } else if (m == "both") {
+                o.extract = sl::Extract::Pipeline;
+                o.bbox_table = true;
+            } else {
+                usage();
+                return 2;
+            }
         } else {
             usage();
             return 2;
         }
+    }
+    if (o.extract == sl::Extract::Pipeline && !o.bbox_table) {
+        o.captures &= ~1U; // the ideal capture (2 mm bins) cannot go through the board's pipeline
     }
     const sl::Table1Result r = sl::run_table1(o);
     if (!json_out.empty() && !write_text(json_out, sl::table1_json(r))) {

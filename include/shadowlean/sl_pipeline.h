@@ -42,7 +42,8 @@
 /// Azimuth = az x 36000 / azimuths + board->radar_yaw_cdeg (vehicle frame, clockwise).
 /// TargetId = track id mod 16. Quality = FILTERED when the track has a valid alpha
 /// (Lean/LeanSigma = the filtered values), else the mapping of the last target's incline
-/// flag (AMBIGUOUS, OUT_OF_MODEL, INVALID). Ranges: the track's last corrected r1 / r2.
+/// flag (AMBIGUOUS, OUT_OF_MODEL, INVALID). Ranges: the track's last corrected r1 / r2, passed
+/// in um and rounded once, by the encoder, to the signal's step (0.02 m / 0.01 m).
 ///
 /// ## Motion (the paper assumed a static vehicle; see `sl_pipeline_window()`)
 /// The consistency mask needs the same (azimuth, bin) cell occupied in the last n rotations.

@@ -73,13 +73,13 @@ int main(int argc, char **argv)
                 p.azimuth_cdeg = static_cast<int32_t>(value(0, 35999, INT32_MIN, INT32_MAX));
                 p.lean_cdeg = static_cast<int32_t>(value(-5000, 5000, -100000, 100000));
                 p.lean_sigma_cdeg = static_cast<uint32_t>(value(0, 620, 0, 100000));
-                p.range_inner_mm = static_cast<uint32_t>(value(0, 10220, 0, UINT32_MAX));
-                p.range_outer_mm = static_cast<uint32_t>(value(0, 10220, 0, UINT32_MAX));
+                p.range_inner_um = static_cast<uint32_t>(value(0, 10229999, 0, UINT32_MAX));
+                p.range_outer_um = static_cast<uint32_t>(value(0, 10229999, 0, UINT32_MAX));
                 sl_can_encode_pole_lean(&tx, &p, &f);
                 ex << "PoleLean target_id=" << unsigned(p.target_id) << " quality=" << unsigned(p.quality)
                    << " azimuth_cdeg=" << p.azimuth_cdeg << " lean_cdeg=" << p.lean_cdeg
-                   << " lean_sigma_cdeg=" << p.lean_sigma_cdeg << " range_inner_mm=" << p.range_inner_mm
-                   << " range_outer_mm=" << p.range_outer_mm << "\n";
+                   << " lean_sigma_cdeg=" << p.lean_sigma_cdeg << " range_inner_um=" << p.range_inner_um
+                   << " range_outer_um=" << p.range_outer_um << "\n";
             } else if (kind < 8) {
                 sl_can_lean_warning_t w{};
                 w.level = static_cast<uint8_t>(value(0, 2, 0, 255));
@@ -88,13 +88,13 @@ int main(int argc, char **argv)
                 w.quality = static_cast<uint8_t>(value(0, 4, 0, 255));
                 w.azimuth_cdeg = static_cast<int32_t>(value(0, 35999, -1000000, 1000000));
                 w.lean_cdeg = static_cast<int32_t>(value(-10240, 10235, -100000, 100000));
-                w.range_mm = static_cast<uint32_t>(value(0, 20470, 0, 1000000));
+                w.range_um = static_cast<uint32_t>(value(0, 20474999, 0, 1000000000));
                 w.lean_sigma_cdeg = static_cast<uint32_t>(value(0, 630, 0, 100000));
                 sl_can_encode_lean_warning(&tx, &w, &f);
                 ex << "LeanWarning level=" << unsigned(w.level) << " has_target=" << int(w.has_target)
                    << " target_id=" << unsigned(w.target_id) << " quality=" << unsigned(w.quality)
                    << " azimuth_cdeg=" << w.azimuth_cdeg << " lean_cdeg=" << w.lean_cdeg
-                   << " range_mm=" << w.range_mm << " lean_sigma_cdeg=" << w.lean_sigma_cdeg << "\n";
+                   << " range_um=" << w.range_um << " lean_sigma_cdeg=" << w.lean_sigma_cdeg << "\n";
             } else if (kind < 9) {
                 sl_can_status_t s{};
                 s.link_state = static_cast<uint8_t>(value(0, 4, 0, 255));

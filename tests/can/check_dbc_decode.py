@@ -58,8 +58,8 @@ MAP = {
         "Azimuth": ("azimuth_cdeg", 100, "angle"),
         "Lean": ("lean_cdeg", 100, "num"),
         "LeanSigma": ("lean_sigma_cdeg", 100, "num"),
-        "RangeInner": ("range_inner_mm", 1000, "num"),
-        "RangeOuter": ("range_outer_mm", 1000, "num"),
+        "RangeInner": ("range_inner_um", 1000000, "num"),
+        "RangeOuter": ("range_outer_um", 1000000, "num"),
     },
     "LeanWarning": {
         "Level": ("level", 1, "level"),
@@ -68,7 +68,7 @@ MAP = {
         "Quality": ("quality", 1, "quality"),
         "Azimuth": ("azimuth_cdeg", 100, "angle"),
         "Lean": ("lean_cdeg", 100, "num"),
-        "Range": ("range_mm", 1000, "num"),
+        "Range": ("range_um", 1000000, "num"),
         "LeanSigma": ("lean_sigma_cdeg", 100, "num"),
     },
     "Status": {

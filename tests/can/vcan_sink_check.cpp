@@ -107,7 +107,7 @@ struct Gen {
             w.level = static_cast<uint8_t>(uni(0, 2));
             w.has_target = true;
             w.lean_cdeg = static_cast<int32_t>(uni(-3000, 3000));
-            w.range_mm = static_cast<uint32_t>(uni(1000, 6000));
+            w.range_um = static_cast<uint32_t>(uni(1000000, 6000000));
             sl_can_encode_lean_warning(&tx, &w, &f);
             break;
         }
@@ -131,8 +131,8 @@ struct Gen {
             p.azimuth_cdeg = static_cast<int32_t>(uni(0, 35999));
             p.lean_cdeg = static_cast<int32_t>(uni(-4000, 4000));
             p.lean_sigma_cdeg = static_cast<uint32_t>(uni(0, 600));
-            p.range_inner_mm = static_cast<uint32_t>(uni(1500, 6000));
-            p.range_outer_mm = p.range_inner_mm + static_cast<uint32_t>(uni(100, 3000));
+            p.range_inner_um = static_cast<uint32_t>(uni(1500000, 6000000));
+            p.range_outer_um = p.range_inner_um + static_cast<uint32_t>(uni(100000, 3000000));
             sl_can_encode_pole_lean(&tx, &p, &f);
             break;
         }

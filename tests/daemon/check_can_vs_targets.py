@@ -18,7 +18,7 @@ documented in sl_pipeline.h. Checks:
   TargetId = id mod 16, Azimuth = az x 360 / azimuths + yaw (+-0.1 deg), Quality
   (FILTERED when valid_hits > 0, else from the incline flag), Lean / LeanSigma (+-half an
   LSB, or clamped with Clamped = 1; 0 unless FILTERED), RangeInner / RangeOuter = r1 / r2
-  (+-0.01 m + 0.5 mm: the pipeline rounds um to mm before the encoder rounds to 0.02 m);
+  (+-half an LSB, 0.01 m: the encoder rounds the um values once, to 0.02 m);
 - LeanWarning: the most severe confirmed track (level, then valid, then |alpha|), or
   HasTarget = 0; Level, TargetId, Azimuth, Lean, Range, LeanSigma, Quality as above;
 - Status: Rotations = records so far, AzimuthsMissing = sum of `missing`, CanDropped 0,
@@ -31,9 +31,8 @@ import sys
 sys.path.insert(0, __import__("os").path.dirname(__file__))
 import sl_can_decode as scd  # noqa: E402
 
-# Ranges are rounded twice on the way to CAN: um -> mm in the pipeline (sl_can.h takes mm),
-# then mm -> LSB in the encoder, so they may be off by half an LSB plus 0.5 mm.
-MM = 0.0005
+# Ranges are rounded once on the way to CAN (sl_can.h takes um; the encoder rounds to the
+# signal's step): within half an LSB, no extra slack.
 QUALITY_OF_FLAG = {1: 1, 3: 2}  # incline AMBIGUOUS -> AMBIGUOUS, OUT_OF_DOMAIN -> OUT_OF_MODEL; else INVALID
 
 
@@ -148,8 +147,8 @@ def main(argv):
                 ("Azimuth", ang_diff(d.phys["Azimuth"], az_deg(hdr, t["az"])) <= 0.1 + 1e-9, az_deg(hdr, t["az"])),
                 ("Lean", abs(d.phys["Lean"] - max(-51.2, min(51.1, lean))) <= 0.05 + 1e-9, lean),
                 ("LeanSigma", abs(d.phys["LeanSigma"] - min(6.2, sigma)) <= 0.1 + 1e-9, sigma),
-                ("RangeInner", abs(d.phys["RangeInner"] - min(10.22, t["r1_um"] / 1e6)) <= 0.01 + MM + 1e-9, t["r1_um"] / 1e6),
-                ("RangeOuter", abs(d.phys["RangeOuter"] - min(10.22, t["r2_um"] / 1e6)) <= 0.01 + MM + 1e-9, t["r2_um"] / 1e6),
+                ("RangeInner", abs(d.phys["RangeInner"] - min(10.22, t["r1_um"] / 1e6)) <= 0.01 + 1e-9, t["r1_um"] / 1e6),
+                ("RangeOuter", abs(d.phys["RangeOuter"] - min(10.22, t["r2_um"] / 1e6)) <= 0.01 + 1e-9, t["r2_um"] / 1e6),
                 ("Clamped", d.raw["Clamped"] == int(clamp or t["r2_um"] > 10220000), int(clamp)),
             ]
             for name, ok, want in checks:
@@ -178,7 +177,7 @@ def main(argv):
                 ("Azimuth", ang_diff(lw.phys["Azimuth"], az_deg(hdr, worst["az"])) <= 0.05 + 1e-9, az_deg(hdr, worst["az"])),
                 ("Lean", abs(lw.phys["Lean"] - lean) <= 0.025 + 1e-9, lean),
                 ("LeanSigma", abs(lw.phys["LeanSigma"] - min(6.3, sigma)) <= 0.05 + 1e-9, sigma),
-                ("Range", abs(lw.phys["Range"] - worst["r1_um"] / 1e6) <= 0.005 + MM + 1e-9, worst["r1_um"] / 1e6),
+                ("Range", abs(lw.phys["Range"] - worst["r1_um"] / 1e6) <= 0.005 + 1e-9, worst["r1_um"] / 1e6),
             ]
             for name, ok, want in checks:
                 if not ok:

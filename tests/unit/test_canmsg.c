@@ -113,8 +113,8 @@ static void test_canmsg_pole_lean_golden_bytes(void **state)
     sl_can_tx_t tx;
     tx_setup(&tx);
     const sl_can_pole_lean_t in = {.target_id = 9, .quality = SL_CAN_QUALITY_FILTERED,
-                                   .azimuth_cdeg = 12340, .range_inner_mm = 2460,
-                                   .range_outer_mm = 3000, .lean_cdeg = -1230,
+                                   .azimuth_cdeg = 12340, .range_inner_um = 2460000,
+                                   .range_outer_um = 3000000, .lean_cdeg = -1230,
                                    .lean_sigma_cdeg = 140};
     sl_can_frame_t f;
     assert_int_equal(sl_can_encode_pole_lean(&tx, &in, &f), SL_OK);
@@ -206,8 +206,8 @@ static void test_canmsg_pole_lean_round_trips_every_raw_value(void **state)
             .azimuth_cdeg = (int32_t)(clamp64(raw, 0, SL_CAN_POLE_AZIMUTH_RAW_MAX) * 20),
             .lean_cdeg = (int32_t)(clamp64(raw, -512, 511) * 10),
             .lean_sigma_cdeg = (uint32_t)(clamp64(raw, 0, 31) * 20),
-            .range_inner_mm = (uint32_t)(clamp64(raw, 0, 511) * 20),
-            .range_outer_mm = (uint32_t)(clamp64(2100 - raw, 0, 511) * 20),
+            .range_inner_um = (uint32_t)(clamp64(raw, 0, 511) * 20000),
+            .range_outer_um = (uint32_t)(clamp64(2100 - raw, 0, 511) * 20000),
         };
         assert_int_equal(sl_can_encode_pole_lean(&tx, &in, &f), SL_OK);
         assert_int_equal(sl_can_decode_pole_lean(&f, &out), SL_OK);
@@ -216,8 +216,8 @@ static void test_canmsg_pole_lean_round_trips_every_raw_value(void **state)
         assert_int_equal(out.azimuth_cdeg, in.azimuth_cdeg);
         assert_int_equal(out.lean_cdeg, in.lean_cdeg);
         assert_int_equal(out.lean_sigma_cdeg, in.lean_sigma_cdeg);
-        assert_int_equal(out.range_inner_mm, in.range_inner_mm);
-        assert_int_equal(out.range_outer_mm, in.range_outer_mm);
+        assert_int_equal(out.range_inner_um, in.range_inner_um);
+        assert_int_equal(out.range_outer_um, in.range_outer_um);
         assert_false(out.clamped);
     }
     assert_int_equal(tx.stats.clamped_frames, 0);
@@ -237,8 +237,8 @@ static void test_canmsg_pole_lean_random_values_within_half_lsb(void **state)
             .azimuth_cdeg = (int32_t)rnd_range(-100000, 100000),
             .lean_cdeg = (int32_t)rnd_range(-5125, 5114),
             .lean_sigma_cdeg = (uint32_t)rnd_range(0, 629),
-            .range_inner_mm = (uint32_t)rnd_range(0, 10229),
-            .range_outer_mm = (uint32_t)rnd_range(0, 10229),
+            .range_inner_um = (uint32_t)rnd_range(0, 10229999),
+            .range_outer_um = (uint32_t)rnd_range(0, 10229999),
         };
         assert_int_equal(sl_can_encode_pole_lean(&tx, &in, &f), SL_OK);
         assert_int_equal(sl_can_decode_pole_lean(&f, &out), SL_OK);
@@ -246,12 +246,52 @@ static void test_canmsg_pole_lean_random_values_within_half_lsb(void **state)
         assert_int_equal(out.lean_cdeg, ref_round(in.lean_cdeg, 10) * 10);
         assert_true(out.lean_cdeg - in.lean_cdeg <= 5 && in.lean_cdeg - out.lean_cdeg <= 5);
         assert_int_equal(out.lean_sigma_cdeg, ref_round(in.lean_sigma_cdeg, 20) * 20);
-        assert_int_equal(out.range_inner_mm, ref_round(in.range_inner_mm, 20) * 20);
-        assert_int_equal(out.range_outer_mm, ref_round(in.range_outer_mm, 20) * 20);
+        assert_int_equal(out.range_inner_um, ref_round(in.range_inner_um, 20000) * 20000);
+        assert_int_equal(out.range_outer_um, ref_round(in.range_outer_um, 20000) * 20000);
         int64_t az = in.azimuth_cdeg % 36000;
         az += (az < 0) ? 36000 : 0;
         assert_int_equal(out.azimuth_cdeg, (ref_round(az, 20) % 1800) * 20);
     }
+}
+
+static void test_canmsg_ranges_are_rounded_once_from_um(void **state)
+{
+    (void)state;
+    sl_can_tx_t tx;
+    tx_setup(&tx);
+    sl_can_frame_t f;
+    // r1 = 2.6499 m: once to 0.02 m is 132.495 -> 132 = 2.64 m (rounding to mm first gave
+    // 2650 mm = 132.5 -> 133 = 2.66 m). r2 = 2.6501 m -> 132.505 -> 133 = 2.66 m.
+    const sl_can_pole_lean_t p = {.range_inner_um = 2649900, .range_outer_um = 2650100};
+    assert_int_equal(sl_can_encode_pole_lean(&tx, &p, &f), SL_OK);
+    sl_can_pole_lean_t po;
+    assert_int_equal(sl_can_decode_pole_lean(&f, &po), SL_OK);
+    assert_int_equal(po.range_inner_um, 2640000);
+    assert_int_equal(po.range_outer_um, 2660000);
+    // Exact half (2.65 m = 132.5 LSB) rounds up, as every signal does.
+    const sl_can_pole_lean_t half = {.range_inner_um = 2650000, .range_outer_um = 2669999};
+    assert_int_equal(sl_can_encode_pole_lean(&tx, &half, &f), SL_OK);
+    assert_int_equal(sl_can_decode_pole_lean(&f, &po), SL_OK);
+    assert_int_equal(po.range_inner_um, 2660000);
+    assert_int_equal(po.range_outer_um, 2660000);
+    // LeanWarning.Range (0.01 m): 2.6449 m -> 264.49 -> 2.64 m (via mm: 2645 -> 2.65 m).
+    const sl_can_lean_warning_t w = {.has_target = true, .range_um = 2644900};
+    assert_int_equal(sl_can_encode_lean_warning(&tx, &w, &f), SL_OK);
+    sl_can_lean_warning_t wo;
+    assert_int_equal(sl_can_decode_lean_warning(&f, &wo), SL_OK);
+    assert_int_equal(wo.range_um, 2640000);
+    assert_false(wo.clamped);
+    // Within half an LSB of the um input everywhere (the whole RangeInner range, 1 um steps
+    // near each rounding edge).
+    for (uint32_t raw = 0; raw < 511U; raw++) {
+        for (uint32_t d = 9990; d <= 10010; d++) {
+            const sl_can_pole_lean_t q = {.range_inner_um = raw * 20000U + d};
+            assert_int_equal(sl_can_encode_pole_lean(&tx, &q, &f), SL_OK);
+            assert_int_equal(sl_can_decode_pole_lean(&f, &po), SL_OK);
+            assert_int_equal(po.range_inner_um, (raw + (d >= 10000U ? 1U : 0U)) * 20000U);
+        }
+    }
+    assert_int_equal(tx.stats.clamped_frames, 0);
 }
 
 static void test_canmsg_clamps_and_flags_out_of_range_values(void **state)
@@ -283,10 +323,10 @@ static void test_canmsg_clamps_and_flags_out_of_range_values(void **state)
         {0, 629, 0, 0, 0, 0, 0, 620, 0, 0, 0, 0, false},
         {0, 630, 0, 0, 0, 0, 0, 620, 0, 0, 0, 0, true},
         {0, UINT32_MAX, 0, 0, 0, 0, 0, 620, 0, 0, 0, 0, true},
-        // ranges max 10.22 m
-        {0, 0, 10229, 10229, 0, 0, 0, 0, 10220, 10220, 0, 0, false},
-        {0, 0, 10230, 5, 0, 0, 0, 0, 10220, 0, 0, 0, true},
-        {0, 0, 5, UINT32_MAX, 0, 0, 0, 0, 0, 10220, 0, 0, true},
+        // ranges (um) max 10.22 m: 10.229999 m rounds to 10.22 m, 10.23 m to 10.24: clamped
+        {0, 0, 10229999, 10229999, 0, 0, 0, 0, 10220000, 10220000, 0, 0, false},
+        {0, 0, 10230000, 5, 0, 0, 0, 0, 10220000, 0, 0, 0, true},
+        {0, 0, 5, UINT32_MAX, 0, 0, 0, 0, 0, 10220000, 0, 0, true},
         // ids and enums
         {0, 0, 0, 0, 15, 4, 0, 0, 0, 0, 15, 4, false},
         {0, 0, 0, 0, 16, 0, 0, 0, 0, 0, 15, 0, true},
@@ -297,13 +337,13 @@ static void test_canmsg_clamps_and_flags_out_of_range_values(void **state)
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
         sl_can_pole_lean_t in = {.target_id = cases[i].id, .quality = cases[i].quality,
                                  .lean_cdeg = cases[i].lean, .lean_sigma_cdeg = cases[i].sigma,
-                                 .range_inner_mm = cases[i].r1, .range_outer_mm = cases[i].r2};
+                                 .range_inner_um = cases[i].r1, .range_outer_um = cases[i].r2};
         assert_int_equal(sl_can_encode_pole_lean(&tx, &in, &f), SL_OK);
         assert_int_equal(sl_can_decode_pole_lean(&f, &out), SL_OK);
         assert_int_equal(out.lean_cdeg, cases[i].want_lean);
         assert_int_equal(out.lean_sigma_cdeg, cases[i].want_sigma);
-        assert_int_equal(out.range_inner_mm, cases[i].want_r1);
-        assert_int_equal(out.range_outer_mm, cases[i].want_r2);
+        assert_int_equal(out.range_inner_um, cases[i].want_r1);
+        assert_int_equal(out.range_outer_um, cases[i].want_r2);
         assert_int_equal(out.target_id, cases[i].want_id);
         assert_int_equal(out.quality, cases[i].want_q);
         assert_int_equal(out.clamped, cases[i].clamped);
@@ -349,7 +389,7 @@ static void test_canmsg_lean_warning_round_trips_and_clamps(void **state)
             .target_id = (uint8_t)((raw + 2048) % 16), .quality = (uint8_t)((raw + 2048) % 5),
             .azimuth_cdeg = (int32_t)(clamp64(raw, 0, 3599) * 10),
             .lean_cdeg = (int32_t)(clamp64(raw, -2048, 2047) * 5),
-            .range_mm = (uint32_t)(clamp64(raw, 0, 2047) * 10),
+            .range_um = (uint32_t)(clamp64(raw, 0, 2047) * 10000),
             .lean_sigma_cdeg = (uint32_t)(clamp64(raw, 0, 63) * 10),
         };
         assert_int_equal(sl_can_encode_lean_warning(&tx, &in, &f), SL_OK);
@@ -361,28 +401,28 @@ static void test_canmsg_lean_warning_round_trips_and_clamps(void **state)
         assert_int_equal(out.quality, in.quality);
         assert_int_equal(out.azimuth_cdeg, in.azimuth_cdeg);
         assert_int_equal(out.lean_cdeg, in.lean_cdeg);
-        assert_int_equal(out.range_mm, in.range_mm);
+        assert_int_equal(out.range_um, in.range_um);
         assert_int_equal(out.lean_sigma_cdeg, in.lean_sigma_cdeg);
         assert_false(out.clamped);
     }
     // Out of range: lean 150 deg, level 7 (-> DANGER, never under-reported), range 30 m.
     sl_can_lean_warning_t in = {.level = 7, .has_target = true, .lean_cdeg = 15000,
-                                .range_mm = 30000, .lean_sigma_cdeg = 100};
+                                .range_um = 30000000, .lean_sigma_cdeg = 100};
     sl_can_encode_lean_warning(&tx, &in, &f);
     assert_int_equal(sl_can_decode_lean_warning(&f, &out), SL_OK);
     assert_int_equal(out.level, SL_CAN_LEVEL_DANGER);
     assert_int_equal(out.lean_cdeg, 2047 * 5);
-    assert_int_equal(out.range_mm, 20470);
+    assert_int_equal(out.range_um, 20470000);
     assert_true(out.clamped);
     // No target: every target field is zero whatever the input says.
     sl_can_lean_warning_t none = {.level = SL_CAN_LEVEL_NONE, .has_target = false,
-                                  .target_id = 3, .lean_cdeg = 999, .range_mm = 77};
+                                  .target_id = 3, .lean_cdeg = 999, .range_um = 77000};
     sl_can_encode_lean_warning(&tx, &none, &f);
     assert_int_equal(sl_can_decode_lean_warning(&f, &out), SL_OK);
     assert_false(out.has_target);
     assert_int_equal(out.target_id, 0);
     assert_int_equal(out.lean_cdeg, 0);
-    assert_int_equal(out.range_mm, 0);
+    assert_int_equal(out.range_um, 0);
     assert_int_equal(f.data[2] | f.data[3] | f.data[4] | f.data[5] | f.data[6] | f.data[7], 0);
 }
 
@@ -490,8 +530,8 @@ static void test_canmsg_e2e_detects_every_single_bit_error(void **state)
     sl_can_tx_t tx;
     tx_setup(&tx);
     sl_can_frame_t f;
-    const sl_can_pole_lean_t p = {.target_id = 3, .lean_cdeg = 456, .range_inner_mm = 3000,
-                                  .range_outer_mm = 3300, .azimuth_cdeg = 9000};
+    const sl_can_pole_lean_t p = {.target_id = 3, .lean_cdeg = 456, .range_inner_um = 3000000,
+                                  .range_outer_um = 3300000, .azimuth_cdeg = 9000};
     sl_can_encode_pole_lean(&tx, &p, &f);
     sl_can_e2e_rx_t rx;
     sl_can_e2e_rx_init(&rx);
@@ -649,6 +689,7 @@ int main(void)
         cmocka_unit_test(test_canmsg_layout_table_is_consistent),
         cmocka_unit_test(test_canmsg_pole_lean_round_trips_every_raw_value),
         cmocka_unit_test(test_canmsg_pole_lean_random_values_within_half_lsb),
+        cmocka_unit_test(test_canmsg_ranges_are_rounded_once_from_um),
         cmocka_unit_test(test_canmsg_clamps_and_flags_out_of_range_values),
         cmocka_unit_test(test_canmsg_azimuth_wraps_modulo_a_turn_not_clamped),
         cmocka_unit_test(test_canmsg_lean_warning_round_trips_and_clamps),

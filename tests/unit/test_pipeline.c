@@ -617,8 +617,9 @@ static void test_pipeline_can_frames_decode_to_the_targets(void **state)
                 }
             }
             assert_non_null(t);
-            assert_true(labs((long)(t->r1_um / 1000) - (long)m.range_inner_mm) <= 20);
-            assert_true(labs((long)(t->r2_um / 1000) - (long)m.range_outer_mm) <= 20);
+            // Ranges are rounded once (um -> 0.02 m): within half an LSB (10 mm).
+            assert_true(labs((long)t->r1_um - (long)m.range_inner_um) <= 10000);
+            assert_true(labs((long)t->r2_um - (long)m.range_outer_um) <= 10000);
             if (t->incline_flag == SL_INCLINE_VALID) {
                 // Identical measurements every rotation: the filtered lean is the measurement.
                 assert_int_equal(m.quality, SL_CAN_QUALITY_FILTERED);
@@ -868,6 +869,133 @@ static void test_pipeline_counts_busy_can_frames_as_drops(void **state)
         }
     }
     assert_true(statuses > 0 && last > 0);
+}
+
+// Status frames sent between rotations (sl_pipeline_send_status, the daemon's idle Status)
+// share the rotations' E2E counter: the sequence has no jump and no repeat across both
+// kinds (and across the modulo-15 wrap), and every frame carries the counters of its time.
+static void test_pipeline_idle_status_frames_continue_the_e2e_sequence(void **state)
+{
+    (void)state;
+    ensure_static_stream();
+    rec_reset(0);
+    const sl_pipeline_cfg_t c = cfg_for(B);
+    assert_int_equal(sl_pipeline_send_status(NULL, 0), SL_ERR_ARG);
+    assert_int_equal(sl_pipeline_init(&pl, B, &c), SL_OK);
+    // Idle Status before any data: CONNECTING, all counters 0.
+    sl_pipeline_set_link_state(&pl, SL_CAN_LINK_CONNECTING);
+    assert_int_equal(sl_pipeline_send_status(&pl, 500000U), SL_OK);
+    assert_int_equal(rec.ncan, 1);
+    sl_can_status_t st;
+    assert_int_equal(sl_can_decode_status(&rec.can[0], &st), SL_OK);
+    assert_int_equal(rec.can[0].id, B->can_id_status);
+    assert_int_equal(st.link_state, SL_CAN_LINK_CONNECTING);
+    assert_int_equal(st.rotations, 0);
+    assert_int_equal(st.counter, 0);
+    sl_pipeline_set_link_state(&pl, SL_CAN_LINK_STREAMING);
+    int idle = 1;
+    size_t i = 0;
+    for (int r = 0; r < g_static.rots; r++) {
+        const uint64_t now = 1000000U + (uint64_t)r * 250000U;
+        assert_int_equal(sl_pipeline_feed(&pl, g_static.buf + i, g_static.rot_end[r] - i, now),
+                         SL_OK);
+        i = g_static.rot_end[r];
+        // One idle Status after every third rotation, two after every fifth.
+        const int k = (r % 3 == 2 ? 1 : 0) + (r % 5 == 4 ? 2 : 0);
+        for (int j = 0; j < k; j++) {
+            if (r == 10) {
+                sl_pipeline_set_link_state(&pl, SL_CAN_LINK_SILENT);
+            }
+            const int before = rec.ncan;
+            assert_int_equal(sl_pipeline_send_status(&pl, now + 1000U), SL_OK);
+            assert_int_equal(rec.ncan, before + 1);
+            assert_int_equal(sl_can_decode_status(&rec.can[before], &st), SL_OK);
+            assert_int_equal(st.rotations, pl.stats.rotations);
+            assert_int_equal(st.azimuths_missing, pl.stats.azimuths_missing);
+            assert_int_equal(st.decoder_resyncs, pl.proto.stats.resyncs);
+            assert_int_equal(st.can_dropped, 0);
+            assert_int_equal(st.link_state, r == 10 ? SL_CAN_LINK_SILENT : SL_CAN_LINK_STREAMING);
+            assert_false(st.saturated);
+            idle++;
+            if (r == 10) {
+                sl_pipeline_set_link_state(&pl, SL_CAN_LINK_STREAMING);
+            }
+        }
+    }
+    assert_int_equal(sl_pipeline_finish(&pl, 99000000U), SL_OK);
+    assert_int_equal(rec.rotations, 24);
+    sl_can_e2e_rx_t rx;
+    sl_can_e2e_rx_init(&rx);
+    int statuses = 0;
+    uint32_t last_rot = 0;
+    for (int j = 0; j < rec.ncan; j++) {
+        if (rec.can[j].id != B->can_id_status) {
+            continue;
+        }
+        assert_int_equal(sl_can_e2e_check(&rx, SL_CAN_DATA_ID_STATUS, &rec.can[j]), SL_OK);
+        assert_int_equal(sl_can_decode_status(&rec.can[j], &st), SL_OK);
+        assert_int_equal(st.counter, (uint8_t)(statuses % 15));
+        assert_true(st.rotations >= last_rot);
+        last_rot = st.rotations;
+        statuses++;
+    }
+    assert_int_equal(statuses, 24 + idle);
+    assert_true(statuses > 30); // wrapped modulo 15 twice
+    assert_int_equal(rx.stats.counter_jumps, 0);
+    assert_int_equal(rx.stats.repeated, 0);
+    assert_int_equal(last_rot, 24);
+    assert_int_equal(pl.stats.can_frames, (uint32_t)rec.ncan);
+    // A refused idle Status is a drop like any other frame, reported by the next one.
+    rec.busy_every = 1;
+    rec.calls = 0;
+    assert_int_equal(sl_pipeline_send_status(&pl, 99100000U), SL_OK);
+    assert_int_equal(pl.stats.can_dropped, 1);
+    rec.busy_every = 0;
+    const int before = rec.ncan;
+    assert_int_equal(sl_pipeline_send_status(&pl, 99200000U), SL_OK);
+    assert_int_equal(sl_can_decode_status(&rec.can[before], &st), SL_OK);
+    assert_int_equal(st.can_dropped, 1);
+    assert_int_equal(sl_can_e2e_check(&rx, SL_CAN_DATA_ID_STATUS, &rec.can[before]), SL_OK);
+    assert_int_equal(rx.stats.lost_frames, 1); // the refused frame used its counter value
+}
+
+// Drops the port noticed after can_tx accepted the frames: added (saturating) and carried
+// by the next Status frame, together with can_tx refusals.
+static void test_pipeline_adds_port_drops_saturating_into_the_next_status(void **state)
+{
+    (void)state;
+    rec_reset(0);
+    const sl_pipeline_cfg_t c = cfg_for(B);
+    assert_int_equal(sl_pipeline_init(&pl, B, &c), SL_OK);
+    sl_can_status_t st;
+    sl_pipeline_add_can_dropped(&pl, 0);
+    sl_pipeline_add_can_dropped(&pl, 7);
+    assert_int_equal(pl.stats.can_dropped, 7);
+    assert_int_equal(sl_pipeline_send_status(&pl, 1000U), SL_OK);
+    assert_int_equal(sl_can_decode_status(&rec.can[0], &st), SL_OK);
+    assert_int_equal(st.can_dropped, 7);
+    assert_false(st.saturated);
+    // A refusal adds one more.
+    rec.busy_every = 1;
+    assert_int_equal(sl_pipeline_send_status(&pl, 2000U), SL_OK);
+    rec.busy_every = 0;
+    assert_int_equal(pl.stats.can_dropped, 8);
+    sl_pipeline_add_can_dropped(&pl, 300); // 308: above the 8-bit field
+    assert_int_equal(sl_pipeline_send_status(&pl, 3000U), SL_OK);
+    assert_int_equal(sl_can_decode_status(&rec.can[1], &st), SL_OK);
+    assert_int_equal(st.can_dropped, 255);
+    assert_true(st.saturated);
+    // The 32-bit total saturates instead of wrapping to a small number.
+    sl_pipeline_add_can_dropped(&pl, UINT32_MAX - 310U); // 308 + that = UINT32_MAX - 2
+    assert_int_equal(pl.stats.can_dropped, UINT32_MAX - 2U);
+    sl_pipeline_add_can_dropped(&pl, 5);
+    assert_int_equal(pl.stats.can_dropped, UINT32_MAX);
+    sl_pipeline_add_can_dropped(&pl, UINT32_MAX);
+    assert_int_equal(pl.stats.can_dropped, UINT32_MAX);
+    assert_int_equal(sl_pipeline_send_status(&pl, 4000U), SL_OK);
+    assert_int_equal(sl_can_decode_status(&rec.can[2], &st), SL_OK);
+    assert_int_equal(st.can_dropped, 255);
+    assert_true(st.saturated);
 }
 
 // n_eff = clamp(floor(D / (v T + r_max |w| T)) + 1, min, n), integer arithmetic.
@@ -1215,6 +1343,8 @@ int main(void)
         cmocka_unit_test(test_pipeline_16_bit_stream_gives_the_same_targets),
         cmocka_unit_test(test_pipeline_truncates_full_length_messages_instead_of_rejecting_them),
         cmocka_unit_test(test_pipeline_counts_busy_can_frames_as_drops),
+        cmocka_unit_test(test_pipeline_idle_status_frames_continue_the_e2e_sequence),
+        cmocka_unit_test(test_pipeline_adds_port_drops_saturating_into_the_next_status),
         cmocka_unit_test(test_pipeline_window_follows_speed_and_yaw),
         cmocka_unit_test(test_pipeline_takes_motion_from_can_and_the_setter),
         cmocka_unit_test(test_pipeline_drive_by_detects_the_pole_only_with_motion_input),

@@ -69,6 +69,8 @@ typedef struct daemon {
     bool gs_on;
     sl_can_sink_t sinks[3];
     size_t n_sinks;
+    uint32_t sink_drops_seen;   // sum of the sinks' dropped counters already in the pipeline's
+                                // can_dropped (wraps like the counters: differences only)
     sld_log_time_t log_time;
 
     // motion input
@@ -149,7 +151,13 @@ static sl_err_t send_frame(daemon_t *d, const sl_can_frame_t *f)
     if (d->n_sinks == 0) {
         return SL_OK;
     }
+    const uint32_t drops_before = sl_can_sinks_dropped(d->sinks, d->n_sinks);
     const sl_err_t e = sl_can_sinks_send(d->sinks, d->n_sinks, f, d->mono_us);
+    if (e != SL_OK && sl_can_sinks_dropped(d->sinks, d->n_sinks) != drops_before) {
+        // The pipeline counts this refused frame itself (can_tx's return value): one of the
+        // sinks' new drops is reported that way, the rest by report_sink_drops().
+        d->sink_drops_seen++;
+    }
     if (d->log_on && d->log.broken_pipe && !d->stop) {
         d->stop = true;
         d->stop_why = "the reader of the CAN log (stdout) went away";
@@ -179,24 +187,25 @@ static void port_on_rotation(void *ctx, const sl_pipeline_rotation_t *r)
             (unsigned)r->level, (unsigned)r->frames_eff);
 }
 
-/// Status frame outside the rotations (no data). Filled like the pipeline's own, encoded
-/// with the pipeline's sender so the E2E counter sequence of the Status id stays intact.
+/// Status frame outside the rotations (no data): the pipeline sends it through the port
+/// (its own sender: the Status E2E counter sequence stays intact; a refusal is counted).
 static void send_idle_status(daemon_t *d)
 {
-    sl_can_status_t st;
-    memset(&st, 0, sizeof st);
-    st.link_state = d->link_state;
-    st.rotations = g_pipe.stats.rotations;
-    st.azimuths_missing = g_pipe.stats.azimuths_missing;
-    st.decoder_resyncs = g_pipe.proto.stats.resyncs;
-    st.can_dropped = g_pipe.stats.can_dropped;
-    sl_can_frame_t f;
-    if (sl_can_encode_status(&g_pipe.can, &st, &f) != SL_OK) {
-        return;
+    if (sl_pipeline_send_status(&g_pipe, pipe_now(d)) == SL_OK) {
+        d->idle_status_frames++;
     }
-    d->idle_status_frames++;
-    if (send_frame(d, &f) != SL_OK) {
-        g_pipe.stats.can_dropped++; // reported in the next Status, as the pipeline does
+}
+
+/// Drops the sinks counted after accepting a frame (SocketCAN stale / bus-off drops of
+/// queued frames, gs_usb frames never confirmed): the increase of the summed sink drop
+/// counters not yet reported goes into the pipeline's count (Status.CanDropped).
+static void report_sink_drops(daemon_t *d)
+{
+    const uint32_t now = sl_can_sinks_dropped(d->sinks, d->n_sinks);
+    const uint32_t fresh = now - d->sink_drops_seen; // modulo 2^32, like the counters
+    d->sink_drops_seen = now;
+    if (fresh != 0) {
+        sl_pipeline_add_can_dropped(&g_pipe, fresh);
     }
 }
 
@@ -593,6 +602,9 @@ static void log_stats(daemon_t *d, int level, const char *what)
             (unsigned)sl_track_max_level(&g_pipe.tracker), g_pipe.proto.stats.messages,
             g_pipe.proto.stats.resyncs, d->frames_out, d->status_frames, d->idle_status_frames,
             s->can_dropped, s->motion_accepted, s->motion_rejected);
+    if (s->motion_set_calls != 0) {
+        sld_log(SLD_LOG_DEBUG, "%s: motion setter (--motion): %" PRIu32 " calls", what, s->motion_set_calls);
+    }
     const sl_detect_stats_t *ds = &g_pipe.detect.stats;
     sld_log(SLD_LOG_DEBUG,
             "%s: detection: %" PRIu32 " runs, %" PRIu32 " groups, %" PRIu32 " targets; rejected near %" PRIu32
@@ -913,6 +925,7 @@ int main(int argc, char **argv)
             }
         }
         sl_can_sinks_poll(d->sinks, d->n_sinks, d->mono_us);
+        report_sink_drops(d);
         if (d->idle_status && d->mono_us >= d->last_status_mono + (uint64_t)d->o.status_period_ms * 1000U) {
             send_idle_status(d);
         }
