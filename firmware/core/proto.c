@@ -15,6 +15,8 @@
 
 #include "shadowlean/sl_proto.h"
 
+#include "shadowlean/sl_bytes.h"
+
 const uint8_t sl_proto_signature[SL_PROTO_SIGNATURE_BYTES] = {
     0x00, 0x01, 0x03, 0x03, 0x07, 0x07, 0x0F, 0x0F,
     0x1F, 0x1F, 0x3F, 0x3F, 0x7F, 0x7F, 0xFE, 0xFE,
@@ -22,43 +24,6 @@ const uint8_t sl_proto_signature[SL_PROTO_SIGNATURE_BYTES] = {
 
 enum { ST_SIG = 0, ST_HDR = 1, ST_PAY = 2 };
 enum { HDR_OK = 0, HDR_BAD_VERSION, HDR_OVERSIZE, HDR_TOO_BIG };
-
-static uint32_t be32(const uint8_t *b)
-{
-    return ((uint32_t)b[0] << 24) | ((uint32_t)b[1] << 16) | ((uint32_t)b[2] << 8) | (uint32_t)b[3];
-}
-
-static uint16_t be16(const uint8_t *b)
-{
-    return (uint16_t)(((uint32_t)b[0] << 8) | (uint32_t)b[1]);
-}
-
-static uint32_t le32(const uint8_t *b)
-{
-    return ((uint32_t)b[3] << 24) | ((uint32_t)b[2] << 16) | ((uint32_t)b[1] << 8) | (uint32_t)b[0];
-}
-
-static void put_be32(uint8_t *b, uint32_t v)
-{
-    b[0] = (uint8_t)(v >> 24);
-    b[1] = (uint8_t)(v >> 16);
-    b[2] = (uint8_t)(v >> 8);
-    b[3] = (uint8_t)v;
-}
-
-static void put_be16(uint8_t *b, uint16_t v)
-{
-    b[0] = (uint8_t)(v >> 8);
-    b[1] = (uint8_t)v;
-}
-
-static void put_le32(uint8_t *b, uint32_t v)
-{
-    b[0] = (uint8_t)v;
-    b[1] = (uint8_t)(v >> 8);
-    b[2] = (uint8_t)(v >> 16);
-    b[3] = (uint8_t)(v >> 24);
-}
 
 // ---------------------------------------------------------------------------------- decoder
 
@@ -126,7 +91,7 @@ static void sig_byte(sl_proto_t *p, uint8_t b)
 // Header tail = version, id, length (BE). Counts the rejection reason.
 static int check_header(sl_proto_t *p, const uint8_t *tail)
 {
-    const uint32_t len = be32(tail + 2);
+    const uint32_t len = sl_get_be32(tail + 2);
     if (tail[0] != SL_PROTO_VERSION) {
         p->stats.bad_version++;
         return HDR_BAD_VERSION;
@@ -257,7 +222,7 @@ sl_err_t sl_proto_feed(sl_proto_t *p, const uint8_t *data, size_t len, uint64_t 
                     i++;
                     continue;
                 }
-                const uint32_t plen = be32(tail + 2);
+                const uint32_t plen = sl_get_be32(tail + 2);
                 p->hunting = false;
                 p->msg_offset = base + i;
                 p->payload_bytes = plen;
@@ -297,7 +262,7 @@ sl_err_t sl_proto_feed(sl_proto_t *p, const uint8_t *data, size_t len, uint64_t 
                 } else {
                     p->hunting = false;
                     p->msg_offset = base + i - SL_PROTO_HEADER_BYTES;
-                    p->payload_bytes = be32(p->hdr + 2);
+                    p->payload_bytes = sl_get_be32(p->hdr + 2);
                     p->payload_got = 0;
                     p->state = ST_PAY;
                     if (p->payload_bytes == 0U) {
@@ -403,7 +368,7 @@ static bool pb_walk(const uint8_t *d, size_t n, sl_proto_config_t *c)
             }
             if (field == 10U) {
                 c->has_range_res = true;
-                c->range_res_m_f32 = le32(d + pos);
+                c->range_res_m_f32 = sl_get_le32(d + pos);
             }
             pos += 4U;
             break;
@@ -425,14 +390,14 @@ sl_err_t sl_proto_parse_config(const sl_proto_msg_t *msg, sl_proto_config_t *out
     }
     const uint8_t *d = msg->payload.data;
     memset(out, 0, sizeof *out);
-    out->azimuths = be16(d + 0);
-    out->bin_size_100um = be16(d + 2);
-    out->range_bins = be16(d + 4);
-    out->encoder_size = be16(d + 6);
-    out->rotation_mhz = be16(d + 8);
-    out->packet_rate = be16(d + 10);
-    out->range_gain_f32 = be32(d + 12);
-    out->range_offset_f32 = be32(d + 16);
+    out->azimuths = sl_get_be16(d + 0);
+    out->bin_size_100um = sl_get_be16(d + 2);
+    out->range_bins = sl_get_be16(d + 4);
+    out->encoder_size = sl_get_be16(d + 6);
+    out->rotation_mhz = sl_get_be16(d + 8);
+    out->packet_rate = sl_get_be16(d + 10);
+    out->range_gain_f32 = sl_get_be32(d + 12);
+    out->range_offset_f32 = sl_get_be32(d + 16);
     out->protobuf.data = d + SL_PROTO_CONFIG_FIXED_BYTES;
     out->protobuf.size = msg->payload.size - SL_PROTO_CONFIG_FIXED_BYTES;
     out->protobuf_malformed = !pb_walk(out->protobuf.data, out->protobuf.size, out);
@@ -498,7 +463,7 @@ sl_err_t sl_proto_parse_fft(const sl_proto_msg_t *msg, sl_proto_fft_t *out)
     }
 #endif
     const uint8_t *d = msg->payload.data;
-    const uint16_t off = be16(d);
+    const uint16_t off = sl_get_be16(d);
     if (off < SL_PROTO_FFT_FIXED_BYTES || off > size) {
         return SL_ERR_MALFORMED;
     }
@@ -510,10 +475,10 @@ sl_err_t sl_proto_parse_fft(const sl_proto_msg_t *msg, sl_proto_fft_t *out)
     out->id = msg->id;
     out->bytes_per_bin = bpb;
     out->data_offset = off;
-    out->sweep_counter = be16(d + 2);
-    out->azimuth_ticks = be16(d + 4);
-    out->seconds = le32(d + 6);
-    out->split_ns = le32(d + 10);
+    out->sweep_counter = sl_get_be16(d + 2);
+    out->azimuth_ticks = sl_get_be16(d + 4);
+    out->seconds = sl_get_le32(d + 6);
+    out->split_ns = sl_get_le32(d + 10);
     out->bins = (uint32_t)(nbytes / bpb);
     out->bin_data = d + off;
     return SL_OK;
@@ -532,7 +497,7 @@ sl_ssize_t sl_proto_encode_header(uint8_t *buf, size_t size, uint8_t id, uint32_
     memcpy(buf, sl_proto_signature, SL_PROTO_SIGNATURE_BYTES);
     buf[16] = SL_PROTO_VERSION;
     buf[17] = id;
-    put_be32(buf + 18, payload_bytes);
+    sl_put_be32(buf + 18, payload_bytes);
     return (sl_ssize_t)SL_PROTO_HEADER_BYTES;
 }
 
@@ -573,7 +538,7 @@ sl_ssize_t sl_proto_encode_config(uint8_t *buf, size_t size, const sl_proto_conf
     }
     if (c->has_range_res) {
         pb[pbn++] = (uint8_t)((10U << 3) | 5U);
-        put_le32(pb + pbn, c->range_res_m_f32);
+        sl_put_le32(pb + pbn, c->range_res_m_f32);
         pbn += 4U;
     }
     const uint64_t payload = (uint64_t)SL_PROTO_CONFIG_FIXED_BYTES + pbn + extra_protobuf.size;
@@ -586,14 +551,14 @@ sl_ssize_t sl_proto_encode_config(uint8_t *buf, size_t size, const sl_proto_conf
     }
     (void)sl_proto_encode_header(buf, size, SL_PROTO_ID_CONFIGURATION, (uint32_t)payload);
     uint8_t *d = buf + SL_PROTO_HEADER_BYTES;
-    put_be16(d + 0, c->azimuths);
-    put_be16(d + 2, c->bin_size_100um);
-    put_be16(d + 4, c->range_bins);
-    put_be16(d + 6, c->encoder_size);
-    put_be16(d + 8, c->rotation_mhz);
-    put_be16(d + 10, c->packet_rate);
-    put_be32(d + 12, c->range_gain_f32);
-    put_be32(d + 16, c->range_offset_f32);
+    sl_put_be16(d + 0, c->azimuths);
+    sl_put_be16(d + 2, c->bin_size_100um);
+    sl_put_be16(d + 4, c->range_bins);
+    sl_put_be16(d + 6, c->encoder_size);
+    sl_put_be16(d + 8, c->rotation_mhz);
+    sl_put_be16(d + 10, c->packet_rate);
+    sl_put_be32(d + 12, c->range_gain_f32);
+    sl_put_be32(d + 16, c->range_offset_f32);
     memcpy(d + SL_PROTO_CONFIG_FIXED_BYTES, pb, pbn);
     if (extra_protobuf.size != 0U) {
         memcpy(d + SL_PROTO_CONFIG_FIXED_BYTES + pbn, extra_protobuf.data, extra_protobuf.size);
@@ -614,11 +579,11 @@ static sl_ssize_t fft_head(uint8_t *buf, size_t size, const sl_proto_fft_t *f, u
     }
     (void)sl_proto_encode_header(buf, size, id, (uint32_t)payload);
     uint8_t *d = buf + SL_PROTO_HEADER_BYTES;
-    put_be16(d + 0, (uint16_t)SL_PROTO_FFT_FIXED_BYTES);
-    put_be16(d + 2, f->sweep_counter);
-    put_be16(d + 4, f->azimuth_ticks);
-    put_le32(d + 6, f->seconds);
-    put_le32(d + 10, f->split_ns);
+    sl_put_be16(d + 0, (uint16_t)SL_PROTO_FFT_FIXED_BYTES);
+    sl_put_be16(d + 2, f->sweep_counter);
+    sl_put_be16(d + 4, f->azimuth_ticks);
+    sl_put_le32(d + 6, f->seconds);
+    sl_put_le32(d + 10, f->split_ns);
     return (sl_ssize_t)total;
 }
 

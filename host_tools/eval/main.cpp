@@ -30,7 +30,9 @@ void usage()
                  "      segmentation, poles at 2.2-2.6 m: beside the paper's Table II.\n"
                  "  sl-eval run CAPTURE.colossus GT.csv [--board NAME] [--scene SCENE.ini]\n"
                  "             [--threshold T] [--beta DEG] [--raw|--half-bin] [--r1-add M] [--d M]\n"
-                 "      Evaluates one capture made by sl-sim against its ground truth.\n"
+                 "             [--extract bbox|pipeline] [--beam-deg DEG] [--speed M/S] [--no-width-radius]\n"
+                 "      Evaluates one capture made by sl-sim against its ground truth. --extract pipeline:\n"
+                 "      the core pipeline (beam, threshold and speed from --scene, or the options).\n"
                  "--quiet silences the progress lines on stderr.\n");
 }
 
@@ -171,10 +173,25 @@ int cmd_run(int argc, char **argv)
     std::string cap, gtp, board, scene_path;
     double threshold = -1, beta = 0, r1_add = 0, d = 0;
     sl::Proc::Bounds bounds = sl::Proc::Bounds::HalfBin;
+    bool pipeline = false, no_width_radius = false;
+    double beam_deg = -1, speed = -1;
     for (int i = 0; i < argc; i++) {
         const std::string a = argv[i];
         auto next = [&]() -> std::string { return i + 1 < argc ? argv[++i] : ""; };
-        if (a == "--board") {
+        if (a == "--extract") {
+            const std::string m = next();
+            if (m != "pipeline" && m != "bbox") {
+                usage();
+                return 2;
+            }
+            pipeline = m == "pipeline";
+        } else if (a == "--beam-deg") {
+            beam_deg = std::atof(next().c_str());
+        } else if (a == "--speed") {
+            speed = std::atof(next().c_str());
+        } else if (a == "--no-width-radius") {
+            no_width_radius = true;
+        } else if (a == "--board") {
             board = next();
         } else if (a == "--scene") {
             scene_path = next();
@@ -219,6 +236,48 @@ int cmd_run(int argc, char **argv)
         b = sl::load_scene(scene_path).board;
     } else {
         b = sl::load_board(board.empty() ? "paper-sim" : board);
+    }
+    if (pipeline) {
+        sl::PipeCfg pc;
+        if (!scene_path.empty()) {
+            pc = sl::pipe_cfg_for_scene(sl::load_scene(scene_path));
+        } else {
+            pc.board = b.name;
+        }
+        if (beam_deg > 0) {
+            pc.beam_deg = beam_deg;
+        }
+        if (speed >= 0) {
+            pc.speed_mps = speed;
+        }
+        if (threshold >= 0) {
+            pc.threshold = static_cast<int>(threshold);
+        }
+        if (no_width_radius) {
+            pc.radius_from_width = 0;
+        }
+        sl::PipelineEval pe(pc);
+        for (const auto &g : gt) {
+            if (g.nominal == 1 && g.valid == 1) {
+                pe.add_truth(g);
+            }
+        }
+        pe.feed(0, bytes.data(), bytes.size());
+        pe.finish();
+        const auto res = pe.result();
+        std::printf("%s\n", sl::kPipelineLabel);
+        std::printf("capture %s: board %s, speed %.3f m/s, beam %.2f deg, threshold %d%s\n", cap.c_str(),
+                    pc.board.c_str(), pc.speed_mps, pc.beam_deg, pc.threshold,
+                    no_width_radius ? ", radius_from_width off" : "");
+        for (const auto &kv : res) {
+            const sl::PipeEval &e = kv.second;
+            std::printf("pole %d: rotations %d, truth rows %d, detected %d (rate %.1f%%), n_eff %d-%d, targets %d "
+                        "(unmatched %d), ambiguous %d, invalid %d: error mean %.3f std %.3f rmse %.3f max %.3f deg\n",
+                        kv.first, e.rotations, e.truth_rows, e.detected, 100.0 * e.rate(), e.frames_eff_min,
+                        e.frames_eff_max, e.targets, e.unmatched, e.err.ambiguous, e.err.invalid, e.err.mean,
+                        e.err.std, e.err.rmse, e.err.maxabs);
+        }
+        return 0;
     }
     std::map<std::pair<int, int>, const sl::GtRow *> want;
     for (const auto &g : gt) {

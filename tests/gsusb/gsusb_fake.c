@@ -3,13 +3,7 @@
 
 #include <string.h>
 
-static void le32(uint8_t *p, uint32_t v)
-{
-    p[0] = (uint8_t)(v & 0xFFU);
-    p[1] = (uint8_t)((v >> 8) & 0xFFU);
-    p[2] = (uint8_t)((v >> 16) & 0xFFU);
-    p[3] = (uint8_t)((v >> 24) & 0xFFU);
-}
+#include "shadowlean/sl_bytes.h"
 
 void gsusb_fake_init(gsusb_fake_t *f)
 {
@@ -174,8 +168,8 @@ static sl_gsusb_io_t fake_control_in(void *ctx, uint8_t rt, uint8_t breq, uint16
     switch (breq) {
     case SL_GSUSB_BREQ_DEVICE_CONFIG:
         ans[3] = f->dev_cfg.icount;
-        le32(ans + 4, f->dev_cfg.sw_version);
-        le32(ans + 8, f->dev_cfg.hw_version);
+        sl_put_le32(ans + 4, f->dev_cfg.sw_version);
+        sl_put_le32(ans + 8, f->dev_cfg.hw_version);
         n = 12;
         break;
     case SL_GSUSB_BREQ_BT_CONST: {
@@ -183,7 +177,7 @@ static sl_gsusb_io_t fake_control_in(void *ctx, uint8_t rt, uint8_t breq, uint16
         const uint32_t v[10] = {c->feature, c->fclk_hz,  c->tseg1_min, c->tseg1_max, c->tseg2_min,
                                 c->tseg2_max, c->sjw_max, c->brp_min,  c->brp_max,   c->brp_inc};
         for (size_t i = 0; i < 10; i++) {
-            le32(ans + 4 * i, v[i]);
+            sl_put_le32(ans + 4 * i, v[i]);
         }
         n = 40;
         break;
@@ -192,9 +186,9 @@ static sl_gsusb_io_t fake_control_in(void *ctx, uint8_t rt, uint8_t breq, uint16
         if ((f->bt_const.feature & SL_GSUSB_FEAT_GET_STATE) == 0U) {
             return SL_GSUSB_IO_STALL;
         }
-        le32(ans + 0, f->can_state.state);
-        le32(ans + 4, f->can_state.rxerr);
-        le32(ans + 8, f->can_state.txerr);
+        sl_put_le32(ans + 0, f->can_state.state);
+        sl_put_le32(ans + 4, f->can_state.rxerr);
+        sl_put_le32(ans + 8, f->can_state.txerr);
         n = 12;
         break;
     default:

@@ -17,6 +17,11 @@ echo "$out" | grep -q 'bbox extraction (detection pipeline not used)'
 echo "$out" | grep -q '4800 FFT rows, 12 rotations'
 # raw bounds: the quantisation bias is positive
 echo "$out" | grep -Eq 'error mean [0-9]'
+# the core pipeline on the same capture (12 rotations at 1 m/s: n_eff 1)
+out=$("$EVAL" run "$WORK/p10.colossus" "$WORK/p10.gt.csv" --scene "$SCENES/paper_pass_p10.ini" --extract pipeline)
+echo "$out"
+echo "$out" | grep -q '^core pipeline (sl_pipeline: mask + detection + corrections + alpha; n_eff from motion)'
+echo "$out" | grep -Eq 'pole 0: rotations 12, truth rows [0-9]+, detected [1-9]'
 # a bad scene is rejected with the key in the message
 printf '[scene]\nboard = paper-sim\n[pole.a]\nx_m = 1\ny_m = 0\nradius = 2\n' > "$WORK/bad.ini"
 if "$SIM" "$WORK/bad.ini" -o "$WORK/bad.colossus" --quiet 2> "$WORK/bad.err"; then exit 1; fi

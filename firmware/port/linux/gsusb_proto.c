@@ -1,26 +1,11 @@
 // gs_usb protocol layer and driver logic (no libusb: see gsusb_proto.h).
 #include "gsusb_proto.h"
 
+#include "shadowlean/sl_bytes.h"
+
 #include <stdarg.h>
 #include <stdio.h>
 #include <string.h>
-
-// ---------------------------------------------------------------------------------------
-// Little-endian helpers (byte by byte: endian-clean on s390x)
-
-static void put_le32(uint8_t *p, uint32_t v)
-{
-    p[0] = (uint8_t)(v & 0xFFU);
-    p[1] = (uint8_t)((v >> 8) & 0xFFU);
-    p[2] = (uint8_t)((v >> 16) & 0xFFU);
-    p[3] = (uint8_t)((v >> 24) & 0xFFU);
-}
-
-static uint32_t get_le32(const uint8_t *p)
-{
-    return (uint32_t)p[0] | ((uint32_t)p[1] << 8) | ((uint32_t)p[2] << 16) |
-           ((uint32_t)p[3] << 24);
-}
 
 // ---------------------------------------------------------------------------------------
 // Identity
@@ -90,22 +75,22 @@ const char *sl_gsusb_io_name(sl_gsusb_io_t io)
 
 void sl_gsusb_encode_host_format(uint8_t out[SL_GSUSB_HOST_FORMAT_BYTES])
 {
-    put_le32(out, (uint32_t)SL_GSUSB_HOST_FORMAT_WORD);
+    sl_put_le32(out, (uint32_t)SL_GSUSB_HOST_FORMAT_WORD);
 }
 
 void sl_gsusb_encode_bittiming(const sl_gsusb_bittiming_t *bt, uint8_t out[SL_GSUSB_BITTIMING_BYTES])
 {
-    put_le32(out + 0, bt->prop_seg);
-    put_le32(out + 4, bt->phase_seg1);
-    put_le32(out + 8, bt->phase_seg2);
-    put_le32(out + 12, bt->sjw);
-    put_le32(out + 16, bt->brp);
+    sl_put_le32(out + 0, bt->prop_seg);
+    sl_put_le32(out + 4, bt->phase_seg1);
+    sl_put_le32(out + 8, bt->phase_seg2);
+    sl_put_le32(out + 12, bt->sjw);
+    sl_put_le32(out + 16, bt->brp);
 }
 
 void sl_gsusb_encode_mode(uint32_t mode, uint32_t flags, uint8_t out[SL_GSUSB_MODE_BYTES])
 {
-    put_le32(out + 0, mode);
-    put_le32(out + 4, flags);
+    sl_put_le32(out + 0, mode);
+    sl_put_le32(out + 4, flags);
 }
 
 sl_err_t sl_gsusb_decode_device_config(const uint8_t *buf, size_t len, sl_gsusb_device_config_t *out)
@@ -117,8 +102,8 @@ sl_err_t sl_gsusb_decode_device_config(const uint8_t *buf, size_t len, sl_gsusb_
         return SL_ERR_MALFORMED;
     }
     out->icount = buf[3];
-    out->sw_version = get_le32(buf + 4);
-    out->hw_version = get_le32(buf + 8);
+    out->sw_version = sl_get_le32(buf + 4);
+    out->hw_version = sl_get_le32(buf + 8);
     return SL_OK;
 }
 
@@ -130,16 +115,16 @@ sl_err_t sl_gsusb_decode_bt_const(const uint8_t *buf, size_t len, sl_gsusb_bt_co
     if (len < SL_GSUSB_BT_CONST_BYTES) {
         return SL_ERR_MALFORMED;
     }
-    out->feature = get_le32(buf + 0);
-    out->fclk_hz = get_le32(buf + 4);
-    out->tseg1_min = get_le32(buf + 8);
-    out->tseg1_max = get_le32(buf + 12);
-    out->tseg2_min = get_le32(buf + 16);
-    out->tseg2_max = get_le32(buf + 20);
-    out->sjw_max = get_le32(buf + 24);
-    out->brp_min = get_le32(buf + 28);
-    out->brp_max = get_le32(buf + 32);
-    out->brp_inc = get_le32(buf + 36);
+    out->feature = sl_get_le32(buf + 0);
+    out->fclk_hz = sl_get_le32(buf + 4);
+    out->tseg1_min = sl_get_le32(buf + 8);
+    out->tseg1_max = sl_get_le32(buf + 12);
+    out->tseg2_min = sl_get_le32(buf + 16);
+    out->tseg2_max = sl_get_le32(buf + 20);
+    out->sjw_max = sl_get_le32(buf + 24);
+    out->brp_min = sl_get_le32(buf + 28);
+    out->brp_max = sl_get_le32(buf + 32);
+    out->brp_inc = sl_get_le32(buf + 36);
     return SL_OK;
 }
 
@@ -151,11 +136,11 @@ sl_err_t sl_gsusb_decode_bittiming(const uint8_t *buf, size_t len, sl_gsusb_bitt
     if (len < SL_GSUSB_BITTIMING_BYTES) {
         return SL_ERR_MALFORMED;
     }
-    out->prop_seg = get_le32(buf + 0);
-    out->phase_seg1 = get_le32(buf + 4);
-    out->phase_seg2 = get_le32(buf + 8);
-    out->sjw = get_le32(buf + 12);
-    out->brp = get_le32(buf + 16);
+    out->prop_seg = sl_get_le32(buf + 0);
+    out->phase_seg1 = sl_get_le32(buf + 4);
+    out->phase_seg2 = sl_get_le32(buf + 8);
+    out->sjw = sl_get_le32(buf + 12);
+    out->brp = sl_get_le32(buf + 16);
     return SL_OK;
 }
 
@@ -167,9 +152,9 @@ sl_err_t sl_gsusb_decode_state(const uint8_t *buf, size_t len, sl_gsusb_can_stat
     if (len < SL_GSUSB_STATE_BYTES) {
         return SL_ERR_MALFORMED;
     }
-    out->state = get_le32(buf + 0);
-    out->rxerr = get_le32(buf + 4);
-    out->txerr = get_le32(buf + 8);
+    out->state = sl_get_le32(buf + 0);
+    out->rxerr = sl_get_le32(buf + 4);
+    out->txerr = sl_get_le32(buf + 8);
     return SL_OK;
 }
 
@@ -355,15 +340,15 @@ sl_ssize_t sl_gsusb_frame_encode(const sl_gsusb_host_frame_t *hf, unsigned fmt, 
     if (cap < n) {
         return SL_ERR_FULL;
     }
-    put_le32(buf + 0, hf->echo_id);
-    put_le32(buf + 4, hf->can_id);
+    sl_put_le32(buf + 0, hf->echo_id);
+    sl_put_le32(buf + 4, hf->can_id);
     buf[8] = hf->can_dlc;
     buf[9] = hf->channel;
     buf[10] = hf->flags;
     buf[11] = hf->reserved;
     memcpy(buf + 12, hf->data, 8);
     if ((fmt & SL_GSUSB_FMT_TIMESTAMP) != 0U) {
-        put_le32(buf + 20, hf->timestamp_us);
+        sl_put_le32(buf + 20, hf->timestamp_us);
     } else if ((fmt & SL_GSUSB_FMT_QUIRK) != 0U) {
         buf[20] = 0U;
     }
@@ -379,14 +364,14 @@ sl_err_t sl_gsusb_frame_decode(const uint8_t *buf, size_t len, unsigned fmt, sl_
     if (len < (ts ? SL_GSUSB_FRAME_TS_BYTES : SL_GSUSB_FRAME_BYTES)) {
         return SL_ERR_MALFORMED;
     }
-    out->echo_id = get_le32(buf + 0);
-    out->can_id = get_le32(buf + 4);
+    out->echo_id = sl_get_le32(buf + 0);
+    out->can_id = sl_get_le32(buf + 4);
     out->can_dlc = buf[8];
     out->channel = buf[9];
     out->flags = buf[10];
     out->reserved = buf[11];
     memcpy(out->data, buf + 12, 8);
-    out->timestamp_us = ts ? get_le32(buf + 20) : 0U;
+    out->timestamp_us = ts ? sl_get_le32(buf + 20) : 0U;
     return SL_OK;
 }
 
