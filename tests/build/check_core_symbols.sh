@@ -1,15 +1,21 @@
 #!/bin/sh
-# check_core_symbols.sh NM ARCHIVE [--no-softfloat]
+# check_core_symbols.sh NM ARCHIVE [--no-softfloat|--sanitized]
 #
 # Fails (exit 1) when the portable core references anything outside the freestanding set:
 # every symbol the archive leaves undefined must either be defined inside the archive or be
 # on the allowlist below (mem* and the compiler's integer helpers). That catches malloc &
 # co., stdio, any OS call, and with --no-softfloat (Cortex-M0) every soft-float helper.
-# It names each offending symbol and the object that references it.
+# It names each offending symbol and the object that references it. --sanitized (the
+# ASan/UBSan build) also allows the sanitizer runtime's hooks (__asan_*, __ubsan_*, ...),
+# which the instrumentation itself adds; everything else stays forbidden.
 set -eu
 NM=$1
 LIB=$2
 NOSOFT=${3:-}
+sanitizer='^$'
+if [ "$NOSOFT" = "--sanitized" ]; then
+    sanitizer='^(__(asan|ubsan|lsan|sanitizer)_[A-Za-z0-9_]+|__sancov_[A-Za-z0-9_]+)$'
+fi
 [ -f "$LIB" ] || { echo "check_core_symbols: no such archive: $LIB" >&2; exit 2; }
 
 # Symbols defined anywhere in the archive.
@@ -27,6 +33,9 @@ for ref in $undef; do
     obj=${ref%%:*}
     sym=${ref#*:}
     if printf '%s\n' "$defined" | grep -qx "$sym"; then
+        continue
+    fi
+    if printf '%s\n' "$sym" | grep -Eq "$sanitizer"; then
         continue
     fi
     if printf '%s\n' "$sym" | grep -Eq "$soft"; then
