@@ -12,10 +12,22 @@ sh scripts/deps.sh build test
 STEPS=${SL_TEST_ONLY:-"host host-asan aarch64 s390x cortex-m0 cortex-m4f"}
 JOBS=${SL_JOBS:-2}
 failed=""
+CTLOG=$(mktemp)
+trap 'rm -f "$CTLOG"' EXIT
 run() { # name, command...
     name=$1; shift
     echo "=== [$name] $*"
     if ! "$@"; then failed="$failed $name"; echo "=== [$name] FAILED"; fi
+}
+run_ctest() { # ctest args...: keeps ctest's summary lines for the closing total
+    set +e
+    ctest "$@" > "$CTLOG.out" 2>&1
+    rc=$?
+    set -e
+    cat "$CTLOG.out"
+    grep -E "tests passed, [0-9]+ tests? failed out of [0-9]+" "$CTLOG.out" >> "$CTLOG" || true
+    rm -f "$CTLOG.out"
+    return $rc
 }
 configure_build() { # preset
     cmake --preset "$1" >/dev/null && cmake --build --preset "$1" -j "$JOBS"
@@ -23,19 +35,24 @@ configure_build() { # preset
 for s in $STEPS; do
     case "$s" in
     host) run host-build configure_build host
-          run host-ctest ctest --preset host --output-on-failure ;;
+          run host-ctest run_ctest --preset host --output-on-failure ;;
     host-asan) run asan-build configure_build host-asan
-          run asan-ctest ctest --preset host-asan --output-on-failure -LE "vm|slow" ;;
+          run asan-ctest run_ctest --preset host-asan --output-on-failure -LE "vm|slow" ;;
     aarch64) run aarch64-build configure_build cross-aarch64
-          run aarch64-ctest ctest --preset cross-aarch64 --output-on-failure ;;
+          run aarch64-ctest run_ctest --preset cross-aarch64 --output-on-failure ;;
     s390x) run s390x-build configure_build cross-s390x
-          run s390x-ctest ctest --preset cross-s390x --output-on-failure ;;
+          run s390x-ctest run_ctest --preset cross-s390x --output-on-failure ;;
     cortex-m0|cortex-m4f) run "$s" configure_build "cross-$s" ;;
     *) echo "unknown step $s"; exit 2 ;;
     esac
 done
 if [ -n "$failed" ]; then
     echo "test.sh: FAILED:$failed"
-    exit 1
+else
+    echo "test.sh: all steps passed ($STEPS)"
 fi
-echo "test.sh: all steps passed ($STEPS)"
+# One closing line over every ctest run: "<failed> tests failed out of <total>" summed.
+awk '{ for (i = 1; i <= NF; i++) if ($i == "out" && $(i+1) == "of") total += $(i+2);
+       for (i = 1; i <= NF; i++) if ($i == "failed" && $(i-2) ~ /^[0-9]+$/) bad += $(i-2) }
+     END { printf "total: %d passed, %d failed\n", total - bad, bad }' "$CTLOG"
+[ -z "$failed" ]
