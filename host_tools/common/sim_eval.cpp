@@ -414,6 +414,7 @@ struct PipelineEval::Impl {
     std::unique_ptr<sl_pipeline_t> p{new sl_pipeline_t()};
     std::map<int, std::vector<sl_target_t>> targets; // by rotation
     std::map<int, int> frames_eff;                    // by rotation
+    std::map<int, std::vector<sl_track_t>> tracks;    // live tracks after each rotation
     std::vector<GtRow> truth;
     uint64_t period_us = 250000;
 
@@ -423,6 +424,13 @@ struct PipelineEval::Impl {
         auto &v = self->targets[static_cast<int>(r->rotation)];
         v.assign(r->targets, r->targets + r->n_targets);
         self->frames_eff[static_cast<int>(r->rotation)] = r->frames_eff;
+        auto &tr = self->tracks[static_cast<int>(r->rotation)];
+        tr.clear();
+        for (uint16_t i = 0; i < r->n_track_slots; i++) {
+            if (r->tracks[i].live != 0) {
+                tr.push_back(r->tracks[i]);
+            }
+        }
     }
     uint64_t now_for(int rotation) const
     {
@@ -567,6 +575,44 @@ std::map<int, PipeEval> PipelineEval::result() const
     }
     return out;
 }
+
+std::vector<PipelineEval::Target> PipelineEval::targets() const
+{
+    std::vector<Target> out;
+    for (const auto &kv : m_->targets) {
+        for (const auto &t : kv.second) {
+            Target x;
+            x.rotation = kv.first;
+            x.az = t.az;
+            x.flag = t.incline_flag;
+            x.alpha_deg = t.alpha_cdeg / 100.0;
+            x.sigma_deg = t.sigma_cdeg / 100.0;
+            out.push_back(x);
+        }
+    }
+    return out;
+}
+
+std::vector<PipelineEval::Track> PipelineEval::tracks() const
+{
+    std::vector<Track> out;
+    for (const auto &kv : m_->tracks) {
+        for (const auto &t : kv.second) {
+            Track x;
+            x.rotation = kv.first;
+            x.az = t.az;
+            x.id = t.id;
+            x.hits = t.hits;
+            x.valid_hits = t.valid_hits;
+            x.last_flag = t.last_flag;
+            x.alpha_deg = t.alpha_cdeg / 100.0;
+            out.push_back(x);
+        }
+    }
+    return out;
+}
+
+std::map<int, int> PipelineEval::frames_eff() const { return m_->frames_eff; }
 
 std::map<int, PipeEval> simulate_pipeline(const Scene &scene, const PipeCfg &c, int threads, int *boundary,
                                           const std::function<void(int done, int total)> &progress)
@@ -1206,7 +1252,8 @@ struct Frames {
     bool have = false;
 };
 
-Frames run_frames(const Scene &s, int threads, double threshold)
+Frames run_frames(const Scene &s, int threads, double threshold,
+                  const std::function<void(int k, const uint8_t *bytes, size_t n)> &on_bytes = {})
 {
     Frames fr;
     int az = -1, nframes = 0;
@@ -1234,12 +1281,95 @@ Frames run_frames(const Scene &s, int threads, double threshold)
                 fr.all[j] += bins[j] >= threshold ? 1.0 : 0.0;
             }
             nframes++;
-        });
+        },
+        {}, on_bytes);
     for (size_t j = 0; j < fr.mean.size(); j++) {
         fr.mean[j] /= std::max(1, nframes);
         fr.all[j] = fr.all[j] >= nframes ? 1.0 : 0.0; // consistent in every frame
     }
     return fr;
+}
+
+// One measurement through the core pipeline: the targets of the last `last` reported
+// rotations at the pole's azimuth (nearest within `assoc_az`), their mean alpha
+// (ambiguous = the bound (beta - theta)/2, as the bbox columns), and the tracker's filtered
+// alpha after the last rotation.
+void realistic_pipe_add(const PipelineEval &pe, const GtRow &gt, int assoc_az, int last, int azimuths,
+                        RealisticPipe &out)
+{
+    const auto fe = pe.frames_eff();
+    out.runs++;
+    if (fe.empty()) {
+        return;
+    }
+    for (const auto &kv : fe) {
+        out.frames_eff_min = out.frames_eff_min == 0 ? kv.second : std::min(out.frames_eff_min, kv.second);
+        out.frames_eff_max = std::max(out.frames_eff_max, kv.second);
+    }
+    const int r_last = fe.rbegin()->first;
+    const int r_first = std::max(fe.begin()->first, r_last - std::max(1, last) + 1);
+    const int az_n = std::max(1, azimuths);
+    auto az_dist = [az_n](int a, int b) {
+        int d = std::abs(a - b) % az_n;
+        return std::min(d, az_n - d);
+    };
+    const double bound = 0.5 * (gt.beta_deg - gt.theta_deg);
+    const auto tg = pe.targets();
+    double sum = 0;
+    int cnt = 0;
+    bool any = false;
+    for (int r = r_first; r <= r_last; r++) {
+        out.rot_checked++;
+        int best = -1, best_d = assoc_az + 1, in_rot = 0;
+        for (size_t j = 0; j < tg.size(); j++) {
+            if (tg[j].rotation != r) {
+                continue;
+            }
+            in_rot++;
+            const int d = az_dist(tg[j].az, gt.azimuth);
+            if (d < best_d) {
+                best_d = d;
+                best = static_cast<int>(j);
+            }
+        }
+        out.unmatched += in_rot - (best >= 0 ? 1 : 0);
+        if (best < 0) {
+            continue;
+        }
+        any = true;
+        out.rot_detected++;
+        const auto &t = tg[static_cast<size_t>(best)];
+        if (t.flag == SL_INCLINE_VALID) {
+            out.valid++;
+            sum += t.alpha_deg;
+            cnt++;
+        } else if (t.flag == SL_INCLINE_AMBIGUOUS) {
+            out.ambiguous++;
+            sum += bound;
+            cnt++;
+        } else {
+            out.other++;
+        }
+    }
+    out.detected += any ? 1 : 0;
+    if (cnt > 0) {
+        out.raw.push_back(sum / cnt);
+    }
+    int best_d = assoc_az + 1;
+    double filt = std::nan("");
+    for (const auto &t : pe.tracks()) {
+        if (t.rotation != r_last || t.valid_hits <= 0) {
+            continue;
+        }
+        const int d = az_dist(t.az, gt.azimuth);
+        if (d < best_d) {
+            best_d = d;
+            filt = t.alpha_deg;
+        }
+    }
+    if (!std::isnan(filt)) {
+        out.filt.push_back(filt);
+    }
 }
 
 } // namespace
@@ -1248,6 +1378,13 @@ RealisticResult run_realistic(const RealisticOptions &o)
 {
     RealisticResult res;
     res.frames = o.frames;
+    res.bbox_table = o.bbox_table;
+    res.pipe_last = o.pipe_last;
+    int pipe_az = 400;
+    if (const sl_board_t *pb = sl_board_find("paper-bench")) {
+        res.pipe_mask_frames = pb->mask_frames;
+        pipe_az = pb->azimuths;
+    }
     res.positions = o.positions;
     res.reps = o.reps;
     const auto t0 = Clock::now();
@@ -1265,7 +1402,8 @@ RealisticResult run_realistic(const RealisticOptions &o)
     std::vector<std::pair<double, double>> cal_paper, cal_ours;
     std::vector<Frames> cal_frames;
     std::vector<double> slopes;
-    const int nc = std::max(2, o.calib_positions);
+    // pipeline only: no bbox calibration (the core's own elongation table is used)
+    const int nc = o.bbox_table ? std::max(2, o.calib_positions) : 0;
     int done = 0;
     const int total = nc * 2 + 5 * o.positions * o.reps;
     for (int c = 0; c < nc; c++) {
@@ -1386,7 +1524,22 @@ RealisticResult run_realistic(const RealisticOptions &o)
             for (int rep = 0; rep < o.reps; rep++) {
                 const uint64_t seed = 7000 + static_cast<uint64_t>(a * 1000 + pI * 10 + rep);
                 const Scene s = realistic_scene(dist, res.angles[a], seed, o.frames, o.range_bins);
-                const Frames f = run_frames(s, o.threads, thr);
+                std::unique_ptr<PipelineEval> pipe;
+                std::function<void(int, const uint8_t *, size_t)> on_bytes;
+                if (o.extract == Extract::Pipeline) {
+                    const PipeCfg pc = pipe_cfg_for_scene(s);
+                    if (!res.have_pipe) {
+                        res.pipe_cfg = pc;
+                        res.have_pipe = true;
+                    }
+                    pipe.reset(new PipelineEval(pc));
+                    on_bytes = [&pipe](int k, const uint8_t *d, size_t n) { pipe->feed(k, d, n); };
+                }
+                const Frames f = run_frames(s, o.threads, thr, on_bytes);
+                if (pipe && f.have) {
+                    pipe->finish();
+                    realistic_pipe_add(*pipe, f.gt, res.pipe_cfg.assoc_az, o.pipe_last, pipe_az, res.pipe[a]);
+                }
                 done++;
                 if (o.progress) {
                     std::fprintf(stderr, "\rsl-eval realistic: run %d/%d (pole %+d deg at %.2f m, rep %d)      ",
@@ -1422,8 +1575,74 @@ RealisticResult run_realistic(const RealisticOptions &o)
     return res;
 }
 
+namespace {
+
+void mean_sd(const std::vector<double> &v, double *mean, double *sd)
+{
+    *mean = *sd = std::nan("");
+    if (v.empty()) {
+        return;
+    }
+    double s = 0;
+    for (double x : v) {
+        s += x;
+    }
+    *mean = s / static_cast<double>(v.size());
+    double q = 0;
+    for (double x : v) {
+        q += (x - *mean) * (x - *mean);
+    }
+    *sd = v.size() > 1 ? std::sqrt(q / static_cast<double>(v.size() - 1)) : 0.0;
+}
+
+void print_realistic_pipeline(std::FILE *f, const RealisticResult &r)
+{
+    const PipeCfg &c = r.pipe_cfg;
+    std::fprintf(f,
+                 "Realistic bench (paper Table II) -- %s.\n"
+                 "Board %s (core table: elongation d(r) keyed by observed r2, beta +3 deg), speed 0 (static\n"
+                 "bench: board n = %u), detection beam width %.2f deg (the simulated azimuth window), threshold %s;\n"
+                 "%d positions x %d repetitions per angle, %d frames per measurement. Per measurement: the\n"
+                 "targets of the last %d rotation(s) at the pole's azimuth (+-%d az), their mean raw alpha\n"
+                 "(ambiguous = the bound (beta - theta)/2), and the tracker's filtered alpha after the last one.\n\n",
+                 kPipelineLabel, c.board.c_str(), r.pipe_mask_frames, c.beam_deg,
+                 c.threshold >= 0 ? std::to_string(c.threshold).c_str() : "board's", r.positions, r.reps, r.frames,
+                 r.pipe_last, c.assoc_az);
+    std::fprintf(f, "%-6s | %-18s | %-33s | %-33s | %-8s | %s\n", "true", "paper mean / std",
+                 "core pipeline raw: mean / std", "core pipeline filtered: mean / std", "detected",
+                 "rotations with target / checked; targets valid/amb/other; unmatched; n_eff");
+    for (int a = 0; a < 5; a++) {
+        const RealisticPipe &p = r.pipe[a];
+        double rm, rs, fm, fs;
+        mean_sd(p.raw, &rm, &rs);
+        mean_sd(p.filt, &fm, &fs);
+        std::fprintf(f, "%+4d   | %+7.2f / %5.2f    | %+7.2f / %5.2f (err %+6.2f) n=%-3zu | %+7.2f / %5.2f (err %+6.2f) n=%-3zu | %3d/%-3d  | %d/%d; %d/%d/%d; %d; %d-%d\n",
+                     r.angles[a], r.paper_mean[a], r.paper_std[a], rm, rs, rm - r.angles[a], p.raw.size(), fm, fs,
+                     fm - r.angles[a], p.filt.size(), p.detected, p.runs, p.rot_detected, p.rot_checked, p.valid,
+                     p.ambiguous, p.other, p.unmatched, p.frames_eff_min, p.frames_eff_max);
+    }
+    double sm = 0, ss = 0;
+    for (int a = 0; a < 5; a++) {
+        double m, sd;
+        mean_sd(r.pipe[a].raw, &m, &sd);
+        sm += std::fabs(m - r.angles[a]) / 5;
+        ss += sd / 5;
+    }
+    std::fprintf(f, "\ncore pipeline raw: average |mean error| / std over the 5 angles: %.2f / %.2f deg\n", sm, ss);
+}
+
+} // namespace
+
 void print_realistic(std::FILE *f, const RealisticResult &r)
 {
+    if (r.have_pipe) {
+        print_realistic_pipeline(f, r);
+        if (!r.bbox_table) {
+            std::fprintf(f, "run time %.1f s\n", r.seconds);
+            return;
+        }
+        std::fprintf(f, "\n");
+    }
     std::fprintf(f,
                  "Realistic bench (paper Table II) -- bbox extraction (detection pipeline not used).\n"
                  "Board paper-bench (theta 26 deg, H 1.45 m, beta +3); 5 cm pole, base at 2.2-2.6 m\n"
@@ -1498,12 +1717,32 @@ std::string realistic_json(const RealisticResult &r)
         o << (i ? ", " : "") << "[" << jnum(r.d_table[i].range_m) << ", " << jnum(r.d_table[i].d_m) << "]";
     }
     o << "],\n  \"rows\": [\n";
-    for (int a = 0; a < 5; a++) {
+    for (int a = 0; a < 5 && r.bbox_table; a++) {
         o << "    {\"true_deg\": " << r.angles[a] << ", \"paper\": {\"mean\": " << r.paper_mean[a]
           << ", \"std\": " << r.paper_std[a] << "}, \"paper_processing\": " << jstats(r.paper_style[a])
           << ", \"improved\": " << jstats(r.improved[a]) << "}" << (a < 4 ? "," : "") << "\n";
     }
-    o << "  ],\n  \"seconds\": " << jnum(r.seconds) << "\n}\n";
+    o << "  ]";
+    if (r.have_pipe) {
+        o << ",\n  \"pipeline\": {\"label\": \"" << kPipelineLabel << "\", \"board\": \"" << r.pipe_cfg.board
+          << "\", \"beam_deg\": " << jnum(r.pipe_cfg.beam_deg) << ", \"mask_frames\": " << r.pipe_mask_frames
+          << ", \"last_rotations\": " << r.pipe_last << ", \"rows\": [\n";
+        for (int a = 0; a < 5; a++) {
+            const RealisticPipe &p = r.pipe[a];
+            double rm, rs, fm, fs;
+            mean_sd(p.raw, &rm, &rs);
+            mean_sd(p.filt, &fm, &fs);
+            o << "    {\"true_deg\": " << r.angles[a] << ", \"raw\": {\"mean\": " << jnum(rm) << ", \"std\": " << jnum(rs)
+              << ", \"n\": " << p.raw.size() << "}, \"filtered\": {\"mean\": " << jnum(fm) << ", \"std\": " << jnum(fs)
+              << ", \"n\": " << p.filt.size() << "}, \"runs\": " << p.runs << ", \"detected\": " << p.detected
+              << ", \"valid\": " << p.valid << ", \"ambiguous\": " << p.ambiguous << ", \"other\": " << p.other
+              << ", \"unmatched\": " << p.unmatched << ", \"rotations_checked\": " << p.rot_checked
+              << ", \"rotations_detected\": " << p.rot_detected << ", \"frames_eff\": [" << p.frames_eff_min << ", "
+              << p.frames_eff_max << "]}" << (a < 4 ? "," : "") << "\n";
+        }
+        o << "  ]}";
+    }
+    o << ",\n  \"seconds\": " << jnum(r.seconds) << "\n}\n";
     return o.str();
 }
 

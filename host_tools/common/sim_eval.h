@@ -200,6 +200,23 @@ public:
     /// Association and statistics, per pole index.
     std::map<int, PipeEval> result() const;
 
+    /// One raw per-rotation target (host units).
+    struct Target {
+        int rotation = 0, az = 0, flag = 0;
+        double alpha_deg = 0, sigma_deg = 0;
+    };
+    /// One live tracker slot as reported after a rotation.
+    struct Track {
+        int rotation = 0, az = 0, id = 0, hits = 0, valid_hits = 0, last_flag = 0;
+        double alpha_deg = 0; ///< filtered alpha (meaningful when valid_hits > 0)
+    };
+    /// All targets reported so far, in rotation order.
+    std::vector<Target> targets() const;
+    /// The live tracks after each reported rotation, in rotation order.
+    std::vector<Track> tracks() const;
+    /// n_eff per reported rotation.
+    std::map<int, int> frames_eff() const;
+
 private:
     struct Impl;
     Impl *m_;
@@ -271,6 +288,25 @@ struct RealisticOptions {
     int calib_positions = 12;   ///< vertical poles over 1.75-3.0 m for d(r)
     bool progress = true;
     int range_bins = 512;       ///< bins per azimuth in the simulated stream (contoured data)
+    Extract extract = Extract::BBox; ///< Pipeline: also feed every measurement's bytes to the
+                                ///< core pipeline (board paper-bench, speed 0: the board's n)
+    bool bbox_table = true;     ///< print the bbox table (false with --extract pipeline)
+    int pipe_last = 4;          ///< pipeline: use the targets of the last N rotations
+};
+
+/// Core-pipeline results for one true angle of the realistic bench (one estimate per
+/// measurement = position x repetition).
+struct RealisticPipe {
+    std::vector<double> raw;    ///< per measurement: mean raw target alpha over the last
+                                ///< rotations (ambiguous targets as the bound (beta - theta)/2)
+    std::vector<double> filt;   ///< per measurement: tracker's filtered alpha after the last rotation
+    int runs = 0;               ///< measurements
+    int detected = 0;           ///< ... with >= 1 target at the pole's azimuth in the last rotations
+    int rot_checked = 0, rot_detected = 0; ///< last rotations checked / with a matched target
+    int valid = 0, ambiguous = 0, other = 0; ///< matched targets by incline flag
+    int unmatched = 0;          ///< targets in the last rotations not at the pole's azimuth
+    int frames_eff_min = 0, frames_eff_max = 0;
+    double rate() const { return runs > 0 ? static_cast<double>(detected) / runs : std::nan(""); }
 };
 
 struct RealisticResult {
@@ -287,6 +323,11 @@ struct RealisticResult {
     std::vector<std::pair<double, double>> calib; ///< (r2_obs, d) samples
     double seconds = 0;
     int frames = 16, positions = 11, reps = 4;
+    bool have_pipe = false, bbox_table = true;
+    RealisticPipe pipe[5];      ///< core pipeline per true angle (have_pipe)
+    PipeCfg pipe_cfg;           ///< the pipeline's configuration (first measurement's)
+    int pipe_last = 4;
+    unsigned pipe_mask_frames = 0; ///< board n (paper-bench)
 };
 
 RealisticResult run_realistic(const RealisticOptions &o);

@@ -25,9 +25,12 @@ void usage()
                  "      pipeline: only the core pipeline (sl_pipeline: mask + detection + corrections +\n"
                  "      alpha; n_eff from motion) on the real-resolution captures; both: the two.\n"
                  "  sl-eval realistic [--quick] [--json] [--json-out FILE] [--positions N] [--reps N] [--frames N]\n"
-                 "                   [--calib N] [--range-bins N] [--threads N]\n"
+                 "                   [--calib N] [--range-bins N] [--threads N] [--extract bbox|pipeline|both]\n"
+                 "                   [--pipe-last N]\n"
                  "      Smear, speckle, noise floor, leakage, measured emission, n-frame\n"
                  "      segmentation, poles at 2.2-2.6 m: beside the paper's Table II.\n"
+                 "      --extract pipeline|both: also the core pipeline (board paper-bench, speed 0, the\n"
+                 "      board's n) on every measurement: targets of the last N rotations (default 4).\n"
                  "  sl-eval run CAPTURE.colossus GT.csv [--board NAME] [--scene SCENE.ini]\n"
                  "             [--threshold T] [--beta DEG] [--raw|--half-bin] [--r1-add M] [--d M]\n"
                  "             [--extract bbox|pipeline] [--beam-deg DEG] [--speed M/S] [--no-width-radius]\n"
@@ -141,6 +144,23 @@ int cmd_realistic(int argc, char **argv)
             json_out = argv[++i];
         } else if (a == "--quiet") {
             o.progress = false;
+        } else if (a == "--pipe-last" && i + 1 < argc) {
+            { const int n = std::atoi(argv[++i]); o.pipe_last = n > 0 ? n : 1; }
+        } else if (a == "--extract" && i + 1 < argc) {
+            const std::string m = argv[++i];
+            if (m == "bbox") {
+                o.extract = sl::Extract::BBox;
+                o.bbox_table = true;
+            } else if (m == "pipeline") {
+                o.extract = sl::Extract::Pipeline;
+                o.bbox_table = false;
+            } else if (m == "both") {
+                o.extract = sl::Extract::Pipeline;
+                o.bbox_table = true;
+            } else {
+                usage();
+                return 2;
+            }
         } else {
             usage();
             return 2;
