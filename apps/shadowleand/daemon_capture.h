@@ -4,7 +4,7 @@
 ///        files, whose radar -> client TCP stream is reassembled (retransmissions,
 ///        reordering, gaps and reconnections handled and reported there).
 ///
-/// Implemented in C++ (host_tools/daemon/daemon_capture_shim.cpp), linked into shadowleand
+/// Implemented in C++ (apps/shadowleand/daemon_capture_shim.cpp), linked into shadowleand
 /// only. The whole stream is held in memory (malloc'd; sld_capture_free releases it).
 #ifndef SHADOWLEAN_DAEMON_CAPTURE_H
 #define SHADOWLEAN_DAEMON_CAPTURE_H
