@@ -44,7 +44,7 @@ check() { # name board capture
     if cmp "$G/$name.candump" "$OUT/$name.pipe.candump"; then
         echo "$name: $n frames byte for byte (stdin pipe)"
     else
-        echo "FAIL: $name: frames through a pipe differ"; fail=1
+        echo "FAIL: $name: frames through a pipe differ"; diff "$G/$name.candump" "$OUT/$name.pipe.candump" | head -5; fail=1
     fi
 }
 
