@@ -444,27 +444,35 @@ static void capture_pull(daemon_t *d)
         sl_port_capture_next(d->cr, &pc);
     }
     if (pc.kind == SL_PORT_CAPTURE_DATA) {
-        if (!d->clock_known && d->lead_len + pc.size > LEAD_MAX) {
-            // No FFT timestamp in the first LEAD_MAX bytes: run on the wall clock. The
-            // lead is fed first (capture_step), then this piece (still valid: the reader
-            // is not called before).
+        // At most LEAD_MAX bytes go to the lead, at most one chunk to the view: the rest of
+        // the piece waits (still valid: the reader is not called before it is taken).
+        const size_t room = d->clock_known ? SL_PORT_CAPTURE_CHUNK : LEAD_MAX - d->lead_len;
+        if (room == 0) {
+            // No FFT timestamp in the first LEAD_MAX bytes: run on the wall clock; the lead
+            // is fed first (capture_step), then this piece.
             d->clock_known = true;
             d->data_us = realtime_us();
             d->pend_piece = pc;
             d->have_pend_piece = true;
             return;
         }
+        const size_t k = pc.size < room ? pc.size : room;
+        if (k < pc.size) {
+            d->pend_piece = pc;
+            d->pend_piece.data += k;
+            d->pend_piece.size -= k;
+            d->pend_piece.output_offset += k;
+            d->have_pend_piece = true;
+        }
+        sl_proto_feed(&d->pacer, pc.data, k, 0);
         if (d->clock_known) {
-            d->n_ix = d->next_ix = 0;
             d->view = pc.data;
             d->view_base = pc.output_offset;
-            d->view_len = pc.size;
-            sl_proto_feed(&d->pacer, pc.data, pc.size, 0);
+            d->view_len = k;
             return;
         }
-        memcpy(d->lead + d->lead_len, pc.data, pc.size);
-        d->lead_len += pc.size;
-        sl_proto_feed(&d->pacer, pc.data, pc.size, 0);
+        memcpy(d->lead + d->lead_len, pc.data, k);
+        d->lead_len += k;
         if (d->n_fft > 0) {
             d->clock_known = true;
         }

@@ -7,6 +7,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #define SNIFF_BYTES 4u
@@ -71,6 +73,10 @@ struct sl_port_capture {
     uint64_t out_off;   // bytes delivered in total
 
     // raw
+    bool mapped;        // regular file: read through a sliding read-only mapping (no copy)
+    uint64_t file_size, map_off;
+    void *map;
+    size_t map_len;
     uint8_t *buf;
     size_t prefix_len;  // sniffed bytes at buf[0..prefix_len) not yet handed on
     size_t prefix_pos;
@@ -714,6 +720,23 @@ sl_port_capture_t *sl_port_capture_open(const char *path, const sl_port_capture_
         sl_port_capture_close(c);
         return NULL;
     }
+    // A regular file is sniffed with pread (nothing consumed) and, when raw, mapped window
+    // by window. Anything else (pipe, FIFO, terminal, device) is read sequentially: the
+    // sniffed bytes are kept and handed on first.
+    struct stat st;
+    if (fstat(c->fd, &st) == 0 && S_ISREG(st.st_mode)) {
+        uint8_t m[4] = {0, 0, 0, 0};
+        const ssize_t n = pread(c->fd, m, sizeof m, 0);
+        const bool pcap_magic = n == 4 && (be32(m) == 0xa1b2c3d4u || be32(m) == 0xd4c3b2a1u ||
+                                           be32(m) == 0xa1b23c4du || be32(m) == 0x4d3cb2a1u ||
+                                           be32(m) == 0x0a0d0d0au);
+        if (n >= 0 && !pcap_magic) {
+            c->mapped = true;
+            c->file_size = (uint64_t)st.st_size;
+            c->rep.format = SL_PORT_CAPTURE_RAW;
+            return c;
+        }
+    }
     // Sniff: read until SNIFF_BYTES are there or the input ends; keep them.
     while (c->prefix_len < SNIFF_BYTES) {
         const ssize_t n = read(c->fd, c->buf + c->prefix_len, SL_PORT_CAPTURE_CHUNK - c->prefix_len);
@@ -780,8 +803,39 @@ static void finish(sl_port_capture_t *c, sl_port_capture_piece_t *pc, sl_port_ca
     *pc = (sl_port_capture_piece_t){.kind = k, .output_offset = c->out_off};
 }
 
+#define MAP_WINDOW (16u << 20) // bytes mapped at a time (a multiple of the page size)
+
+static void next_mapped(sl_port_capture_t *c, sl_port_capture_piece_t *pc)
+{
+    if (c->map != NULL) {
+        munmap(c->map, c->map_len);
+        c->map = NULL;
+        c->map_off += c->map_len;
+    }
+    if (c->map_off >= c->file_size) {
+        finish(c, pc, SL_PORT_CAPTURE_END);
+        return;
+    }
+    const uint64_t left = c->file_size - c->map_off;
+    c->map_len = left < MAP_WINDOW ? (size_t)left : MAP_WINDOW;
+    c->map = mmap(NULL, c->map_len, PROT_READ, MAP_PRIVATE | MAP_POPULATE, c->fd, (off_t)c->map_off);
+    if (c->map == MAP_FAILED) {
+        c->map = NULL;
+        snprintf(c->err, sizeof c->err, "mmap: %s", strerror(errno));
+        finish(c, pc, SL_PORT_CAPTURE_ERROR);
+        return;
+    }
+    (void)madvise(c->map, c->map_len, MADV_SEQUENTIAL);
+    c->rep.bytes_in += c->map_len;
+    data_piece(c, pc, c->map, c->map_len);
+}
+
 static void next_raw(sl_port_capture_t *c, sl_port_capture_piece_t *pc)
 {
+    if (c->mapped) {
+        next_mapped(c, pc);
+        return;
+    }
     if (c->prefix_pos < c->prefix_len) {
         const size_t n = c->prefix_len - c->prefix_pos;
         c->rep.bytes_in += n;
@@ -982,6 +1036,9 @@ void sl_port_capture_close(sl_port_capture_t *c)
         pcap_close(c->pc); // closes c->fp
     } else if (c->fp != NULL) {
         fclose(c->fp);
+    }
+    if (c->map != NULL) {
+        munmap(c->map, c->map_len);
     }
     free(c->held);
     if (c->sel.pend != NULL) {

@@ -19,8 +19,13 @@
 /// order), BREAK (bytes are missing here, or a new TCP session starts: a decoder must be
 /// finished before the next DATA so it does not glue two half messages), END, ERROR.
 ///
+/// A raw capture in a regular file is sniffed with pread() and read through a read-only
+/// mapping that slides over the file 16 MiB at a time (no copy; the size is taken at open,
+/// so bytes appended later are not read; truncating the file while it is read is not
+/// supported).
+///
 /// Memory: bounded whatever the capture's size. Raw: one SL_PORT_CAPTURE_CHUNK read
-/// buffer. Pcap: libpcap's packet buffer, plus out-of-order segments held until the hole
+/// buffer, or one 16 MiB mapped window. Pcap: libpcap's packet buffer, plus out-of-order segments held until the hole
 /// before them fills, at most SL_PORT_CAPTURE_PENDING_MAX bytes per reassembled session
 /// (the selected one and at most one candidate successor); a hole still open when that
 /// bound is reached is declared a gap. Flows are tracked in a fixed table of
