@@ -137,7 +137,7 @@ static void emit_status(sl_pipeline_t *p)
         .link_state = p->link_state,
         .rotations = p->stats.rotations,
         .azimuths_missing = p->stats.azimuths_missing,
-        .decoder_resyncs = p->proto.stats.resyncs,
+        .decoder_resyncs = p->decoder_stats->resyncs,
         .can_dropped = p->stats.can_dropped,
     };
     sl_can_frame_t f;
@@ -470,6 +470,7 @@ sl_err_t sl_pipeline_init(sl_pipeline_t *p, const sl_board_t *board,
         .ctx = p,
     };
     e = sl_proto_init(&p->proto, &pc);
+    p->decoder_stats = &p->proto.stats;
     if (e != SL_OK) {
         set_err(p, e, (uint8_t)SL_PIPELINE_STAGE_INIT, "sl_proto_init failed");
         return e;
@@ -488,6 +489,23 @@ sl_err_t sl_pipeline_feed(sl_pipeline_t *p, const uint8_t *data, size_t len, uin
     }
     p->now_us = now_us;
     return sl_proto_feed(&p->proto, data, len, now_us);
+}
+
+sl_err_t sl_pipeline_on_msg(sl_pipeline_t *p, const sl_proto_msg_t *msg, uint64_t now_us)
+{
+    if (p == NULL || msg == NULL || !p->ready) {
+        return SL_ERR_ARG;
+    }
+    p->now_us = now_us;
+    on_msg(p, msg);
+    return SL_OK;
+}
+
+void sl_pipeline_set_decoder_stats(sl_pipeline_t *p, const sl_proto_stats_t *stats)
+{
+    if (p != NULL) {
+        p->decoder_stats = stats != NULL ? stats : &p->proto.stats;
+    }
 }
 
 sl_err_t sl_pipeline_finish(sl_pipeline_t *p, uint64_t now_us)
