@@ -45,7 +45,6 @@
 #define FAST_MSGS_PER_TURN 512U   // capture messages fed per loop turn in --fast mode
 #define MAX_PLAY_GAP_US 5000000U  // --realtime: longer timestamp gaps are shortened to this
 #define DRAIN_MS 500U             // at exit: wait at most this long for queued frames
-#define PIPE_REASM_HOST (1U << 20) // pacer decoder limit (host captures)
 
 #define LEAD_MAX (1U << 20)        // capture bytes held until the first FFT timestamp is known
 #define IX_CAP ((LEAD_MAX + SL_PORT_CAPTURE_CHUNK) / SL_PROTO_HEADER_BYTES + 16U)
@@ -109,6 +108,7 @@ typedef struct daemon {
     sl_port_capture_piece_t pend_piece; // read, not yet taken (the lead is fed first)
     bool have_pend_piece;
     bool clock_known;           // data_us started (first FFT seen, or given up waiting)
+    bool decode_once;           // --fast: the pacer hands messages to the pipeline
     bool cap_end;               // the reader returned END or ERROR
     bool cap_error;
     uint64_t fed;               // stream bytes fed to the pipeline
@@ -243,15 +243,18 @@ static void fixed_motion(const daemon_t *d, uint64_t now_us)
 
 static void radar_on_bytes(void *ctx, const uint8_t *data, size_t len, uint64_t now_us)
 {
+    (void)data;
+    (void)len;
     daemon_t *d = ctx;
     d->fed_since_finish = true;
     fixed_motion(d, now_us);
-    sl_pipeline_feed(&g_pipe, data, len, now_us);
 }
 
+/// Decode once: the radar client's decoder hands every message to the pipeline.
 static void radar_on_msg(void *ctx, const sl_proto_msg_t *msg, uint64_t now_us)
 {
     daemon_t *d = ctx;
+    sl_pipeline_on_msg(&g_pipe, msg, now_us);
     if (msg->id == SL_PROTO_ID_FFT_DATA || msg->id == SL_PROTO_ID_FFT_DATA_16) {
         d->last_fft_mono = now_us;
         d->had_fft = true;
@@ -352,12 +355,13 @@ static int radar_setup(daemon_t *d)
     cfg.non_contour = d->o.non_contour;
     cfg.reasm_buf = d->radar_reasm;
     cfg.reasm_size = reasm;
-    cfg.max_payload_bytes = (uint32_t)reasm;
+    cfg.max_payload_bytes = d->board->max_message_bytes; // the pipeline decoder's limit
     cfg.on_msg = radar_on_msg;
     cfg.on_bytes = radar_on_bytes;
     cfg.on_event = radar_on_event;
     cfg.ctx = d;
     const sl_err_t e = sl_radar_client_init(&d->radar, &cfg);
+    sl_pipeline_set_decoder_stats(&g_pipe, &d->radar.proto.stats); // Status.DecoderResyncs
     if (e != SL_OK) {
         sld_log(SLD_LOG_ERR, "radar %s:%u: %s", d->o.radar_host, (unsigned)d->o.radar_port,
                 e == SL_ERR_PORT ? "cannot resolve the name" : sl_err_str(e));
@@ -372,6 +376,22 @@ static int radar_setup(daemon_t *d)
 static void pacer_on_msg(void *ctx, const sl_proto_msg_t *msg)
 {
     daemon_t *d = ctx;
+    if (d->decode_once) {
+        // --fast: every message straight to the pipeline at its data clock.
+        sl_proto_fft_t fft;
+        if ((msg->id == SL_PROTO_ID_FFT_DATA || msg->id == SL_PROTO_ID_FFT_DATA_16) &&
+            sl_proto_parse_fft(msg, &fft) == SL_OK) {
+            const uint64_t t = sl_proto_fft_time_us(&fft);
+            if (d->n_fft == 0 || t > d->data_us) {
+                d->data_us = t;
+            }
+            d->n_fft++;
+        }
+        d->n_msgs++;
+        fixed_motion(d, pipe_now(d));
+        sl_pipeline_on_msg(&g_pipe, msg, pipe_now(d));
+        return;
+    }
     if (d->n_ix >= IX_CAP) { // cannot happen: a piece holds at most IX_CAP headers
         return;
     }
@@ -398,17 +418,28 @@ static int capture_setup(daemon_t *d)
         sld_log(SLD_LOG_ERR, "--input: %s", err);
         return -1;
     }
-    d->pacer_reasm = malloc(PIPE_REASM_HOST);
+    // Decode once as fast as possible; with --realtime the pacer only indexes (message
+    // ends, FFT timestamps) and the pipeline decodes the bytes when they are due.
+    d->decode_once = !d->o.realtime;
+    size_t reasm = d->board->max_message_bytes;
+    if (reasm < 65536U) {
+        reasm = 65536U;
+    }
+    d->pacer_reasm = malloc(reasm);
     d->ix = malloc(IX_CAP * sizeof *d->ix);
     d->lead = malloc(LEAD_MAX);
     if (d->pacer_reasm == NULL || d->ix == NULL || d->lead == NULL) {
         sld_log(SLD_LOG_ERR, "out of memory");
         return -1;
     }
-    const sl_proto_cfg_t pc = {.reasm_buf = d->pacer_reasm, .reasm_size = PIPE_REASM_HOST,
-                              .max_payload_bytes = PIPE_REASM_HOST, .truncate_long = false,
+    // The pipeline decoder's limit: both decoders accept and reject the same headers.
+    const sl_proto_cfg_t pc = {.reasm_buf = d->pacer_reasm, .reasm_size = reasm,
+                              .max_payload_bytes = d->board->max_message_bytes, .truncate_long = false,
                               .on_msg = pacer_on_msg, .ctx = d};
     sl_proto_init(&d->pacer, &pc);
+    if (d->decode_once) {
+        sl_pipeline_set_decoder_stats(&g_pipe, &d->pacer.stats); // Status.DecoderResyncs
+    }
     sld_log(SLD_LOG_INFO, "input %s (%s)", d->o.capture,
             sl_port_capture_format_name(sl_port_capture_report(d->cr)->format));
     return 0;
@@ -498,9 +529,41 @@ static void capture_pull(daemon_t *d)
     }
 }
 
+/// --fast, decode once: the reader's pieces go through the pacer straight into the pipeline.
+static void capture_step_fast(daemon_t *d)
+{
+    for (unsigned turn = 0; turn < 16U && !d->cap_done && !d->stop; turn++) {
+        sl_port_capture_piece_t pc;
+        sl_port_capture_next(d->cr, &pc);
+        if (pc.kind == SL_PORT_CAPTURE_DATA) {
+            sl_proto_feed(&d->pacer, pc.data, pc.size, 0);
+            d->fed += pc.size;
+        } else if (pc.kind == SL_PORT_CAPTURE_BREAK) {
+            sl_proto_finish(&d->pacer);
+            sl_pipeline_finish(&g_pipe, pipe_now(d));
+            d->n_breaks++;
+        } else {
+            sl_proto_finish(&d->pacer);
+            if (d->n_fft == 0) {
+                d->data_us = realtime_us();
+            }
+            sl_pipeline_finish(&g_pipe, pipe_now(d));
+            if (pc.kind == SL_PORT_CAPTURE_ERROR) {
+                d->cap_error = true;
+                sld_log(SLD_LOG_ERR, "--input %s: %s", d->o.capture, sl_port_capture_error(d->cr));
+            }
+            d->cap_done = true;
+        }
+    }
+}
+
 /// Feed what is due. @return the monotonic time of the next due message (0 = now / done).
 static uint64_t capture_step(daemon_t *d)
 {
+    if (d->decode_once) {
+        capture_step_fast(d);
+        return 0;
+    }
     unsigned budget = FAST_MSGS_PER_TURN;
     while (!d->cap_done && !d->stop && budget-- > 0) {
         if (!d->clock_known) {
