@@ -97,7 +97,19 @@ struct sl_port_capture {
     bool brk_pending;
     sl_port_capture_piece_t brk;
     uint8_t *tail;      // last SL_PORT_CAPTURE_TAIL delivered bytes of the selected session (ring)
+    // Payload seen before the radar port is known (auto-detection), replayed into the
+    // session of the flow that turns out to be the radar's.
+    struct held_seg {
+        int flow;
+        int64_t data_rel;
+        uint32_t len;
+        uint8_t *data;
+    } *pre;
+    size_t n_pre, pre_bytes;
 };
+
+#define PRE_SEGS 4096u
+#define PRE_BYTES (4u << 20)
 
 // ---------------------------------------------------------------------------------------
 // helpers
@@ -286,7 +298,9 @@ static void set_gap(sl_port_capture_t *c, uint64_t missing)
 {
     c->brk_pending = true;
     c->brk = (sl_port_capture_piece_t){.kind = SL_PORT_CAPTURE_BREAK, .brk = SL_PORT_CAPTURE_GAP,
-                                       .output_offset = c->out_off, .missing_bytes = missing};
+                                       .output_offset = c->out_off, .missing_bytes = missing,
+                                       .stream_offset = (uint64_t)c->sel.cursor,
+                                       .session = c->rep.sessions > 0 ? (uint32_t)(c->rep.sessions - 1) : 0u};
     c->rep.gaps++;
     c->rep.gap_bytes += missing;
 }
@@ -347,6 +361,37 @@ static flow_t *flow_find(sl_port_capture_t *c, const uint8_t *src, const uint8_t
     return &c->flows[found];
 }
 
+/// Count one selected-session segment [a, a+len) against what was seen before.
+static void classify(sl_port_capture_t *c, sess_t *s, int64_t a, const uint8_t *d, uint32_t len)
+{
+    const int64_t b = a + (int64_t)len;
+    c->rep.segments++;
+    c->rep.payload_bytes += len;
+    const int64_t cov = sess_covered(s, a, b);
+    if (cov == (int64_t)len) {
+        c->rep.retransmitted_segments++;
+    } else {
+        if (cov > 0) {
+            c->rep.partial_overlap_segments++;
+        }
+        const int64_t lim = b < s->max_end ? b : s->max_end;
+        if (a < lim && sess_covered(s, a, lim) < lim - a) {
+            c->rep.out_of_order_segments++;
+        }
+    }
+    c->rep.retransmitted_bytes += (uint64_t)cov;
+    if (s->max_end < b) {
+        s->max_end = b;
+    }
+    // Re-sent bytes already delivered: compare with the tail still held.
+    const int64_t lo = a > s->cursor - (int64_t)SL_PORT_CAPTURE_TAIL ? a : s->cursor - (int64_t)SL_PORT_CAPTURE_TAIL;
+    const int64_t hi = b < s->cursor ? b : s->cursor;
+    for (int64_t k = lo; k < hi; k++) {
+        c->rep.retransmit_mismatch_bytes +=
+            c->tail[(uint64_t)k % SL_PORT_CAPTURE_TAIL] != d[k - a] ? 1u : 0u;
+    }
+}
+
 /// Segment of the selected session. @return 1 with `pc` set (DATA), 0 consumed, -1 retry
 /// after the hole before the held bytes is declared a gap and they are delivered.
 static int sel_segment(sl_port_capture_t *c, sl_port_capture_piece_t *pc)
@@ -378,31 +423,7 @@ static int sel_segment(sl_port_capture_t *c, sl_port_capture_piece_t *pc)
     const int64_t b = a + (int64_t)len;
     if (!ps->counted) {
         ps->counted = true;
-        c->rep.segments++;
-        c->rep.payload_bytes += len;
-        const int64_t cov = sess_covered(s, a, b);
-        if (cov == (int64_t)len) {
-            c->rep.retransmitted_segments++;
-        } else {
-            if (cov > 0) {
-                c->rep.partial_overlap_segments++;
-            }
-            const int64_t lim = b < s->max_end ? b : s->max_end;
-            if (a < lim && sess_covered(s, a, lim) < lim - a) {
-                c->rep.out_of_order_segments++;
-            }
-        }
-        c->rep.retransmitted_bytes += (uint64_t)cov;
-        if (s->max_end < b) {
-            s->max_end = b;
-        }
-        // Re-sent bytes already delivered: compare with the tail still held.
-        const int64_t lo = a > s->cursor - (int64_t)SL_PORT_CAPTURE_TAIL ? a : s->cursor - (int64_t)SL_PORT_CAPTURE_TAIL;
-        const int64_t hi = b < s->cursor ? b : s->cursor;
-        for (int64_t k = lo; k < hi; k++) {
-            c->rep.retransmit_mismatch_bytes +=
-                c->tail[(uint64_t)k % SL_PORT_CAPTURE_TAIL] != d[k - a] ? 1u : 0u;
-        }
+        classify(c, s, a, d, len);
     }
     if (b <= s->cursor) {
         return 0;
@@ -450,6 +471,78 @@ static void cand_segment(sl_port_capture_t *c)
     if (sess_full(s, 65536u)) {
         c->sel.closing = true;
     }
+}
+
+static void pre_free(sl_port_capture_t *c)
+{
+    for (size_t i = 0; i < c->n_pre; i++) {
+        free(c->pre[i].data);
+    }
+    c->n_pre = 0;
+    c->pre_bytes = 0;
+}
+
+/// Before the radar port is known: keep a copy (bounded; beyond, the bytes are lost and
+/// show as a gap or a later start if that flow is the radar's).
+static void pre_store(sl_port_capture_t *c, int flow, int64_t data_rel, const uint8_t *d, size_t n)
+{
+    if (c->pre == NULL || c->n_pre >= PRE_SEGS || c->pre_bytes + n > PRE_BYTES) {
+        return;
+    }
+    uint8_t *copy = malloc(n);
+    if (copy == NULL) {
+        return;
+    }
+    memcpy(copy, d, n);
+    c->pre[c->n_pre++] = (struct held_seg){flow, data_rel, (uint32_t)n, copy};
+    c->pre_bytes += n;
+}
+
+/// The radar's flow is known and selected: its payload seen before goes into the session.
+static void pre_replay(sl_port_capture_t *c, int flow, int64_t cur_rel)
+{
+    sess_t *s = &c->sel;
+    const flow_t *f = &c->flows[flow];
+    bool any = false;
+    int64_t lo = cur_rel;
+    for (size_t i = 0; i < c->n_pre; i++) {
+        if (c->pre[i].flow == flow) {
+            any = true;
+            lo = c->pre[i].data_rel < lo ? c->pre[i].data_rel : lo;
+        }
+    }
+    if (any) {
+        s->have_base = true;
+        if (f->syn) {
+            s->base = f->syn_rel + 1;
+        } else {
+            s->base = lo;
+            c->rep.started_mid_stream = true;
+        }
+        for (size_t i = 0; i < c->n_pre; i++) {
+            const struct held_seg *h = &c->pre[i];
+            if (h->flow != flow) {
+                continue;
+            }
+            int64_t a = h->data_rel - s->base;
+            const uint8_t *d = h->data;
+            uint32_t len = h->len;
+            if (a < 0) {
+                const int64_t cut = -a < (int64_t)len ? -a : (int64_t)len;
+                d += cut;
+                len -= (uint32_t)cut;
+                a = 0;
+            }
+            if (len == 0) {
+                continue;
+            }
+            classify(c, s, a, d, len);
+            (void)sess_insert(c, s, a, d, len);
+        }
+    }
+    pre_free(c);
+    free(c->pre);
+    c->pre = NULL;
 }
 
 /// Parse one packet; set c->ps when it carries payload of a session. @return false when
@@ -655,6 +748,9 @@ static void on_packet(sl_port_capture_t *c, const struct pcap_pkthdr *h, const u
             c->port_locked = true;
             c->rep.radar_port = sport;
             c->rep.port_auto_detected = true;
+        } else if (!c->opt.port_explicit) {
+            pre_store(c, fi, data_rel, payload, payload_cap);
+            return;
         }
     }
     if (!c->port_locked || sport != c->radar_port) {
@@ -666,11 +762,15 @@ static void on_packet(sl_port_capture_t *c, const struct pcap_pkthdr *h, const u
                 c->brk_pending = true;
                 c->brk = (sl_port_capture_piece_t){.kind = SL_PORT_CAPTURE_BREAK,
                                                    .brk = SL_PORT_CAPTURE_NEW_SESSION,
-                                                   .output_offset = c->out_off};
+                                                   .output_offset = c->out_off,
+                                                   .session = (uint32_t)c->rep.sessions};
             }
             sess_reset(&c->sel, fi);
             f->role = ROLE_SELECTED;
             c->rep.sessions++;
+            if (c->pre != NULL) {
+                pre_replay(c, fi, data_rel);
+            }
         } else if (!c->cand.active) {
             sess_reset(&c->cand, fi);
             f->role = ROLE_CANDIDATE;
@@ -770,6 +870,7 @@ sl_port_capture_t *sl_port_capture_open(const char *path, const sl_port_capture_
     c->sel.pend = malloc(SL_PORT_CAPTURE_PENDING_SEGS * sizeof(seg_t));
     c->cand.pend = malloc(SL_PORT_CAPTURE_PENDING_SEGS * sizeof(seg_t));
     c->tail = malloc(SL_PORT_CAPTURE_TAIL);
+    c->pre = c->opt.port_explicit ? NULL : malloc(PRE_SEGS * sizeof *c->pre);
     c->sel.flow = c->cand.flow = -1;
     const cookie_io_functions_t io = {.read = cookie_read, .close = cookie_close};
     c->fp = (c->sel.pend && c->cand.pend && c->tail) ? fopencookie(c, "r", io) : NULL;
@@ -943,7 +1044,8 @@ static void next_pcap(sl_port_capture_t *c, sl_port_capture_piece_t *pc)
             c->brk_pending = true;
             c->brk = (sl_port_capture_piece_t){.kind = SL_PORT_CAPTURE_BREAK,
                                                .brk = SL_PORT_CAPTURE_NEW_SESSION,
-                                               .output_offset = c->out_off};
+                                               .output_offset = c->out_off,
+                                               .session = (uint32_t)(c->rep.sessions - 1)};
             continue;
         }
         if (c->eof) {
@@ -1040,6 +1142,8 @@ void sl_port_capture_close(sl_port_capture_t *c)
     if (c->map != NULL) {
         munmap(c->map, c->map_len);
     }
+    pre_free(c);
+    free(c->pre);
     free(c->held);
     if (c->sel.pend != NULL) {
         sess_free(&c->sel);

@@ -86,6 +86,9 @@ typedef struct sl_port_capture_piece {
     sl_port_capture_break_kind_t brk;  ///< BREAK only
     uint64_t output_offset;            ///< stream offset (bytes delivered so far) of this piece
     uint64_t missing_bytes;            ///< GAP only: bytes absent from the capture
+    uint64_t stream_offset;            ///< GAP only: TCP stream offset of the hole (from the
+                                       ///< session's first byte, ISN + 1)
+    uint32_t session;                  ///< BREAK: index of the session after it (0-based)
 } sl_port_capture_piece_t;
 
 /// Everything counted so far (final after END). Counts refer to the reassembled (selected)
