@@ -28,7 +28,7 @@
 #include "can_sink.h"
 #include "can_socketcan.h"
 #include "capture_reader.h"
-#include "daemon_candump.h"
+#include "candump.h"
 #include "daemon_log.h"
 #include "daemon_motion.h"
 #include "daemon_opts.h"

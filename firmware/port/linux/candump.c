@@ -1,7 +1,9 @@
-// can-utils text frames and candump -L lines (see candump_text.h).
-#include "candump_text.h"
+// candump.c: the candump text format (frames, -L lines, both ways) and the log file sink (see candump.h).
+#include "candump.h"
 
 #include <ctype.h>
+#include <errno.h>
+#include <inttypes.h>
 #include <stdbool.h>
 #include <stdio.h>
 #include <string.h>
@@ -179,4 +181,110 @@ char *sl_candump_format_line(const sl_can_frame_t *f, uint64_t t_us, const char 
     (void)snprintf(buf, cap, "(%010lu.%06lu) %s %s", (unsigned long)(t_us / 1000000U),
                    (unsigned long)(t_us % 1000000U), iface, sl_candump_format_frame(f, fr, sizeof fr));
     return buf;
+}
+
+bool sl_candump_frame_ok(const sl_can_frame_t *f)
+{
+    const uint32_t lim = (f->flags & (SL_CAN_FLAG_EFF | SL_CAN_FLAG_ERR)) != 0U ? SL_CAN_EFF_MASK : SL_CAN_SFF_MASK;
+    return f->dlc <= 8U && f->id <= lim;
+}
+
+// ---------------------------------------------------------------------------------------
+// Log file sink
+
+sl_err_t sld_candump_open(sld_candump_t *c, const char *path, const char *iface)
+{
+    memset(c, 0, sizeof *c);
+    const size_t n = iface != NULL ? strlen(iface) : 0;
+    if (path == NULL || n == 0 || n >= sizeof c->iface || strpbrk(iface, " \t\n") != NULL) {
+        return SL_ERR_ARG;
+    }
+    memcpy(c->iface, iface, n + 1);
+    if (strcmp(path, "-") == 0) {
+        c->fp = stdout;
+        c->own = false;
+        return SL_OK;
+    }
+    c->fp = fopen(path, "w");
+    if (c->fp == NULL) {
+        c->last_errno = errno;
+        return SL_ERR_PORT;
+    }
+    c->own = true;
+    return SL_OK;
+}
+
+static void count_io_error(sld_candump_t *c)
+{
+    c->last_errno = errno;
+    c->stats.errors++;
+    if (errno == EPIPE) {
+        c->broken_pipe = true;
+    }
+}
+
+sl_err_t sld_candump_send(sld_candump_t *c, const sl_can_frame_t *f)
+{
+    char text[40];
+    if (f == NULL || !sl_candump_frame_ok(f)) {
+        c->stats.dropped++;
+        return SL_ERR_ARG;
+    }
+    if (c->fp == NULL || c->broken_pipe) {
+        c->stats.dropped++;
+        return SL_ERR_PORT;
+    }
+    (void)sl_candump_format_frame(f, text, sizeof text);
+    const uint64_t sec = c->stamp_us / 1000000U;
+    const uint64_t usec = c->stamp_us % 1000000U;
+    if (fprintf(c->fp, "(%010" PRIu64 ".%06" PRIu64 ") %s %s\n", sec, usec, c->iface, text) < 0) {
+        count_io_error(c);
+        c->stats.dropped++;
+        return SL_ERR_PORT;
+    }
+    c->stats.sent++;
+    return SL_OK;
+}
+
+void sld_candump_flush(sld_candump_t *c)
+{
+    if (c->fp != NULL && !c->broken_pipe && fflush(c->fp) != 0) {
+        count_io_error(c);
+    }
+}
+
+void sld_candump_close(sld_candump_t *c)
+{
+    if (c->fp == NULL) {
+        return;
+    }
+    sld_candump_flush(c);
+    if (c->own && fclose(c->fp) != 0) {
+        count_io_error(c);
+    }
+    c->fp = NULL;
+}
+
+static sl_err_t sink_send(void *ctx, const sl_can_frame_t *f, uint64_t t_us)
+{
+    (void)t_us;
+    return sld_candump_send(ctx, f);
+}
+
+static void sink_poll(void *ctx, uint64_t t_us)
+{
+    (void)t_us;
+    sld_candump_flush(ctx);
+}
+
+static void sink_stats(void *ctx, sl_can_sink_stats_t *out)
+{
+    const sld_candump_t *c = ctx;
+    *out = c->stats;
+}
+
+sl_can_sink_t sld_candump_sink(sld_candump_t *c)
+{
+    sl_can_sink_t s = {"candump", c, sink_send, sink_poll, sink_stats};
+    return s;
 }
