@@ -183,6 +183,104 @@ char *sl_candump_format_line(const sl_can_frame_t *f, uint64_t t_us, const char 
     return buf;
 }
 
+sl_err_t sl_candump_parse_record(const char *line, sl_candump_record_t *out, const char **why)
+{
+    const char *dummy = NULL;
+    if (why == NULL) {
+        why = &dummy;
+    }
+    memset(out, 0, sizeof *out);
+    const char *p = line;
+    if (*p != '(') {
+        *why = "line does not start with '('";
+        return SL_ERR_MALFORMED;
+    }
+    p++;
+    uint64_t sec = 0, frac = 0;
+    size_t nsec = 0, nfrac = 0;
+    for (; *p >= '0' && *p <= '9'; p++, nsec++) {
+        if (sec > 18000000000000ULL) {
+            *why = "bad seconds in the time stamp";
+            return SL_ERR_MALFORMED;
+        }
+        sec = sec * 10U + (uint64_t)(*p - '0');
+    }
+    if (nsec == 0 || *p != '.') {
+        *why = strchr(line, ')') == NULL ? "no ')' after the time stamp"
+                                         : "time stamp is not <seconds>.<1..9 digits>";
+        return SL_ERR_MALFORMED;
+    }
+    for (p++; *p >= '0' && *p <= '9'; p++, nfrac++) {
+        if (nfrac < 6) {
+            frac = frac * 10U + (uint64_t)(*p - '0');
+        }
+    }
+    if (*p != ')') {
+        *why = strchr(p, ')') == NULL ? "no ')' after the time stamp" : "bad fraction in the time stamp";
+        return SL_ERR_MALFORMED;
+    }
+    if (nfrac == 0 || nfrac > 9) {
+        *why = "time stamp is not <seconds>.<1..9 digits>";
+        return SL_ERR_MALFORMED;
+    }
+    for (size_t k = nfrac; k < 6; k++) {
+        frac *= 10U;
+    }
+    out->t_us = sec * 1000000U + frac;
+    p++;
+    // Tokens: iface, frame, optional direction marker.
+    const char *tok[4];
+    size_t len[4], n = 0;
+    while (*p != '\0' && *p != '\n' && *p != '\r') {
+        while (*p == ' ' || *p == '\t') {
+            p++;
+        }
+        const char *e = p;
+        while (*e != '\0' && *e != ' ' && *e != '\t' && *e != '\n' && *e != '\r') {
+            e++;
+        }
+        if (e > p) {
+            if (n == 4) {
+                *why = "unexpected text after the frame";
+                return SL_ERR_MALFORMED;
+            }
+            tok[n] = p;
+            len[n++] = (size_t)(e - p);
+        }
+        p = e;
+    }
+    if (*p == '\r' || *p == '\n') {
+        while (*p == '\r' || *p == '\n') {
+            p++;
+        }
+        if (*p != '\0') {
+            *why = "unexpected text after the frame";
+            return SL_ERR_MALFORMED;
+        }
+    }
+    if (n < 2) {
+        *why = "expected '<iface> <frame>' after the time stamp";
+        return SL_ERR_MALFORMED;
+    }
+    if (n > 3 || (n == 3 && !(len[2] == 1 && (tok[2][0] == 'R' || tok[2][0] == 'T')))) {
+        *why = "unexpected text after the frame";
+        return SL_ERR_MALFORMED;
+    }
+    if (len[0] >= sizeof out->iface) {
+        *why = "interface name longer than 15 characters";
+        return SL_ERR_MALFORMED;
+    }
+    memcpy(out->iface, tok[0], len[0]);
+    char frame[64];
+    if (len[1] >= sizeof frame) {
+        *why = "frame text too long";
+        return SL_ERR_MALFORMED;
+    }
+    memcpy(frame, tok[1], len[1]);
+    frame[len[1]] = '\0';
+    return sl_candump_parse_frame(frame, &out->frame, why);
+}
+
 bool sl_candump_frame_ok(const sl_can_frame_t *f)
 {
     const uint32_t lim = (f->flags & (SL_CAN_FLAG_EFF | SL_CAN_FLAG_ERR)) != 0U ? SL_CAN_EFF_MASK : SL_CAN_SFF_MASK;

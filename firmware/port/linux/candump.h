@@ -42,6 +42,18 @@ char *sl_candump_format_frame(const sl_can_frame_t *f, char *buf, size_t cap);
 char *sl_candump_format_line(const sl_can_frame_t *f, uint64_t t_us, const char *iface, char *buf,
                              size_t cap);
 
+/// One candump -L line, parsed strictly (sl_candump_parse_record).
+typedef struct sl_candump_record {
+    uint64_t t_us;          ///< sec x 1e6 + usec (fraction digits beyond 6 dropped)
+    char iface[16];         ///< interface name (IFNAMSIZ)
+    sl_can_frame_t frame;
+} sl_candump_record_t;
+
+/// Parse one log line strictly: "(<seconds>.<1..9 digits>) <iface> <frame>", optionally
+/// followed by python-can's " R"/" T" marker; a trailing '\n'/'\r' is allowed.
+/// @return SL_OK, or SL_ERR_MALFORMED with `*why` a static reason (`why` may be NULL).
+sl_err_t sl_candump_parse_record(const char *line, sl_candump_record_t *out, const char **why);
+
 /// True when `f` can be written: the id fits its kind (11 or 29 bits), dlc <= 8.
 bool sl_candump_frame_ok(const sl_can_frame_t *f);
 
