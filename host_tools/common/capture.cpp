@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <cstdlib>
 #include <cstring>
 
 namespace sl {
@@ -126,6 +127,26 @@ bool load_capture(const std::string &path, Capture &out, std::string &err, const
         rep.flows_ignored = r->flows_ignored;
         rep.started_mid_stream = r->started_mid_stream;
         rep.read_error = r->read_error;
+        std::vector<sl_port_capture_flow_t> fl(SL_PORT_CAPTURE_MAX_FLOWS);
+        const size_t nf = sl_port_capture_flows(c, fl.data(), fl.size());
+        for (size_t i = 0; i < nf && i < fl.size(); ++i) {
+            PcapFlow f;
+            f.src = fl[i].src;
+            f.dst = fl[i].dst;
+            const char *colon = std::strrchr(fl[i].src, ':');
+            f.src_port = colon != nullptr ? static_cast<uint16_t>(std::atoi(colon + 1)) : 0;
+            colon = std::strrchr(fl[i].dst, ':');
+            f.dst_port = colon != nullptr ? static_cast<uint16_t>(std::atoi(colon + 1)) : 0;
+            f.packets = fl[i].packets;
+            f.payload_bytes = fl[i].payload_bytes;
+            f.first_ts_s = static_cast<double>(fl[i].first_ts_us) * 1e-6;
+            f.last_ts_s = static_cast<double>(fl[i].last_ts_us) * 1e-6;
+            f.syn = fl[i].syn;
+            f.fin = fl[i].fin;
+            f.rst = fl[i].rst;
+            f.selected = fl[i].selected;
+            rep.flows.push_back(f);
+        }
     }
     sl_port_capture_close(c);
     return ok;

@@ -34,6 +34,8 @@ typedef struct flow {
     bool syn, fin, rst, had_payload;
     int64_t syn_rel, fin_rel;
     uint64_t first_ts_us, last_ts_us;
+    uint64_t packets, payload_bytes;
+    bool was_selected;
     int role;       // ROLE_*
 } flow_t;
 
@@ -705,6 +707,8 @@ static void on_packet(sl_port_capture_t *c, const struct pcap_pkthdr *h, const u
         return;
     }
     f->last_ts_us = ts;
+    f->packets++;
+    f->payload_bytes += payload_cap;
     if (!f->have_seq) {
         f->have_seq = true;
         f->last_seq = seq;
@@ -767,6 +771,7 @@ static void on_packet(sl_port_capture_t *c, const struct pcap_pkthdr *h, const u
             }
             sess_reset(&c->sel, fi);
             f->role = ROLE_SELECTED;
+            f->was_selected = true;
             c->rep.sessions++;
             if (c->pre != NULL) {
                 pre_replay(c, fi, data_rel);
@@ -1029,6 +1034,7 @@ static void next_pcap(sl_port_capture_t *c, sl_port_capture_piece_t *pc)
             s->closing = false;
             c->cand = (sess_t){.pend = sp, .flow = -1};
             c->flows[s->flow].role = ROLE_SELECTED;
+            c->flows[s->flow].was_selected = true;
             if (!c->flows[s->flow].syn) {
                 c->rep.started_mid_stream = true;
                 if (s->n_pend > 0) { // mid-stream: start at the first byte held
@@ -1102,6 +1108,48 @@ void sl_port_capture_next(sl_port_capture_t *c, sl_port_capture_piece_t *pc)
     } else {
         next_pcap(c, pc);
     }
+}
+
+static void addr_str(char *out, size_t size, const uint8_t *a, uint8_t alen, uint16_t port)
+{
+    if ((alen & 0x7Fu) == 4u) {
+        snprintf(out, size, "%u.%u.%u.%u:%u", a[0], a[1], a[2], a[3], (unsigned)port);
+        return;
+    }
+    size_t k = (size_t)snprintf(out, size, "[");
+    for (unsigned i = 0; i < 16 && k < size; i += 2) {
+        k += (size_t)snprintf(out + k, size - k, "%s%x", i ? ":" : "", (unsigned)be16(a + i));
+    }
+    if (k < size) {
+        snprintf(out + k, size - k, "]:%u", (unsigned)port);
+    }
+}
+
+size_t sl_port_capture_flows(const sl_port_capture_t *c, sl_port_capture_flow_t *out, size_t max)
+{
+    size_t n = 0;
+    for (size_t i = 0; i < c->n_flows; i++) {
+        const flow_t *f = &c->flows[i];
+        if (!c->port_locked || f->sport != c->radar_port || !f->had_payload) {
+            continue;
+        }
+        if (n < max) {
+            sl_port_capture_flow_t *o = &out[n];
+            memset(o, 0, sizeof *o);
+            addr_str(o->src, sizeof o->src, f->src, f->alen, f->sport);
+            addr_str(o->dst, sizeof o->dst, f->dst, f->alen, f->dport);
+            o->packets = f->packets;
+            o->payload_bytes = f->payload_bytes;
+            o->first_ts_us = f->first_ts_us;
+            o->last_ts_us = f->last_ts_us;
+            o->syn = f->syn;
+            o->fin = f->fin;
+            o->rst = f->rst;
+            o->selected = f->was_selected;
+        }
+        n++;
+    }
+    return n;
 }
 
 const sl_port_capture_report_t *sl_port_capture_report(const sl_port_capture_t *c) { return &c->rep; }

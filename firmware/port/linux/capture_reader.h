@@ -142,6 +142,20 @@ const sl_port_capture_report_t *sl_port_capture_report(const sl_port_capture_t *
 /// The error message after ERROR ("" otherwise).
 const char *sl_port_capture_error(const sl_port_capture_t *c);
 
+/// One direction of one TCP connection from the radar port (pcap), as tracked so far.
+typedef struct sl_port_capture_flow {
+    char src[64], dst[64];       ///< "addr:port" ("[v6]:port" for IPv6)
+    uint64_t packets;            ///< packets of this direction
+    uint64_t payload_bytes;      ///< TCP payload bytes captured (with retransmissions)
+    uint64_t first_ts_us, last_ts_us; ///< capture timestamps (UNIX microseconds)
+    bool syn, fin, rst;
+    bool selected;               ///< part of the reassembled stream
+} sl_port_capture_flow_t;
+
+/// The radar-side flows that carried payload (pcap), in order of appearance: up to `max`
+/// into `out`. @return their number (may exceed `max`). O(SL_PORT_CAPTURE_MAX_FLOWS).
+size_t sl_port_capture_flows(const sl_port_capture_t *c, sl_port_capture_flow_t *out, size_t max);
+
 /// "raw", "pcap", "pcapng".
 const char *sl_port_capture_format_name(sl_port_capture_format_t f);
 
