@@ -973,7 +973,9 @@ int main(int argc, char **argv)
     d->link_state = d->is_radar ? SL_CAN_LINK_CONNECTING : SL_CAN_LINK_STREAMING;
     sl_pipeline_set_link_state(&g_pipe, d->link_state);
     // A live radar gets a Status frame at once (CONNECTING); a capture replayed in real time
-    // only when a rotation is late, so --realtime and --fast write the same frames.
+    // only when a rotation is late, so --realtime and --fast write the same frames. The
+    // clock is read again here: opening the outputs (a gs_usb adapter) may take a while.
+    d->mono_us = sl_port_now_us();
     d->last_status_mono = d->is_radar ? d->mono_us - (uint64_t)d->o.status_period_ms * 1000U : d->mono_us;
     d->next_stats_mono = d->o.stats_every_ms != 0 ? d->mono_us + (uint64_t)d->o.stats_every_ms * 1000U : UINT64_MAX;
     const uint64_t end_mono = d->o.duration_ms != 0 ? d->mono_us + (uint64_t)d->o.duration_ms * 1000U : UINT64_MAX;
