@@ -128,6 +128,7 @@
 #include "shadowlean/sl_detect.h"
 #include "shadowlean/sl_err.h"
 #include "shadowlean/sl_mask.h"
+#include "shadowlean/sl_port.h"
 #include "shadowlean/sl_proto.h"
 #include "shadowlean/sl_scan.h"
 #include "shadowlean/sl_thresh.h"
@@ -160,17 +161,7 @@ typedef enum sl_pipeline_reason {
     SL_PIPELINE_STAGE_INIT = 6,       ///< a stage's init rejected the board (see err)
 } sl_pipeline_reason_t;
 
-/// Output port: a const vtable + context (copied at init). Both callbacks are optional.
-typedef struct sl_pipeline_rotation sl_pipeline_rotation_t;
-typedef struct sl_port {
-    /// Send one CAN frame (borrowed for the call). Must not block: return SL_ERR_BUSY when
-    /// the bus/queue cannot take it (counted as a drop); SL_OK when queued/sent.
-    sl_err_t (*can_tx)(void *ctx, const sl_can_frame_t *f);
-    /// One completed rotation (borrowed for the call; every pointer in it is valid only
-    /// until the callback returns).
-    void (*on_rotation)(void *ctx, const sl_pipeline_rotation_t *r);
-    void *ctx;
-} sl_port_t;
+/// Output port: sl_port_t (shadowlean/sl_port.h).
 
 /// Pipeline configuration. Get defaults from sl_pipeline_cfg_default(), change fields,
 /// pass to sl_pipeline_init() (copied).
