@@ -45,6 +45,7 @@ void sl_pipeline_cfg_default(sl_pipeline_cfg_t *cfg, const sl_board_t *board)
     cfg->motion_budget_um = board != NULL ? board->bin_size_um : 43800U;
     cfg->motion_timeout_us = 500000U;
     cfg->rotation_us = 250000U;
+    cfg->row_timeout_us = 1000000U;
 }
 
 uint8_t sl_pipeline_window(uint8_t n, uint8_t min_frames, int32_t speed_mm_s,
@@ -100,9 +101,31 @@ static bool motion_now(const sl_pipeline_t *p, uint64_t now_us, sl_can_vehicle_m
 
 // ------------------------------------------------------------------------------- output
 
-static void can_send(sl_pipeline_t *p, const sl_can_frame_t *f)
+// Hard output ceiling (sl_can.h): per 100 ms of the port's clock at most
+// SL_CAN_MAX_DATA_FRAMES_PER_100MS PoleLean/LeanWarning and SL_CAN_MAX_STATUS_FRAMES_PER_100MS
+// Status/Health frames; the rest is withheld, counted and flagged (CAN_RATE_LIMITED).
+static bool can_budget(sl_pipeline_t *p, bool status)
 {
-    if (p->cfg.port.can_tx == NULL) {
+    if (p->now_us < p->can_window_us || p->now_us - p->can_window_us >= 100000U) {
+        p->can_window_us = p->now_us;
+        p->can_window_data = 0U;
+        p->can_window_status = 0U;
+    }
+    uint8_t *used = status ? &p->can_window_status : &p->can_window_data;
+    const uint8_t cap = (uint8_t)(status ? SL_CAN_MAX_STATUS_FRAMES_PER_100MS
+                                         : SL_CAN_MAX_DATA_FRAMES_PER_100MS);
+    if (*used >= cap) {
+        p->stats.can_rate_limited++;
+        p->fault_latched |= (uint16_t)SL_CAN_FAULT_CAN_RATE_LIMITED;
+        return false;
+    }
+    (*used)++;
+    return true;
+}
+
+static void can_send_kind(sl_pipeline_t *p, const sl_can_frame_t *f, bool status)
+{
+    if (p->cfg.port.can_tx == NULL || !can_budget(p, status)) {
         return;
     }
     if (p->cfg.port.can_tx(p->cfg.port.ctx, f) == SL_OK) {
@@ -110,6 +133,11 @@ static void can_send(sl_pipeline_t *p, const sl_can_frame_t *f)
     } else {
         p->stats.can_dropped++; // SL_ERR_BUSY or a port error: never retried, never blocks
     }
+}
+
+static void can_send(sl_pipeline_t *p, const sl_can_frame_t *f)
+{
+    can_send_kind(p, f, false);
 }
 
 static int32_t vehicle_az_cdeg(const sl_pipeline_t *p, uint16_t az)
@@ -130,11 +158,75 @@ static uint8_t quality_of(const sl_track_t *t)
     }
 }
 
-// One Status frame with the current counters and link state (rotation or idle).
+// A usable row arrived within cfg.row_timeout_us of now.
+static bool rows_fresh(const sl_pipeline_t *p)
+{
+    return p->have_row && p->now_us >= p->last_row_us &&
+           p->now_us - p->last_row_us <= (uint64_t)p->cfg.row_timeout_us;
+}
+
+// Reconnects within the flapping window at `now`.
+static bool flapping(const sl_pipeline_t *p)
+{
+    if (p->stats.reconnects < SL_CAN_FLAP_RECONNECTS) {
+        return false;
+    }
+    // The oldest of the last SL_CAN_FLAP_RECONNECTS reconnect times.
+    const uint64_t oldest = p->reconnect_t_us[p->reconnect_next % SL_CAN_FLAP_RECONNECTS];
+    return p->now_us >= oldest && p->now_us - oldest <= (uint64_t)SL_CAN_FLAP_WINDOW_MS * 1000U;
+}
+
+uint16_t sl_pipeline_faults(const sl_pipeline_t *p)
+{
+    if (p == NULL) {
+        return 0U;
+    }
+    uint16_t f = p->fault_latched;
+    if (p->geometry_bad) {
+        f |= (uint16_t)SL_CAN_FAULT_CONFIG_MISMATCH;
+    }
+    if (p->bin_size_bad) {
+        f |= (uint16_t)SL_CAN_FAULT_RANGE_RESOLUTION_MISMATCH;
+    }
+    const bool connected = p->link_state == (uint8_t)SL_CAN_LINK_STREAMING ||
+                           p->link_state == (uint8_t)SL_CAN_LINK_SILENT ||
+                           p->link_state == (uint8_t)SL_CAN_LINK_WAIT_CONFIG;
+    const bool fft_seen = p->scan.stats.fft != p->snap.fft;
+    if (!rows_fresh(p) && (connected || fft_seen)) {
+        f |= (uint16_t)SL_CAN_FAULT_NO_USABLE_ROWS;
+    }
+    if (p->proto.stats.resyncs != p->snap.resyncs || p->scan.stats.malformed != p->snap.malformed ||
+        p->scan.stats.bad_azimuth != p->snap.bad_azimuth ||
+        p->scan.stats.empty_rows != p->snap.empty_rows) {
+        f |= (uint16_t)SL_CAN_FAULT_MALFORMED_DATA;
+    }
+    if (p->stats.can_dropped != p->snap.can_dropped) {
+        f |= (uint16_t)SL_CAN_FAULT_CAN_OUTPUT_ERRORS;
+    }
+    if (p->scan.stats.disorder != p->snap.disorder) {
+        f |= (uint16_t)SL_CAN_FAULT_AZIMUTH_DISORDER;
+    }
+    if (p->detect.stats.target_overflow != p->snap.target_overflow) {
+        f |= (uint16_t)SL_CAN_FAULT_TARGET_SLOTS_OVERFLOW;
+    }
+    if (flapping(p)) {
+        f |= (uint16_t)SL_CAN_FAULT_LINK_FLAPPING;
+    }
+    return f;
+}
+
+// One Status frame with the current counters and link state (rotation or idle), then one
+// Health frame. The link state sent is STREAMING only while usable rows arrive: a port
+// that says STREAMING without a usable row since the previous Status is reported SILENT.
 static void emit_status(sl_pipeline_t *p)
 {
+    uint8_t link = p->link_state;
+    if (link == (uint8_t)SL_CAN_LINK_STREAMING && p->rows_since_status == 0U && !rows_fresh(p)) {
+        link = (uint8_t)SL_CAN_LINK_SILENT;
+    }
+    p->rows_since_status = 0U;
     const sl_can_status_t st = {
-        .link_state = p->link_state,
+        .link_state = link,
         .rotations = p->stats.rotations,
         .azimuths_missing = p->stats.azimuths_missing,
         .decoder_resyncs = p->proto.stats.resyncs,
@@ -142,7 +234,31 @@ static void emit_status(sl_pipeline_t *p)
     };
     sl_can_frame_t f;
     if (sl_can_encode_status(&p->can, &st, &f) == SL_OK) {
-        can_send(p, &f);
+        can_send_kind(p, &f, true);
+    }
+    const uint16_t faults = sl_pipeline_faults(p);
+    const sl_can_health_t h = {
+        .fault = faults,
+        .reconnects = p->stats.reconnects,
+        .candidates_dropped = p->detect.stats.target_overflow,
+    };
+    p->last_faults = faults;
+    p->faults_seen |= faults;
+    // The next Health reports what happens from now on, including the fate of this Health
+    // frame itself (a refusal counts as a CAN output error next time); persistent faults
+    // are re-derived each time.
+    p->fault_latched = 0U;
+    p->rows_since_health = 0U;
+    p->snap.fft = p->scan.stats.fft;
+    p->snap.resyncs = p->proto.stats.resyncs;
+    p->snap.malformed = p->scan.stats.malformed;
+    p->snap.bad_azimuth = p->scan.stats.bad_azimuth;
+    p->snap.empty_rows = p->scan.stats.empty_rows;
+    p->snap.can_dropped = p->stats.can_dropped;
+    p->snap.disorder = p->scan.stats.disorder;
+    p->snap.target_overflow = p->detect.stats.target_overflow;
+    if (sl_can_encode_health(&p->can, &h, &f) == SL_OK) {
+        can_send_kind(p, &f, true);
     }
 }
 
@@ -259,6 +375,10 @@ static void on_row(void *ctx, const sl_scan_row_t *row)
         begin_rotation(p);
     }
     p->stats.azimuths++;
+    p->rows_since_status++;
+    p->rows_since_health++;
+    p->last_row_us = p->now_us;
+    p->have_row = true;
     sl_thresh_u8(row->power, p->mask_bins, p->cfg.threshold, p->bits);
     if (row->idx >= p->next_az) {
         if (row->idx > p->next_az) {
@@ -289,6 +409,13 @@ static void measure_period(sl_pipeline_t *p, const sl_scan_rot_t *rot)
 static void on_rot(void *ctx, const sl_scan_rot_t *rot)
 {
     sl_pipeline_t *p = ctx;
+    if (p->in_rotation == 0U && p->geometry_bad) {
+        // Every row of this rotation was refused (configuration mismatch): nothing was
+        // seen, so it is not a processed rotation; all its azimuths are missing.
+        p->stats.azimuths_missing += rot->azimuths;
+        p->stats.refused_rotations++;
+        return;
+    }
     if (p->in_rotation == 0U) {
         begin_rotation(p); // cannot happen (a rotation has a row); keeps the state sane
     }
@@ -351,7 +478,33 @@ static void on_msg(void *ctx, const sl_proto_msg_t *m)
     }
     const uint32_t rejected = p->scan.stats.config_rejected;
     const uint32_t accepted = p->scan.stats.configs;
+    const uint32_t blind = p->scan.stats.blind_rotations;
     (void)sl_scan_on_msg(&p->scan, m);
+    if (p->scan.stats.blind_rotations != blind) {
+        // A rotation's worth of FFT messages gave no row: its azimuths are missing.
+        const uint32_t add = (p->scan.stats.blind_rotations - blind) * (uint32_t)p->board->azimuths;
+        p->stats.azimuths_missing = (add > UINT32_MAX - p->stats.azimuths_missing)
+                                        ? UINT32_MAX
+                                        : p->stats.azimuths_missing + add;
+        p->stats.blind_rotations += p->scan.stats.blind_rotations - blind;
+    }
+    if (m->id == (uint8_t)SL_PROTO_ID_CONFIGURATION) {
+        sl_proto_config_t c;
+        if (sl_proto_parse_config(m, &c) == SL_OK) {
+            // The board's bin size is the expected one; > 1 % off is flagged (ranges and
+            // leans would be scaled wrong by that much).
+            const uint32_t um = sl_proto_config_bin_size_um(&c);
+            const uint64_t b = p->board->bin_size_um;
+            const uint64_t diff = (um > b) ? um - b : b - um;
+            p->radar_bin_um = um;
+            p->bin_size_bad = um == 0U || diff * 100U > b;
+            if (p->bin_size_bad) {
+                p->stats.bin_size_mismatch++;
+                set_err(p, SL_ERR_RANGE, (uint8_t)SL_PIPELINE_OK,
+                        "radar bin size differs from the board's by more than 1 %");
+            }
+        }
+    }
     if (p->scan.stats.config_rejected != rejected) {
         // Rows of this radar would be mapped with the board's geometry: drop them until a
         // matching Configuration arrives.
@@ -475,6 +628,9 @@ sl_err_t sl_pipeline_init(sl_pipeline_t *p, const sl_board_t *board,
         return e;
     }
     p->rotation_us = c->rotation_us != 0U ? c->rotation_us : 250000U;
+    if (p->cfg.row_timeout_us == 0U) {
+        p->cfg.row_timeout_us = 1000000U;
+    }
     p->frames_eff = c->mask_frames;
     p->link_state = (uint8_t)SL_CAN_LINK_DISCONNECTED;
     p->ready = true;
@@ -544,6 +700,17 @@ sl_err_t sl_pipeline_send_status(sl_pipeline_t *p, uint64_t now_us)
     p->now_us = now_us;
     emit_status(p);
     return SL_OK;
+}
+
+void sl_pipeline_add_reconnect(sl_pipeline_t *p, uint64_t now_us)
+{
+    SL_ASSERT(p != NULL);
+    if (p->stats.reconnects != UINT32_MAX) {
+        p->stats.reconnects++;
+    }
+    p->reconnect_t_us[p->reconnect_next % SL_CAN_FLAP_RECONNECTS] = now_us;
+    p->reconnect_next = (uint8_t)((p->reconnect_next + 1U) % SL_CAN_FLAP_RECONNECTS);
+    p->now_us = now_us;
 }
 
 void sl_pipeline_add_can_dropped(sl_pipeline_t *p, uint32_t n)

@@ -539,10 +539,13 @@ sl_err_t sl_proto_parse_fft(const sl_proto_msg_t *msg, sl_proto_fft_t *out)
         return SL_ERR_MALFORMED;
     }
     const uint8_t bpb = (msg->id == SL_PROTO_ID_FFT_DATA_16) ? 2U : 1U;
-    const size_t nbytes = size - off;
-    if ((nbytes % bpb) != 0U) {
+    // Parity of the message as sent, not of the prefix kept: an odd-length 16-bit message
+    // is malformed whatever the reassembly size it was truncated to.
+    const size_t wire = (msg->truncated && msg->wire_bytes > size) ? msg->wire_bytes : size;
+    if (((wire - off) % bpb) != 0U) {
         return SL_ERR_MALFORMED;
     }
+    const size_t nbytes = (size - off) - ((size - off) % bpb);
     out->id = msg->id;
     out->bytes_per_bin = bpb;
     out->data_offset = off;

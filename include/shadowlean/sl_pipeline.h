@@ -31,11 +31,16 @@
 ///    matched this rotation, `hits >= cfg.confirm_hits`), in slot order; one LeanWarning
 ///    (the most severe confirmed track: highest level, then largest |filtered alpha|;
 ///    HasTarget = 0 when there is none); one Status (link state, rotations, missing
-///    azimuths, decoder resyncs, CAN drops). `can_tx` must not block: SL_ERR_BUSY (or any
+///    azimuths, decoder resyncs, CAN drops; LinkState STREAMING only while usable rows
+///    arrive: none since the previous Status and none within `cfg.row_timeout_us` -> SILENT), then one Health (Fault bits, Reconnects,
+///    CandidatesDropped; sl_can.h). Every frame passes the hard output ceiling
+///    (SL_CAN_MAX_*_FRAMES_PER_100MS per 100 ms of `now_us`; withheld frames are counted in
+///    `stats.can_rate_limited` and raise CAN_RATE_LIMITED). `can_tx` must not block: SL_ERR_BUSY (or any
 ///    other error) counts the frame as dropped (`stats.can_dropped`, reported in the next
 ///    Status frame) and the pipeline moves on. Drops the port notices later (after can_tx
 ///    returned SL_OK) are added with `sl_pipeline_add_can_dropped()`. Between rotations
-///    the port sends Status frames with `sl_pipeline_send_status()` (same E2E sequence).
+///    the port sends Status + Health frames with `sl_pipeline_send_status()` (same E2E
+///    sequences).
 /// Callbacks must not call back into the same pipeline (not reentrant).
 ///
 /// ## Mapping to CAN (sl_can.h)
@@ -196,6 +201,8 @@ typedef struct sl_pipeline_cfg {
     uint32_t motion_budget_um;   ///< D: displacement allowed over the window (default: bin)
     uint32_t motion_timeout_us;  ///< motion older than this is ignored (default 500 ms)
     uint32_t rotation_us;        ///< rotation period when timestamps are unusable (250000)
+    uint32_t row_timeout_us;     ///< Status says STREAMING (and Health has no NO_USABLE_ROWS)
+                                 ///< only while a usable row arrived within this (1 s; 0 = 1 s)
 } sl_pipeline_cfg_t;
 
 /// Defaults for `board` (threshold, n from the board; detection and tracker defaults;
@@ -243,6 +250,12 @@ typedef struct sl_pipeline_stats {
     uint32_t geometry_rejected;  ///< Configurations whose geometry does not match the board
     uint32_t rows_dropped;       ///< rows ignored after such a Configuration (until one matches)
     uint32_t restarts;           ///< radar restarts seen (geometry change, finish)
+    uint32_t reconnects;         ///< sl_pipeline_add_reconnect() calls (Health.Reconnects)
+    uint32_t can_rate_limited;   ///< frames withheld by the output ceiling (sl_can.h)
+    uint32_t bin_size_mismatch;  ///< Configurations whose bin size is > 1 % off the board's
+    uint32_t blind_rotations;    ///< rotations' worth of FFT messages without a usable row
+    uint32_t refused_rotations;  ///< rotations whose rows were all refused (config mismatch):
+                                 ///< not counted in `rotations`, their azimuths are missing
 } sl_pipeline_stats_t;
 
 /// The pipeline. Caller-allocated (static); fields read-only to the application. Stage
@@ -281,6 +294,25 @@ typedef struct sl_pipeline {
     sl_tracker_t tracker;
     sl_can_tx_t can;
     sl_pipeline_stats_t stats;
+    // health (Status link state, Health frame)
+    bool bin_size_bad;           ///< the radar's bin size is > 1 % off the board's
+    uint32_t radar_bin_um;       ///< bin size of the last Configuration (0: none yet)
+    uint32_t rows_since_status;  ///< usable rows since the last Status
+    uint32_t rows_since_health;  ///< usable rows since the last Health
+    bool have_row;               ///< a usable row arrived since init
+    uint64_t last_row_us;        ///< now_us of the last usable row
+    uint16_t fault_latched;      ///< fault bits raised since the last Health
+    uint16_t last_faults;        ///< Fault of the last Health frame
+    uint16_t faults_seen;        ///< every Fault bit sent since init
+    uint8_t reconnect_next;      ///< internal: ring index
+    uint8_t can_window_data;     ///< output ceiling: data frames in the current 100 ms
+    uint8_t can_window_status;   ///< output ceiling: Status/Health frames in it
+    uint64_t can_window_us;      ///< start of the current 100 ms window
+    uint64_t reconnect_t_us[SL_CAN_FLAP_RECONNECTS]; ///< times of the last reconnects
+    struct {
+        uint32_t fft, resyncs, malformed, bad_azimuth, empty_rows, can_dropped, disorder,
+            target_overflow;
+    } snap;                      ///< internal: counters at the last Health
     uint32_t bits[SL_MASK_WORDS]; ///< thresholded row (internal)
     uint32_t occ[SL_MASK_WORDS];  ///< stable-occupied row (internal)
     uint8_t row8[SL_CFG_MASK_BINS]; ///< scan's row buffer (16-bit reduction, short rows)
@@ -352,6 +384,17 @@ void sl_pipeline_set_link_state(sl_pipeline_t *p, uint8_t link_state);
 /// nothing is sent). `now_us` is the port's clock (stored as the call's time only).
 /// @return SL_OK, or SL_ERR_ARG (NULL or not initialised). O(1).
 sl_err_t sl_pipeline_send_status(sl_pipeline_t *p, uint64_t now_us);
+
+/// The port re-opened the radar link (a reconnect after a drop, or after the data watchdog
+/// gave up on a silent link). Counted in `stats.reconnects` (Health.Reconnects, saturating
+/// at 255 on the wire); SL_CAN_FLAP_RECONNECTS within SL_CAN_FLAP_WINDOW_MS raise
+/// LINK_FLAPPING. O(1).
+void sl_pipeline_add_reconnect(sl_pipeline_t *p, uint64_t now_us);
+
+/// The Fault bits (SL_CAN_FAULT_*) the next Health frame would carry now: faults raised
+/// since the last Health plus those that still hold (configuration mismatches; no usable
+/// row since the last Health while the link is up or FFT messages arrive). O(1).
+uint16_t sl_pipeline_faults(const sl_pipeline_t *p);
 
 /// Add `n` frames the port lost AFTER `can_tx` accepted them (a sink's stale or bus-off
 /// drops, gs_usb frames never confirmed) to `stats.can_dropped` (saturating at UINT32_MAX),

@@ -256,7 +256,9 @@ typedef struct sl_proto_fft {
 
 /// Parse an FFT payload. Bins start at `data_offset` (read from the payload, not assumed).
 /// @return SL_OK; SL_ERR_ARG (NULL, or id not 30/31); SL_ERR_MALFORMED (payload < 14,
-/// data_offset < 14 or > payload size, 16-bit data with an odd byte count).
+/// data_offset < 14 or > payload size, 16-bit data with an odd byte count AS SENT: checked on
+/// `wire_bytes` for a truncated message, so the result never depends on the reassembly size;
+/// a truncated prefix with an odd byte count gives its whole bins only).
 sl_err_t sl_proto_parse_fft(const sl_proto_msg_t *msg, sl_proto_fft_t *out);
 
 /// Bin `i` of a 16-bit FFT message (little-endian on the wire). No bounds check. O(1).
