@@ -80,7 +80,7 @@ echo
 echo "== 3. shadowleand --board $BOARD --radar 127.0.0.1:$PORT --can-log $OUT/can.log${MOTION:+ $MOTION}"
 echo "   (stops 1.5 s after the last FFT message: --exit-idle 1.5)"
 # shellcheck disable=SC2086
-"$BIN/daemon/shadowleand" --board "$BOARD" --radar "127.0.0.1:$PORT" --can-log "$OUT/can.log" $MOTION \
+build/host-release/apps/shadowleand/shadowleand --board "$BOARD" --radar "127.0.0.1:$PORT" --can-log "$OUT/can.log" $MOTION \
     --targets-out "$OUT/targets.jsonl" --exit-idle 1.5 --duration 300 --stats-every 2 2>&1 |
     sed 's/^/   /'
 kill "$REPLAY_PID" 2>/dev/null || true

@@ -10,7 +10,8 @@ for g in "$@"; do
              libopencv-dev libpcap-dev libusb-1.0-0-dev nlohmann-json3-dev" ;;
     test) pkgs="$pkgs valgrind clang libfuzzer-14-dev libclang-rt-14-dev
              gcc-arm-none-eabi libnewlib-arm-none-eabi gcc-aarch64-linux-gnu gcc-s390x-linux-gnu libc6-dev-arm64-cross libc6-dev-s390x-cross
-             qemu-user libcmocka-dev:arm64 libcmocka-dev:s390x libc6:arm64 libc6:s390x
+             qemu-user libcmocka-dev:arm64 libcmocka-dev:s390x
+             libpcap-dev:arm64 libusb-1.0-0-dev:arm64 libinih-dev:arm64 libc6:arm64 libc6:s390x
              python3-canmatrix python3-can python3-numpy can-utils user-mode-linux iproute2 kmod
              qemu-system-x86 busybox-static cpio usbutils" ;;
     demo) pkgs="$pkgs python3-canmatrix can-utils" ;;

@@ -27,8 +27,8 @@
 
 #include "can_sink.h"
 #include "can_socketcan.h"
+#include "capture_reader.h"
 #include "daemon_candump.h"
-#include "daemon_capture.h"
 #include "daemon_log.h"
 #include "daemon_motion.h"
 #include "daemon_opts.h"
@@ -47,10 +47,15 @@
 #define DRAIN_MS 500U             // at exit: wait at most this long for queued frames
 #define PIPE_REASM_HOST (1U << 20) // pacer decoder limit (host captures)
 
-/// One capture message: where it ends and its FFT timestamp (0 = not FFT data).
+#define LEAD_MAX (1U << 20)        // capture bytes held until the first FFT timestamp is known
+#define IX_CAP ((LEAD_MAX + SL_PORT_CAPTURE_CHUNK) / SL_PROTO_HEADER_BYTES + 16U)
+
+/// One queued capture event: a message (where it ends in the stream, its FFT timestamp or
+/// 0 = not FFT data) or a discontinuity (the pipeline's decoder is finished there).
 typedef struct msg_ix {
     uint64_t end;
     uint64_t t_us;
+    bool brk;
 } msg_ix_t;
 
 typedef struct daemon {
@@ -87,11 +92,27 @@ typedef struct daemon {
     bool had_fft;               // any FFT data since start
     sl_radar_state_t last_radar_state;
 
-    // input: capture
-    sld_capture_t cap;
+    // input: capture, streamed (bounded memory): pieces from the port's reader are decoded
+    // once by the pacer (message ends + FFT timestamps, queued in ix) and fed to the
+    // pipeline message by message; bytes before the first FFT timestamp are held in `lead`
+    // (the data clock starts there).
+    sl_port_capture_t *cr;
+    sl_proto_t pacer;
+    uint8_t *pacer_reasm;
     msg_ix_t *ix;
-    size_t n_ix, next_ix, next_break;
-    uint64_t fed;               // bytes of cap fed to the pipeline
+    size_t n_ix, next_ix;
+    const uint8_t *view;        // stream bytes [view_base, view_base + view_len) not yet all fed
+    uint64_t view_base;
+    size_t view_len;
+    uint8_t *lead;
+    size_t lead_len;
+    sl_port_capture_piece_t pend_piece; // read, not yet taken (the lead is fed first)
+    bool have_pend_piece;
+    bool clock_known;           // data_us started (first FFT seen, or given up waiting)
+    bool cap_end;               // the reader returned END or ERROR
+    bool cap_error;
+    uint64_t fed;               // stream bytes fed to the pipeline
+    uint64_t n_msgs, n_fft, n_breaks;
     bool cap_done;
     uint64_t play_wall0, play_us, play_prev_t;
     bool play_started;
@@ -348,89 +369,48 @@ static int radar_setup(daemon_t *d)
 // ---------------------------------------------------------------------------------------
 // Input: capture file
 
-typedef struct index_ctx {
-    msg_ix_t *ix;
-    size_t n, cap;
-    bool oom;
-} index_ctx_t;
-
-static void index_on_msg(void *ctx, const sl_proto_msg_t *msg)
+static void pacer_on_msg(void *ctx, const sl_proto_msg_t *msg)
 {
-    index_ctx_t *c = ctx;
-    if (c->n == c->cap) {
-        const size_t ncap = c->cap != 0 ? 2 * c->cap : 4096;
-        msg_ix_t *p = realloc(c->ix, ncap * sizeof *p);
-        if (p == NULL) {
-            c->oom = true;
-            return;
-        }
-        c->ix = p;
-        c->cap = ncap;
+    daemon_t *d = ctx;
+    if (d->n_ix >= IX_CAP) { // cannot happen: a piece holds at most IX_CAP headers
+        return;
     }
-    msg_ix_t m = {msg->stream_offset + SL_PROTO_HEADER_BYTES + msg->payload.size, 0};
+    msg_ix_t m = {msg->stream_offset + SL_PROTO_HEADER_BYTES + msg->payload.size, 0, false};
     sl_proto_fft_t fft;
     if ((msg->id == SL_PROTO_ID_FFT_DATA || msg->id == SL_PROTO_ID_FFT_DATA_16) &&
         sl_proto_parse_fft(msg, &fft) == SL_OK) {
         m.t_us = sl_proto_fft_time_us(&fft);
+        if (!d->clock_known && d->n_fft == 0) {
+            d->data_us = m.t_us; // the data clock starts at the first FFT message
+        }
+        d->n_fft++;
     }
-    c->ix[c->n++] = m;
+    d->n_msgs++;
+    d->ix[d->n_ix++] = m;
 }
 
-/// Index the capture's messages (ends and FFT timestamps) for pacing and the data clock.
+/// Open the capture (path or "-"): nothing is read beyond the format sniff.
 static int capture_setup(daemon_t *d)
 {
     char err[512];
-    if (sld_capture_load(d->o.capture, &d->cap, err, sizeof err) != 0) {
+    d->cr = sl_port_capture_open(d->o.capture, NULL, err, sizeof err);
+    if (d->cr == NULL) {
         sld_log(SLD_LOG_ERR, "--input: %s", err);
         return -1;
     }
-    uint8_t *reasm = malloc(PIPE_REASM_HOST);
-    if (reasm == NULL) {
+    d->pacer_reasm = malloc(PIPE_REASM_HOST);
+    d->ix = malloc(IX_CAP * sizeof *d->ix);
+    d->lead = malloc(LEAD_MAX);
+    if (d->pacer_reasm == NULL || d->ix == NULL || d->lead == NULL) {
         sld_log(SLD_LOG_ERR, "out of memory");
         return -1;
     }
-    index_ctx_t ic = {NULL, 0, 0, false};
-    sl_proto_t p;
-    const sl_proto_cfg_t pc = {.reasm_buf = reasm, .reasm_size = PIPE_REASM_HOST,
+    const sl_proto_cfg_t pc = {.reasm_buf = d->pacer_reasm, .reasm_size = PIPE_REASM_HOST,
                               .max_payload_bytes = PIPE_REASM_HOST, .truncate_long = false,
-                              .on_msg = index_on_msg, .ctx = &ic};
-    sl_proto_init(&p, &pc);
-    uint64_t off = 0;
-    for (size_t b = 0; b <= d->cap.n_breaks; b++) {
-        const uint64_t end = b < d->cap.n_breaks ? d->cap.breaks[b] : d->cap.size;
-        if (end > off) {
-            sl_proto_feed(&p, d->cap.bytes + off, (size_t)(end - off), 0);
-            off = end;
-        }
-        sl_proto_finish(&p);
-    }
-    free(reasm);
-    if (ic.oom) {
-        free(ic.ix);
-        sld_log(SLD_LOG_ERR, "out of memory indexing the capture");
-        return -1;
-    }
-    d->ix = ic.ix;
-    d->n_ix = ic.n;
-    size_t n_fft = 0;
-    for (size_t i = 0; i < d->n_ix; i++) {
-        if (d->ix[i].t_us != 0) {
-            if (n_fft == 0) {
-                d->data_us = d->ix[i].t_us; // the data clock starts at the first FFT message
-            }
-            n_fft++;
-        }
-    }
-    if (n_fft == 0) {
-        d->data_us = realtime_us();
-    }
-    sld_log(SLD_LOG_INFO, "input %s (%s): %zu bytes, %zu messages, %zu FFT, %zu discontinuities%s%s",
-            d->o.capture, d->cap.format, d->cap.size, d->n_ix, n_fft, d->cap.n_breaks,
-            d->cap.report[0] != '\0' ? "; " : "", d->cap.report);
-    if (p.stats.resyncs != 0 || p.stats.truncated != 0) {
-        sld_log(SLD_LOG_WARN, "input: %" PRIu32 " decoder resyncs, %" PRIu32 " truncated messages, %" PRIu64
-                " bytes skipped", p.stats.resyncs, p.stats.truncated, p.stats.bytes_skipped);
-    }
+                              .on_msg = pacer_on_msg, .ctx = d};
+    sl_proto_init(&d->pacer, &pc);
+    sld_log(SLD_LOG_INFO, "input %s (%s)", d->o.capture,
+            sl_port_capture_format_name(sl_port_capture_report(d->cr)->format));
     return 0;
 }
 
@@ -438,8 +418,75 @@ static void capture_feed_to(daemon_t *d, uint64_t end)
 {
     if (end > d->fed) {
         fixed_motion(d, pipe_now(d));
-        sl_pipeline_feed(&g_pipe, d->cap.bytes + d->fed, (size_t)(end - d->fed), pipe_now(d));
+        sl_pipeline_feed(&g_pipe, d->view + (d->fed - d->view_base), (size_t)(end - d->fed), pipe_now(d));
         d->fed = end;
+    }
+}
+
+static void queue_break(daemon_t *d, uint64_t at)
+{
+    sl_proto_finish(&d->pacer);
+    if (d->n_ix < IX_CAP) {
+        d->ix[d->n_ix++] = (msg_ix_t){at, 0, true};
+    }
+    d->n_breaks++;
+}
+
+/// Pull the next piece from the reader into the queue (all queued events fed, all of the
+/// view fed, unless the data clock is still unknown and the bytes go to `lead`).
+static void capture_pull(daemon_t *d)
+{
+    sl_port_capture_piece_t pc;
+    if (d->have_pend_piece) {
+        pc = d->pend_piece;
+        d->have_pend_piece = false;
+    } else {
+        sl_port_capture_next(d->cr, &pc);
+    }
+    if (pc.kind == SL_PORT_CAPTURE_DATA) {
+        if (!d->clock_known && d->lead_len + pc.size > LEAD_MAX) {
+            // No FFT timestamp in the first LEAD_MAX bytes: run on the wall clock. The
+            // lead is fed first (capture_step), then this piece (still valid: the reader
+            // is not called before).
+            d->clock_known = true;
+            d->data_us = realtime_us();
+            d->pend_piece = pc;
+            d->have_pend_piece = true;
+            return;
+        }
+        if (d->clock_known) {
+            d->n_ix = d->next_ix = 0;
+            d->view = pc.data;
+            d->view_base = pc.output_offset;
+            d->view_len = pc.size;
+            sl_proto_feed(&d->pacer, pc.data, pc.size, 0);
+            return;
+        }
+        memcpy(d->lead + d->lead_len, pc.data, pc.size);
+        d->lead_len += pc.size;
+        sl_proto_feed(&d->pacer, pc.data, pc.size, 0);
+        if (d->n_fft > 0) {
+            d->clock_known = true;
+        }
+        d->view = d->lead;
+        d->view_base = 0;
+        d->view_len = d->lead_len;
+        return;
+    }
+    if (pc.kind == SL_PORT_CAPTURE_BREAK) {
+        queue_break(d, pc.output_offset);
+        return;
+    }
+    // END or ERROR
+    sl_proto_finish(&d->pacer);
+    d->cap_end = true;
+    d->clock_known = true;
+    if (d->n_fft == 0 && d->data_us == 0) {
+        d->data_us = realtime_us();
+    }
+    if (pc.kind == SL_PORT_CAPTURE_ERROR) {
+        d->cap_error = true;
+        sld_log(SLD_LOG_ERR, "--input %s: %s", d->o.capture, sl_port_capture_error(d->cr));
     }
 }
 
@@ -448,21 +495,33 @@ static uint64_t capture_step(daemon_t *d)
 {
     unsigned budget = FAST_MSGS_PER_TURN;
     while (!d->cap_done && !d->stop && budget-- > 0) {
-        // A discontinuity before the next message's end: feed up to it, end the stream.
-        const uint64_t next_end = d->next_ix < d->n_ix ? d->ix[d->next_ix].end : d->cap.size;
-        if (d->next_break < d->cap.n_breaks && d->cap.breaks[d->next_break] <= next_end) {
-            capture_feed_to(d, d->cap.breaks[d->next_break]);
-            sl_pipeline_finish(&g_pipe, pipe_now(d));
-            d->next_break++;
+        if (!d->clock_known) {
+            capture_pull(d);
             continue;
         }
         if (d->next_ix >= d->n_ix) {
-            capture_feed_to(d, d->cap.size); // trailing junk or a partial message
-            sl_pipeline_finish(&g_pipe, pipe_now(d));
-            d->cap_done = true;
-            break;
+            // Every queued event fed: hand the rest of the view (a partial message or
+            // junk) to the pipeline, then read on.
+            capture_feed_to(d, d->view_base + d->view_len);
+            if (d->cap_end) {
+                sl_pipeline_finish(&g_pipe, pipe_now(d));
+                d->cap_done = true;
+                break;
+            }
+            if (d->view == d->lead) {
+                d->lead_len = 0;
+            }
+            d->n_ix = d->next_ix = 0;
+            capture_pull(d);
+            continue;
         }
         const msg_ix_t *m = &d->ix[d->next_ix];
+        if (m->brk) {
+            capture_feed_to(d, m->end);
+            sl_pipeline_finish(&g_pipe, pipe_now(d));
+            d->next_ix++;
+            continue;
+        }
         if (m->t_us != 0) {
             if (d->o.realtime) {
                 if (!d->play_started) {
@@ -490,6 +549,29 @@ static uint64_t capture_step(daemon_t *d)
         d->next_ix++;
     }
     return 0;
+}
+
+/// End of capture: what was read, decoded and skipped. @return false when the input ended
+/// with a read error, or held bytes but not one Colossus message (junk: every byte skipped).
+static bool capture_report(daemon_t *d)
+{
+    const sl_port_capture_report_t *r = sl_port_capture_report(d->cr);
+    char line[512];
+    sl_port_capture_report_line(d->cr, line, sizeof line);
+    sld_log(SLD_LOG_INFO, "input %s (%s): %" PRIu64 " bytes read, %" PRIu64 " stream bytes, %" PRIu64
+            " messages, %" PRIu64 " FFT, %" PRIu64 " discontinuities, %" PRIu64 " bytes skipped%s%s",
+            d->o.capture, sl_port_capture_format_name(r->format), r->bytes_in, r->stream_bytes, d->n_msgs,
+            d->n_fft, d->n_breaks, d->pacer.stats.bytes_skipped, line[0] != '\0' ? "; " : "", line);
+    if (d->pacer.stats.resyncs != 0 || d->pacer.stats.truncated != 0) {
+        sld_log(SLD_LOG_WARN, "input: %" PRIu32 " decoder resyncs, %" PRIu32 " truncated messages, %" PRIu64
+                " bytes skipped", d->pacer.stats.resyncs, d->pacer.stats.truncated, d->pacer.stats.bytes_skipped);
+    }
+    if (d->n_msgs == 0 && r->bytes_in > 0 && !d->stop) {
+        sld_log(SLD_LOG_ERR, "--input %s: no Colossus message in %" PRIu64 " bytes (%" PRIu64 " skipped)",
+                d->o.capture, r->stream_bytes, d->pacer.stats.bytes_skipped);
+        return false;
+    }
+    return !d->cap_error;
 }
 
 // ---------------------------------------------------------------------------------------
@@ -946,10 +1028,13 @@ int main(int argc, char **argv)
     } else if (!d->is_radar) {
         sld_log(SLD_LOG_INFO, "end of capture");
     }
+    const bool input_ok = d->is_radar || capture_report(d);
     shutdown_all(d);
-    sld_capture_free(&d->cap);
+    sl_port_capture_close(d->cr);
     free(d->ix);
+    free(d->lead);
+    free(d->pacer_reasm);
     free(d->radar_reasm);
     sld_log_close();
-    return 0;
+    return input_ok ? 0 : 1;
 }

@@ -1,0 +1,150 @@
+/// @file capture_reader.h
+/// @brief Streaming reader of radar captures (Linux port, C11 + POSIX + libpcap).
+///
+/// A capture holds the radar -> client byte stream of the Colossus protocol:
+///   - raw `.colossus`: the bytes exactly as the radar sent them (`sl-replay record`,
+///     `sl-replay from-oxford`, the simulator);
+///   - pcap / pcapng (tcpdump, Wireshark): the radar -> client direction of the TCP session
+///     (source port 6317 unless told otherwise; when no payload comes from that port, the
+///     first flow carrying Colossus radar messages is taken and the port is reported as
+///     auto-detected) is reassembled here, packet by packet.
+///
+/// Input: a path, or "-" for stdin. Pipes, FIFOs, character devices and regular files all
+/// work the same way: the file is opened once and read sequentially; the format is sniffed
+/// from the first bytes already read (pcap magic a1b2c3d4 / a1b23c4d in either byte order,
+/// pcapng block type 0a0d0d0a; anything else is raw), which are then handed on, never
+/// re-read (libpcap reads through a stdio stream that first returns them).
+///
+/// Output: a sequence of pieces, pulled with sl_port_capture_next(): DATA (stream bytes, in
+/// order), BREAK (bytes are missing here, or a new TCP session starts: a decoder must be
+/// finished before the next DATA so it does not glue two half messages), END, ERROR.
+///
+/// Memory: bounded whatever the capture's size. Raw: one SL_PORT_CAPTURE_CHUNK read
+/// buffer. Pcap: libpcap's packet buffer, plus out-of-order segments held until the hole
+/// before them fills, at most SL_PORT_CAPTURE_PENDING_MAX bytes per reassembled session
+/// (the selected one and at most one candidate successor); a hole still open when that
+/// bound is reached is declared a gap. Flows are tracked in a fixed table of
+/// SL_PORT_CAPTURE_MAX_FLOWS entries (more are counted, not tracked).
+///
+/// Reassembly (same contract as the host tools' reader, streamed): retransmissions (full or
+/// partial) are dropped and counted; re-sent bytes are compared with the first copy when
+/// it is still held (out-of-order store or the last SL_PORT_CAPTURE_TAIL delivered bytes)
+/// and differences counted; missing bytes are never invented: each hole is a BREAK. A new
+/// radar-side session is taken when the current one has ended (FIN/RST), or when the
+/// current one sends nothing more for as long as the newcomer fills its out-of-order store
+/// or until the end of the file; a session overlapping the one taken (the current one
+/// keeps sending after the newcomer started) is counted in flows_ignored, as before.
+///
+/// Not thread-safe; one reader per thread. Errors: -1 from open with a message; a read
+/// error during reading ends the stream with ERROR (raw) or is reported in
+/// `report.read_error` and ends it with END after the packets read (pcap, as before).
+#ifndef SHADOWLEAN_PORT_CAPTURE_READER_H
+#define SHADOWLEAN_PORT_CAPTURE_READER_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define SL_PORT_CAPTURE_CHUNK (1u << 20)        ///< raw read size, bytes
+#define SL_PORT_CAPTURE_PENDING_MAX (8u << 20)  ///< out-of-order bytes held per session
+#define SL_PORT_CAPTURE_PENDING_SEGS 8192u      ///< out-of-order segments held per session
+#define SL_PORT_CAPTURE_TAIL (64u << 10)        ///< delivered bytes kept to compare re-sends
+#define SL_PORT_CAPTURE_MAX_FLOWS 64u           ///< TCP flow directions tracked
+
+typedef enum sl_port_capture_format {
+    SL_PORT_CAPTURE_RAW = 0,
+    SL_PORT_CAPTURE_PCAP,
+    SL_PORT_CAPTURE_PCAPNG,
+} sl_port_capture_format_t;
+
+typedef enum sl_port_capture_piece_kind {
+    SL_PORT_CAPTURE_DATA = 0,  ///< `data`/`size`: the next stream bytes
+    SL_PORT_CAPTURE_BREAK,     ///< bytes missing (gap) or a new session starts here
+    SL_PORT_CAPTURE_END,       ///< no more pieces
+    SL_PORT_CAPTURE_ERROR,     ///< read error (message in sl_port_capture_error()); no more pieces
+} sl_port_capture_piece_kind_t;
+
+typedef enum sl_port_capture_break_kind {
+    SL_PORT_CAPTURE_GAP = 0,
+    SL_PORT_CAPTURE_NEW_SESSION,
+} sl_port_capture_break_kind_t;
+
+/// One piece of the stream. `data` is valid until the next sl_port_capture_next() call.
+typedef struct sl_port_capture_piece {
+    sl_port_capture_piece_kind_t kind;
+    const uint8_t *data;
+    size_t size;
+    sl_port_capture_break_kind_t brk;  ///< BREAK only
+    uint64_t output_offset;            ///< stream offset (bytes delivered so far) of this piece
+    uint64_t missing_bytes;            ///< GAP only: bytes absent from the capture
+} sl_port_capture_piece_t;
+
+/// Everything counted so far (final after END). Counts refer to the reassembled (selected)
+/// direction unless the name says otherwise. Raw captures only fill bytes_in / stream_bytes.
+typedef struct sl_port_capture_report {
+    sl_port_capture_format_t format;
+    uint64_t bytes_in;              ///< bytes read from the file (every byte counted)
+    uint64_t stream_bytes;          ///< bytes delivered as DATA
+    char link_type[32];             ///< libpcap DLT name, e.g. "EN10MB"
+    uint16_t radar_port;            ///< TCP source port of the reassembled direction
+    bool port_auto_detected;
+    uint64_t packets_total;         ///< all packets in the file
+    uint64_t packets_undecoded;     ///< not Ethernet/SLL/raw IP, not IPv4/IPv6, or not TCP
+    uint64_t ip_fragments;          ///< IP fragments (skipped)
+    uint64_t packets_truncated;     ///< captured length < TCP payload (snap length)
+    uint64_t segments;              ///< selected-session TCP segments with payload
+    uint64_t payload_bytes;         ///< their captured payload bytes
+    uint64_t retransmitted_segments;///< segments whose bytes had all been seen before
+    uint64_t retransmitted_bytes;   ///< bytes received more than once
+    uint64_t partial_overlap_segments;
+    uint64_t retransmit_mismatch_bytes; ///< re-sent bytes that differ from the held first copy
+    uint64_t out_of_order_segments; ///< segments that arrived after a later segment
+    uint64_t gaps;                  ///< holes in the byte stream
+    uint64_t gap_bytes;             ///< bytes missing in those holes (0 when unknowable)
+    uint64_t sessions;              ///< radar-side sessions reassembled
+    uint64_t flows_ignored;         ///< radar-side sessions overlapping a selected one
+    uint64_t flows_untracked;       ///< flow directions beyond SL_PORT_CAPTURE_MAX_FLOWS
+    bool started_mid_stream;        ///< a selected session has no SYN
+    char read_error[256];           ///< libpcap error that ended reading early ("" if none)
+} sl_port_capture_report_t;
+
+typedef struct sl_port_capture_opts {
+    uint16_t radar_port;  ///< 0 = 6317
+    bool port_explicit;   ///< never auto-detect another port
+} sl_port_capture_opts_t;
+
+typedef struct sl_port_capture sl_port_capture_t;
+
+/// Open `path` ("-" = stdin) and sniff its format. `opts` may be NULL.
+/// @return the reader (malloc'd, bounded: see above), or NULL with `err` set (an
+/// unreadable path, a pcap libpcap rejects). An empty input is a raw capture that ends at once.
+sl_port_capture_t *sl_port_capture_open(const char *path, const sl_port_capture_opts_t *opts,
+                                        char *err, size_t err_size);
+
+/// The next piece. After END or ERROR every call returns the same kind again.
+void sl_port_capture_next(sl_port_capture_t *c, sl_port_capture_piece_t *piece);
+
+/// Counters so far (final after END).
+const sl_port_capture_report_t *sl_port_capture_report(const sl_port_capture_t *c);
+
+/// The error message after ERROR ("" otherwise).
+const char *sl_port_capture_error(const sl_port_capture_t *c);
+
+/// "raw", "pcap", "pcapng".
+const char *sl_port_capture_format_name(sl_port_capture_format_t f);
+
+/// One line summarising the pcap reassembly ("" for raw), as the daemon logs it.
+void sl_port_capture_report_line(const sl_port_capture_t *c, char *buf, size_t size);
+
+/// Close the file (not stdin) and free the reader. NULL is allowed.
+void sl_port_capture_close(sl_port_capture_t *c);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif // SHADOWLEAN_PORT_CAPTURE_READER_H
