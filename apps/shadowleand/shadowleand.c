@@ -70,6 +70,7 @@ typedef struct daemon {
     bool sc_on;
     sld_candump_t log;
     bool log_on;
+    bool log_error_logged;
     sl_gsusb_sink_t gs;
     bool gs_on;
     sl_can_sink_t sinks[3];
@@ -253,8 +254,13 @@ static void radar_on_msg(void *ctx, const sl_proto_msg_t *msg, uint64_t now_us)
 {
     daemon_t *d = ctx;
     if (msg->id == SL_PROTO_ID_FFT_DATA || msg->id == SL_PROTO_ID_FFT_DATA_16) {
-        d->last_fft_mono = now_us;
-        d->had_fft = true;
+        // Liveness is usable data, not the message id: a malformed or empty FFT message
+        // does not keep the link STREAMING.
+        sl_proto_fft_t f;
+        if (sl_proto_parse_fft(msg, &f) == SL_OK && f.bins > 0U) {
+            d->last_fft_mono = now_us;
+            d->had_fft = true;
+        }
     } else if (msg->id == SL_PROTO_ID_CONFIGURATION) {
         sl_proto_config_t c;
         if (sl_proto_parse_config(msg, &c) == SL_OK) {
@@ -262,9 +268,17 @@ static void radar_on_msg(void *ctx, const sl_proto_msg_t *msg, uint64_t now_us)
                     (unsigned)c.azimuths, (unsigned)c.range_bins, sl_proto_config_bin_size_um(&c),
                     (unsigned)(c.rotation_mhz / 1000U), (unsigned)(c.rotation_mhz % 1000U));
             if (c.azimuths != d->board->azimuths || c.encoder_size != d->board->encoder_size) {
-                sld_log(SLD_LOG_WARN, "radar geometry (%u azimuths, %u ticks) differs from board %s (%u, %u)",
+                sld_log(SLD_LOG_ERR, "radar geometry (%u azimuths, %u ticks) differs from board %s (%u, %u):"
+                        " every row is refused (Health CONFIG_MISMATCH)",
                         (unsigned)c.azimuths, (unsigned)c.encoder_size, d->board->name,
                         (unsigned)d->board->azimuths, (unsigned)d->board->encoder_size);
+            }
+            const uint32_t um = sl_proto_config_bin_size_um(&c);
+            const uint32_t bu = d->board->bin_size_um;
+            if ((uint64_t)(um > bu ? um - bu : bu - um) * 100U > bu) {
+                sld_log(SLD_LOG_ERR, "radar bin size %" PRIu32 " um differs from board %s (%" PRIu32
+                        " um) by more than 1 %%: ranges and leans are scaled wrong (Health "
+                        "RANGE_RESOLUTION_MISMATCH)", um, d->board->name, bu);
             }
         }
     }
@@ -285,6 +299,9 @@ static void radar_on_event(void *ctx, sl_radar_event_t ev, sl_radar_reason_t rea
     switch (ev) {
     case SL_RADAR_EV_CONNECTED:
         sld_log(SLD_LOG_INFO, "radar %s:%u connected", d->o.radar_host, (unsigned)d->o.radar_port);
+        if (c->stats.connects > 1U) {
+            sl_pipeline_add_reconnect(&g_pipe, now_us); // Health.Reconnects, LINK_FLAPPING
+        }
         break;
     case SL_RADAR_EV_CONFIG:
         d->stream_start_mono = now_us;
@@ -349,6 +366,9 @@ static int radar_setup(daemon_t *d)
     cfg.port = d->o.radar_port;
     cfg.connect_timeout_ms = d->o.connect_timeout_ms;
     cfg.silence_timeout_ms = d->o.silence_timeout_ms;
+    // Data watchdog: no usable FFT row for the silence timeout -> Start FFT again, then
+    // reconnect (keep-alives or a byte trickle no longer keep a blind link open).
+    cfg.data_timeout_ms = d->o.data_timeout_ms != 0 ? d->o.data_timeout_ms : d->o.silence_timeout_ms;
     cfg.non_contour = d->o.non_contour;
     cfg.reasm_buf = d->radar_reasm;
     cfg.reasm_size = reasm;
@@ -983,7 +1003,14 @@ int main(int argc, char **argv)
         if (d->motion_on) {
             sld_motion_read(&d->motion, d->mono_us, on_motion_frame, d);
         }
-        if (d->is_radar) {
+        if (d->is_radar && d->o.exit_idle_ms != 0 && d->had_fft &&
+            d->mono_us >= d->last_fft_mono + (uint64_t)d->o.exit_idle_ms * 1000U) {
+            // Before the client's timers: a late wake-up stops with the link still open
+            // (Stop FFT is sent) rather than after a watchdog drop.
+            d->stop = true;
+            d->stop_why = "--exit-idle";
+        }
+        if (d->is_radar && !d->stop) {
             const short rev = rc > 0 ? fds[i_radar].revents : 0;
             sl_radar_client_handle(&d->radar, rev, d->mono_us);
             if (d->radar.state != d->last_radar_state) {
@@ -1000,14 +1027,14 @@ int main(int argc, char **argv)
                 d->link_state = ls;
                 sl_pipeline_set_link_state(&g_pipe, ls);
             }
-            if (d->o.exit_idle_ms != 0 && d->had_fft &&
-                d->mono_us >= d->last_fft_mono + (uint64_t)d->o.exit_idle_ms * 1000U) {
-                d->stop = true;
-                d->stop_why = "--exit-idle";
-            }
         }
         sl_can_sinks_poll(d->sinks, d->n_sinks, d->mono_us);
         report_sink_drops(d);
+        if (d->log_on && d->log.stats.errors != 0U && !d->log_error_logged) {
+            d->log_error_logged = true;
+            sld_log(SLD_LOG_ERR, "--can-log %s: write failed: %s (frames are lost; Health "
+                    "CAN_OUTPUT_ERRORS)", d->o.can_log, strerror(d->log.last_errno));
+        }
         if (d->idle_status && d->mono_us >= d->last_status_mono + (uint64_t)d->o.status_period_ms * 1000U) {
             send_idle_status(d);
         }
@@ -1030,11 +1057,32 @@ int main(int argc, char **argv)
     }
     const bool input_ok = d->is_radar || capture_report(d);
     shutdown_all(d);
+    // Exit status (README "Exit statuses"): 1 unreadable input, 4 an output could not be
+    // written (CAN log, targets), 3 capture mode without a usable rotation or with a
+    // configuration fault raised, 0 otherwise (2: bad options, before this point).
+    const bool log_failed = d->log_on && d->log.stats.errors != 0U;
+    if (log_failed) {
+        sld_log(SLD_LOG_ERR, "--can-log %s: %" PRIu32 " write errors (%s), %" PRIu32 " frames lost",
+                d->o.can_log, d->log.stats.errors, strerror(d->log.last_errno), d->log.stats.dropped);
+    }
+    const uint16_t cfg_faults = (uint16_t)(g_pipe.faults_seen | sl_pipeline_faults(&g_pipe)) &
+                                (uint16_t)(SL_CAN_FAULT_CONFIG_MISMATCH | SL_CAN_FAULT_RANGE_RESOLUTION_MISMATCH);
+    int exit_rc = 0;
+    if (!input_ok) {
+        exit_rc = 1;
+    } else if (log_failed || d->targets_failed) {
+        exit_rc = 4;
+    } else if (!d->is_radar && (g_pipe.stats.rotations == 0U || cfg_faults != 0U)) {
+        sld_log(SLD_LOG_ERR, "input %s: %s", d->o.capture,
+                cfg_faults != 0U ? "the radar's configuration does not match the board (see above)"
+                                 : "no usable rotation");
+        exit_rc = 3;
+    }
     sl_port_capture_close(d->cr);
     free(d->ix);
     free(d->lead);
     free(d->pacer_reasm);
     free(d->radar_reasm);
     sld_log_close();
-    return input_ok ? 0 : 1;
+    return exit_rc;
 }

@@ -101,33 +101,44 @@ static bool motion_now(const sl_pipeline_t *p, uint64_t now_us, sl_can_vehicle_m
 
 // ------------------------------------------------------------------------------- output
 
-// Hard output ceiling (sl_can.h): per 100 ms of the port's clock at most
-// SL_CAN_MAX_DATA_FRAMES_PER_100MS PoleLean/LeanWarning and SL_CAN_MAX_STATUS_FRAMES_PER_100MS
-// Status/Health frames; the rest is withheld, counted and flagged (CAN_RATE_LIMITED).
-static bool can_budget(sl_pipeline_t *p, bool status)
+// Hard output ceiling (sl_can.h): two token buckets on the port's clock, one for
+// PoleLean/LeanWarning, one for Status/Health: refilled at SL_CAN_MAX_*_FRAMES_PER_100MS per
+// 100 ms, holding at most SL_CAN_BURST_WINDOWS times that (a backlog after a stall). A frame
+// without a token is withheld, counted and flagged (CAN_RATE_LIMITED). Tokens in 1/1000.
+static bool can_budget(sl_pipeline_t *p, bool status, uint32_t frames)
 {
-    if (p->now_us < p->can_window_us || p->now_us - p->can_window_us >= 100000U) {
-        p->can_window_us = p->now_us;
-        p->can_window_data = 0U;
-        p->can_window_status = 0U;
+    uint32_t *tokens = status ? &p->can_tokens_status : &p->can_tokens_data;
+    if (!p->can_clock_set) {
+        p->can_clock_set = true;
+        p->can_tokens_data = SL_CAN_MAX_DATA_FRAMES_PER_100MS * SL_CAN_BURST_WINDOWS * 1000U;
+        p->can_tokens_status = SL_CAN_MAX_STATUS_FRAMES_PER_100MS * SL_CAN_BURST_WINDOWS * 1000U;
+        p->can_clock_us = p->now_us;
     }
-    uint8_t *used = status ? &p->can_window_status : &p->can_window_data;
-    const uint8_t cap = (uint8_t)(status ? SL_CAN_MAX_STATUS_FRAMES_PER_100MS
-                                         : SL_CAN_MAX_DATA_FRAMES_PER_100MS);
-    if (*used >= cap) {
-        p->stats.can_rate_limited++;
+    if (p->now_us > p->can_clock_us) {
+        const uint64_t dt = p->now_us - p->can_clock_us;
+        // rate frames per 100,000 us = rate / 100 milli-frames per us; both buckets.
+        const uint64_t add_d = dt * SL_CAN_MAX_DATA_FRAMES_PER_100MS / 100U;
+        const uint64_t add_s = dt * SL_CAN_MAX_STATUS_FRAMES_PER_100MS / 100U;
+        const uint64_t cap_d = (uint64_t)SL_CAN_MAX_DATA_FRAMES_PER_100MS * SL_CAN_BURST_WINDOWS * 1000U;
+        const uint64_t cap_s = (uint64_t)SL_CAN_MAX_STATUS_FRAMES_PER_100MS * SL_CAN_BURST_WINDOWS * 1000U;
+        const uint64_t td = p->can_tokens_data + add_d;
+        const uint64_t ts = p->can_tokens_status + add_s;
+        p->can_tokens_data = (uint32_t)(td > cap_d ? cap_d : td);
+        p->can_tokens_status = (uint32_t)(ts > cap_s ? cap_s : ts);
+    }
+    p->can_clock_us = p->now_us; // a clock going backwards refills nothing
+    if (*tokens < frames * 1000U) {
+        p->stats.can_rate_limited += frames;
         p->fault_latched |= (uint16_t)SL_CAN_FAULT_CAN_RATE_LIMITED;
         return false;
     }
-    (*used)++;
+    *tokens -= frames * 1000U;
     return true;
 }
 
-static void can_send_kind(sl_pipeline_t *p, const sl_can_frame_t *f, bool status)
+// One frame to the port (budget already taken).
+static void can_out(sl_pipeline_t *p, const sl_can_frame_t *f)
 {
-    if (p->cfg.port.can_tx == NULL || !can_budget(p, status)) {
-        return;
-    }
     if (p->cfg.port.can_tx(p->cfg.port.ctx, f) == SL_OK) {
         p->stats.can_frames++;
     } else {
@@ -137,7 +148,9 @@ static void can_send_kind(sl_pipeline_t *p, const sl_can_frame_t *f, bool status
 
 static void can_send(sl_pipeline_t *p, const sl_can_frame_t *f)
 {
-    can_send_kind(p, f, false);
+    if (p->cfg.port.can_tx != NULL && can_budget(p, false, 1U)) {
+        can_out(p, f);
+    }
 }
 
 static int32_t vehicle_az_cdeg(const sl_pipeline_t *p, uint16_t az)
@@ -232,9 +245,11 @@ static void emit_status(sl_pipeline_t *p)
         .decoder_resyncs = p->proto.stats.resyncs,
         .can_dropped = p->stats.can_dropped,
     };
+    // Status and its Health pass the ceiling together (a Health never goes missing alone).
+    const bool send = p->cfg.port.can_tx != NULL && can_budget(p, true, 2U);
     sl_can_frame_t f;
-    if (sl_can_encode_status(&p->can, &st, &f) == SL_OK) {
-        can_send_kind(p, &f, true);
+    if (sl_can_encode_status(&p->can, &st, &f) == SL_OK && send) {
+        can_out(p, &f);
     }
     const uint16_t faults = sl_pipeline_faults(p);
     const sl_can_health_t h = {
@@ -242,8 +257,13 @@ static void emit_status(sl_pipeline_t *p)
         .reconnects = p->stats.reconnects,
         .candidates_dropped = p->detect.stats.target_overflow,
     };
-    p->last_faults = faults;
     p->faults_seen |= faults;
+    sl_can_frame_t hf;
+    const bool hok = sl_can_encode_health(&p->can, &h, &hf) == SL_OK; // counter advances
+    if (!send) {
+        return; // withheld by the ceiling: the next Health that goes out reports all of it
+    }
+    p->last_faults = faults;
     // The next Health reports what happens from now on, including the fate of this Health
     // frame itself (a refusal counts as a CAN output error next time); persistent faults
     // are re-derived each time.
@@ -257,8 +277,8 @@ static void emit_status(sl_pipeline_t *p)
     p->snap.can_dropped = p->stats.can_dropped;
     p->snap.disorder = p->scan.stats.disorder;
     p->snap.target_overflow = p->detect.stats.target_overflow;
-    if (sl_can_encode_health(&p->can, &h, &f) == SL_OK) {
-        can_send_kind(p, &f, true);
+    if (hok) {
+        can_out(p, &hf);
     }
 }
 

@@ -2,7 +2,7 @@
 //
 //   sl-replay serve CAPTURE [--port P] [--bind ADDR] [--rate realtime|max] [--loop] ...
 //   sl-replay record --radar HOST:PORT --out FILE [--duration S] [--non-contour]
-//   sl-replay from-oxford DIR --out FILE [--bin-size-m 0.0438]
+//   sl-replay from-oxford DIR --out FILE [--bin-size-m 0.0432]
 #include "replay.h"
 
 #include "capture.h"
@@ -68,7 +68,7 @@ void usage()
         "      --duration S        stop after S seconds (default: Ctrl-C)\n"
         "      --non-contour       start with id 140 instead of 21\n"
         "      --silence-ms N      reconnect when nothing arrives for N ms (default 3000)\n"
-        "  sl-replay from-oxford DIR --out FILE [--bin-size-m 0.0438]\n"
+        "  sl-replay from-oxford DIR --out FILE [--bin-size-m 0.0432]\n"
         "      DIR/radar/*.png (or DIR/*.png), Oxford Radar RobotCar polar PNGs\n"
         "      --encoder-size N --rotation-mhz N --packet-rate N (defaults 5600 4000 1600)\n");
 }

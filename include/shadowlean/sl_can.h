@@ -123,10 +123,12 @@
 /// - bit5 RANGE_RESOLUTION_MISMATCH: the Configuration's bin size differs from the board's
 ///   by more than 1 %.
 /// - bit6 AZIMUTH_DISORDER: azimuths stepped back beyond the reorder window.
-/// - bit7 CAN_RATE_LIMITED: frames were withheld by the hard output ceiling: at most
-///   SL_CAN_MAX_DATA_FRAMES_PER_100MS PoleLean + LeanWarning frames and
-///   SL_CAN_MAX_STATUS_FRAMES_PER_100MS Status + Health frames per 100 ms of the port's
-///   clock (48 x ~130 bits per 100 ms: under 13 % of a 500 kbit/s bus, whatever the input).
+/// - bit7 CAN_RATE_LIMITED: frames were withheld by the hard output ceiling: token buckets
+///   on the port's clock refilled with SL_CAN_MAX_DATA_FRAMES_PER_100MS PoleLean +
+///   LeanWarning and SL_CAN_MAX_STATUS_FRAMES_PER_100MS Status + Health frames per 100 ms,
+///   holding at most SL_CAN_BURST_WINDOWS x that (the backlog of a ~3 s stall of a 4 Hz
+///   radar). Sustained: 48 frames x ~130 bits per 100 ms, under 13 % of a 500 kbit/s bus;
+///   in any 100 ms at most (SL_CAN_BURST_WINDOWS + 1) x 48 frames, whatever the input.
 /// - bit8 TARGET_SLOTS_OVERFLOW: detection had more candidates than target slots.
 /// Note: Data ID 0x54 is also VehicleMotion's (received, opposite direction); the two are
 /// told apart by their CAN ids only.
@@ -277,6 +279,7 @@ typedef enum sl_can_link_state {
 /// Hard output ceiling per 100 ms (a rotation with 32 targets sends 33 data frames).
 #define SL_CAN_MAX_DATA_FRAMES_PER_100MS 40U
 #define SL_CAN_MAX_STATUS_FRAMES_PER_100MS 8U
+#define SL_CAN_BURST_WINDOWS 3U
 
 // ---------------------------------------------------------------------------------------
 // Signal limits (raw values). The layout table and the encoders use these; tests too.

@@ -33,8 +33,9 @@
 ///    HasTarget = 0 when there is none); one Status (link state, rotations, missing
 ///    azimuths, decoder resyncs, CAN drops; LinkState STREAMING only while usable rows
 ///    arrive: none since the previous Status and none within `cfg.row_timeout_us` -> SILENT), then one Health (Fault bits, Reconnects,
-///    CandidatesDropped; sl_can.h). Every frame passes the hard output ceiling
-///    (SL_CAN_MAX_*_FRAMES_PER_100MS per 100 ms of `now_us`; withheld frames are counted in
+///    CandidatesDropped; sl_can.h). Every frame passes the hard output ceiling (token
+///    buckets on `now_us`: SL_CAN_MAX_*_FRAMES_PER_100MS per 100 ms sustained, bursts up to
+///    SL_CAN_BURST_WINDOWS times that; withheld frames are counted in
 ///    `stats.can_rate_limited` and raise CAN_RATE_LIMITED). `can_tx` must not block: SL_ERR_BUSY (or any
 ///    other error) counts the frame as dropped (`stats.can_dropped`, reported in the next
 ///    Status frame) and the pipeline moves on. Drops the port notices later (after can_tx
@@ -305,9 +306,10 @@ typedef struct sl_pipeline {
     uint16_t last_faults;        ///< Fault of the last Health frame
     uint16_t faults_seen;        ///< every Fault bit sent since init
     uint8_t reconnect_next;      ///< internal: ring index
-    uint8_t can_window_data;     ///< output ceiling: data frames in the current 100 ms
-    uint8_t can_window_status;   ///< output ceiling: Status/Health frames in it
-    uint64_t can_window_us;      ///< start of the current 100 ms window
+    bool can_clock_set;          ///< output ceiling: buckets initialised (full)
+    uint32_t can_tokens_data;    ///< output ceiling: PoleLean/LeanWarning tokens (1/1000)
+    uint32_t can_tokens_status;  ///< output ceiling: Status/Health tokens (1/1000)
+    uint64_t can_clock_us;       ///< output ceiling: now_us of the last refill
     uint64_t reconnect_t_us[SL_CAN_FLAP_RECONNECTS]; ///< times of the last reconnects
     struct {
         uint32_t fft, resyncs, malformed, bad_azimuth, empty_rows, can_dropped, disorder,

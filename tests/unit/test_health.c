@@ -288,10 +288,9 @@ static void assert_ceiling(void)
         const bool st = rec.can[i].id == B->can_id_status || rec.can[i].id == B->can_id_health;
         status += st ? 1 : 0;
         data += st ? 0 : 1;
-        // The ceiling is per window starting at its first frame; any sliding 100 ms span
-        // holds at most two windows' worth.
-        assert_true(data <= 2 * (int)SL_CAN_MAX_DATA_FRAMES_PER_100MS);
-        assert_true(status <= 2 * (int)SL_CAN_MAX_STATUS_FRAMES_PER_100MS);
+        // Token buckets: a full bucket plus one window's refill in any 100 ms span.
+        assert_true(data <= (int)((SL_CAN_BURST_WINDOWS + 1U) * SL_CAN_MAX_DATA_FRAMES_PER_100MS));
+        assert_true(status <= (int)((SL_CAN_BURST_WINDOWS + 1U) * SL_CAN_MAX_STATUS_FRAMES_PER_100MS));
     }
 }
 
@@ -361,8 +360,9 @@ static void test_health_can_output_ceiling_holds_for_any_input(void **state)
     assert_true(rec.rotations >= 3000);
     assert_true(pl.stats.can_rate_limited > 0);
     assert_ceiling();
-    // 2 s of input: at most 20 windows x (40 + 8) frames.
-    assert_true(rec.n <= 21 * (int)(SL_CAN_MAX_DATA_FRAMES_PER_100MS + SL_CAN_MAX_STATUS_FRAMES_PER_100MS));
+    // 2 s of input: at most the full buckets plus 20 windows' refill.
+    assert_true(rec.n <= (int)((20U + SL_CAN_BURST_WINDOWS) *
+                               (SL_CAN_MAX_DATA_FRAMES_PER_100MS + SL_CAN_MAX_STATUS_FRAMES_PER_100MS)));
     bool limited = false;
     for (int i = 0; i < rec.n; i++) {
         sl_can_health_t h;
