@@ -1055,6 +1055,11 @@ int main(int argc, char **argv)
     } else if (!d->is_radar) {
         sld_log(SLD_LOG_INFO, "end of capture");
     }
+    if (!d->is_radar && (g_pipe.stats.rotations == 0U || sl_pipeline_faults(&g_pipe) != 0U)) {
+        // A capture that ends blind or faulty says so on CAN: one last Status + Health
+        // (a clean capture ends with its last rotation's frames, as before).
+        send_idle_status(d);
+    }
     const bool input_ok = d->is_radar || capture_report(d);
     shutdown_all(d);
     // Exit status (README "Exit statuses"): 1 unreadable input, 4 an output could not be
@@ -1073,9 +1078,18 @@ int main(int argc, char **argv)
     } else if (log_failed || d->targets_failed) {
         exit_rc = 4;
     } else if (!d->is_radar && (g_pipe.stats.rotations == 0U || cfg_faults != 0U)) {
-        sld_log(SLD_LOG_ERR, "input %s: %s", d->o.capture,
-                cfg_faults != 0U ? "the radar's configuration does not match the board (see above)"
-                                 : "no usable rotation");
+        if ((cfg_faults & SL_CAN_FAULT_CONFIG_MISMATCH) != 0U) {
+            sld_log(SLD_LOG_ERR, "input %s: the radar's geometry (azimuths / encoder size) differs from "
+                    "board %s: %" PRIu32 " rows refused", d->o.capture, d->board->name, g_pipe.stats.rows_dropped);
+        }
+        if ((cfg_faults & SL_CAN_FAULT_RANGE_RESOLUTION_MISMATCH) != 0U) {
+            sld_log(SLD_LOG_ERR, "input %s: radar bin size %" PRIu32 " um differs from board %s (%" PRIu32
+                    " um) by more than 1 %%", d->o.capture, g_pipe.radar_bin_um, d->board->name,
+                    d->board->bin_size_um);
+        }
+        if (g_pipe.stats.rotations == 0U) {
+            sld_log(SLD_LOG_ERR, "input %s: no usable rotation", d->o.capture);
+        }
         exit_rc = 3;
     }
     sl_port_capture_close(d->cr);
