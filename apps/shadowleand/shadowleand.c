@@ -126,6 +126,7 @@ typedef struct daemon {
     uint8_t link_state;
     uint64_t last_status_mono;
     bool idle_status;           // send Status frames when no rotation does
+    uint64_t cap_next_due;      // capture: mono time the next message is due (0 = now)
     uint32_t status_frames, idle_status_frames, frames_out, rotations_seen;
     uint64_t next_stats_mono;
     uint64_t start_mono;
@@ -548,6 +549,10 @@ static uint64_t capture_step(daemon_t *d)
                     d->play_started = true;
                     d->play_wall0 = d->mono_us;
                     d->play_prev_t = m->t_us;
+                    // The idle-Status clock starts with the data, not with the set-up
+                    // (opening a gs_usb device in a slow VM took > 1 s: an idle Status
+                    // before the first rotation).
+                    d->last_status_mono = d->mono_us;
                 } else {
                     uint64_t dt = m->t_us > d->play_prev_t ? m->t_us - d->play_prev_t : 0;
                     if (dt > MAX_PLAY_GAP_US) {
@@ -968,6 +973,7 @@ int main(int argc, char **argv)
             }
         } else if (!d->cap_done) {
             const uint64_t cap_due = capture_step(d);
+            d->cap_next_due = cap_due;
             if (cap_due == 0) {
                 wake = d->mono_us; // more to feed now: just look at the fds
             } else {
@@ -1035,7 +1041,14 @@ int main(int argc, char **argv)
             sld_log(SLD_LOG_ERR, "--can-log %s: write failed: %s (frames are lost; Health "
                     "CAN_OUTPUT_ERRORS)", d->o.can_log, strerror(d->log.last_errno));
         }
-        if (d->idle_status && d->mono_us >= d->last_status_mono + (uint64_t)d->o.status_period_ms * 1000U) {
+        // A capture replayed in real time is idle only when its next message is due later
+        // (a gap in the capture). When its data is due already, the daemon is behind
+        // schedule (descheduled under load): the data is fed next time round and the
+        // rotation's own Status follows; an idle Status here would be a timing artefact
+        // (the flaky "Status frame outside a rotation group" of daemon_gs_usb_output_in_vm).
+        const bool behind = !d->is_radar && (d->cap_next_due == 0 || d->cap_next_due <= d->mono_us);
+        if (d->idle_status && !behind &&
+            d->mono_us >= d->last_status_mono + (uint64_t)d->o.status_period_ms * 1000U) {
             send_idle_status(d);
         }
         if (d->mono_us >= d->next_stats_mono) {
