@@ -709,6 +709,15 @@ static void log_stats(daemon_t *d, int level, const char *what)
             (unsigned)sl_track_max_level(&g_pipe.tracker), g_pipe.proto.stats.messages,
             g_pipe.proto.stats.resyncs, d->frames_out, d->status_frames, d->idle_status_frames,
             s->can_dropped, s->motion_accepted, s->motion_rejected);
+    if (s->can_rx != 0) {
+        const sl_can_e2e_rx_t *e2e = &g_pipe.motion_rx.e2e;
+        sld_log(level, "%s: VehicleMotion E2E: %" PRIu32 " accepted, %" PRIu32 " CRC errors, %" PRIu32
+                " repeated, %" PRIu32 " bad counter, %" PRIu32 " bad DLC, %" PRIu32 " counter jumps (%" PRIu32
+                " lost), %" PRIu32 " timeouts, %" PRIu32 " other ids",
+                what, e2e->stats.accepted, e2e->stats.crc_errors, e2e->stats.repeated, e2e->stats.bad_counter,
+                e2e->stats.bad_dlc, e2e->stats.counter_jumps, e2e->stats.lost_frames,
+                g_pipe.motion_rx.stats.timeouts, g_pipe.motion_rx.stats.other_ids);
+    }
     if (s->motion_set_calls != 0) {
         sld_log(SLD_LOG_DEBUG, "%s: motion setter (--motion): %" PRIu32 " calls", what, s->motion_set_calls);
     }
