@@ -256,8 +256,9 @@ typedef enum sl_can_link_state {
     SL_CAN_LINK_DISCONNECTED = 0, ///< no TCP connection
     SL_CAN_LINK_CONNECTING = 1,   ///< TCP connect in progress
     SL_CAN_LINK_WAIT_CONFIG = 2,  ///< connected, waiting for the radar's configuration
-    SL_CAN_LINK_STREAMING = 3,    ///< azimuth data flowing
-    SL_CAN_LINK_SILENT = 4,       ///< connected but no data for longer than the timeout
+    SL_CAN_LINK_STREAMING = 3,    ///< usable azimuth rows arriving (within the last second:
+                                  ///< malformed, empty or refused rows do not count)
+    SL_CAN_LINK_SILENT = 4,       ///< connected but no usable data for longer than the timeout
 } sl_can_link_state_t;
 #define SL_CAN_LINK_STATE_MAX 4U
 
