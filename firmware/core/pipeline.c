@@ -490,6 +490,39 @@ static void on_rot(void *ctx, const sl_scan_rot_t *rot)
     p->in_rotation = 0U;
 }
 
+// Ranges from the radar's own bin size: detection runs on a copy of the board whose
+// bin size (and near-exclusion band, in bins) is the radar's; the shadow geometry is in
+// micrometres, so detection's per-azimuth windows follow. Re-initialising detection drops
+// the rotation's open candidates (a Configuration means a (re)start). When the radar's
+// bins are so small that detection would need more bins than are masked, the board's
+// bin size is kept (RANGE_RESOLUTION_MISMATCH stays raised) rather than cutting the shadow.
+static void use_bin_size(sl_pipeline_t *p, uint32_t um)
+{
+    if (um == 0U || um == p->det_board.bin_size_um) {
+        return;
+    }
+    const sl_board_t *b = p->board;
+    sl_board_t nb = *b;
+    nb.bin_size_um = um;
+    const uint64_t near_um = (uint64_t)b->near_exclusion_bins * b->bin_size_um;
+    const uint64_t near = (near_um + um - 1U) / um;
+    nb.near_exclusion_bins = (uint16_t)(near > nb.roi_bins ? nb.roi_bins : near);
+    nb.shadow_bins = NULL; // in the board's bins; detection uses shadow_um
+    if (b->shadow_um == NULL) {
+        return; // no micrometre shadow table: cannot move to other bins
+    }
+    const sl_board_t keep = p->det_board;
+    p->det_board = nb;
+    if (sl_detect_init(&p->detect, &p->det_board, &p->cfg.detect) != SL_OK ||
+        sl_detect_bins_needed(&p->detect) > p->mask_bins) {
+        p->det_board = keep;
+        (void)sl_detect_init(&p->detect, &p->det_board, &p->cfg.detect);
+        p->stats.bin_size_unserved++;
+        return;
+    }
+    p->stats.bin_size_changes++;
+}
+
 static void on_msg(void *ctx, const sl_proto_msg_t *m)
 {
     sl_pipeline_t *p = ctx;
@@ -523,6 +556,7 @@ static void on_msg(void *ctx, const sl_proto_msg_t *m)
                 set_err(p, SL_ERR_RANGE, (uint8_t)SL_PIPELINE_OK,
                         "radar bin size differs from the board's by more than 1 %");
             }
+            use_bin_size(p, um);
         }
     }
     if (p->scan.stats.config_rejected != rejected) {
@@ -577,7 +611,8 @@ sl_err_t sl_pipeline_init(sl_pipeline_t *p, const sl_board_t *board,
                 "board roi_bins exceed SL_CFG_ROI_BINS");
         return SL_ERR_RANGE;
     }
-    sl_err_t e = sl_detect_init(&p->detect, board, &c->detect);
+    p->det_board = *board;
+    sl_err_t e = sl_detect_init(&p->detect, &p->det_board, &c->detect);
     if (e != SL_OK) {
         set_err(p, e, (uint8_t)SL_PIPELINE_STAGE_INIT, "sl_detect_init rejected the board");
         return e;

@@ -121,7 +121,7 @@
 /// - bit3 LINK_FLAPPING: SL_CAN_FLAP_RECONNECTS reconnects within SL_CAN_FLAP_WINDOW_MS.
 /// - bit4 CAN_OUTPUT_ERRORS: CAN frames were dropped by the sinks.
 /// - bit5 RANGE_RESOLUTION_MISMATCH: the Configuration's bin size differs from the board's
-///   by more than 1 %.
+///   by more than 1 % (ranges follow the radar's value; the board is not this installation).
 /// - bit6 AZIMUTH_DISORDER: azimuths stepped back beyond the reorder window.
 /// - bit7 CAN_RATE_LIMITED: frames were withheld by the hard output ceiling: token buckets
 ///   on the port's clock refilled with SL_CAN_MAX_DATA_FRAMES_PER_100MS PoleLean +

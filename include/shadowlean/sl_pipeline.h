@@ -48,7 +48,11 @@
 /// Azimuth = az x 36000 / azimuths + board->radar_yaw_cdeg (vehicle frame, clockwise).
 /// TargetId = track id mod 16. Quality = FILTERED when the track has a valid alpha
 /// (Lean/LeanSigma = the filtered values), else the mapping of the last target's incline
-/// flag (AMBIGUOUS, OUT_OF_MODEL, INVALID). Ranges: the track's last corrected r1 / r2, passed
+/// flag (AMBIGUOUS, OUT_OF_MODEL, INVALID). Bin size: the radar's Configuration's (its
+/// `rangeresolutionmetres`, else the fixed field): detection runs on `det_board`, a copy of
+/// the board with that bin size, so ranges and corrections follow the radar; a difference
+/// of more than 1 % from the board's (the expected value) raises RANGE_RESOLUTION_MISMATCH.
+/// Ranges: the track's last corrected r1 / r2, passed
 /// in um and rounded once, by the encoder, to the signal's step (0.02 m / 0.01 m).
 ///
 /// ## Motion (the paper assumed a static vehicle; see `sl_pipeline_window()`)
@@ -255,6 +259,8 @@ typedef struct sl_pipeline_stats {
     uint32_t can_rate_limited;   ///< frames withheld by the output ceiling (sl_can.h)
     uint32_t bin_size_mismatch;  ///< Configurations whose bin size is > 1 % off the board's
     uint32_t blind_rotations;    ///< rotations' worth of FFT messages without a usable row
+    uint32_t bin_size_changes;   ///< detection moved to the radar's bin size (Configuration)
+    uint32_t bin_size_unserved;  ///< radar bin size too small for the masked bins: board's kept
     uint32_t refused_rotations;  ///< rotations whose rows were all refused (config mismatch):
                                  ///< not counted in `rotations`, their azimuths are missing
 } sl_pipeline_stats_t;
@@ -295,6 +301,8 @@ typedef struct sl_pipeline {
     sl_tracker_t tracker;
     sl_can_tx_t can;
     sl_pipeline_stats_t stats;
+    sl_board_t det_board;        ///< the board as detection uses it: bin size from the radar's
+                                 ///< Configuration (the board's until one arrives)
     // health (Status link state, Health frame)
     bool bin_size_bad;           ///< the radar's bin size is > 1 % off the board's
     uint32_t radar_bin_um;       ///< bin size of the last Configuration (0: none yet)

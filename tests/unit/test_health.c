@@ -237,6 +237,60 @@ static void test_health_range_resolution_mismatch_is_flagged(void **state)
     }
 }
 
+// Issue 14.2: ranges come from the radar's bin size. The same returns (a post occupying
+// bins 50..56 on two azimuths) from a radar that says 0.0596 m bins and from one that says
+// 0.0438 m: RangeInner on CAN is the bin index times the radar's bin size, not the board's.
+static uint32_t pole_range_um(uint16_t bin_100um)
+{
+    init();
+    reset_stream();
+    sl_pipeline_set_link_state(&pl, SL_CAN_LINK_STREAMING);
+    put_config(400, 5600, bin_100um);
+    static uint8_t row[256];
+    for (int r = 0; r < 24; r++) {
+        for (uint16_t a = 0; a < 400; a++) {
+            memset(row, 10, sizeof row);
+            if (a == 100 || a == 101) {
+                memset(row + 50, 200, 7);
+            }
+            const uint64_t t = 1700000000ULL * 1000000ULL + (uint64_t)g_msg++ * 625U;
+            const sl_proto_fft_t f = {.sweep_counter = g_sweep++, .azimuth_ticks = (uint16_t)(a * 14U),
+                                      .seconds = (uint32_t)(t / 1000000U),
+                                      .split_ns = (uint32_t)(t % 1000000U) * 1000U, .bins = 256};
+            const sl_ssize_t k = sl_proto_encode_fft8(g_buf + g_n, sizeof g_buf - g_n, &f, row);
+            assert_true(k > 0);
+            g_n += (size_t)k;
+        }
+    }
+    feed_paced(1000000U);
+    uint32_t r1 = 0;
+    for (int i = 0; i < rec.n; i++) {
+        sl_can_pole_lean_t pole;
+        if (rec.can[i].id == B->can_id_pole_lean && sl_can_decode_pole_lean(&rec.can[i], &pole) == SL_OK) {
+            r1 = pole.range_inner_um;
+        }
+    }
+    return r1;
+}
+
+static void test_health_ranges_use_the_radars_bin_size(void **state)
+{
+    (void)state;
+    const uint32_t r_board = pole_range_um(438);
+    const uint32_t r_cir = pole_range_um(596);
+    print_message("RangeInner: %u um with 0.0438 m bins, %u um with 0.0596 m bins\n", r_board, r_cir);
+    assert_true(r_board > 0U && r_cir > 0U); // a target was sent in both cases
+    // r1 = 50 bins (+ the half-bin and other corrections, < 2 bins) x the radar's bin size.
+    assert_true(r_board >= 50U * 43800U && r_board <= 52U * 43800U);
+    assert_true(r_cir >= 50U * 59600U && r_cir <= 52U * 59600U);
+    assert_int_equal(pl.stats.bin_size_changes, 1);
+    sl_can_status_t st;
+    sl_can_health_t h;
+    assert_int_equal(sl_pipeline_send_status(&pl, g_now), SL_OK);
+    last_status(&st, &h);
+    assert_true((h.fault & SL_CAN_FAULT_RANGE_RESOLUTION_MISMATCH) != 0U); // still flagged
+}
+
 // Issue 14.5: reconnects are counted on CAN (saturating) and flapping is a fault.
 static void test_health_reconnects_counted_and_flapping_flagged(void **state)
 {
@@ -469,6 +523,7 @@ int main(void)
         cmocka_unit_test(test_health_config_mismatch_is_a_fault_on_can),
         cmocka_unit_test(test_health_unusable_fft_is_silent_malformed_and_missing),
         cmocka_unit_test(test_health_range_resolution_mismatch_is_flagged),
+        cmocka_unit_test(test_health_ranges_use_the_radars_bin_size),
         cmocka_unit_test(test_health_reconnects_counted_and_flapping_flagged),
         cmocka_unit_test(test_health_shuffled_azimuths_are_bounded_disorder),
         cmocka_unit_test(test_health_can_output_ceiling_holds_for_any_input),
