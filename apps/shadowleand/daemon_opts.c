@@ -7,6 +7,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "daemon_log.h"
 #include "shadowlean/sl_board.h"
@@ -161,6 +162,8 @@ static int apply(sld_opts_t *o, const char *section, const char *key, const char
         if (parse_u32(val, &o->connect_timeout_ms) != 0 || o->connect_timeout_ms == 0) BAD("expected ms > 0");
     } else if (IS("input", "silence_timeout_ms")) {
         if (parse_u32(val, &o->silence_timeout_ms) != 0) BAD("expected ms");
+    } else if (IS("input", "data_timeout_ms")) {
+        if (parse_u32(val, &o->data_timeout_ms) != 0) BAD("expected ms");
     } else if (IS("input", "silent_ms")) {
         if (parse_u32(val, &o->silent_ms) != 0 || o->silent_ms == 0) BAD("expected ms > 0");
     } else if (IS("input", "motion")) {
@@ -240,12 +243,15 @@ static int apply(sld_opts_t *o, const char *section, const char *key, const char
 // ---------------------------------------------------------------------------------------
 // Config file
 
+#define INI_MAX_KEYS 128
 typedef struct ini_ctx {
     sld_opts_t *o;
     char *err;
     size_t err_size;
     bool failed;
     bool has_radar, has_capture;
+    unsigned n_keys;
+    char keys[INI_MAX_KEYS][96]; ///< "section.name" seen so far (duplicates are errors)
 } ini_ctx_t;
 
 static int on_ini(void *user, const char *section, const char *name, const char *value)
@@ -253,6 +259,19 @@ static int on_ini(void *user, const char *section, const char *name, const char 
     ini_ctx_t *c = user;
     if (c->failed) {
         return 0;
+    }
+    char key[96];
+    snprintf(key, sizeof key, "%s.%s", section, name);
+    for (unsigned i = 0; i < c->n_keys; i++) {
+        if (strcmp(c->keys[i], key) == 0) {
+            snprintf(c->err, c->err_size, "%s: duplicate key (set once; the command line overrides)",
+                     key);
+            c->failed = true;
+            return 0;
+        }
+    }
+    if (c->n_keys < INI_MAX_KEYS) {
+        memcpy(c->keys[c->n_keys++], key, sizeof key);
     }
     if (apply(c->o, section, name, value, c->err, c->err_size) != 0) {
         c->failed = true;
@@ -270,7 +289,21 @@ static int on_ini(void *user, const char *section, const char *name, const char 
 int sld_opts_load_file(sld_opts_t *o, const char *path, char *err, size_t err_size)
 {
     char why[512] = "";
-    ini_ctx_t c = {o, why, sizeof why, false, false, false};
+    struct stat sb;
+    if (stat(path, &sb) != 0) {
+        snprintf(err, err_size, "%s: cannot open: %s", path, strerror(errno));
+        return -1;
+    }
+    if (!S_ISREG(sb.st_mode)) {
+        snprintf(err, err_size, "%s: not a regular file (%s)", path,
+                 S_ISDIR(sb.st_mode) ? "a directory" : "a device, pipe or socket");
+        return -1;
+    }
+    static ini_ctx_t c;
+    memset(&c, 0, sizeof c);
+    c.o = o;
+    c.err = why;
+    c.err_size = sizeof why;
     const int rc = ini_parse(path, on_ini, &c);
     if (rc == -1) {
         snprintf(err, err_size, "%s: cannot open: %s", path, strerror(errno));
@@ -319,6 +352,7 @@ static const cli_opt_t k_cli[] = {
     {"--non-contour", "input", "non_contour", 0, "true"},
     {"--connect-timeout-ms", "input", "connect_timeout_ms", 1, NULL},
     {"--silence-timeout-ms", "input", "silence_timeout_ms", 1, NULL},
+    {"--data-timeout-ms", "input", "data_timeout_ms", 1, NULL},
     {"--silent-ms", "input", "silent_ms", 1, NULL},
     {"--motion", "input", "motion", 1, NULL},
     {"--can", "can", "interface", 1, NULL},
@@ -350,6 +384,8 @@ void sld_opts_usage(void *fpv)
         "  --non-contour            [input] non_contour       radar: Start Non-Contour FFT (140)\n"
         "  --connect-timeout-ms N   [input] connect_timeout_ms  radar connect timeout (2000)\n"
         "  --silence-timeout-ms N   [input] silence_timeout_ms  reconnect after N ms without a byte (3000)\n"
+        "  --data-timeout-ms N      [input] data_timeout_ms   no usable FFT row for N ms: Start FFT again,\n"
+        "                                                     then reconnect after N more (0: = silence timeout)\n"
         "  --silent-ms N            [input] silent_ms         Status LinkState SILENT after N ms without FFT data (1000)\n"
         "  --motion V[,W]           [input] motion            constant vehicle motion instead of VehicleMotion frames:\n"
         "                                                     V m/s (> 0 forward), W deg/s (> 0 counter-clockwise); none = off\n"
@@ -550,6 +586,7 @@ void sld_opts_print(const sld_opts_t *o, void *fpv)
     if (o->fixed_motion) {
         fprintf(fp, "motion = %.3f,%.2f\n", (double)o->fixed_speed_mm_s / 1000.0, (double)o->fixed_yaw_cdeg_s / 100.0);
     }
+    fprintf(fp, "data_timeout_ms = %u\n", (unsigned)o->data_timeout_ms);
     fprintf(fp, "realtime = %s\nnon_contour = %s\nconnect_timeout_ms = %u\nsilence_timeout_ms = %u\nsilent_ms = %u\n",
             o->realtime ? "true" : "false", o->non_contour ? "true" : "false", (unsigned)o->connect_timeout_ms,
             (unsigned)o->silence_timeout_ms, (unsigned)o->silent_ms);

@@ -53,6 +53,7 @@ typedef struct sld_opts {
     bool non_contour;                  ///< --non-contour                     [input] non_contour
     uint32_t connect_timeout_ms;       ///< --connect-timeout-ms (2000)       [input] connect_timeout_ms
     uint32_t silence_timeout_ms;       ///< --silence-timeout-ms (3000): reconnect [input] silence_timeout_ms
+    uint32_t data_timeout_ms;          ///< --data-timeout-ms (0 = silence timeout): data watchdog [input] data_timeout_ms
     uint32_t silent_ms;                ///< --silent-ms (1000): no FFT data -> SILENT [input] silent_ms
     char can_iface[SLD_IFACE_CHARS];   ///< --can IFACE                       [can] interface
     char can_log[SLD_PATH_CHARS];      ///< --can-log FILE ("-" stdout)        [can] log

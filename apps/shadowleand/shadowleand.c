@@ -69,6 +69,7 @@ typedef struct daemon {
     bool sc_on;
     sld_candump_t log;
     bool log_on;
+    bool log_error_logged;
     sl_gsusb_sink_t gs;
     bool gs_on;
     sl_can_sink_t sinks[3];
@@ -125,6 +126,7 @@ typedef struct daemon {
     uint8_t link_state;
     uint64_t last_status_mono;
     bool idle_status;           // send Status frames when no rotation does
+    uint64_t cap_next_due;      // capture: mono time the next message is due (0 = now)
     uint32_t status_frames, idle_status_frames, frames_out, rotations_seen;
     uint64_t next_stats_mono;
     uint64_t start_mono;
@@ -256,8 +258,13 @@ static void radar_on_msg(void *ctx, const sl_proto_msg_t *msg, uint64_t now_us)
     daemon_t *d = ctx;
     sl_pipeline_on_msg(&g_pipe, msg, now_us);
     if (msg->id == SL_PROTO_ID_FFT_DATA || msg->id == SL_PROTO_ID_FFT_DATA_16) {
-        d->last_fft_mono = now_us;
-        d->had_fft = true;
+        // Liveness is usable data, not the message id: a malformed or empty FFT message
+        // does not keep the link STREAMING.
+        sl_proto_fft_t f;
+        if (sl_proto_parse_fft(msg, &f) == SL_OK && f.bins > 0U) {
+            d->last_fft_mono = now_us;
+            d->had_fft = true;
+        }
     } else if (msg->id == SL_PROTO_ID_CONFIGURATION) {
         sl_proto_config_t c;
         if (sl_proto_parse_config(msg, &c) == SL_OK) {
@@ -265,9 +272,17 @@ static void radar_on_msg(void *ctx, const sl_proto_msg_t *msg, uint64_t now_us)
                     (unsigned)c.azimuths, (unsigned)c.range_bins, sl_proto_config_bin_size_um(&c),
                     (unsigned)(c.rotation_mhz / 1000U), (unsigned)(c.rotation_mhz % 1000U));
             if (c.azimuths != d->board->azimuths || c.encoder_size != d->board->encoder_size) {
-                sld_log(SLD_LOG_WARN, "radar geometry (%u azimuths, %u ticks) differs from board %s (%u, %u)",
+                sld_log(SLD_LOG_ERR, "radar geometry (%u azimuths, %u ticks) differs from board %s (%u, %u):"
+                        " every row is refused (Health CONFIG_MISMATCH)",
                         (unsigned)c.azimuths, (unsigned)c.encoder_size, d->board->name,
                         (unsigned)d->board->azimuths, (unsigned)d->board->encoder_size);
+            }
+            const uint32_t um = sl_proto_config_bin_size_um(&c);
+            const uint32_t bu = d->board->bin_size_um;
+            if ((uint64_t)(um > bu ? um - bu : bu - um) * 100U > bu) {
+                sld_log(SLD_LOG_ERR, "radar bin size %" PRIu32 " um differs from board %s (%" PRIu32
+                        " um) by more than 1 %%: ranges and leans are scaled wrong (Health "
+                        "RANGE_RESOLUTION_MISMATCH)", um, d->board->name, bu);
             }
         }
     }
@@ -288,6 +303,9 @@ static void radar_on_event(void *ctx, sl_radar_event_t ev, sl_radar_reason_t rea
     switch (ev) {
     case SL_RADAR_EV_CONNECTED:
         sld_log(SLD_LOG_INFO, "radar %s:%u connected", d->o.radar_host, (unsigned)d->o.radar_port);
+        if (c->stats.connects > 1U) {
+            sl_pipeline_add_reconnect(&g_pipe, now_us); // Health.Reconnects, LINK_FLAPPING
+        }
         break;
     case SL_RADAR_EV_CONFIG:
         d->stream_start_mono = now_us;
@@ -352,6 +370,9 @@ static int radar_setup(daemon_t *d)
     cfg.port = d->o.radar_port;
     cfg.connect_timeout_ms = d->o.connect_timeout_ms;
     cfg.silence_timeout_ms = d->o.silence_timeout_ms;
+    // Data watchdog: no usable FFT row for the silence timeout -> Start FFT again, then
+    // reconnect (keep-alives or a byte trickle no longer keep a blind link open).
+    cfg.data_timeout_ms = d->o.data_timeout_ms != 0 ? d->o.data_timeout_ms : d->o.silence_timeout_ms;
     cfg.non_contour = d->o.non_contour;
     cfg.reasm_buf = d->radar_reasm;
     cfg.reasm_size = reasm;
@@ -599,6 +620,10 @@ static uint64_t capture_step(daemon_t *d)
                     d->play_started = true;
                     d->play_wall0 = d->mono_us;
                     d->play_prev_t = m->t_us;
+                    // The idle-Status clock starts with the data, not with the set-up
+                    // (opening a gs_usb device in a slow VM took > 1 s: an idle Status
+                    // before the first rotation).
+                    d->last_status_mono = d->mono_us;
                 } else {
                     uint64_t dt = m->t_us > d->play_prev_t ? m->t_us - d->play_prev_t : 0;
                     if (dt > MAX_PLAY_GAP_US) {
@@ -755,6 +780,15 @@ static void log_stats(daemon_t *d, int level, const char *what)
             (unsigned)sl_track_max_level(&g_pipe.tracker), g_pipe.proto.stats.messages,
             g_pipe.proto.stats.resyncs, d->frames_out, d->status_frames, d->idle_status_frames,
             s->can_dropped, s->motion_accepted, s->motion_rejected);
+    if (s->can_rx != 0) {
+        const sl_can_e2e_rx_t *e2e = &g_pipe.motion_rx.e2e;
+        sld_log(level, "%s: VehicleMotion E2E: %" PRIu32 " accepted, %" PRIu32 " CRC errors, %" PRIu32
+                " repeated, %" PRIu32 " bad counter, %" PRIu32 " bad DLC, %" PRIu32 " counter jumps (%" PRIu32
+                " lost), %" PRIu32 " timeouts, %" PRIu32 " other ids",
+                what, e2e->stats.accepted, e2e->stats.crc_errors, e2e->stats.repeated, e2e->stats.bad_counter,
+                e2e->stats.bad_dlc, e2e->stats.counter_jumps, e2e->stats.lost_frames,
+                g_pipe.motion_rx.stats.timeouts, g_pipe.motion_rx.stats.other_ids);
+    }
     if (s->motion_set_calls != 0) {
         sld_log(SLD_LOG_DEBUG, "%s: motion setter (--motion): %" PRIu32 " calls", what, s->motion_set_calls);
     }
@@ -1021,6 +1055,7 @@ int main(int argc, char **argv)
             }
         } else if (!d->cap_done) {
             const uint64_t cap_due = capture_step(d);
+            d->cap_next_due = cap_due;
             if (cap_due == 0) {
                 wake = d->mono_us; // more to feed now: just look at the fds
             } else {
@@ -1056,7 +1091,14 @@ int main(int argc, char **argv)
         if (d->motion_on) {
             sld_motion_read(&d->motion, d->mono_us, on_motion_frame, d);
         }
-        if (d->is_radar) {
+        if (d->is_radar && d->o.exit_idle_ms != 0 && d->had_fft &&
+            d->mono_us >= d->last_fft_mono + (uint64_t)d->o.exit_idle_ms * 1000U) {
+            // Before the client's timers: a late wake-up stops with the link still open
+            // (Stop FFT is sent) rather than after a watchdog drop.
+            d->stop = true;
+            d->stop_why = "--exit-idle";
+        }
+        if (d->is_radar && !d->stop) {
             const short rev = rc > 0 ? fds[i_radar].revents : 0;
             sl_radar_client_handle(&d->radar, rev, d->mono_us);
             if (d->radar.state != d->last_radar_state) {
@@ -1073,15 +1115,22 @@ int main(int argc, char **argv)
                 d->link_state = ls;
                 sl_pipeline_set_link_state(&g_pipe, ls);
             }
-            if (d->o.exit_idle_ms != 0 && d->had_fft &&
-                d->mono_us >= d->last_fft_mono + (uint64_t)d->o.exit_idle_ms * 1000U) {
-                d->stop = true;
-                d->stop_why = "--exit-idle";
-            }
         }
         sl_can_sinks_poll(d->sinks, d->n_sinks, d->mono_us);
         report_sink_drops(d);
-        if (d->idle_status && d->mono_us >= d->last_status_mono + (uint64_t)d->o.status_period_ms * 1000U) {
+        if (d->log_on && d->log.stats.errors != 0U && !d->log_error_logged) {
+            d->log_error_logged = true;
+            sld_log(SLD_LOG_ERR, "--can-log %s: write failed: %s (frames are lost; Health "
+                    "CAN_OUTPUT_ERRORS)", d->o.can_log, strerror(d->log.last_errno));
+        }
+        // A capture replayed in real time is idle only when its next message is due later
+        // (a gap in the capture). When its data is due already, the daemon is behind
+        // schedule (descheduled under load): the data is fed next time round and the
+        // rotation's own Status follows; an idle Status here would be a timing artefact
+        // (the flaky "Status frame outside a rotation group" of daemon_gs_usb_output_in_vm).
+        const bool behind = !d->is_radar && (d->cap_next_due == 0 || d->cap_next_due <= d->mono_us);
+        if (d->idle_status && !behind &&
+            d->mono_us >= d->last_status_mono + (uint64_t)d->o.status_period_ms * 1000U) {
             send_idle_status(d);
         }
         if (d->mono_us >= d->next_stats_mono) {
@@ -1101,13 +1150,48 @@ int main(int argc, char **argv)
     } else if (!d->is_radar) {
         sld_log(SLD_LOG_INFO, "end of capture");
     }
+    if (!d->is_radar && (g_pipe.stats.rotations == 0U || sl_pipeline_faults(&g_pipe) != 0U)) {
+        // A capture that ends blind or faulty says so on CAN: one last Status + Health
+        // (a clean capture ends with its last rotation's frames, as before).
+        send_idle_status(d);
+    }
     const bool input_ok = d->is_radar || capture_report(d);
     shutdown_all(d);
+    // Exit status (README "Exit statuses"): 1 unreadable input, 4 an output could not be
+    // written (CAN log, targets), 3 capture mode without a usable rotation or with a
+    // configuration fault raised, 0 otherwise (2: bad options, before this point).
+    const bool log_failed = d->log_on && d->log.stats.errors != 0U;
+    if (log_failed) {
+        sld_log(SLD_LOG_ERR, "--can-log %s: %" PRIu32 " write errors (%s), %" PRIu32 " frames lost",
+                d->o.can_log, d->log.stats.errors, strerror(d->log.last_errno), d->log.stats.dropped);
+    }
+    const uint16_t cfg_faults = (uint16_t)(g_pipe.faults_seen | sl_pipeline_faults(&g_pipe)) &
+                                (uint16_t)(SL_CAN_FAULT_CONFIG_MISMATCH | SL_CAN_FAULT_RANGE_RESOLUTION_MISMATCH);
+    int exit_rc = 0;
+    if (!input_ok) {
+        exit_rc = 1;
+    } else if (log_failed || d->targets_failed) {
+        exit_rc = 4;
+    } else if (!d->is_radar && (g_pipe.stats.rotations == 0U || cfg_faults != 0U)) {
+        if ((cfg_faults & SL_CAN_FAULT_CONFIG_MISMATCH) != 0U) {
+            sld_log(SLD_LOG_ERR, "input %s: the radar's geometry (azimuths / encoder size) differs from "
+                    "board %s: %" PRIu32 " rows refused", d->o.capture, d->board->name, g_pipe.stats.rows_dropped);
+        }
+        if ((cfg_faults & SL_CAN_FAULT_RANGE_RESOLUTION_MISMATCH) != 0U) {
+            sld_log(SLD_LOG_ERR, "input %s: radar bin size %" PRIu32 " um differs from board %s (%" PRIu32
+                    " um) by more than 1 %%", d->o.capture, g_pipe.radar_bin_um, d->board->name,
+                    d->board->bin_size_um);
+        }
+        if (g_pipe.stats.rotations == 0U) {
+            sld_log(SLD_LOG_ERR, "input %s: no usable rotation", d->o.capture);
+        }
+        exit_rc = 3;
+    }
     sl_port_capture_close(d->cr);
     free(d->ix);
     free(d->lead);
     free(d->pacer_reasm);
     free(d->radar_reasm);
     sld_log_close();
-    return input_ok ? 0 : 1;
+    return exit_rc;
 }

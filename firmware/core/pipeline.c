@@ -45,6 +45,7 @@ void sl_pipeline_cfg_default(sl_pipeline_cfg_t *cfg, const sl_board_t *board)
     cfg->motion_budget_um = board != NULL ? board->bin_size_um : 43800U;
     cfg->motion_timeout_us = 500000U;
     cfg->rotation_us = 250000U;
+    cfg->row_timeout_us = 1000000U;
 }
 
 uint8_t sl_pipeline_window(uint8_t n, uint8_t min_frames, int32_t speed_mm_s,
@@ -100,15 +101,55 @@ static bool motion_now(const sl_pipeline_t *p, uint64_t now_us, sl_can_vehicle_m
 
 // ------------------------------------------------------------------------------- output
 
-static void can_send(sl_pipeline_t *p, const sl_can_frame_t *f)
+// Hard output ceiling (sl_can.h): two token buckets on the port's clock, one for
+// PoleLean/LeanWarning, one for Status/Health: refilled at SL_CAN_MAX_*_FRAMES_PER_100MS per
+// 100 ms, holding at most SL_CAN_BURST_WINDOWS times that (a backlog after a stall). A frame
+// without a token is withheld, counted and flagged (CAN_RATE_LIMITED). Tokens in 1/1000.
+static bool can_budget(sl_pipeline_t *p, bool status, uint32_t frames)
 {
-    if (p->cfg.port.can_tx == NULL) {
-        return;
+    uint32_t *tokens = status ? &p->can_tokens_status : &p->can_tokens_data;
+    if (!p->can_clock_set) {
+        p->can_clock_set = true;
+        p->can_tokens_data = SL_CAN_MAX_DATA_FRAMES_PER_100MS * SL_CAN_BURST_WINDOWS * 1000U;
+        p->can_tokens_status = SL_CAN_MAX_STATUS_FRAMES_PER_100MS * SL_CAN_BURST_WINDOWS * 1000U;
+        p->can_clock_us = p->now_us;
     }
+    if (p->now_us > p->can_clock_us) {
+        const uint64_t dt = p->now_us - p->can_clock_us;
+        // rate frames per 100,000 us = rate / 100 milli-frames per us; both buckets.
+        const uint64_t add_d = dt * SL_CAN_MAX_DATA_FRAMES_PER_100MS / 100U;
+        const uint64_t add_s = dt * SL_CAN_MAX_STATUS_FRAMES_PER_100MS / 100U;
+        const uint64_t cap_d = (uint64_t)SL_CAN_MAX_DATA_FRAMES_PER_100MS * SL_CAN_BURST_WINDOWS * 1000U;
+        const uint64_t cap_s = (uint64_t)SL_CAN_MAX_STATUS_FRAMES_PER_100MS * SL_CAN_BURST_WINDOWS * 1000U;
+        const uint64_t td = p->can_tokens_data + add_d;
+        const uint64_t ts = p->can_tokens_status + add_s;
+        p->can_tokens_data = (uint32_t)(td > cap_d ? cap_d : td);
+        p->can_tokens_status = (uint32_t)(ts > cap_s ? cap_s : ts);
+    }
+    p->can_clock_us = p->now_us; // a clock going backwards refills nothing
+    if (*tokens < frames * 1000U) {
+        p->stats.can_rate_limited += frames;
+        p->fault_latched |= (uint16_t)SL_CAN_FAULT_CAN_RATE_LIMITED;
+        return false;
+    }
+    *tokens -= frames * 1000U;
+    return true;
+}
+
+// One frame to the port (budget already taken).
+static void can_out(sl_pipeline_t *p, const sl_can_frame_t *f)
+{
     if (p->cfg.port.can_tx(p->cfg.port.ctx, f) == SL_OK) {
         p->stats.can_frames++;
     } else {
         p->stats.can_dropped++; // SL_ERR_BUSY or a port error: never retried, never blocks
+    }
+}
+
+static void can_send(sl_pipeline_t *p, const sl_can_frame_t *f)
+{
+    if (p->cfg.port.can_tx != NULL && can_budget(p, false, 1U)) {
+        can_out(p, f);
     }
 }
 
@@ -130,19 +171,114 @@ static uint8_t quality_of(const sl_track_t *t)
     }
 }
 
-// One Status frame with the current counters and link state (rotation or idle).
+// A usable row arrived within cfg.row_timeout_us of now.
+static bool rows_fresh(const sl_pipeline_t *p)
+{
+    return p->have_row && p->now_us >= p->last_row_us &&
+           p->now_us - p->last_row_us <= (uint64_t)p->cfg.row_timeout_us;
+}
+
+// Reconnects within the flapping window at `now`.
+static bool flapping(const sl_pipeline_t *p)
+{
+    if (p->stats.reconnects < SL_CAN_FLAP_RECONNECTS) {
+        return false;
+    }
+    // The oldest of the last SL_CAN_FLAP_RECONNECTS reconnect times.
+    const uint64_t oldest = p->reconnect_t_us[p->reconnect_next % SL_CAN_FLAP_RECONNECTS];
+    return p->now_us >= oldest && p->now_us - oldest <= (uint64_t)SL_CAN_FLAP_WINDOW_MS * 1000U;
+}
+
+uint16_t sl_pipeline_faults(const sl_pipeline_t *p)
+{
+    if (p == NULL) {
+        return 0U;
+    }
+    uint16_t f = p->fault_latched;
+    if (p->geometry_bad) {
+        f |= (uint16_t)SL_CAN_FAULT_CONFIG_MISMATCH;
+    }
+    if (p->bin_size_bad) {
+        f |= (uint16_t)SL_CAN_FAULT_RANGE_RESOLUTION_MISMATCH;
+    }
+    const bool connected = p->link_state == (uint8_t)SL_CAN_LINK_STREAMING ||
+                           p->link_state == (uint8_t)SL_CAN_LINK_SILENT ||
+                           p->link_state == (uint8_t)SL_CAN_LINK_WAIT_CONFIG;
+    const bool fft_seen = p->scan.stats.fft != p->snap.fft;
+    if (!rows_fresh(p) && (connected || fft_seen)) {
+        f |= (uint16_t)SL_CAN_FAULT_NO_USABLE_ROWS;
+    }
+    if (p->proto.stats.resyncs != p->snap.resyncs || p->scan.stats.malformed != p->snap.malformed ||
+        p->scan.stats.bad_azimuth != p->snap.bad_azimuth ||
+        p->scan.stats.empty_rows != p->snap.empty_rows) {
+        f |= (uint16_t)SL_CAN_FAULT_MALFORMED_DATA;
+    }
+    if (p->stats.can_dropped != p->snap.can_dropped) {
+        f |= (uint16_t)SL_CAN_FAULT_CAN_OUTPUT_ERRORS;
+    }
+    if (p->scan.stats.disorder != p->snap.disorder) {
+        f |= (uint16_t)SL_CAN_FAULT_AZIMUTH_DISORDER;
+    }
+    if (p->detect.stats.target_overflow != p->snap.target_overflow) {
+        f |= (uint16_t)SL_CAN_FAULT_TARGET_SLOTS_OVERFLOW;
+    }
+    if (flapping(p)) {
+        f |= (uint16_t)SL_CAN_FAULT_LINK_FLAPPING;
+    }
+    return f;
+}
+
+// One Status frame with the current counters and link state (rotation or idle), then one
+// Health frame. The link state sent is STREAMING only while usable rows arrive: a port
+// that says STREAMING without a usable row since the previous Status is reported SILENT.
 static void emit_status(sl_pipeline_t *p)
 {
+    uint8_t link = p->link_state;
+    if (link == (uint8_t)SL_CAN_LINK_STREAMING && p->rows_since_status == 0U && !rows_fresh(p)) {
+        link = (uint8_t)SL_CAN_LINK_SILENT;
+    }
+    p->rows_since_status = 0U;
     const sl_can_status_t st = {
-        .link_state = p->link_state,
+        .link_state = link,
         .rotations = p->stats.rotations,
         .azimuths_missing = p->stats.azimuths_missing,
         .decoder_resyncs = p->decoder_stats->resyncs,
         .can_dropped = p->stats.can_dropped,
     };
+    // Status and its Health pass the ceiling together (a Health never goes missing alone).
+    const bool send = p->cfg.port.can_tx != NULL && can_budget(p, true, 2U);
     sl_can_frame_t f;
-    if (sl_can_encode_status(&p->can, &st, &f) == SL_OK) {
-        can_send(p, &f);
+    if (sl_can_encode_status(&p->can, &st, &f) == SL_OK && send) {
+        can_out(p, &f);
+    }
+    const uint16_t faults = sl_pipeline_faults(p);
+    const sl_can_health_t h = {
+        .fault = faults,
+        .reconnects = p->stats.reconnects,
+        .candidates_dropped = p->detect.stats.target_overflow,
+    };
+    p->faults_seen |= faults;
+    sl_can_frame_t hf;
+    const bool hok = sl_can_encode_health(&p->can, &h, &hf) == SL_OK; // counter advances
+    if (!send) {
+        return; // withheld by the ceiling: the next Health that goes out reports all of it
+    }
+    p->last_faults = faults;
+    // The next Health reports what happens from now on, including the fate of this Health
+    // frame itself (a refusal counts as a CAN output error next time); persistent faults
+    // are re-derived each time.
+    p->fault_latched = 0U;
+    p->rows_since_health = 0U;
+    p->snap.fft = p->scan.stats.fft;
+    p->snap.resyncs = p->proto.stats.resyncs;
+    p->snap.malformed = p->scan.stats.malformed;
+    p->snap.bad_azimuth = p->scan.stats.bad_azimuth;
+    p->snap.empty_rows = p->scan.stats.empty_rows;
+    p->snap.can_dropped = p->stats.can_dropped;
+    p->snap.disorder = p->scan.stats.disorder;
+    p->snap.target_overflow = p->detect.stats.target_overflow;
+    if (hok) {
+        can_out(p, &hf);
     }
 }
 
@@ -259,6 +395,10 @@ static void on_row(void *ctx, const sl_scan_row_t *row)
         begin_rotation(p);
     }
     p->stats.azimuths++;
+    p->rows_since_status++;
+    p->rows_since_health++;
+    p->last_row_us = p->now_us;
+    p->have_row = true;
     sl_thresh_u8(row->power, p->mask_bins, p->cfg.threshold, p->bits);
     if (row->idx >= p->next_az) {
         if (row->idx > p->next_az) {
@@ -289,6 +429,13 @@ static void measure_period(sl_pipeline_t *p, const sl_scan_rot_t *rot)
 static void on_rot(void *ctx, const sl_scan_rot_t *rot)
 {
     sl_pipeline_t *p = ctx;
+    if (p->in_rotation == 0U && p->geometry_bad) {
+        // Every row of this rotation was refused (configuration mismatch): nothing was
+        // seen, so it is not a processed rotation; all its azimuths are missing.
+        p->stats.azimuths_missing += rot->azimuths;
+        p->stats.refused_rotations++;
+        return;
+    }
     if (p->in_rotation == 0U) {
         begin_rotation(p); // cannot happen (a rotation has a row); keeps the state sane
     }
@@ -343,6 +490,39 @@ static void on_rot(void *ctx, const sl_scan_rot_t *rot)
     p->in_rotation = 0U;
 }
 
+// Ranges from the radar's own bin size: detection runs on a copy of the board whose
+// bin size (and near-exclusion band, in bins) is the radar's; the shadow geometry is in
+// micrometres, so detection's per-azimuth windows follow. Re-initialising detection drops
+// the rotation's open candidates (a Configuration means a (re)start). When the radar's
+// bins are so small that detection would need more bins than are masked, the board's
+// bin size is kept (RANGE_RESOLUTION_MISMATCH stays raised) rather than cutting the shadow.
+static void use_bin_size(sl_pipeline_t *p, uint32_t um)
+{
+    if (um == 0U || um == p->det_board.bin_size_um) {
+        return;
+    }
+    const sl_board_t *b = p->board;
+    sl_board_t nb = *b;
+    nb.bin_size_um = um;
+    const uint64_t near_um = (uint64_t)b->near_exclusion_bins * b->bin_size_um;
+    const uint64_t near = (near_um + um - 1U) / um;
+    nb.near_exclusion_bins = (uint16_t)(near > nb.roi_bins ? nb.roi_bins : near);
+    nb.shadow_bins = NULL; // in the board's bins; detection uses shadow_um
+    if (b->shadow_um == NULL) {
+        return; // no micrometre shadow table: cannot move to other bins
+    }
+    const sl_board_t keep = p->det_board;
+    p->det_board = nb;
+    if (sl_detect_init(&p->detect, &p->det_board, &p->cfg.detect) != SL_OK ||
+        sl_detect_bins_needed(&p->detect) > p->mask_bins) {
+        p->det_board = keep;
+        (void)sl_detect_init(&p->detect, &p->det_board, &p->cfg.detect);
+        p->stats.bin_size_unserved++;
+        return;
+    }
+    p->stats.bin_size_changes++;
+}
+
 static void on_msg(void *ctx, const sl_proto_msg_t *m)
 {
     sl_pipeline_t *p = ctx;
@@ -351,7 +531,34 @@ static void on_msg(void *ctx, const sl_proto_msg_t *m)
     }
     const uint32_t rejected = p->scan.stats.config_rejected;
     const uint32_t accepted = p->scan.stats.configs;
+    const uint32_t blind = p->scan.stats.blind_rotations;
     (void)sl_scan_on_msg(&p->scan, m);
+    if (p->scan.stats.blind_rotations != blind) {
+        // A rotation's worth of FFT messages gave no row: its azimuths are missing.
+        const uint32_t add = (p->scan.stats.blind_rotations - blind) * (uint32_t)p->board->azimuths;
+        p->stats.azimuths_missing = (add > UINT32_MAX - p->stats.azimuths_missing)
+                                        ? UINT32_MAX
+                                        : p->stats.azimuths_missing + add;
+        p->stats.blind_rotations += p->scan.stats.blind_rotations - blind;
+    }
+    if (m->id == (uint8_t)SL_PROTO_ID_CONFIGURATION) {
+        sl_proto_config_t c;
+        if (sl_proto_parse_config(m, &c) == SL_OK) {
+            // The board's bin size is the expected one; > 1 % off is flagged (ranges and
+            // leans would be scaled wrong by that much).
+            const uint32_t um = sl_proto_config_bin_size_um(&c);
+            const uint64_t b = p->board->bin_size_um;
+            const uint64_t diff = (um > b) ? um - b : b - um;
+            p->radar_bin_um = um;
+            p->bin_size_bad = um == 0U || diff * 100U > b;
+            if (p->bin_size_bad) {
+                p->stats.bin_size_mismatch++;
+                set_err(p, SL_ERR_RANGE, (uint8_t)SL_PIPELINE_OK,
+                        "radar bin size differs from the board's by more than 1 %");
+            }
+            use_bin_size(p, um);
+        }
+    }
     if (p->scan.stats.config_rejected != rejected) {
         // Rows of this radar would be mapped with the board's geometry: drop them until a
         // matching Configuration arrives.
@@ -404,7 +611,8 @@ sl_err_t sl_pipeline_init(sl_pipeline_t *p, const sl_board_t *board,
                 "board roi_bins exceed SL_CFG_ROI_BINS");
         return SL_ERR_RANGE;
     }
-    sl_err_t e = sl_detect_init(&p->detect, board, &c->detect);
+    p->det_board = *board;
+    sl_err_t e = sl_detect_init(&p->detect, &p->det_board, &c->detect);
     if (e != SL_OK) {
         set_err(p, e, (uint8_t)SL_PIPELINE_STAGE_INIT, "sl_detect_init rejected the board");
         return e;
@@ -476,6 +684,9 @@ sl_err_t sl_pipeline_init(sl_pipeline_t *p, const sl_board_t *board,
         return e;
     }
     p->rotation_us = c->rotation_us != 0U ? c->rotation_us : 250000U;
+    if (p->cfg.row_timeout_us == 0U) {
+        p->cfg.row_timeout_us = 1000000U;
+    }
     p->frames_eff = c->mask_frames;
     p->link_state = (uint8_t)SL_CAN_LINK_DISCONNECTED;
     p->ready = true;
@@ -562,6 +773,17 @@ sl_err_t sl_pipeline_send_status(sl_pipeline_t *p, uint64_t now_us)
     p->now_us = now_us;
     emit_status(p);
     return SL_OK;
+}
+
+void sl_pipeline_add_reconnect(sl_pipeline_t *p, uint64_t now_us)
+{
+    SL_ASSERT(p != NULL);
+    if (p->stats.reconnects != UINT32_MAX) {
+        p->stats.reconnects++;
+    }
+    p->reconnect_t_us[p->reconnect_next % SL_CAN_FLAP_RECONNECTS] = now_us;
+    p->reconnect_next = (uint8_t)((p->reconnect_next + 1U) % SL_CAN_FLAP_RECONNECTS);
+    p->now_us = now_us;
 }
 
 void sl_pipeline_add_can_dropped(sl_pipeline_t *p, uint32_t n)

@@ -57,6 +57,65 @@ static inline void prefetch_ahead(const sl_proto_t *p, const uint8_t *data, size
     }
 }
 
+// Horspool bad-character shift on the last byte of a 16-byte window: 15 - (last position of
+// the byte among signature bytes 0..14), 16 for a byte not in the signature.
+static const uint8_t sig_shift[256] = {
+    15, 14, 16, 12, 16, 16, 16, 10, 16, 16, 16, 16, 16, 16, 16,  8,
+    16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16,  6,
+    16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16,
+    16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16,  4,
+    16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16,
+    16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16,
+    16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16,
+    16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16,  2,
+    16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16,
+    16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16,
+    16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16,
+    16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16,
+    16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16,
+    16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16,
+    16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16,
+    16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16,  1, 16,
+};
+
+// First position s >= from at which a whole signature lies in d[0..len), or, when there is
+// none, the first position at which one could still begin (a partial signature at the end,
+// s >= len - 15, or s == from when fewer than 16 bytes remain); *found tells which.
+// Horspool over 16-byte windows keyed on the window's last byte: zero fill advances 15
+// bytes per step, bytes not in the signature 16; a window ending in 0xFE is also keyed on
+// its byte 13 (a run of 0xFE advances 14). Each step is O(1): the full compare runs only
+// when the window ends in 7F FE and starts with 0x00.
+static size_t sig_search(const uint8_t *d, size_t from, size_t len, bool *found)
+{
+    size_t s = from;
+    if (len - from >= SL_PROTO_SIGNATURE_BYTES) {
+        const size_t last = len - SL_PROTO_SIGNATURE_BYTES;
+        while (s <= last) {
+            const uint8_t b = d[s + (SL_PROTO_SIGNATURE_BYTES - 1U)];
+            if (b != 0xFEU) {
+                s += sig_shift[b];
+                continue;
+            }
+            // Last byte matches: key on byte 13 (0x7F in a signature) as well. Shifted by
+            // k >= 1 it would sit at signature index 13 - k <= 12: 0xFE never does (skip
+            // 14), 0x7F at 12 (skip 1), any other byte as the last-byte table less 2.
+            const uint8_t c = d[s + 13U];
+            if (c == 0x7FU) {
+                if (d[s] == 0x00U &&
+                    memcmp(d + s + 1U, sl_proto_signature + 1U, SL_PROTO_SIGNATURE_BYTES - 2U) == 0) {
+                    *found = true;
+                    return s;
+                }
+                s += 1U;
+            } else {
+                s += (c == 0xFEU) ? 14U : (size_t)sig_shift[c] - 2U;
+            }
+        }
+    }
+    *found = false;
+    return s;
+}
+
 static void skip(sl_proto_t *p, uint64_t n)
 {
     if (n != 0U) {
@@ -202,19 +261,24 @@ sl_err_t sl_proto_feed(sl_proto_t *p, const uint8_t *data, size_t len, uint64_t 
     p->stats.bytes_in += len;
     size_t i = 0;
     while (i < len) {
-        if (p->state == ST_SIG && p->sig_got == 0U) {
-            // Fast scan over junk: a signature can only start at 0x00.
-            size_t j = i;
-            while (j < len && data[j] != 0x00U) {
-                j++;
-            }
+        if (p->state == ST_SIG && p->sig_got <= i && len - (i - p->sig_got) >= SL_PROTO_SIGNATURE_BYTES) {
+            // Fast resync. A held partial signature that lies in this chunk is given back
+            // (it is re-examined as part of a window), then the Horspool search rules out
+            // every start position before the next whole signature. The rewind happens
+            // only while 16 bytes remain, and the search then either finds a signature
+            // (state leaves ST_SIG or a message is delivered) or leaves i >= len - 15, so
+            // it cannot repeat without progress.
+            i -= p->sig_got;
+            p->sig_got = 0;
+            bool found;
+            const size_t j = sig_search(data, i, len, &found);
             skip(p, j - i);
             i = j;
-            if (i == len) {
-                break;
-            }
-            if (len - i >= SL_PROTO_HEADER_BYTES &&
-                memcmp(data + i, sl_proto_signature, SL_PROTO_SIGNATURE_BYTES) == 0) {
+            if (!found) {
+                if (i == len) {
+                    break;
+                }
+            } else if (len - i >= SL_PROTO_HEADER_BYTES) {
                 const uint8_t *tail = data + i + SL_PROTO_SIGNATURE_BYTES;
                 if (check_header(p, tail) != HDR_OK) {
                     // Same as the slow path: drop the signature's first byte, rescan after it.
@@ -236,6 +300,13 @@ sl_err_t sl_proto_feed(sl_proto_t *p, const uint8_t *data, size_t len, uint64_t 
                     p->state = ST_PAY;
                     p->payload_got = 0;
                 }
+                continue;
+            } else {
+                // Whole signature, header tail beyond this chunk: as if matched bytewise.
+                i += SL_PROTO_SIGNATURE_BYTES;
+                p->state = ST_HDR;
+                p->sig_got = (uint8_t)SL_PROTO_SIGNATURE_BYTES;
+                p->hdr_got = 0;
                 continue;
             }
         }
@@ -468,10 +539,13 @@ sl_err_t sl_proto_parse_fft(const sl_proto_msg_t *msg, sl_proto_fft_t *out)
         return SL_ERR_MALFORMED;
     }
     const uint8_t bpb = (msg->id == SL_PROTO_ID_FFT_DATA_16) ? 2U : 1U;
-    const size_t nbytes = size - off;
-    if ((nbytes % bpb) != 0U) {
+    // Parity of the message as sent, not of the prefix kept: an odd-length 16-bit message
+    // is malformed whatever the reassembly size it was truncated to.
+    const size_t wire = (msg->truncated && msg->wire_bytes > size) ? msg->wire_bytes : size;
+    if (((wire - off) % bpb) != 0U) {
         return SL_ERR_MALFORMED;
     }
+    const size_t nbytes = (size - off) - ((size - off) % bpb);
     out->id = msg->id;
     out->bytes_per_bin = bpb;
     out->data_offset = off;

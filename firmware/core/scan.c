@@ -334,6 +334,23 @@ static void duplicate(sl_scan_t *s, uint16_t idx)
     }
 }
 
+// An FFT message that gave no row (encoder value out of range, no bins, malformed). A
+// whole rotation's worth of them in a row is a rotation the radar sent and nobody saw:
+// its azimuths count as missing (stats.missing, stats.blind_rotations) even though no frame
+// was opened for it.
+static void unusable(sl_scan_t *s)
+{
+    if (s->azimuths == 0U) {
+        return;
+    }
+    s->unusable_run++;
+    if (s->unusable_run >= s->azimuths) {
+        s->unusable_run = 0;
+        s->stats.blind_rotations++;
+        s->stats.missing += s->azimuths;
+    }
+}
+
 sl_err_t sl_scan_on_fft(sl_scan_t *s, const sl_proto_fft_t *f)
 {
     if (s == NULL || f == NULL || (f->bytes_per_bin != 1U && f->bytes_per_bin != 2U) ||
@@ -348,10 +365,17 @@ sl_err_t sl_scan_on_fft(sl_scan_t *s, const sl_proto_fft_t *f)
     const int32_t sidx = sl_scan_az_index(s->azimuths, s->encoder_size, f->azimuth_ticks);
     if (sidx < 0) {
         s->stats.bad_azimuth++;
+        unusable(s);
         return SL_ERR_RANGE;
     }
     const uint16_t idx = (uint16_t)sidx;
     const uint16_t n = s->azimuths;
+    if (f->bins == 0U) {
+        s->stats.empty_rows++; // no range bin: not an azimuth (it stays missing)
+        unusable(s);
+        return SL_ERR_MALFORMED;
+    }
+    s->unusable_run = 0;
     if (s->have_sweep && f->sweep_counter != (uint16_t)(s->last_sweep + 1U)) {
         s->stats.sweep_gaps++;
     }
@@ -362,29 +386,62 @@ sl_err_t sl_scan_on_fft(sl_scan_t *s, const sl_proto_fft_t *f)
         sl_scan_rot_t *fr = &s->rot;
         const uint16_t du = (uint16_t)(f->sweep_counter - fr->head_sweep);
         const int32_t dsweep = (du < 0x8000U) ? (int32_t)du : (int32_t)du - 0x10000;
-        if (!s->cfg.ignore_sweep && dsweep >= (int32_t)n) {
+        const bool sweep = !s->cfg.ignore_sweep;
+        if (sweep && dsweep >= (int32_t)n) {
             frame_complete(s, SL_SCAN_END_SWEEP_GAP);
         } else {
             const uint16_t head = fr->head;
             const uint32_t fwd = (idx >= head) ? (uint32_t)idx - head : (uint32_t)idx + n - head;
+            const bool filled = (fr->flags[idx] & SL_SCAN_AZ_VALID) != 0U;
+            // Sent more than half a rotation of messages after the head (sweep counters
+            // usable): a message for an already stored azimuth is then the next rotation's,
+            // not a duplicate (a jittered encoder value one message later stays a duplicate).
+            const bool newer = sweep && dsweep > (int32_t)(n / 2U);
             if (fwd == 0U) {
-                duplicate(s, idx);
-                return SL_OK;
-            }
-            if (fwd >= (uint32_t)(n - s->window)) {
-                // A small step backwards: a late message.
+                if (!newer) {
+                    duplicate(s, idx);
+                    return SL_OK;
+                }
+                frame_complete(s, SL_SCAN_END_WRAP);
+            } else if (fwd >= (uint32_t)(n - s->window) && !(idx > head && sweep && dsweep > 0)) {
+                // A small step backwards: a late message. (Just above the head but sent after
+                // it, by the sweep counters, it is this rotation's: a forward step below.)
                 if (idx > head) {
                     s->stats.late_dropped++; // its rotation was already completed
-                } else if ((fr->flags[idx] & SL_SCAN_AZ_VALID) != 0U) {
-                    duplicate(s, idx);
-                } else {
+                    return SL_OK;
+                }
+                if (!filled) {
                     fr->stats.out_of_order++;
                     s->stats.out_of_order++;
+                    s->behind_head++;
                     store(s, f, idx, SL_SCAN_AZ_LATE); // syncs the frame's stats
+                    return SL_OK;
                 }
-                return SL_OK;
-            }
-            if (idx < head) {
+                if (!newer) {
+                    duplicate(s, idx);
+                    return SL_OK;
+                }
+                frame_complete(s, SL_SCAN_END_WRAP);
+            } else if (idx < head) {
+                // A step back beyond the reorder window. It starts the next rotation when
+                // the sweep counters moved forward by about `fwd` messages (in order across
+                // index 0, with or without a gap), or when this azimuth was already stored
+                // in this rotation (whatever the sweep counter says: it restarts with the
+                // radar).
+                // Otherwise it is DISORDER: stored into its empty slot and counted, and the
+                // rotation stays open (a shuffled rotation is one rotation, not many).
+                // (Only when at most W rows were stored behind the head since it was set:
+                // a reversed rotation matches the sweep arithmetic half way round.)
+                const bool wrap_by_sweep = sweep && dsweep > 0 && s->behind_head <= s->window &&
+                                           (uint32_t)dsweep + s->window >= fwd &&
+                                           (uint32_t)dsweep <= fwd + s->window;
+                if (!wrap_by_sweep && !filled) {
+                    fr->stats.disorder++;
+                    s->stats.disorder++;
+                    s->behind_head++;
+                    store(s, f, idx, SL_SCAN_AZ_LATE);
+                    return SL_OK;
+                }
                 frame_complete(s, SL_SCAN_END_WRAP);
             }
         }
@@ -394,6 +451,7 @@ sl_err_t sl_scan_on_fft(sl_scan_t *s, const sl_proto_fft_t *f)
     }
     s->rot.head = idx;
     s->rot.head_sweep = f->sweep_counter;
+    s->behind_head = 0;
     store(s, f, idx, 0);
     return SL_OK;
 }
@@ -417,6 +475,7 @@ sl_err_t sl_scan_on_msg(sl_scan_t *s, const sl_proto_msg_t *msg)
         sl_proto_fft_t f;
         if (sl_proto_parse_fft(msg, &f) != SL_OK) {
             s->stats.malformed++;
+            unusable(s);
             return SL_ERR_MALFORMED;
         }
         return sl_scan_on_fft(s, &f);

@@ -21,7 +21,7 @@
 namespace sl {
 
 struct OxfordOptions {
-    double bin_size_m = 0.0438;   ///< written as round(m * 10000) in 0.1 mm units + protobuf
+    double bin_size_m = 0.0432;   ///< Oxford SDK value (boards/robotcar-leaf); written as round(m * 10000) in 0.1 mm units + protobuf
     uint16_t encoder_size = 5600;
     uint16_t rotation_mhz = 4000;
     uint16_t packet_rate = 1600;

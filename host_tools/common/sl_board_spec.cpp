@@ -46,7 +46,7 @@ const std::set<std::string> kKnown = {
     "detect.range_sigma_m", "detect.theta_sigma_deg", "detect.caution_lean_deg",
     "detect.danger_lean_deg", "detect.track_timeout_s", "detect.elongation",
     "can.bitrate", "can.id_pole_lean", "can.id_lean_warning", "can.id_status",
-    "can.id_vehicle_motion",
+    "can.id_vehicle_motion", "can.id_health",
 };
 
 class Reader {
@@ -296,7 +296,8 @@ BoardSpec load_board(const std::string &name_or_path)
     }
     b.near_exclusion_m = r.real("roi.near_exclusion_m", 0, 20);
 
-    b.threshold = static_cast<int>(r.integer("detect.threshold", 1, 65535));
+    // Rows are 8-bit power (16-bit data is reduced to 8 bits first): 1..255.
+    b.threshold = static_cast<int>(r.integer("detect.threshold", 1, 255));
     b.mask_frames = static_cast<int>(r.integer("detect.mask_frames", 1, SL_CFG_MASK_FRAMES_MAX));
     b.max_targets = static_cast<int>(r.integer("detect.max_targets", 1, SL_CFG_MAX_TARGETS));
     b.pole_radius_m = r.real("detect.pole_radius_m", 0, 1, 0.0);
@@ -330,10 +331,14 @@ BoardSpec load_board(const std::string &name_or_path)
     b.can_id_lean_warning = can_id("can.id_lean_warning", 0x621);
     b.can_id_status = can_id("can.id_status", 0x622);
     b.can_id_vehicle_motion = can_id("can.id_vehicle_motion", 0x300);
+    if (!r.has("can.id_health")) {
+        r.fail("can.id_health", "missing (required: the Health message's CAN id, e.g. 0x623)");
+    }
+    b.can_id_health = can_id("can.id_health", 0x623);
     const std::set<unsigned> ids = {b.can_id_pole_lean, b.can_id_lean_warning, b.can_id_status,
-                                    b.can_id_vehicle_motion};
-    if (ids.size() != 4U) {
-        r.fail("can", "the four CAN ids must differ");
+                                    b.can_id_vehicle_motion, b.can_id_health};
+    if (ids.size() != 5U) {
+        r.fail("can", "the five CAN ids must differ");
     }
 
     for (int i = 0; i < b.azimuths; i++) {

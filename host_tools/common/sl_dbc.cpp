@@ -94,6 +94,10 @@ const std::map<std::string, std::string> kMessageComments = {
                "and stop at their maximum (Saturated = 1)."},
     {"VehicleMotion", "Input from the vehicle for the motion-aware masks: speed and yaw "
                       "rate with E2E protection; CRC errors and counter jumps are counted."},
+    {"Health", "Sent right after every Status: why the output may be degraded or blind. "
+               "Any Fault bit set means do not trust an absent warning. A bit is set when "
+               "its condition held since the previous Health frame or still holds. "
+               "Data ID 0x54 is also VehicleMotion's (opposite direction); ids tell them apart."},
 };
 
 // key "Message.Signal"
@@ -128,6 +132,19 @@ const std::map<std::string, std::string> kSignalComments = {
     {"Status.AzimuthsMissing", "Azimuths lost in gaps of the radar stream (saturating)."},
     {"Status.DecoderResyncs", "Radar stream decoder resynchronisations (saturating)."},
     {"Status.CanDropped", "CAN frames the module's CAN outputs dropped (saturating)."},
+    {"Health.Fault",
+     "Bitfield; the value table names each bit's value: 1 CONFIG_MISMATCH (radar azimuths or "
+     "encoder size differ from the board: every row refused), 2 NO_USABLE_ROWS (link up, no "
+     "usable FFT row), 4 MALFORMED_DATA (malformed messages, resyncs, empty rows, encoder "
+     "values out of range), 8 LINK_FLAPPING (3 reconnects within 30 s), 16 CAN_OUTPUT_ERRORS "
+     "(frames dropped by the CAN outputs), 32 RANGE_RESOLUTION_MISMATCH (radar bin size "
+     "differs from the board's by more than 1 %), 64 AZIMUTH_DISORDER (azimuths stepped back "
+     "beyond the reorder window), 128 CAN_RATE_LIMITED (frames withheld by the output "
+     "ceiling), 256 TARGET_SLOTS_OVERFLOW (more candidates than target slots). Bits 9..15 "
+     "reserved (0)."},
+    {"Health.Reconnects", "Radar link reconnects since start (saturating at 255)."},
+    {"Health.CandidatesDropped", "Detection candidates dropped for lack of target slots since "
+                                 "start (saturating at 4095)."},
     {"VehicleMotion.SpeedValid", "1: Speed is valid."},
     {"VehicleMotion.YawRateValid", "1: YawRate is valid."},
     {"VehicleMotion.Speed", "Vehicle speed over ground; positive forward."},
@@ -172,6 +189,8 @@ uint32_t board_id(const BoardSpec &b, sl_can_msg_t m)
         return b.can_id_status;
     case SL_CAN_MSG_VEHICLE_MOTION:
         return b.can_id_vehicle_motion;
+    case SL_CAN_MSG_HEALTH:
+        return b.can_id_health;
     case SL_CAN_MSG_COUNT:
         break;
     }

@@ -25,6 +25,15 @@ struct ServeOptions {
     uint64_t close_after = 0;        ///< close a connection after N FFT messages (0 = off)
     uint64_t stall_after = 0;        ///< go silent on a connection after N FFT messages
     uint32_t max_gap_ms = 1000;      ///< realtime: longer timestamp gaps are shortened to this
+    // Fault injection (each recovery of the client has a test: tests/daemon/faults.sh)
+    uint64_t cut_after = 0;          ///< after N FFT messages: half a message, then close
+    bool cut_rst = false;            ///< ... with a TCP RST (SO_LINGER 0) instead of FIN
+    bool keepalive_only = false;     ///< accept Start FFT but never send FFT data
+    uint32_t trickle_bps = 0;        ///< send at most this many bytes per second (slowloris)
+    int config_azimuths = -1;        ///< rewrite the served Configuration's azimuth count
+    int config_encoder = -1;         ///< ... encoder size
+    double config_bin_size_m = 0;    ///< ... bin size (fixed part and protobuf field 10)
+    unsigned shuffle = 0;            ///< permute FFT messages within blocks of N (fixed seed)
     double timeout_s = 0;            ///< exit by itself after this long (0 = never)
     bool verbose = false;
 };

@@ -2,7 +2,7 @@
 //
 //   sl-replay serve CAPTURE [--port P] [--bind ADDR] [--rate realtime|max] [--loop] ...
 //   sl-replay record --radar HOST:PORT --out FILE [--duration S] [--non-contour]
-//   sl-replay from-oxford DIR --out FILE [--bin-size-m 0.0438]
+//   sl-replay from-oxford DIR --out FILE [--bin-size-m 0.0432]
 #include "replay.h"
 
 #include "capture.h"
@@ -62,13 +62,21 @@ void usage()
         "                          the next connection continues where it stopped\n"
         "      --stall-after N     go silent on a connection after N FFT messages (no data,\n"
         "                          no keep-alive, socket open); the next connection continues\n"
+        "      --cut-after N       after N FFT messages send half of the next one, then close\n"
+        "                          (FIN); the next connection resends it whole\n"
+        "      --rst-after N       the same, ending with a TCP RST\n"
+        "      --keepalive-only    accept Start FFT, send only keep-alives (no FFT data)\n"
+        "      --trickle-bps N     send at most N bytes per second, one at a time (slowloris)\n"
+        "      --config-azimuths N, --config-encoder N, --config-bin-size-m M\n"
+        "                          serve a Configuration with this geometry (mismatch tests)\n"
+        "      --shuffle N         reorder FFT messages within blocks of N (fixed seed)\n"
         "      --timeout S         exit by itself after S seconds\n"
         "      -v                  log connections\n"
         "  sl-replay record --radar HOST:PORT --out FILE [options]\n"
         "      --duration S        stop after S seconds (default: Ctrl-C)\n"
         "      --non-contour       start with id 140 instead of 21\n"
         "      --silence-ms N      reconnect when nothing arrives for N ms (default 3000)\n"
-        "  sl-replay from-oxford DIR --out FILE [--bin-size-m 0.0438]\n"
+        "  sl-replay from-oxford DIR --out FILE [--bin-size-m 0.0432]\n"
         "      DIR/radar/*.png (or DIR/*.png), Oxford Radar RobotCar polar PNGs\n"
         "      --encoder-size N --rotation-mhz N --packet-rate N (defaults 5600 4000 1600)\n");
 }
@@ -170,6 +178,29 @@ int cmd_serve(int argc, char **argv)
             NEED_ARG();
             if (!parse_u64(argv[++i], v) || v > 64) return usage(), 2;
             o.split = static_cast<unsigned>(v);
+        } else if (a == "--cut-after" || a == "--rst-after") {
+            NEED_ARG();
+            if (!parse_u64(argv[++i], v) || v == 0) return usage(), 2;
+            o.cut_after = v;
+            o.cut_rst = a == "--rst-after";
+        } else if (a == "--keepalive-only") {
+            o.keepalive_only = true;
+        } else if (a == "--trickle-bps") {
+            NEED_ARG();
+            if (!parse_u64(argv[++i], v) || v == 0 || v > 1000000) return usage(), 2;
+            o.trickle_bps = static_cast<uint32_t>(v);
+        } else if (a == "--config-azimuths" || a == "--config-encoder") {
+            NEED_ARG();
+            if (!parse_u64(argv[++i], v) || v > 65535) return usage(), 2;
+            (a == "--config-azimuths" ? o.config_azimuths : o.config_encoder) = static_cast<int>(v);
+        } else if (a == "--config-bin-size-m") {
+            NEED_ARG();
+            if (!parse_double(argv[++i], o.config_bin_size_m) || !(o.config_bin_size_m > 0) ||
+                o.config_bin_size_m > 6.5) return usage(), 2;
+        } else if (a == "--shuffle") {
+            NEED_ARG();
+            if (!parse_u64(argv[++i], v) || v < 2 || v > 100000) return usage(), 2;
+            o.shuffle = static_cast<unsigned>(v);
         } else if (a == "--close-after") {
             NEED_ARG();
             if (!parse_u64(argv[++i], v)) return usage(), 2;

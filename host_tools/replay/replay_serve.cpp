@@ -110,6 +110,54 @@ bool load_source(const ServeOptions &o, Source &src, std::string &err)
         err = o.capture + ": no valid Configuration message (id 10) in the capture";
         return false;
     }
+    if (o.config_azimuths >= 0 || o.config_encoder >= 0 || o.config_bin_size_m > 0) {
+        // Fault injection: serve another geometry than the capture's.
+        sl_proto_msg_t pm{};
+        pm.id = SL_PROTO_ID_CONFIGURATION;
+        pm.payload.data = src.config.data() + SL_PROTO_HEADER_BYTES;
+        pm.payload.size = src.config.size() - SL_PROTO_HEADER_BYTES;
+        sl_proto_config_t c{};
+        if (sl_proto_parse_config(&pm, &c) != SL_OK) {
+            err = "cannot re-parse the Configuration";
+            return false;
+        }
+        if (o.config_azimuths >= 0) c.azimuths = static_cast<uint16_t>(o.config_azimuths);
+        if (o.config_encoder >= 0) c.encoder_size = static_cast<uint16_t>(o.config_encoder);
+        if (o.config_bin_size_m > 0) {
+            c.bin_size_100um = static_cast<uint16_t>(o.config_bin_size_m * 10000.0 + 0.5);
+            const float f = static_cast<float>(o.config_bin_size_m);
+            uint32_t bits = 0;
+            std::memcpy(&bits, &f, sizeof bits);
+            c.has_range_res = true;
+            c.range_res_m_f32 = bits;
+        }
+        std::vector<uint8_t> out(256);
+        const sl_ssize_t k = sl_proto_encode_config(out.data(), out.size(), &c, sl_bytes_t{nullptr, 0});
+        if (k <= 0) {
+            err = "cannot re-encode the Configuration";
+            return false;
+        }
+        out.resize(static_cast<size_t>(k));
+        src.config = out;
+    }
+    if (o.shuffle > 1) {
+        // Fault injection: the transport reorders messages within blocks of `shuffle`
+        // (each keeps its own azimuth, sweep counter and timestamp; pacing by position).
+        uint64_t x = 0x9E3779B97F4A7C15ULL;
+        for (size_t b = 0; b < src.fft.size(); b += o.shuffle) {
+            const size_t e = std::min(src.fft.size(), b + o.shuffle);
+            for (size_t i = e - 1; i > b; --i) {
+                x ^= x << 13;
+                x ^= x >> 7;
+                x ^= x << 17;
+                const size_t j = b + static_cast<size_t>(x % (i - b + 1));
+                std::swap(src.fft[i].offset, src.fft[j].offset);
+                std::swap(src.fft[i].size, src.fft[j].size);
+                std::swap(src.fft[i].ts_ns, src.fft[j].ts_ns);
+                std::swap(src.fft[i].sweep, src.fft[j].sweep);
+            }
+        }
+    }
     if (src.fft.empty()) {
         err = o.capture + ": no FFT data message in the capture";
         return false;
@@ -152,6 +200,8 @@ struct Client {
     size_t q_off = 0;   // bytes of q.front() already sent
     size_t q_bytes = 0; // bytes queued and not yet sent
     bool streaming = false, stalled = false, close_when_drained = false, dead = false;
+    bool rst_on_close = false;
+    uint64_t next_byte_us = 0; // --trickle-bps: when the next byte may go
     const char *why = "";
     uint64_t cursor = 0; // FFT index over all passes (pass = cursor / N)
     uint64_t anchor_wall_us = 0;
@@ -283,6 +333,18 @@ void kill_client(Client &c, const char *why)
 bool check_faults(Client &c)
 {
     const ServeOptions &o = c.srv->o;
+    if (o.cut_after > 0 && c.fft_sent >= o.cut_after && has_more(c)) {
+        // Half of the next message, then the connection ends (FIN or RST); the next
+        // connection starts with that message, whole.
+        const Source &s = c.srv->src;
+        const FftEntry &e = s.fft[c.cursor % n_fft(c)];
+        const uint8_t *p = s.cap.bytes.data() + e.offset;
+        enqueue(c, std::vector<uint8_t>(p, p + e.size / 2));
+        c.close_when_drained = true;
+        c.rst_on_close = o.cut_rst;
+        c.srv->resume = c.cursor;
+        return true;
+    }
     if (o.close_after > 0 && c.fft_sent >= o.close_after) {
         c.close_when_drained = true;
         c.srv->resume = c.cursor;
@@ -324,7 +386,7 @@ uint64_t produce(Client &c, uint64_t now)
         }
         wake = c.next_ka_us;
     }
-    if (!c.streaming || c.close_when_drained) {
+    if (!c.streaming || c.close_when_drained || o.keepalive_only) {
         return wake;
     }
     if (o.realtime) {
@@ -363,9 +425,20 @@ uint64_t produce(Client &c, uint64_t now)
 
 void flush(Client &c)
 {
+    const uint32_t bps = c.srv->o.trickle_bps;
     while (!c.dead && !c.q.empty()) {
         const auto &front = c.q.front();
-        const ssize_t n = send(c.fd, front.data() + c.q_off, front.size() - c.q_off, MSG_NOSIGNAL | MSG_DONTWAIT);
+        size_t len = front.size() - c.q_off;
+        if (bps > 0) {
+            // --trickle-bps: one byte at a time, at most bps per second.
+            const uint64_t now = sl_port_now_us();
+            if (now < c.next_byte_us) {
+                return;
+            }
+            c.next_byte_us = now + 1000000u / bps;
+            len = 1;
+        }
+        const ssize_t n = send(c.fd, front.data() + c.q_off, len, MSG_NOSIGNAL | MSG_DONTWAIT);
         if (n < 0) {
             if (errno == EINTR) {
                 continue;
@@ -385,9 +458,15 @@ void flush(Client &c)
         }
     }
     if (!c.dead && c.q.empty() && c.close_when_drained) {
-        shutdown(c.fd, SHUT_RDWR);
         ++c.srv->closed_by_fault;
-        kill_client(c, "closed (--close-after)");
+        if (c.rst_on_close) {
+            const linger lg{1, 0}; // close() sends a RST
+            setsockopt(c.fd, SOL_SOCKET, SO_LINGER, &lg, sizeof lg);
+            kill_client(c, "reset (--rst-after)");
+        } else {
+            shutdown(c.fd, SHUT_RDWR);
+            kill_client(c, "closed (--close-after / --cut-after)");
+        }
     }
 }
 
@@ -576,6 +655,9 @@ int serve(const ServeOptions &o)
         for (auto &c : s.clients) {
             wake = std::min(wake, produce(*c, now));
             flush(*c);
+            if (o.trickle_bps > 0 && !c->q.empty()) {
+                wake = std::min(wake, c->next_byte_us);
+            }
         }
         // Forget closed clients.
         for (size_t i = 0; i < s.clients.size();) {
@@ -589,7 +671,7 @@ int serve(const ServeOptions &o)
         pfds.push_back({lfd, POLLIN, 0});
         for (auto &c : s.clients) {
             short ev = POLLIN;
-            if (!c->q.empty()) {
+            if (!c->q.empty() && o.trickle_bps == 0) {
                 ev = static_cast<short>(ev | POLLOUT);
             }
             pfds.push_back({c->fd, ev, 0});

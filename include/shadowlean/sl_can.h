@@ -59,6 +59,14 @@
 /// and the LeanWarning frame carries the most severe lean at 0.05 deg over +-102 deg.
 /// Lean and LeanSigma are meaningful only when Quality is VALID or FILTERED.
 ///
+/// **Quality, one meaning for consumers** (PoleLean and LeanWarning alike): VALID (0) or
+/// FILTERED (4) = Lean and LeanSigma are a usable estimate; AMBIGUOUS (1), OUT_OF_MODEL (2),
+/// INVALID (3) = no lean number (Lean and LeanSigma are sent as 0). This module sends only
+/// confirmed tracks, whose lean is always the tracker's filtered estimate: it sends
+/// FILTERED, never VALID (VALID is reserved for a single-rotation estimate, e.g. from
+/// another producer). A LeanWarning without a target (HasTarget = 0) carries INVALID, so a
+/// consumer that gates on "VALID or FILTERED" never reads a lean that is not there.
+///
 /// ## LeanWarning (board `can.id_lean_warning`, the most severe target of the rotation)
 ///
 /// | start | len | signal    | type | factor | range (physical) | unit | note |
@@ -87,6 +95,43 @@
 /// | 34 | 14 | AzimuthsMissing | u | 0..16383     | azimuths lost in gaps (saturating) |
 /// | 48 | 8  | DecoderResyncs  | u | 0..255       | stream decoder resyncs (saturating) |
 /// | 56 | 8  | CanDropped      | u | 0..255       | CAN frames dropped by the sinks (saturating) |
+///
+/// ## Health (board `can.id_health`, SHADOWLEAN -> VEHICLE, sent right after every Status)
+///
+/// | start | len | signal            | type | range    | note |
+/// |------:|----:|-------------------|------|----------|------|
+/// |  0 | 8  | Crc               | u | 0..255   | E2E, Data ID 0x54 |
+/// |  8 | 4  | Counter           | u | 0..14    | E2E |
+/// | 12 | 4  | (reserved)        |   | 0        | |
+/// | 16 | 16 | Fault             | u | bitfield | SL_CAN_FAULT_* below, one bit per condition |
+/// | 32 | 8  | Reconnects        | u | 0..255   | radar link re-opened since start (saturating) |
+/// | 40 | 12 | CandidatesDropped | u | 0..4095  | detection candidates dropped for lack of target slots (saturating) |
+/// | 52 | 12 | (reserved)        |   | 0        | |
+///
+/// Fault bits (the DBC carries a value table naming each bit's value): a bit is set in a
+/// Health frame when its condition held at any time since the previous Health frame, or
+/// still holds (configuration faults hold until a matching Configuration arrives). A
+/// consumer should treat any set bit as "the pole-lean output is degraded or blind":
+/// - bit0 CONFIG_MISMATCH: the radar's Configuration has another azimuth count or encoder
+///   size than the board; every row is refused until a matching one arrives.
+/// - bit1 NO_USABLE_ROWS: the link is up but no usable FFT row arrived since the previous
+///   Health (malformed, empty, out-of-range or refused rows only; or none at all).
+/// - bit2 MALFORMED_DATA: malformed messages, decoder resyncs, empty rows or encoder values
+///   out of range were seen.
+/// - bit3 LINK_FLAPPING: SL_CAN_FLAP_RECONNECTS reconnects within SL_CAN_FLAP_WINDOW_MS.
+/// - bit4 CAN_OUTPUT_ERRORS: CAN frames were dropped by the sinks.
+/// - bit5 RANGE_RESOLUTION_MISMATCH: the Configuration's bin size differs from the board's
+///   by more than 1 % (ranges follow the radar's value; the board is not this installation).
+/// - bit6 AZIMUTH_DISORDER: azimuths stepped back beyond the reorder window.
+/// - bit7 CAN_RATE_LIMITED: frames were withheld by the hard output ceiling: token buckets
+///   on the port's clock refilled with SL_CAN_MAX_DATA_FRAMES_PER_100MS PoleLean +
+///   LeanWarning and SL_CAN_MAX_STATUS_FRAMES_PER_100MS Status + Health frames per 100 ms,
+///   holding at most SL_CAN_BURST_WINDOWS x that (the backlog of a ~3 s stall of a 4 Hz
+///   radar). Sustained: 48 frames x ~130 bits per 100 ms, under 13 % of a 500 kbit/s bus;
+///   in any 100 ms at most (SL_CAN_BURST_WINDOWS + 1) x 48 frames, whatever the input.
+/// - bit8 TARGET_SLOTS_OVERFLOW: detection had more candidates than target slots.
+/// Note: Data ID 0x54 is also VehicleMotion's (received, opposite direction); the two are
+/// told apart by their CAN ids only.
 ///
 /// ## VehicleMotion (board `can.id_vehicle_motion`, VEHICLE -> SHADOWLEAN, input)
 ///
@@ -163,13 +208,15 @@ typedef enum sl_can_msg {
     SL_CAN_MSG_LEAN_WARNING = 1,
     SL_CAN_MSG_STATUS = 2,
     SL_CAN_MSG_VEHICLE_MOTION = 3,
-    SL_CAN_MSG_COUNT = 4,
+    SL_CAN_MSG_HEALTH = 4,
+    SL_CAN_MSG_COUNT = 5,
 } sl_can_msg_t;
 
 #define SL_CAN_DATA_ID_POLE_LEAN 0x51U      ///< E2E Data ID (first CRC byte)
 #define SL_CAN_DATA_ID_LEAN_WARNING 0x52U
 #define SL_CAN_DATA_ID_STATUS 0x53U
 #define SL_CAN_DATA_ID_VEHICLE_MOTION 0x54U
+#define SL_CAN_DATA_ID_HEALTH 0x54U ///< same value as VehicleMotion's (fixed layout, see Health)
 
 #define SL_CAN_COUNTER_MODULO 15U ///< counters run 0..14; 15 is invalid on the wire
 
@@ -179,6 +226,7 @@ typedef enum sl_can_msg {
 #define SL_CAN_CYCLE_MS_LEAN_WARNING 250U
 #define SL_CAN_CYCLE_MS_STATUS 1000U
 #define SL_CAN_CYCLE_MS_VEHICLE_MOTION 20U
+#define SL_CAN_CYCLE_MS_HEALTH 1000U
 
 // ---------------------------------------------------------------------------------------
 // Value tables
@@ -208,10 +256,31 @@ typedef enum sl_can_link_state {
     SL_CAN_LINK_DISCONNECTED = 0, ///< no TCP connection
     SL_CAN_LINK_CONNECTING = 1,   ///< TCP connect in progress
     SL_CAN_LINK_WAIT_CONFIG = 2,  ///< connected, waiting for the radar's configuration
-    SL_CAN_LINK_STREAMING = 3,    ///< azimuth data flowing
-    SL_CAN_LINK_SILENT = 4,       ///< connected but no data for longer than the timeout
+    SL_CAN_LINK_STREAMING = 3,    ///< usable azimuth rows arriving (within the last second:
+                                  ///< malformed, empty or refused rows do not count)
+    SL_CAN_LINK_SILENT = 4,       ///< connected but no usable data for longer than the timeout
 } sl_can_link_state_t;
 #define SL_CAN_LINK_STATE_MAX 4U
+
+/// Health.Fault bits (see "Health" above).
+#define SL_CAN_FAULT_CONFIG_MISMATCH 0x0001U
+#define SL_CAN_FAULT_NO_USABLE_ROWS 0x0002U
+#define SL_CAN_FAULT_MALFORMED_DATA 0x0004U
+#define SL_CAN_FAULT_LINK_FLAPPING 0x0008U
+#define SL_CAN_FAULT_CAN_OUTPUT_ERRORS 0x0010U
+#define SL_CAN_FAULT_RANGE_RESOLUTION_MISMATCH 0x0020U
+#define SL_CAN_FAULT_AZIMUTH_DISORDER 0x0040U
+#define SL_CAN_FAULT_CAN_RATE_LIMITED 0x0080U
+#define SL_CAN_FAULT_TARGET_SLOTS_OVERFLOW 0x0100U
+#define SL_CAN_FAULT_DEFINED 0x01FFU ///< bits 9..15 are reserved (sent as 0)
+
+/// LINK_FLAPPING: this many reconnects within this window.
+#define SL_CAN_FLAP_RECONNECTS 3U
+#define SL_CAN_FLAP_WINDOW_MS 30000U
+/// Hard output ceiling per 100 ms (a rotation with 32 targets sends 33 data frames).
+#define SL_CAN_MAX_DATA_FRAMES_PER_100MS 40U
+#define SL_CAN_MAX_STATUS_FRAMES_PER_100MS 8U
+#define SL_CAN_BURST_WINDOWS 3U
 
 // ---------------------------------------------------------------------------------------
 // Signal limits (raw values). The layout table and the encoders use these; tests too.
@@ -243,6 +312,8 @@ typedef enum sl_can_link_state {
 #define SL_CAN_STATUS_AZ_MISSING_MAX 16383UL ///< 14 bits
 #define SL_CAN_STATUS_RESYNCS_MAX 255UL
 #define SL_CAN_STATUS_DROPPED_MAX 255UL
+#define SL_CAN_HEALTH_RECONNECTS_MAX 255UL
+#define SL_CAN_HEALTH_CANDIDATES_DROPPED_MAX 4095UL
 
 #define SL_CAN_MOTION_SPEED_MM_S_PER_LSB 10  ///< 0.01 m/s
 #define SL_CAN_MOTION_YAW_CDEG_S_PER_LSB 1   ///< 0.01 deg/s
@@ -293,6 +364,14 @@ typedef struct sl_can_status {
     bool saturated;            ///< decode only: a counter is at its maximum
     uint8_t counter;           ///< decode only
 } sl_can_status_t;
+
+/// Module health (Health), sent with every Status.
+typedef struct sl_can_health {
+    uint16_t fault;              ///< in: SL_CAN_FAULT_* bits (reserved bits are sent as 0)
+    uint32_t reconnects;         ///< in: radar link reconnects since start (saturates at 255)
+    uint32_t candidates_dropped; ///< in: candidates dropped for lack of target slots (4095)
+    uint8_t counter;             ///< decode only
+} sl_can_health_t;
 
 /// Vehicle motion (input from the vehicle; encoded here for tests and simulators).
 typedef struct sl_can_vehicle_motion {
@@ -351,7 +430,7 @@ typedef struct sl_can_ids {
     uint32_t id[SL_CAN_MSG_COUNT]; ///< indexed by sl_can_msg_t
 } sl_can_ids_t;
 
-/// The four ids of a board (`can_id_*` fields). O(1).
+/// The five ids of a board (`can_id_*` fields). O(1).
 void sl_can_ids_from_board(sl_can_ids_t *ids, const struct sl_board *board);
 
 /// Sender state: ids and one E2E counter per message type. Fields read-only.
@@ -376,13 +455,17 @@ sl_err_t sl_can_encode_pole_lean(sl_can_tx_t *tx, const sl_can_pole_lean_t *in,
                                  sl_can_frame_t *out);
 
 /// Encode one LeanWarning frame (same rules; level > 2 is sent as DANGER with Clamped set;
-/// has_target false sends every target field as 0).
+/// has_target false sends every target field as 0 and Quality INVALID).
 sl_err_t sl_can_encode_lean_warning(sl_can_tx_t *tx, const sl_can_lean_warning_t *in,
                                     sl_can_frame_t *out);
 
 /// Encode one Status frame. Counters saturate at their field maximum (Saturated bit);
 /// link_state > 4 is sent as DISCONNECTED with Saturated set.
 sl_err_t sl_can_encode_status(sl_can_tx_t *tx, const sl_can_status_t *in, sl_can_frame_t *out);
+
+/// Encode one Health frame. Counters saturate at their field maximum (counted in
+/// stats.clamped_frames); fault bits above SL_CAN_FAULT_DEFINED are not sent.
+sl_err_t sl_can_encode_health(sl_can_tx_t *tx, const sl_can_health_t *in, sl_can_frame_t *out);
 
 /// Encode one VehicleMotion frame (for tests, simulators and replay tools). Out-of-range
 /// speed or yaw rate is clamped and counted in stats.clamped_frames (the message has no
@@ -401,6 +484,7 @@ sl_err_t sl_can_decode_pole_lean(const sl_can_frame_t *f, sl_can_pole_lean_t *ou
 sl_err_t sl_can_decode_lean_warning(const sl_can_frame_t *f, sl_can_lean_warning_t *out);
 sl_err_t sl_can_decode_status(const sl_can_frame_t *f, sl_can_status_t *out);
 sl_err_t sl_can_decode_vehicle_motion(const sl_can_frame_t *f, sl_can_vehicle_motion_t *out);
+sl_err_t sl_can_decode_health(const sl_can_frame_t *f, sl_can_health_t *out);
 
 /// VehicleMotion receiver for the motion-aware masks: id match, E2E check (CRC errors and
 /// counter jumps counted in `e2e.stats`), latest accepted value with its time.

@@ -32,18 +32,28 @@
 ///    matched this rotation, `hits >= cfg.confirm_hits`), in slot order; one LeanWarning
 ///    (the most severe confirmed track: highest level, then largest |filtered alpha|;
 ///    HasTarget = 0 when there is none); one Status (link state, rotations, missing
-///    azimuths, decoder resyncs, CAN drops). `can_tx` must not block: SL_ERR_BUSY (or any
+///    azimuths, decoder resyncs, CAN drops; LinkState STREAMING only while usable rows
+///    arrive: none since the previous Status and none within `cfg.row_timeout_us` -> SILENT), then one Health (Fault bits, Reconnects,
+///    CandidatesDropped; sl_can.h). Every frame passes the hard output ceiling (token
+///    buckets on `now_us`: SL_CAN_MAX_*_FRAMES_PER_100MS per 100 ms sustained, bursts up to
+///    SL_CAN_BURST_WINDOWS times that; withheld frames are counted in
+///    `stats.can_rate_limited` and raise CAN_RATE_LIMITED). `can_tx` must not block: SL_ERR_BUSY (or any
 ///    other error) counts the frame as dropped (`stats.can_dropped`, reported in the next
 ///    Status frame) and the pipeline moves on. Drops the port notices later (after can_tx
 ///    returned SL_OK) are added with `sl_pipeline_add_can_dropped()`. Between rotations
-///    the port sends Status frames with `sl_pipeline_send_status()` (same E2E sequence).
+///    the port sends Status + Health frames with `sl_pipeline_send_status()` (same E2E
+///    sequences).
 /// Callbacks must not call back into the same pipeline (not reentrant).
 ///
 /// ## Mapping to CAN (sl_can.h)
 /// Azimuth = az x 36000 / azimuths + board->radar_yaw_cdeg (vehicle frame, clockwise).
 /// TargetId = track id mod 16. Quality = FILTERED when the track has a valid alpha
 /// (Lean/LeanSigma = the filtered values), else the mapping of the last target's incline
-/// flag (AMBIGUOUS, OUT_OF_MODEL, INVALID). Ranges: the track's last corrected r1 / r2, passed
+/// flag (AMBIGUOUS, OUT_OF_MODEL, INVALID). Bin size: the radar's Configuration's (its
+/// `rangeresolutionmetres`, else the fixed field): detection runs on `det_board`, a copy of
+/// the board with that bin size, so ranges and corrections follow the radar; a difference
+/// of more than 1 % from the board's (the expected value) raises RANGE_RESOLUTION_MISMATCH.
+/// Ranges: the track's last corrected r1 / r2, passed
 /// in um and rounded once, by the encoder, to the signal's step (0.02 m / 0.01 m).
 ///
 /// ## Motion (the paper assumed a static vehicle; see `sl_pipeline_window()`)
@@ -188,6 +198,8 @@ typedef struct sl_pipeline_cfg {
     uint32_t motion_budget_um;   ///< D: displacement allowed over the window (default: bin)
     uint32_t motion_timeout_us;  ///< motion older than this is ignored (default 500 ms)
     uint32_t rotation_us;        ///< rotation period when timestamps are unusable (250000)
+    uint32_t row_timeout_us;     ///< Status says STREAMING (and Health has no NO_USABLE_ROWS)
+                                 ///< only while a usable row arrived within this (1 s; 0 = 1 s)
 } sl_pipeline_cfg_t;
 
 /// Defaults for `board` (threshold, n from the board; detection and tracker defaults;
@@ -235,6 +247,14 @@ typedef struct sl_pipeline_stats {
     uint32_t geometry_rejected;  ///< Configurations whose geometry does not match the board
     uint32_t rows_dropped;       ///< rows ignored after such a Configuration (until one matches)
     uint32_t restarts;           ///< radar restarts seen (geometry change, finish)
+    uint32_t reconnects;         ///< sl_pipeline_add_reconnect() calls (Health.Reconnects)
+    uint32_t can_rate_limited;   ///< frames withheld by the output ceiling (sl_can.h)
+    uint32_t bin_size_mismatch;  ///< Configurations whose bin size is > 1 % off the board's
+    uint32_t blind_rotations;    ///< rotations' worth of FFT messages without a usable row
+    uint32_t bin_size_changes;   ///< detection moved to the radar's bin size (Configuration)
+    uint32_t bin_size_unserved;  ///< radar bin size too small for the masked bins: board's kept
+    uint32_t refused_rotations;  ///< rotations whose rows were all refused (config mismatch):
+                                 ///< not counted in `rotations`, their azimuths are missing
 } sl_pipeline_stats_t;
 
 /// The pipeline. Caller-allocated (static); fields read-only to the application. Stage
@@ -275,6 +295,28 @@ typedef struct sl_pipeline {
     sl_tracker_t tracker;
     sl_can_tx_t can;
     sl_pipeline_stats_t stats;
+    sl_board_t det_board;        ///< the board as detection uses it: bin size from the radar's
+                                 ///< Configuration (the board's until one arrives)
+    // health (Status link state, Health frame)
+    bool bin_size_bad;           ///< the radar's bin size is > 1 % off the board's
+    uint32_t radar_bin_um;       ///< bin size of the last Configuration (0: none yet)
+    uint32_t rows_since_status;  ///< usable rows since the last Status
+    uint32_t rows_since_health;  ///< usable rows since the last Health
+    bool have_row;               ///< a usable row arrived since init
+    uint64_t last_row_us;        ///< now_us of the last usable row
+    uint16_t fault_latched;      ///< fault bits raised since the last Health
+    uint16_t last_faults;        ///< Fault of the last Health frame
+    uint16_t faults_seen;        ///< every Fault bit sent since init
+    uint8_t reconnect_next;      ///< internal: ring index
+    bool can_clock_set;          ///< output ceiling: buckets initialised (full)
+    uint32_t can_tokens_data;    ///< output ceiling: PoleLean/LeanWarning tokens (1/1000)
+    uint32_t can_tokens_status;  ///< output ceiling: Status/Health tokens (1/1000)
+    uint64_t can_clock_us;       ///< output ceiling: now_us of the last refill
+    uint64_t reconnect_t_us[SL_CAN_FLAP_RECONNECTS]; ///< times of the last reconnects
+    struct {
+        uint32_t fft, resyncs, malformed, bad_azimuth, empty_rows, can_dropped, disorder,
+            target_overflow;
+    } snap;                      ///< internal: counters at the last Health
     uint32_t bits[SL_MASK_WORDS]; ///< thresholded row (internal)
     uint32_t occ[SL_MASK_WORDS];  ///< stable-occupied row (internal)
     uint8_t row8[SL_CFG_MASK_BINS]; ///< scan's row buffer (16-bit reduction, short rows)
@@ -363,6 +405,17 @@ void sl_pipeline_set_link_state(sl_pipeline_t *p, uint8_t link_state);
 /// nothing is sent). `now_us` is the port's clock (stored as the call's time only).
 /// @return SL_OK, or SL_ERR_ARG (NULL or not initialised). O(1).
 sl_err_t sl_pipeline_send_status(sl_pipeline_t *p, uint64_t now_us);
+
+/// The port re-opened the radar link (a reconnect after a drop, or after the data watchdog
+/// gave up on a silent link). Counted in `stats.reconnects` (Health.Reconnects, saturating
+/// at 255 on the wire); SL_CAN_FLAP_RECONNECTS within SL_CAN_FLAP_WINDOW_MS raise
+/// LINK_FLAPPING. O(1).
+void sl_pipeline_add_reconnect(sl_pipeline_t *p, uint64_t now_us);
+
+/// The Fault bits (SL_CAN_FAULT_*) the next Health frame would carry now: faults raised
+/// since the last Health plus those that still hold (configuration mismatches; no usable
+/// row since the last Health while the link is up or FFT messages arrive). O(1).
+uint16_t sl_pipeline_faults(const sl_pipeline_t *p);
 
 /// Add `n` frames the port lost AFTER `can_tx` accepted them (a sink's stale or bus-off
 /// drops, gs_usb frames never confirmed) to `stats.can_dropped` (saturating at UINT32_MAX),

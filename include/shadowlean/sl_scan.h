@@ -30,11 +30,23 @@
 ///   is COMPLETE (`SL_SCAN_END_WRAP`) and idx opens the next frame.
 /// - fwd >= azimuths - W (a small step backwards): a late (out-of-order) message. If idx <
 ///   head its slot is filled when still empty (`SL_SCAN_AZ_LATE`, `out_of_order`), else it
-///   is a duplicate. If idx > head it belongs to the previous, already completed rotation:
-///   dropped and counted (`late_dropped`).
+///   is a duplicate (or, when its sweep counter is newer than the head's, the first message
+///   of the next rotation). If idx > head it belongs to the previous, already completed
+///   rotation: dropped and counted (`late_dropped`), unless its sweep counter is newer than
+///   the head's (then it is this rotation's, stored as a forward step).
+/// - idx < head with fwd < azimuths - W (a step back beyond the window): this closes the
+///   rotation (`SL_SCAN_END_WRAP`) only when the azimuth was already stored in it, or the
+///   sweep counters moved forward by fwd +- W messages with at most W rows stored behind the
+///   head since it was set (an in-order gap across index 0). Otherwise it
+///   is DISORDER (`disorder`): stored into its empty slot as a late row, the rotation stays
+///   open. So shuffled or reversed azimuths close about one rotation per pass over every
+///   index (one reversed rotation is one rotation, not many).
 /// - Sweep counter (unless `cfg.ignore_sweep`): if the signed 16-bit sweep difference to the
 ///   head's message is >= azimuths (a whole rotation of packets lost), the frame completes
 ///   (`SL_SCAN_END_SWEEP_GAP`) before idx is stored, whatever the index says.
+/// - Rows with 0 bins are not azimuths (`empty_rows`, SL_ERR_MALFORMED). A run of
+///   `azimuths` consecutive FFT messages that give no row (out-of-range encoder values,
+///   empty, malformed) adds one rotation's azimuths to `missing` (`blind_rotations`).
 /// Duplicates keep the FIRST row (it may already have been thresholded downstream) and set
 /// `SL_SCAN_AZ_DUP` on it. Missing rows are zero-filled at completion, flags 0.
 ///
@@ -126,6 +138,7 @@ typedef struct sl_scan_frame_stats {
     uint16_t out_of_order;    ///< late messages stored into an empty slot
     uint16_t short_azimuths;  ///< rows with fewer than roi_bins bins
     uint16_t wide_azimuths;   ///< rows reduced from 16-bit data
+    uint16_t disorder;        ///< steps back beyond the reorder window stored (or dropped)
 } sl_scan_frame_stats_t;
 
 /// One rotation. Caller-owned (usually static: ~210 KB with the default capacities).
@@ -232,6 +245,11 @@ typedef struct sl_scan_stats {
     uint32_t configs;         ///< Configuration messages accepted
     uint32_t config_changes;  ///< ... of which changed the geometry
     uint32_t config_rejected; ///< Configurations rejected (0 / oversized / unexpected geometry)
+    uint32_t disorder;        ///< messages that stepped back beyond the reorder window
+    uint32_t empty_rows;      ///< FFT messages with 0 bins (not azimuths; they stay missing)
+    uint32_t blind_rotations; ///< runs of `azimuths` consecutive FFT messages without a row
+                              ///< (out-of-range encoder values, empty, malformed): each adds
+                              ///< a rotation's azimuths to `missing`
 } sl_scan_stats_t;
 
 /// Scan assembler. Caller-allocated; fields read-only to the application.
@@ -247,6 +265,8 @@ typedef struct sl_scan {
     bool have_sweep;          ///< `last_sweep` valid
     uint16_t last_sweep;      ///< sweep counter of the previous FFT message
     uint32_t rotation;        ///< next frame's sequence number
+    uint16_t unusable_run;    ///< FFT messages without a row since the last stored one
+    uint16_t behind_head;     ///< rows stored behind the head since it was last set
     sl_scan_stats_t stats;
     sl_scan_rot_t rot;        ///< bookkeeping of the rotation being assembled (both modes)
 } sl_scan_t;

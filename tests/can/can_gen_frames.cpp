@@ -54,6 +54,7 @@ int main(int argc, char **argv)
         ids.id[SL_CAN_MSG_LEAN_WARNING] = b.can_id_lean_warning;
         ids.id[SL_CAN_MSG_STATUS] = b.can_id_status;
         ids.id[SL_CAN_MSG_VEHICLE_MOTION] = b.can_id_vehicle_motion;
+        ids.id[SL_CAN_MSG_HEALTH] = b.can_id_health;
         sl_can_tx_t tx;
         if (sl_can_tx_init(&tx, &ids) != SL_OK) {
             std::cerr << "can_gen_frames: bad ids\n";
@@ -65,7 +66,7 @@ int main(int argc, char **argv)
         uint64_t t_us = 1700000000000000ULL;
         for (long i = 0; i < n; i++) {
             sl_can_frame_t f;
-            const int64_t kind = uni(0, 9);
+            const int64_t kind = uni(0, 10);
             if (kind < 6) {
                 sl_can_pole_lean_t p{};
                 p.target_id = static_cast<uint8_t>(value(0, 15, 0, 255));
@@ -106,6 +107,14 @@ int main(int argc, char **argv)
                 ex << "Status link_state=" << unsigned(s.link_state) << " rotations=" << s.rotations
                    << " azimuths_missing=" << s.azimuths_missing << " decoder_resyncs=" << s.decoder_resyncs
                    << " can_dropped=" << s.can_dropped << "\n";
+            } else if (kind == 10) {
+                sl_can_health_t h{};
+                h.fault = static_cast<uint16_t>(value(0, 0x1FF, 0, 0xFFFF));
+                h.reconnects = static_cast<uint32_t>(value(0, 255, 0, 100000));
+                h.candidates_dropped = static_cast<uint32_t>(value(0, 4095, 0, 1000000));
+                sl_can_encode_health(&tx, &h, &f);
+                ex << "Health fault=" << unsigned(h.fault) << " reconnects=" << h.reconnects
+                   << " candidates_dropped=" << h.candidates_dropped << "\n";
             } else {
                 sl_can_vehicle_motion_t m{};
                 m.speed_mm_s = static_cast<int32_t>(value(-60000, 60000, -1000000, 1000000));

@@ -66,6 +66,11 @@ MAP = {
         "DecoderResyncs": ("decoder_resyncs", 1, "num"),
         "CanDropped": ("can_dropped", 1, "num"),
     },
+    "Health": {
+        "Fault": ("fault", 1, "fault"),
+        "Reconnects": ("reconnects", 1, "num"),
+        "CandidatesDropped": ("candidates_dropped", 1, "num"),
+    },
     "VehicleMotion": {
         "Speed": ("speed_mm_s", 1000, "num"),
         "YawRate": ("yaw_rate_cdeg_s", 100, "num"),
@@ -84,6 +89,8 @@ def expected_raw(sig, kind, value):
     rmax = int(dec(sig.max) / f)
     if kind == "flag":
         return int(value), False
+    if kind == "fault":
+        return int(value) & 0x1FF, False  # bits 9..15 reserved: never sent
     if kind in ("id", "quality", "level", "link"):
         v = int(value)
         if v <= rmax:
@@ -142,7 +149,9 @@ def main():
             sig = fr.signal_by_name(sname)
             f = dec(sig.factor)
             if not has_target and sname in TARGET_FIELDS:
-                want_raw, cl, value = 0, False, D(0)
+                # no target: every target field 0, Quality INVALID (3) so that nobody
+                # gating on VALID/FILTERED reads a lean
+                want_raw, cl, value = (3 if sname == "Quality" else 0), False, D(0)
             else:
                 value = D(int(inputs[key])) / scale
                 want_raw, cl = expected_raw(sig, kind, value)

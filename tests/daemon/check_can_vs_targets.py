@@ -2,7 +2,7 @@
 """Every CAN frame shadowleand wrote decodes with the board's generated DBC
 (python3-canmatrix) and carries exactly what the pipeline computed (--targets-out).
 
-    check_can_vs_targets.py BOARD.dbc CAN.log TARGETS.jsonl [--link STATE] [--idle-ok]
+    check_can_vs_targets.py BOARD.dbc CAN.log TARGETS.jsonl [--link STATE] [--idle-ok] [--no-fault]
                             [--rotations N] [--min-poles N]
 
 Independent of the C encoder: layout and scaling come only from the DBC, the CRC is
@@ -11,9 +11,10 @@ documented in sl_pipeline.h. Checks:
 - every frame: id known to the DBC, DLC 8, Crc = CRC-8 SAE J1850 over [SlE2EDataId,
   bytes 1..7], Counter = previous + 1 mod 15 per message, canmatrix re-encodes the
   decoded raw values to the same bytes;
-- frames come in rotation groups PoleLean* LeanWarning Status, one per JSON rotation
-  record, in order (Status frames without a group are idle Status frames: allowed with
-  --idle-ok, rejected otherwise);
+- frames come in rotation groups PoleLean* LeanWarning Status Health, one per JSON
+  rotation record, in order (Status + Health without a group are idle Status frames:
+  allowed with --idle-ok, rejected otherwise); every Status is followed at once by its
+  Health; with --no-fault every rotation group's Health has Fault 0 (a clean stream);
 - PoleLean: one per confirmed track (live, updated, hits >= confirm_hits) in slot order:
   TargetId = id mod 16, Azimuth = az x 360 / azimuths + yaw (+-0.1 deg), Quality
   (FILTERED when valid_hits > 0, else from the incline flag), Lean / LeanSigma (+-half an
@@ -83,6 +84,7 @@ def main(argv):
     groups = []
     cur = []
     idle = 0
+    after_status = None  # "group" / "idle": the Status just seen, its Health must follow
     for n, (t, iface, cid, eff, data) in enumerate(frames, 1):
         d = scd.decode(db, cid, eff, data)
         where = f"frame {n} (id 0x{cid:X})"
@@ -100,17 +102,38 @@ def main(argv):
         if prev is not None and d.raw["Counter"] != (prev + 1) % 15:
             errors.append(f"{where}: {d.name} Counter {d.raw['Counter']} after {prev}")
         counters[d.name] = d.raw["Counter"]
+        if after_status is not None:
+            # Health follows every Status at once (rotation group or idle Status)
+            if d.name != "Health":
+                errors.append(f"{where}: {d.name} after a Status, want Health")
+            elif after_status == "group":
+                # --no-fault: a clean stream, no Fault bit in any rotation's Health
+                if "--no-fault" in flags and d.raw["Fault"] != 0:
+                    errors.append(f"{where}: Health Fault {d.raw['Fault']:#x} in a rotation group")
+                cur.append(d)
+                groups.append(cur)
+                cur = []
+            after_status = None
+            if d.name == "Health":
+                continue
+        if d.name == "Health":
+            errors.append(f"{where}: Health without a Status before it")
+            continue
         if d.name == "Status":
             if not cur:
                 idle += 1
                 if "--idle-ok" not in flags:
                     errors.append(f"{where}: Status frame outside a rotation group")
+                after_status = "idle"
                 continue
             cur.append(d)
-            groups.append(cur)
-            cur = []
+            after_status = "group"
         else:
             cur.append(d)
+    if after_status == "group":
+        errors.append("no Health after the last Status")
+        groups.append(cur)
+        cur = []
     if cur:
         errors.append(f"{len(cur)} frames after the last Status frame")
     if len(groups) != len(rots):
@@ -128,8 +151,8 @@ def main(argv):
         want_pl = [t for t in confirmed if t["updated"]]
         poles = [d for d in g if d.name == "PoleLean"]
         rest = [d.name for d in g if d.name != "PoleLean"]
-        if rest != ["LeanWarning", "Status"]:
-            errors.append(f"{w}: frames {[d.name for d in g]}, want PoleLean* LeanWarning Status")
+        if rest != ["LeanWarning", "Status", "Health"]:
+            errors.append(f"{w}: frames {[d.name for d in g]}, want PoleLean* LeanWarning Status Health")
             continue
         if len(poles) != len(want_pl):
             errors.append(f"{w}: {len(poles)} PoleLean frames, {len(want_pl)} confirmed tracks seen")
@@ -161,7 +184,7 @@ def main(argv):
                     t["level"] == worst["level"] and t["valid_hits"] > 0 and
                     (worst["valid_hits"] == 0 or abs(t["alpha_cdeg"]) > abs(worst["alpha_cdeg"]))):
                 worst = t
-        lw = g[-2]
+        lw = g[-3]
         if worst is None:
             if lw.raw["HasTarget"] != 0 or lw.raw["Level"] != 0:
                 errors.append(f"{w}: LeanWarning HasTarget {lw.raw['HasTarget']} Level {lw.raw['Level']}, want 0 0")
@@ -182,7 +205,7 @@ def main(argv):
             for name, ok, want in checks:
                 if not ok:
                     errors.append(f"{w}: LeanWarning {name} = {lw.phys.get(name)}, want {want}")
-        st = g[-1]
+        st = g[-2]
         if st.raw["Rotations"] != k + 1:
             errors.append(f"{w}: Status Rotations {st.raw['Rotations']}, want {k + 1}")
         if st.raw["AzimuthsMissing"] != missing:

@@ -53,6 +53,12 @@ rejects "a bad value" "badval.ini:3: daemon.stats_every" --config "$OUT/badval.i
 printf '[input]\nradar = 1.2.3.4\ncapture = x\n' > "$OUT/both.ini"
 rejects "radar and capture in one file" "both \[input\] radar and capture" --config "$OUT/both.ini" --board paper-sim
 rejects "a missing file" "cannot open" --config "$OUT/nope.ini"
+mkdir -p "$OUT/confdir"
+rejects "a directory as --config" "not a regular file (a directory)" --config "$OUT/confdir" --board paper-sim --input x
+printf '[daemon]\nboard = paper-sim\n[input]\ncapture = x\nsilent_ms = 100\nsilent_ms = 200\n' > "$OUT/dup.ini"
+rejects "a duplicate key" "dup.ini:6: input.silent_ms: duplicate key" --config "$OUT/dup.ini"
+printf '[daemon]\nboard = paper-sim\n[input]\ncapture = x\n[daemon]\nboard = robotcar-leaf\n' > "$OUT/dup2.ini"
+rejects "a key repeated in a second section" "dup2.ini:6: daemon.board: duplicate key" --config "$OUT/dup2.ini"
 rejects "an unknown board" "unknown board 'moon-rover'" --board moon-rover --input x
 rejects "no input" "no input" --board paper-sim
 rejects "--realtime with a radar" "--realtime applies to --input only" --board paper-sim --radar 1.2.3.4 --realtime
@@ -71,7 +77,9 @@ rejects "two stdout outputs" "cannot both be stdout" --board paper-sim --input x
 if [ "$(id -u)" -eq 0 ] && id nobody > /dev/null 2>&1; then
     printf '' > "$OUT/empty.colossus"
     "$D" --board paper-sim --input "$OUT/empty.colossus" --can-log "$OUT/user.log" --user nobody \
-        2> "$OUT/user.err" || { cat "$OUT/user.err"; fail "--user nobody"; }
+        2> "$OUT/user.err"
+    rc=$?  # an empty capture: no usable rotation (exit 3), after the privilege drop
+    [ $rc -eq 3 ] || { cat "$OUT/user.err"; fail "--user nobody: exit $rc, want 3"; }
     grep -q "running as nobody (uid $(id -u nobody)" "$OUT/user.err" || { cat "$OUT/user.err"; fail "no privilege drop logged"; }
     "$D" --board paper-sim --input "$OUT/empty.colossus" --user no-such-user-xyz 2> "$OUT/user2.err"
     [ $? -eq 1 ] || fail "--user with an unknown user must fail"

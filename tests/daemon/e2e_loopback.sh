@@ -13,7 +13,8 @@ rm -rf "$OUT"; mkdir -p "$OUT"
 REPLAY_PID=""
 trap 'stop_pid "$REPLAY_PID"' EXIT
 "$SL_SIM" "$SRC/scenes/static_four_poles.ini" -o "$OUT/scene.colossus" --quiet || exit 1
-start_replay "$OUT/replay.out" "$OUT/scene.colossus" --rate max || exit 1
+# real-time pacing: the CAN output ceiling (sl_can.h) is on the daemon's clock
+start_replay "$OUT/replay.out" "$OUT/scene.colossus" --rate realtime || exit 1
 echo "sl-replay serving on 127.0.0.1:$REPLAY_PORT"
 "$DAEMON" --board paper-sim --radar "127.0.0.1:$REPLAY_PORT" --can-log "$OUT/can.log" \
     --targets-out "$OUT/targets.jsonl" --exit-idle 1.5 --duration 60 --stats-every 1 || {

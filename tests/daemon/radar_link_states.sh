@@ -50,11 +50,11 @@ grep -q "stopping (SIGTERM)" "$OUT/none.err" || { echo "FAIL: no clean stop logg
 
 # 2. a radar that stalls after 2000 FFT messages (5 rotations), then comes back
 "$SL_SIM" "$SRC/scenes/static_four_poles.ini" --rotations 8 -o "$OUT/s.colossus" --quiet || exit 1
-start_replay "$OUT/replay.out" "$OUT/s.colossus" --rate max --stall-after 2000 || exit 1
+start_replay "$OUT/replay.out" "$OUT/s.colossus" --rate realtime --stall-after 2000 || exit 1
 # Ends by itself 3 s after the last FFT message (the replay then only sends keep-alives).
 "$DAEMON" --board paper-sim --radar "127.0.0.1:$REPLAY_PORT" --can-log "$OUT/stall.log" \
     --targets-out "$OUT/stall.jsonl" --silent-ms 300 --status-period-ms 200 \
-    --silence-timeout-ms 1500 --exit-idle 3 --duration 30 2> "$OUT/stall.err"
+    --silence-timeout-ms 1500 --data-timeout-ms 10000 --exit-idle 3 --duration 30 2> "$OUT/stall.err"
 rc=$?
 stop_pid "$REPLAY_PID"; REPLAY_PID=""
 cat "$OUT/stall.err"
@@ -64,7 +64,8 @@ echo "${s% |*}" | tr ' ' '\n' | grep -q '^4$' || { echo "FAIL: no SILENT Status 
 grep -q "radar disconnected (SILENCE" "$OUT/stall.err" || { echo "FAIL: no silence timeout"; exit 1; }
 grep -q "1 reconnects" "$OUT/stall.err" || { echo "FAIL: no reconnection"; exit 1; }
 grep -q "Stop FFT sent to the radar" "$OUT/stall.err" || { echo "FAIL: no Stop FFT at exit"; exit 1; }
-# ... and the radar emulator received it on the second connection (its own count).
+# ... and the radar emulator received it on the second connection (its own count; the data
+# watchdog is set beyond --exit-idle here, data_watchdog.sh tests it).
 grep -q "client 2 .* starts 1, stops 1," "$OUT/replay.out.err" || {
     cat "$OUT/replay.out.err"; echo "FAIL: sl-replay did not see Start + Stop FFT"; exit 1; }
 rot=${s#*| }
@@ -73,7 +74,7 @@ rot=${s#*| }
     --rotations 8 || exit 1
 
 # 3. SIGINT in the middle of a real-time capture replay: exit 0, the partial rotation is
-#    flushed (the log ends with its Status frame), the targets file is complete JSON.
+#    flushed (the log ends with its Status and Health frames), the targets file is complete JSON.
 "$DAEMON" --board paper-sim --input "$OUT/s.colossus" --realtime --can-log "$OUT/int.log" \
     --targets-out "$OUT/int.jsonl" 2> "$OUT/int.err" &
 DPID=$!
@@ -83,5 +84,6 @@ kill -INT $DPID; wait $DPID; rc=$?; DPID=""
 cat "$OUT/int.err"
 [ $rc -eq 0 ] || { echo "FAIL: exit status $rc after SIGINT"; exit 1; }
 grep -q "stopping (SIGINT)" "$OUT/int.err" || { echo "FAIL: no clean stop logged"; exit 1; }
-tail -1 "$OUT/int.log" | grep -q ' 622#' || { echo "FAIL: the log does not end with a Status frame"; exit 1; }
+tail -2 "$OUT/int.log" | head -1 | grep -q ' 622#' && tail -1 "$OUT/int.log" | grep -q ' 623#' ||
+    { echo "FAIL: the log does not end with a Status frame and its Health frame"; exit 1; }
 "$PY" "$SRC/check_can_vs_targets.py" "$DBC" "$OUT/int.log" "$OUT/int.jsonl" || exit 1

@@ -247,7 +247,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     CHECK(a.digest == b.digest);
     same_stats(&a.p.stats, &b.p.stats);
     const sl_scan_stats_t *ss = &scan.stats;
-    CHECK(ss->fft == ss->azimuths + ss->duplicates + ss->late_dropped + ss->bad_azimuth + ss->no_config);
+    CHECK(ss->fft == ss->azimuths + ss->duplicates + ss->late_dropped + ss->bad_azimuth + ss->no_config +
+          ss->empty_rows);
     CHECK(g_frame_valid_sum == ss->azimuths);
     CHECK(ss->out_of_order <= ss->azimuths);
     CHECK(ss->fft <= b.p.stats.fft8 + b.p.stats.fft16);

@@ -423,7 +423,10 @@ static void test_canmsg_lean_warning_round_trips_and_clamps(void **state)
     assert_int_equal(out.target_id, 0);
     assert_int_equal(out.lean_cdeg, 0);
     assert_int_equal(out.range_um, 0);
-    assert_int_equal(f.data[2] | f.data[3] | f.data[4] | f.data[5] | f.data[6] | f.data[7], 0);
+    assert_int_equal(f.data[2] | f.data[3] | f.data[4] | f.data[5] | f.data[6], 0);
+    // ... and Quality INVALID (bits 61..63), never VALID: no lean to read.
+    assert_int_equal(out.quality, SL_CAN_QUALITY_INVALID);
+    assert_int_equal(f.data[7], SL_CAN_QUALITY_INVALID << 5);
 }
 
 static void test_canmsg_status_counters_saturate_and_flag(void **state)
@@ -611,7 +614,7 @@ static void test_canmsg_tx_init_validates_ids(void **state)
     assert_int_equal(sl_can_tx_init(&tx, &dup), SL_ERR_ARG);
     sl_can_ids_t eff_bad = {{0x80000000UL | 0x20000000UL, 1U, 2U, 3U}};
     assert_int_equal(sl_can_tx_init(&tx, &eff_bad), SL_ERR_ARG);
-    sl_can_ids_t eff = {{0x80000000UL | 0x18FF1234UL, 0x7FFU, 0U, 0x123U}};
+    sl_can_ids_t eff = {{0x80000000UL | 0x18FF1234UL, 0x7FFU, 0U, 0x123U, 0x124U}};
     assert_int_equal(sl_can_tx_init(&tx, &eff), SL_OK);
     assert_int_equal(sl_can_tx_init(NULL, &eff), SL_ERR_ARG);
     sl_can_frame_t f;

@@ -595,11 +595,11 @@ static void test_pipeline_can_frames_decode_to_the_targets(void **state)
     sl_pipeline_set_link_state(&pl, SL_CAN_LINK_STREAMING);
     feed_stream(&g_static, 1448, 0);
     assert_int_equal(rec.rotations, 24);
-    sl_can_e2e_rx_t rx[3];
-    for (int i = 0; i < 3; i++) {
+    sl_can_e2e_rx_t rx[4];
+    for (int i = 0; i < 4; i++) {
         sl_can_e2e_rx_init(&rx[i]);
     }
-    int pole_frames[MAXROT] = {0}, statuses = 0, warnings = 0;
+    int pole_frames[MAXROT] = {0}, statuses = 0, warnings = 0, healths = 0;
     const int n = B->mask_frames, confirm = c.confirm_hits;
     for (int i = 0; i < rec.ncan; i++) {
         const sl_can_frame_t *f = &rec.can[i];
@@ -657,10 +657,19 @@ static void test_pipeline_can_frames_decode_to_the_targets(void **state)
             assert_int_equal(st.azimuths_missing, 0);
             assert_int_equal(st.decoder_resyncs, 0);
             assert_int_equal(st.can_dropped, 0);
+        } else if (f->id == B->can_id_health) {
+            assert_int_equal(sl_can_e2e_check(&rx[3], SL_CAN_DATA_ID_HEALTH, f), SL_OK);
+            sl_can_health_t h;
+            assert_int_equal(sl_can_decode_health(f, &h), SL_OK);
+            healths++;
+            assert_int_equal(h.fault, 0); // a clean stream raises no fault
+            assert_int_equal(h.reconnects, 0);
+            assert_int_equal(h.candidates_dropped, 0);
         } else {
             fail_msg("frame with unexpected id 0x%x", (unsigned)f->id);
         }
     }
+    assert_int_equal(healths, 24);
     assert_int_equal(statuses, 24);
     assert_int_equal(warnings, 24);
     for (int k = 0; k < 24; k++) {
@@ -885,7 +894,8 @@ static void test_pipeline_idle_status_frames_continue_the_e2e_sequence(void **st
     // Idle Status before any data: CONNECTING, all counters 0.
     sl_pipeline_set_link_state(&pl, SL_CAN_LINK_CONNECTING);
     assert_int_equal(sl_pipeline_send_status(&pl, 500000U), SL_OK);
-    assert_int_equal(rec.ncan, 1);
+    assert_int_equal(rec.ncan, 2); // Status, then Health
+    assert_int_equal(rec.can[1].id, B->can_id_health);
     sl_can_status_t st;
     assert_int_equal(sl_can_decode_status(&rec.can[0], &st), SL_OK);
     assert_int_equal(rec.can[0].id, B->can_id_status);
@@ -908,7 +918,7 @@ static void test_pipeline_idle_status_frames_continue_the_e2e_sequence(void **st
             }
             const int before = rec.ncan;
             assert_int_equal(sl_pipeline_send_status(&pl, now + 1000U), SL_OK);
-            assert_int_equal(rec.ncan, before + 1);
+            assert_int_equal(rec.ncan, before + 2);
             assert_int_equal(sl_can_decode_status(&rec.can[before], &st), SL_OK);
             assert_int_equal(st.rotations, pl.stats.rotations);
             assert_int_equal(st.azimuths_missing, pl.stats.azimuths_missing);
@@ -949,12 +959,15 @@ static void test_pipeline_idle_status_frames_continue_the_e2e_sequence(void **st
     rec.busy_every = 1;
     rec.calls = 0;
     assert_int_equal(sl_pipeline_send_status(&pl, 99100000U), SL_OK);
-    assert_int_equal(pl.stats.can_dropped, 1);
+    assert_int_equal(pl.stats.can_dropped, 2); // the Status and the Health frame
     rec.busy_every = 0;
     const int before = rec.ncan;
     assert_int_equal(sl_pipeline_send_status(&pl, 99200000U), SL_OK);
     assert_int_equal(sl_can_decode_status(&rec.can[before], &st), SL_OK);
-    assert_int_equal(st.can_dropped, 1);
+    assert_int_equal(st.can_dropped, 2);
+    sl_can_health_t h;
+    assert_int_equal(sl_can_decode_health(&rec.can[before + 1], &h), SL_OK);
+    assert_true((h.fault & SL_CAN_FAULT_CAN_OUTPUT_ERRORS) != 0U);
     assert_int_equal(sl_can_e2e_check(&rx, SL_CAN_DATA_ID_STATUS, &rec.can[before]), SL_OK);
     assert_int_equal(rx.stats.lost_frames, 1); // the refused frame used its counter value
 }
@@ -979,10 +992,10 @@ static void test_pipeline_adds_port_drops_saturating_into_the_next_status(void *
     rec.busy_every = 1;
     assert_int_equal(sl_pipeline_send_status(&pl, 2000U), SL_OK);
     rec.busy_every = 0;
-    assert_int_equal(pl.stats.can_dropped, 8);
-    sl_pipeline_add_can_dropped(&pl, 300); // 308: above the 8-bit field
+    assert_int_equal(pl.stats.can_dropped, 9); // Status and Health refused
+    sl_pipeline_add_can_dropped(&pl, 299); // 308: above the 8-bit field
     assert_int_equal(sl_pipeline_send_status(&pl, 3000U), SL_OK);
-    assert_int_equal(sl_can_decode_status(&rec.can[1], &st), SL_OK);
+    assert_int_equal(sl_can_decode_status(&rec.can[2], &st), SL_OK);
     assert_int_equal(st.can_dropped, 255);
     assert_true(st.saturated);
     // The 32-bit total saturates instead of wrapping to a small number.
@@ -993,7 +1006,7 @@ static void test_pipeline_adds_port_drops_saturating_into_the_next_status(void *
     sl_pipeline_add_can_dropped(&pl, UINT32_MAX);
     assert_int_equal(pl.stats.can_dropped, UINT32_MAX);
     assert_int_equal(sl_pipeline_send_status(&pl, 4000U), SL_OK);
-    assert_int_equal(sl_can_decode_status(&rec.can[2], &st), SL_OK);
+    assert_int_equal(sl_can_decode_status(&rec.can[4], &st), SL_OK);
     assert_int_equal(st.can_dropped, 255);
     assert_true(st.saturated);
 }

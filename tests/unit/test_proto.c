@@ -504,6 +504,174 @@ static void test_proto_resyncs_after_nasty_junk_for_every_chunking(void **state)
     free(s);
 }
 
+// Long runs of the junk the fast resync skips by windows (zero fill, 0xFE runs, repeated
+// signature prefixes of every length 1..15, random bytes, signatures with bad headers) before
+// every message: the events and counters are those of the byte-at-a-time decoder for every
+// chunk size 1..70 and random chunkings, and every message is found at its offset.
+static size_t make_long_junk(uint8_t *out, unsigned kind, uint64_t seed)
+{
+    uint64_t s = seed * 0x9E3779B97F4A7C15ULL + 3;
+    size_t o = 0;
+    const size_t want = 300 + rng_next(&s) % 700;
+    while (o < want) {
+        switch (kind % 5) {
+        case 0: out[o++] = 0x00; break;
+        case 1: out[o++] = 0xFE; break;
+        case 2: { // prefix of length 1..15, repeated
+            const size_t k = 1 + (kind / 5) % 15;
+            memcpy(out + o, sl_proto_signature, k);
+            o += k;
+            break;
+        }
+        case 3: out[o++] = (uint8_t)rng_next(&s); break;
+        default: // whole signature, version 0, then the same again
+            memcpy(out + o, sl_proto_signature, 16);
+            memset(out + o + 16, 0, 6);
+            o += 22;
+            break;
+        }
+    }
+    return o;
+}
+
+static void test_proto_long_junk_runs_same_events_for_every_chunking(void **state)
+{
+    (void)state;
+    sl_golden_params_t g = small_params();
+    g.rotations = 1;
+    g.azimuths = 8;
+    size_t n;
+    uint8_t *s = build(&g, &n);
+    ev_t *want = calloc(4096, sizeof *want);
+    const size_t nw = expected_events(&g, s, want);
+    uint8_t *mix = malloc(n + nw * 1100 + 1100);
+    size_t *junk_before = calloc(nw + 1, sizeof *junk_before);
+    size_t o = 0, total_junk = 0;
+    for (size_t i = 0; i < nw; i++) {
+        const size_t j = make_long_junk(mix + o, (unsigned)i, 77 + i);
+        o += j;
+        total_junk += j;
+        junk_before[i] = total_junk;
+        memcpy(mix + o, s + want[i].offset, 22 + want[i].size);
+        o += 22 + want[i].size;
+    }
+    const size_t tail = make_long_junk(mix + o, 2, 5); // trailing partial signatures
+    o += tail;
+    dec_t bytes;
+    dec_init(&bytes, 4096, 4096);
+    for (size_t i = 0; i < o; i++) {
+        feed(&bytes, mix + i, 1);
+    }
+    assert_int_equal(bytes.rec.n, nw);
+    for (size_t i = 0; i < nw; i++) {
+        assert_int_equal(bytes.rec.ev[i].offset, want[i].offset + junk_before[i]);
+        assert_true(bytes.rec.ev[i].hash == want[i].hash);
+    }
+    for (size_t chunk = 2; chunk <= 70; chunk++) {
+        dec_t d;
+        dec_init(&d, 4096, 4096);
+        for (size_t i = 0; i < o; i += chunk) {
+            feed(&d, mix + i, (o - i < chunk) ? o - i : chunk);
+        }
+        assert_same_events(&bytes.rec, &d.rec);
+        assert_same_stats(&bytes.p.stats, &d.p.stats);
+        assert_int_equal(sl_proto_buffered(&d.p), sl_proto_buffered(&bytes.p));
+        dec_free(&d);
+    }
+    for (uint64_t seed = 1; seed <= 30; seed++) {
+        dec_t d;
+        dec_init(&d, 4096, 4096);
+        feed_random_chunks(&d, mix, o, seed);
+        assert_same_events(&bytes.rec, &d.rec);
+        assert_same_stats(&bytes.p.stats, &d.p.stats);
+        dec_free(&d);
+    }
+    dec_t whole;
+    dec_init(&whole, 4096, 4096);
+    feed(&whole, mix, o);
+    assert_same_events(&bytes.rec, &whole.rec);
+    assert_same_stats(&bytes.p.stats, &whole.p.stats);
+    assert_int_equal(whole.p.stats.bytes_skipped + sl_proto_buffered(&whole.p), total_junk + tail);
+    dec_free(&whole);
+    dec_free(&bytes);
+    free(junk_before);
+    free(mix);
+    free(want);
+    free(s);
+}
+
+// An odd-length 16-bit FFT message is malformed whatever the reassembly size it is
+// truncated to (odd or even, longer or shorter than the message), and an even one is
+// accepted in every case: the verdict depends on the message as sent only.
+// What the decoder delivers for a reassembly size `reasm` (payload cut to reasm bytes when
+// longer), built by hand, then parsed.
+static sl_err_t parse16_with(const uint8_t *m, size_t n, size_t reasm, sl_proto_fft_t *out)
+{
+    sl_proto_msg_t got;
+    memset(&got, 0, sizeof got);
+    const uint32_t wire = (uint32_t)(n - SL_PROTO_HEADER_BYTES);
+    got.id = m[17];
+    got.truncated = wire > reasm;
+    got.wire_bytes = wire;
+    got.payload.data = m + SL_PROTO_HEADER_BYTES;
+    got.payload.size = got.truncated ? reasm : wire;
+    return sl_proto_parse_fft(&got, out);
+}
+
+static uint32_t g_odd_seen;
+static sl_err_t g_odd_err[2];
+static void odd_on_msg(void *ctx, const sl_proto_msg_t *m)
+{
+    (void)ctx;
+    sl_proto_fft_t f;
+    if (g_odd_seen < 2) {
+        g_odd_err[g_odd_seen] = sl_proto_parse_fft(m, &f);
+    }
+    g_odd_seen++;
+}
+
+static void test_proto_odd_16_bit_fft_is_malformed_for_every_reassembly_size(void **state)
+{
+    (void)state;
+    static uint16_t bins[300];
+    for (int odd = 0; odd < 2; odd++) {
+        uint8_t m[22 + 14 + 600 + 1];
+        const sl_proto_fft_t f = {.sweep_counter = 1, .azimuth_ticks = 14, .bins = 300};
+        sl_ssize_t k = sl_proto_encode_fft16(m, sizeof m, &f, bins);
+        assert_true(k > 0);
+        size_t n = (size_t)k;
+        if (odd) {
+            m[n++] = 0xAB; // one stray byte: 601 bin bytes
+            const uint32_t len = (uint32_t)(n - 22);
+            m[18] = (uint8_t)(len >> 24);
+            m[19] = (uint8_t)(len >> 16);
+            m[20] = (uint8_t)(len >> 8);
+            m[21] = (uint8_t)len;
+        }
+        for (size_t reasm = 15; reasm <= 700; reasm += 1) {
+            sl_proto_fft_t out;
+            const sl_err_t e = parse16_with(m, n, reasm, &out);
+            assert_int_equal(e, odd ? SL_ERR_MALFORMED : SL_OK);
+            if (!odd) {
+                assert_true(out.bins <= 300);
+            }
+        }
+        // Through the decoder itself, whole and truncated.
+        for (size_t reasm = 64; reasm <= 1024; reasm += 61) {
+            uint8_t *buf = malloc(reasm);
+            sl_proto_t p;
+            const sl_proto_cfg_t c = {.reasm_buf = buf, .reasm_size = reasm,
+                                      .truncate_long = true, .on_msg = odd_on_msg};
+            assert_int_equal(sl_proto_init(&p, &c), SL_OK);
+            g_odd_seen = 0;
+            assert_int_equal(sl_proto_feed(&p, m, n, 0), SL_OK);
+            assert_int_equal(g_odd_seen, 1);
+            assert_int_equal(g_odd_err[0], odd ? SL_ERR_MALFORMED : SL_OK);
+            free(buf);
+        }
+    }
+}
+
 static size_t keep_alive_at(uint8_t *b)
 {
     return (size_t)sl_proto_encode_keep_alive(b, 22);
@@ -1113,6 +1281,8 @@ int main(void)
         cmocka_unit_test(test_proto_gives_identical_events_for_random_chunkings),
         cmocka_unit_test(test_proto_gives_identical_events_for_every_two_chunk_split),
         cmocka_unit_test(test_proto_resyncs_after_nasty_junk_for_every_chunking),
+        cmocka_unit_test(test_proto_long_junk_runs_same_events_for_every_chunking),
+        cmocka_unit_test(test_proto_odd_16_bit_fft_is_malformed_for_every_reassembly_size),
         cmocka_unit_test(test_proto_finds_a_signature_split_across_chunks),
         cmocka_unit_test(test_proto_finds_a_signature_right_after_a_partial_signature),
         cmocka_unit_test(test_proto_rejects_a_wrong_version_and_finds_a_message_inside_its_header),

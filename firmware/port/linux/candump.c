@@ -341,14 +341,20 @@ sl_err_t sld_candump_send(sld_candump_t *c, const sl_can_frame_t *f)
         return SL_ERR_PORT;
     }
     c->stats.sent++;
+    c->unflushed++;
     return SL_OK;
 }
 
 void sld_candump_flush(sld_candump_t *c)
 {
-    if (c->fp != NULL && !c->broken_pipe && fflush(c->fp) != 0) {
-        count_io_error(c);
+    if (c->fp == NULL || c->broken_pipe) {
+        return;
     }
+    if (fflush(c->fp) != 0) {
+        count_io_error(c);
+        c->stats.dropped += c->unflushed; // buffered lines that never reached the file
+    }
+    c->unflushed = 0;
 }
 
 void sld_candump_close(sld_candump_t *c)

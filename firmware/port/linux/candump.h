@@ -79,7 +79,9 @@ typedef struct sld_candump {
     char iface[16];
     uint64_t stamp_us;        ///< timestamp of the next line (set by the owner)
     int last_errno;
-    sl_can_sink_stats_t stats;///< sent = lines, dropped, errors = I/O errors
+    uint32_t unflushed;       ///< lines written since the last successful flush
+    sl_can_sink_stats_t stats;///< sent = lines, dropped (incl. lines a failed flush lost),
+                              ///< errors = I/O errors
 } sld_candump_t;
 
 /// Open (truncate) `path`, "-" = stdout. @return SL_OK, SL_ERR_ARG (bad iface), SL_ERR_PORT

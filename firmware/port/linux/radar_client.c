@@ -30,6 +30,7 @@ void sl_radar_client_cfg_defaults(sl_radar_client_cfg_t *cfg)
     cfg->port = 6317;
     cfg->connect_timeout_ms = 2000;
     cfg->silence_timeout_ms = 3000;
+    cfg->data_timeout_ms = 3000;
     cfg->config_request_ms = 1000;
     cfg->config_timeout_ms = 5000;
     cfg->backoff_initial_ms = 100;
@@ -58,6 +59,7 @@ const char *sl_radar_reason_str(sl_radar_reason_t r)
     case SL_RADAR_REASON_CONFIG_TIMEOUT: return "CONFIG_TIMEOUT";
     case SL_RADAR_REASON_CONNECT_TIMEOUT: return "CONNECT_TIMEOUT";
     case SL_RADAR_REASON_STOP: return "STOP";
+    case SL_RADAR_REASON_NO_DATA: return "NO_DATA";
     }
     return "?";
 }
@@ -91,6 +93,7 @@ static void close_socket(sl_radar_client_t *c)
     c->tx_len = 0;
     c->have_config = false;
     c->config_requested = false;
+    c->data_restarted = false;
 }
 
 // Drop the connection (or failed attempt) and schedule the next attempt after the backoff.
@@ -163,19 +166,28 @@ static void on_proto_msg(void *ctx, const sl_proto_msg_t *msg)
         c->stats.keep_alives++;
         break;
     case SL_PROTO_ID_FFT_DATA:
-    case SL_PROTO_ID_FFT_DATA_16:
+    case SL_PROTO_ID_FFT_DATA_16: {
         c->stats.fft_messages++;
+        sl_proto_fft_t f;
+        if (sl_proto_parse_fft(msg, &f) == SL_OK && f.bins > 0U) {
+            c->stats.usable_fft++;
+            c->last_data_us = c->now_us;
+            c->data_restarted = false;
+            // A healthy session (usable data, not just a Configuration): the next failure
+            // starts again from the initial backoff.
+            c->stats.backoff_ms = c->cfg.backoff_initial_ms;
+        }
         break;
+    }
     case SL_PROTO_ID_CONFIGURATION:
         c->stats.configs++;
-        // A healthy session: the next failure starts again from the initial backoff.
-        c->stats.backoff_ms = c->cfg.backoff_initial_ms;
         if (c->fd >= 0 && !c->have_config) {
             c->have_config = true;
             queue_command(c, c->cfg.non_contour ? (uint8_t)SL_PROTO_ID_START_NONCONTOUR_FFT
                                                 : (uint8_t)SL_PROTO_ID_START_FFT);
             c->stats.starts_sent++;
             c->state = SL_RADAR_STREAMING;
+            c->last_data_us = c->now_us; // the watchdog measures from Start FFT
         }
         emit(c, SL_RADAR_EV_CONFIG, SL_RADAR_REASON_NONE);
         break;
@@ -287,6 +299,10 @@ static uint64_t next_deadline(const sl_radar_client_t *c)
     case SL_RADAR_STREAMING:
         if (c->cfg.silence_timeout_ms > 0U) {
             const uint64_t t = c->last_rx_us + ms_to_us(c->cfg.silence_timeout_ms);
+            d = t < d ? t : d;
+        }
+        if (c->state == SL_RADAR_STREAMING && c->cfg.data_timeout_ms > 0U) {
+            const uint64_t t = c->last_data_us + ms_to_us(c->cfg.data_timeout_ms);
             d = t < d ? t : d;
         }
         break;
@@ -442,6 +458,23 @@ sl_err_t sl_radar_client_handle(sl_radar_client_t *c, short revents, uint64_t no
             now_us >= c->last_rx_us + ms_to_us(c->cfg.silence_timeout_ms)) {
             c->stats.silence_timeouts++;
             drop(c, SL_RADAR_EV_DISCONNECTED, SL_RADAR_REASON_SILENCE);
+            break;
+        }
+        if (c->fd >= 0 && c->state == SL_RADAR_STREAMING && c->cfg.data_timeout_ms > 0U &&
+            now_us >= c->last_data_us + ms_to_us(c->cfg.data_timeout_ms)) {
+            if (!c->data_restarted) {
+                // Bytes but no usable rows: ask for the data again, once.
+                c->data_restarted = true;
+                c->stats.data_restarts++;
+                c->last_data_us = now_us;
+                queue_command(c, c->cfg.non_contour ? (uint8_t)SL_PROTO_ID_START_NONCONTOUR_FFT
+                                                    : (uint8_t)SL_PROTO_ID_START_FFT);
+                c->stats.starts_sent++;
+                try_send(c);
+            } else {
+                c->stats.data_timeouts++;
+                drop(c, SL_RADAR_EV_DISCONNECTED, SL_RADAR_REASON_NO_DATA);
+            }
         }
         break;
     }

@@ -11,11 +11,17 @@
 ///   `non_contour` is set: FFT data then flows;
 /// - feeds every received byte into the core decoder (`sl_proto`, byte-wise resync) and
 ///   hands each decoded message to `on_msg`;
+/// - data watchdog: while streaming, when no usable FFT row (an FFT message that parses and
+///   holds at least one bin) arrived for `data_timeout_ms` (keep-alives only, a byte
+///   trickle, malformed FFT messages), sends Start FFT again once (`stats.data_restarts`);
+///   if still nothing usable after another `data_timeout_ms`, drops the connection
+///   (`SL_RADAR_REASON_NO_DATA`, `stats.data_timeouts`) and reconnects with the backoff;
 /// - treats a silent radar (no byte at all, keep-alives included, for `silence_timeout_ms`),
 ///   EOF, socket errors and connect failures alike: close, `sl_proto_finish()` (a partial
 ///   message is counted as truncated), event, then reconnect after a backoff that starts at
 ///   `backoff_initial_ms` and doubles up to `backoff_max_ms`; the backoff returns to its
-///   initial value each time a Configuration arrives (a healthy session);
+///   initial value each time a usable FFT message arrives (a healthy session; a radar that
+///   only sends its Configuration and keep-alives keeps backing off);
 /// - on `sl_radar_client_stop()`, sends Stop FFT (22) when streaming and closes.
 /// Everything is counted in `stats` (and the decoder's `proto.stats`).
 ///
@@ -86,6 +92,7 @@ typedef enum sl_radar_reason {
     SL_RADAR_REASON_CONFIG_TIMEOUT = 4,  ///< no Configuration within config_timeout_ms
     SL_RADAR_REASON_CONNECT_TIMEOUT = 5, ///< connect() not done within connect_timeout_ms
     SL_RADAR_REASON_STOP = 6,            ///< the application stopped the client
+    SL_RADAR_REASON_NO_DATA = 7,         ///< bytes but no usable FFT row (data watchdog)
 } sl_radar_reason_t;
 
 /// Decoded message callback: same contract as `sl_proto_on_msg_fn` (the message and its
@@ -105,6 +112,7 @@ typedef struct sl_radar_client_cfg {
     uint16_t port;                 ///< TCP port (radar default 6317)
     uint32_t connect_timeout_ms;   ///< default 2000
     uint32_t silence_timeout_ms;   ///< default 3000; 0 = never (not recommended)
+    uint32_t data_timeout_ms;      ///< data watchdog (above); default 3000; 0 = never
     uint32_t config_request_ms;    ///< send id 20 once after this long; 0 = never. Default 1000
     uint32_t config_timeout_ms;    ///< default 5000; 0 = never
     uint32_t backoff_initial_ms;   ///< default 100 (>= 1)
@@ -130,6 +138,9 @@ typedef struct sl_radar_client_stats {
     uint32_t disconnects_eof;   ///< the radar closed (recv() == 0)
     uint32_t disconnects_error; ///< recv()/send() error on an established connection
     uint32_t silence_timeouts;  ///< connections dropped because the radar went silent
+    uint32_t data_restarts;     ///< Start FFT re-sent by the data watchdog
+    uint32_t data_timeouts;     ///< connections dropped by the data watchdog
+    uint32_t usable_fft;        ///< FFT messages that parse and hold at least one bin
     uint32_t config_timeouts;   ///< connections dropped waiting for the Configuration
     uint32_t configs;           ///< Configuration messages received
     uint32_t config_requests;   ///< Configuration Requests (20) sent
@@ -160,6 +171,9 @@ typedef struct sl_radar_client {
     unsigned next_addr;
     uint64_t deadline_us;              ///< backoff end / connect timeout (state-dependent)
     uint64_t last_rx_us;               ///< time of the last received byte
+    uint64_t last_data_us;             ///< time of the last usable FFT message (or of the
+                                       ///< Start FFT the watchdog measures from)
+    bool data_restarted;               ///< the watchdog re-sent Start FFT on this connection
     uint64_t connected_us;             ///< time the connection was established
     bool config_requested;             ///< id 20 already sent on this connection
     bool have_config;                  ///< a Configuration arrived on this connection
