@@ -469,7 +469,9 @@ sl_err_t sl_proto_parse_fft(const sl_proto_msg_t *msg, sl_proto_fft_t *out)
     }
     const uint8_t bpb = (msg->id == SL_PROTO_ID_FFT_DATA_16) ? 2U : 1U;
     const size_t nbytes = size - off;
-    if ((nbytes % bpb) != 0U) {
+    // bpb is 1 or 2: shifts, not divisions (this runs once per azimuth).
+    const unsigned bpb_log2 = bpb - 1U;
+    if ((nbytes & (size_t)bpb_log2) != 0U) {
         return SL_ERR_MALFORMED;
     }
     out->id = msg->id;
@@ -479,7 +481,7 @@ sl_err_t sl_proto_parse_fft(const sl_proto_msg_t *msg, sl_proto_fft_t *out)
     out->azimuth_ticks = sl_get_be16(d + 4);
     out->seconds = sl_get_le32(d + 6);
     out->split_ns = sl_get_le32(d + 10);
-    out->bins = (uint32_t)(nbytes / bpb);
+    out->bins = (uint32_t)(nbytes >> bpb_log2);
     out->bin_data = d + off;
     return SL_OK;
 }

@@ -139,6 +139,28 @@ static void test_scan_maps_encoder_values_to_the_azimuth_cell_containing_them(vo
     }
 }
 
+// The per-azimuth index uses a reciprocal set with the geometry (no division): it must
+// equal the division for every encoder value, on geometries from the CTS350-X's to the
+// extremes (one azimuth per tick, 16-bit encoders, coprime sizes, azimuths > encoder values).
+static void test_scan_reciprocal_index_equals_the_division_for_every_encoder_value(void **state)
+{
+    (void)state;
+    static const uint16_t geo[][2] = {{400, 5600}, {400, 65535}, {400, 400},  {7, 13},
+                                      {399, 65521}, {8, 65535},  {400, 401},  {400, 399},
+                                      {256, 4096},  {360, 5760}, {400, 1},    {13, 7}};
+    for (size_t g = 0; g < sizeof geo / sizeof geo[0]; g++) {
+        sl_scan_t s;
+        scan_init(&s, 64, false, geo[g][0], geo[g][1]);
+        for (uint32_t t = 0; t <= 65535U; t++) {
+            const int32_t want = sl_scan_az_index(geo[g][0], geo[g][1], (uint16_t)t);
+            if (sl_scan_az_index_geo(&s, (uint16_t)t) != want) {
+                fail_msg("geometry %u/%u ticks %u: %d != %d", geo[g][0], geo[g][1], t,
+                         sl_scan_az_index_geo(&s, (uint16_t)t), want);
+            }
+        }
+    }
+}
+
 static void test_scan_completes_a_frame_when_the_azimuth_index_wraps(void **state)
 {
     (void)state;
@@ -911,6 +933,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_scan_maps_encoder_values_to_the_azimuth_cell_containing_them),
+        cmocka_unit_test(test_scan_reciprocal_index_equals_the_division_for_every_encoder_value),
         cmocka_unit_test(test_scan_completes_a_frame_when_the_azimuth_index_wraps),
         cmocka_unit_test(test_scan_oxford_png_rows_fill_exactly_one_frame),
         cmocka_unit_test(test_scan_counts_and_zero_fills_missing_azimuths),
