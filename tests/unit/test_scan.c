@@ -161,6 +161,27 @@ static void test_scan_reciprocal_index_equals_the_division_for_every_encoder_val
     }
 }
 
+// sl_proto_fft_time_us() divides split_ns by 1000 with a multiply: exact at the edges of
+// every 1000-block over the whole 32-bit range (the proof is in sl_proto.h).
+static void test_scan_timestamp_us_multiply_equals_the_division(void **state)
+{
+    (void)state;
+    sl_proto_fft_t f = fft8(0, 0, g_bins, 0);
+    f.seconds = 1700000000U;
+    for (uint64_t b = 0; b <= UINT32_MAX; b += 999983U) { // a prime stride over 2^32
+        for (uint32_t d = 0; d < 2000U && b + d <= UINT32_MAX; d++) {
+            f.split_ns = (uint32_t)(b + d);
+            const uint64_t want = 1700000000ULL * 1000000ULL + (uint64_t)f.split_ns / 1000U;
+            assert_true(sl_proto_fft_time_us(&f) == want);
+        }
+    }
+    const uint32_t edge[] = {0U, 999U, 1000U, 999999999U, 1000000000U, UINT32_MAX - 1U, UINT32_MAX};
+    for (size_t i = 0; i < sizeof edge / sizeof edge[0]; i++) {
+        f.split_ns = edge[i];
+        assert_true(sl_proto_fft_time_us(&f) == 1700000000ULL * 1000000ULL + edge[i] / 1000U);
+    }
+}
+
 static void test_scan_completes_a_frame_when_the_azimuth_index_wraps(void **state)
 {
     (void)state;
@@ -934,6 +955,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_scan_maps_encoder_values_to_the_azimuth_cell_containing_them),
         cmocka_unit_test(test_scan_reciprocal_index_equals_the_division_for_every_encoder_value),
+        cmocka_unit_test(test_scan_timestamp_us_multiply_equals_the_division),
         cmocka_unit_test(test_scan_completes_a_frame_when_the_azimuth_index_wraps),
         cmocka_unit_test(test_scan_oxford_png_rows_fill_exactly_one_frame),
         cmocka_unit_test(test_scan_counts_and_zero_fills_missing_azimuths),
