@@ -10,3 +10,4 @@ set(SL_SIZE arm-none-eabi-size CACHE STRING "")
 # (mps2-an385 is a Cortex-M3: QEMU has no Cortex-M0 board; ARMv6-M code runs on it unchanged).
 set(SL_FW_CPU cortex-m0 CACHE STRING "")
 set(SL_FW_MACHINE mps2-an385 CACHE STRING "")
+set(SL_CPU_TAG cortex-m0 CACHE STRING "CPU column of firmware/size_budget.txt")
