@@ -470,7 +470,7 @@ sl_err_t sl_proto_parse_fft(const sl_proto_msg_t *msg, sl_proto_fft_t *out)
     const uint8_t bpb = (msg->id == SL_PROTO_ID_FFT_DATA_16) ? 2U : 1U;
     const size_t nbytes = size - off;
     // bpb is 1 or 2: shifts, not divisions (this runs once per azimuth).
-    const unsigned bpb_log2 = bpb - 1U;
+    const uint32_t bpb_log2 = (uint32_t)bpb - 1U;
     if ((nbytes & (size_t)bpb_log2) != 0U) {
         return SL_ERR_MALFORMED;
     }
