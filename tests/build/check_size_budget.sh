@@ -35,11 +35,11 @@ printf '%s\n' "$rows" | awk -v cpu="$CPU" -v bf="$BUDGET" '
         if (i == 0) { print "check_size_budget: no budget row for " $1; bad = 1; next }
         printf "%-26s %6d/%-7d %6d/%-7d %10d %10d\n", $1, $2, bt[i], $3, br[i], $4, $5
         chk($1, "text", $2, bt[i]); chk($1, "rodata", $3, br[i]); chk($1, "data", $4, bd[i]); chk($1, "bss", $5, bb[i])
-        if ($1 != "image") { st += $2; sr += $3; sd += $4; sb += $5 }
+        if ($1 != "image") { st += $2; sr += $3; sd += $4; sb += $5; na++ }
     }
     END {
         if (nb == 0) exit 2
-        for (i = 1; i <= nb; i++) if (pat[i] == "TOTAL") {
+        for (i = 1; i <= nb; i++) if (pat[i] == "TOTAL" && na > 0) {
             printf "%-26s %6d/%-7d %6d/%-7d %10d %10d\n", "TOTAL (archive)", st, bt[i], sr, br[i], sd, sb
             chk("TOTAL", "text", st, bt[i]); chk("TOTAL", "rodata", sr, br[i]); chk("TOTAL", "data", sd, bd[i]); chk("TOTAL", "bss", sb, bb[i])
         }
