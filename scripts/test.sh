@@ -31,9 +31,9 @@ run_ctest() { # ctest args...: keeps ctest's summary lines for the closing total
     return $rc
 }
 firmware_figures() { # re-runs the few firmware tests verbosely (seconds) for their figures
-    ctest --preset host -R "thumb_run|check_stack_cortex|check_size_budget_cortex_m" -V > "$CTLOG.fw" 2>&1
+    ctest --preset host -R "thumb_run|thumb_oxford_m|check_stack_cortex|check_size_budget_cortex_m" -V > "$CTLOG.fw" 2>&1
     rc=$?
-    sed -n 's/^[0-9]*: \(thumb: .*\|stack: .*\|.*TOTAL (archive).*\|image .*\|check_size_budget: .*\)$/  \1/p' "$CTLOG.fw"
+    sed -n 's/^[0-9]*: \(thumb: .*\|stack: .*\|.*TOTAL (core.*\|image .*\|check_size_budget: .*\)$/  \1/p' "$CTLOG.fw"
     grep -E "tests passed, [0-9]+ tests? failed out of [0-9]+" "$CTLOG.fw" >> "$CTLOG" || true
     rm -f "$CTLOG.fw"
     return $rc

@@ -1,6 +1,7 @@
 // The example firmware's main (QEMU MPS2 boards): calibrates SysTick against a loop of known
-// instruction count, runs the core pipeline over the capture linked into flash (fw_app.c),
-// and reports over semihosting:
+// instruction count, runs the core pipeline over the capture linked into flash (fw_app.c)
+// or, when QEMU placed one in the board's 16 MB PSRAM, over that one (a capture too
+// large for flash, e.g. the Oxford scans: see PSRAM_* below), and reports over semihosting:
 //   the frames and rotations (compared with the host's by ctest, label thumb),
 //   "thumb: <cpu> <N> instructions per azimuth", the stack high-water mark, RAM of the pipeline.
 // Exit status 0 when the run completed.
@@ -9,6 +10,7 @@
 
 #include "fw_app.h"
 #include "mps2.h"
+#include "shadowlean/sl_board.h"
 #include "shadowlean/sl_pipeline.h"
 
 #ifndef SL_FW_CPU
@@ -20,6 +22,17 @@
 #define CAL_LOOPS 1000000U // 2 instructions each (subs + bne)
 
 extern const uint8_t fw_capture[], fw_capture_end[];
+
+// A capture in PSRAM (MPS2: 16 MB at 0x21000000), put there by QEMU's generic loader:
+//   -device loader,addr=0x21000000,data=0x50434c53,data-len=4     magic "SLCP"
+//   -device loader,addr=0x21000004,data=<bytes>,data-len=4        length
+//   -device loader,addr=0x21000008,data=<i>,data-len=4            board: sl_board_at(i)
+//   -device loader,addr=0x2100000c,data=<n>,data-len=4            feed chunk (0: 1460)
+//   -device loader,file=<capture>,addr=0x21000010,force-raw=on    the bytes
+#define PSRAM_BASE 0x21000000U
+#define PSRAM_MAGIC 0x50434c53U
+#define PSRAM_DATA (PSRAM_BASE + 16U)
+#define PSRAM_MAX (0x01000000U - 16U)
 extern uint32_t _sstack, _estack;
 
 void mps2_calib_loop(uint32_t n); // calib.S: 2 n instructions
@@ -54,9 +67,31 @@ int main(void)
     const uint32_t cal = calibrate();
     const fw_platform_t pf = {mps2_write, mps2_ticks, 0x00FFFFFFU};
     fw_result_t res;
-    const size_t len = (size_t)(fw_capture_end - fw_capture);
-    line2("capture ", len, " bytes in flash\n");
-    const sl_err_t e = fw_app_run(&pf, SL_FW_BOARD, fw_capture, len, 1460U, &res);
+    const uint8_t *cap = fw_capture;
+    size_t len = (size_t)(fw_capture_end - fw_capture);
+    const char *board = SL_FW_BOARD;
+    size_t chunk = 1460U; // a TCP segment
+    const volatile uint32_t *hdr = (const volatile uint32_t *)PSRAM_BASE;
+    if (hdr[0] == PSRAM_MAGIC && hdr[1] <= PSRAM_MAX) { // QEMU's loader put one there
+        const sl_board_t *b = sl_board_at(hdr[2]);
+        if (b == NULL) {
+            mps2_write("PSRAM capture: no such board index\n");
+            return 1;
+        }
+        cap = (const uint8_t *)PSRAM_DATA;
+        len = hdr[1];
+        board = b->name;
+        if (hdr[3] != 0U) {
+            chunk = hdr[3];
+        }
+        line2("capture ", len, " bytes in PSRAM, board ");
+        mps2_write(board);
+        mps2_write("\n");
+    } else {
+        line2("capture ", len, " bytes in flash\n");
+    }
+    line2("feed chunks of ", chunk, " bytes\n");
+    const sl_err_t e = fw_app_run(&pf, board, cap, len, chunk, &res);
     if (e != SL_OK) {
         mps2_write("fw_app_run failed: ");
         mps2_write(sl_err_str(e));
