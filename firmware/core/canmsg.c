@@ -179,6 +179,7 @@ static void put_sig(uint8_t d[8], const sl_can_signal_desc_t *s, int64_t raw)
 /// Read a field as its raw value (sign-extended for signed signals).
 static int64_t get_sig(const uint8_t d[8], const sl_can_signal_desc_t *s)
 {
+    SL_ASSERT(s->length >= 1U && s->length <= 32U); // layout table invariant
     const uint32_t v = get_bits(d, s->start, s->length);
     if (s->is_signed && ((v >> (s->length - 1U)) & 1U) != 0U) {
         return (int64_t)v - ((int64_t)1 << s->length);

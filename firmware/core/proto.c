@@ -540,12 +540,15 @@ sl_err_t sl_proto_parse_fft(const sl_proto_msg_t *msg, sl_proto_fft_t *out)
     }
     const uint8_t bpb = (msg->id == SL_PROTO_ID_FFT_DATA_16) ? 2U : 1U;
     // Parity of the message as sent, not of the prefix kept: an odd-length 16-bit message
-    // is malformed whatever the reassembly size it was truncated to.
+    // is malformed whatever the reassembly size it was truncated to. bpb is 1 or 2: masks
+    // and shifts, not divisions (this runs once per azimuth).
+    const uint32_t bpb_log2 = (uint32_t)bpb - 1U;
     const size_t wire = (msg->truncated && msg->wire_bytes > size) ? msg->wire_bytes : size;
-    if (((wire - off) % bpb) != 0U) {
+    if (((wire - off) & (size_t)bpb_log2) != 0U) {
         return SL_ERR_MALFORMED;
     }
-    const size_t nbytes = (size - off) - ((size - off) % bpb);
+    // A truncated 16-bit message may have kept an odd prefix: whole bins only.
+    const size_t nbytes = (size - off) & ~(size_t)bpb_log2;
     out->id = msg->id;
     out->bytes_per_bin = bpb;
     out->data_offset = off;
@@ -553,7 +556,7 @@ sl_err_t sl_proto_parse_fft(const sl_proto_msg_t *msg, sl_proto_fft_t *out)
     out->azimuth_ticks = sl_get_be16(d + 4);
     out->seconds = sl_get_le32(d + 6);
     out->split_ns = sl_get_le32(d + 10);
-    out->bins = (uint32_t)(nbytes / bpb);
+    out->bins = (uint32_t)(nbytes >> bpb_log2);
     out->bin_data = d + off;
     return SL_OK;
 }

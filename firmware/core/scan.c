@@ -19,6 +19,30 @@ int32_t sl_scan_az_index(uint16_t azimuths, uint16_t encoder_size, uint16_t tick
     return (int32_t)idx;
 }
 
+// sl_scan_az_index_geo(): sl_scan_az_index() without a division, for the per-azimuth path:
+// the reciprocal recip = floor(az 2^16 / enc) is set with the geometry (az <= enc).
+// est = ticks recip / 2^16 is idx or idx - 1 (recip is low by < 1, times ticks / 2^16 < 1),
+// and one compare fixes it. All products < 2^32: ticks < 2^16, recip <= 2^16 when
+// az <= enc, idx < az <= 4096.
+int32_t sl_scan_az_index_geo(const sl_scan_t *s, uint16_t ticks)
+{
+    SL_ASSERT(s != NULL);
+    if (s->azimuths == 0U) {
+        return -1;
+    }
+    if (s->az_recip == 0U) {
+        return sl_scan_az_index(s->azimuths, s->encoder_size, ticks);
+    }
+    if (ticks >= s->encoder_size) {
+        return -1;
+    }
+    uint32_t est = ((uint32_t)ticks * s->az_recip) >> 16;
+    if ((est + 1U) * s->encoder_size <= (uint32_t)ticks * s->azimuths) {
+        est++;
+    }
+    return (int32_t)est;
+}
+
 static void frame_clear(sl_scan_frame_t *f)
 {
     memset(f, 0, sizeof *f);
@@ -134,6 +158,9 @@ static void apply_geometry(sl_scan_t *s, uint16_t azimuths, uint16_t encoder_siz
     }
     s->azimuths = azimuths;
     s->encoder_size = encoder_size;
+    s->az_recip = (azimuths <= encoder_size)
+                      ? (uint32_t)(((uint32_t)azimuths << 16) / encoder_size)
+                      : 0U;
     uint16_t w = (s->cfg.reorder_azimuths != 0U) ? s->cfg.reorder_azimuths
                                                  : (uint16_t)(azimuths / 8U);
     const uint16_t wmax = (uint16_t)((azimuths - 1U) / 2U);
@@ -362,7 +389,7 @@ sl_err_t sl_scan_on_fft(sl_scan_t *s, const sl_proto_fft_t *f)
         s->stats.no_config++;
         return SL_ERR_STATE;
     }
-    const int32_t sidx = sl_scan_az_index(s->azimuths, s->encoder_size, f->azimuth_ticks);
+    const int32_t sidx = sl_scan_az_index_geo(s, f->azimuth_ticks);
     if (sidx < 0) {
         s->stats.bad_azimuth++;
         unusable(s);

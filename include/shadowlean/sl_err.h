@@ -15,6 +15,8 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "shadowlean/sl_config.h" // SL_CFG_USER_HEADER may define SL_ASSERT
+
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -44,14 +46,37 @@ typedef struct sl_bytes {
 /// Never NULL; unknown codes give "SL_ERR_?". Cost: O(1).
 const char *sl_err_str(sl_err_t err);
 
+/// @def SL_ASSERT(x)
+/// Caller-bug check (NULL self, impossible state; never input data). Override it for the
+/// whole build, core included, by defining it before any shadowlean header is read:
+/// - in `sl_config_user.h` (tests/unit/assert_user/ is a working example) (with `SL_CFG_USER_HEADER` defined; sl_config.h includes it
+///   and this header includes sl_config.h), e.g.
+///   `#define SL_ASSERT(x) do { if (!(x)) { board_fault(__FILE__, __LINE__); } } while (0)`
+///   where board_fault() is the application's (it must not return into the core);
+/// - or on the compiler command line (`-D'SL_ASSERT(x)=...'`), where the build tool allows
+///   function-like definitions (CMake's compile definitions do not).
+/// The core must see the same definition as the application (compile both with it).
+/// Default: GCC and Clang trap (`__builtin_trap()`: `udf` on Arm, a HardFault the board's
+/// handler reports). Other compilers (IAR, Arm Compiler 5, TASKING, MSVC ...) that define
+/// no `SL_ASSERT` get an endless loop, which stops the caller where a debugger or the
+/// watchdog sees it: define SL_ASSERT for them if that is not what the product wants.
 #ifndef SL_ASSERT
-/// Caller-bug check. Default: trap (no stdio, no OS). Override before including.
+#if defined(__GNUC__) || defined(__clang__)
 #define SL_ASSERT(x)                                                                         \
     do {                                                                                     \
         if (!(x)) {                                                                          \
             __builtin_trap();                                                                \
         }                                                                                    \
     } while (0)
+#else
+#define SL_ASSERT(x)                                                                         \
+    do {                                                                                     \
+        if (!(x)) {                                                                          \
+            for (;;) {                                                                       \
+            }                                                                                \
+        }                                                                                    \
+    } while (0)
+#endif
 #endif
 
 #ifdef __cplusplus

@@ -124,7 +124,31 @@
 ///   of capture for a 535 MB capture (Oxford x32), 30-50 GB/s when it fits the L3 cache;
 ///   a NumPy implementation of the front end (host_tools/bench/reference_numpy.py) does
 ///   ~1.2-1.3 GB/s on the same data (compare.sh: 10-12x).
-/// Stack: < 1 KB plus the port callbacks'. Task context only; not reentrant.
+/// Stack (computed from the call graph by ctest check_stack_cortex_m0/_m4f, libgcc frames
+/// included, Cortex-M -Os firmware configuration): worst case 1,004 B on Cortex-M0 and
+/// 816 B on Cortex-M4F from sl_pipeline_feed(), plus the port callbacks' own stack on top of
+/// at most 664 B (M0) / 552 B (M4F) at their call site. Budget 1,024 B (M0).
+///
+/// ## Execution context: which call may run where
+/// One pipeline belongs to one execution context (a task, or the main loop), the *owner*:
+/// - Owner only, never concurrently with each other: sl_pipeline_init(), _feed(),
+///   _finish(), _on_can_rx(), _set_motion(), _set_link_state(), _send_status(),
+///   _add_can_dropped(). None is reentrant or interrupt-safe: they share the decoder,
+///   tracker, E2E counters and stats without locks.
+/// - Never from an interrupt while the owner may be inside the pipeline. In particular do
+///   not call sl_pipeline_on_can_rx() from the CAN receive ISR: the ISR copies the frame
+///   (sl_can_frame_t, 16 bytes) into a queue, the owner drains it between feeds. Likewise
+///   a CAN TX-complete/error ISR counts drops in its own counter and the owner passes the
+///   total to sl_pipeline_add_can_dropped().
+/// - `port.can_tx` and `port.on_rotation` run in the owner's context, inside the feed /
+///   finish / send_status call that produced them. They must not call back into the same
+///   pipeline, must not block (can_tx: queue into the driver's TX FIFO or return
+///   SL_ERR_BUSY), and their stack adds to the figure above.
+/// - No floating point anywhere in the core (built with -mgeneral-regs-only on Cortex-M,
+///   checked by check_core_no_vfp_cortex_m4f): under an RTOS the owner task needs no FP
+///   context, and the core runs with the FPU still off after reset.
+/// - Different pipelines (separate sl_pipeline_t objects) are independent and may run in
+///   different contexts; the core has no global state (no .data/.bss: size budget).
 #ifndef SHADOWLEAN_SL_PIPELINE_H
 #define SHADOWLEAN_SL_PIPELINE_H
 

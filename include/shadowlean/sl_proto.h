@@ -270,7 +270,11 @@ static inline uint16_t sl_proto_fft_bin16(const sl_proto_fft_t *f, uint32_t i)
 /// FFT timestamp as UNIX microseconds: seconds * 1e6 + split_ns / 1000 (truncated). O(1).
 static inline uint64_t sl_proto_fft_time_us(const sl_proto_fft_t *f)
 {
-    return (uint64_t)f->seconds * 1000000U + (uint64_t)(f->split_ns / 1000U);
+    // split_ns / 1000 as a multiply (once per azimuth; no division helper on ARMv6-M):
+    // m = ceil(2^38 / 1000) = 274877907, m x 1000 - 2^38 = 56 and 56 x 2^32 < 2^38, so
+    // (x m) >> 38 == x / 1000 for every 32-bit x.
+    return (uint64_t)f->seconds * 1000000U +
+           (((uint64_t)f->split_ns * 274877907U) >> 38);
 }
 
 // ------------------------------------------------------------------------------------------

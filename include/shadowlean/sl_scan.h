@@ -261,6 +261,8 @@ typedef struct sl_scan {
     bool in_frame;            ///< `fill` holds at least one row
     uint16_t azimuths;        ///< current geometry (0 = none yet)
     uint16_t encoder_size;
+    uint32_t az_recip;        ///< floor(azimuths 2^16 / encoder_size), set with the geometry
+                              ///< (no division per azimuth); 0: azimuths > encoder_size
     uint16_t window;          ///< effective reorder window
     bool have_sweep;          ///< `last_sweep` valid
     uint16_t last_sweep;      ///< sweep counter of the previous FFT message
@@ -290,6 +292,12 @@ sl_err_t sl_scan_init(sl_scan_t *s, const sl_scan_cfg_t *cfg, sl_scan_frame_t *f
 /// Nearest azimuth index of an encoder value (formula in the file comment), or -1 when
 /// `ticks >= encoder_size`, `azimuths == 0` or `encoder_size == 0`. O(1).
 int32_t sl_scan_az_index(uint16_t azimuths, uint16_t encoder_size, uint16_t ticks);
+
+/// The same index for the scan's current geometry, without a division (the reciprocal
+/// `az_recip` is set when the geometry is): what sl_scan_on_fft() uses per azimuth. Equal
+/// to sl_scan_az_index(s->azimuths, s->encoder_size, ticks) for every input (-1 when there
+/// is no geometry or ticks >= encoder_size). O(1): three 32-bit multiplies.
+int32_t sl_scan_az_index_geo(const sl_scan_t *s, uint16_t ticks);
 
 /// Set the geometry without a Configuration message (e.g. a capture that starts
 /// mid-stream, geometry from the board). Same effect as a config with these values.

@@ -1,5 +1,6 @@
 #!/bin/sh
 # selftest_inject.sh CHECKER NM AR CC CFLAGS ARCHIVE SRC SYMBOL_REGEX [--no-softfloat]
+# (CHECKER is called as CHECKER NM ARCHIVE [MODE]; the VFP check takes objdump as NM.)
 # Proves the symbol check can fail: copies the real core archive, adds one object compiled
 # from SRC (which references a forbidden symbol), and requires the checker to exit 1 and
 # name the symbol. Also requires the untouched copy to pass, so the failure is the

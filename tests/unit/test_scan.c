@@ -139,6 +139,49 @@ static void test_scan_maps_encoder_values_to_the_azimuth_cell_containing_them(vo
     }
 }
 
+// The per-azimuth index uses a reciprocal set with the geometry (no division): it must
+// equal the division for every encoder value, on geometries from the CTS350-X's to the
+// extremes (one azimuth per tick, 16-bit encoders, coprime sizes, azimuths > encoder values).
+static void test_scan_reciprocal_index_equals_the_division_for_every_encoder_value(void **state)
+{
+    (void)state;
+    static const uint16_t geo[][2] = {{400, 5600}, {400, 65535}, {400, 400},  {7, 13},
+                                      {399, 65521}, {8, 65535},  {400, 401},  {400, 399},
+                                      {256, 4096},  {360, 5760}, {400, 1},    {13, 7}};
+    for (size_t g = 0; g < sizeof geo / sizeof geo[0]; g++) {
+        sl_scan_t s;
+        scan_init(&s, 64, false, geo[g][0], geo[g][1]);
+        for (uint32_t t = 0; t <= 65535U; t++) {
+            const int32_t want = sl_scan_az_index(geo[g][0], geo[g][1], (uint16_t)t);
+            if (sl_scan_az_index_geo(&s, (uint16_t)t) != want) {
+                fail_msg("geometry %u/%u ticks %u: %d != %d", geo[g][0], geo[g][1], t,
+                         sl_scan_az_index_geo(&s, (uint16_t)t), want);
+            }
+        }
+    }
+}
+
+// sl_proto_fft_time_us() divides split_ns by 1000 with a multiply: exact at the edges of
+// every 1000-block over the whole 32-bit range (the proof is in sl_proto.h).
+static void test_scan_timestamp_us_multiply_equals_the_division(void **state)
+{
+    (void)state;
+    sl_proto_fft_t f = fft8(0, 0, g_bins, 0);
+    f.seconds = 1700000000U;
+    for (uint64_t b = 0; b <= UINT32_MAX; b += 999983U) { // a prime stride over 2^32
+        for (uint32_t d = 0; d < 2000U && b + d <= UINT32_MAX; d++) {
+            f.split_ns = (uint32_t)(b + d);
+            const uint64_t want = 1700000000ULL * 1000000ULL + (uint64_t)f.split_ns / 1000U;
+            assert_true(sl_proto_fft_time_us(&f) == want);
+        }
+    }
+    const uint32_t edge[] = {0U, 999U, 1000U, 999999999U, 1000000000U, UINT32_MAX - 1U, UINT32_MAX};
+    for (size_t i = 0; i < sizeof edge / sizeof edge[0]; i++) {
+        f.split_ns = edge[i];
+        assert_true(sl_proto_fft_time_us(&f) == 1700000000ULL * 1000000ULL + edge[i] / 1000U);
+    }
+}
+
 static void test_scan_completes_a_frame_when_the_azimuth_index_wraps(void **state)
 {
     (void)state;
@@ -1011,6 +1054,8 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_scan_maps_encoder_values_to_the_azimuth_cell_containing_them),
+        cmocka_unit_test(test_scan_reciprocal_index_equals_the_division_for_every_encoder_value),
+        cmocka_unit_test(test_scan_timestamp_us_multiply_equals_the_division),
         cmocka_unit_test(test_scan_completes_a_frame_when_the_azimuth_index_wraps),
         cmocka_unit_test(test_scan_oxford_png_rows_fill_exactly_one_frame),
         cmocka_unit_test(test_scan_counts_and_zero_fills_missing_azimuths),
