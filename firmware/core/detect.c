@@ -420,7 +420,19 @@ static void finalize(sl_detect_t *d, sl_detect_cand_t *c)
     t.bin_first = rep->first;
     t.bin_last = rep->last;
     t.occupied = rep->count;
-    sl_detect_correct(bd, &d->cfg, az, rep->first, rep->last, t.az_count, &t);
+    // Radius width (D4 of EXTRACTION.md): the contiguous columns around the representative
+    // azimuth whose run covers its first bin (the column at the pole's inner edge), not the
+    // whole group, which a leaning pole widens in bearing along its length.
+    uint32_t lo = best, hi = best;
+    while (lo > 0U && c->run[lo - 1U].count != 0U && c->run[lo - 1U].first <= rep->first &&
+           c->run[lo - 1U].last >= rep->first) {
+        lo--;
+    }
+    while (hi + 1U < span && hi + 1U < SL_CFG_DETECT_MAX_SPAN && c->run[hi + 1U].count != 0U &&
+           c->run[hi + 1U].first <= rep->first && c->run[hi + 1U].last >= rep->first) {
+        hi++;
+    }
+    sl_detect_correct(bd, &d->cfg, az, rep->first, rep->last, (uint16_t)(hi - lo + 1U), &t);
     t.shadow_slant_um = sl_detect_shadow_slant_um(bd, az);
     if ((c->flags & CF_WRAPS) != 0U) {
         t.flags |= SL_TARGET_WRAPS;
