@@ -163,6 +163,11 @@ void sl_detect_correct(const sl_board_t *board, const sl_detect_cfg_t *cfg, uint
         const uint64_t width = (az_count > 0U ? (uint64_t)az_count - 1U : 0U) * step;
         radius = width > beam_bam ? half_arc_um(r1_hb, width - beam_bam) : 0U;
         t->flags |= SL_TARGET_RADIUS_WIDTH;
+        // A beam footprint wider than twice the estimated diameter cannot resolve it: one
+        // azimuth step more or less is then most of the estimate (EXTRACTION.md D4).
+        if (half_arc_um(r1_hb, beam_bam) > 2U * radius) {
+            radius = 0U;
+        }
         if (radius > cfg->max_radius_um) {
             radius = cfg->max_radius_um;
             t->flags |= SL_TARGET_RADIUS_CLAMPED;

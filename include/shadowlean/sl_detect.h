@@ -54,7 +54,8 @@
 ///      edge: az_count here is the number of contiguous azimuths around the representative
 ///      one whose run covers its first bin (a leaning pole spreads in bearing along its
 ///      length, so the whole group's width overstates the diameter; EXTRACTION.md D4),
-///      R = r1 * tan(w / 2) with w = (az_count - 1) * step - beam, the smallest arc consistent with az_count
+///      R = r1 * tan(w / 2) with w = (az_count - 1) * step - beam, set to 0 when the beam's
+///      half footprint r1 * beam / 2 exceeds 2 R (the beam cannot resolve the diameter), the smallest arc consistent with az_count
 ///      azimuth samples less the beam's own spread (small angle; clamped to
 ///      [0, cfg.max_radius_um]; flags RADIUS_WIDTH and RADIUS_CLAMPED). It is biased low on
 ///      purpose: a thin pole seen on 2-3 azimuths gets R = 0 rather than a fake radius;
@@ -138,6 +139,7 @@ typedef enum sl_detect_reject {
 #define SL_TARGET_RADIUS_CLAMPED 0x04U ///< ... and clamped to cfg.max_radius_um
 #define SL_TARGET_ELONG 0x08U          ///< the elongation table was applied (d != 0)
 #define SL_TARGET_WRAPS 0x10U          ///< the group crosses azimuth 0
+#define SL_TARGET_PROFILE 0x20U        ///< bounds from the range profile (sl_profile.h)
 
 /// Detection parameters that are not (yet) board fields.
 typedef struct sl_detect_cfg {

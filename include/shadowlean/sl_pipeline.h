@@ -127,6 +127,7 @@
 #include "shadowlean/sl_detect.h"
 #include "shadowlean/sl_err.h"
 #include "shadowlean/sl_mask.h"
+#include "shadowlean/sl_profile.h"
 #include "shadowlean/sl_proto.h"
 #include "shadowlean/sl_scan.h"
 #include "shadowlean/sl_thresh.h"
@@ -196,6 +197,10 @@ typedef struct sl_pipeline_cfg {
     uint32_t motion_budget_um;   ///< D: displacement allowed over the window (default: bin)
     uint32_t motion_timeout_us;  ///< motion older than this is ignored (default 500 ms)
     uint32_t rotation_us;        ///< rotation period when timestamps are unusable (250000)
+    // --- extraction
+    bool profile;                ///< refine bounds from range profiles (sl_profile.h;
+                                 ///< default true); false = the mask's bounds and d(r)
+    sl_profile_cfg_t profile_cfg; ///< profile parameters (sl_profile_cfg_default)
 } sl_pipeline_cfg_t;
 
 /// Defaults for `board` (threshold, n from the board; detection and tracker defaults;
@@ -278,6 +283,7 @@ typedef struct sl_pipeline {
     sl_scan_t scan;
     sl_mask_t mask;
     sl_detect_t detect;
+    sl_profile_t prof;           ///< range profiles of the azimuths showing something
     sl_tracker_t tracker;
     sl_can_tx_t can;
     sl_pipeline_stats_t stats;
