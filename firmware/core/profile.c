@@ -11,6 +11,8 @@
 #define FIT_BINS 8U
 #define FIT_MIN_BINS 4U
 #define CAL_GATE_N 4U       // fits before the +-30 % gate applies
+#define LOCAL_BINS 6U       // bins of the local tail fit during the walk
+#define MARGIN_MIN_Q8 256U  // 1 value: the tail test's margin covers the rounding of a difference
 
 void sl_profile_cfg_default(sl_profile_cfg_t *cfg)
 {
@@ -229,24 +231,36 @@ sl_profile_bounds_t sl_profile_extract(const uint16_t *sum, uint32_t n, uint32_t
         }
     }
     r.slope_q8 = (uint16_t)s;
-    // 4. walk back over the tail: bin j is tail while 6 (S[j-1] - S[j]) >= 5 F s_loc.
+    // 4. walk back over the tail: bin j is tail while S[j-1] - S[j] >= F (s_loc - m),
+    //    m = max(s_loc / 6, 1 value): the margin, at least the rounding of a difference.
     uint32_t s_loc = s; // Q8 per frame
     j = e;
     while (j > i1) {
         const int64_t dlt = (int64_t)sum[j - 1U] - (int64_t)sum[j]; // x F, values
-        const int64_t lhs = 6 * dlt * 256;
-        const int64_t rhs = 5 * (int64_t)frames * (int64_t)s_loc;
-        if (lhs < rhs) {
-            break;
+        const uint32_t mg = s_loc / 6U > MARGIN_MIN_Q8 ? s_loc / 6U : MARGIN_MIN_Q8;
+        const int64_t lim = (int64_t)frames * ((int64_t)s_loc - (int64_t)mg); // Q8
+        if (dlt * 256 < lim) {
+            // One shallow step inside a tail (a knee between two smear components, a
+            // rounding step) is passed when the step before it and the two together fall
+            // like the tail; two shallow steps in a row are the pole's own bins.
+            if (j < i1 + 2U) {
+                break;
+            }
+            const int64_t d1 = (int64_t)sum[j - 2U] - (int64_t)sum[j - 1U];
+            const int64_t d2 = (int64_t)sum[j - 2U] - (int64_t)sum[j];
+            if (d1 * 256 < lim || d2 * 256 < 2 * lim) {
+                break;
+            }
         }
-        // follow a steepening tail: mean of the decrements walked (weight 1/4), a step
-        // counted only up to 2 s_loc
-        int64_t step_q8 = (dlt * 256) / (int64_t)frames;
-        if (step_q8 > 2 * (int64_t)s_loc) {
-            step_q8 = 2 * (int64_t)s_loc;
-        }
-        s_loc = (uint32_t)((3 * (int64_t)s_loc + step_q8 + 2) / 4);
         j--;
+        // follow a tail that steepens towards the pole: the slope fitted on the LOCAL_BINS
+        // tail bins nearest to the walk (j .. j + LOCAL_BINS - 1), when plausible
+        if (j + LOCAL_BINS - 1U <= e) {
+            const uint32_t sl = fit_slope_q8(sum, j + LOCAL_BINS - 1U, LOCAL_BINS, frames);
+            if (sl >= SLOPE_MIN_Q8 && sl <= SLOPE_MAX_Q8) {
+                s_loc = sl;
+            }
+        }
     }
     r.i1 = (uint16_t)i1;
     r.i2 = (uint16_t)j;

@@ -30,13 +30,16 @@
 ///    s in 1/256 value per bin per frame; plausible in [0.5, 24] values/bin over >= 4 bins,
 ///    else the running calibration (below) is used, else NO_TAIL.
 /// 4. Walk back from e while the bin before decays into this one like a tail:
-///    6 (S[j-1] - S[j]) >= 5 F s_loc (a bin is the pole's own when it decays by less than
-///    5/6 of the local tail slope). s_loc starts at the fit and follows the decrements of
+///    S[j-1] - S[j] >= F (s_loc - m), m = max(s_loc / 6, 1 value) (a bin is the pole's
+///    own when it decays by clearly less than the local tail slope; 1 value covers the
+///    8-bit rounding of the difference of two bins of a static, undithered profile).
+///    One shallow step is passed when the step before it and both together fall like the
+///    tail (a knee between two smear components); two shallow steps stop the walk. s_loc starts at the fit and follows the decrements of
 ///    the tail bins already walked (mean with weight 1/4, a step is used only up to 2 s_loc),
 ///    so a tail that steepens towards the pole (two-component smear) is followed.
 ///    The bin where the walk stops is the last own bin: r2.
 /// 5. Result in bins (relative to bin0): i1, i2, the slope used and where it came from.
-/// The value scale (log of power) only enters through the ratio 5/6 and T/4; nothing depends
+/// The value scale (log of power) only enters through the margin m and T/4; nothing depends
 /// on the simulator's kernel, the board's d(r) or n.
 ///
 /// ## Online calibration (D3)
