@@ -50,12 +50,13 @@
 ///    - elongation: r2 -= d(r2), d = piecewise-linear interpolation of the board's table
 ///      (elong_range_um -> elong_d_um), constant beyond its ends, 0 without a table;
 ///    - radius R: the board's pole_radius_um when non-zero (flag RADIUS_BOARD); otherwise,
-///      when cfg.radius_from_width, from the azimuthal width of the column at the inner
-///      edge: az_count here is the number of contiguous azimuths around the representative
-///      one whose run covers its first bin (a leaning pole spreads in bearing along its
+///      when cfg.radius_from_width, from the azimuthal width of the inner edge: az_count
+///      here is the number of contiguous azimuths around the representative one whose run
+///      reaches into the 3-bin slab [bin_first, bin_first + 2] (a round pole's silhouette
+///      lies ~R behind its front; a leaning pole spreads in bearing along its
 ///      length, so the whole group's width overstates the diameter; EXTRACTION.md D4),
 ///      R = r1 * tan(w / 2) with w = (az_count - 1) * step - beam, set to 0 when the beam's
-///      half footprint r1 * beam / 2 exceeds 2 R (the beam cannot resolve the diameter), the smallest arc consistent with az_count
+///      half footprint r1 * beam / 2 exceeds 4 R (the beam cannot resolve the diameter), the smallest arc consistent with az_count
 ///      azimuth samples less the beam's own spread (small angle; clamped to
 ///      [0, cfg.max_radius_um]; flags RADIUS_WIDTH and RADIUS_CLAMPED). It is biased low on
 ///      purpose: a thin pole seen on 2-3 azimuths gets R = 0 rather than a fake radius;

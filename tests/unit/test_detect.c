@@ -540,14 +540,14 @@ static void test_detect_radius_from_the_column_at_the_inner_edge(void **state)
 {
     (void)state;
     assert_int_equal(sl_detect_init(&det, &board, NULL), SL_OK);
-    // 9 azimuths; the inner bin 64 is covered only on azimuths 40..42 (the strongest
-    // columns), the others slide outward by 1 bin per azimuth (3 columns: w = 2 x 0.9 - 1.8
+    // 9 azimuths; the inner slab (bins 64..66) is reached only on azimuths 40..42 (the
+    // strongest columns), the others slide outward by 3 bins per azimuth (3 columns: w = 2 x 0.9 - 1.8
     // = 0 deg, R = 0; the whole group would give 8 x 0.9 - 1.8 = 5.4 deg).
     for (int a = 40; a < 49; a++) {
         if (a <= 42) {
             set_run(a, 64, 76);
         } else {
-            set_run(a, (uint32_t)(64 + a - 42), (uint32_t)(64 + a - 42 + 8));
+            set_run(a, (uint32_t)(64 + 3 * (a - 42)), (uint32_t)(64 + 3 * (a - 42) + 8));
         }
     }
     assert_int_equal(run_rotation(), 1);
@@ -562,7 +562,7 @@ static void test_detect_radius_from_the_column_at_the_inner_edge(void **state)
         if (a <= 45) {
             set_run(a, 64, 76);
         } else {
-            set_run(a, (uint32_t)(64 + a - 45), (uint32_t)(64 + a - 45 + 8));
+            set_run(a, (uint32_t)(64 + 3 * (a - 45)), (uint32_t)(64 + 3 * (a - 45) + 8));
         }
     }
     assert_int_equal(run_rotation(), 1);
