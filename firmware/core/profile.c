@@ -12,7 +12,6 @@
 #define FIT_MIN_BINS 4U
 #define CAL_GATE_N 4U       // fits before the +-30 % gate applies
 #define LOCAL_BINS 6U       // bins of the local tail fit during the walk
-#define MARGIN_MIN_Q8 256U  // 1 value: the tail test's margin covers the rounding of a difference
 
 void sl_profile_cfg_default(sl_profile_cfg_t *cfg)
 {
@@ -170,8 +169,10 @@ static uint32_t fit_slope_q8(const uint16_t *sum, uint32_t e, uint32_t m, uint32
     return q > 0xFFFF ? 0xFFFFU : (uint32_t)q;
 }
 
-sl_profile_bounds_t sl_profile_extract(const uint16_t *sum, uint32_t n, uint32_t frames,
-                                       uint32_t threshold, uint32_t hint, uint32_t cal_slope_q8)
+// One extraction; `fit_bins` != 0 fixes the size of the tail fit (bins ending at e).
+static sl_profile_bounds_t extract_once(const uint16_t *sum, uint32_t n, uint32_t frames,
+                                        uint32_t threshold, uint32_t hint, uint32_t cal_slope_q8,
+                                        uint32_t fit_bins)
 {
     sl_profile_bounds_t r;
     memset(&r, 0, sizeof r);
@@ -219,6 +220,9 @@ sl_profile_bounds_t sl_profile_extract(const uint16_t *sum, uint32_t n, uint32_t
     // 3. tail slope: self fit, else the calibration
     uint32_t m = e - i1 + 1U;
     m = m > FIT_BINS ? FIT_BINS : m;
+    if (fit_bins != 0U && fit_bins < m) {
+        m = fit_bins;
+    }
     uint32_t s = m >= FIT_MIN_BINS ? fit_slope_q8(sum, e, m, frames) : 0U;
     r.slope_src = SL_PROFILE_SLOPE_FIT;
     if (s < SLOPE_MIN_Q8 || s > SLOPE_MAX_Q8) {
@@ -231,24 +235,34 @@ sl_profile_bounds_t sl_profile_extract(const uint16_t *sum, uint32_t n, uint32_t
         }
     }
     r.slope_q8 = (uint16_t)s;
-    // 4. walk back over the tail: bin j is tail while S[j-1] - S[j] >= F (s_loc - m),
-    //    m = max(s_loc / 6, 1 value): the margin, at least the rounding of a difference.
+    // 4. walk back over the tail: bin j is tail while S[j-1] - S[j] >= F (s_loc - s_loc / 6)
+    //    (the bin before decays into it like the tail: it holds little power of its own).
     uint32_t s_loc = s; // Q8 per frame
     j = e;
     while (j > i1) {
         const int64_t dlt = (int64_t)sum[j - 1U] - (int64_t)sum[j]; // x F, values
-        const uint32_t mg = s_loc / 6U > MARGIN_MIN_Q8 ? s_loc / 6U : MARGIN_MIN_Q8;
-        const int64_t lim = (int64_t)frames * ((int64_t)s_loc - (int64_t)mg); // Q8
+        const int64_t lim = (int64_t)frames * ((int64_t)s_loc - (int64_t)(s_loc / 6U)); // Q8
         if (dlt * 256 < lim) {
-            // One shallow step inside a tail (a knee between two smear components, a
-            // rounding step) is passed when the step before it and the two together fall
-            // like the tail; two shallow steps in a row are the pole's own bins.
-            if (j < i1 + 2U) {
-                break;
+            // Rounding: 8-bit values of a static scene are not dithered, so a tail step can
+            // read up to one value short of the slope; it is still tail when it is short by
+            // less than one value and it and the step after it (already walked) fall by at
+            // least two slopes less one value (the rounding bound of a two-step difference).
+            const int64_t f256 = (int64_t)frames * 256;
+            const bool pair_after =
+                j + 1U <= e && dlt * 256 > (int64_t)frames * (int64_t)s_loc - f256 &&
+                ((int64_t)sum[j - 1U] - (int64_t)sum[j + 1U]) * 256 >=
+                    2 * (int64_t)frames * (int64_t)s_loc - f256;
+            // A knee between two smear components, while the slope still comes from the
+            // first fit (which may straddle it): one shallow step is passed when the step
+            // before it and both together fall like the tail; two shallow steps in a row are
+            // the pole's own bins.
+            bool knee = false;
+            if (!pair_after && j >= i1 + 2U && j + LOCAL_BINS - 1U > e) {
+                const int64_t d1 = (int64_t)sum[j - 2U] - (int64_t)sum[j - 1U];
+                const int64_t d2 = (int64_t)sum[j - 2U] - (int64_t)sum[j];
+                knee = d1 * 256 >= lim && d2 * 256 >= 2 * lim;
             }
-            const int64_t d1 = (int64_t)sum[j - 2U] - (int64_t)sum[j - 1U];
-            const int64_t d2 = (int64_t)sum[j - 2U] - (int64_t)sum[j];
-            if (d1 * 256 < lim || d2 * 256 < 2 * lim) {
+            if (!pair_after && !knee) {
                 break;
             }
         }
@@ -266,6 +280,23 @@ sl_profile_bounds_t sl_profile_extract(const uint16_t *sum, uint32_t n, uint32_t
     r.i2 = (uint16_t)j;
     r.e = (uint16_t)e;
     r.fail = (uint8_t)SL_PROFILE_OK;
+    return r;
+}
+
+sl_profile_bounds_t sl_profile_extract(const uint16_t *sum, uint32_t n, uint32_t frames,
+                                       uint32_t threshold, uint32_t hint, uint32_t cal_slope_q8)
+{
+    sl_profile_bounds_t r = extract_once(sum, n, frames, threshold, hint, cal_slope_q8, 0U);
+    // The first fit may reach into the pole's own bins when the tail is short: refit on the
+    // tail the walk found (when it has >= FIT_MIN_BINS bins) and walk again.
+    if (r.fail == (uint8_t)SL_PROFILE_OK && r.slope_src == SL_PROFILE_SLOPE_FIT &&
+        (uint32_t)r.i2 + FIT_BINS > r.e && (uint32_t)r.e >= (uint32_t)r.i2 + FIT_MIN_BINS) {
+        const sl_profile_bounds_t r2 =
+            extract_once(sum, n, frames, threshold, hint, cal_slope_q8, (uint32_t)r.e - r.i2);
+        if (r2.fail == (uint8_t)SL_PROFILE_OK) {
+            r = r2;
+        }
+    }
     return r;
 }
 

@@ -30,16 +30,20 @@
 ///    s in 1/256 value per bin per frame; plausible in [0.5, 24] values/bin over >= 4 bins,
 ///    else the running calibration (below) is used, else NO_TAIL.
 /// 4. Walk back from e while the bin before decays into this one like a tail:
-///    S[j-1] - S[j] >= F (s_loc - m), m = max(s_loc / 6, 1 value) (a bin is the pole's
-///    own when it decays by clearly less than the local tail slope; 1 value covers the
-///    8-bit rounding of the difference of two bins of a static, undithered profile).
-///    One shallow step is passed when the step before it and both together fall like the
-///    tail (a knee between two smear components); two shallow steps stop the walk. s_loc starts at the fit and follows the decrements of
-///    the tail bins already walked (mean with weight 1/4, a step is used only up to 2 s_loc),
-///    so a tail that steepens towards the pole (two-component smear) is followed.
-///    The bin where the walk stops is the last own bin: r2.
+///    S[j-1] - S[j] >= F (s_loc - s_loc / 6) (a bin is the pole's own when it decays by
+///    clearly less than the local tail slope). A shallower step is still tail when it is
+///    short of s_loc by less than one value and it and the step after it (already walked)
+///    fall by at least 2 s_loc - 1 value (8-bit values of a static scene are not dithered:
+///    that is the rounding bound), or, while s_loc is still the first fit, when the step
+///    before it and both together fall like the tail (a knee between two smear
+///    components); two shallow steps in
+///    a row stop the walk. s_loc is the slope fitted on the 6 tail bins nearest to the walk
+///    (j .. j + 5) once there are 6, so a tail that steepens towards the pole is followed.
+///    The bin where the walk stops is the last own bin: r2. When the first fit window
+///    reached into the pole's own bins (a short tail), the fit is repeated on the tail the
+///    walk found (>= 4 bins) and the walk done again.
 /// 5. Result in bins (relative to bin0): i1, i2, the slope used and where it came from.
-/// The value scale (log of power) only enters through the margin m and T/4; nothing depends
+/// The value scale (log of power) only enters through the ratio 1/6 and T/4; nothing depends
 /// on the simulator's kernel, the board's d(r) or n.
 ///
 /// ## Online calibration (D3)
