@@ -44,6 +44,15 @@ sl_err_t sl_profile_init(sl_profile_t *pr, uint16_t azimuths, uint16_t near_bins
     return SL_OK;
 }
 
+// Count of trailing zeros of a non-zero word (portable de Bruijn, as in detect.c).
+static uint32_t ctz32(uint32_t v)
+{
+    static const uint8_t tab[32] = {0,  1,  28, 2,  29, 14, 24, 3,  30, 22, 20,
+                                    15, 25, 17, 4,  8,  31, 27, 13, 23, 21, 19,
+                                    16, 7,  26, 12, 18, 6,  11, 5,  10, 9};
+    return tab[((v & (0U - v)) * 0x077CB531U) >> 27];
+}
+
 // First set bit in [lo, hi) of `bits`, or hi.
 static uint32_t first_set(const uint32_t *bits, uint32_t lo, uint32_t hi)
 {
@@ -54,11 +63,7 @@ static uint32_t first_set(const uint32_t *bits, uint32_t lo, uint32_t hi)
             pos = (pos | 31U) + 1U;
             continue;
         }
-        uint32_t k = 0;
-        while (((w >> k) & 1U) == 0U) {
-            k++;
-        }
-        pos += k;
+        pos += ctz32(w);
         return pos < hi ? pos : hi;
     }
     return hi;
@@ -102,6 +107,10 @@ void sl_profile_row(sl_profile_t *pr, uint16_t az, const uint8_t *power, uint32_
     if (first >= hi) {
         return;
     }
+    if (pr->n_live >= SL_CFG_PROFILE_SLOTS) {
+        pr->stats.claim_full++;
+        return;
+    }
     for (uint32_t i = 0; i < SL_CFG_PROFILE_SLOTS; i++) {
         sl_profile_slot_t *s = &pr->slot[i];
         if (s->live != 0U) {
@@ -113,6 +122,7 @@ void sl_profile_row(sl_profile_t *pr, uint16_t az, const uint8_t *power, uint32_
         s->az = az;
         s->bin0 = (uint16_t)(first > pr->cfg.lead_bins ? first - pr->cfg.lead_bins : 0U);
         pr->slot_of[az] = (uint8_t)i;
+        pr->n_live++;
         pr->stats.claims++;
         slot_add(pr, s, power, n);
         return;
@@ -136,6 +146,7 @@ void sl_profile_end_rotation(sl_profile_t *pr, bool reset)
         } else if (++s->idle > pr->cfg.max_idle) {
             s->live = 0U;
             pr->slot_of[s->az] = SL_PROFILE_NONE;
+            pr->n_live--;
             pr->stats.released++;
             continue;
         }

@@ -151,6 +151,7 @@ typedef struct sl_profile {
     uint16_t near_bins;
     uint16_t slope_q8;      ///< calibrated tail slope (0: none yet)
     uint16_t cal_n;         ///< fits taken into slope_q8 (saturating)
+    uint16_t n_live;        ///< slots in use
     uint8_t slot_of[SL_CFG_MAX_AZIMUTHS]; ///< slot index per azimuth, SL_PROFILE_NONE
     sl_profile_slot_t slot[SL_CFG_PROFILE_SLOTS];
     sl_profile_stats_t stats;
