@@ -8,7 +8,9 @@
 ///              the bytes the pipeline reads) -> sl_scan (frame-less: one row view per
 ///              azimuth) -> sl_thresh (first `mask_bins` bins only) -> sl_mask (n-frame
 ///              consistency, window shortened with vehicle speed) -> sl_detect (runs in
-///              the shadow, corrections, alpha) -> sl_track -> CAN (sl_can_tx_t)
+///              the shadow, corrections, alpha) -> sl_profile (bounds re-extracted from
+///              the summed 8-bit rows of the azimuths that show something in the shadow,
+///              smear tail removed; cfg.profile) -> sl_track -> CAN (sl_can_tx_t)
 ///
 /// so `sizeof(sl_pipeline_t)` is the whole RAM of the module (see the budget below).
 ///
@@ -88,11 +90,12 @@
 /// ## RAM budget (sizeof(sl_pipeline_t)); asserted below for the firmware configuration
 /// Dominated by the mask: SL_CFG_MAX_AZIMUTHS x (1 + ceil(log2 SL_CFG_MASK_FRAMES_MAX)) x
 /// SL_CFG_MASK_BINS / 8 bytes; then detection (8,424 B), the tracker (1,864 B), the scan
-/// bookkeeping (624 B), the reassembly buffer (SL_PIPELINE_REASM_BYTES) and a row buffer.
+/// bookkeeping (624 B), the range profiles (sl_profile.h, 2.1 KB), the reassembly buffer
+/// (SL_PIPELINE_REASM_BYTES) and a row buffer.
 ///
 /// | configuration (400 azimuths, 32 targets)              | x86-64    | Cortex-M0 |
 /// |--------------------------------------------------------|-----------|-----------|
-/// | firmware: SL_CFG_MASK_BINS 160, SL_CFG_MASK_FRAMES_MAX 16 | 52,808 B  | 52,712 B  |
+/// | firmware: SL_CFG_MASK_BINS 160, SL_CFG_MASK_FRAMES_MAX 16 | 54,944 B  | (not re-measured; 52,712 B before sl_profile's 2.1 KB) |
 /// | SL_CFG_MASK_BINS 192, SL_CFG_MASK_FRAMES_MAX 16          | 60,912 B  | 60,816 B  |
 /// | host default: mask bins 512 (whole ROI), n <= 32          | 167,552 B | 167,456 B |
 ///
