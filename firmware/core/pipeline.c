@@ -307,6 +307,7 @@ static void on_rot(void *ctx, const sl_scan_rot_t *rot)
         for (uint32_t i = 0; i < n_targets; i++) {
             (void)sl_profile_refine(&p->prof, p->board, p->cfg.threshold, &p->detect.targets[i]);
         }
+        sl_profile_assign(&p->prof, p->detect.targets, n_targets);
         // A profile must not mix positions: cleared every rotation while the window is short.
         sl_profile_end_rotation(&p->prof, p->frames_eff < p->cfg.mask_frames);
     }

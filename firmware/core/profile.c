@@ -246,6 +246,16 @@ static sl_profile_bounds_t extract_once(const uint16_t *sum, uint32_t n, uint32_
         }
     }
     r.slope_q8 = (uint16_t)s;
+    // No tail at all: the return ends in a cliff (the step after its last bin above the
+    // threshold falls by more than two tail slopes), so its last bins are its own.
+    if (((int64_t)sum[last] - (int64_t)sum[last + 1U]) * 256 > 2 * (int64_t)frames * (int64_t)s) {
+        r.i1 = (uint16_t)i1;
+        r.i2 = (uint16_t)last;
+        r.e = (uint16_t)e;
+        r.slope_src = SL_PROFILE_SLOPE_CLIFF;
+        r.fail = (uint8_t)SL_PROFILE_OK;
+        return r;
+    }
     // 4. walk back over the tail: bin j is tail while S[j-1] - S[j] >= F (s_loc - s_loc / 6)
     //    (the bin before decays into it like the tail: it holds little power of its own).
     uint32_t s_loc = s; // Q8 per frame
@@ -379,4 +389,54 @@ uint8_t sl_profile_refine(sl_profile_t *pr, const sl_board_t *board, uint32_t th
     }
     pr->stats.extracted++;
     return (uint8_t)SL_PROFILE_OK;
+}
+
+void sl_profile_assign(sl_profile_t *pr, const sl_target_t *targets, uint32_t n)
+{
+    SL_ASSERT(pr != NULL && (targets != NULL || n == 0U));
+    uint8_t keep[SL_CFG_PROFILE_SLOTS];
+    memset(keep, 0, sizeof keep);
+    for (uint32_t j = 0; j < n; j++) {
+        const uint16_t az = targets[j].az;
+        if (az < pr->azimuths && pr->slot_of[az] != SL_PROFILE_NONE) {
+            keep[pr->slot_of[az]] = 1U;
+        }
+    }
+    for (uint32_t j = 0; j < n; j++) {
+        const sl_target_t *t = &targets[j];
+        if (t->az >= pr->azimuths || pr->slot_of[t->az] != SL_PROFILE_NONE) {
+            continue;
+        }
+        // A free slot, else one watching an azimuth that is no target's (claimed on
+        // evidence that did not become a target, or a target's former azimuth).
+        uint32_t pick = SL_CFG_PROFILE_SLOTS;
+        for (uint32_t i = 0; i < SL_CFG_PROFILE_SLOTS; i++) {
+            if (pr->slot[i].live == 0U) {
+                pick = i;
+                break;
+            }
+            if (pick == SL_CFG_PROFILE_SLOTS && keep[i] == 0U) {
+                pick = i;
+            }
+        }
+        if (pick == SL_CFG_PROFILE_SLOTS) {
+            pr->stats.assign_full++;
+            continue;
+        }
+        sl_profile_slot_t *s = &pr->slot[pick];
+        if (s->live != 0U) {
+            pr->slot_of[s->az] = SL_PROFILE_NONE;
+            pr->stats.stolen++;
+        } else {
+            pr->n_live++;
+        }
+        memset(s, 0, sizeof *s);
+        s->live = 1U;
+        s->seen = 1U;
+        s->az = t->az;
+        s->bin0 = (uint16_t)(t->bin_first > pr->cfg.lead_bins ? (uint32_t)t->bin_first - pr->cfg.lead_bins : 0U);
+        pr->slot_of[t->az] = (uint8_t)pick;
+        keep[pick] = 1U;
+        pr->stats.assigned++;
+    }
 }

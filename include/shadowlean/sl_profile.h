@@ -17,6 +17,9 @@
 /// - An azimuth without a slot claims a free one when this row has an occupied bit (the
 ///   per-frame threshold bits) in the search window `[near, win)` (the detector's window:
 ///   the shadow). `bin0 = max(0, first occupied bin - cfg.lead_bins)`.
+/// - Evidence alone can fill every slot (a wide return, clutter), so once targets exist,
+///   sl_profile_assign() gives each target's representative azimuth a slot, taking it from
+///   an azimuth that is no target's when none is free.
 /// - sl_profile_end_rotation(): slots whose azimuth showed no bit in the window for more
 ///   than `cfg.max_idle` rotations are freed; with `reset` (the vehicle moved: the caller
 ///   passes n_eff < n) every sum is cleared, so a profile never mixes positions.
@@ -29,6 +32,8 @@
 /// 3. Tail slope, self-fitted: integer least squares over the (up to) 8 bins ending at e,
 ///    s in 1/256 value per bin per frame; plausible in [0.5, 24] values/bin over >= 4 bins,
 ///    else the running calibration (below) is used, else NO_TAIL.
+///    No tail: when the step after the run's last bin above F T falls by more than 2 F s
+///    (a cliff, not a smear tail), r2 is that last bin and there is no walk.
 /// 4. Walk back from e while the bin before decays into this one like a tail:
 ///    S[j-1] - S[j] >= F (s_loc - s_loc / 6) (a bin is the pole's own when it decays by
 ///    clearly less than the local tail slope). A shallower step is still tail when it is
@@ -104,6 +109,7 @@ typedef enum sl_profile_fail {
 /// Where the slope of an extraction came from.
 #define SL_PROFILE_SLOPE_FIT 1U ///< self-fitted on this profile
 #define SL_PROFILE_SLOPE_CAL 2U ///< the running calibration (tail too short to fit)
+#define SL_PROFILE_SLOPE_CLIFF 3U ///< no tail: the return ends in a cliff, r2 = its last bin
 
 typedef struct sl_profile_cfg {
     uint16_t max_frames; ///< halve the sums at this many frames (2..257, default 128)
@@ -141,6 +147,9 @@ typedef struct sl_profile_stats {
     uint32_t resets;        ///< sl_profile_end_rotation with reset
     uint32_t extracted;     ///< targets refined from a profile
     uint32_t fallback[SL_PROFILE_FAIL_COUNT]; ///< targets left with the mask's bounds, by reason
+    uint32_t assigned;      ///< slots given to targets' azimuths (sl_profile_assign)
+    uint32_t stolen;        ///< ... taken from an azimuth that was no target's
+    uint32_t assign_full;   ///< targets left without a slot (every slot watches a target)
     uint32_t cal_accepted;  ///< self-fitted slopes taken into the calibration
     uint32_t cal_rejected;  ///< ... refused by the +-30 % gate
 } sl_profile_stats_t;
@@ -171,6 +180,12 @@ void sl_profile_row(sl_profile_t *pr, uint16_t az, const uint8_t *power, uint32_
 
 /// End of a rotation: age and free idle slots; `reset` clears every sum (vehicle moving).
 void sl_profile_end_rotation(sl_profile_t *pr, bool reset);
+
+/// After a rotation's targets are known: every target's representative azimuth without a
+/// slot gets one (a free slot, else one watching an azimuth that is no target's, counted
+/// `stolen`; `assign_full` when every slot watches a target), with bin0 = bin_first -
+/// lead_bins. Its profile starts with the next row. O(targets x slots).
+void sl_profile_assign(sl_profile_t *pr, const sl_target_t *targets, uint32_t n);
 
 /// Smear-aware bounds from a profile (pure; see "Extraction"). `hint` = the mask's first
 /// bin relative to the profile start, `cal_slope_q8` the fallback slope (0: none).

@@ -223,11 +223,28 @@ static void test_profile_reports_why_it_cannot_extract(void **state)
         sum[k] = (k >= 5 && k < 15) ? 4 * 80 : 0;
     }
     assert_int_equal(sl_profile_extract(sum, NB, 4, 40, 5, 0).fail, SL_PROFILE_NO_TAIL);
+    // with a calibrated slope it extracts; the run ends in a cliff: r2 = its last bin
     const sl_profile_bounds_t r = sl_profile_extract(sum, NB, 4, 40, 5, 3U * 256U);
     assert_int_equal(r.fail, SL_PROFILE_OK);
-    assert_int_equal(r.slope_src, SL_PROFILE_SLOPE_CAL);
+    assert_int_equal(r.slope_src, SL_PROFILE_SLOPE_CLIFF);
     assert_int_equal(r.i1, 5);
     assert_int_equal(r.i2, 14);
+}
+
+// No smear at all (noise-free simulation, a return that simply ends): the pole's own bins
+// may decay like a tail, but the run ends in a cliff, so none of them is removed.
+static void test_profile_keeps_the_own_bins_of_a_return_without_smear(void **state)
+{
+    (void)state;
+    uint16_t sum[NB];
+    for (int k = 0; k < NB; k++) {
+        sum[k] = (uint16_t)(k >= 8 && k <= 20 ? 16 * (110 - 4 * (k - 8)) : 0);
+    }
+    const sl_profile_bounds_t r = sl_profile_extract(sum, NB, 16, 40, 8, 0U);
+    assert_int_equal(r.fail, SL_PROFILE_OK);
+    assert_int_equal(r.slope_src, SL_PROFILE_SLOPE_CLIFF);
+    assert_int_equal(r.i1, 8);
+    assert_int_equal(r.i2, 20);
 }
 
 int main(void)
@@ -238,6 +255,7 @@ int main(void)
         cmocka_unit_test(test_profile_extracts_own_bins_under_exponential_smear),
         cmocka_unit_test(test_profile_extracts_own_bins_under_other_smear_shapes),
         cmocka_unit_test(test_profile_reports_why_it_cannot_extract),
+        cmocka_unit_test(test_profile_keeps_the_own_bins_of_a_return_without_smear),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
