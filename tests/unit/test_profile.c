@@ -247,6 +247,43 @@ static void test_profile_keeps_the_own_bins_of_a_return_without_smear(void **sta
     assert_int_equal(r.i2, 20);
 }
 
+// Evidence fills every slot; targets then take slots from azimuths that are no target's,
+// keep their own, and are counted when every slot already watches a target.
+static void test_profile_slots_follow_the_targets(void **state)
+{
+    (void)state;
+    assert_int_equal(sl_profile_init(&pr, 400, 0, NULL), SL_OK);
+    uint8_t row[64];
+    memset(row, 50, sizeof row);
+    uint32_t bits[2] = {1U << 20, 0U};
+    for (uint16_t a = 0; a < SL_CFG_PROFILE_SLOTS + 3U; a++) {
+        sl_profile_row(&pr, a, row, 64, bits, 64);
+    }
+    assert_int_equal(pr.stats.claims, SL_CFG_PROFILE_SLOTS);
+    assert_int_equal(pr.stats.claim_full, 3);
+    sl_target_t t[SL_CFG_PROFILE_SLOTS + 1];
+    memset(t, 0, sizeof t);
+    t[0].az = 3;   // watched already: keeps its slot
+    t[0].bin_first = 20;
+    t[1].az = 200; // not watched: takes a slot from an azimuth that is no target's
+    t[1].bin_first = 30;
+    sl_profile_assign(&pr, t, 2);
+    assert_int_equal(pr.slot_of[3] != SL_PROFILE_NONE, 1);
+    assert_int_equal(pr.slot[pr.slot_of[3]].frames, 1);
+    assert_true(pr.slot_of[200] != SL_PROFILE_NONE);
+    assert_int_equal(pr.slot[pr.slot_of[200]].bin0, 30 - pr.cfg.lead_bins);
+    assert_int_equal(pr.slot[pr.slot_of[200]].frames, 0);
+    assert_int_equal(pr.stats.stolen, 1);
+    // every slot watching a target: one more target is counted, nothing is taken
+    for (uint32_t i = 0; i <= SL_CFG_PROFILE_SLOTS; i++) {
+        t[i].az = (uint16_t)(300U + i);
+        t[i].bin_first = 10;
+    }
+    sl_profile_assign(&pr, t, SL_CFG_PROFILE_SLOTS + 1U);
+    assert_int_equal(pr.stats.assign_full, 1);
+    assert_int_equal(pr.n_live, SL_CFG_PROFILE_SLOTS);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -256,6 +293,7 @@ int main(void)
         cmocka_unit_test(test_profile_extracts_own_bins_under_other_smear_shapes),
         cmocka_unit_test(test_profile_reports_why_it_cannot_extract),
         cmocka_unit_test(test_profile_keeps_the_own_bins_of_a_return_without_smear),
+        cmocka_unit_test(test_profile_slots_follow_the_targets),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
