@@ -15,6 +15,8 @@
 #define ST_CLOSED 2U
 
 #define EMPTY_LO 0xFFFFU
+// Depth of the inner-edge slab whose columns give the width radius (bins after the first).
+#define RADIUS_SLAB_BINS 2U
 #define EMPTY_HI 0U
 
 // 2^32 / (2 pi), rounded: radians -> bam32.
@@ -163,6 +165,12 @@ void sl_detect_correct(const sl_board_t *board, const sl_detect_cfg_t *cfg, uint
         const uint64_t width = (az_count > 0U ? (uint64_t)az_count - 1U : 0U) * step;
         radius = width > beam_bam ? half_arc_um(r1_hb, width - beam_bam) : 0U;
         t->flags |= SL_TARGET_RADIUS_WIDTH;
+        // A beam footprint wider than four times the estimated diameter cannot resolve
+        // it: one azimuth step more or less is then most of the estimate (EXTRACTION.md
+        // D4; a 60 mm pole under a 1.8 deg beam at 4 m is still resolved).
+        if (half_arc_um(r1_hb, beam_bam) > 4U * radius) {
+            radius = 0U;
+        }
         if (radius > cfg->max_radius_um) {
             radius = cfg->max_radius_um;
             t->flags |= SL_TARGET_RADIUS_CLAMPED;
@@ -420,7 +428,23 @@ static void finalize(sl_detect_t *d, sl_detect_cand_t *c)
     t.bin_first = rep->first;
     t.bin_last = rep->last;
     t.occupied = rep->count;
-    sl_detect_correct(bd, &d->cfg, az, rep->first, rep->last, t.az_count, &t);
+    // Radius width (D4 of EXTRACTION.md): the contiguous columns around the representative
+    // azimuth whose run reaches into the slab [first, first + RADIUS_SLAB_BINS] at the
+    // pole's inner edge, not the whole group, which a leaning pole widens in bearing along
+    // its length.
+    // The slab is RADIUS_SLAB_BINS + 1 bins deep: the silhouette of a round pole lies about
+    // R behind its front surface, which only the middle columns show.
+    const uint32_t slab = (uint32_t)rep->first + RADIUS_SLAB_BINS;
+    uint32_t lo = best, hi = best;
+    while (lo > 0U && c->run[lo - 1U].count != 0U && c->run[lo - 1U].first <= slab &&
+           c->run[lo - 1U].last >= rep->first) {
+        lo--;
+    }
+    while (hi + 1U < span && hi + 1U < SL_CFG_DETECT_MAX_SPAN && c->run[hi + 1U].count != 0U &&
+           c->run[hi + 1U].first <= slab && c->run[hi + 1U].last >= rep->first) {
+        hi++;
+    }
+    sl_detect_correct(bd, &d->cfg, az, rep->first, rep->last, (uint16_t)(hi - lo + 1U), &t);
     t.shadow_slant_um = sl_detect_shadow_slant_um(bd, az);
     if ((c->flags & CF_WRAPS) != 0U) {
         t.flags |= SL_TARGET_WRAPS;

@@ -46,6 +46,8 @@ void sl_pipeline_cfg_default(sl_pipeline_cfg_t *cfg, const sl_board_t *board)
     cfg->motion_timeout_us = 500000U;
     cfg->rotation_us = 250000U;
     cfg->row_timeout_us = 1000000U;
+    cfg->profile = true;
+    sl_profile_cfg_default(&cfg->profile_cfg);
 }
 
 uint8_t sl_pipeline_window(uint8_t n, uint8_t min_frames, int32_t speed_mm_s,
@@ -400,6 +402,10 @@ static void on_row(void *ctx, const sl_scan_row_t *row)
     p->last_row_us = p->now_us;
     p->have_row = true;
     sl_thresh_u8(row->power, p->mask_bins, p->cfg.threshold, p->bits);
+    if (p->cfg.profile) {
+        sl_profile_row(&p->prof, row->idx, row->power, p->mask_bins, p->bits,
+                       p->detect.win_bins[row->idx < p->detect.azimuths ? row->idx : 0U]);
+    }
     if (row->idx >= p->next_az) {
         if (row->idx > p->next_az) {
             feed_held(p, p->next_az, row->idx);
@@ -444,6 +450,14 @@ static void on_rot(void *ctx, const sl_scan_rot_t *rot)
     sl_mask_end_rotation(&p->mask);
     const sl_ssize_t nt = sl_detect_end(&p->detect);
     const uint32_t n_targets = nt > 0 ? (uint32_t)nt : 0U;
+    if (p->cfg.profile) {
+        for (uint32_t i = 0; i < n_targets; i++) {
+            (void)sl_profile_refine(&p->prof, p->board, p->cfg.threshold, &p->detect.targets[i]);
+        }
+        sl_profile_assign(&p->prof, p->detect.targets, n_targets);
+        // A profile must not mix positions: cleared every rotation while the window is short.
+        sl_profile_end_rotation(&p->prof, p->frames_eff < p->cfg.mask_frames);
+    }
     measure_period(p, rot);
     // Tracker gates follow the ego motion of one rotation.
     uint32_t disp_um = 0, yaw_bam = 0;
@@ -637,6 +651,10 @@ sl_err_t sl_pipeline_init(sl_pipeline_t *p, const sl_board_t *board,
                                  ? UINT32_MAX
                                  : (uint64_t)need * board->bin_size_um);
     e = sl_mask_init(&p->mask, board->azimuths, (uint16_t)bins, c->mask_frames, c->max_missed);
+    if (e == SL_OK && c->profile) {
+        e = sl_profile_init(&p->prof, board->azimuths, board->near_exclusion_bins,
+                            &c->profile_cfg);
+    }
     if (e == SL_OK) {
         e = sl_track_init(&p->tracker, board, &c->track);
     }

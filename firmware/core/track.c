@@ -60,8 +60,11 @@ static uint8_t raw_level(const sl_tracker_t *tr, int32_t a, int32_t lower)
     return (uint8_t)SL_WARN_NONE;
 }
 
+// `repeat`: the measurement's bounds are identical to the previous one's (a static scene
+// quantised the same way every rotation). Its error is then the same as last time, not a
+// new independent draw, so the variance is not allowed below the measurement's own.
 static void filter_update(const sl_tracker_t *tr, sl_track_t *t, int32_t z_cdeg,
-                          uint16_t sigma_cdeg)
+                          uint16_t sigma_cdeg, bool repeat)
 {
     const uint64_t sz = sigma_cdeg > tr->cfg.min_sigma_cdeg ? sigma_cdeg : tr->cfg.min_sigma_cdeg;
     const uint64_t r = sz * sz;
@@ -73,7 +76,10 @@ static void filter_update(const sl_tracker_t *tr, sl_track_t *t, int32_t z_cdeg,
         const uint64_t k = (p << 16) / (p + r + 0U); // Q16 gain in [0, 65536]
         const int64_t e = (int64_t)z_cdeg * 256 - t->alpha_q8;
         t->alpha_q8 = sl_fx_sat32(t->alpha_q8 + sl_fx_rshift_round64((int64_t)k * e, 16U));
-        const uint64_t pn = sl_fx_urshift_round64((65536U - k) * p, 16U);
+        uint64_t pn = sl_fx_urshift_round64((65536U - k) * p, 16U);
+        if (repeat && pn < r) {
+            pn = r;
+        }
         t->var_cdeg2 = sl_fx_usat32((int64_t)(pn == 0U ? 1U : pn));
     }
     t->alpha_cdeg = (int32_t)sl_fx_rshift_round64(t->alpha_q8, 8U);
@@ -111,6 +117,7 @@ static void level_update(sl_tracker_t *tr, sl_track_t *t)
 
 static void track_take(sl_tracker_t *tr, sl_track_t *t, const sl_target_t *g, uint64_t now_us)
 {
+    const bool repeat = t->valid_hits != 0U && t->r1_um == g->r1_um && t->r2_um == g->r2_um;
     t->az = g->az;
     t->r1_um = g->r1_um;
     t->r2_um = g->r2_um;
@@ -125,7 +132,7 @@ static void track_take(sl_tracker_t *tr, sl_track_t *t, const sl_target_t *g, ui
         t->hits++;
     }
     if (g->incline_flag == (uint8_t)SL_INCLINE_VALID) {
-        filter_update(tr, t, g->alpha_cdeg, g->sigma_cdeg);
+        filter_update(tr, t, g->alpha_cdeg, g->sigma_cdeg, repeat);
         level_update(tr, t);
     }
 }

@@ -1,7 +1,7 @@
 // sl-bench: the whole detection pipeline (sl_pipeline_feed) over a capture file.
 //
 //   sl-bench CAPTURE [--board NAME] [--chunk BYTES] [--repeat N] [--loop N] [--n N]
-//                    [--beam-cdeg N] [--threshold T] [--speed-mm-s V]
+//                    [--beam-cdeg N] [--threshold T] [--speed-mm-s V] [--no-profile]
 //                    [--callgrind run|latency] [--quiet]
 //
 // CAPTURE is a raw Colossus stream (`.colossus`: sl-sim, `sl-replay from-oxford`,
@@ -116,13 +116,14 @@ typedef struct opts {
     size_t chunk;
     int repeat, loop, n, beam_cdeg, threshold;
     long speed_mm_s;
+    int no_profile;
     bool quiet;
 } opts_t;
 
 static int usage(void)
 {
     fprintf(stderr, "usage: sl-bench CAPTURE [--board NAME] [--chunk BYTES] [--repeat N] "
-                    "[--loop N] [--n N] [--beam-cdeg N] [--threshold T] [--speed-mm-s V] "
+                    "[--loop N] [--n N] [--beam-cdeg N] [--threshold T] [--speed-mm-s V] [--no-profile] "
                     "[--callgrind run|latency] [--quiet]\n");
     return 2;
 }
@@ -198,6 +199,9 @@ static int init_pipeline(const opts_t *o, const sl_board_t *board)
     if (o->beam_cdeg > 0) {
         c.detect.beam_width_cdeg = (uint16_t)o->beam_cdeg;
     }
+    if (o->no_profile) {
+        c.profile = false; // the mask's bounds and the board's d(r) (sl_profile.h off)
+    }
     if (o->threshold >= 0) {
         c.threshold = (uint16_t)o->threshold;
     }
@@ -243,6 +247,8 @@ int main(int argc, char **argv)
             o.n = atoi(v), i++;
         } else if (strcmp(a, "--beam-cdeg") == 0 && v) {
             o.beam_cdeg = atoi(v), i++;
+        } else if (strcmp(a, "--no-profile") == 0) {
+            o.no_profile = 1;
         } else if (strcmp(a, "--threshold") == 0 && v) {
             o.threshold = atoi(v), i++;
         } else if (strcmp(a, "--speed-mm-s") == 0 && v) {

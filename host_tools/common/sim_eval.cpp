@@ -463,6 +463,9 @@ PipelineEval::PipelineEval(const PipeCfg &c) : m_(new Impl)
     if (c.mask_frames > 0) {
         pc.mask_frames = static_cast<uint8_t>(c.mask_frames);
     }
+    if (c.profile >= 0) {
+        pc.profile = c.profile != 0;
+    }
     const sl_err_t e = sl_pipeline_init(m_->p.get(), b, &pc);
     if (e != SL_OK) {
         const std::string msg = m_->p->last_err_msg != nullptr ? m_->p->last_err_msg : "?";
@@ -558,10 +561,16 @@ std::map<int, PipeEval> PipelineEval::result() const
         e.amb_bound_deg = 0.5 * (g.beta_deg - g.theta_deg);
         pe.err.add(e, g.alpha_deg);
         if (std::getenv("SL_EVAL_PIPE_DEBUG") != nullptr) {
-            std::fprintf(stderr, "rot %d az %d/%d n %u bins %u-%u r1 %.4f/%.4f r2 %.4f/%.4f R %u alpha %.2f truth %.2f model %.2f flag %d\n",
+            std::fprintf(stderr, "rot %d az %d/%d n %u bins %u-%u r1 %.4f/%.4f r2 %.4f/%.4f R %u alpha %.2f truth %.2f model %.2f flag %d tflags 0x%02x\n",
                          g.rotation, t.az, g.azimuth, t.az_count, t.bin_first, t.bin_last, e.r1_m, g.r1_m, e.r2_m, g.r2_m,
-                         t.radius_um, e.alpha_deg, g.alpha_deg, g.alpha_model_deg, e.flag);
+                         t.radius_um, e.alpha_deg, g.alpha_deg, g.alpha_model_deg, e.flag, t.flags);
         }
+    }
+    if (std::getenv("SL_EVAL_PIPE_DEBUG") != nullptr) {
+        const sl_profile_stats_t &ps = p.prof.stats;
+        std::fprintf(stderr, "profile: claims %u full %u released %u extracted %u fallback slot/lead/norun/tailcut/notail %u/%u/%u/%u/%u slope %u/256 (n %u)\n",
+                     ps.claims, ps.claim_full, ps.released, ps.extracted, ps.fallback[1], ps.fallback[2], ps.fallback[3],
+                     ps.fallback[4], ps.fallback[5], p.prof.slope_q8, p.prof.cal_n);
     }
     int unmatched = 0;
     for (const auto &kv : used) {
@@ -1355,6 +1364,11 @@ void realistic_pipe_add(const PipelineEval &pe, const GtRow &gt, int assoc_az, i
     if (cnt > 0) {
         out.raw.push_back(sum / cnt);
     }
+    if (std::getenv("SL_EVAL_PIPE_DEBUG") != nullptr) {
+        std::fprintf(stderr, "measurement: truth %.2f at %.2f m: %s %.2f\n", gt.alpha_deg, gt.r1_m,
+                     cnt > 0 ? "alpha" : "missed", cnt > 0 ? sum / cnt : 0.0);
+        (void)pe.result();
+    }
     int best_d = assoc_az + 1;
     double filt = std::nan("");
     for (const auto &t : pe.tracks()) {
@@ -1409,7 +1423,9 @@ RealisticResult run_realistic(const RealisticOptions &o)
     for (int c = 0; c < nc; c++) {
         const double dist = 1.75 + (2.85 - 1.75) * c / (nc - 1);
         for (int rep = 0; rep < 2; rep++) {
-            const Scene s = realistic_scene(dist, 0.0, 5000 + static_cast<uint64_t>(c * 10 + rep), o.frames, o.range_bins);
+            Scene s = realistic_scene(dist, 0.0, 5000 + static_cast<uint64_t>(c * 10 + rep), o.frames, o.range_bins);
+            s.smear_decay_db = o.smear_decay_db;
+            s.speckle_static = o.speckle_static;
             const Frames f = run_frames(s, o.threads, thr);
             done++;
             if (o.progress) {
@@ -1523,11 +1539,15 @@ RealisticResult run_realistic(const RealisticOptions &o)
             const double dist = o.positions == 1 ? 2.4 : 2.2 + 0.4 * pI / (o.positions - 1);
             for (int rep = 0; rep < o.reps; rep++) {
                 const uint64_t seed = 7000 + static_cast<uint64_t>(a * 1000 + pI * 10 + rep);
-                const Scene s = realistic_scene(dist, res.angles[a], seed, o.frames, o.range_bins);
+                Scene s = realistic_scene(dist, res.angles[a], seed, o.frames, o.range_bins);
+                s.smear_decay_db = o.smear_decay_db;
+                s.speckle_static = o.speckle_static;
                 std::unique_ptr<PipelineEval> pipe;
                 std::function<void(int, const uint8_t *, size_t)> on_bytes;
                 if (o.extract == Extract::Pipeline) {
-                    const PipeCfg pc = pipe_cfg_for_scene(s);
+                    PipeCfg pc = pipe_cfg_for_scene(s);
+                    pc.mask_frames = o.frames; // the window is the measurement's frames
+                    pc.profile = o.pipe_profile ? 1 : 0;
                     if (!res.have_pipe) {
                         res.pipe_cfg = pc;
                         res.have_pipe = true;
@@ -1629,6 +1649,25 @@ void print_realistic_pipeline(std::FILE *f, const RealisticResult &r)
         ss += sd / 5;
     }
     std::fprintf(f, "\ncore pipeline raw: average |mean error| / std over the 5 angles: %.2f / %.2f deg\n", sm, ss);
+    std::fprintf(f, "core pipeline raw |error| per angle: median / p90 (deg); missed = measurements without a\n"
+                    "target at the pole; ambiguous = matched targets flagged AMBIGUOUS\n");
+    for (int a = 0; a < 5; a++) {
+        const RealisticPipe &p = r.pipe[a];
+        std::vector<double> e;
+        for (double x : p.raw) {
+            e.push_back(std::fabs(x - r.angles[a]));
+        }
+        std::sort(e.begin(), e.end());
+        auto q = [&e](double t) {
+            return e.empty() ? std::nan("")
+                             : e[std::min(e.size() - 1, static_cast<size_t>(std::ceil(t * static_cast<double>(e.size())) - 1))];
+        };
+        const int matched = p.valid + p.ambiguous + p.other;
+        std::fprintf(f, "%+4d   | median %5.2f  p90 %5.2f | missed %d/%d (%.0f %%) | ambiguous %d/%d (%.0f %%)\n", r.angles[a],
+                     q(0.5), q(0.9), p.runs - p.detected, p.runs,
+                     p.runs > 0 ? 100.0 * (p.runs - p.detected) / p.runs : 0.0, p.ambiguous, matched,
+                     matched > 0 ? 100.0 * p.ambiguous / matched : 0.0);
+    }
 }
 
 } // namespace

@@ -158,6 +158,7 @@ struct PipeCfg {
     bool motion = true;         ///< pass the speed (false: no motion input, board's n)
     int mask_frames = 0;        ///< > 0: overrides the board's n
     int radius_from_width = -1; ///< cfg.detect.radius_from_width: -1 default (on), 0 off, 1 on
+    int profile = -1;           ///< cfg.profile (range-profile bounds): -1 default (on), 0 off, 1 on
     int assoc_az = 3;           ///< a target is the pole's when |az - truth azimuth| <= this
     bool clip_ambiguous = false; ///< ErrStats: count AMBIGUOUS as the model's bound
     double rotation_hz = 4;     ///< for now_us (the pipeline measures the period itself)
@@ -292,6 +293,10 @@ struct RealisticOptions {
                                 ///< core pipeline (board paper-bench, speed 0: the board's n)
     bool bbox_table = true;     ///< print the bbox table (false with --extract pipeline)
     int pipe_last = 4;          ///< pipeline: use the targets of the last N rotations
+    // Variations of the condition (defaults = the paper Table II condition)
+    double smear_decay_db = 3.3; ///< exponential smear decay per bin (dB)
+    int speckle_static = 1;     ///< 1: speckle frozen over the frames, 0: new every frame
+    bool pipe_profile = true;   ///< pipeline: range-profile bounds (false: mask + d(r))
 };
 
 /// Core-pipeline results for one true angle of the realistic bench (one estimate per

@@ -26,11 +26,15 @@ void usage()
                  "      alpha; n_eff from motion) on the real-resolution captures; both: the two.\n"
                  "  sl-eval realistic [--quick] [--json] [--json-out FILE] [--positions N] [--reps N] [--frames N]\n"
                  "                   [--calib N] [--range-bins N] [--threads N] [--extract bbox|pipeline|both]\n"
-                 "                   [--pipe-last N]\n"
+                 "                   [--pipe-last N] [--smear-decay DB] [--speckle-per-frame] [--no-profile]\n"
                  "      Smear, speckle, noise floor, leakage, measured emission, n-frame\n"
                  "      segmentation, poles at 2.2-2.6 m: beside the paper's Table II.\n"
                  "      --extract pipeline|both: also the core pipeline (board paper-bench, speed 0, the\n"
                  "      board's n) on every measurement: targets of the last N rotations (default 4).\n"
+                 "      --smear-decay DB: exponential smear decay per bin (default 3.3); --speckle-per-frame:\n"
+                 "      speckle drawn anew every frame (default frozen); --no-profile: the pipeline's mask\n"
+                 "      bounds with the board's d(r) instead of the range-profile bounds; --frames N is\n"
+                 "      also the pipeline's window n.\n"
                  "  sl-eval run CAPTURE.colossus GT.csv [--board NAME] [--scene SCENE.ini]\n"
                  "             [--threshold T] [--beta DEG] [--raw|--half-bin] [--r1-add M] [--d M]\n"
                  "             [--extract bbox|pipeline] [--beam-deg DEG] [--speed M/S] [--no-width-radius]\n"
@@ -144,6 +148,12 @@ int cmd_realistic(int argc, char **argv)
             json_out = argv[++i];
         } else if (a == "--quiet") {
             o.progress = false;
+        } else if (a == "--smear-decay" && i + 1 < argc) {
+            o.smear_decay_db = std::atof(argv[++i]);
+        } else if (a == "--speckle-per-frame") {
+            o.speckle_static = 0;
+        } else if (a == "--no-profile") {
+            o.pipe_profile = false;
         } else if (a == "--pipe-last" && i + 1 < argc) {
             { const int n = std::atoi(argv[++i]); o.pipe_last = n > 0 ? n : 1; }
         } else if (a == "--extract" && i + 1 < argc) {

@@ -50,8 +50,13 @@
 ///    - elongation: r2 -= d(r2), d = piecewise-linear interpolation of the board's table
 ///      (elong_range_um -> elong_d_um), constant beyond its ends, 0 without a table;
 ///    - radius R: the board's pole_radius_um when non-zero (flag RADIUS_BOARD); otherwise,
-///      when cfg.radius_from_width, from the group's azimuthal width, R = r1 * tan(w / 2)
-///      with w = (az_count - 1) * step - beam, the smallest arc consistent with az_count
+///      when cfg.radius_from_width, from the azimuthal width of the inner edge: az_count
+///      here is the number of contiguous azimuths around the representative one whose run
+///      reaches into the 3-bin slab [bin_first, bin_first + 2] (a round pole's silhouette
+///      lies ~R behind its front; a leaning pole spreads in bearing along its
+///      length, so the whole group's width overstates the diameter; EXTRACTION.md D4),
+///      R = r1 * tan(w / 2) with w = (az_count - 1) * step - beam, set to 0 when the beam's
+///      half footprint r1 * beam / 2 exceeds 4 R (the beam cannot resolve the diameter), the smallest arc consistent with az_count
 ///      azimuth samples less the beam's own spread (small angle; clamped to
 ///      [0, cfg.max_radius_um]; flags RADIUS_WIDTH and RADIUS_CLAMPED). It is biased low on
 ///      purpose: a thin pole seen on 2-3 azimuths gets R = 0 rather than a fake radius;
@@ -135,6 +140,7 @@ typedef enum sl_detect_reject {
 #define SL_TARGET_RADIUS_CLAMPED 0x04U ///< ... and clamped to cfg.max_radius_um
 #define SL_TARGET_ELONG 0x08U          ///< the elongation table was applied (d != 0)
 #define SL_TARGET_WRAPS 0x10U          ///< the group crosses azimuth 0
+#define SL_TARGET_PROFILE 0x20U        ///< bounds from the range profile (sl_profile.h)
 
 /// Detection parameters that are not (yet) board fields.
 typedef struct sl_detect_cfg {
@@ -263,8 +269,9 @@ sl_ssize_t sl_detect_rotation_from_mask(sl_detect_t *d, const sl_mask_t *mask);
 /// O(azimuths).
 uint16_t sl_detect_bins_needed(const sl_detect_t *d);
 
-/// Stage 5 alone (MATH.md s.4) for a run `bin_first..bin_last` on azimuth `az` of a group
-/// `az_count` azimuths wide. Fills r1_raw_um, r2_raw_um, r1_um, r2_um, radius_um, elong_um
+/// Stage 5 alone (MATH.md s.4) for a run `bin_first..bin_last` on azimuth `az`, with
+/// `az_count` the azimuths the radius estimate sees (sl_detect_end passes the column at the
+/// inner edge, see stage 5). Fills r1_raw_um, r2_raw_um, r1_um, r2_um, radius_um, elong_um
 /// and the RADIUS_* / ELONG flags of `t` (other fields untouched). `cfg` NULL = defaults.
 /// `az` is not used yet (kept for per-azimuth beam or range-offset tables). Pure;
 /// O(elong points) plus one isqrt when a radius applies.

@@ -8,7 +8,9 @@
 ///              the bytes the pipeline reads) -> sl_scan (frame-less: one row view per
 ///              azimuth) -> sl_thresh (first `mask_bins` bins only) -> sl_mask (n-frame
 ///              consistency, window shortened with vehicle speed) -> sl_detect (runs in
-///              the shadow, corrections, alpha) -> sl_track -> CAN (sl_can_tx_t)
+///              the shadow, corrections, alpha) -> sl_profile (bounds re-extracted from
+///              the summed 8-bit rows of the azimuths that show something in the shadow,
+///              smear tail removed; cfg.profile) -> sl_track -> CAN (sl_can_tx_t)
 ///
 /// so `sizeof(sl_pipeline_t)` is the whole RAM of the module (see the budget below).
 ///
@@ -99,11 +101,12 @@
 /// ## RAM budget (sizeof(sl_pipeline_t)); asserted below for the firmware configuration
 /// Dominated by the mask: SL_CFG_MAX_AZIMUTHS x (1 + ceil(log2 SL_CFG_MASK_FRAMES_MAX)) x
 /// SL_CFG_MASK_BINS / 8 bytes; then detection (8,424 B), the tracker (1,864 B), the scan
-/// bookkeeping (624 B), the reassembly buffer (SL_PIPELINE_REASM_BYTES) and a row buffer.
+/// bookkeeping (624 B), the range profiles (sl_profile.h, 2.1 KB), the reassembly buffer
+/// (SL_PIPELINE_REASM_BYTES) and a row buffer.
 ///
 /// | configuration (400 azimuths, 32 targets)              | x86-64    | Cortex-M0 |
 /// |--------------------------------------------------------|-----------|-----------|
-/// | firmware: SL_CFG_MASK_BINS 160, SL_CFG_MASK_FRAMES_MAX 16 | 52,808 B  | 52,712 B  |
+/// | firmware: SL_CFG_MASK_BINS 160, SL_CFG_MASK_FRAMES_MAX 16 | 54,952 B  | (not re-measured; 52,712 B before sl_profile's 2.1 KB) |
 /// | SL_CFG_MASK_BINS 192, SL_CFG_MASK_FRAMES_MAX 16          | 60,912 B  | 60,816 B  |
 /// | host default: mask bins 512 (whole ROI), n <= 32          | 167,552 B | 167,456 B |
 ///
@@ -163,6 +166,7 @@
 #include "shadowlean/sl_err.h"
 #include "shadowlean/sl_mask.h"
 #include "shadowlean/sl_port.h"
+#include "shadowlean/sl_profile.h"
 #include "shadowlean/sl_proto.h"
 #include "shadowlean/sl_scan.h"
 #include "shadowlean/sl_thresh.h"
@@ -224,6 +228,10 @@ typedef struct sl_pipeline_cfg {
     uint32_t rotation_us;        ///< rotation period when timestamps are unusable (250000)
     uint32_t row_timeout_us;     ///< Status says STREAMING (and Health has no NO_USABLE_ROWS)
                                  ///< only while a usable row arrived within this (1 s; 0 = 1 s)
+    // --- extraction
+    bool profile;                ///< refine bounds from range profiles (sl_profile.h;
+                                 ///< default true); false = the mask's bounds and d(r)
+    sl_profile_cfg_t profile_cfg; ///< profile parameters (sl_profile_cfg_default)
 } sl_pipeline_cfg_t;
 
 /// Defaults for `board` (threshold, n from the board; detection and tracker defaults;
@@ -316,6 +324,7 @@ typedef struct sl_pipeline {
     sl_scan_t scan;
     sl_mask_t mask;
     sl_detect_t detect;
+    sl_profile_t prof;           ///< range profiles of the azimuths showing something
     sl_tracker_t tracker;
     sl_can_tx_t can;
     sl_pipeline_stats_t stats;

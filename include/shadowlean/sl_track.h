@@ -27,6 +27,10 @@
 ///     else:    P += q^2 (q = cfg.q_cdeg, the random walk allowed per update)
 ///              K = P / (P + sigma_z^2)              (Q16, one 64-bit division)
 ///              alpha += K (z - alpha);  P = (1 - K) P   (round half up via sl_fx)
+///              repeat:  P = max(P, sigma_z^2) when the target's corrected r1 and r2 equal
+///                       the previous valid measurement's (a static scene quantised the
+///                       same way every rotation is one measurement, not many: variance
+///                       floor while the bins repeat, EXTRACTION.md D6)
 ///
 /// `alpha_cdeg` and `sigma_cdeg` (= isqrt(P)) are the reported values.
 ///

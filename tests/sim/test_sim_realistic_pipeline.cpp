@@ -4,8 +4,8 @@
 // n = 16 window) -> targets of the last rotations at the pole's azimuth. Reduced run
 // (3 positions x 1 repetition, 160 bins per azimuth, no bbox calibration) to stay a few seconds.
 // Asserted: detection in most measurements, the static window, and that the estimates are
-// ordered like the truth. Accuracy is NOT asserted (measured: a positive bias that shrinks
-// with alpha, see the full run in the report / issue notes).
+// ordered like the truth. Accuracy is asserted by sim_extraction_smear_robust
+// (test_sim_extraction.cpp); the full runs are in the README (Results).
 #include <cmath>
 #include <cstdarg>
 #include <cstddef>

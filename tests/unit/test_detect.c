@@ -533,6 +533,46 @@ static void test_detect_agrees_with_the_generated_paper_sim_board(void **state)
     assert_true(abs(got.alpha_cdeg - det.targets[0].alpha_cdeg) <= 1);
 }
 
+// A leaning pole spreads in bearing along its length: the group is wide, but the column at
+// its inner edge is narrow. The radius comes from that column (EXTRACTION.md D4), not from
+// the group (which would give the clamp).
+static void test_detect_radius_from_the_column_at_the_inner_edge(void **state)
+{
+    (void)state;
+    assert_int_equal(sl_detect_init(&det, &board, NULL), SL_OK);
+    // 9 azimuths; the inner slab (bins 64..66) is reached only on azimuths 40..42 (the
+    // strongest columns), the others slide outward by 3 bins per azimuth (3 columns: w = 2 x 0.9 - 1.8
+    // = 0 deg, R = 0; the whole group would give 8 x 0.9 - 1.8 = 5.4 deg).
+    for (int a = 40; a < 49; a++) {
+        if (a <= 42) {
+            set_run(a, 64, 76);
+        } else {
+            set_run(a, (uint32_t)(64 + 3 * (a - 42)), (uint32_t)(64 + 3 * (a - 42) + 8));
+        }
+    }
+    assert_int_equal(run_rotation(), 1);
+    assert_int_equal(det.targets[0].az_count, 9);
+    assert_int_equal(det.targets[0].bin_first, 64);
+    assert_true((det.targets[0].flags & SL_TARGET_RADIUS_CLAMPED) == 0U);
+    assert_true((det.targets[0].flags & SL_TARGET_RADIUS_WIDTH) != 0U);
+    assert_int_equal(det.targets[0].radius_um, 0);
+    // Six columns cover the inner bin: w = 5 x 0.9 - 1.8 = 2.7 deg.
+    memset(rows, 0, sizeof rows);
+    for (int a = 40; a < 49; a++) {
+        if (a <= 45) {
+            set_run(a, 64, 76);
+        } else {
+            set_run(a, (uint32_t)(64 + 3 * (a - 45)), (uint32_t)(64 + 3 * (a - 45) + 8));
+        }
+    }
+    assert_int_equal(run_rotation(), 1);
+    const sl_target_t *t = &det.targets[0];
+    assert_int_equal(t->bin_first, 64);
+    const double r1 = half_bin_um((uint16_t)t->bin_first) * 1e-6;
+    const double rexp = r1 * tan(2.7 / 2.0 * kPi / 180.0) * 1e6;
+    assert_true(fabs((double)t->radius_um - rexp) < rexp * 0.01 + 2.0);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -545,6 +585,7 @@ int main(void)
         cmocka_unit_test_setup(test_detect_merges_groups_joined_by_a_later_azimuth, setup),
         cmocka_unit_test_setup(test_detect_handles_empty_saturated_and_misordered_input, setup),
         cmocka_unit_test_setup(test_detect_correct_half_bin_elongation_and_radius, setup),
+        cmocka_unit_test_setup(test_detect_radius_from_the_column_at_the_inner_edge, setup),
         cmocka_unit_test_setup(test_detect_from_mask_reports_the_pole_after_n_stable_rotations,
                                setup),
         cmocka_unit_test_setup(test_detect_agrees_with_the_generated_paper_sim_board, setup),

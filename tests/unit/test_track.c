@@ -275,6 +275,31 @@ static void test_track_counts_targets_beyond_its_capacity(void **state)
     assert_int_equal(sl_track_init(&trk, NULL, NULL), SL_ERR_ARG);
 }
 
+// A static scene quantised the same way every rotation: identical bounds are one
+// measurement, so the filtered sigma stays at the measurement's own (variance floor while
+// the bins repeat); bounds that change are independent and shrink it as before.
+static void test_track_does_not_trust_repeated_identical_bounds(void **state)
+{
+    (void)state;
+    assert_int_equal(sl_track_init(&trk, &board, NULL), SL_OK);
+    uint64_t now = 0;
+    for (int i = 0; i < 20; i++) {
+        sl_target_t t = tgt(50, 2500000U, 300, 120, SL_INCLINE_VALID);
+        sl_track_update(&trk, &t, 1, now);
+        now += 250000;
+    }
+    assert_int_equal(trk.tracks[0].alpha_cdeg, 300);
+    assert_true(trk.tracks[0].sigma_cdeg >= 120);
+    // The same measurement noise with bounds that move: independent, sigma shrinks.
+    assert_int_equal(sl_track_init(&trk, &board, NULL), SL_OK);
+    for (int i = 0; i < 20; i++) {
+        sl_target_t t = tgt(50, 2500000U + (uint32_t)(i % 2) * 1000U, 300, 120, SL_INCLINE_VALID);
+        sl_track_update(&trk, &t, 1, now);
+        now += 250000;
+    }
+    assert_true(trk.tracks[0].sigma_cdeg < 60);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -286,6 +311,7 @@ int main(void)
         cmocka_unit_test_setup(test_track_keeps_poles_apart_by_azimuth_and_range_gates, setup),
         cmocka_unit_test_setup(test_track_motion_widens_the_gates, setup),
         cmocka_unit_test_setup(test_track_counts_targets_beyond_its_capacity, setup),
+        cmocka_unit_test_setup(test_track_does_not_trust_repeated_identical_bounds, setup),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

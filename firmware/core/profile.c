@@ -1,0 +1,442 @@
+// Range profiles beside the bit mask and smear-aware bounds from them (sl_profile.h).
+#include <stdint.h>
+#include <string.h>
+
+#include "shadowlean/sl_fx.h"
+#include "shadowlean/sl_profile.h"
+#include "shadowlean/sl_thresh.h"
+
+#define SLOPE_MIN_Q8 128U   // 0.5 value per bin
+#define SLOPE_MAX_Q8 6144U  // 24 values per bin
+#define FIT_BINS 8U
+#define FIT_MIN_BINS 4U
+#define CAL_GATE_N 4U       // fits before the +-30 % gate applies
+#define LOCAL_BINS 6U       // bins of the local tail fit during the walk
+
+void sl_profile_cfg_default(sl_profile_cfg_t *cfg)
+{
+    SL_ASSERT(cfg != NULL);
+    cfg->max_frames = 128U;
+    cfg->lead_bins = 6U;
+    cfg->max_idle = 4U;
+}
+
+sl_err_t sl_profile_init(sl_profile_t *pr, uint16_t azimuths, uint16_t near_bins,
+                         const sl_profile_cfg_t *cfg)
+{
+    if (pr == NULL || azimuths == 0U || azimuths > SL_CFG_MAX_AZIMUTHS) {
+        return SL_ERR_ARG;
+    }
+    sl_profile_cfg_t c;
+    if (cfg != NULL) {
+        c = *cfg;
+    } else {
+        sl_profile_cfg_default(&c);
+    }
+    if (c.max_frames < 2U || c.max_frames > 257U) {
+        return SL_ERR_ARG;
+    }
+    memset(pr, 0, sizeof *pr);
+    pr->cfg = c;
+    pr->azimuths = azimuths;
+    pr->near_bins = near_bins;
+    memset(pr->slot_of, SL_PROFILE_NONE, sizeof pr->slot_of);
+    return SL_OK;
+}
+
+// Count of trailing zeros of a non-zero word (portable de Bruijn, as in detect.c).
+static uint32_t ctz32(uint32_t v)
+{
+    static const uint8_t tab[32] = {0,  1,  28, 2,  29, 14, 24, 3,  30, 22, 20,
+                                    15, 25, 17, 4,  8,  31, 27, 13, 23, 21, 19,
+                                    16, 7,  26, 12, 18, 6,  11, 5,  10, 9};
+    return tab[((v & (0U - v)) * 0x077CB531U) >> 27];
+}
+
+// First set bit in [lo, hi) of `bits`, or hi.
+static uint32_t first_set(const uint32_t *bits, uint32_t lo, uint32_t hi)
+{
+    uint32_t pos = lo;
+    while (pos < hi) {
+        const uint32_t w = bits[pos >> 5] >> (pos & 31U);
+        if (w == 0U) {
+            pos = (pos | 31U) + 1U;
+            continue;
+        }
+        pos += ctz32(w);
+        return pos < hi ? pos : hi;
+    }
+    return hi;
+}
+
+static void slot_add(const sl_profile_t *pr, sl_profile_slot_t *s, const uint8_t *power,
+                     uint32_t n)
+{
+    if (s->frames >= pr->cfg.max_frames) {
+        for (uint32_t k = 0; k < SL_CFG_PROFILE_BINS; k++) {
+            s->sum[k] = (uint16_t)(s->sum[k] >> 1);
+        }
+        s->frames = (uint16_t)(s->frames >> 1);
+    }
+    const uint32_t b0 = s->bin0;
+    const uint32_t m = n > b0 ? (n - b0 < SL_CFG_PROFILE_BINS ? n - b0 : SL_CFG_PROFILE_BINS) : 0U;
+    for (uint32_t k = 0; k < m; k++) {
+        s->sum[k] = (uint16_t)(s->sum[k] + power[b0 + k]);
+    }
+    s->frames++;
+}
+
+void sl_profile_row(sl_profile_t *pr, uint16_t az, const uint8_t *power, uint32_t n,
+                    const uint32_t *bits, uint32_t win)
+{
+    SL_ASSERT(pr != NULL && power != NULL && bits != NULL);
+    if (az >= pr->azimuths) {
+        return;
+    }
+    const uint32_t hi = win < n ? win : n;
+    const uint32_t first = pr->near_bins < hi ? first_set(bits, pr->near_bins, hi) : hi;
+    const uint8_t si = pr->slot_of[az];
+    if (si != SL_PROFILE_NONE) {
+        sl_profile_slot_t *s = &pr->slot[si];
+        if (first < hi) {
+            s->seen = 1U;
+        }
+        slot_add(pr, s, power, n);
+        return;
+    }
+    if (first >= hi) {
+        return;
+    }
+    if (pr->n_live >= SL_CFG_PROFILE_SLOTS) {
+        pr->stats.claim_full++;
+        return;
+    }
+    for (uint32_t i = 0; i < SL_CFG_PROFILE_SLOTS; i++) {
+        sl_profile_slot_t *s = &pr->slot[i];
+        if (s->live != 0U) {
+            continue;
+        }
+        memset(s, 0, sizeof *s);
+        s->live = 1U;
+        s->seen = 1U;
+        s->az = az;
+        s->bin0 = (uint16_t)(first > pr->cfg.lead_bins ? first - pr->cfg.lead_bins : 0U);
+        pr->slot_of[az] = (uint8_t)i;
+        pr->n_live++;
+        pr->stats.claims++;
+        slot_add(pr, s, power, n);
+        return;
+    }
+    pr->stats.claim_full++;
+}
+
+void sl_profile_end_rotation(sl_profile_t *pr, bool reset)
+{
+    SL_ASSERT(pr != NULL);
+    if (reset) {
+        pr->stats.resets++;
+    }
+    for (uint32_t i = 0; i < SL_CFG_PROFILE_SLOTS; i++) {
+        sl_profile_slot_t *s = &pr->slot[i];
+        if (s->live == 0U) {
+            continue;
+        }
+        if (s->seen != 0U) {
+            s->idle = 0U;
+        } else if (++s->idle > pr->cfg.max_idle) {
+            s->live = 0U;
+            pr->slot_of[s->az] = SL_PROFILE_NONE;
+            pr->n_live--;
+            pr->stats.released++;
+            continue;
+        }
+        s->seen = 0U;
+        if (reset) {
+            memset(s->sum, 0, sizeof s->sum);
+            s->frames = 0U;
+        }
+    }
+}
+
+// Least-squares slope (decay, > 0 for a falling tail) of sum[e-m+1 .. e], per frame, Q8.
+// 0 when the bins rise.
+static uint32_t fit_slope_q8(const uint16_t *sum, uint32_t e, uint32_t m, uint32_t frames)
+{
+    int64_t sx = 0, sy = 0, sxx = 0, sxy = 0;
+    for (uint32_t x = 0; x < m; x++) {
+        const int64_t y = sum[e + 1U - m + x];
+        sx += (int64_t)x;
+        sy += y;
+        sxx += (int64_t)x * (int64_t)x;
+        sxy += (int64_t)x * y;
+    }
+    const int64_t mm = (int64_t)m;
+    const int64_t num = sx * sy - mm * sxy; // = -(m sxy - sx sy): decay
+    const int64_t den = (mm * sxx - sx * sx) * (int64_t)frames;
+    if (num <= 0 || den <= 0) {
+        return 0U;
+    }
+    const int64_t q = (num * 256 + den / 2) / den;
+    return q > 0xFFFF ? 0xFFFFU : (uint32_t)q;
+}
+
+// One extraction; `fit_bins` != 0 fixes the size of the tail fit (bins ending at e).
+static sl_profile_bounds_t extract_once(const uint16_t *sum, uint32_t n, uint32_t frames,
+                                        uint32_t threshold, uint32_t hint, uint32_t cal_slope_q8,
+                                        uint32_t fit_bins)
+{
+    sl_profile_bounds_t r;
+    memset(&r, 0, sizeof r);
+    SL_ASSERT(sum != NULL);
+    if (frames == 0U || n < 2U) {
+        r.fail = (uint8_t)SL_PROFILE_NO_SLOT;
+        return r;
+    }
+    const uint32_t thr = frames * threshold;
+    const uint32_t thr_e = frames * (threshold + threshold / 4U);
+    // 1. leading edge
+    uint32_t j = hint > 3U ? hint - 3U : 0U;
+    while (j < n && sum[j] < thr) {
+        j++;
+    }
+    if (j >= n || j > hint + 3U) {
+        r.fail = (uint8_t)SL_PROFILE_NO_RUN;
+        return r;
+    }
+    while (j > 0U && sum[j - 1U] >= thr) {
+        j--; // the mean starts before the mask's (AND) first bin
+    }
+    if (j == 0U) {
+        r.fail = (uint8_t)SL_PROFILE_LEAD_CUT;
+        return r;
+    }
+    const uint32_t i1 = j;
+    // 2. the run above the threshold (gaps <= 2 bridged), and the end of the usable tail
+    uint32_t last = i1;
+    uint32_t e = i1;
+    for (uint32_t k = i1; k < n; k++) {
+        if (sum[k] >= thr) {
+            last = k;
+            if (sum[k] >= thr_e) {
+                e = k;
+            }
+        } else if (k > last + 2U) {
+            break;
+        }
+    }
+    if (last + 3U >= n) {
+        r.fail = (uint8_t)SL_PROFILE_TAIL_CUT;
+        return r;
+    }
+    // 3. tail slope: self fit, else the calibration
+    uint32_t m = e - i1 + 1U;
+    m = m > FIT_BINS ? FIT_BINS : m;
+    if (fit_bins != 0U && fit_bins < m) {
+        m = fit_bins;
+    }
+    uint32_t s = m >= FIT_MIN_BINS ? fit_slope_q8(sum, e, m, frames) : 0U;
+    r.slope_src = SL_PROFILE_SLOPE_FIT;
+    if (s < SLOPE_MIN_Q8 || s > SLOPE_MAX_Q8) {
+        s = cal_slope_q8;
+        r.slope_src = SL_PROFILE_SLOPE_CAL;
+        if (s < SLOPE_MIN_Q8 || s > SLOPE_MAX_Q8) {
+            r.fail = (uint8_t)SL_PROFILE_NO_TAIL;
+            r.slope_src = 0U;
+            return r;
+        }
+    }
+    r.slope_q8 = (uint16_t)s;
+    // No tail at all: the return ends in a cliff (the step after its last bin above the
+    // threshold falls by more than two tail slopes), so its last bins are its own.
+    if (((int64_t)sum[last] - (int64_t)sum[last + 1U]) * 256 > 2 * (int64_t)frames * (int64_t)s) {
+        r.i1 = (uint16_t)i1;
+        r.i2 = (uint16_t)last;
+        r.e = (uint16_t)e;
+        r.slope_src = SL_PROFILE_SLOPE_CLIFF;
+        r.fail = (uint8_t)SL_PROFILE_OK;
+        return r;
+    }
+    // 4. walk back over the tail: bin j is tail while S[j-1] - S[j] >= F (s_loc - s_loc / 6)
+    //    (the bin before decays into it like the tail: it holds little power of its own).
+    uint32_t s_loc = s; // Q8 per frame
+    j = e;
+    while (j > i1) {
+        const int64_t dlt = (int64_t)sum[j - 1U] - (int64_t)sum[j]; // x F, values
+        const int64_t lim = (int64_t)frames * ((int64_t)s_loc - (int64_t)(s_loc / 6U)); // Q8
+        if (dlt * 256 < lim) {
+            // Rounding: 8-bit values of a static scene are not dithered, so a tail step can
+            // read up to one value short of the slope; it is still tail when it is short by
+            // less than one value and it and the step after it (already walked) fall by at
+            // least two slopes less one value (the rounding bound of a two-step difference).
+            const int64_t f256 = (int64_t)frames * 256;
+            const bool pair_after =
+                j + 1U <= e && dlt * 256 > (int64_t)frames * (int64_t)s_loc - f256 &&
+                ((int64_t)sum[j - 1U] - (int64_t)sum[j + 1U]) * 256 >=
+                    2 * (int64_t)frames * (int64_t)s_loc - f256;
+            // A knee between two smear components, while the slope still comes from the
+            // first fit (which may straddle it): one shallow step is passed when the step
+            // before it and both together fall like the tail; two shallow steps in a row are
+            // the pole's own bins.
+            bool knee = false;
+            if (!pair_after && j >= i1 + 2U && j + LOCAL_BINS - 1U > e) {
+                const int64_t d1 = (int64_t)sum[j - 2U] - (int64_t)sum[j - 1U];
+                const int64_t d2 = (int64_t)sum[j - 2U] - (int64_t)sum[j];
+                knee = d1 * 256 >= lim && d2 * 256 >= 2 * lim;
+            }
+            if (!pair_after && !knee) {
+                break;
+            }
+        }
+        j--;
+        // follow a tail that steepens towards the pole: the slope fitted on the LOCAL_BINS
+        // tail bins nearest to the walk (j .. j + LOCAL_BINS - 1), when plausible
+        if (j + LOCAL_BINS - 1U <= e) {
+            const uint32_t sl = fit_slope_q8(sum, j + LOCAL_BINS - 1U, LOCAL_BINS, frames);
+            if (sl >= SLOPE_MIN_Q8 && sl <= SLOPE_MAX_Q8) {
+                s_loc = sl;
+            }
+        }
+    }
+    r.i1 = (uint16_t)i1;
+    r.i2 = (uint16_t)j;
+    r.e = (uint16_t)e;
+    r.fail = (uint8_t)SL_PROFILE_OK;
+    return r;
+}
+
+sl_profile_bounds_t sl_profile_extract(const uint16_t *sum, uint32_t n, uint32_t frames,
+                                       uint32_t threshold, uint32_t hint, uint32_t cal_slope_q8)
+{
+    sl_profile_bounds_t r = extract_once(sum, n, frames, threshold, hint, cal_slope_q8, 0U);
+    // The first fit may reach into the pole's own bins when the tail is short: refit on the
+    // tail the walk found (when it has >= FIT_MIN_BINS bins) and walk again.
+    if (r.fail == (uint8_t)SL_PROFILE_OK && r.slope_src == SL_PROFILE_SLOPE_FIT &&
+        (uint32_t)r.i2 + FIT_BINS > r.e && (uint32_t)r.e >= (uint32_t)r.i2 + FIT_MIN_BINS) {
+        const sl_profile_bounds_t r2 =
+            extract_once(sum, n, frames, threshold, hint, cal_slope_q8, (uint32_t)r.e - r.i2);
+        if (r2.fail == (uint8_t)SL_PROFILE_OK) {
+            r = r2;
+        }
+    }
+    return r;
+}
+
+static void calibrate(sl_profile_t *pr, uint32_t s)
+{
+    if (pr->cal_n >= CAL_GATE_N) {
+        const uint32_t c = pr->slope_q8;
+        if (s * 10U < c * 7U || s * 10U > c * 13U) {
+            pr->stats.cal_rejected++;
+            return;
+        }
+    }
+    if (pr->cal_n == 0U) {
+        pr->slope_q8 = (uint16_t)s;
+    } else {
+        pr->slope_q8 = (uint16_t)((7U * pr->slope_q8 + s + 4U) / 8U);
+    }
+    if (pr->cal_n < 0xFFFFU) {
+        pr->cal_n++;
+    }
+    pr->stats.cal_accepted++;
+}
+
+uint8_t sl_profile_refine(sl_profile_t *pr, const sl_board_t *board, uint32_t threshold,
+                          sl_target_t *t)
+{
+    SL_ASSERT(pr != NULL && board != NULL && t != NULL);
+    const uint8_t si = t->az < pr->azimuths ? pr->slot_of[t->az] : (uint8_t)SL_PROFILE_NONE;
+    if (si == SL_PROFILE_NONE || pr->slot[si].frames == 0U || t->bin_first < pr->slot[si].bin0) {
+        const uint8_t why = (si != SL_PROFILE_NONE && pr->slot[si].frames != 0U)
+                                ? (uint8_t)SL_PROFILE_LEAD_CUT
+                                : (uint8_t)SL_PROFILE_NO_SLOT;
+        pr->stats.fallback[why]++;
+        return why;
+    }
+    const sl_profile_slot_t *s = &pr->slot[si];
+    const sl_profile_bounds_t pb =
+        sl_profile_extract(s->sum, SL_CFG_PROFILE_BINS, s->frames, threshold,
+                           (uint32_t)t->bin_first - s->bin0, pr->slope_q8);
+    if (pb.fail != (uint8_t)SL_PROFILE_OK) {
+        pr->stats.fallback[pb.fail]++;
+        return pb.fail;
+    }
+    if (pb.slope_src == SL_PROFILE_SLOPE_FIT) {
+        calibrate(pr, pb.slope_q8);
+    }
+    const uint64_t b = board->bin_size_um;
+    const uint64_t i1 = (uint64_t)s->bin0 + pb.i1, i2 = (uint64_t)s->bin0 + pb.i2;
+    // The detector's bounds are half-bin centres + radius terms (- d on r2): keep the
+    // radius terms, replace the centres, drop d.
+    const int64_t r1_hb_mask = (int64_t)((((uint64_t)2U * t->bin_first + 1U) * b + 1U) / 2U);
+    const int64_t r2_hb_mask = (int64_t)((((uint64_t)2U * t->bin_last + 1U) * b + 1U) / 2U);
+    const int64_t r1_term = (int64_t)t->r1_um - r1_hb_mask;
+    const int64_t r2_term = (int64_t)t->r2_um - (r2_hb_mask - (int64_t)t->elong_um);
+    const int64_t r1_hb = (int64_t)(((2U * i1 + 1U) * b + 1U) / 2U);
+    const int64_t r2_hb = (int64_t)(((2U * i2 + 1U) * b + 1U) / 2U);
+    t->r1_um = sl_fx_usat32(r1_hb + r1_term);
+    t->r2_um = sl_fx_usat32(r2_hb + r2_term);
+    t->elong_um = sl_fx_sat32(r2_hb_mask - r2_hb);
+    t->flags = (uint8_t)((t->flags & ~SL_TARGET_ELONG) | SL_TARGET_PROFILE);
+    if (board->geom != NULL) {
+        const sl_incline_result_t res = sl_incline_estimate(
+            t->r1_um, t->r2_um, &board->geom[t->az], board->range_sigma_um,
+            board->theta_sigma_cdeg);
+        t->alpha_cdeg = res.alpha_cdeg;
+        t->sigma_cdeg = res.sigma_cdeg;
+        t->incline_flag = res.flag;
+        t->incline_branch = res.branch;
+    }
+    pr->stats.extracted++;
+    return (uint8_t)SL_PROFILE_OK;
+}
+
+void sl_profile_assign(sl_profile_t *pr, const sl_target_t *targets, uint32_t n)
+{
+    SL_ASSERT(pr != NULL && (targets != NULL || n == 0U));
+    uint8_t keep[SL_CFG_PROFILE_SLOTS];
+    memset(keep, 0, sizeof keep);
+    for (uint32_t j = 0; j < n; j++) {
+        const uint16_t az = targets[j].az;
+        if (az < pr->azimuths && pr->slot_of[az] != SL_PROFILE_NONE) {
+            keep[pr->slot_of[az]] = 1U;
+        }
+    }
+    for (uint32_t j = 0; j < n; j++) {
+        const sl_target_t *t = &targets[j];
+        if (t->az >= pr->azimuths || pr->slot_of[t->az] != SL_PROFILE_NONE) {
+            continue;
+        }
+        // A free slot, else one watching an azimuth that is no target's (claimed on
+        // evidence that did not become a target, or a target's former azimuth).
+        uint32_t pick = SL_CFG_PROFILE_SLOTS;
+        for (uint32_t i = 0; i < SL_CFG_PROFILE_SLOTS; i++) {
+            if (pr->slot[i].live == 0U) {
+                pick = i;
+                break;
+            }
+            if (pick == SL_CFG_PROFILE_SLOTS && keep[i] == 0U) {
+                pick = i;
+            }
+        }
+        if (pick == SL_CFG_PROFILE_SLOTS) {
+            pr->stats.assign_full++;
+            continue;
+        }
+        sl_profile_slot_t *s = &pr->slot[pick];
+        if (s->live != 0U) {
+            pr->slot_of[s->az] = SL_PROFILE_NONE;
+            pr->stats.stolen++;
+        } else {
+            pr->n_live++;
+        }
+        memset(s, 0, sizeof *s);
+        s->live = 1U;
+        s->seen = 1U;
+        s->az = t->az;
+        s->bin0 = (uint16_t)(t->bin_first > pr->cfg.lead_bins ? (uint32_t)t->bin_first - pr->cfg.lead_bins : 0U);
+        pr->slot_of[t->az] = (uint8_t)pick;
+        keep[pick] = 1U;
+        pr->stats.assigned++;
+    }
+}

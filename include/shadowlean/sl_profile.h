@@ -1,0 +1,207 @@
+/// @file sl_profile.h
+/// @brief Range profiles beside the bit mask: amplitude kept where a pole is, smear-aware
+/// bounds from it (EXTRACTION.md D1-D3).
+///
+/// The threshold + n-frame AND of the mask keeps one bit per bin, so r2 is where the smear
+/// tail crosses the threshold, and the tail's length depends on the level the pole leaves
+/// at its last own bin (compression: short returns read long). This module keeps, for a few
+/// azimuths that show something inside the shadow, the SUM of the 8-bit rows over the
+/// rotations (a bounded per-azimuth accumulator) and extracts the bounds from it with a tail
+/// model fitted on the profile itself, so no board constant has to be right.
+///
+/// ## Accumulation (sl_profile_row, once per azimuth row, any order)
+/// - A *slot* watches one azimuth: `sum[k]` = sum over `frames` rows of `power[bin0 + k]`,
+///   k < SL_CFG_PROFILE_BINS (8-bit values, so up to 257 rows fit a uint16; at
+///   `cfg.max_frames` the sums and the count are halved: an exponential forgetting that
+///   keeps the mean and bounds the memory).
+/// - An azimuth without a slot claims a free one when this row has an occupied bit (the
+///   per-frame threshold bits) in the search window `[near, win)` (the detector's window:
+///   the shadow). `bin0 = max(0, first occupied bin - cfg.lead_bins)`.
+/// - Evidence alone can fill every slot (a wide return, clutter), so once targets exist,
+///   sl_profile_assign() gives each target's representative azimuth a slot, taking it from
+///   an azimuth that is no target's when none is free.
+/// - sl_profile_end_rotation(): slots whose azimuth showed no bit in the window for more
+///   than `cfg.max_idle` rotations are freed; with `reset` (the vehicle moved: the caller
+///   passes n_eff < n) every sum is cleared, so a profile never mixes positions.
+///
+/// ## Extraction (sl_profile_extract, pure; S = sum, F = frames, T = threshold)
+/// 1. r1: the first bin at or after `hint - 3` (the mask's first bin) with S >= F T.
+/// 2. The run above F T from there (gaps up to 2 bins bridged) must end inside the profile
+///    (else TAIL_CUT); e = its last bin with S >= F (T + T/4) (below, the noise floor
+///    flattens the tail).
+/// 3. Tail slope, self-fitted: integer least squares over the (up to) 8 bins ending at e,
+///    s in 1/256 value per bin per frame; plausible in [0.5, 24] values/bin over >= 4 bins,
+///    else the running calibration (below) is used, else NO_TAIL.
+///    No tail: when the step after the run's last bin above F T falls by more than 2 F s
+///    (a cliff, not a smear tail), r2 is that last bin and there is no walk.
+/// 4. Walk back from e while the bin before decays into this one like a tail:
+///    S[j-1] - S[j] >= F (s_loc - s_loc / 6) (a bin is the pole's own when it decays by
+///    clearly less than the local tail slope). A shallower step is still tail when it is
+///    short of s_loc by less than one value and it and the step after it (already walked)
+///    fall by at least 2 s_loc - 1 value (8-bit values of a static scene are not dithered:
+///    that is the rounding bound), or, while s_loc is still the first fit, when the step
+///    before it and both together fall like the tail (a knee between two smear
+///    components); two shallow steps in
+///    a row stop the walk. s_loc is the slope fitted on the 6 tail bins nearest to the walk
+///    (j .. j + 5) once there are 6, so a tail that steepens towards the pole is followed.
+///    The bin where the walk stops is the last own bin: r2. When the first fit window
+///    reached into the pole's own bins (a short tail), the fit is repeated on the tail the
+///    walk found (>= 4 bins) and the walk done again.
+/// 5. Result in bins (relative to bin0): i1, i2, the slope used and where it came from.
+/// The value scale (log of power) only enters through the ratio 1/6 and T/4; nothing depends
+/// on the simulator's kernel, the board's d(r) or n.
+///
+/// ## Online calibration (D3)
+/// `slope_q8`: exponential mean (weight 1/8) of the self-fitted slopes of accepted
+/// extractions, each gated to +-30 % of the current value once 4 fits are in
+/// (`stats.cal_rejected` counts the others). It is the fallback for short tails only.
+/// Not done: residual r1/r2 offsets from upright poles (EXTRACTION.md D3): see the report.
+///
+/// ## Ownership, memory, cost
+/// Caller-owned `sl_profile_t`, no allocation. RAM: SL_CFG_MAX_AZIMUTHS bytes + slots x
+/// (2 x SL_CFG_PROFILE_BINS + 12) (400 + 12 x 140 = 2,080 B with the defaults).
+/// sl_profile_row: an unwatched azimuth costs one table read and the OR of the window's
+/// words; a watched one SL_CFG_PROFILE_BINS additions. sl_profile_extract: O(bins), one
+/// 64-bit division. Not reentrant per instance.
+#ifndef SHADOWLEAN_SL_PROFILE_H
+#define SHADOWLEAN_SL_PROFILE_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "shadowlean/sl_config.h"
+#include "shadowlean/sl_detect.h"
+#include "shadowlean/sl_err.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/// Azimuths watched at once (slots).
+#ifndef SL_CFG_PROFILE_SLOTS
+#define SL_CFG_PROFILE_SLOTS 12
+#endif
+#if SL_CFG_PROFILE_SLOTS < 1 || SL_CFG_PROFILE_SLOTS > 254
+#error "SL_CFG_PROFILE_SLOTS must be in [1, 254]"
+#endif
+
+/// Bins per watched profile (from the slot's bin0).
+#ifndef SL_CFG_PROFILE_BINS
+#define SL_CFG_PROFILE_BINS 64
+#endif
+#if SL_CFG_PROFILE_BINS < 16 || SL_CFG_PROFILE_BINS > 1024
+#error "SL_CFG_PROFILE_BINS must be in [16, 1024]"
+#endif
+
+#define SL_PROFILE_NONE 0xFFU
+
+/// Why an extraction fell back to the mask's bounds (`sl_profile_stats_t.fallback`).
+typedef enum sl_profile_fail {
+    SL_PROFILE_OK = 0,
+    SL_PROFILE_NO_SLOT = 1,   ///< the azimuth is not watched (or has no frame yet)
+    SL_PROFILE_LEAD_CUT = 2,  ///< the run starts before the profile (no leading edge)
+    SL_PROFILE_NO_RUN = 3,    ///< nothing above the threshold near the mask's first bin
+    SL_PROFILE_TAIL_CUT = 4,  ///< the run reaches the profile's end
+    SL_PROFILE_NO_TAIL = 5,   ///< no plausible tail slope (self fit or calibration)
+    SL_PROFILE_FAIL_COUNT = 6
+} sl_profile_fail_t;
+
+/// Where the slope of an extraction came from.
+#define SL_PROFILE_SLOPE_FIT 1U ///< self-fitted on this profile
+#define SL_PROFILE_SLOPE_CAL 2U ///< the running calibration (tail too short to fit)
+#define SL_PROFILE_SLOPE_CLIFF 3U ///< no tail: the return ends in a cliff, r2 = its last bin
+
+typedef struct sl_profile_cfg {
+    uint16_t max_frames; ///< halve the sums at this many frames (2..257, default 128)
+    uint8_t lead_bins;   ///< bins kept before the first occupied bin at claim (default 6)
+    uint8_t max_idle;    ///< rotations without evidence before a slot is freed (default 4)
+} sl_profile_cfg_t;
+
+void sl_profile_cfg_default(sl_profile_cfg_t *cfg);
+
+typedef struct sl_profile_slot {
+    uint16_t sum[SL_CFG_PROFILE_BINS]; ///< sum of power[bin0 + k] over `frames` rows
+    uint16_t az;
+    uint16_t bin0;
+    uint16_t frames;
+    uint8_t idle;  ///< rotations without an occupied bit in the window
+    uint8_t seen;  ///< an occupied bit in the window this rotation
+    uint8_t live;
+    uint8_t pad_;
+} sl_profile_slot_t;
+
+/// Result of one extraction (bins relative to the slot's bin0).
+typedef struct sl_profile_bounds {
+    uint16_t i1;        ///< first bin of the pole (leading edge)
+    uint16_t i2;        ///< last own bin (tail removed)
+    uint16_t e;         ///< last bin of the tail used for the fit
+    uint16_t slope_q8;  ///< tail slope used, 1/256 value per bin (per frame)
+    uint8_t slope_src;  ///< SL_PROFILE_SLOPE_*
+    uint8_t fail;       ///< sl_profile_fail_t (SL_PROFILE_OK: the fields above are valid)
+} sl_profile_bounds_t;
+
+typedef struct sl_profile_stats {
+    uint32_t claims;        ///< slots claimed
+    uint32_t claim_full;    ///< azimuths with evidence but no free slot
+    uint32_t released;      ///< slots freed after max_idle
+    uint32_t resets;        ///< sl_profile_end_rotation with reset
+    uint32_t extracted;     ///< targets refined from a profile
+    uint32_t fallback[SL_PROFILE_FAIL_COUNT]; ///< targets left with the mask's bounds, by reason
+    uint32_t assigned;      ///< slots given to targets' azimuths (sl_profile_assign)
+    uint32_t stolen;        ///< ... taken from an azimuth that was no target's
+    uint32_t assign_full;   ///< targets left without a slot (every slot watches a target)
+    uint32_t cal_accepted;  ///< self-fitted slopes taken into the calibration
+    uint32_t cal_rejected;  ///< ... refused by the +-30 % gate
+} sl_profile_stats_t;
+
+typedef struct sl_profile {
+    sl_profile_cfg_t cfg;
+    uint16_t azimuths;
+    uint16_t near_bins;
+    uint16_t slope_q8;      ///< calibrated tail slope (0: none yet)
+    uint16_t cal_n;         ///< fits taken into slope_q8 (saturating)
+    uint16_t n_live;        ///< slots in use
+    uint8_t slot_of[SL_CFG_MAX_AZIMUTHS]; ///< slot index per azimuth, SL_PROFILE_NONE
+    sl_profile_slot_t slot[SL_CFG_PROFILE_SLOTS];
+    sl_profile_stats_t stats;
+} sl_profile_t;
+
+/// Initialise (no slot in use). `cfg` NULL = defaults. @return SL_ERR_ARG for NULL `pr`,
+/// azimuths 0 or > SL_CFG_MAX_AZIMUTHS, max_frames outside 2..257.
+sl_err_t sl_profile_init(sl_profile_t *pr, uint16_t azimuths, uint16_t near_bins,
+                         const sl_profile_cfg_t *cfg);
+
+/// One azimuth row: `power` (n bins from bin 0, 8-bit), this frame's threshold bits `bits`
+/// (layout sl_thresh.h, at least ceil(min(n, win)/32) words) and the detector's search
+/// window end `win` for this azimuth. Adds the row to the azimuth's slot, claiming one when
+/// the row has an occupied bit in [near, win). Rows of an azimuth out of range are ignored.
+void sl_profile_row(sl_profile_t *pr, uint16_t az, const uint8_t *power, uint32_t n,
+                    const uint32_t *bits, uint32_t win);
+
+/// End of a rotation: age and free idle slots; `reset` clears every sum (vehicle moving).
+void sl_profile_end_rotation(sl_profile_t *pr, bool reset);
+
+/// After a rotation's targets are known: every target's representative azimuth without a
+/// slot gets one (a free slot, else one watching an azimuth that is no target's, counted
+/// `stolen`; `assign_full` when every slot watches a target), with bin0 = bin_first -
+/// lead_bins. Its profile starts with the next row. O(targets x slots).
+void sl_profile_assign(sl_profile_t *pr, const sl_target_t *targets, uint32_t n);
+
+/// Smear-aware bounds from a profile (pure; see "Extraction"). `hint` = the mask's first
+/// bin relative to the profile start, `cal_slope_q8` the fallback slope (0: none).
+sl_profile_bounds_t sl_profile_extract(const uint16_t *sum, uint32_t n, uint32_t frames,
+                                       uint32_t threshold, uint32_t hint, uint32_t cal_slope_q8);
+
+/// Refine a detected target with the profile of its azimuth: r1 from the leading edge, r2
+/// from the last own bin (half-bin centres, the target's radius terms kept, no d(r)), alpha
+/// re-estimated; flag SL_TARGET_PROFILE, `elong_um` = the smear removed (mask r2 centre -
+/// profile r2 centre). Without a usable profile the target is left as it is (counted by
+/// reason). Updates the slope calibration. @return the extraction's sl_profile_fail_t.
+uint8_t sl_profile_refine(sl_profile_t *pr, const sl_board_t *board, uint32_t threshold,
+                          sl_target_t *t);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif // SHADOWLEAN_SL_PROFILE_H

@@ -1,0 +1,140 @@
+// Smear-robust extraction through the CORE PIPELINE (range profiles, sl_profile.h) on the
+// realistic bench (paper Table II condition, sl-eval realistic --extract pipeline) and its
+// variations, with one and the same configuration (no constant refitted per condition):
+// smear decay 3.3 and 4.5 dB per bin, speckle drawn anew every frame at n = 4 and 16.
+// Reduced runs (3 positions x 2 repetitions, 160 bins per azimuth) to stay well under a
+// minute each; the full runs are in the README (Results).
+// Asserted per true angle (at -10 deg the estimator's ambiguity fold at (beta - theta) / 2
+// = -11.5 deg flags part of the measurements AMBIGUOUS, counted at the bound: that angle is
+// only required to stay within 1.6 deg): |mean error| <= 1.0 deg on the paper condition
+// (6 measurements per angle; the full run's figure is in the README), <= 1.5 deg on the
+// variations (the criterion), std <= 1.5 deg, the pole found in >= 5 of 6
+// measurements; the n = 4 -> 16 shift <= 0.5 deg. On the paper condition the
+// same bounds with the profile off are NOT met (the mask + board d(r) path is biased), so
+// the test fails if the refinement is not applied.
+#include <algorithm>
+#include <cmath>
+#include <cstdarg>
+#include <cstddef>
+#include <cstdint>
+#include <cstdio>
+#include <setjmp.h>
+
+extern "C" {
+#include <cmocka.h>
+}
+
+#include "sim_eval.h"
+
+using namespace sl;
+
+static RealisticOptions quick()
+{
+    RealisticOptions o;
+    o.positions = 3;
+    o.reps = 2;
+    o.range_bins = 160;
+    o.progress = false;
+    o.threads = 2;
+    o.extract = Extract::Pipeline;
+    o.bbox_table = false;
+    return o;
+}
+
+static void mean_sd(const std::vector<double> &v, double *m, double *s)
+{
+    double a = 0, b = 0;
+    for (double x : v) {
+        a += x;
+    }
+    a /= static_cast<double>(v.size());
+    for (double x : v) {
+        b += (x - a) * (x - a);
+    }
+    *m = a;
+    *s = v.size() > 1 ? std::sqrt(b / static_cast<double>(v.size() - 1)) : 0.0;
+}
+
+// Checks the accuracy bounds; returns the mean error per angle in `err`.
+static bool within(const RealisticResult &r, double err[5], bool assert_it, double lim_mean)
+{
+    bool ok = true;
+    for (int a = 0; a < 5; a++) {
+        const RealisticPipe &p = r.pipe[a];
+        if (p.raw.empty()) {
+            if (assert_it) {
+                fail_msg("angle %d: no estimate", r.angles[a]);
+            }
+            return false;
+        }
+        double m, s;
+        mean_sd(p.raw, &m, &s);
+        err[a] = m - r.angles[a];
+        const double lim = r.angles[a] == -10 ? std::max(1.6, lim_mean) : lim_mean;
+        const bool this_ok = std::fabs(err[a]) <= lim && s <= 1.5 && p.detected * 6 >= p.runs * 5;
+        std::printf("  %+3d deg: mean error %+6.2f std %5.2f detected %d/%d -> %s\n", r.angles[a], err[a], s,
+                    p.detected, p.runs, this_ok ? "ok" : "OUT");
+        if (assert_it && !this_ok) {
+            fail_msg("angle %d: mean error %.2f (limit %.1f) std %.2f detected %d/%d", r.angles[a], err[a], lim, s,
+                     p.detected, p.runs);
+        }
+        ok = ok && this_ok;
+    }
+    return ok;
+}
+
+static void test_extraction_paper_condition_within_1_deg(void **)
+{
+    RealisticOptions o = quick();
+    const RealisticResult r = run_realistic(o);
+    double e[5];
+    std::printf("smear 3.3 dB/bin, frozen speckle, n = 16:\n");
+    within(r, e, true, 1.0);
+    // The same captures without the profile: the mask's bounds and the board's d(r).
+    o.pipe_profile = false;
+    const RealisticResult r0 = run_realistic(o);
+    double e0[5];
+    std::printf("same, profile off (mask + board d(r)):\n");
+    assert_false(within(r0, e0, false, 1.0));
+}
+
+static void test_extraction_steeper_smear_same_configuration(void **)
+{
+    RealisticOptions o = quick();
+    o.smear_decay_db = 4.5;
+    const RealisticResult r = run_realistic(o);
+    double e[5];
+    std::printf("smear 4.5 dB/bin:\n");
+    within(r, e, true, 1.5);
+}
+
+// Per-frame speckle: the profile is a mean, not the AND's minimum statistic, so the estimate
+// does not drift with n (the mask's r2 shortens with n: EXTRACTION.md s.1 cause 3).
+static void test_extraction_does_not_drift_with_n_under_per_frame_speckle(void **)
+{
+    double e[2][5];
+    const int ns[2] = {4, 16};
+    for (int i = 0; i < 2; i++) {
+        RealisticOptions o = quick();
+        o.speckle_static = 0;
+        o.frames = ns[i];
+        const RealisticResult r = run_realistic(o);
+        std::printf("speckle per frame, n = %d:\n", ns[i]);
+        within(r, e[i], true, 1.5);
+    }
+    for (int a = 1; a < 5; a++) {
+        const double shift = std::fabs(e[1][a] - e[0][a]);
+        std::printf("  %+3d deg: mean shift n = 4 -> 16: %.2f deg\n", -10 + 5 * a, shift);
+        assert_true(shift <= 0.5);
+    }
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_extraction_paper_condition_within_1_deg),
+        cmocka_unit_test(test_extraction_steeper_smear_same_configuration),
+        cmocka_unit_test(test_extraction_does_not_drift_with_n_under_per_frame_speckle),
+    };
+    return cmocka_run_group_tests(tests, nullptr, nullptr);
+}

@@ -1,0 +1,299 @@
+// Unit tests for sl_profile.h: the per-azimuth accumulator against a naive sum (claims,
+// idle release, reset, halving), and the smear-aware extraction on synthetic profiles whose
+// own bins are known: a pole's own power convolved with smear kernels of several shapes
+// (single exponential of 2.5 / 3.3 / 4.5 dB per bin, a two-component tail, a level-dependent
+// decay), mapped to 8-bit log values like a radar's output.
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <string.h>
+#include <cmocka.h>
+#include <math.h>
+
+#include "shadowlean/sl_profile.h"
+
+#define NB SL_CFG_PROFILE_BINS
+
+static sl_profile_t pr;
+
+// Deterministic pseudo-random numbers (xorshift32).
+static uint32_t rng_state = 12345U;
+static uint32_t rnd(void)
+{
+    uint32_t x = rng_state;
+    x ^= x << 13;
+    x ^= x >> 17;
+    x ^= x << 5;
+    rng_state = x;
+    return x;
+}
+
+static void test_profile_accumulates_like_a_naive_sum(void **state)
+{
+    (void)state;
+    assert_int_equal(sl_profile_init(&pr, 400, 10, NULL), SL_OK);
+    static uint8_t rows[20][160];
+    uint32_t bits[5];
+    uint32_t naive[NB];
+    memset(naive, 0, sizeof naive);
+    for (int f = 0; f < 20; f++) {
+        for (int k = 0; k < 160; k++) {
+            rows[f][k] = (uint8_t)(rnd() & 0x3FU);
+        }
+        memset(bits, 0, sizeof bits);
+        // frame 0: an occupied bin at 30 (inside [10, 80)): claim with bin0 = 24
+        bits[30 >> 5] |= 1U << (30 & 31);
+        sl_profile_row(&pr, 123, rows[f], 160, bits, 80);
+        // azimuth 124: only a bit beyond the window, never claimed
+        memset(bits, 0, sizeof bits);
+        bits[100 >> 5] |= 1U << (100 & 31);
+        sl_profile_row(&pr, 124, rows[f], 160, bits, 80);
+        for (int k = 0; k < NB; k++) {
+            naive[k] += rows[f][24 + k];
+        }
+        sl_profile_end_rotation(&pr, false);
+    }
+    const uint8_t si = pr.slot_of[123];
+    assert_true(si != SL_PROFILE_NONE);
+    assert_int_equal(pr.slot_of[124], SL_PROFILE_NONE);
+    assert_int_equal(pr.slot[si].bin0, 24);
+    assert_int_equal(pr.slot[si].frames, 20);
+    for (int k = 0; k < NB; k++) {
+        assert_int_equal(pr.slot[si].sum[k], naive[k]);
+    }
+    assert_int_equal(pr.stats.claims, 1);
+    // No evidence for more than max_idle rotations: released.
+    memset(bits, 0, sizeof bits);
+    for (int r = 0; r <= pr.cfg.max_idle; r++) {
+        sl_profile_row(&pr, 123, rows[0], 160, bits, 80);
+        sl_profile_end_rotation(&pr, false);
+    }
+    assert_int_equal(pr.slot_of[123], SL_PROFILE_NONE);
+    assert_int_equal(pr.stats.released, 1);
+}
+
+static void test_profile_halves_reset_and_counts_full(void **state)
+{
+    (void)state;
+    sl_profile_cfg_t c;
+    sl_profile_cfg_default(&c);
+    c.max_frames = 8;
+    assert_int_equal(sl_profile_init(&pr, 400, 0, &c), SL_OK);
+    uint8_t row[64];
+    memset(row, 100, sizeof row);
+    uint32_t bits[2] = {1U, 0U};
+    for (int f = 0; f < 9; f++) {
+        sl_profile_row(&pr, 5, row, 64, bits, 64);
+    }
+    const sl_profile_slot_t *s = &pr.slot[pr.slot_of[5]];
+    // 8 frames -> halved to 4 (sum 400) -> + 1 frame = 5 frames, sum 500: mean kept
+    assert_int_equal(s->frames, 5);
+    assert_int_equal(s->sum[0], 500);
+    sl_profile_end_rotation(&pr, true);
+    assert_int_equal(s->frames, 0);
+    assert_int_equal(s->sum[0], 0);
+    // every slot in use: the next azimuth with evidence is counted, not claimed
+    for (uint16_t a = 10; a < 10 + SL_CFG_PROFILE_SLOTS; a++) {
+        sl_profile_row(&pr, a, row, 64, bits, 64);
+    }
+    assert_int_equal(pr.stats.claim_full, 1);
+    assert_int_equal(sl_profile_init(&pr, 0, 0, NULL), SL_ERR_ARG);
+    c.max_frames = 300;
+    assert_int_equal(sl_profile_init(&pr, 400, 0, &c), SL_ERR_ARG);
+}
+
+// Synthetic mean profile: own power own[k] on bins [a, b] convolved with a smear kernel,
+// noise floor, mapped to v = round(c10 log10(P / P0)) clamped to 0..255, summed over F frames.
+// kernel(j, level_db): power ratio of the smear j bins after a bin of that level.
+typedef double (*kernel_fn)(int j, double level_db);
+
+static double g_decay_db = 3.3;
+static double k_exp(int j, double level_db)
+{
+    (void)level_db;
+    return pow(10.0, -g_decay_db * j / 10.0);
+}
+// Two components: 3.3 dB/bin plus a 1.5 dB/bin skirt at -15 dB.
+static double k_two(int j, double level_db)
+{
+    (void)level_db;
+    return pow(10.0, -3.3 * j / 10.0) + pow(10.0, (-15.0 - 1.5 * j) / 10.0) * (j > 0 ? 1.0 : 0.0);
+}
+// Decay that depends on the level (+-0.5 dB/bin over 40 dB).
+static double k_level(int j, double level_db)
+{
+    const double d = 3.3 + 0.5 * (level_db - 80.0) / 40.0;
+    return pow(10.0, -d * j / 10.0);
+}
+
+static void synth(uint16_t *sum, int frames, int a, int b, const double *own_db, kernel_fn kern)
+{
+    double p[NB];
+    for (int k = 0; k < NB; k++) {
+        p[k] = pow(10.0, 10.0 / 10.0); // noise floor: 10 dB
+    }
+    for (int k = a; k <= b; k++) {
+        const double lvl = own_db[k - a];
+        const double pk = pow(10.0, lvl / 10.0);
+        for (int j = 0; k + j < NB; j++) {
+            p[k + j] += pk * kern(j, lvl);
+        }
+    }
+    for (int k = 0; k < NB; k++) {
+        double v = floor(10.0 * log10(p[k]) + 0.5);
+        v = v < 0 ? 0 : (v > 255 ? 255 : v);
+        sum[k] = (uint16_t)(v * frames);
+    }
+}
+
+static void check_shape(kernel_fn kern, const double *own_db, int len, int frames)
+{
+    uint16_t sum[NB];
+    const int a = 10;
+    const int b = a + len - 1;
+    synth(sum, frames, a, b, own_db, kern);
+    const sl_profile_bounds_t r = sl_profile_extract(sum, NB, (uint32_t)frames, 40U, (uint32_t)a, 0U);
+    assert_int_equal(r.fail, SL_PROFILE_OK);
+    assert_int_equal(r.slope_src, SL_PROFILE_SLOPE_FIT);
+    assert_int_equal(r.i1, a);
+    assert_int_equal(r.i2, b);
+}
+
+static void test_profile_extracts_own_bins_under_exponential_smear(void **state)
+{
+    (void)state;
+    // uniform pole, a "foot" (concentrated end, alpha < 0) and a rising return
+    double uni[12], foot[5], rise[9];
+    for (int i = 0; i < 12; i++) {
+        uni[i] = 70.0;
+    }
+    for (int i = 0; i < 5; i++) {
+        foot[i] = 60.0 + 10.0 * i;
+    }
+    for (int i = 0; i < 9; i++) {
+        rise[i] = 85.0 - 1.0 * i;
+    }
+    const double decays[3] = {2.5, 3.3, 4.5};
+    for (int d = 0; d < 3; d++) {
+        g_decay_db = decays[d];
+        for (int f = 1; f <= 16; f *= 4) {
+            check_shape(k_exp, uni, 12, f);
+            check_shape(k_exp, foot, 5, f);
+            check_shape(k_exp, rise, 9, f);
+        }
+    }
+}
+
+static void test_profile_extracts_own_bins_under_other_smear_shapes(void **state)
+{
+    (void)state;
+    double uni[12], foot[5];
+    for (int i = 0; i < 12; i++) {
+        uni[i] = 70.0;
+    }
+    for (int i = 0; i < 5; i++) {
+        foot[i] = 60.0 + 10.0 * i;
+    }
+    check_shape(k_two, uni, 12, 16);
+    check_shape(k_two, foot, 5, 16);
+    check_shape(k_level, uni, 12, 16);
+    check_shape(k_level, foot, 5, 16);
+}
+
+static void test_profile_reports_why_it_cannot_extract(void **state)
+{
+    (void)state;
+    uint16_t sum[NB];
+    memset(sum, 0, sizeof sum);
+    // nothing above the threshold
+    assert_int_equal(sl_profile_extract(sum, NB, 4, 40, 10, 0).fail, SL_PROFILE_NO_RUN);
+    // run from bin 0: no leading edge
+    for (int k = 0; k < 20; k++) {
+        sum[k] = (uint16_t)(4 * (100 - 3 * k));
+    }
+    assert_int_equal(sl_profile_extract(sum, NB, 4, 40, 0, 0).fail, SL_PROFILE_LEAD_CUT);
+    // run to the end of the profile
+    for (int k = 0; k < NB; k++) {
+        sum[k] = k < 5 ? 0 : 4 * 200;
+    }
+    assert_int_equal(sl_profile_extract(sum, NB, 4, 40, 5, 0).fail, SL_PROFILE_TAIL_CUT);
+    // flat run, no tail to fit and no calibration; with one the calibration is used
+    for (int k = 0; k < NB; k++) {
+        sum[k] = (k >= 5 && k < 15) ? 4 * 80 : 0;
+    }
+    assert_int_equal(sl_profile_extract(sum, NB, 4, 40, 5, 0).fail, SL_PROFILE_NO_TAIL);
+    // with a calibrated slope it extracts; the run ends in a cliff: r2 = its last bin
+    const sl_profile_bounds_t r = sl_profile_extract(sum, NB, 4, 40, 5, 3U * 256U);
+    assert_int_equal(r.fail, SL_PROFILE_OK);
+    assert_int_equal(r.slope_src, SL_PROFILE_SLOPE_CLIFF);
+    assert_int_equal(r.i1, 5);
+    assert_int_equal(r.i2, 14);
+}
+
+// No smear at all (noise-free simulation, a return that simply ends): the pole's own bins
+// may decay like a tail, but the run ends in a cliff, so none of them is removed.
+static void test_profile_keeps_the_own_bins_of_a_return_without_smear(void **state)
+{
+    (void)state;
+    uint16_t sum[NB];
+    for (int k = 0; k < NB; k++) {
+        sum[k] = (uint16_t)(k >= 8 && k <= 20 ? 16 * (110 - 4 * (k - 8)) : 0);
+    }
+    const sl_profile_bounds_t r = sl_profile_extract(sum, NB, 16, 40, 8, 0U);
+    assert_int_equal(r.fail, SL_PROFILE_OK);
+    assert_int_equal(r.slope_src, SL_PROFILE_SLOPE_CLIFF);
+    assert_int_equal(r.i1, 8);
+    assert_int_equal(r.i2, 20);
+}
+
+// Evidence fills every slot; targets then take slots from azimuths that are no target's,
+// keep their own, and are counted when every slot already watches a target.
+static void test_profile_slots_follow_the_targets(void **state)
+{
+    (void)state;
+    assert_int_equal(sl_profile_init(&pr, 400, 0, NULL), SL_OK);
+    uint8_t row[64];
+    memset(row, 50, sizeof row);
+    uint32_t bits[2] = {1U << 20, 0U};
+    for (uint16_t a = 0; a < SL_CFG_PROFILE_SLOTS + 3U; a++) {
+        sl_profile_row(&pr, a, row, 64, bits, 64);
+    }
+    assert_int_equal(pr.stats.claims, SL_CFG_PROFILE_SLOTS);
+    assert_int_equal(pr.stats.claim_full, 3);
+    sl_target_t t[SL_CFG_PROFILE_SLOTS + 1];
+    memset(t, 0, sizeof t);
+    t[0].az = 3;   // watched already: keeps its slot
+    t[0].bin_first = 20;
+    t[1].az = 200; // not watched: takes a slot from an azimuth that is no target's
+    t[1].bin_first = 30;
+    sl_profile_assign(&pr, t, 2);
+    assert_int_equal(pr.slot_of[3] != SL_PROFILE_NONE, 1);
+    assert_int_equal(pr.slot[pr.slot_of[3]].frames, 1);
+    assert_true(pr.slot_of[200] != SL_PROFILE_NONE);
+    assert_int_equal(pr.slot[pr.slot_of[200]].bin0, 30 - pr.cfg.lead_bins);
+    assert_int_equal(pr.slot[pr.slot_of[200]].frames, 0);
+    assert_int_equal(pr.stats.stolen, 1);
+    // every slot watching a target: one more target is counted, nothing is taken
+    for (uint32_t i = 0; i <= SL_CFG_PROFILE_SLOTS; i++) {
+        t[i].az = (uint16_t)(300U + i);
+        t[i].bin_first = 10;
+    }
+    sl_profile_assign(&pr, t, SL_CFG_PROFILE_SLOTS + 1U);
+    assert_int_equal(pr.stats.assign_full, 1);
+    assert_int_equal(pr.n_live, SL_CFG_PROFILE_SLOTS);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_profile_accumulates_like_a_naive_sum),
+        cmocka_unit_test(test_profile_halves_reset_and_counts_full),
+        cmocka_unit_test(test_profile_extracts_own_bins_under_exponential_smear),
+        cmocka_unit_test(test_profile_extracts_own_bins_under_other_smear_shapes),
+        cmocka_unit_test(test_profile_reports_why_it_cannot_extract),
+        cmocka_unit_test(test_profile_keeps_the_own_bins_of_a_return_without_smear),
+        cmocka_unit_test(test_profile_slots_follow_the_targets),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
