@@ -393,6 +393,61 @@ static uint32_t allowed_span(const sl_detect_t *d, uint32_t r1_um)
     return n > 0xFFFFFFFFU ? 0xFFFFFFFFU : (uint32_t)n;
 }
 
+// ---- clutter rejection and slots by evidence (stage 4 clutter tests, stage 4b)
+
+int sl_detect_clutter_reason(const sl_board_t *board, const sl_target_t *t, uint32_t rho_q28)
+{
+    SL_ASSERT(board != NULL && t != NULL);
+    if (t->bin_last <= t->bin_first) {
+        return SL_DETECT_REJ_SHORT;
+    }
+    if (t->incline_flag == (uint8_t)SL_INCLINE_INVALID ||
+        t->incline_flag == (uint8_t)SL_INCLINE_OUT_OF_DOMAIN) {
+        return board->geom != NULL ? SL_DETECT_REJ_RHO : -1; // no tables: no model to test
+    }
+    if (t->incline_flag == (uint8_t)SL_INCLINE_AMBIGUOUS && board->geom != NULL &&
+        t->r1_um != 0U) {
+        // One bin of quantisation below the fold, in UQ4.28: b / r1 * 2^28.
+        const uint64_t tol = ((uint64_t)board->bin_size_um << 28) / t->r1_um;
+        const uint64_t amb = board->geom[t->az].rho_amb_q28;
+        if ((uint64_t)rho_q28 + tol < amb) {
+            return SL_DETECT_REJ_RHO;
+        }
+    }
+    return -1;
+}
+
+uint16_t sl_detect_evidence(uint32_t occupied_total, uint32_t az_with_run, uint32_t extent_bins)
+{
+    const uint64_t e = 4ULL * occupied_total + 16ULL * az_with_run + 8ULL * extent_bins;
+    return (uint16_t)(e > 0xFFFFU ? 0xFFFFU : e);
+}
+
+// A target that passed every test takes a free slot; with none free it replaces the target
+// with the least evidence when it has more (ties keep the earlier one). One drop counted
+// either way.
+static void slot_take(sl_detect_t *d, const sl_target_t *t)
+{
+    if (d->n_targets < d->max_targets) {
+        d->targets[d->n_targets++] = *t;
+        d->stats.targets++;
+        return;
+    }
+    d->stats.target_overflow++;
+    if (d->n_targets == 0U) {
+        return;
+    }
+    uint32_t weakest = 0;
+    for (uint32_t i = 1; i < d->n_targets; i++) {
+        if (d->targets[i].evidence < d->targets[weakest].evidence) {
+            weakest = i;
+        }
+    }
+    if (t->evidence > d->targets[weakest].evidence) {
+        d->targets[weakest] = *t;
+    }
+}
+
 static void finalize(sl_detect_t *d, sl_detect_cand_t *c)
 {
     d->stats.groups++;
@@ -445,10 +500,7 @@ static void finalize(sl_detect_t *d, sl_detect_cand_t *c)
         d->stats.rejected[reason]++;
         return;
     }
-    if (d->n_targets >= d->max_targets) {
-        d->stats.target_overflow++;
-        return;
-    }
+    uint32_t rho_q28 = 0U;
     if (bd->geom != NULL) {
         const sl_incline_result_t res = sl_incline_estimate(
             t.r1_um, t.r2_um, &bd->geom[az], bd->range_sigma_um, bd->theta_sigma_cdeg);
@@ -456,11 +508,22 @@ static void finalize(sl_detect_t *d, sl_detect_cand_t *c)
         t.sigma_cdeg = res.sigma_cdeg;
         t.incline_flag = res.flag;
         t.incline_branch = res.branch;
+        rho_q28 = res.rho_q28;
     } else {
         t.incline_flag = (uint8_t)SL_INCLINE_OUT_OF_DOMAIN;
     }
-    d->targets[d->n_targets++] = t;
-    d->stats.targets++;
+    reason = sl_detect_clutter_reason(bd, &t, rho_q28);
+    if (reason >= 0) {
+        d->stats.rejected[reason]++;
+        return;
+    }
+    uint32_t occ_total = 0U, az_runs = 0U;
+    for (uint32_t i = 0; i < span && i < SL_CFG_DETECT_MAX_SPAN; i++) {
+        occ_total += c->run[i].count;
+        az_runs += c->run[i].count != 0U ? 1U : 0U;
+    }
+    t.evidence = sl_detect_evidence(occ_total, az_runs, (uint32_t)rep->last - rep->first + 1U);
+    slot_take(d, &t);
 }
 
 // Close groups that can no longer grow (no run on a - 1). Groups starting at azimuth 0

@@ -39,7 +39,19 @@
 ///    >= S(az): the base is not inside the shadow);
 ///    WIDE (the group spans more azimuths than a pole of `cfg.max_pole_diameter_um` at r1
 ///    can: allowed = floor((D / r1 [rad] + beam) / step) + 1 + `cfg.width_slack_az`);
-///    BROKEN (the representative run has a gap).
+///    BROKEN (the representative run has a gap);
+///    then the clutter tests (sl_detect_clutter_reason(), after the corrections and alpha):
+///    SHORT (the representative run is one bin: a speck of gravel or a noise spike, no
+///    extent to measure); RHO (the incline flag is INVALID (r1 >= r2) or OUT_OF_DOMAIN, or
+///    AMBIGUOUS with rho below the model's minimum rho_amb of that azimuth by more than the
+///    quantisation can explain: rho < rho_amb - b / r1, b the bin size; a run of n bins
+///    measures (n - 1) b between its bin centres and the true extent is < n b, so a real
+///    pole near the fold reads at most b / r1 below rho_amb).
+/// 4b. **Slots by evidence**. When more targets pass than `max_targets`, the ones with the
+///    least evidence are dropped (never the later azimuths): evidence =
+///    4 x (occupied bins of the group over all its azimuths) + 16 x (azimuths with a run) +
+///    8 x (extent of the representative run in bins) (sl_target_t.evidence). Each drop is
+///    counted in `stats.target_overflow` (CandidatesDropped on CAN). Ties keep the earlier.
 /// 5. **Corrections** (sl_detect_correct(), MATH.md s.4), b = bin_size_um:
 ///    - raw bounds: r1_raw = bin_first * b (near edge of the first occupied bin),
 ///      r2_raw = (bin_last + 1) * b (far edge of the last occupied bin);
@@ -126,7 +138,10 @@ typedef enum sl_detect_reject {
     SL_DETECT_REJ_SHADOW = 1, ///< the return reaches the shadow edge (base not in the shadow)
     SL_DETECT_REJ_WIDE = 2,   ///< too wide in azimuth for a slender pole at its range
     SL_DETECT_REJ_BROKEN = 3, ///< a gap inside the run on the representative azimuth
-    SL_DETECT_REJ_COUNT = 4
+    SL_DETECT_REJ_SHORT = 4,  ///< the representative run is a single bin (no extent: no rho)
+    SL_DETECT_REJ_RHO = 5,    ///< rho outside what the model gives on this azimuth (below
+                              ///< the fold by more than one bin, above the domain, r1 >= r2)
+    SL_DETECT_REJ_COUNT = 6
 } sl_detect_reject_t;
 
 /// `sl_target_t.flags`.
@@ -172,6 +187,7 @@ typedef struct sl_target {
     uint8_t incline_flag;   ///< sl_incline_flag_t
     uint8_t incline_branch; ///< sl_incline_branch_t
     uint8_t flags;          ///< SL_TARGET_*
+    uint16_t evidence;      ///< slot priority (stage 4b), saturating
 } sl_target_t;
 
 /// Counters (cumulative since init; never asserted).
@@ -184,7 +200,8 @@ typedef struct sl_detect_stats {
     uint32_t rejected[SL_DETECT_REJ_COUNT]; ///< groups rejected, by first reason
     uint32_t span_overflow;    ///< groups wider than SL_CFG_DETECT_MAX_SPAN (also WIDE)
     uint32_t cand_overflow;    ///< runs dropped: no free group slot
-    uint32_t target_overflow;  ///< accepted targets dropped: more than max_targets
+    uint32_t target_overflow;  ///< accepted targets dropped: more than max_targets (the
+                               ///< least evidence; stage 4b)
     uint32_t order_errors;     ///< rows ignored: azimuth out of range or not increasing
 } sl_detect_stats_t;
 
@@ -248,8 +265,9 @@ sl_err_t sl_detect_row(sl_detect_t *d, uint16_t az, const uint32_t *occ, uint32_
 /// Close the rotation: wrap merge (azimuth azimuths-1 with 0), representative azimuth,
 /// rejections, corrections and alpha for every remaining group.
 /// @return the number of targets in `d->targets` (0..max_targets), in the order their
-/// groups closed (increasing last azimuth; wrapping groups last). They stay valid until
-/// the next sl_detect_begin().
+/// groups closed (increasing last azimuth; wrapping groups last) as long as they fit; once
+/// the slots are full a stronger target takes the slot of the weakest (stage 4b). They
+/// stay valid until the next sl_detect_begin().
 sl_ssize_t sl_detect_end(sl_detect_t *d);
 
 /// begin + one row per azimuth from `mask` (held rows of stale azimuths included; none for
@@ -262,6 +280,15 @@ sl_ssize_t sl_detect_rotation_from_mask(sl_detect_t *d, const sl_mask_t *mask);
 /// else needs the far range: it cuts those two stages ~3x on paper-sim (160 of 512 bins).
 /// O(azimuths).
 uint16_t sl_detect_bins_needed(const sl_detect_t *d);
+
+/// Clutter tests of stage 4 (SHORT, RHO) on a finished target `t` (bin_first/bin_last,
+/// r1_um, incline flag and rho set) on azimuth `t->az`: the rejection reason, or -1 when the
+/// target may take a slot. Pure; O(1) (one 64-bit division).
+int sl_detect_clutter_reason(const sl_board_t *board, const sl_target_t *t, uint32_t rho_q28);
+
+/// Evidence of a target (stage 4b) from the group's total occupied bins, its azimuths with
+/// a run and the representative run's extent in bins. Pure, O(1), saturating at 65535.
+uint16_t sl_detect_evidence(uint32_t occupied_total, uint32_t az_with_run, uint32_t extent_bins);
 
 /// Stage 5 alone (MATH.md s.4) for a run `bin_first..bin_last` on azimuth `az` of a group
 /// `az_count` azimuths wide. Fills r1_raw_um, r2_raw_um, r1_um, r2_um, radius_um, elong_um

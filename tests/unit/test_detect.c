@@ -357,6 +357,76 @@ static void test_detect_merges_groups_joined_by_a_later_azimuth(void **state)
     assert_int_equal(det.stats.groups, 1);
 }
 
+static void test_detect_rejects_clutter_before_it_takes_a_slot(void **state)
+{
+    (void)state;
+    assert_int_equal(sl_detect_init(&det, &board, NULL), SL_OK);
+    set_run(40, 118, 118);  // a speck: one bin -> SHORT
+    set_run(80, 118, 119);  // two bins at 5.2 m: rho 1.008, far below rho_amb 1.026 -> RHO
+    set_run(120, 116, 118); // three bins at 5.1 m: rho 1.017 < 1.026 - b/r1 (1.018) -> RHO
+    set_run(160, 68, 70);   // three bins at 3 m: rho 1.029, a pole near the fold: kept
+    for (int a = 200; a < 204; a++) {
+        set_run(a, 69, 82); // a slanted pole: kept
+    }
+    assert_int_equal(run_rotation(), 2);
+    assert_int_equal(det.stats.rejected[SL_DETECT_REJ_SHORT], 1);
+    assert_int_equal(det.stats.rejected[SL_DETECT_REJ_RHO], 2);
+    assert_int_equal(det.targets[0].az, 160);
+    assert_int_equal(det.targets[1].az_first, 200);
+    // The rule alone: AMBIGUOUS within one bin of the fold passes, further below does not.
+    sl_target_t t;
+    memset(&t, 0, sizeof t);
+    t.az = 3;
+    t.bin_first = 68;
+    t.bin_last = 70;
+    t.r1_um = 3000000U;
+    t.incline_flag = SL_INCLINE_AMBIGUOUS;
+    const uint32_t amb = geom[3].rho_amb_q28;
+    const uint32_t tol = (uint32_t)(((uint64_t)BIN_UM << 28) / 3000000U);
+    assert_int_equal(sl_detect_clutter_reason(&board, &t, amb - tol), -1);
+    assert_int_equal(sl_detect_clutter_reason(&board, &t, amb - tol - 1U), SL_DETECT_REJ_RHO);
+    t.incline_flag = SL_INCLINE_INVALID;
+    assert_int_equal(sl_detect_clutter_reason(&board, &t, 0), SL_DETECT_REJ_RHO);
+    t.incline_flag = SL_INCLINE_VALID;
+    assert_int_equal(sl_detect_clutter_reason(&board, &t, amb + 1000U), -1);
+    t.bin_last = 68;
+    assert_int_equal(sl_detect_clutter_reason(&board, &t, amb + 1000U), SL_DETECT_REJ_SHORT);
+}
+
+static void test_detect_slots_go_to_the_strongest_not_the_lowest_azimuths(void **state)
+{
+    (void)state;
+    assert_int_equal(sl_detect_init(&det, &board, NULL), SL_OK);
+    // 20 clutter returns that pass every test (6 bins, one azimuth each, valid rho) at the
+    // lowest azimuths, then two poles at higher azimuths: 22 candidates for 16 slots.
+    for (int k = 0; k < 20; k++) {
+        set_run(10 + 4 * k, 110, 115);
+    }
+    for (int a = 300; a < 305; a++) {
+        set_run(a, 69, 82);
+    }
+    for (int a = 350; a < 354; a++) {
+        set_run(a, 70, 76);
+    }
+    assert_int_equal(run_rotation(), 16);
+    assert_int_equal(det.stats.target_overflow, 6);
+    int poles = 0, clutter = 0;
+    for (int i = 0; i < 16; i++) {
+        const sl_target_t *t = &det.targets[i];
+        if (t->az_first == 300 || t->az_first == 350) {
+            poles++;
+            assert_true(t->evidence > sl_detect_evidence(6, 1, 6));
+        } else {
+            clutter++;
+            assert_int_equal(t->evidence, sl_detect_evidence(6, 1, 6));
+        }
+    }
+    assert_int_equal(poles, 2);
+    assert_int_equal(clutter, 14);
+    assert_int_equal(sl_detect_evidence(6, 1, 6), 4 * 6 + 16 + 8 * 6);
+    assert_int_equal(sl_detect_evidence(100000, 0, 0), 0xFFFF);
+}
+
 static void test_detect_handles_empty_saturated_and_misordered_input(void **state)
 {
     (void)state;
@@ -382,11 +452,12 @@ static void test_detect_handles_empty_saturated_and_misordered_input(void **stat
     for (uint32_t k = 40; k <= 132U; k += 2U) {
         set_run(7, k, k); // 47 one-bin runs
     }
-    assert_int_equal(run_rotation(), 16);
+    // Every group that got a slot is a single bin: rejected SHORT before taking a target slot.
+    assert_int_equal(run_rotation(), 0);
     assert_int_equal(det.stats.runs, 47);
     assert_int_equal(det.stats.cand_overflow, 47 - SL_CFG_DETECT_MAX_CANDIDATES);
-    assert_int_equal(det.stats.target_overflow, SL_CFG_DETECT_MAX_CANDIDATES - 16);
-    assert_int_equal(det.targets[0].incline_flag, SL_INCLINE_INVALID); // r1 == r2
+    assert_int_equal(det.stats.rejected[SL_DETECT_REJ_SHORT], SL_CFG_DETECT_MAX_CANDIDATES);
+    assert_int_equal(det.stats.target_overflow, 0);
     // Init rejects boards it cannot use.
     sl_board_t bad = board;
     bad.shadow_um = NULL;
@@ -544,6 +615,8 @@ int main(void)
         cmocka_unit_test_setup(test_detect_groups_across_the_azimuth_wrap, setup),
         cmocka_unit_test_setup(test_detect_merges_groups_joined_by_a_later_azimuth, setup),
         cmocka_unit_test_setup(test_detect_handles_empty_saturated_and_misordered_input, setup),
+        cmocka_unit_test_setup(test_detect_rejects_clutter_before_it_takes_a_slot, setup),
+        cmocka_unit_test_setup(test_detect_slots_go_to_the_strongest_not_the_lowest_azimuths, setup),
         cmocka_unit_test_setup(test_detect_correct_half_bin_elongation_and_radius, setup),
         cmocka_unit_test_setup(test_detect_from_mask_reports_the_pole_after_n_stable_rotations,
                                setup),
