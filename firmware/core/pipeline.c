@@ -154,7 +154,7 @@ static void emit_can(sl_pipeline_t *p)
     const sl_track_t *worst = NULL;
     for (uint32_t i = 0; i < SL_CFG_MAX_TARGETS; i++) {
         const sl_track_t *t = &tr->tracks[i];
-        if (t->live == 0U || t->hits < confirm) {
+        if (t->live == 0U || t->hits < confirm || t->confirmed == 0U) {
             continue;
         }
         // The most severe confirmed track: level, then |filtered alpha| (valid ones first).

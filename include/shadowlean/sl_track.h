@@ -17,6 +17,25 @@
 /// per rotation (no prediction: a static point moves by at most that much between
 /// rotations, in any direction).
 ///
+/// ## Static-object prediction and confirmation (clutter never confirms)
+/// Everything shadowlean reports stands still on the ground, so before associating, each
+/// live track's position is predicted for a static object under the ego motion of one
+/// rotation (sl_track_predict_static()): with b the track's bearing from the vehicle's
+/// forward axis (azimuth + board->radar_yaw_cdeg, clockwise) and d the displacement, the
+/// point (r cos b, r sin b) becomes (r cos b - d, r sin b): r' = |.|, b' = atan2 (integer
+/// sin/cos, error < 0.2 %; yaw is not predicted, only tolerated). The gates above are
+/// centred on this prediction instead of the last position. A track then accumulates
+/// `evidence`: +1 for an association whose residual from the prediction is within
+/// `cfg.consist_az` azimuths (+ the yaw per rotation) and `cfg.consist_range_um`, capped at
+/// `cfg.confirm_min + 2`; an association outside that tolerance resets it to 1 (the track
+/// jumped: what it followed does not move like a static object); a rotation without an
+/// association takes 1 off and moves the track's az / r1 to the prediction (dead reckoning,
+/// so a pole missed for a rotation is still predicted where it is). `confirmed` = evidence >= `cfg.confirm_min` (default 3, i.e.
+/// three rotations whose range AND bearing follow the ego motion). Scattered clutter at
+/// every azimuth associates now and then (the gates are wide while moving) but almost never
+/// where a static object would be, three times running, so its tracks never confirm. The
+/// pipeline sends PoleLean only for confirmed tracks.
+///
 /// ## Filter (1-D Kalman, fixed point)
 /// State alpha in 1/256 cdeg (Q8 cdeg), variance P in cdeg^2 (uint32). Only targets with
 /// `incline_flag == SL_INCLINE_VALID` update it; other flags refresh the track's position
@@ -82,6 +101,13 @@ typedef struct sl_track_cfg {
     uint16_t hysteresis_cdeg;  ///< lowering margin below each threshold (default 100 = 1 deg)
     uint8_t confirm;           ///< consecutive valid updates needed to raise (default 3)
     bool caution_abs;          ///< CAUTION on |alpha| (default true, as sl_board.h says)
+    uint32_t consist_range_um; ///< |r1 - predicted r1| of a consistent update (default
+                               ///< 0.2 m: +-1 bin of quantisation on each side plus the
+                               ///< width-based radius correction's jitter)
+    uint16_t consist_az;       ///< |az - predicted az| of a consistent update, azimuths
+                               ///< (default 3: the representative azimuth of a 2 deg beam
+                               ///< return moves by up to half its 4-8 azimuths)
+    uint8_t confirm_min;       ///< evidence needed for `confirmed` (default 3)
 } sl_track_cfg_t;
 
 /// Defaults as listed on each field.
@@ -106,6 +132,10 @@ typedef struct sl_track {
     uint8_t last_flag;       ///< incline flag of the last associated target
     uint8_t live;            ///< 1 = slot in use
     uint8_t updated;         ///< 1 = matched by the last sl_track_update()
+    uint8_t evidence;        ///< consistent static-object updates (see "confirmation")
+    uint8_t confirmed;       ///< 1 = evidence >= cfg.confirm_min
+    uint16_t pred_az;        ///< internal: predicted azimuth for this update
+    uint32_t pred_r1_um;     ///< internal: predicted r1 for this update
 } sl_track_t;
 
 /// Counters (cumulative; never asserted).
@@ -117,6 +147,8 @@ typedef struct sl_track_stats {
     uint32_t full;           ///< targets without a track: no free slot
     uint32_t level_changes;  ///< warning level transitions (any direction)
     uint32_t time_backwards; ///< now_us earlier than a track's last_seen_us (treated as 0 s)
+    uint32_t inconsistent;   ///< associations off the static prediction (evidence reset)
+    uint32_t confirmations;  ///< tracks that became confirmed
 } sl_track_stats_t;
 
 /// The tracker. Caller-owned; fields read-only to the application.
@@ -145,6 +177,12 @@ void sl_track_update(sl_tracker_t *tr, const sl_target_t *targets, uint32_t n,
 /// `disp_um` (>= 0) and |yaw| `yaw_bam32` (2^32 = one turn). Stays in effect until changed;
 /// 0, 0 = static. O(1).
 void sl_track_set_motion(sl_tracker_t *tr, uint32_t disp_um, uint32_t yaw_bam32);
+
+/// Where a static object seen at azimuth index `az`, range `r_um` is expected after the ego
+/// displacement `disp_um` forward (see "Static-object prediction"). Pure; O(1) (one isqrt,
+/// one atan2, two divisions).
+void sl_track_predict_static(const sl_board_t *board, uint16_t az, uint32_t r_um,
+                             uint32_t disp_um, uint16_t *az_out, uint32_t *r_out);
 
 /// Highest warning level over live tracks (SL_WARN_NONE when none). O(tracks).
 sl_warn_level_t sl_track_max_level(const sl_tracker_t *tr);
