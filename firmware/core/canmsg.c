@@ -94,6 +94,28 @@ static const sl_can_signal_desc_t motion_sigs[M_N] = {
      SL_CAN_MOTION_RAW_MAX, "deg/s", NULL, 0U},
 };
 
+static const sl_can_value_name_t fault_names[] = {
+    {SL_CAN_FAULT_CONFIG_MISMATCH, "CONFIG_MISMATCH"},
+    {SL_CAN_FAULT_NO_USABLE_ROWS, "NO_USABLE_ROWS"},
+    {SL_CAN_FAULT_MALFORMED_DATA, "MALFORMED_DATA"},
+    {SL_CAN_FAULT_LINK_FLAPPING, "LINK_FLAPPING"},
+    {SL_CAN_FAULT_CAN_OUTPUT_ERRORS, "CAN_OUTPUT_ERRORS"},
+    {SL_CAN_FAULT_RANGE_RESOLUTION_MISMATCH, "RANGE_RESOLUTION_MISMATCH"},
+    {SL_CAN_FAULT_AZIMUTH_DISORDER, "AZIMUTH_DISORDER"},
+    {SL_CAN_FAULT_CAN_RATE_LIMITED, "CAN_RATE_LIMITED"},
+    {SL_CAN_FAULT_TARGET_SLOTS_OVERFLOW, "TARGET_SLOTS_OVERFLOW"},
+};
+
+enum { H_FAULT = 2, H_RECONNECTS, H_DROPPED, H_N };
+static const sl_can_signal_desc_t health_sigs[H_N] = {
+    E2E_SIGNALS,
+    {"Fault", 16U, 16U, false, 1, 1, 0, (int32_t)SL_CAN_HEALTH_FAULT_MAX, "", fault_names,
+     NV(fault_names)},
+    {"Reconnects", 32U, 8U, false, 1, 1, 0, (int32_t)SL_CAN_HEALTH_RECONNECTS_MAX, "", NULL, 0U},
+    {"CandidatesDropped", 40U, 12U, false, 1, 1, 0, (int32_t)SL_CAN_HEALTH_DROPPED_MAX, "",
+     NULL, 0U},
+};
+
 static const sl_can_message_desc_t messages[SL_CAN_MSG_COUNT] = {
     {"PoleLean", SL_CAN_DATA_ID_POLE_LEAN, SL_CAN_CYCLE_MS_POLE_LEAN, false, pole_sigs, P_N},
     {"LeanWarning", SL_CAN_DATA_ID_LEAN_WARNING, SL_CAN_CYCLE_MS_LEAN_WARNING, false, warn_sigs,
@@ -101,6 +123,7 @@ static const sl_can_message_desc_t messages[SL_CAN_MSG_COUNT] = {
     {"Status", SL_CAN_DATA_ID_STATUS, SL_CAN_CYCLE_MS_STATUS, false, status_sigs, T_N},
     {"VehicleMotion", SL_CAN_DATA_ID_VEHICLE_MOTION, SL_CAN_CYCLE_MS_VEHICLE_MOTION, true,
      motion_sigs, M_N},
+    {"Health", SL_CAN_DATA_ID_HEALTH, SL_CAN_CYCLE_MS_HEALTH, false, health_sigs, H_N},
 };
 
 const sl_can_message_desc_t *sl_can_layout(sl_can_msg_t m)
@@ -243,6 +266,7 @@ void sl_can_ids_from_board(sl_can_ids_t *ids, const struct sl_board *board)
     ids->id[SL_CAN_MSG_LEAN_WARNING] = board->can_id_lean_warning;
     ids->id[SL_CAN_MSG_STATUS] = board->can_id_status;
     ids->id[SL_CAN_MSG_VEHICLE_MOTION] = board->can_id_vehicle_motion;
+    ids->id[SL_CAN_MSG_HEALTH] = board->can_id_health;
 }
 
 sl_err_t sl_can_tx_init(sl_can_tx_t *tx, const sl_can_ids_t *ids)
@@ -363,6 +387,21 @@ sl_err_t sl_can_encode_status(sl_can_tx_t *tx, const sl_can_status_t *in, sl_can
     put_sig(d, &s[T_DROP], clamp_raw(&s[T_DROP], in->can_dropped, &sat));
     put_sig(d, &s[T_SAT], sat ? 1 : 0);
     finish(tx, SL_CAN_MSG_STATUS, d, sat, out);
+    return SL_OK;
+}
+
+sl_err_t sl_can_encode_health(sl_can_tx_t *tx, const sl_can_health_t *in, sl_can_frame_t *out)
+{
+    if (tx == NULL || in == NULL || out == NULL) {
+        return SL_ERR_ARG;
+    }
+    const sl_can_signal_desc_t *s = health_sigs;
+    uint8_t d[8] = {0};
+    bool sat = false;
+    put_sig(d, &s[H_FAULT], (uint32_t)(in->fault & SL_CAN_FAULT_DEFINED));
+    put_sig(d, &s[H_RECONNECTS], clamp_raw(&s[H_RECONNECTS], in->reconnects, &sat));
+    put_sig(d, &s[H_DROPPED], clamp_raw(&s[H_DROPPED], in->candidates_dropped, &sat));
+    finish(tx, SL_CAN_MSG_HEALTH, d, sat, out);
     return SL_OK;
 }
 
@@ -514,6 +553,21 @@ sl_err_t sl_can_decode_status(const sl_can_frame_t *f, sl_can_status_t *out)
     out->azimuths_missing = (uint32_t)get_sig(d, &s[T_AZMISS]);
     out->decoder_resyncs = (uint32_t)get_sig(d, &s[T_RESYNC]);
     out->can_dropped = (uint32_t)get_sig(d, &s[T_DROP]);
+    return SL_OK;
+}
+
+sl_err_t sl_can_decode_health(const sl_can_frame_t *f, sl_can_health_t *out)
+{
+    const sl_err_t e = decode_check(f, out, SL_CAN_MSG_HEALTH);
+    if (e != SL_OK) {
+        return e;
+    }
+    const sl_can_signal_desc_t *s = health_sigs;
+    const uint8_t *d = f->data;
+    out->counter = (uint8_t)get_sig(d, &s[S_COUNTER]);
+    out->fault = (uint16_t)get_sig(d, &s[H_FAULT]);
+    out->reconnects = (uint32_t)get_sig(d, &s[H_RECONNECTS]);
+    out->candidates_dropped = (uint32_t)get_sig(d, &s[H_DROPPED]);
     return SL_OK;
 }
 

@@ -130,6 +130,24 @@ static uint8_t quality_of(const sl_track_t *t)
     }
 }
 
+// Health, sent right after every Status. This branch fills the slot-overflow part (Fault
+// bit TARGET_SLOTS_OVERFLOW for the last rotation, CandidatesDropped = detection's total of
+// targets dropped for lack of slots); the other fault bits and Reconnects belong to the
+// port/link health work and are 0 here.
+static void emit_health(sl_pipeline_t *p)
+{
+    sl_can_health_t h;
+    memset(&h, 0, sizeof h);
+    if (p->slots_overflowed) {
+        h.fault |= SL_CAN_FAULT_TARGET_SLOTS_OVERFLOW;
+    }
+    h.candidates_dropped = p->detect.stats.target_overflow;
+    sl_can_frame_t f;
+    if (sl_can_encode_health(&p->can, &h, &f) == SL_OK) {
+        can_send(p, &f);
+    }
+}
+
 // One Status frame with the current counters and link state (rotation or idle).
 static void emit_status(sl_pipeline_t *p)
 {
@@ -144,6 +162,7 @@ static void emit_status(sl_pipeline_t *p)
     if (sl_can_encode_status(&p->can, &st, &f) == SL_OK) {
         can_send(p, &f);
     }
+    emit_health(p);
 }
 
 static void emit_can(sl_pipeline_t *p)
@@ -207,6 +226,7 @@ static void emit_can(sl_pipeline_t *p)
 
 static void begin_rotation(sl_pipeline_t *p)
 {
+    p->overflow_at_begin = p->detect.stats.target_overflow;
     sl_can_vehicle_motion_t m;
     uint8_t w = p->cfg.mask_frames;
     p->motion_valid = false;
@@ -296,6 +316,7 @@ static void on_rot(void *ctx, const sl_scan_rot_t *rot)
                                                               : p->mask.azimuths);
     sl_mask_end_rotation(&p->mask);
     const sl_ssize_t nt = sl_detect_end(&p->detect);
+    p->slots_overflowed = p->detect.stats.target_overflow != p->overflow_at_begin;
     const uint32_t n_targets = nt > 0 ? (uint32_t)nt : 0U;
     measure_period(p, rot);
     // Tracker gates follow the ego motion of one rotation.

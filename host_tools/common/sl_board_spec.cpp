@@ -45,7 +45,7 @@ const std::set<std::string> kKnown = {
     "detect.threshold", "detect.mask_frames", "detect.max_targets", "detect.pole_radius_m",
     "detect.range_sigma_m", "detect.theta_sigma_deg", "detect.caution_lean_deg",
     "detect.danger_lean_deg", "detect.track_timeout_s", "detect.elongation",
-    "can.bitrate", "can.id_pole_lean", "can.id_lean_warning", "can.id_status",
+    "can.bitrate", "can.id_pole_lean", "can.id_lean_warning", "can.id_status", "can.id_health",
     "can.id_vehicle_motion",
 };
 
@@ -330,10 +330,11 @@ BoardSpec load_board(const std::string &name_or_path)
     b.can_id_lean_warning = can_id("can.id_lean_warning", 0x621);
     b.can_id_status = can_id("can.id_status", 0x622);
     b.can_id_vehicle_motion = can_id("can.id_vehicle_motion", 0x300);
+    b.can_id_health = can_id("can.id_health", 0x623);
     const std::set<unsigned> ids = {b.can_id_pole_lean, b.can_id_lean_warning, b.can_id_status,
-                                    b.can_id_vehicle_motion};
-    if (ids.size() != 4U) {
-        r.fail("can", "the four CAN ids must differ");
+                                    b.can_id_vehicle_motion, b.can_id_health};
+    if (ids.size() != 5U) {
+        r.fail("can", "the five CAN ids must differ");
     }
 
     for (int i = 0; i < b.azimuths; i++) {
@@ -348,6 +349,11 @@ BoardSpec load_board(const std::string &name_or_path)
               << b.lower_bound_deg << "): the beam must clear the body";
             r.fail("chassis", o.str());
         }
+    }
+    // Checked last so that the other checks report first on a board that has no [can].
+    if (!r.has("can.id_health")) {
+        r.fail("can.id_health", "missing (required: the Health message's id, 0x623 on the "
+                                "boards carried)");
     }
     return b;
 }

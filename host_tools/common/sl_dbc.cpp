@@ -94,6 +94,8 @@ const std::map<std::string, std::string> kMessageComments = {
                "and stop at their maximum (Saturated = 1)."},
     {"VehicleMotion", "Input from the vehicle for the motion-aware masks: speed and yaw "
                       "rate with E2E protection; CRC errors and counter jumps are counted."},
+    {"Health", "Sent with every Status: fault bits of the last rotation and health totals "
+               "since start (saturating)."},
 };
 
 // key "Message.Signal"
@@ -132,6 +134,10 @@ const std::map<std::string, std::string> kSignalComments = {
     {"VehicleMotion.YawRateValid", "1: YawRate is valid."},
     {"VehicleMotion.Speed", "Vehicle speed over ground; positive forward."},
     {"VehicleMotion.YawRate", "Yaw rate; positive counter-clockwise seen from above (ISO 8855)."},
+    {"Health.Fault", "Bitfield; the value table names each bit (bits 9..15 reserved, 0)."},
+    {"Health.Reconnects", "Radar link reconnects since start (saturating)."},
+    {"Health.CandidatesDropped", "Targets dropped for lack of target slots since start "
+                                 "(saturating); the weakest by evidence are dropped."},
 };
 
 std::string signal_comment(const std::string &msg, const std::string &sig)
@@ -172,6 +178,8 @@ uint32_t board_id(const BoardSpec &b, sl_can_msg_t m)
         return b.can_id_status;
     case SL_CAN_MSG_VEHICLE_MOTION:
         return b.can_id_vehicle_motion;
+    case SL_CAN_MSG_HEALTH:
+        return b.can_id_health;
     case SL_CAN_MSG_COUNT:
         break;
     }
@@ -246,7 +254,7 @@ std::string make_dbc(const BoardSpec &b)
            b.description)
       << ";\n";
     o << "CM_ BU_ " << kVehicle << " "
-      << q("The vehicle: consumes PoleLean, LeanWarning, Status; sends VehicleMotion.")
+      << q("The vehicle: consumes PoleLean, LeanWarning, Status, Health; sends VehicleMotion.")
       << ";\n";
     for (unsigned mi = 0; mi < SL_CAN_MSG_COUNT; mi++) {
         const sl_can_message_desc_t &m = *sl_can_layout(static_cast<sl_can_msg_t>(mi));

@@ -63,6 +63,7 @@ typedef struct sl_board {
     uint32_t can_id_lean_warning;
     uint32_t can_id_status;
     uint32_t can_id_vehicle_motion;
+    uint32_t can_id_health;        ///< Health (sl_can.h)
     // --- generated per-azimuth tables, `azimuths` entries each
     const sl_incline_geom_t *geom; ///< trig + branch bounds per azimuth
     const int16_t *theta_cdeg;     ///< opening angle theta per azimuth, 0.01 deg

@@ -99,6 +99,23 @@
 /// | 16 | 16 | Speed        | s | 0.01 | -327.68..327.67  | m/s   | > 0 forward |
 /// | 32 | 16 | YawRate      | s | 0.01 | -327.68..327.67  | deg/s | > 0 counter-clockwise from above (ISO 8855) |
 ///
+/// ## Health (board `can.id_health`, SHADOWLEAN -> VEHICLE, sent with every Status)
+///
+/// | start | len | signal            | type | range      | note |
+/// |------:|----:|-------------------|------|------------|------|
+/// |  0 | 8  | Crc               | u | 0..255     | E2E, Data ID 0x54 |
+/// |  8 | 4  | Counter           | u | 0..14      | E2E |
+/// | 12 | 4  | (reserved)        |   | 0          | |
+/// | 16 | 16 | Fault             | u | bitfield   | SL_CAN_FAULT_* (value table: one name per bit) |
+/// | 32 | 8  | Reconnects        | u | 0..255     | radar link reconnects (saturating total) |
+/// | 40 | 12 | CandidatesDropped | u | 0..4095    | targets dropped for lack of slots (saturating total) |
+/// | 52 | 12 | (reserved)        |   | 0          | |
+///
+/// Fault bits: 0 CONFIG_MISMATCH, 1 NO_USABLE_ROWS, 2 MALFORMED_DATA, 3 LINK_FLAPPING,
+/// 4 CAN_OUTPUT_ERRORS, 5 RANGE_RESOLUTION_MISMATCH, 6 AZIMUTH_DISORDER, 7 CAN_RATE_LIMITED,
+/// 8 TARGET_SLOTS_OVERFLOW (the last rotation had more targets than slots: the weakest were
+/// dropped, see sl_detect.h stage 4b), 9..15 reserved 0.
+///
 /// Unlisted bits are reserved: sent as 0, ignored by the decoders.
 ///
 /// ## Encoding rules (house style: rounding place 3)
@@ -163,13 +180,15 @@ typedef enum sl_can_msg {
     SL_CAN_MSG_LEAN_WARNING = 1,
     SL_CAN_MSG_STATUS = 2,
     SL_CAN_MSG_VEHICLE_MOTION = 3,
-    SL_CAN_MSG_COUNT = 4,
+    SL_CAN_MSG_HEALTH = 4,
+    SL_CAN_MSG_COUNT = 5,
 } sl_can_msg_t;
 
 #define SL_CAN_DATA_ID_POLE_LEAN 0x51U      ///< E2E Data ID (first CRC byte)
 #define SL_CAN_DATA_ID_LEAN_WARNING 0x52U
 #define SL_CAN_DATA_ID_STATUS 0x53U
 #define SL_CAN_DATA_ID_VEHICLE_MOTION 0x54U
+#define SL_CAN_DATA_ID_HEALTH 0x54U
 
 #define SL_CAN_COUNTER_MODULO 15U ///< counters run 0..14; 15 is invalid on the wire
 
@@ -179,6 +198,7 @@ typedef enum sl_can_msg {
 #define SL_CAN_CYCLE_MS_LEAN_WARNING 250U
 #define SL_CAN_CYCLE_MS_STATUS 1000U
 #define SL_CAN_CYCLE_MS_VEHICLE_MOTION 20U
+#define SL_CAN_CYCLE_MS_HEALTH 1000U
 
 // ---------------------------------------------------------------------------------------
 // Value tables
@@ -244,6 +264,22 @@ typedef enum sl_can_link_state {
 #define SL_CAN_STATUS_RESYNCS_MAX 255UL
 #define SL_CAN_STATUS_DROPPED_MAX 255UL
 
+#define SL_CAN_HEALTH_FAULT_MAX 0xFFFFUL
+#define SL_CAN_HEALTH_RECONNECTS_MAX 255UL
+#define SL_CAN_HEALTH_DROPPED_MAX 4095UL
+
+/// Health.Fault bits.
+#define SL_CAN_FAULT_CONFIG_MISMATCH 0x0001U
+#define SL_CAN_FAULT_NO_USABLE_ROWS 0x0002U
+#define SL_CAN_FAULT_MALFORMED_DATA 0x0004U
+#define SL_CAN_FAULT_LINK_FLAPPING 0x0008U
+#define SL_CAN_FAULT_CAN_OUTPUT_ERRORS 0x0010U
+#define SL_CAN_FAULT_RANGE_RESOLUTION_MISMATCH 0x0020U
+#define SL_CAN_FAULT_AZIMUTH_DISORDER 0x0040U
+#define SL_CAN_FAULT_CAN_RATE_LIMITED 0x0080U
+#define SL_CAN_FAULT_TARGET_SLOTS_OVERFLOW 0x0100U
+#define SL_CAN_FAULT_DEFINED 0x01FFU ///< bits 9..15 are reserved (sent as 0)
+
 #define SL_CAN_MOTION_SPEED_MM_S_PER_LSB 10  ///< 0.01 m/s
 #define SL_CAN_MOTION_YAW_CDEG_S_PER_LSB 1   ///< 0.01 deg/s
 #define SL_CAN_MOTION_RAW_MIN (-32768)
@@ -293,6 +329,15 @@ typedef struct sl_can_status {
     bool saturated;            ///< decode only: a counter is at its maximum
     uint8_t counter;           ///< decode only
 } sl_can_status_t;
+
+/// Module health (Health). Totals since start; the encoder saturates them (and counts the
+/// frame in stats.clamped_frames: the message has no Saturated bit).
+typedef struct sl_can_health {
+    uint16_t fault;              ///< in: SL_CAN_FAULT_* bits (reserved bits are sent as 0)
+    uint32_t reconnects;         ///< in: radar link reconnects
+    uint32_t candidates_dropped; ///< in: targets dropped for lack of slots
+    uint8_t counter;             ///< decode only
+} sl_can_health_t;
 
 /// Vehicle motion (input from the vehicle; encoded here for tests and simulators).
 typedef struct sl_can_vehicle_motion {
@@ -351,7 +396,7 @@ typedef struct sl_can_ids {
     uint32_t id[SL_CAN_MSG_COUNT]; ///< indexed by sl_can_msg_t
 } sl_can_ids_t;
 
-/// The four ids of a board (`can_id_*` fields). O(1).
+/// The ids of a board (`can_id_*` fields). O(1).
 void sl_can_ids_from_board(sl_can_ids_t *ids, const struct sl_board *board);
 
 /// Sender state: ids and one E2E counter per message type. Fields read-only.
@@ -384,6 +429,10 @@ sl_err_t sl_can_encode_lean_warning(sl_can_tx_t *tx, const sl_can_lean_warning_t
 /// link_state > 4 is sent as DISCONNECTED with Saturated set.
 sl_err_t sl_can_encode_status(sl_can_tx_t *tx, const sl_can_status_t *in, sl_can_frame_t *out);
 
+/// Encode one Health frame. Reserved fault bits are cleared; counters saturate at their
+/// field maximum (counted in stats.clamped_frames).
+sl_err_t sl_can_encode_health(sl_can_tx_t *tx, const sl_can_health_t *in, sl_can_frame_t *out);
+
 /// Encode one VehicleMotion frame (for tests, simulators and replay tools). Out-of-range
 /// speed or yaw rate is clamped and counted in stats.clamped_frames (the message has no
 /// Clamped bit: the vehicle owns it).
@@ -401,6 +450,7 @@ sl_err_t sl_can_decode_pole_lean(const sl_can_frame_t *f, sl_can_pole_lean_t *ou
 sl_err_t sl_can_decode_lean_warning(const sl_can_frame_t *f, sl_can_lean_warning_t *out);
 sl_err_t sl_can_decode_status(const sl_can_frame_t *f, sl_can_status_t *out);
 sl_err_t sl_can_decode_vehicle_motion(const sl_can_frame_t *f, sl_can_vehicle_motion_t *out);
+sl_err_t sl_can_decode_health(const sl_can_frame_t *f, sl_can_health_t *out);
 
 /// VehicleMotion receiver for the motion-aware masks: id match, E2E check (CRC errors and
 /// counter jumps counted in `e2e.stats`), latest accepted value with its time.

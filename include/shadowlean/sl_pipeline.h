@@ -28,14 +28,18 @@
 ///    r1/r2, alpha, sigma, flags, representative azimuth: `sl_target_t`) and the tracker's
 ///    tracks (filtered alpha, sigma, warning level: `sl_track_t`, live slots only matter).
 /// 2. `port.can_tx(ctx, f)` (optional) for: one PoleLean per *confirmed* track (live,
-///    matched this rotation, `hits >= cfg.confirm_hits`), in slot order; one LeanWarning
+///    matched this rotation, `hits >= cfg.confirm_hits` and `confirmed` by the tracker's
+///    static-object evidence, sl_track.h), in slot order; one LeanWarning
 ///    (the most severe confirmed track: highest level, then largest |filtered alpha|;
 ///    HasTarget = 0 when there is none); one Status (link state, rotations, missing
-///    azimuths, decoder resyncs, CAN drops). `can_tx` must not block: SL_ERR_BUSY (or any
+///    azimuths, decoder resyncs, CAN drops); one Health right after every Status
+///    (Fault bit TARGET_SLOTS_OVERFLOW when the last rotation dropped targets for lack of
+///    slots, CandidatesDropped = `detect.stats.target_overflow`). `can_tx` must not block: SL_ERR_BUSY (or any
 ///    other error) counts the frame as dropped (`stats.can_dropped`, reported in the next
 ///    Status frame) and the pipeline moves on. Drops the port notices later (after can_tx
 ///    returned SL_OK) are added with `sl_pipeline_add_can_dropped()`. Between rotations
-///    the port sends Status frames with `sl_pipeline_send_status()` (same E2E sequence).
+///    the port sends Status (+ Health) frames with `sl_pipeline_send_status()` (same E2E
+///    sequences).
 /// Callbacks must not call back into the same pipeline (not reentrant).
 ///
 /// ## Mapping to CAN (sl_can.h)
@@ -268,6 +272,8 @@ typedef struct sl_pipeline {
     int32_t yaw_cdeg_s;          ///< ... its yaw rate (0 when invalid)
     uint64_t last_t_last_us;     ///< previous rotation's t_last_us (0 = none)
     uint64_t now_us;             ///< now_us of the current call
+    uint32_t overflow_at_begin;  ///< internal: detect.stats.target_overflow at rotation start
+    bool slots_overflowed;       ///< the last rotation dropped targets for lack of slots
     // motion input
     sl_can_motion_rx_t motion_rx; ///< CAN VehicleMotion receiver (E2E)
     sl_can_vehicle_motion_t motion; ///< last motion from the setter
