@@ -11,7 +11,8 @@ documented in sl_pipeline.h. Checks:
 - every frame: id known to the DBC, DLC 8, Crc = CRC-8 SAE J1850 over [SlE2EDataId,
   bytes 1..7], Counter = previous + 1 mod 15 per message, canmatrix re-encodes the
   decoded raw values to the same bytes;
-- frames come in rotation groups PoleLean* LeanWarning Status, one per JSON rotation
+- frames come in rotation groups PoleLean* LeanWarning Status (Health right after every
+  Status, rotation or idle, belongs to it), one per JSON rotation
   record, in order (Status frames without a group are idle Status frames: allowed with
   --idle-ok, rejected otherwise);
 - PoleLean: one per confirmed track (live, updated, hits >= confirm_hits) in slot order:
@@ -80,6 +81,7 @@ def main(argv):
     rots = [r for r in recs[1:] if r["type"] == "rotation"]
     errors = []
     counters = {}
+    last_name = None
     groups = []
     cur = []
     idle = 0
@@ -100,6 +102,15 @@ def main(argv):
         if prev is not None and d.raw["Counter"] != (prev + 1) % 15:
             errors.append(f"{where}: {d.name} Counter {d.raw['Counter']} after {prev}")
         counters[d.name] = d.raw["Counter"]
+        if d.name == "Health":
+            # Sent right after every Status (rotation or idle): belongs to that Status.
+            if last_name != "Status":
+                errors.append(f"{where}: Health not right after a Status frame")
+            if d.raw["Fault"] & ~0x1FF:
+                errors.append(f"{where}: Health Fault reserved bits set ({d.raw['Fault']:#x})")
+            last_name = d.name
+            continue
+        last_name = d.name
         if d.name == "Status":
             if not cur:
                 idle += 1
@@ -124,7 +135,7 @@ def main(argv):
     for k, (g, r) in enumerate(zip(groups, rots)):
         w = f"rotation {r['rotation']}"
         missing += r["missing"]
-        confirmed = [t for t in r["tracks"] if t["hits"] >= confirm]
+        confirmed = [t for t in r["tracks"] if t["hits"] >= confirm and t.get("confirmed", 1)]
         want_pl = [t for t in confirmed if t["updated"]]
         poles = [d for d in g if d.name == "PoleLean"]
         rest = [d.name for d in g if d.name != "PoleLean"]

@@ -83,5 +83,5 @@ kill -INT $DPID; wait $DPID; rc=$?; DPID=""
 cat "$OUT/int.err"
 [ $rc -eq 0 ] || { echo "FAIL: exit status $rc after SIGINT"; exit 1; }
 grep -q "stopping (SIGINT)" "$OUT/int.err" || { echo "FAIL: no clean stop logged"; exit 1; }
-tail -1 "$OUT/int.log" | grep -q ' 622#' || { echo "FAIL: the log does not end with a Status frame"; exit 1; }
+tail -2 "$OUT/int.log" | head -1 | grep -q ' 622#' && tail -1 "$OUT/int.log" | grep -q ' 623#' || { echo "FAIL: the log does not end with a Status frame and its Health"; exit 1; }
 "$PY" "$SRC/check_can_vs_targets.py" "$DBC" "$OUT/int.log" "$OUT/int.jsonl" || exit 1
