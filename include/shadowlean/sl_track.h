@@ -65,7 +65,7 @@
 ///
 /// ## Ownership, memory, cost
 /// Caller-owned `sl_tracker_t`; borrows `board` until re-init. RAM: SL_CFG_MAX_TARGETS x
-/// sizeof(sl_track_t) (56 bytes) + 64 bytes (defaults: 1,856 bytes on x86-64). Cost per update:
+/// sizeof(sl_track_t) (64 bytes) + 88 bytes (defaults: 2,136 bytes on x86-64). Cost per update:
 /// O(tracks x targets x min(tracks, targets)) gate tests (worst case 32^3 = 32k simple
 /// steps; a few hundred instructions for a handful of poles) + one 64-bit division and one
 /// isqrt per valid measurement. Not reentrant per instance.
