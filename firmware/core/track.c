@@ -137,14 +137,18 @@ void sl_track_predict_static(const sl_board_t *board, uint16_t az, uint32_t r_um
         *r_out = r_um;
         return;
     }
+    // Keep |x|, |y| < 2^31 so that the squares below fit (1 km is far beyond any shadow).
+    const uint32_t lim = 1U << 30;
+    r_um = r_um > lim ? lim : r_um;
+    disp_um = disp_um > lim ? lim : disp_um;
     // Bearing from vehicle forward, clockwise, bam32.
     const int64_t yaw = (int64_t)board->radar_yaw_cdeg * 4294967296LL / 36000;
     const uint32_t b = (uint32_t)(((uint64_t)az << 32) / n + (uint64_t)yaw);
     const int64_t x = (((int64_t)r_um * sin_q15(b + 0x40000000U)) >> 15) - (int64_t)disp_um;
     const int64_t y = ((int64_t)r_um * sin_q15(b)) >> 15;
-    const uint64_t r2 = (uint64_t)(x * x) + (uint64_t)(y * y);
+    const uint64_t r2 = (uint64_t)(x * x) + (uint64_t)(y * y); // < 2^63
     *r_out = sl_fx_isqrt64(r2);
-    // atan2 on values scaled into int32 (|x|, |y| <= r + d < 2^33 um: shift by 2).
+    // atan2 on values scaled into int32 (|x|, |y| < 2^31: shift by 2 for margin).
     const sl_bam32_t b2 = sl_incline_atan2_bam32((int32_t)(y >> 2), (int32_t)(x >> 2));
     const uint32_t rel = b2 - (uint32_t)yaw;
     *az_out = (uint16_t)(((((uint64_t)rel * n) + 0x80000000ULL) >> 32) % n);

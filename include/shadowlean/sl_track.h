@@ -179,8 +179,8 @@ void sl_track_update(sl_tracker_t *tr, const sl_target_t *targets, uint32_t n,
 void sl_track_set_motion(sl_tracker_t *tr, uint32_t disp_um, uint32_t yaw_bam32);
 
 /// Where a static object seen at azimuth index `az`, range `r_um` is expected after the ego
-/// displacement `disp_um` forward (see "Static-object prediction"). Pure; O(1) (one isqrt,
-/// one atan2, two divisions).
+/// displacement `disp_um` forward (see "Static-object prediction"); r and d are clamped to
+/// 2^30 um (1 km). Pure; O(1) (one isqrt, one atan2, two divisions).
 void sl_track_predict_static(const sl_board_t *board, uint16_t az, uint32_t r_um,
                              uint32_t disp_um, uint16_t *az_out, uint32_t *r_out);
 
