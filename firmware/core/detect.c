@@ -423,6 +423,28 @@ uint16_t sl_detect_evidence(uint32_t occupied_total, uint32_t az_with_run, uint3
     return (uint16_t)(e > 0xFFFFU ? 0xFFFFU : e);
 }
 
+void sl_detect_hints_clear(sl_detect_t *d)
+{
+    SL_ASSERT(d != NULL);
+    memset(d->hint_bits, 0, sizeof d->hint_bits);
+}
+
+void sl_detect_hint(sl_detect_t *d, uint16_t az, uint16_t half_width)
+{
+    SL_ASSERT(d != NULL);
+    const uint32_t n = d->azimuths;
+    if (az >= n || n == 0U) {
+        return;
+    }
+    const uint32_t w = (uint32_t)half_width * 2U + 1U;
+    const uint32_t cnt = w < n ? w : n;
+    uint32_t a = ((uint32_t)az + n - ((uint32_t)half_width % n)) % n;
+    for (uint32_t i = 0; i < cnt; i++) {
+        d->hint_bits[a >> 5] |= (uint32_t)1U << (a & 31U);
+        a = a + 1U == n ? 0U : a + 1U;
+    }
+}
+
 // A target that passed every test takes a free slot; with none free it replaces the target
 // with the least evidence when it has more (ties keep the earlier one). One drop counted
 // either way.
@@ -523,6 +545,10 @@ static void finalize(sl_detect_t *d, sl_detect_cand_t *c)
         az_runs += c->run[i].count != 0U ? 1U : 0U;
     }
     t.evidence = sl_detect_evidence(occ_total, az_runs, (uint32_t)rep->last - rep->first + 1U);
+    if (((d->hint_bits[az >> 5] >> (az & 31U)) & 1U) != 0U) {
+        const uint32_t e = (uint32_t)t.evidence + SL_DETECT_EVIDENCE_TRACK;
+        t.evidence = (uint16_t)(e > 0xFFFFU ? 0xFFFFU : e);
+    }
     slot_take(d, &t);
 }
 

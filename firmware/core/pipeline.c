@@ -224,6 +224,21 @@ static void emit_can(sl_pipeline_t *p)
 
 // ------------------------------------------------------------------------------- rotation
 
+// Slots by evidence (sl_detect.h stage 4b): the azimuths where confirmed tracks are,
+// widened by the tracker's azimuth gate, get the track bonus, so an established pole keeps
+// its slot however much clutter competes for the slots.
+static void detect_hints_from_tracks(sl_pipeline_t *p)
+{
+    sl_detect_hints_clear(&p->detect);
+    const sl_tracker_t *tr = &p->tracker;
+    for (uint32_t i = 0; i < SL_CFG_MAX_TARGETS; i++) {
+        const sl_track_t *t = &tr->tracks[i];
+        if (t->live != 0U && t->confirmed != 0U) {
+            sl_detect_hint(&p->detect, t->az, sl_track_gate_az(tr, t));
+        }
+    }
+}
+
 static void begin_rotation(sl_pipeline_t *p)
 {
     p->overflow_at_begin = p->detect.stats.target_overflow;
@@ -245,6 +260,7 @@ static void begin_rotation(sl_pipeline_t *p)
     p->frames_eff = w;
     (void)sl_mask_set_window(&p->mask, w);
     sl_detect_begin(&p->detect);
+    detect_hints_from_tracks(p);
     p->next_az = 0U;
     p->in_rotation = 1U;
 }

@@ -222,6 +222,27 @@ static uint16_t new_id(sl_tracker_t *tr)
     }
 }
 
+// Azimuth gate widened by the angle the ego displacement subtends at r1:
+// d / r1 rad = d * naz / (2 pi r1) azimuth steps (710/113 ~ 2 pi, rounded up).
+static uint64_t gate_az(const sl_tracker_t *tr, const sl_track_t *t, uint64_t base)
+{
+    uint64_t ag = base;
+    if (tr->motion_um != 0U) {
+        const uint64_t naz = tr->board->azimuths;
+        const uint64_t r1 = t->r1_um > 100000U ? t->r1_um : 100000U; // >= 0.1 m
+        ag += ((uint64_t)tr->motion_um * naz * 113U + r1 * 710U - 1U) / (r1 * 710U);
+    }
+    return ag;
+}
+
+uint16_t sl_track_gate_az(const sl_tracker_t *tr, const sl_track_t *t)
+{
+    SL_ASSERT(tr != NULL && t != NULL);
+    const uint64_t yaw_az = ((uint64_t)tr->motion_yaw_bam * tr->board->azimuths + 0xFFFFFFFFULL) >> 32;
+    const uint64_t ag = gate_az(tr, t, (uint64_t)tr->cfg.az_gate + yaw_az);
+    return (uint16_t)(ag > 0xFFFFU ? 0xFFFFU : ag);
+}
+
 void sl_track_update(sl_tracker_t *tr, const sl_target_t *targets, uint32_t n,
                      uint64_t now_us)
 {
@@ -254,13 +275,7 @@ void sl_track_update(sl_tracker_t *tr, const sl_target_t *targets, uint32_t n,
             if (t->live == 0U || t->updated != 0U) {
                 continue;
             }
-            // Azimuth gate widened by the angle the ego displacement subtends at r1:
-            // d / r1 rad = d * naz / (2 pi r1) azimuth steps (710/113 ~ 2 pi, rounded up).
-            uint64_t ag = ag0 + yaw_az;
-            if (tr->motion_um != 0U) {
-                const uint64_t r1 = t->r1_um > 100000U ? t->r1_um : 100000U; // >= 0.1 m
-                ag += ((uint64_t)tr->motion_um * naz * 113U + r1 * 710U - 1U) / (r1 * 710U);
-            }
+            const uint64_t ag = gate_az(tr, t, ag0 + yaw_az);
             for (uint32_t j = 0; j < n; j++) {
                 if (used[j]) {
                     continue;

@@ -50,8 +50,11 @@
 /// 4b. **Slots by evidence**. When more targets pass than `max_targets`, the ones with the
 ///    least evidence are dropped (never the later azimuths): evidence =
 ///    4 x (occupied bins of the group over all its azimuths) + 16 x (azimuths with a run) +
-///    8 x (extent of the representative run in bins) (sl_target_t.evidence). Each drop is
-///    counted in `stats.target_overflow` (CandidatesDropped on CAN). Ties keep the earlier.
+///    8 x (extent of the representative run in bins), plus SL_DETECT_EVIDENCE_TRACK when
+///    the representative azimuth is hinted (sl_detect_hint(): where the caller expects a
+///    confirmed track, so an established pole keeps its slot against any amount of clutter)
+///    (sl_target_t.evidence). Each drop is counted in `stats.target_overflow`
+///    (CandidatesDropped on CAN). Ties keep the earlier.
 /// 5. **Corrections** (sl_detect_correct(), MATH.md s.4), b = bin_size_um:
 ///    - raw bounds: r1_raw = bin_first * b (near edge of the first occupied bin),
 ///      r2_raw = (bin_last + 1) * b (far edge of the last occupied bin);
@@ -131,6 +134,9 @@ extern "C" {
 #if SL_CFG_DETECT_MAX_CANDIDATES < 1 || SL_CFG_DETECT_MAX_CANDIDATES > 255
 #error "SL_CFG_DETECT_MAX_CANDIDATES must be in [1, 255]"
 #endif
+
+/// Evidence bonus of a target on a hinted azimuth (stage 4b).
+#define SL_DETECT_EVIDENCE_TRACK 1024U
 
 /// Rejection reasons (index of `sl_detect_stats_t.rejected`).
 typedef enum sl_detect_reject {
@@ -241,6 +247,7 @@ typedef struct sl_detect {
     uint32_t open_bits[(SL_CFG_DETECT_MAX_CANDIDATES + 31) / 32]; ///< open groups (bitmap)
     sl_detect_cand_t cand[SL_CFG_DETECT_MAX_CANDIDATES];
     sl_target_t targets[SL_CFG_MAX_TARGETS];
+    uint32_t hint_bits[(SL_CFG_MAX_AZIMUTHS + 31) / 32]; ///< hinted azimuths (stage 4b)
     sl_detect_stats_t stats;
 } sl_detect_t;
 
@@ -280,6 +287,15 @@ sl_ssize_t sl_detect_rotation_from_mask(sl_detect_t *d, const sl_mask_t *mask);
 /// else needs the far range: it cuts those two stages ~3x on paper-sim (160 of 512 bins).
 /// O(azimuths).
 uint16_t sl_detect_bins_needed(const sl_detect_t *d);
+
+/// Clear every hint (stage 4b). Hints stay until cleared (sl_detect_begin keeps them).
+/// O(azimuths / 32).
+void sl_detect_hints_clear(sl_detect_t *d);
+
+/// Hint azimuths `az - half_width .. az + half_width` (circular): a target whose
+/// representative azimuth is hinted gets SL_DETECT_EVIDENCE_TRACK more evidence. Out of
+/// range `az` is ignored. O(half_width).
+void sl_detect_hint(sl_detect_t *d, uint16_t az, uint16_t half_width);
 
 /// Clutter tests of stage 4 (SHORT, RHO) on a finished target `t` (bin_first/bin_last,
 /// r1_um, incline flag and rho set) on azimuth `t->az`: the rejection reason, or -1 when the

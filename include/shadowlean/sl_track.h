@@ -184,6 +184,11 @@ void sl_track_set_motion(sl_tracker_t *tr, uint32_t disp_um, uint32_t yaw_bam32)
 void sl_track_predict_static(const sl_board_t *board, uint16_t az, uint32_t r_um,
                              uint32_t disp_um, uint16_t *az_out, uint32_t *r_out);
 
+/// The azimuth gate of track `t` under the current motion (cfg.az_gate + the yaw per update
+/// + the angle the displacement subtends at the track's r1), in azimuths, saturated at
+/// 65535. O(1).
+uint16_t sl_track_gate_az(const sl_tracker_t *tr, const sl_track_t *t);
+
 /// Highest warning level over live tracks (SL_WARN_NONE when none). O(tracks).
 sl_warn_level_t sl_track_max_level(const sl_tracker_t *tr);
 

@@ -425,6 +425,42 @@ static void test_detect_slots_go_to_the_strongest_not_the_lowest_azimuths(void *
     assert_int_equal(clutter, 14);
     assert_int_equal(sl_detect_evidence(6, 1, 6), 4 * 6 + 16 + 8 * 6);
     assert_int_equal(sl_detect_evidence(100000, 0, 0), 0xFFFF);
+    // A hint (a confirmed track expected there) keeps a weak return's slot: the clutter
+    // return at azimuth 90 is hinted and survives 21 stronger candidates (20 copies of the
+    // second pole's shape at azimuths 110..300 and the pole at 350).
+    memset(rows, 0, sizeof rows);
+    assert_int_equal(sl_detect_init(&det, &board, NULL), SL_OK);
+    sl_detect_hint(&det, 91, 1); // 90..92
+    set_run(90, 110, 115);
+    for (int k = 0; k < 20; k++) {
+        for (int a = 110 + 10 * k; a < 114 + 10 * k; a++) {
+            set_run(a, 70, 76);
+        }
+    }
+    for (int a = 350; a < 354; a++) {
+        set_run(a, 70, 76);
+    }
+    assert_int_equal(run_rotation(), 16);
+    int hinted = 0;
+    for (int i = 0; i < 16; i++) {
+        if (det.targets[i].az == 90) {
+            hinted++;
+            assert_int_equal(det.targets[i].evidence,
+                             sl_detect_evidence(6, 1, 6) + SL_DETECT_EVIDENCE_TRACK);
+        }
+    }
+    assert_int_equal(hinted, 1);
+    assert_int_equal(det.stats.target_overflow, 6);
+    // Hints wrap around azimuth 0 and are cleared explicitly.
+    sl_detect_hints_clear(&det);
+    sl_detect_hint(&det, 1, 2); // 399, 0, 1, 2, 3
+    assert_int_equal(det.hint_bits[0], 0xFU);
+    assert_int_equal(det.hint_bits[(NAZ - 1) / 32] >> ((NAZ - 2) % 32), 0x2U);
+    sl_detect_hint(&det, NAZ, 2); // out of range: ignored
+    sl_detect_hints_clear(&det);
+    for (unsigned w = 0; w < (NAZ + 31) / 32; w++) {
+        assert_int_equal(det.hint_bits[w], 0);
+    }
 }
 
 static void test_detect_handles_empty_saturated_and_misordered_input(void **state)
