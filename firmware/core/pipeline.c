@@ -350,6 +350,7 @@ static void on_rot(void *ctx, const sl_scan_rot_t *rot)
         yaw_bam = bam > UINT32_MAX ? UINT32_MAX : (uint32_t)bam;
     }
     sl_track_set_motion(&p->tracker, disp_um, yaw_bam);
+    sl_track_set_reverse(&p->tracker, p->motion_valid && p->speed_mm_s < 0);
     sl_track_update(&p->tracker, p->detect.targets, n_targets, p->now_us);
     p->stats.rotations++;
     p->stats.azimuths_missing += rot->stats.missing;

@@ -154,6 +154,29 @@ void sl_track_predict_static(const sl_board_t *board, uint16_t az, uint32_t r_um
     *az_out = (uint16_t)(((((uint64_t)rel * n) + 0x80000000ULL) >> 32) % n);
 }
 
+void sl_track_set_reverse(sl_tracker_t *tr, bool reverse)
+{
+    SL_ASSERT(tr != NULL);
+    tr->motion_reverse = reverse;
+}
+
+// The track's predicted position for this update. Reversing by d is the mirror image of
+// driving forward by d seen from the bearing turned by half a turn.
+static void predict(const sl_tracker_t *tr, sl_track_t *t)
+{
+    if (!tr->motion_reverse) {
+        sl_track_predict_static(tr->board, t->az, t->r1_um, tr->motion_um, &t->pred_az,
+                                &t->pred_r1_um);
+        return;
+    }
+    const uint16_t n = tr->board->azimuths;
+    const uint16_t half = (uint16_t)(n / 2U);
+    uint16_t paz;
+    sl_track_predict_static(tr->board, (uint16_t)((t->az + half) % n), t->r1_um, tr->motion_um,
+                            &paz, &t->pred_r1_um);
+    t->pred_az = (uint16_t)((paz + n - half) % n);
+}
+
 // Evidence after an association (consistent or not with the static prediction).
 static void evidence_update(sl_tracker_t *tr, sl_track_t *t, const sl_target_t *g, uint32_t yaw_az)
 {
@@ -262,8 +285,7 @@ void sl_track_update(sl_tracker_t *tr, const sl_target_t *targets, uint32_t n,
         t->updated = 0U;
         used[i] = false;
         if (t->live != 0U) {
-            sl_track_predict_static(tr->board, t->az, t->r1_um, tr->motion_um, &t->pred_az,
-                                    &t->pred_r1_um);
+            predict(tr, t);
         }
     }
     // Greedy global nearest neighbour. Cost |d az| / ag + |d r| / rg, scaled by ag * rg.

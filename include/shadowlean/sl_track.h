@@ -161,6 +161,7 @@ typedef struct sl_tracker {
     sl_track_stats_t stats;
     uint32_t motion_um;      ///< ego displacement per update (sl_track_set_motion), um
     uint32_t motion_yaw_bam; ///< |yaw| per update, bam32 (2^32 = one turn)
+    bool motion_reverse;     ///< the displacement is backwards (sl_track_set_reverse)
 } sl_tracker_t;
 
 /// Initialise (no tracks). `cfg` NULL = defaults (copied). Borrows `board`.
@@ -178,8 +179,13 @@ void sl_track_update(sl_tracker_t *tr, const sl_target_t *targets, uint32_t n,
 /// 0, 0 = static. O(1).
 void sl_track_set_motion(sl_tracker_t *tr, uint32_t disp_um, uint32_t yaw_bam32);
 
+/// Direction of the displacement given to sl_track_set_motion(): true = the vehicle
+/// reverses (the static-object prediction moves the other way). Default false. O(1).
+void sl_track_set_reverse(sl_tracker_t *tr, bool reverse);
+
 /// Where a static object seen at azimuth index `az`, range `r_um` is expected after the ego
-/// displacement `disp_um` forward (see "Static-object prediction"); r and d are clamped to
+/// displacement `disp_um` forward (a negative displacement: pass the reverse flag through
+/// sl_track_set_reverse(); this pure function takes `disp_um` forward only) (see "Static-object prediction"); r and d are clamped to
 /// 2^30 um (1 km). Pure; O(1) (one isqrt, one atan2, two divisions).
 void sl_track_predict_static(const sl_board_t *board, uint16_t az, uint32_t r_um,
                              uint32_t disp_um, uint16_t *az_out, uint32_t *r_out);

@@ -347,6 +347,32 @@ static void test_track_confirms_static_objects_not_scattered_clutter(void **stat
     assert_int_equal(trk.stats.confirmations, 0);
 }
 
+// Reversing: a static pole ahead-right (bearing 45 deg, 3.5 m) seen while the vehicle backs
+// away at 1 m/s confirms only when the tracker knows the direction (sl_track_set_reverse).
+static void test_track_prediction_follows_a_reversing_vehicle(void **state)
+{
+    (void)state;
+    const double kPi = 3.14159265358979323846;
+    for (int told = 0; told < 2; told++) {
+        assert_int_equal(sl_track_init(&trk, &board, NULL), SL_OK);
+        sl_track_set_motion(&trk, 250000U, 0U);
+        sl_track_set_reverse(&trk, told != 0);
+        double x = 3.5 * cos(45.0 * kPi / 180.0), y = 3.5 * sin(45.0 * kPi / 180.0);
+        uint64_t now = 1000000;
+        for (int k = 0; k < 5; k++) {
+            const double b = fmod(atan2(y, x) * 180.0 / kPi + 360.0, 360.0);
+            sl_target_t t = tgt((uint16_t)lround(b / 0.9) % 400U, (uint32_t)lround(hypot(x, y) * 1e6),
+                                500, 80, SL_INCLINE_VALID);
+            sl_track_update(&trk, &t, 1, now);
+            now += 250000;
+            x += 0.25; // the vehicle backs off: the pole moves forward in its frame
+        }
+        assert_int_equal(trk.live, 1);
+        assert_int_equal(trk.tracks[0].confirmed, told ? 1 : 0);
+        assert_int_equal(trk.stats.inconsistent, told ? 0U : 4U);
+    }
+}
+
 static void test_track_counts_targets_beyond_its_capacity(void **state)
 {
     (void)state;
@@ -379,6 +405,7 @@ int main(void)
         cmocka_unit_test_setup(test_track_counts_targets_beyond_its_capacity, setup),
         cmocka_unit_test_setup(test_track_predicts_a_static_object_under_ego_motion, setup),
         cmocka_unit_test_setup(test_track_confirms_static_objects_not_scattered_clutter, setup),
+        cmocka_unit_test_setup(test_track_prediction_follows_a_reversing_vehicle, setup),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
