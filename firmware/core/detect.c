@@ -9,6 +9,8 @@
 #define CF_SHADOW 0x02U
 #define CF_SPAN 0x04U
 #define CF_WRAPS 0x08U
+#define CF_AMP 0x10U    // an amplitude row was seen for a run of the group
+#define CF_STRONG 0x20U // ... and some run rose clearly above its floor
 
 #define ST_FREE 0U
 #define ST_OPEN 1U
@@ -32,6 +34,8 @@ void sl_detect_cfg_default(sl_detect_cfg_t *cfg)
     cfg->link_bins = 1U;
     cfg->width_slack_az = 1U;
     cfg->radius_from_width = true;
+    cfg->weak_margin = 6U;
+    cfg->weak_contrast = 20U;
 }
 
 // ---- bit scanning (portable: de Bruijn count of trailing zeros)
@@ -512,6 +516,8 @@ static void finalize(sl_detect_t *d, sl_detect_cand_t *c)
         reason = SL_DETECT_REJ_WIDE;
     } else if ((uint32_t)rep->count < (uint32_t)rep->last - rep->first + 1U) {
         reason = SL_DETECT_REJ_BROKEN;
+    } else if ((c->flags & (CF_AMP | CF_STRONG)) == CF_AMP) {
+        reason = SL_DETECT_REJ_WEAK;
     }
     if ((c->flags & CF_SPAN) != 0U) {
         d->stats.span_overflow++;
@@ -550,6 +556,45 @@ static void finalize(sl_detect_t *d, sl_detect_cand_t *c)
         t.evidence = (uint16_t)(e > 0xFFFFU ? 0xFFFFU : e);
     }
     slot_take(d, &t);
+}
+
+// WEAK test of one run [s, e) against the amplitude row (sl_detect.h stage 4): CF_AMP, plus
+// CF_STRONG when its peak is >= threshold + weak_margin or >= floor + weak_contrast, the
+// floor being the mean of the gap_bins + 1 bins on each side (free by construction).
+static uint8_t run_strength(const sl_detect_t *d, uint32_t s, uint32_t e)
+{
+    const uint8_t *p = d->amp;
+    const uint32_t nb = d->amp_bins;
+    if (p == NULL || s >= nb) {
+        return 0U;
+    }
+    uint32_t peak = 0U;
+    for (uint32_t k = s; k < e && k < nb; k++) {
+        peak = p[k] > peak ? p[k] : peak;
+    }
+    const uint32_t side = (uint32_t)d->cfg.gap_bins + 1U;
+    uint32_t sum = 0U, cnt = 0U;
+    for (uint32_t k = s > side ? s - side : 0U; k < s; k++) {
+        sum += p[k];
+        cnt++;
+    }
+    for (uint32_t k = e; k < e + side && k < nb; k++) {
+        sum += p[k];
+        cnt++;
+    }
+    const uint32_t floor_v = cnt != 0U ? sum / cnt : 0U;
+    const bool strong = peak >= (uint32_t)d->amp_threshold + d->cfg.weak_margin ||
+                        peak >= floor_v + d->cfg.weak_contrast;
+    return (uint8_t)(CF_AMP | (strong ? CF_STRONG : 0U));
+}
+
+void sl_detect_set_amplitude(sl_detect_t *d, const uint8_t *power, uint16_t bins,
+                             uint8_t threshold)
+{
+    SL_ASSERT(d != NULL);
+    d->amp = power;
+    d->amp_bins = power != NULL ? bins : 0U;
+    d->amp_threshold = threshold;
 }
 
 // Close groups that can no longer grow (no run on a - 1). Groups starting at azimuth 0
@@ -628,6 +673,7 @@ sl_err_t sl_detect_row(sl_detect_t *d, uint16_t az, const uint32_t *occ, uint32_
     SL_ASSERT(d != NULL && (occ != NULL || words == 0U));
     if (az >= d->azimuths || (int32_t)az <= d->last_az) {
         d->stats.order_errors++;
+        d->amp = NULL;
         return SL_ERR_RANGE;
     }
     d->last_az = az;
@@ -639,6 +685,7 @@ sl_err_t sl_detect_row(sl_detect_t *d, uint16_t az, const uint32_t *occ, uint32_
     const uint32_t win = d->win_bins[az] < limit ? d->win_bins[az] : limit;
     const uint32_t near = d->near_bins;
     if (win <= near) {
+        d->amp = NULL;
         return SL_OK;
     }
     // Fast exit for the common azimuth: nothing occupied in [near, win) (the last word is
@@ -648,6 +695,7 @@ sl_err_t sl_detect_row(sl_detect_t *d, uint16_t az, const uint32_t *occ, uint32_
         any |= occ[w];
     }
     if (any == 0U) {
+        d->amp = NULL;
         return SL_OK;
     }
     const uint32_t edge = d->edge_bins[az];
@@ -678,9 +726,11 @@ sl_err_t sl_detect_row(sl_detect_t *d, uint16_t az, const uint32_t *occ, uint32_
         if (e >= limit || e - 1U >= edge) {
             rf |= CF_SHADOW;
         }
+        rf |= run_strength(d, s, e);
         add_run(d, az, s, e - 1U, count, rf);
         pos = e;
     }
+    d->amp = NULL;
     return SL_OK;
 }
 

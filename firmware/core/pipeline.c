@@ -301,6 +301,8 @@ static void on_row(void *ctx, const sl_scan_row_t *row)
             feed_held(p, p->next_az, row->idx);
         }
         if (sl_mask_update(&p->mask, row->idx, p->bits, p->occ, NULL) == SL_OK) {
+            sl_detect_set_amplitude(&p->detect, row->power, p->mask_bins,
+                                    (uint8_t)(p->cfg.threshold > 255U ? 255U : p->cfg.threshold));
             (void)sl_detect_row(&p->detect, row->idx, p->occ, p->mask_words);
         }
         p->next_az = (uint16_t)(row->idx + 1U);

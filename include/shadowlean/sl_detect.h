@@ -46,7 +46,13 @@
 ///    AMBIGUOUS with rho below the model's minimum rho_amb of that azimuth by more than the
 ///    quantisation can explain: rho < rho_amb - b / r1, b the bin size; a run of n bins
 ///    measures (n - 1) b between its bin centres and the true extent is < n b, so a real
-///    pole near the fold reads at most b / r1 below rho_amb).
+///    pole near the fold reads at most b / r1 below rho_amb); WEAK (checked before SHORT,
+///    only when amplitude rows were given: sl_detect_set_amplitude()): no run of the group
+///    is clearly above its local floor, i.e. for every run its peak power is below
+///    threshold + `cfg.weak_margin` AND below floor + `cfg.weak_contrast`, the floor being
+///    the mean power of the gap_bins + 1 bins on each side of the run (free bins by
+///    construction of a run). A rough verge or gravel just over the threshold in a band of
+///    weak returns fails both; a weak pole over a quiet floor passes the second.
 /// 4b. **Slots by evidence**. When more targets pass than `max_targets`, the ones with the
 ///    least evidence are dropped (never the later azimuths): evidence =
 ///    4 x (occupied bins of the group over all its azimuths) + 16 x (azimuths with a run) +
@@ -147,7 +153,9 @@ typedef enum sl_detect_reject {
     SL_DETECT_REJ_SHORT = 4,  ///< the representative run is a single bin (no extent: no rho)
     SL_DETECT_REJ_RHO = 5,    ///< rho outside what the model gives on this azimuth (below
                               ///< the fold by more than one bin, above the domain, r1 >= r2)
-    SL_DETECT_REJ_COUNT = 6
+    SL_DETECT_REJ_WEAK = 6,   ///< no run of the group rises clearly above its local floor
+                              ///< (needs the amplitude row: sl_detect_set_amplitude)
+    SL_DETECT_REJ_COUNT = 7
 } sl_detect_reject_t;
 
 /// `sl_target_t.flags`.
@@ -167,10 +175,15 @@ typedef struct sl_detect_cfg {
     uint8_t link_bins;             ///< extent overlap tolerance between adjacent azimuths
     uint8_t width_slack_az;        ///< extra azimuths allowed by the WIDE test
     bool radius_from_width;        ///< estimate R from the width when the board has none
+    uint8_t weak_margin;           ///< WEAK test: a peak this far above the threshold is
+                                   ///< strong whatever the floor (default 6 counts, ~6 dB
+                                   ///< on the sensor's 19.8-counts-per-decade scale)
+    uint8_t weak_contrast;         ///< WEAK test: or this far above the local floor
+                                   ///< (default 20 counts, ~10x in amplitude)
 } sl_detect_cfg_t;
 
 /// Defaults: D_max 0.3 m, R clamp 0.15 m, beam 1.8 deg (CTS350-X), gap 2 bins, link 1 bin,
-/// slack 1 azimuth, radius from width on.
+/// slack 1 azimuth, radius from width on, weak margin 6, weak contrast 20.
 void sl_detect_cfg_default(sl_detect_cfg_t *cfg);
 
 /// One detected target (one rotation). Plain value.
@@ -248,6 +261,9 @@ typedef struct sl_detect {
     sl_detect_cand_t cand[SL_CFG_DETECT_MAX_CANDIDATES];
     sl_target_t targets[SL_CFG_MAX_TARGETS];
     uint32_t hint_bits[(SL_CFG_MAX_AZIMUTHS + 31) / 32]; ///< hinted azimuths (stage 4b)
+    const uint8_t *amp;     ///< amplitude row for the next sl_detect_row (borrowed) or NULL
+    uint16_t amp_bins;      ///< its length
+    uint8_t amp_threshold;  ///< the threshold it was cut at
     sl_detect_stats_t stats;
 } sl_detect_t;
 
@@ -287,6 +303,12 @@ sl_ssize_t sl_detect_rotation_from_mask(sl_detect_t *d, const sl_mask_t *mask);
 /// else needs the far range: it cuts those two stages ~3x on paper-sim (160 of 512 bins).
 /// O(azimuths).
 uint16_t sl_detect_bins_needed(const sl_detect_t *d);
+
+/// The power row (8-bit, `bins` values, thresholded at `threshold`) of the azimuth passed
+/// to the NEXT sl_detect_row() call, for the WEAK test; borrowed until that call returns,
+/// then forgotten (rows fed without one, e.g. held rows, are not tested). O(1).
+void sl_detect_set_amplitude(sl_detect_t *d, const uint8_t *power, uint16_t bins,
+                             uint8_t threshold);
 
 /// Clear every hint (stage 4b). Hints stay until cleared (sl_detect_begin keeps them).
 /// O(azimuths / 32).

@@ -393,6 +393,42 @@ static void test_detect_rejects_clutter_before_it_takes_a_slot(void **state)
     assert_int_equal(sl_detect_clutter_reason(&board, &t, amb + 1000U), SL_DETECT_REJ_SHORT);
 }
 
+// WEAK: with amplitude rows, a group none of whose runs is clearly above its local floor
+// (peak < threshold + 6 and < floor + 20) is rejected; the same bins over a quiet floor, or
+// 6 counts over the threshold, are kept. Rows without amplitude are not tested.
+static uint8_t amp[NAZ][512];
+static void test_detect_rejects_returns_never_clearly_above_the_floor(void **state)
+{
+    (void)state;
+    assert_int_equal(sl_detect_init(&det, &board, NULL), SL_OK);
+    memset(amp, 0, sizeof amp);
+    const uint16_t azs[4] = {50, 100, 150, 200};
+    for (int i = 0; i < 4; i++) {
+        for (int a = azs[i]; a < azs[i] + 4; a++) {
+            set_run(a, 69, 82); // a slanted pole's bins
+            for (uint32_t k = 60; k < 95; k++) {
+                // 50: clutter band (floor 30, peak 45); 100: quiet floor (5), peak 45;
+                // 150: floor 35, peak 46 (threshold 40 + 6); 200: like 50, no amplitude.
+                const bool in = k >= 69 && k <= 82;
+                amp[a][k] = (uint8_t)(i == 1 ? (in ? 45 : 5) : i == 2 ? (in ? 46 : 35) : (in ? 45 : 30));
+            }
+        }
+    }
+    sl_detect_begin(&det);
+    for (int a = 0; a < NAZ; a++) {
+        if (a < 200 || a >= 204) {
+            sl_detect_set_amplitude(&det, amp[a], 512, 40);
+        }
+        assert_int_equal(sl_detect_row(&det, (uint16_t)a, rows[a], NW), SL_OK);
+        assert_null(det.amp); // used by one row only
+    }
+    assert_int_equal(sl_detect_end(&det), 3);
+    assert_int_equal(det.stats.rejected[SL_DETECT_REJ_WEAK], 1);
+    for (int i = 0; i < 3; i++) {
+        assert_true(det.targets[i].az_first != 50);
+    }
+}
+
 static void test_detect_slots_go_to_the_strongest_not_the_lowest_azimuths(void **state)
 {
     (void)state;
@@ -652,6 +688,7 @@ int main(void)
         cmocka_unit_test_setup(test_detect_merges_groups_joined_by_a_later_azimuth, setup),
         cmocka_unit_test_setup(test_detect_handles_empty_saturated_and_misordered_input, setup),
         cmocka_unit_test_setup(test_detect_rejects_clutter_before_it_takes_a_slot, setup),
+        cmocka_unit_test_setup(test_detect_rejects_returns_never_clearly_above_the_floor, setup),
         cmocka_unit_test_setup(test_detect_slots_go_to_the_strongest_not_the_lowest_azimuths, setup),
         cmocka_unit_test_setup(test_detect_correct_half_bin_elongation_and_radius, setup),
         cmocka_unit_test_setup(test_detect_from_mask_reports_the_pole_after_n_stable_rotations,

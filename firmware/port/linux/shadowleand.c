@@ -609,14 +609,14 @@ static void log_stats(daemon_t *d, int level, const char *what)
     const sl_detect_stats_t *ds = &g_pipe.detect.stats;
     sld_log(SLD_LOG_DEBUG,
             "%s: detection: %" PRIu32 " runs, %" PRIu32 " groups, %" PRIu32 " targets; rejected near %" PRIu32
-            " shadow %" PRIu32 " wide %" PRIu32 " broken %" PRIu32 " short %" PRIu32 " rho %" PRIu32
+            " shadow %" PRIu32 " wide %" PRIu32 " broken %" PRIu32 " short %" PRIu32 " rho %" PRIu32 " weak %" PRIu32
             "; overflows cand %" PRIu32 " target %" PRIu32
             "; tracks: %" PRIu32 " created %" PRIu32 " dropped %" PRIu32 " confirmed %" PRIu32
             " inconsistent; mask bins %u",
             what, ds->runs, ds->groups, ds->targets, ds->rejected[SL_DETECT_REJ_NEAR],
             ds->rejected[SL_DETECT_REJ_SHADOW], ds->rejected[SL_DETECT_REJ_WIDE],
             ds->rejected[SL_DETECT_REJ_BROKEN], ds->rejected[SL_DETECT_REJ_SHORT],
-            ds->rejected[SL_DETECT_REJ_RHO], ds->cand_overflow, ds->target_overflow,
+            ds->rejected[SL_DETECT_REJ_RHO], ds->rejected[SL_DETECT_REJ_WEAK], ds->cand_overflow, ds->target_overflow,
             g_pipe.tracker.stats.created, g_pipe.tracker.stats.dropped,
             g_pipe.tracker.stats.confirmations, g_pipe.tracker.stats.inconsistent,
             (unsigned)g_pipe.mask_bins);
