@@ -568,9 +568,13 @@ static uint8_t run_strength(const sl_detect_t *d, uint32_t s, uint32_t e)
     if (p == NULL || s >= nb) {
         return 0U;
     }
+    const uint32_t strong_at = (uint32_t)d->amp_threshold + d->cfg.weak_margin;
     uint32_t peak = 0U;
     for (uint32_t k = s; k < e && k < nb; k++) {
         peak = p[k] > peak ? p[k] : peak;
+        if (peak >= strong_at) {
+            return (uint8_t)(CF_AMP | CF_STRONG); // clearly above the threshold
+        }
     }
     const uint32_t side = (uint32_t)d->cfg.gap_bins + 1U;
     uint32_t sum = 0U, cnt = 0U;
@@ -583,8 +587,7 @@ static uint8_t run_strength(const sl_detect_t *d, uint32_t s, uint32_t e)
         cnt++;
     }
     const uint32_t floor_v = cnt != 0U ? sum / cnt : 0U;
-    const bool strong = peak >= (uint32_t)d->amp_threshold + d->cfg.weak_margin ||
-                        peak >= floor_v + d->cfg.weak_contrast;
+    const bool strong = peak >= floor_v + d->cfg.weak_contrast;
     return (uint8_t)(CF_AMP | (strong ? CF_STRONG : 0U));
 }
 
@@ -726,7 +729,9 @@ sl_err_t sl_detect_row(sl_detect_t *d, uint16_t az, const uint32_t *occ, uint32_
         if (e >= limit || e - 1U >= edge) {
             rf |= CF_SHADOW;
         }
-        rf |= run_strength(d, s, e);
+        if ((rf & CF_SHADOW) == 0U) { // a SHADOW group is rejected anyway
+            rf |= run_strength(d, s, e);
+        }
         add_run(d, az, s, e - 1U, count, rf);
         pos = e;
     }

@@ -91,14 +91,14 @@
 ///
 /// ## RAM budget (sizeof(sl_pipeline_t)); asserted below for the firmware configuration
 /// Dominated by the mask: SL_CFG_MAX_AZIMUTHS x (1 + ceil(log2 SL_CFG_MASK_FRAMES_MAX)) x
-/// SL_CFG_MASK_BINS / 8 bytes; then detection (8,432 B), the tracker (2,136 B), the scan
+/// SL_CFG_MASK_BINS / 8 bytes; then detection (8,504 B), the tracker (2,136 B), the scan
 /// bookkeeping (624 B), the reassembly buffer (SL_PIPELINE_REASM_BYTES) and a row buffer.
 ///
 /// | configuration (400 azimuths, 32 targets)              | x86-64    | Cortex-M0 |
 /// |--------------------------------------------------------|-----------|-----------|
-/// | firmware: SL_CFG_MASK_BINS 160, SL_CFG_MASK_FRAMES_MAX 16 | 53,112 B  | 53,016 B  |
-/// | SL_CFG_MASK_BINS 192, SL_CFG_MASK_FRAMES_MAX 16          | 61,216 B  | 61,120 B  |
-/// | host default: mask bins 512 (whole ROI), n <= 32          | 167,856 B | 167,760 B |
+/// | firmware: SL_CFG_MASK_BINS 160, SL_CFG_MASK_FRAMES_MAX 16 | 53,184 B  | 53,080 B  |
+/// | SL_CFG_MASK_BINS 192, SL_CFG_MASK_FRAMES_MAX 16          | 61,288 B  | 61,184 B  |
+/// | host default: mask bins 512 (whole ROI), n <= 32          | 167,928 B | 167,824 B |
 ///
 /// The boards carried today need 135 (paper-sim), 119 (paper-bench) and 141 (robotcar-leaf)
 /// masked bins (sl_detect_bins_needed(), rounded up to 160).
