@@ -98,7 +98,7 @@
 /// Caller-owned `sl_detect_t`, no allocation; it borrows `board` (static const) until
 /// re-init. RAM: sizeof(sl_detect_t) = 4 x SL_CFG_MAX_AZIMUTHS (window tables) +
 /// SL_CFG_DETECT_MAX_CANDIDATES x (14 + 6 x SL_CFG_DETECT_MAX_SPAN) + SL_CFG_MAX_TARGETS x
-/// sizeof(sl_target_t) (52) + ~40 bytes (defaults: 8,504 bytes on x86-64).
+/// sizeof(sl_target_t) (52) + 50 bytes of azimuth hints + ~60 bytes (defaults: 8,504 bytes on x86-64).
 /// Cost: sl_detect_row O(words up to the shadow edge + runs x candidates); an azimuth
 /// with nothing occupied in its window exits after one OR per window word. Measured by
 /// host_tools/bench_mask (x86-64 -O2, 400 x 512, 6 poles + walls + clutter): the whole
