@@ -6,7 +6,9 @@
 ///
 /// ## Association
 /// A target may continue a live track when both gates hold: circular azimuth distance
-/// `<= cfg.az_gate` azimuths and `|r1 - track r1| <= cfg.range_gate_um`. Pairs are taken
+/// `<= cfg.az_gate` azimuths and `|r1 - track r1| <= cfg.range_gate_um`, both measured from
+/// the track's predicted position (see "Static-object prediction" below; the last position
+/// itself when the vehicle stands still). Pairs are taken
 /// greedily by increasing normalised distance (|d az| / az_gate + |d r1| / range_gate), each
 /// track and target at most once (global nearest neighbour). Unmatched targets open new
 /// tracks while slots are free (`stats.full` otherwise). Tracks not matched for longer than
