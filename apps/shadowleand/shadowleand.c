@@ -775,11 +775,12 @@ static void log_stats(daemon_t *d, int level, const char *what)
             "%s: %" PRIu32 " rotations, %" PRIu32 " azimuths (%" PRIu32 " missing), %" PRIu32
             " targets, level %u, decoder: %" PRIu32 " messages %" PRIu32 " resyncs; CAN: %" PRIu32
             " frames (%" PRIu32 " Status, %" PRIu32 " idle Status), %" PRIu32 " dropped; motion: %" PRIu32
-            " accepted %" PRIu32 " rejected",
+            " accepted %" PRIu32 " rejected; candidates dropped (no target slot) %" PRIu32,
             what, s->rotations, s->azimuths, s->azimuths_missing, s->targets,
             (unsigned)sl_track_max_level(&g_pipe.tracker), g_pipe.proto.stats.messages,
             g_pipe.proto.stats.resyncs, d->frames_out, d->status_frames, d->idle_status_frames,
-            s->can_dropped, s->motion_accepted, s->motion_rejected);
+            s->can_dropped, s->motion_accepted, s->motion_rejected,
+            g_pipe.detect.stats.target_overflow);
     if (s->can_rx != 0) {
         const sl_can_e2e_rx_t *e2e = &g_pipe.motion_rx.e2e;
         sld_log(level, "%s: VehicleMotion E2E: %" PRIu32 " accepted, %" PRIu32 " CRC errors, %" PRIu32
@@ -795,12 +796,17 @@ static void log_stats(daemon_t *d, int level, const char *what)
     const sl_detect_stats_t *ds = &g_pipe.detect.stats;
     sld_log(SLD_LOG_DEBUG,
             "%s: detection: %" PRIu32 " runs, %" PRIu32 " groups, %" PRIu32 " targets; rejected near %" PRIu32
-            " shadow %" PRIu32 " wide %" PRIu32 " broken %" PRIu32 "; overflows cand %" PRIu32 " target %" PRIu32
-            "; tracks: %" PRIu32 " created %" PRIu32 " dropped; mask bins %u",
+            " shadow %" PRIu32 " wide %" PRIu32 " broken %" PRIu32 " short %" PRIu32 " rho %" PRIu32 " weak %" PRIu32
+            "; overflows cand %" PRIu32 " target %" PRIu32
+            "; tracks: %" PRIu32 " created %" PRIu32 " dropped %" PRIu32 " confirmed %" PRIu32
+            " inconsistent; mask bins %u",
             what, ds->runs, ds->groups, ds->targets, ds->rejected[SL_DETECT_REJ_NEAR],
             ds->rejected[SL_DETECT_REJ_SHADOW], ds->rejected[SL_DETECT_REJ_WIDE],
-            ds->rejected[SL_DETECT_REJ_BROKEN], ds->cand_overflow, ds->target_overflow,
-            g_pipe.tracker.stats.created, g_pipe.tracker.stats.dropped, (unsigned)g_pipe.mask_bins);
+            ds->rejected[SL_DETECT_REJ_BROKEN], ds->rejected[SL_DETECT_REJ_SHORT],
+            ds->rejected[SL_DETECT_REJ_RHO], ds->rejected[SL_DETECT_REJ_WEAK], ds->cand_overflow, ds->target_overflow,
+            g_pipe.tracker.stats.created, g_pipe.tracker.stats.dropped,
+            g_pipe.tracker.stats.confirmations, g_pipe.tracker.stats.inconsistent,
+            (unsigned)g_pipe.mask_bins);
     for (size_t i = 0; i < d->n_sinks; i++) {
         sl_can_sink_stats_t st = {0, 0, 0, 0};
         d->sinks[i].get_stats(d->sinks[i].ctx, &st);

@@ -9,6 +9,8 @@
 #define CF_SHADOW 0x02U
 #define CF_SPAN 0x04U
 #define CF_WRAPS 0x08U
+#define CF_AMP 0x10U    // an amplitude row was seen for a run of the group
+#define CF_STRONG 0x20U // ... and some run rose clearly above its floor
 
 #define ST_FREE 0U
 #define ST_OPEN 1U
@@ -34,6 +36,8 @@ void sl_detect_cfg_default(sl_detect_cfg_t *cfg)
     cfg->link_bins = 1U;
     cfg->width_slack_az = 1U;
     cfg->radius_from_width = true;
+    cfg->weak_margin = 6U;
+    cfg->weak_contrast = 20U;
 }
 
 // ---- bit scanning (portable: de Bruijn count of trailing zeros)
@@ -401,6 +405,83 @@ static uint32_t allowed_span(const sl_detect_t *d, uint32_t r1_um)
     return n > 0xFFFFFFFFU ? 0xFFFFFFFFU : (uint32_t)n;
 }
 
+// ---- clutter rejection and slots by evidence (stage 4 clutter tests, stage 4b)
+
+int sl_detect_clutter_reason(const sl_board_t *board, const sl_target_t *t, uint32_t rho_q28)
+{
+    SL_ASSERT(board != NULL && t != NULL);
+    if (t->bin_last <= t->bin_first) {
+        return SL_DETECT_REJ_SHORT;
+    }
+    if (t->incline_flag == (uint8_t)SL_INCLINE_INVALID ||
+        t->incline_flag == (uint8_t)SL_INCLINE_OUT_OF_DOMAIN) {
+        return board->geom != NULL ? SL_DETECT_REJ_RHO : -1; // no tables: no model to test
+    }
+    if (t->incline_flag == (uint8_t)SL_INCLINE_AMBIGUOUS && board->geom != NULL &&
+        t->r1_um != 0U) {
+        // One bin of quantisation below the fold, in UQ4.28: b / r1 * 2^28.
+        const uint64_t tol = ((uint64_t)board->bin_size_um << 28) / t->r1_um;
+        const uint64_t amb = board->geom[t->az].rho_amb_q28;
+        if ((uint64_t)rho_q28 + tol < amb) {
+            return SL_DETECT_REJ_RHO;
+        }
+    }
+    return -1;
+}
+
+uint16_t sl_detect_evidence(uint32_t occupied_total, uint32_t az_with_run, uint32_t extent_bins)
+{
+    const uint64_t e = 4ULL * occupied_total + 16ULL * az_with_run + 8ULL * extent_bins;
+    return (uint16_t)(e > 0xFFFFU ? 0xFFFFU : e);
+}
+
+void sl_detect_hints_clear(sl_detect_t *d)
+{
+    SL_ASSERT(d != NULL);
+    memset(d->hint_bits, 0, sizeof d->hint_bits);
+}
+
+void sl_detect_hint(sl_detect_t *d, uint16_t az, uint16_t half_width)
+{
+    SL_ASSERT(d != NULL);
+    const uint32_t n = d->azimuths;
+    if (az >= n || n == 0U) {
+        return;
+    }
+    const uint32_t w = (uint32_t)half_width * 2U + 1U;
+    const uint32_t cnt = w < n ? w : n;
+    uint32_t a = ((uint32_t)az + n - ((uint32_t)half_width % n)) % n;
+    for (uint32_t i = 0; i < cnt; i++) {
+        d->hint_bits[a >> 5] |= (uint32_t)1U << (a & 31U);
+        a = a + 1U == n ? 0U : a + 1U;
+    }
+}
+
+// A target that passed every test takes a free slot; with none free it replaces the target
+// with the least evidence when it has more (ties keep the earlier one). One drop counted
+// either way.
+static void slot_take(sl_detect_t *d, const sl_target_t *t)
+{
+    if (d->n_targets < d->max_targets) {
+        d->targets[d->n_targets++] = *t;
+        d->stats.targets++;
+        return;
+    }
+    d->stats.target_overflow++;
+    if (d->n_targets == 0U) {
+        return;
+    }
+    uint32_t weakest = 0;
+    for (uint32_t i = 1; i < d->n_targets; i++) {
+        if (d->targets[i].evidence < d->targets[weakest].evidence) {
+            weakest = i;
+        }
+    }
+    if (t->evidence > d->targets[weakest].evidence) {
+        d->targets[weakest] = *t;
+    }
+}
+
 static void finalize(sl_detect_t *d, sl_detect_cand_t *c)
 {
     d->stats.groups++;
@@ -459,6 +540,8 @@ static void finalize(sl_detect_t *d, sl_detect_cand_t *c)
         reason = SL_DETECT_REJ_WIDE;
     } else if ((uint32_t)rep->count < (uint32_t)rep->last - rep->first + 1U) {
         reason = SL_DETECT_REJ_BROKEN;
+    } else if ((c->flags & (CF_AMP | CF_STRONG)) == CF_AMP) {
+        reason = SL_DETECT_REJ_WEAK;
     }
     if ((c->flags & CF_SPAN) != 0U) {
         d->stats.span_overflow++;
@@ -469,10 +552,7 @@ static void finalize(sl_detect_t *d, sl_detect_cand_t *c)
         d->stats.rejected[reason]++;
         return;
     }
-    if (d->n_targets >= d->max_targets) {
-        d->stats.target_overflow++;
-        return;
-    }
+    uint32_t rho_q28 = 0U;
     if (bd->geom != NULL) {
         const sl_incline_result_t res = sl_incline_estimate(
             t.r1_um, t.r2_um, &bd->geom[az], bd->range_sigma_um, bd->theta_sigma_cdeg);
@@ -480,11 +560,68 @@ static void finalize(sl_detect_t *d, sl_detect_cand_t *c)
         t.sigma_cdeg = res.sigma_cdeg;
         t.incline_flag = res.flag;
         t.incline_branch = res.branch;
+        rho_q28 = res.rho_q28;
     } else {
         t.incline_flag = (uint8_t)SL_INCLINE_OUT_OF_DOMAIN;
     }
-    d->targets[d->n_targets++] = t;
-    d->stats.targets++;
+    reason = sl_detect_clutter_reason(bd, &t, rho_q28);
+    if (reason >= 0) {
+        d->stats.rejected[reason]++;
+        return;
+    }
+    uint32_t occ_total = 0U, az_runs = 0U;
+    for (uint32_t i = 0; i < span && i < SL_CFG_DETECT_MAX_SPAN; i++) {
+        occ_total += c->run[i].count;
+        az_runs += c->run[i].count != 0U ? 1U : 0U;
+    }
+    t.evidence = sl_detect_evidence(occ_total, az_runs, (uint32_t)rep->last - rep->first + 1U);
+    if (((d->hint_bits[az >> 5] >> (az & 31U)) & 1U) != 0U) {
+        const uint32_t e = (uint32_t)t.evidence + SL_DETECT_EVIDENCE_TRACK;
+        t.evidence = (uint16_t)(e > 0xFFFFU ? 0xFFFFU : e);
+    }
+    slot_take(d, &t);
+}
+
+// WEAK test of one run [s, e) against the amplitude row (sl_detect.h stage 4): CF_AMP, plus
+// CF_STRONG when its peak is >= threshold + weak_margin or >= floor + weak_contrast, the
+// floor being the mean of the gap_bins + 1 bins on each side (free by construction).
+static uint8_t run_strength(const sl_detect_t *d, uint32_t s, uint32_t e)
+{
+    const uint8_t *p = d->amp;
+    const uint32_t nb = d->amp_bins;
+    if (p == NULL || s >= nb) {
+        return 0U;
+    }
+    const uint32_t strong_at = (uint32_t)d->amp_threshold + d->cfg.weak_margin;
+    uint32_t peak = 0U;
+    for (uint32_t k = s; k < e && k < nb; k++) {
+        peak = p[k] > peak ? p[k] : peak;
+        if (peak >= strong_at) {
+            return (uint8_t)(CF_AMP | CF_STRONG); // clearly above the threshold
+        }
+    }
+    const uint32_t side = (uint32_t)d->cfg.gap_bins + 1U;
+    uint32_t sum = 0U, cnt = 0U;
+    for (uint32_t k = s > side ? s - side : 0U; k < s; k++) {
+        sum += p[k];
+        cnt++;
+    }
+    for (uint32_t k = e; k < e + side && k < nb; k++) {
+        sum += p[k];
+        cnt++;
+    }
+    const uint32_t floor_v = cnt != 0U ? sum / cnt : 0U;
+    const bool strong = peak >= floor_v + d->cfg.weak_contrast;
+    return (uint8_t)(CF_AMP | (strong ? CF_STRONG : 0U));
+}
+
+void sl_detect_set_amplitude(sl_detect_t *d, const uint8_t *power, uint16_t bins,
+                             uint8_t threshold)
+{
+    SL_ASSERT(d != NULL);
+    d->amp = power;
+    d->amp_bins = power != NULL ? bins : 0U;
+    d->amp_threshold = threshold;
 }
 
 // Close groups that can no longer grow (no run on a - 1). Groups starting at azimuth 0
@@ -563,6 +700,7 @@ sl_err_t sl_detect_row(sl_detect_t *d, uint16_t az, const uint32_t *occ, uint32_
     SL_ASSERT(d != NULL && (occ != NULL || words == 0U));
     if (az >= d->azimuths || (int32_t)az <= d->last_az) {
         d->stats.order_errors++;
+        d->amp = NULL;
         return SL_ERR_RANGE;
     }
     d->last_az = az;
@@ -574,6 +712,7 @@ sl_err_t sl_detect_row(sl_detect_t *d, uint16_t az, const uint32_t *occ, uint32_
     const uint32_t win = d->win_bins[az] < limit ? d->win_bins[az] : limit;
     const uint32_t near = d->near_bins;
     if (win <= near) {
+        d->amp = NULL;
         return SL_OK;
     }
     // Fast exit for the common azimuth: nothing occupied in [near, win) (the last word is
@@ -583,6 +722,7 @@ sl_err_t sl_detect_row(sl_detect_t *d, uint16_t az, const uint32_t *occ, uint32_
         any |= occ[w];
     }
     if (any == 0U) {
+        d->amp = NULL;
         return SL_OK;
     }
     const uint32_t edge = d->edge_bins[az];
@@ -613,9 +753,13 @@ sl_err_t sl_detect_row(sl_detect_t *d, uint16_t az, const uint32_t *occ, uint32_
         if (e >= limit || e - 1U >= edge) {
             rf |= CF_SHADOW;
         }
+        if ((rf & CF_SHADOW) == 0U) { // a SHADOW group is rejected anyway
+            rf |= run_strength(d, s, e);
+        }
         add_run(d, az, s, e - 1U, count, rf);
         pos = e;
     }
+    d->amp = NULL;
     return SL_OK;
 }
 

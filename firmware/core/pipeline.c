@@ -292,7 +292,7 @@ static void emit_can(sl_pipeline_t *p)
     const sl_track_t *worst = NULL;
     for (uint32_t i = 0; i < SL_CFG_MAX_TARGETS; i++) {
         const sl_track_t *t = &tr->tracks[i];
-        if (t->live == 0U || t->hits < confirm) {
+        if (t->live == 0U || t->hits < confirm || t->confirmed == 0U) {
             continue;
         }
         // The most severe confirmed track: level, then |filtered alpha| (valid ones first).
@@ -343,6 +343,21 @@ static void emit_can(sl_pipeline_t *p)
 
 // ------------------------------------------------------------------------------- rotation
 
+// Slots by evidence (sl_detect.h stage 4b): the azimuths where confirmed tracks are,
+// widened by the tracker's azimuth gate, get the track bonus, so an established pole keeps
+// its slot however much clutter competes for the slots.
+static void detect_hints_from_tracks(sl_pipeline_t *p)
+{
+    sl_detect_hints_clear(&p->detect);
+    const sl_tracker_t *tr = &p->tracker;
+    for (uint32_t i = 0; i < SL_CFG_MAX_TARGETS; i++) {
+        const sl_track_t *t = &tr->tracks[i];
+        if (t->live != 0U && t->confirmed != 0U) {
+            sl_detect_hint(&p->detect, t->az, sl_track_gate_az(tr, t));
+        }
+    }
+}
+
 static void begin_rotation(sl_pipeline_t *p)
 {
     sl_can_vehicle_motion_t m;
@@ -363,6 +378,7 @@ static void begin_rotation(sl_pipeline_t *p)
     p->frames_eff = w;
     (void)sl_mask_set_window(&p->mask, w);
     sl_detect_begin(&p->detect);
+    detect_hints_from_tracks(p);
     p->next_az = 0U;
     p->in_rotation = 1U;
 }
@@ -411,6 +427,8 @@ static void on_row(void *ctx, const sl_scan_row_t *row)
             feed_held(p, p->next_az, row->idx);
         }
         if (sl_mask_update(&p->mask, row->idx, p->bits, p->occ, NULL) == SL_OK) {
+            sl_detect_set_amplitude(&p->detect, row->power, p->mask_bins,
+                                    (uint8_t)(p->cfg.threshold > 255U ? 255U : p->cfg.threshold));
             (void)sl_detect_row(&p->detect, row->idx, p->occ, p->mask_words);
         }
         p->next_az = (uint16_t)(row->idx + 1U);
@@ -474,6 +492,7 @@ static void on_rot(void *ctx, const sl_scan_rot_t *rot)
         yaw_bam = bam > UINT32_MAX ? UINT32_MAX : (uint32_t)bam;
     }
     sl_track_set_motion(&p->tracker, disp_um, yaw_bam);
+    sl_track_set_reverse(&p->tracker, p->motion_valid && p->speed_mm_s < 0);
     sl_track_update(&p->tracker, p->detect.targets, n_targets, p->now_us);
     p->stats.rotations++;
     p->stats.azimuths_missing += rot->stats.missing;

@@ -3,6 +3,7 @@
 #include <string.h>
 
 #include "shadowlean/sl_fx.h"
+#include "shadowlean/sl_incline.h"
 #include "shadowlean/sl_track.h"
 
 void sl_track_cfg_default(sl_track_cfg_t *cfg)
@@ -16,6 +17,9 @@ void sl_track_cfg_default(sl_track_cfg_t *cfg)
     cfg->hysteresis_cdeg = 100U;
     cfg->confirm = 3U;
     cfg->caution_abs = true;
+    cfg->consist_range_um = 200000U;
+    cfg->consist_az = 3U;
+    cfg->confirm_min = 3U;
 }
 
 sl_err_t sl_track_init(sl_tracker_t *tr, const sl_board_t *board, const sl_track_cfg_t *cfg)
@@ -115,6 +119,97 @@ static void level_update(sl_tracker_t *tr, sl_track_t *t)
     }
 }
 
+// ---- static-object prediction and confirmation
+
+static void confirm_update(sl_tracker_t *tr, sl_track_t *t);
+
+// sin of a bam32 angle in Q15 (Bhaskara I: 16 u (1 - u) / (5 - 4 u (1 - u)) for x = pi u,
+// |error| < 0.0017).
+static int32_t sin_q15(uint32_t bam)
+{
+    const uint64_t u = (uint64_t)(bam & 0x7FFFFFFFU) >> 16; // fraction of pi, Q15
+    const uint64_t p = u * (32768U - u);                    // Q30, <= 2^28
+    const int32_t s = (int32_t)(((16U * p) << 15) / ((5ULL << 30) - 4U * p));
+    return (bam & 0x80000000U) != 0U ? -s : s;
+}
+
+void sl_track_predict_static(const sl_board_t *board, uint16_t az, uint32_t r_um,
+                             uint32_t disp_um, uint16_t *az_out, uint32_t *r_out)
+{
+    SL_ASSERT(board != NULL && az_out != NULL && r_out != NULL && board->azimuths != 0U);
+    const uint32_t n = board->azimuths;
+    if (disp_um == 0U) {
+        *az_out = az;
+        *r_out = r_um;
+        return;
+    }
+    // Keep |x|, |y| < 2^31 so that the squares below fit (1 km is far beyond any shadow).
+    const uint32_t lim = 1U << 30;
+    r_um = r_um > lim ? lim : r_um;
+    disp_um = disp_um > lim ? lim : disp_um;
+    // Bearing from vehicle forward, clockwise, bam32.
+    const int64_t yaw = (int64_t)board->radar_yaw_cdeg * 4294967296LL / 36000;
+    const uint32_t b = (uint32_t)(((uint64_t)az << 32) / n + (uint64_t)yaw);
+    const int64_t x = (((int64_t)r_um * sin_q15(b + 0x40000000U)) >> 15) - (int64_t)disp_um;
+    const int64_t y = ((int64_t)r_um * sin_q15(b)) >> 15;
+    const uint64_t r2 = (uint64_t)(x * x) + (uint64_t)(y * y); // < 2^63
+    *r_out = sl_fx_isqrt64(r2);
+    // atan2 on values scaled into int32 (|x|, |y| < 2^31: shift by 2 for margin).
+    const sl_bam32_t b2 = sl_incline_atan2_bam32((int32_t)(y >> 2), (int32_t)(x >> 2));
+    const uint32_t rel = b2 - (uint32_t)yaw;
+    *az_out = (uint16_t)(((((uint64_t)rel * n) + 0x80000000ULL) >> 32) % n);
+}
+
+void sl_track_set_reverse(sl_tracker_t *tr, bool reverse)
+{
+    SL_ASSERT(tr != NULL);
+    tr->motion_reverse = reverse;
+}
+
+// The track's predicted position for this update. Reversing by d is the mirror image of
+// driving forward by d seen from the bearing turned by half a turn.
+static void predict(const sl_tracker_t *tr, sl_track_t *t)
+{
+    if (!tr->motion_reverse) {
+        sl_track_predict_static(tr->board, t->az, t->r1_um, tr->motion_um, &t->pred_az,
+                                &t->pred_r1_um);
+        return;
+    }
+    const uint16_t n = tr->board->azimuths;
+    const uint16_t half = (uint16_t)(n / 2U);
+    uint16_t paz;
+    sl_track_predict_static(tr->board, (uint16_t)((t->az + half) % n), t->r1_um, tr->motion_um,
+                            &paz, &t->pred_r1_um);
+    t->pred_az = (uint16_t)((paz + n - half) % n);
+}
+
+// Evidence after an association (consistent or not with the static prediction).
+static void evidence_update(sl_tracker_t *tr, sl_track_t *t, const sl_target_t *g, uint32_t yaw_az)
+{
+    const uint32_t da = az_dist(t->pred_az, g->az, tr->board->azimuths);
+    const uint32_t dr = t->pred_r1_um > g->r1_um ? t->pred_r1_um - g->r1_um
+                                                 : g->r1_um - t->pred_r1_um;
+    const uint8_t cap = (uint8_t)(tr->cfg.confirm_min > 253U ? 255U : tr->cfg.confirm_min + 2U);
+    if (da <= (uint32_t)tr->cfg.consist_az + yaw_az && dr <= tr->cfg.consist_range_um) {
+        if (t->evidence < cap) {
+            t->evidence++;
+        }
+    } else {
+        t->evidence = 1U;
+        tr->stats.inconsistent++;
+    }
+    confirm_update(tr, t);
+}
+
+static void confirm_update(sl_tracker_t *tr, sl_track_t *t)
+{
+    const uint8_t c = t->evidence >= tr->cfg.confirm_min ? 1U : 0U;
+    if (c != 0U && t->confirmed == 0U) {
+        tr->stats.confirmations++;
+    }
+    t->confirmed = c;
+}
+
 static void track_take(sl_tracker_t *tr, sl_track_t *t, const sl_target_t *g, uint64_t now_us)
 {
     const bool repeat = t->valid_hits != 0U && t->r1_um == g->r1_um && t->r2_um == g->r2_um;
@@ -157,6 +252,27 @@ static uint16_t new_id(sl_tracker_t *tr)
     }
 }
 
+// Azimuth gate widened by the angle the ego displacement subtends at r1:
+// d / r1 rad = d * naz / (2 pi r1) azimuth steps (710/113 ~ 2 pi, rounded up).
+static uint64_t gate_az(const sl_tracker_t *tr, const sl_track_t *t, uint64_t base)
+{
+    uint64_t ag = base;
+    if (tr->motion_um != 0U) {
+        const uint64_t naz = tr->board->azimuths;
+        const uint64_t r1 = t->r1_um > 100000U ? t->r1_um : 100000U; // >= 0.1 m
+        ag += ((uint64_t)tr->motion_um * naz * 113U + r1 * 710U - 1U) / (r1 * 710U);
+    }
+    return ag;
+}
+
+uint16_t sl_track_gate_az(const sl_tracker_t *tr, const sl_track_t *t)
+{
+    SL_ASSERT(tr != NULL && t != NULL);
+    const uint64_t yaw_az = ((uint64_t)tr->motion_yaw_bam * tr->board->azimuths + 0xFFFFFFFFULL) >> 32;
+    const uint64_t ag = gate_az(tr, t, (uint64_t)tr->cfg.az_gate + yaw_az);
+    return (uint16_t)(ag > 0xFFFFU ? 0xFFFFU : ag);
+}
+
 void sl_track_update(sl_tracker_t *tr, const sl_target_t *targets, uint32_t n,
                      uint64_t now_us)
 {
@@ -172,8 +288,12 @@ void sl_track_update(sl_tracker_t *tr, const sl_target_t *targets, uint32_t n,
     const uint64_t yaw_az = ((uint64_t)tr->motion_yaw_bam * naz + 0xFFFFFFFFULL) >> 32;
     bool used[SL_CFG_MAX_TARGETS];
     for (uint32_t i = 0; i < SL_CFG_MAX_TARGETS; i++) {
-        tr->tracks[i].updated = 0U;
+        sl_track_t *t = &tr->tracks[i];
+        t->updated = 0U;
         used[i] = false;
+        if (t->live != 0U) {
+            predict(tr, t);
+        }
     }
     // Greedy global nearest neighbour. Cost |d az| / ag + |d r| / rg, scaled by ag * rg.
     for (;;) {
@@ -184,20 +304,15 @@ void sl_track_update(sl_tracker_t *tr, const sl_target_t *targets, uint32_t n,
             if (t->live == 0U || t->updated != 0U) {
                 continue;
             }
-            // Azimuth gate widened by the angle the ego displacement subtends at r1:
-            // d / r1 rad = d * naz / (2 pi r1) azimuth steps (710/113 ~ 2 pi, rounded up).
-            uint64_t ag = ag0 + yaw_az;
-            if (tr->motion_um != 0U) {
-                const uint64_t r1 = t->r1_um > 100000U ? t->r1_um : 100000U; // >= 0.1 m
-                ag += ((uint64_t)tr->motion_um * naz * 113U + r1 * 710U - 1U) / (r1 * 710U);
-            }
+            const uint64_t ag = gate_az(tr, t, ag0 + yaw_az);
             for (uint32_t j = 0; j < n; j++) {
                 if (used[j]) {
                     continue;
                 }
-                const uint32_t da = az_dist(t->az, targets[j].az, naz);
-                const uint32_t dr = t->r1_um > targets[j].r1_um ? t->r1_um - targets[j].r1_um
-                                                                : targets[j].r1_um - t->r1_um;
+                const uint32_t da = az_dist(t->pred_az, targets[j].az, naz);
+                const uint32_t dr = t->pred_r1_um > targets[j].r1_um
+                                        ? t->pred_r1_um - targets[j].r1_um
+                                        : targets[j].r1_um - t->pred_r1_um;
                 if (da > ag || dr > rg) {
                     continue;
                 }
@@ -213,6 +328,7 @@ void sl_track_update(sl_tracker_t *tr, const sl_target_t *targets, uint32_t n,
             break;
         }
         used[bj] = true;
+        evidence_update(tr, &tr->tracks[bi], &targets[bj], (uint32_t)yaw_az);
         track_take(tr, &tr->tracks[bi], &targets[bj], now_us);
         tr->stats.associated++;
     }
@@ -221,6 +337,14 @@ void sl_track_update(sl_tracker_t *tr, const sl_target_t *targets, uint32_t n,
         sl_track_t *t = &tr->tracks[i];
         if (t->live == 0U || t->updated != 0U) {
             continue;
+        }
+        // A rotation without an association: the object is carried to where a static one
+        // is now (so the next prediction starts from there) and loses one evidence.
+        t->az = t->pred_az;
+        t->r1_um = t->pred_r1_um;
+        if (t->evidence > 0U) {
+            t->evidence--;
+            confirm_update(tr, t);
         }
         if (now_us < t->last_seen_us) {
             tr->stats.time_backwards++;
@@ -253,6 +377,8 @@ void sl_track_update(sl_tracker_t *tr, const sl_target_t *targets, uint32_t n,
         t->live = 1U;
         t->first_seen_us = now_us;
         t->last_seen_us = now_us;
+        t->evidence = 1U;
+        confirm_update(tr, t);
         tr->live++;
         tr->stats.created++;
         track_take(tr, t, &targets[j], now_us);

@@ -77,7 +77,7 @@ struct Simulator::RotationGeom {
 namespace {
 
 constexpr uint64_t kSaltSpeckle = 0x5BEC1EULL, kSaltPhase = 0x9A5EULL, kSaltNoise = 0x4015EULL,
-                   kSaltLeak = 0x1EA4ULL;
+                   kSaltLeak = 0x1EA4ULL, kSaltClutter = 0xC1A77E4ULL;
 
 void add_uniform(std::vector<double> &e, double bin, double a, double c, double E)
 {
@@ -857,16 +857,56 @@ void Simulator::map_column(int k, int i, const SimColumn &col, uint8_t *out) con
     }
 }
 
+// Clutter: weak returns in a band just inside the shadow edge (slant S(az) - inner_m ..
+// S(az) - outer_m), fixed to the vehicle. Each cell returns with probability `density` and a
+// value uniform in [value_min, value_max]; both are redrawn every `change_rotations`
+// rotations, staggered per cell (0: drawn once). Counter-based: same seed, same bytes.
+void Simulator::apply_clutter(int k, int i, uint8_t *out) const
+{
+    if (!s_.clutter) {
+        return;
+    }
+    const BoardSpec &b = s_.board;
+    const double rs = b.shadow_radius_m(i), h = b.radar_height_m;
+    const double edge = std::sqrt(rs * rs + h * h);
+    const double lo = edge - s_.clutter_inner_m, hi = edge - s_.clutter_outer_m;
+    const double bin = bin_m();
+    const int nb = bins();
+    const int j0 = std::max(0, static_cast<int>(std::ceil(lo / bin - 0.5)));
+    const int j1 = std::min(nb - 1, static_cast<int>(std::floor(hi / bin - 0.5)));
+    const uint64_t span = static_cast<uint64_t>(s_.clutter_value_max - s_.clutter_value_min) + 1U;
+    const uint64_t salt = sim_hash(s_.seed, kSaltClutter);
+    for (int j = j0; j <= j1; j++) {
+        uint64_t epoch = 0;
+        if (s_.clutter_change_rotations > 0) {
+            const uint64_t per = static_cast<uint64_t>(s_.clutter_change_rotations);
+            const uint64_t phase = sim_hash(salt, static_cast<uint64_t>(i), static_cast<uint64_t>(j)) % per;
+            epoch = (static_cast<uint64_t>(k) + phase) / per + 1U;
+        }
+        const uint64_t hc = sim_hash(salt ^ 0x5A5AULL, epoch, static_cast<uint64_t>(i),
+                                     static_cast<uint64_t>(j));
+        if (sim_uniform(hc) >= s_.clutter_density) {
+            continue;
+        }
+        const uint64_t v = static_cast<uint64_t>(s_.clutter_value_min) + sim_hash(hc, 7) % span;
+        if (v > out[j]) {
+            out[j] = static_cast<uint8_t>(v);
+        }
+    }
+}
+
 std::vector<uint8_t> Simulator::render_bins(int k, int i) const
 {
     std::vector<uint8_t> out(static_cast<size_t>(bins()));
     if (!static_cols_.empty()) {
         map_column(k, i, static_cols_[static_cast<size_t>(i)], out.data());
+        apply_clutter(k, i, out.data());
         return out;
     }
     SimColumn col;
     geometry_column(k, i, col);
     map_column(k, i, col, out.data());
+    apply_clutter(k, i, out.data());
     return out;
 }
 
@@ -907,6 +947,7 @@ void Simulator::render_rotation(int k, std::vector<uint8_t> &bytes, std::vector<
             column_from(rg, i, col);
             map_column(k, i, col, out);
         }
+        apply_clutter(k, i, out);
         at += msg;
     }
 }

@@ -103,6 +103,8 @@ private:
     void grid_ground_boxes(const RadarPose &r, int i, SimColumn &col) const;
     void splat_pole(const PoleView &pv, int i, SimColumn *col, double *r1s, double *r2s) const;
     void map_column(int k, int i, const SimColumn &col, uint8_t *out) const;
+    /// [clutter]: max(out, clutter value) on the band's cells of azimuth i, rotation k.
+    void apply_clutter(int k, int i, uint8_t *out) const;
 
     Scene s_;
     std::vector<PoleGeom> poles_;

@@ -145,7 +145,7 @@ private:
 Scene build(const Parsed &p)
 {
     static const std::set<std::string> kSections = {"scene", "vehicle", "ground", "beam",
-                                                    "output", "effects"};
+                                                    "output", "effects", "clutter"};
     for (const auto &name : p.order) {
         if (kSections.count(name) != 0U) {
             continue;
@@ -158,7 +158,7 @@ Scene build(const Parsed &p)
             continue;
         }
         throw SceneError(p.file + ": [" + name +
-                         "]: unknown section (scene, vehicle, ground, beam, output, effects, "
+                         "]: unknown section (scene, vehicle, ground, beam, output, effects, clutter, "
                          "pole.<name>, box.<name>, wall.<name>)");
     }
     auto sec = [&](const std::string &n) {
@@ -265,6 +265,19 @@ Scene build(const Parsed &p)
         s.leak_shoulder_end_m = c.real("leak_shoulder_end_m", s.leak_shoulder_end_m, 0, 50);
         s.leak_jitter = c.real("leak_jitter", s.leak_jitter, 0, 1);
     }
+    {
+        Sec c = sec("clutter");
+        c.only({"enabled", "value_min", "value_max", "inner_m", "outer_m", "density",
+                "change_rotations"});
+        s.clutter = c.boolean("enabled", false);
+        s.clutter_value_min = static_cast<int>(c.integer("value_min", s.clutter_value_min, 0, 255));
+        s.clutter_value_max = static_cast<int>(c.integer("value_max", s.clutter_value_max, 0, 255));
+        s.clutter_inner_m = c.real("inner_m", s.clutter_inner_m, 0, 50);
+        s.clutter_outer_m = c.real("outer_m", s.clutter_outer_m, -5, 50);
+        s.clutter_density = c.real("density", s.clutter_density, 0, 1);
+        s.clutter_change_rotations =
+            static_cast<int>(c.integer("change_rotations", s.clutter_change_rotations, 0, 1000000));
+    }
     for (const auto &name : p.order) {
         const auto dot = name.find('.');
         const std::string kind = name.substr(0, dot), obj = name.substr(dot + 1);
@@ -364,6 +377,12 @@ void validate_scene(Scene &s)
     if (s.amplitude == AmplitudeModel::Peak && (s.smear || s.mapping == OutputMapping::Log)) {
         fail("output.amplitude = peak (RadaRays max-per-cell) works with mapping = linear and "
              "no smear only");
+    }
+    if (s.clutter_value_max < s.clutter_value_min) {
+        fail("clutter.value_max must be >= value_min");
+    }
+    if (s.clutter_inner_m <= s.clutter_outer_m) {
+        fail("clutter.inner_m must be > outer_m (the band spans edge - inner_m .. edge - outer_m)");
     }
     if (s.leak_shoulder_end_m < s.leak_edge_m) {
         fail("effects.leak_shoulder_end_m must be >= leak_edge_m");

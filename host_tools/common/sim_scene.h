@@ -109,6 +109,15 @@ struct Scene {
     double leak_edge_m = 1.5;      ///< end of the bright band
     double leak_shoulder_end_m = 2.2; ///< end of the shoulder
     double leak_jitter = 0.08;     ///< fixed per-pixel relative amplitude variation
+    // [clutter]: weak, changing returns in a band just inside the shadow edge (verge,
+    // gravel, vegetation), in the 8-bit output domain, fixed to the vehicle frame
+    bool clutter = false;
+    int clutter_value_min = 20;    ///< 8-bit values drawn uniformly in [min, max]
+    int clutter_value_max = 45;
+    double clutter_inner_m = 0.8;  ///< band starts this far inside the shadow edge (slant)
+    double clutter_outer_m = 0.05; ///< ... and ends this far inside it
+    double clutter_density = 1.0;  ///< fraction of the band's cells that return
+    int clutter_change_rotations = 1; ///< a cell is redrawn every N rotations (0: never)
 };
 
 struct SceneError : std::runtime_error {

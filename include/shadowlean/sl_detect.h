@@ -39,7 +39,28 @@
 ///    >= S(az): the base is not inside the shadow);
 ///    WIDE (the group spans more azimuths than a pole of `cfg.max_pole_diameter_um` at r1
 ///    can: allowed = floor((D / r1 [rad] + beam) / step) + 1 + `cfg.width_slack_az`);
-///    BROKEN (the representative run has a gap).
+///    BROKEN (the representative run has a gap);
+///    then the clutter tests (sl_detect_clutter_reason(), after the corrections and alpha):
+///    SHORT (the representative run is one bin: a speck of gravel or a noise spike, no
+///    extent to measure); RHO (the incline flag is INVALID (r1 >= r2) or OUT_OF_DOMAIN, or
+///    AMBIGUOUS with rho below the model's minimum rho_amb of that azimuth by more than the
+///    quantisation can explain: rho < rho_amb - b / r1, b the bin size; a run of n bins
+///    measures (n - 1) b between its bin centres and the true extent is < n b, so a real
+///    pole near the fold reads at most b / r1 below rho_amb); WEAK (checked before SHORT,
+///    only when amplitude rows were given: sl_detect_set_amplitude()): no run of the group
+///    is clearly above its local floor, i.e. for every run its peak power is below
+///    threshold + `cfg.weak_margin` AND below floor + `cfg.weak_contrast`, the floor being
+///    the mean power of the gap_bins + 1 bins on each side of the run (free bins by
+///    construction of a run). A rough verge or gravel just over the threshold in a band of
+///    weak returns fails both; a weak pole over a quiet floor passes the second.
+/// 4b. **Slots by evidence**. When more targets pass than `max_targets`, the ones with the
+///    least evidence are dropped (never the later azimuths): evidence =
+///    4 x (occupied bins of the group over all its azimuths) + 16 x (azimuths with a run) +
+///    8 x (extent of the representative run in bins), plus SL_DETECT_EVIDENCE_TRACK when
+///    the representative azimuth is hinted (sl_detect_hint(): where the caller expects a
+///    confirmed track, so an established pole keeps its slot against any amount of clutter)
+///    (sl_target_t.evidence). Each drop is counted in `stats.target_overflow`
+///    (CandidatesDropped on CAN). Ties keep the earlier.
 /// 5. **Corrections** (sl_detect_correct(), MATH.md s.4), b = bin_size_um:
 ///    - raw bounds: r1_raw = bin_first * b (near edge of the first occupied bin),
 ///      r2_raw = (bin_last + 1) * b (far edge of the last occupied bin);
@@ -82,7 +103,7 @@
 /// Caller-owned `sl_detect_t`, no allocation; it borrows `board` (static const) until
 /// re-init. RAM: sizeof(sl_detect_t) = 4 x SL_CFG_MAX_AZIMUTHS (window tables) +
 /// SL_CFG_DETECT_MAX_CANDIDATES x (14 + 6 x SL_CFG_DETECT_MAX_SPAN) + SL_CFG_MAX_TARGETS x
-/// sizeof(sl_target_t) (52) + ~40 bytes (defaults: 8,424 bytes on x86-64).
+/// sizeof(sl_target_t) (52) + 50 bytes of azimuth hints + ~60 bytes (defaults: 8,504 bytes on x86-64).
 /// Cost: sl_detect_row O(words up to the shadow edge + runs x candidates); an azimuth
 /// with nothing occupied in its window exits after one OR per window word. Measured by
 /// host_tools/bench_mask (x86-64 -O2, 400 x 512, 6 poles + walls + clutter): the whole
@@ -125,13 +146,21 @@ extern "C" {
 #error "SL_CFG_DETECT_MAX_CANDIDATES must be in [1, 255]"
 #endif
 
+/// Evidence bonus of a target on a hinted azimuth (stage 4b).
+#define SL_DETECT_EVIDENCE_TRACK 1024U
+
 /// Rejection reasons (index of `sl_detect_stats_t.rejected`).
 typedef enum sl_detect_reject {
     SL_DETECT_REJ_NEAR = 0,   ///< a run crosses into the near-field exclusion band
     SL_DETECT_REJ_SHADOW = 1, ///< the return reaches the shadow edge (base not in the shadow)
     SL_DETECT_REJ_WIDE = 2,   ///< too wide in azimuth for a slender pole at its range
     SL_DETECT_REJ_BROKEN = 3, ///< a gap inside the run on the representative azimuth
-    SL_DETECT_REJ_COUNT = 4
+    SL_DETECT_REJ_SHORT = 4,  ///< the representative run is a single bin (no extent: no rho)
+    SL_DETECT_REJ_RHO = 5,    ///< rho outside what the model gives on this azimuth (below
+                              ///< the fold by more than one bin, above the domain, r1 >= r2)
+    SL_DETECT_REJ_WEAK = 6,   ///< no run of the group rises clearly above its local floor
+                              ///< (needs the amplitude row: sl_detect_set_amplitude)
+    SL_DETECT_REJ_COUNT = 7
 } sl_detect_reject_t;
 
 /// `sl_target_t.flags`.
@@ -152,10 +181,15 @@ typedef struct sl_detect_cfg {
     uint8_t link_bins;             ///< extent overlap tolerance between adjacent azimuths
     uint8_t width_slack_az;        ///< extra azimuths allowed by the WIDE test
     bool radius_from_width;        ///< estimate R from the width when the board has none
+    uint8_t weak_margin;           ///< WEAK test: a peak this far above the threshold is
+                                   ///< strong whatever the floor (default 6 counts, ~6 dB
+                                   ///< on the sensor's 19.8-counts-per-decade scale)
+    uint8_t weak_contrast;         ///< WEAK test: or this far above the local floor
+                                   ///< (default 20 counts, ~10x in amplitude)
 } sl_detect_cfg_t;
 
 /// Defaults: D_max 0.3 m, R clamp 0.15 m, beam 1.8 deg (CTS350-X), gap 2 bins, link 1 bin,
-/// slack 1 azimuth, radius from width on.
+/// slack 1 azimuth, radius from width on, weak margin 6, weak contrast 20.
 void sl_detect_cfg_default(sl_detect_cfg_t *cfg);
 
 /// One detected target (one rotation). Plain value.
@@ -178,6 +212,7 @@ typedef struct sl_target {
     uint8_t incline_flag;   ///< sl_incline_flag_t
     uint8_t incline_branch; ///< sl_incline_branch_t
     uint8_t flags;          ///< SL_TARGET_*
+    uint16_t evidence;      ///< slot priority (stage 4b), saturating
 } sl_target_t;
 
 /// Counters (cumulative since init; never asserted).
@@ -190,7 +225,8 @@ typedef struct sl_detect_stats {
     uint32_t rejected[SL_DETECT_REJ_COUNT]; ///< groups rejected, by first reason
     uint32_t span_overflow;    ///< groups wider than SL_CFG_DETECT_MAX_SPAN (also WIDE)
     uint32_t cand_overflow;    ///< runs dropped: no free group slot
-    uint32_t target_overflow;  ///< accepted targets dropped: more than max_targets
+    uint32_t target_overflow;  ///< accepted targets dropped: more than max_targets (the
+                               ///< least evidence; stage 4b)
     uint32_t order_errors;     ///< rows ignored: azimuth out of range or not increasing
 } sl_detect_stats_t;
 
@@ -230,6 +266,10 @@ typedef struct sl_detect {
     uint32_t open_bits[(SL_CFG_DETECT_MAX_CANDIDATES + 31) / 32]; ///< open groups (bitmap)
     sl_detect_cand_t cand[SL_CFG_DETECT_MAX_CANDIDATES];
     sl_target_t targets[SL_CFG_MAX_TARGETS];
+    uint32_t hint_bits[(SL_CFG_MAX_AZIMUTHS + 31) / 32]; ///< hinted azimuths (stage 4b)
+    const uint8_t *amp;     ///< amplitude row for the next sl_detect_row (borrowed) or NULL
+    uint16_t amp_bins;      ///< its length
+    uint8_t amp_threshold;  ///< the threshold it was cut at
     sl_detect_stats_t stats;
 } sl_detect_t;
 
@@ -254,8 +294,9 @@ sl_err_t sl_detect_row(sl_detect_t *d, uint16_t az, const uint32_t *occ, uint32_
 /// Close the rotation: wrap merge (azimuth azimuths-1 with 0), representative azimuth,
 /// rejections, corrections and alpha for every remaining group.
 /// @return the number of targets in `d->targets` (0..max_targets), in the order their
-/// groups closed (increasing last azimuth; wrapping groups last). They stay valid until
-/// the next sl_detect_begin().
+/// groups closed (increasing last azimuth; wrapping groups last) as long as they fit; once
+/// the slots are full a stronger target takes the slot of the weakest (stage 4b). They
+/// stay valid until the next sl_detect_begin().
 sl_ssize_t sl_detect_end(sl_detect_t *d);
 
 /// begin + one row per azimuth from `mask` (held rows of stale azimuths included; none for
@@ -268,6 +309,30 @@ sl_ssize_t sl_detect_rotation_from_mask(sl_detect_t *d, const sl_mask_t *mask);
 /// else needs the far range: it cuts those two stages ~3x on paper-sim (160 of 512 bins).
 /// O(azimuths).
 uint16_t sl_detect_bins_needed(const sl_detect_t *d);
+
+/// The power row (8-bit, `bins` values, thresholded at `threshold`) of the azimuth passed
+/// to the NEXT sl_detect_row() call, for the WEAK test; borrowed until that call returns,
+/// then forgotten (rows fed without one, e.g. held rows, are not tested). O(1).
+void sl_detect_set_amplitude(sl_detect_t *d, const uint8_t *power, uint16_t bins,
+                             uint8_t threshold);
+
+/// Clear every hint (stage 4b). Hints stay until cleared (sl_detect_begin keeps them).
+/// O(azimuths / 32).
+void sl_detect_hints_clear(sl_detect_t *d);
+
+/// Hint azimuths `az - half_width .. az + half_width` (circular): a target whose
+/// representative azimuth is hinted gets SL_DETECT_EVIDENCE_TRACK more evidence. Out of
+/// range `az` is ignored. O(half_width).
+void sl_detect_hint(sl_detect_t *d, uint16_t az, uint16_t half_width);
+
+/// Clutter tests of stage 4 (SHORT, RHO) on a finished target `t` (bin_first/bin_last,
+/// r1_um, incline flag and rho set) on azimuth `t->az`: the rejection reason, or -1 when the
+/// target may take a slot. Pure; O(1) (one 64-bit division).
+int sl_detect_clutter_reason(const sl_board_t *board, const sl_target_t *t, uint32_t rho_q28);
+
+/// Evidence of a target (stage 4b) from the group's total occupied bins, its azimuths with
+/// a run and the representative run's extent in bins. Pure, O(1), saturating at 65535.
+uint16_t sl_detect_evidence(uint32_t occupied_total, uint32_t az_with_run, uint32_t extent_bins);
 
 /// Stage 5 alone (MATH.md s.4) for a run `bin_first..bin_last` on azimuth `az`, with
 /// `az_count` the azimuths the radius estimate sees (sl_detect_end passes the column at the

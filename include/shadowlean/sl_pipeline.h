@@ -31,7 +31,8 @@
 ///    r1/r2, alpha, sigma, flags, representative azimuth: `sl_target_t`) and the tracker's
 ///    tracks (filtered alpha, sigma, warning level: `sl_track_t`, live slots only matter).
 /// 2. `port.can_tx(ctx, f)` (optional) for: one PoleLean per *confirmed* track (live,
-///    matched this rotation, `hits >= cfg.confirm_hits`), in slot order; one LeanWarning
+///    matched this rotation, `hits >= cfg.confirm_hits` and `confirmed` by the tracker's
+///    static-object evidence, sl_track.h), in slot order; one LeanWarning
 ///    (the most severe confirmed track: highest level, then largest |filtered alpha|;
 ///    HasTarget = 0 when there is none); one Status (link state, rotations, missing
 ///    azimuths, decoder resyncs, CAN drops; LinkState STREAMING only while usable rows

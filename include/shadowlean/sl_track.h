@@ -6,7 +6,9 @@
 ///
 /// ## Association
 /// A target may continue a live track when both gates hold: circular azimuth distance
-/// `<= cfg.az_gate` azimuths and `|r1 - track r1| <= cfg.range_gate_um`. Pairs are taken
+/// `<= cfg.az_gate` azimuths and `|r1 - track r1| <= cfg.range_gate_um`, both measured from
+/// the track's predicted position (see "Static-object prediction" below; the last position
+/// itself when the vehicle stands still). Pairs are taken
 /// greedily by increasing normalised distance (|d az| / az_gate + |d r1| / range_gate), each
 /// track and target at most once (global nearest neighbour). Unmatched targets open new
 /// tracks while slots are free (`stats.full` otherwise). Tracks not matched for longer than
@@ -16,6 +18,25 @@
 /// the azimuth gate, per track, by the angle `d` subtends at the track's r1 plus the yaw
 /// per rotation (no prediction: a static point moves by at most that much between
 /// rotations, in any direction).
+///
+/// ## Static-object prediction and confirmation (clutter never confirms)
+/// Everything shadowlean reports stands still on the ground, so before associating, each
+/// live track's position is predicted for a static object under the ego motion of one
+/// rotation (sl_track_predict_static()): with b the track's bearing from the vehicle's
+/// forward axis (azimuth + board->radar_yaw_cdeg, clockwise) and d the displacement, the
+/// point (r cos b, r sin b) becomes (r cos b - d, r sin b): r' = |.|, b' = atan2 (integer
+/// sin/cos, error < 0.2 %; yaw is not predicted, only tolerated). The gates above are
+/// centred on this prediction instead of the last position. A track then accumulates
+/// `evidence`: +1 for an association whose residual from the prediction is within
+/// `cfg.consist_az` azimuths (+ the yaw per rotation) and `cfg.consist_range_um`, capped at
+/// `cfg.confirm_min + 2`; an association outside that tolerance resets it to 1 (the track
+/// jumped: what it followed does not move like a static object); a rotation without an
+/// association takes 1 off and moves the track's az / r1 to the prediction (dead reckoning,
+/// so a pole missed for a rotation is still predicted where it is). `confirmed` = evidence >= `cfg.confirm_min` (default 3, i.e.
+/// three rotations whose range AND bearing follow the ego motion). Scattered clutter at
+/// every azimuth associates now and then (the gates are wide while moving) but almost never
+/// where a static object would be, three times running, so its tracks never confirm. The
+/// pipeline sends PoleLean only for confirmed tracks.
 ///
 /// ## Filter (1-D Kalman, fixed point)
 /// State alpha in 1/256 cdeg (Q8 cdeg), variance P in cdeg^2 (uint32). Only targets with
@@ -50,7 +71,7 @@
 ///
 /// ## Ownership, memory, cost
 /// Caller-owned `sl_tracker_t`; borrows `board` until re-init. RAM: SL_CFG_MAX_TARGETS x
-/// sizeof(sl_track_t) (56 bytes) + 64 bytes (defaults: 1,856 bytes on x86-64). Cost per update:
+/// sizeof(sl_track_t) (64 bytes) + 88 bytes (defaults: 2,136 bytes on x86-64). Cost per update:
 /// O(tracks x targets x min(tracks, targets)) gate tests (worst case 32^3 = 32k simple
 /// steps; a few hundred instructions for a handful of poles) + one 64-bit division and one
 /// isqrt per valid measurement. Not reentrant per instance.
@@ -86,6 +107,13 @@ typedef struct sl_track_cfg {
     uint16_t hysteresis_cdeg;  ///< lowering margin below each threshold (default 100 = 1 deg)
     uint8_t confirm;           ///< consecutive valid updates needed to raise (default 3)
     bool caution_abs;          ///< CAUTION on |alpha| (default true, as sl_board.h says)
+    uint32_t consist_range_um; ///< |r1 - predicted r1| of a consistent update (default
+                               ///< 0.2 m: +-1 bin of quantisation on each side plus the
+                               ///< width-based radius correction's jitter)
+    uint16_t consist_az;       ///< |az - predicted az| of a consistent update, azimuths
+                               ///< (default 3: the representative azimuth of a 2 deg beam
+                               ///< return moves by up to half its 4-8 azimuths)
+    uint8_t confirm_min;       ///< evidence needed for `confirmed` (default 3)
 } sl_track_cfg_t;
 
 /// Defaults as listed on each field.
@@ -110,6 +138,10 @@ typedef struct sl_track {
     uint8_t last_flag;       ///< incline flag of the last associated target
     uint8_t live;            ///< 1 = slot in use
     uint8_t updated;         ///< 1 = matched by the last sl_track_update()
+    uint8_t evidence;        ///< consistent static-object updates (see "confirmation")
+    uint8_t confirmed;       ///< 1 = evidence >= cfg.confirm_min
+    uint16_t pred_az;        ///< internal: predicted azimuth for this update
+    uint32_t pred_r1_um;     ///< internal: predicted r1 for this update
 } sl_track_t;
 
 /// Counters (cumulative; never asserted).
@@ -121,6 +153,8 @@ typedef struct sl_track_stats {
     uint32_t full;           ///< targets without a track: no free slot
     uint32_t level_changes;  ///< warning level transitions (any direction)
     uint32_t time_backwards; ///< now_us earlier than a track's last_seen_us (treated as 0 s)
+    uint32_t inconsistent;   ///< associations off the static prediction (evidence reset)
+    uint32_t confirmations;  ///< tracks that became confirmed
 } sl_track_stats_t;
 
 /// The tracker. Caller-owned; fields read-only to the application.
@@ -133,6 +167,7 @@ typedef struct sl_tracker {
     sl_track_stats_t stats;
     uint32_t motion_um;      ///< ego displacement per update (sl_track_set_motion), um
     uint32_t motion_yaw_bam; ///< |yaw| per update, bam32 (2^32 = one turn)
+    bool motion_reverse;     ///< the displacement is backwards (sl_track_set_reverse)
 } sl_tracker_t;
 
 /// Initialise (no tracks). `cfg` NULL = defaults (copied). Borrows `board`.
@@ -149,6 +184,22 @@ void sl_track_update(sl_tracker_t *tr, const sl_target_t *targets, uint32_t n,
 /// `disp_um` (>= 0) and |yaw| `yaw_bam32` (2^32 = one turn). Stays in effect until changed;
 /// 0, 0 = static. O(1).
 void sl_track_set_motion(sl_tracker_t *tr, uint32_t disp_um, uint32_t yaw_bam32);
+
+/// Direction of the displacement given to sl_track_set_motion(): true = the vehicle
+/// reverses (the static-object prediction moves the other way). Default false. O(1).
+void sl_track_set_reverse(sl_tracker_t *tr, bool reverse);
+
+/// Where a static object seen at azimuth index `az`, range `r_um` is expected after the ego
+/// displacement `disp_um` forward (a negative displacement: pass the reverse flag through
+/// sl_track_set_reverse(); this pure function takes `disp_um` forward only) (see "Static-object prediction"); r and d are clamped to
+/// 2^30 um (1 km). Pure; O(1) (one isqrt, one atan2, two divisions).
+void sl_track_predict_static(const sl_board_t *board, uint16_t az, uint32_t r_um,
+                             uint32_t disp_um, uint16_t *az_out, uint32_t *r_out);
+
+/// The azimuth gate of track `t` under the current motion (cfg.az_gate + the yaw per update
+/// + the angle the displacement subtends at the track's r1), in azimuths, saturated at
+/// 65535. O(1).
+uint16_t sl_track_gate_az(const sl_tracker_t *tr, const sl_track_t *t);
 
 /// Highest warning level over live tracks (SL_WARN_NONE when none). O(tracks).
 sl_warn_level_t sl_track_max_level(const sl_tracker_t *tr);

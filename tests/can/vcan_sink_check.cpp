@@ -220,6 +220,7 @@ int main(int argc, char **argv)
     ids.id[SL_CAN_MSG_LEAN_WARNING] = b.can_id_lean_warning;
     ids.id[SL_CAN_MSG_STATUS] = b.can_id_status;
     ids.id[SL_CAN_MSG_VEHICLE_MOTION] = b.can_id_vehicle_motion;
+    ids.id[SL_CAN_MSG_HEALTH] = b.can_id_health;
     CHECK(sl_can_tx_init(&gen.tx, &ids) == SL_OK);
 
     sl::CandumpWriter produced, sent_log;

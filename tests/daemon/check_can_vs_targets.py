@@ -81,6 +81,7 @@ def main(argv):
     rots = [r for r in recs[1:] if r["type"] == "rotation"]
     errors = []
     counters = {}
+    last_name = None
     groups = []
     cur = []
     idle = 0
@@ -147,7 +148,7 @@ def main(argv):
     for k, (g, r) in enumerate(zip(groups, rots)):
         w = f"rotation {r['rotation']}"
         missing += r["missing"]
-        confirmed = [t for t in r["tracks"] if t["hits"] >= confirm]
+        confirmed = [t for t in r["tracks"] if t["hits"] >= confirm and t.get("confirmed", 1)]
         want_pl = [t for t in confirmed if t["updated"]]
         poles = [d for d in g if d.name == "PoleLean"]
         rest = [d.name for d in g if d.name != "PoleLean"]

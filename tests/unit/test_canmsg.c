@@ -13,6 +13,7 @@
 #define ID_WARN 0x621U
 #define ID_STATUS 0x622U
 #define ID_MOTION 0x300U
+#define ID_HEALTH 0x623U
 
 static uint64_t rng_state = 0x9E3779B97F4A7C15ull;
 static uint32_t rnd32(void)
@@ -31,7 +32,7 @@ static int64_t rnd_range(int64_t lo, int64_t hi)
 
 static void tx_setup(sl_can_tx_t *tx)
 {
-    sl_can_ids_t ids = {{ID_POLE, ID_WARN, ID_STATUS, ID_MOTION}};
+    sl_can_ids_t ids = {{ID_POLE, ID_WARN, ID_STATUS, ID_MOTION, ID_HEALTH}};
     assert_int_equal(sl_can_tx_init(tx, &ids), SL_OK);
 }
 
@@ -470,6 +471,62 @@ static void test_canmsg_status_counters_saturate_and_flag(void **state)
     assert_int_equal(tx.stats.clamped_frames, 2);
 }
 
+// Health: every fault bit and counter value round-trips; reserved bits are never sent;
+// the totals saturate at their field maximum (counted as clamped frames); the golden bytes
+// follow the fixed layout (Fault 16|16, Reconnects 32|8, CandidatesDropped 40|12).
+static void test_canmsg_health_round_trips_saturates_and_keeps_reserved_bits_zero(void **state)
+{
+    (void)state;
+    sl_can_tx_t tx;
+    tx_setup(&tx);
+    sl_can_frame_t f;
+    sl_can_health_t out;
+    for (int i = 0; i < 20000; i++) {
+        const sl_can_health_t in = {.fault = (uint16_t)rnd_range(0, 0x1FF),
+                                    .reconnects = (uint32_t)rnd_range(0, 255),
+                                    .candidates_dropped = (uint32_t)rnd_range(0, 4095)};
+        assert_int_equal(sl_can_encode_health(&tx, &in, &f), SL_OK);
+        assert_int_equal(f.id, ID_HEALTH);
+        assert_int_equal(f.dlc, 8);
+        assert_int_equal(sl_can_decode_health(&f, &out), SL_OK);
+        assert_int_equal(out.fault, in.fault);
+        assert_int_equal(out.reconnects, in.reconnects);
+        assert_int_equal(out.candidates_dropped, in.candidates_dropped);
+        assert_int_equal(f.data[1] & 0xF0U, 0);   // reserved 12|4
+        assert_int_equal(f.data[6] & 0xF0U, 0);   // reserved 52|12
+        assert_int_equal(f.data[7], 0);
+        assert_int_equal(f.data[0], sl_can_e2e_crc(SL_CAN_DATA_ID_HEALTH, f.data));
+    }
+    assert_int_equal(tx.stats.clamped_frames, 0);
+    const sl_can_health_t big = {.fault = 0xFFFFU, .reconnects = 256, .candidates_dropped = 5000};
+    sl_can_encode_health(&tx, &big, &f);
+    assert_int_equal(sl_can_decode_health(&f, &out), SL_OK);
+    assert_int_equal(out.fault, SL_CAN_FAULT_DEFINED);
+    assert_int_equal(out.reconnects, 255);
+    assert_int_equal(out.candidates_dropped, 4095);
+    assert_int_equal(tx.stats.clamped_frames, 1);
+    // Golden: TARGET_SLOTS_OVERFLOW, 3 reconnects, 0xABC dropped.
+    const sl_can_health_t g = {.fault = SL_CAN_FAULT_TARGET_SLOTS_OVERFLOW, .reconnects = 3,
+                               .candidates_dropped = 0xABCU};
+    sl_can_encode_health(&tx, &g, &f);
+    assert_int_equal(f.data[2], 0x00);
+    assert_int_equal(f.data[3], 0x01);
+    assert_int_equal(f.data[4], 0x03);
+    assert_int_equal(f.data[5], 0xBC);
+    assert_int_equal(f.data[6], 0x0A);
+    assert_int_equal(sl_can_decode_health(NULL, NULL), SL_ERR_ARG);
+    assert_int_equal(sl_can_encode_health(NULL, &g, &f), SL_ERR_ARG);
+    f.data[0] ^= 1U;
+    assert_int_equal(sl_can_decode_health(&f, &out), SL_ERR_MALFORMED);
+    const sl_can_message_desc_t *md = sl_can_layout(SL_CAN_MSG_HEALTH);
+    assert_string_equal(md->name, "Health");
+    assert_int_equal(md->data_id, SL_CAN_DATA_ID_HEALTH);
+    assert_int_equal(md->signals[2].n_values, 9);
+    for (unsigned k = 0; k < md->signals[2].n_values; k++) {
+        assert_int_equal(md->signals[2].values[k].value, 1U << k);
+    }
+}
+
 static void test_canmsg_vehicle_motion_round_trips_full_range(void **state)
 {
     (void)state;
@@ -698,6 +755,7 @@ int main(void)
         cmocka_unit_test(test_canmsg_lean_warning_round_trips_and_clamps),
         cmocka_unit_test(test_canmsg_status_counters_saturate_and_flag),
         cmocka_unit_test(test_canmsg_vehicle_motion_round_trips_full_range),
+        cmocka_unit_test(test_canmsg_health_round_trips_saturates_and_keeps_reserved_bits_zero),
         cmocka_unit_test(test_canmsg_counter_wraps_modulo_15_per_message),
         cmocka_unit_test(test_canmsg_e2e_detects_every_single_bit_error),
         cmocka_unit_test(test_canmsg_e2e_counts_jumps_and_rejects_repeats),

@@ -357,6 +357,148 @@ static void test_detect_merges_groups_joined_by_a_later_azimuth(void **state)
     assert_int_equal(det.stats.groups, 1);
 }
 
+static void test_detect_rejects_clutter_before_it_takes_a_slot(void **state)
+{
+    (void)state;
+    assert_int_equal(sl_detect_init(&det, &board, NULL), SL_OK);
+    set_run(40, 118, 118);  // a speck: one bin -> SHORT
+    set_run(80, 118, 119);  // two bins at 5.2 m: rho 1.008, far below rho_amb 1.026 -> RHO
+    set_run(120, 116, 118); // three bins at 5.1 m: rho 1.017 < 1.026 - b/r1 (1.018) -> RHO
+    set_run(160, 68, 70);   // three bins at 3 m: rho 1.029, a pole near the fold: kept
+    for (int a = 200; a < 204; a++) {
+        set_run(a, 69, 82); // a slanted pole: kept
+    }
+    assert_int_equal(run_rotation(), 2);
+    assert_int_equal(det.stats.rejected[SL_DETECT_REJ_SHORT], 1);
+    assert_int_equal(det.stats.rejected[SL_DETECT_REJ_RHO], 2);
+    assert_int_equal(det.targets[0].az, 160);
+    assert_int_equal(det.targets[1].az_first, 200);
+    // The rule alone: AMBIGUOUS within one bin of the fold passes, further below does not.
+    sl_target_t t;
+    memset(&t, 0, sizeof t);
+    t.az = 3;
+    t.bin_first = 68;
+    t.bin_last = 70;
+    t.r1_um = 3000000U;
+    t.incline_flag = SL_INCLINE_AMBIGUOUS;
+    const uint32_t amb = geom[3].rho_amb_q28;
+    const uint32_t tol = (uint32_t)(((uint64_t)BIN_UM << 28) / 3000000U);
+    assert_int_equal(sl_detect_clutter_reason(&board, &t, amb - tol), -1);
+    assert_int_equal(sl_detect_clutter_reason(&board, &t, amb - tol - 1U), SL_DETECT_REJ_RHO);
+    t.incline_flag = SL_INCLINE_INVALID;
+    assert_int_equal(sl_detect_clutter_reason(&board, &t, 0), SL_DETECT_REJ_RHO);
+    t.incline_flag = SL_INCLINE_VALID;
+    assert_int_equal(sl_detect_clutter_reason(&board, &t, amb + 1000U), -1);
+    t.bin_last = 68;
+    assert_int_equal(sl_detect_clutter_reason(&board, &t, amb + 1000U), SL_DETECT_REJ_SHORT);
+}
+
+// WEAK: with amplitude rows, a group none of whose runs is clearly above its local floor
+// (peak < threshold + 6 and < floor + 20) is rejected; the same bins over a quiet floor, or
+// 6 counts over the threshold, are kept. Rows without amplitude are not tested.
+static uint8_t amp[NAZ][512];
+static void test_detect_rejects_returns_never_clearly_above_the_floor(void **state)
+{
+    (void)state;
+    assert_int_equal(sl_detect_init(&det, &board, NULL), SL_OK);
+    memset(amp, 0, sizeof amp);
+    const uint16_t azs[4] = {50, 100, 150, 200};
+    for (int i = 0; i < 4; i++) {
+        for (int a = azs[i]; a < azs[i] + 4; a++) {
+            set_run(a, 69, 82); // a slanted pole's bins
+            for (uint32_t k = 60; k < 95; k++) {
+                // 50: clutter band (floor 30, peak 45); 100: quiet floor (5), peak 45;
+                // 150: floor 35, peak 46 (threshold 40 + 6); 200: like 50, no amplitude.
+                const bool in = k >= 69 && k <= 82;
+                amp[a][k] = (uint8_t)(i == 1 ? (in ? 45 : 5) : i == 2 ? (in ? 46 : 35) : (in ? 45 : 30));
+            }
+        }
+    }
+    sl_detect_begin(&det);
+    for (int a = 0; a < NAZ; a++) {
+        if (a < 200 || a >= 204) {
+            sl_detect_set_amplitude(&det, amp[a], 512, 40);
+        }
+        assert_int_equal(sl_detect_row(&det, (uint16_t)a, rows[a], NW), SL_OK);
+        assert_null(det.amp); // used by one row only
+    }
+    assert_int_equal(sl_detect_end(&det), 3);
+    assert_int_equal(det.stats.rejected[SL_DETECT_REJ_WEAK], 1);
+    for (int i = 0; i < 3; i++) {
+        assert_true(det.targets[i].az_first != 50);
+    }
+}
+
+static void test_detect_slots_go_to_the_strongest_not_the_lowest_azimuths(void **state)
+{
+    (void)state;
+    assert_int_equal(sl_detect_init(&det, &board, NULL), SL_OK);
+    // 20 clutter returns that pass every test (6 bins, one azimuth each, valid rho) at the
+    // lowest azimuths, then two poles at higher azimuths: 22 candidates for 16 slots.
+    for (int k = 0; k < 20; k++) {
+        set_run(10 + 4 * k, 110, 115);
+    }
+    for (int a = 300; a < 305; a++) {
+        set_run(a, 69, 82);
+    }
+    for (int a = 350; a < 354; a++) {
+        set_run(a, 70, 76);
+    }
+    assert_int_equal(run_rotation(), 16);
+    assert_int_equal(det.stats.target_overflow, 6);
+    int poles = 0, clutter = 0;
+    for (int i = 0; i < 16; i++) {
+        const sl_target_t *t = &det.targets[i];
+        if (t->az_first == 300 || t->az_first == 350) {
+            poles++;
+            assert_true(t->evidence > sl_detect_evidence(6, 1, 6));
+        } else {
+            clutter++;
+            assert_int_equal(t->evidence, sl_detect_evidence(6, 1, 6));
+        }
+    }
+    assert_int_equal(poles, 2);
+    assert_int_equal(clutter, 14);
+    assert_int_equal(sl_detect_evidence(6, 1, 6), 4 * 6 + 16 + 8 * 6);
+    assert_int_equal(sl_detect_evidence(100000, 0, 0), 0xFFFF);
+    // A hint (a confirmed track expected there) keeps a weak return's slot: the clutter
+    // return at azimuth 90 is hinted and survives 21 stronger candidates (20 copies of the
+    // second pole's shape at azimuths 110..300 and the pole at 350).
+    memset(rows, 0, sizeof rows);
+    assert_int_equal(sl_detect_init(&det, &board, NULL), SL_OK);
+    sl_detect_hint(&det, 91, 1); // 90..92
+    set_run(90, 110, 115);
+    for (int k = 0; k < 20; k++) {
+        for (int a = 110 + 10 * k; a < 114 + 10 * k; a++) {
+            set_run(a, 70, 76);
+        }
+    }
+    for (int a = 350; a < 354; a++) {
+        set_run(a, 70, 76);
+    }
+    assert_int_equal(run_rotation(), 16);
+    int hinted = 0;
+    for (int i = 0; i < 16; i++) {
+        if (det.targets[i].az == 90) {
+            hinted++;
+            assert_int_equal(det.targets[i].evidence,
+                             sl_detect_evidence(6, 1, 6) + SL_DETECT_EVIDENCE_TRACK);
+        }
+    }
+    assert_int_equal(hinted, 1);
+    assert_int_equal(det.stats.target_overflow, 6);
+    // Hints wrap around azimuth 0 and are cleared explicitly.
+    sl_detect_hints_clear(&det);
+    sl_detect_hint(&det, 1, 2); // 399, 0, 1, 2, 3
+    assert_int_equal(det.hint_bits[0], 0xFU);
+    assert_int_equal(det.hint_bits[(NAZ - 1) / 32] >> ((NAZ - 2) % 32), 0x2U);
+    sl_detect_hint(&det, NAZ, 2); // out of range: ignored
+    sl_detect_hints_clear(&det);
+    for (unsigned w = 0; w < (NAZ + 31) / 32; w++) {
+        assert_int_equal(det.hint_bits[w], 0);
+    }
+}
+
 static void test_detect_handles_empty_saturated_and_misordered_input(void **state)
 {
     (void)state;
@@ -382,11 +524,12 @@ static void test_detect_handles_empty_saturated_and_misordered_input(void **stat
     for (uint32_t k = 40; k <= 132U; k += 2U) {
         set_run(7, k, k); // 47 one-bin runs
     }
-    assert_int_equal(run_rotation(), 16);
+    // Every group that got a slot is a single bin: rejected SHORT before taking a target slot.
+    assert_int_equal(run_rotation(), 0);
     assert_int_equal(det.stats.runs, 47);
     assert_int_equal(det.stats.cand_overflow, 47 - SL_CFG_DETECT_MAX_CANDIDATES);
-    assert_int_equal(det.stats.target_overflow, SL_CFG_DETECT_MAX_CANDIDATES - 16);
-    assert_int_equal(det.targets[0].incline_flag, SL_INCLINE_INVALID); // r1 == r2
+    assert_int_equal(det.stats.rejected[SL_DETECT_REJ_SHORT], SL_CFG_DETECT_MAX_CANDIDATES);
+    assert_int_equal(det.stats.target_overflow, 0);
     // Init rejects boards it cannot use.
     sl_board_t bad = board;
     bad.shadow_um = NULL;
@@ -584,6 +727,9 @@ int main(void)
         cmocka_unit_test_setup(test_detect_groups_across_the_azimuth_wrap, setup),
         cmocka_unit_test_setup(test_detect_merges_groups_joined_by_a_later_azimuth, setup),
         cmocka_unit_test_setup(test_detect_handles_empty_saturated_and_misordered_input, setup),
+        cmocka_unit_test_setup(test_detect_rejects_clutter_before_it_takes_a_slot, setup),
+        cmocka_unit_test_setup(test_detect_rejects_returns_never_clearly_above_the_floor, setup),
+        cmocka_unit_test_setup(test_detect_slots_go_to_the_strongest_not_the_lowest_azimuths, setup),
         cmocka_unit_test_setup(test_detect_correct_half_bin_elongation_and_radius, setup),
         cmocka_unit_test_setup(test_detect_radius_from_the_column_at_the_inner_edge, setup),
         cmocka_unit_test_setup(test_detect_from_mask_reports_the_pole_after_n_stable_rotations,

@@ -955,7 +955,8 @@ static void test_pipeline_idle_status_frames_continue_the_e2e_sequence(void **st
     assert_int_equal(rx.stats.repeated, 0);
     assert_int_equal(last_rot, 24);
     assert_int_equal(pl.stats.can_frames, (uint32_t)rec.ncan);
-    // A refused idle Status is a drop like any other frame, reported by the next one.
+    // A refused idle Status (and its Health) is a drop like any other frame, reported by
+    // the next one.
     rec.busy_every = 1;
     rec.calls = 0;
     assert_int_equal(sl_pipeline_send_status(&pl, 99100000U), SL_OK);
@@ -988,7 +989,7 @@ static void test_pipeline_adds_port_drops_saturating_into_the_next_status(void *
     assert_int_equal(sl_can_decode_status(&rec.can[0], &st), SL_OK);
     assert_int_equal(st.can_dropped, 7);
     assert_false(st.saturated);
-    // A refusal adds one more.
+    // A refusal adds one per frame (Status and its Health).
     rec.busy_every = 1;
     assert_int_equal(sl_pipeline_send_status(&pl, 2000U), SL_OK);
     rec.busy_every = 0;
@@ -1280,6 +1281,91 @@ static void test_pipeline_drive_by_detects_the_pole_only_with_motion_input(void 
 
 // ---------------------------------------------------------------------------- init checks
 
+// Slot overflow (issue 18): 20 static returns that pass every rejection test (6 bins, one
+// azimuth each, a valid rho) at the LOWEST azimuths, then two poles at higher azimuths: 22
+// targets for the board's 16 slots every rotation. The poles keep their slots (evidence, not
+// azimuth order) and are sent as PoleLean; the drops are counted on CAN: Health's
+// CandidatesDropped grows by 6 per rotation and its Fault has TARGET_SLOTS_OVERFLOW.
+static void overflow_fn(void *ctx, int rot, uint32_t az, uint64_t t, uint8_t *row, uint32_t bins)
+{
+    (void)t;
+    render_static(ctx, rot, az, row, bins);
+    if (az >= 10U && az < 90U && (az - 10U) % 4U == 0U) {
+        for (uint32_t k = 110; k <= 115 && k < bins; k++) {
+            row[k] = 90;
+        }
+    }
+}
+
+static void test_pipeline_slot_overflow_keeps_the_poles_and_is_counted_on_can(void **state)
+{
+    (void)state;
+    scene_t sc;
+    scene_defaults(&sc);
+    sc.flicker = false;
+    sc.p[0] = (tpole_t){300, 3.0, 0.0, 2, 0};
+    sc.p[1] = (tpole_t){350, 3.1, 10.0, 2, 0};
+    sc.np = 2;
+    stream_t st;
+    st_init(&st, 24u << 20);
+    sopt_t o = sopt_defaults();
+    o.rotations = 20;
+    build(&st, &o, overflow_fn, &sc);
+    rec_reset(0);
+    const sl_pipeline_cfg_t c = cfg_for(B);
+    assert_int_equal(sl_pipeline_init(&pl, B, &c), SL_OK);
+    assert_int_equal(B->max_targets, 16);
+    feed_stream(&st, 65536, 0);
+    st_free(&st);
+    assert_int_equal(rec.rotations, 20);
+    const int first = B->mask_frames - 1; // first rotation with stable returns
+    for (int k = first; k < 20; k++) {
+        assert_int_equal(rec.nt[k], 16);
+    }
+    assert_int_equal(pl.detect.stats.target_overflow, (uint32_t)(6 * (20 - first)));
+    // The last rotation's targets include both poles.
+    const sl_target_t *tg = pl.detect.targets;
+    int poles = 0;
+    for (int i = 0; i < pl.detect.n_targets; i++) {
+        poles += (tg[i].az >= 298 && tg[i].az <= 302) || (tg[i].az >= 348 && tg[i].az <= 352);
+    }
+    assert_int_equal(pl.detect.n_targets, 16);
+    assert_int_equal(poles, 2);
+    // CAN: PoleLean at both poles in the last rotation; Health after every Status.
+    bool seen300 = false, seen350 = false;
+    int n_health = 0, n_status = 0;
+    sl_can_health_t last_h;
+    memset(&last_h, 0, sizeof last_h);
+    sl_can_e2e_rx_t rxh;
+    sl_can_e2e_rx_init(&rxh);
+    for (int i = 0; i < rec.ncan; i++) {
+        const sl_can_frame_t *f = &rec.can[i];
+        if (f->id == B->can_id_status) {
+            n_status++;
+            assert_true(i + 1 < rec.ncan);
+            assert_int_equal(rec.can[i + 1].id, B->can_id_health);
+        } else if (f->id == B->can_id_health) {
+            n_health++;
+            assert_int_equal(sl_can_e2e_check(&rxh, SL_CAN_DATA_ID_HEALTH, f), SL_OK);
+            assert_int_equal(sl_can_decode_health(f, &last_h), SL_OK);
+            const int k = rec.can_rot[i];
+            const bool overflow = k >= first;
+            assert_int_equal((last_h.fault & SL_CAN_FAULT_TARGET_SLOTS_OVERFLOW) != 0, overflow);
+            assert_int_equal(last_h.candidates_dropped, overflow ? (uint32_t)(6 * (k - first + 1)) : 0U);
+        } else if (f->id == B->can_id_pole_lean && rec.can_rot[i] == 19) {
+            sl_can_pole_lean_t pl_f;
+            assert_int_equal(sl_can_decode_pole_lean(f, &pl_f), SL_OK);
+            const int32_t az = pl_f.azimuth_cdeg - B->radar_yaw_cdeg;
+            seen300 |= az >= 26800 && az <= 27200;
+            seen350 |= az >= 31300 && az <= 31700;
+        }
+    }
+    assert_true(n_status >= 20);
+    assert_int_equal(n_health, n_status);
+    assert_true(seen300 && seen350);
+    assert_int_equal(last_h.candidates_dropped, 6 * (20 - first));
+}
+
 static void test_pipeline_rejects_boards_that_need_more_mask_bins(void **state)
 {
     (void)state;
@@ -1362,6 +1448,7 @@ int main(void)
         cmocka_unit_test(test_pipeline_takes_motion_from_can_and_the_setter),
         cmocka_unit_test(test_pipeline_drive_by_detects_the_pole_only_with_motion_input),
         cmocka_unit_test(test_pipeline_rejects_boards_that_need_more_mask_bins),
+        cmocka_unit_test(test_pipeline_slot_overflow_keeps_the_poles_and_is_counted_on_can),
     };
     const int rc = cmocka_run_group_tests(tests, setup, NULL);
     st_free(&g_static);

@@ -26,6 +26,12 @@ static int setup(void **state)
     return 0;
 }
 
+static uint32_t az_dist_test(uint32_t a, uint32_t b)
+{
+    const uint32_t d = (a > b ? a - b : b - a) % 400U;
+    return d > 200U ? 400U - d : d;
+}
+
 static sl_target_t tgt(uint16_t az, uint32_t r1_um, int32_t alpha_cdeg, uint16_t sigma_cdeg,
                        uint8_t flag)
 {
@@ -231,22 +237,25 @@ static void test_track_motion_widens_the_gates(void **state)
         assert_int_equal(trk.stats.created, moving ? 1U : 2U);
         assert_int_equal(trk.stats.associated, moving ? 1U : 0U);
     }
-    // Slack at r1 = 2.8 m for 0.75 m: 0.268 rad = 17.1 azimuths -> gate 3 + 18 = 21.
-    assert_int_equal(sl_track_init(&trk, &board, NULL), SL_OK);
-    sl_track_set_motion(&trk, 750000U, 0U);
-    sl_target_t t = tgt(100, 2800000U, 500, 80, SL_INCLINE_VALID);
-    sl_track_update(&trk, &t, 1, 1000000);
-    t = tgt(121, 2800000U, 500, 80, SL_INCLINE_VALID);
-    sl_track_update(&trk, &t, 1, 1250000);
-    assert_int_equal(trk.stats.associated, 1U);
-    t = tgt(143, 2800000U, 500, 80, SL_INCLINE_VALID); // 22 steps: outside
-    sl_track_update(&trk, &t, 1, 1500000);
-    assert_int_equal(trk.stats.associated, 1U);
-    assert_int_equal(trk.stats.created, 2U);
+    // Slack at r1 = 2.8 m for 0.75 m: 0.268 rad = 17.1 azimuths -> gate 3 + 18 = 21, centred
+    // on where a static object at azimuth 100 (abeam), 2.8 m, is expected after 0.75 m.
+    uint16_t paz;
+    uint32_t pr;
+    sl_track_predict_static(&board, 100, 2800000U, 750000U, &paz, &pr);
+    for (int off = 21; off <= 22; off++) {
+        assert_int_equal(sl_track_init(&trk, &board, NULL), SL_OK);
+        sl_track_set_motion(&trk, 750000U, 0U);
+        sl_target_t t = tgt(100, 2800000U, 500, 80, SL_INCLINE_VALID);
+        sl_track_update(&trk, &t, 1, 1000000);
+        t = tgt((uint16_t)(paz + off), pr, 500, 80, SL_INCLINE_VALID);
+        sl_track_update(&trk, &t, 1, 1250000);
+        assert_int_equal(trk.stats.associated, off == 21 ? 1U : 0U);
+        assert_int_equal(trk.stats.created, off == 21 ? 1U : 2U);
+    }
     // Yaw only: 9 deg per update = 10 azimuths (rounded up) on top of the gate of 3.
     assert_int_equal(sl_track_init(&trk, &board, NULL), SL_OK);
     sl_track_set_motion(&trk, 0U, (uint32_t)(9.0 / 360.0 * 4294967296.0));
-    t = tgt(200, 2800000U, 500, 80, SL_INCLINE_VALID);
+    sl_target_t t = tgt(200, 2800000U, 500, 80, SL_INCLINE_VALID);
     sl_track_update(&trk, &t, 1, 1000000);
     t = tgt(187, 2800000U, 500, 80, SL_INCLINE_VALID);
     sl_track_update(&trk, &t, 1, 1250000);
@@ -254,6 +263,114 @@ static void test_track_motion_widens_the_gates(void **state)
     t = tgt(173, 2800000U, 500, 80, SL_INCLINE_VALID); // 14 steps: outside
     sl_track_update(&trk, &t, 1, 1500000);
     assert_int_equal(trk.stats.associated, 1U);
+}
+
+// A static object under ego motion: the prediction against the exact geometry (double).
+static void test_track_predicts_a_static_object_under_ego_motion(void **state)
+{
+    (void)state;
+    const double kPi = 3.14159265358979323846;
+    for (int yaw = 0; yaw < 2; yaw++) {
+        board.radar_yaw_cdeg = yaw ? 9000 : 0; // encoder zero 90 deg right of forward
+        for (uint16_t az = 0; az < 400; az += 7) {
+            for (uint32_t d = 0; d <= 600000U; d += 150000U) {
+                const uint32_t r = 3100000U;
+                uint16_t paz;
+                uint32_t pr;
+                sl_track_predict_static(&board, az, r, d, &paz, &pr);
+                const double b = (az * 0.9 + (yaw ? 90.0 : 0.0)) * kPi / 180.0;
+                const double x = r * cos(b) - d, y = r * sin(b);
+                const double re = hypot(x, y);
+                double be = atan2(y, x) * 180.0 / kPi - (yaw ? 90.0 : 0.0);
+                be = fmod(be + 720.0, 360.0) / 0.9;
+                double da = fabs(be - paz);
+                da = da > 200.0 ? 400.0 - da : da;
+                assert_true(fabs(re - pr) < 0.002 * r + 2.0);
+                assert_true(da <= 0.5 + 0.15);
+            }
+        }
+    }
+    board.radar_yaw_cdeg = 0;
+}
+
+// Confirmation: a static pole passed at 1 m/s (range and bearing follow the ego motion)
+// confirms at its third rotation and stays confirmed through one missed rotation; clutter
+// that appears somewhere in a band every rotation (inside the gates, off the prediction)
+// never confirms, however often it associates.
+static void test_track_confirms_static_objects_not_scattered_clutter(void **state)
+{
+    (void)state;
+    assert_int_equal(sl_track_init(&trk, &board, NULL), SL_OK);
+    sl_track_set_motion(&trk, 250000U, 0U);
+    uint16_t az = 60;
+    uint32_t r = 4000000U;
+    uint64_t now = 1000000;
+    for (int k = 0; k < 8; k++) {
+        if (k != 5) { // rotation 5: the pole is missed
+            sl_target_t t = tgt(az, r, 500, 80, SL_INCLINE_VALID);
+            sl_track_update(&trk, &t, 1, now);
+        } else {
+            sl_track_update(&trk, NULL, 0, now);
+        }
+        const sl_track_t *tt = &trk.tracks[0];
+        assert_int_equal(trk.live, 1);
+        assert_int_equal(tt->confirmed, k >= 2 ? 1 : 0);
+        sl_track_predict_static(&board, az, r, 250000U, &az, &r);
+        now += 250000;
+    }
+    assert_int_equal(trk.stats.created, 1);
+    assert_int_equal(trk.stats.inconsistent, 0);
+    // Clutter: one return per rotation in a band at 5.1 .. 5.8 m within 6 azimuths of the
+    // last one, but never where a static object would be.
+    assert_int_equal(sl_track_init(&trk, &board, NULL), SL_OK);
+    sl_track_set_motion(&trk, 250000U, 0U);
+    uint32_t seed = 12345U;
+    az = 100;
+    for (int k = 0; k < 200; k++) {
+        seed = seed * 1103515245U + 12345U;
+        const uint32_t rr = 5100000U + (seed >> 8) % 700000U;
+        seed = seed * 1103515245U + 12345U;
+        uint16_t paz;
+        uint32_t pr;
+        sl_track_predict_static(&board, az, rr, 250000U, &paz, &pr);
+        az = (uint16_t)((az + 4U + (seed >> 12) % 3U) % 400U); // always >= 4 off the track
+        if (az_dist_test(az, paz) <= 3U) {
+            az = (uint16_t)((paz + 5U) % 400U);
+        }
+        sl_target_t t = tgt(az, rr, 300, 80, SL_INCLINE_VALID);
+        sl_track_update(&trk, &t, 1, now);
+        now += 250000;
+        for (int i = 0; i < SL_CFG_MAX_TARGETS; i++) {
+            assert_int_equal(trk.tracks[i].confirmed, 0);
+        }
+    }
+    assert_int_equal(trk.stats.confirmations, 0);
+}
+
+// Reversing: a static pole ahead-right (bearing 45 deg, 3.5 m) seen while the vehicle backs
+// away at 1 m/s confirms only when the tracker knows the direction (sl_track_set_reverse).
+static void test_track_prediction_follows_a_reversing_vehicle(void **state)
+{
+    (void)state;
+    const double kPi = 3.14159265358979323846;
+    for (int told = 0; told < 2; told++) {
+        assert_int_equal(sl_track_init(&trk, &board, NULL), SL_OK);
+        sl_track_set_motion(&trk, 250000U, 0U);
+        sl_track_set_reverse(&trk, told != 0);
+        double x = 3.5 * cos(45.0 * kPi / 180.0), y = 3.5 * sin(45.0 * kPi / 180.0);
+        uint64_t now = 1000000;
+        for (int k = 0; k < 5; k++) {
+            const double b = fmod(atan2(y, x) * 180.0 / kPi + 360.0, 360.0);
+            sl_target_t t = tgt((uint16_t)lround(b / 0.9) % 400U, (uint32_t)lround(hypot(x, y) * 1e6),
+                                500, 80, SL_INCLINE_VALID);
+            sl_track_update(&trk, &t, 1, now);
+            now += 250000;
+            x += 0.25; // the vehicle backs off: the pole moves forward in its frame
+        }
+        assert_int_equal(trk.live, 1);
+        assert_int_equal(trk.tracks[0].confirmed, told ? 1 : 0);
+        assert_int_equal(trk.stats.inconsistent, told ? 0U : 4U);
+    }
 }
 
 static void test_track_counts_targets_beyond_its_capacity(void **state)
@@ -312,6 +429,9 @@ int main(void)
         cmocka_unit_test_setup(test_track_motion_widens_the_gates, setup),
         cmocka_unit_test_setup(test_track_counts_targets_beyond_its_capacity, setup),
         cmocka_unit_test_setup(test_track_does_not_trust_repeated_identical_bounds, setup),
+        cmocka_unit_test_setup(test_track_predicts_a_static_object_under_ego_motion, setup),
+        cmocka_unit_test_setup(test_track_confirms_static_objects_not_scattered_clutter, setup),
+        cmocka_unit_test_setup(test_track_prediction_follows_a_reversing_vehicle, setup),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
