@@ -12,7 +12,7 @@ for g in "$@"; do
              gcc-arm-none-eabi libnewlib-arm-none-eabi gcc-aarch64-linux-gnu gcc-s390x-linux-gnu libc6-dev-arm64-cross libc6-dev-s390x-cross
              qemu-user libcmocka-dev:arm64 libcmocka-dev:s390x libc6:arm64 libc6:s390x
              python3-canmatrix python3-can python3-numpy can-utils user-mode-linux iproute2 kmod
-             qemu-system-x86 busybox-static cpio usbutils" ;;
+             qemu-system-x86 busybox-static cpio usbutils tshark" ;;
     demo) pkgs="$pkgs python3-canmatrix can-utils" ;;
     *) echo "deps.sh: unknown group '$g'" >&2; exit 2 ;;
     esac
