@@ -14,7 +14,7 @@ for g in "$@"; do
              libpcap-dev:arm64 libusb-1.0-0-dev:arm64 libinih-dev:arm64 libc6:arm64 libc6:s390x
              python3-canmatrix python3-can python3-numpy can-utils user-mode-linux iproute2 kmod
              qemu-system-x86 busybox-static cpio usbutils
-             qemu-system-arm cppcheck clang-tidy" ;;
+             qemu-system-arm cppcheck clang-tidy tshark" ;;
     demo) pkgs="$pkgs python3-canmatrix can-utils" ;;
     *) echo "deps.sh: unknown group '$g'" >&2; exit 2 ;;
     esac

@@ -1,9 +1,11 @@
-// replay.h: the sl-replay subcommands (serve, record, from-oxford).
+// replay.h: the sl-replay subcommands (serve, record, from-oxford, to-pcapng).
 #pragma once
 
 #include <csignal>
 #include <cstdint>
 #include <string>
+
+#include "pcapng_writer.h"
 
 namespace sl::replay {
 
@@ -51,5 +53,15 @@ struct RecordOptions {
     bool verbose = false;
 };
 int record(const RecordOptions &o);
+
+struct PcapngOptions {
+    std::string input;         ///< raw .colossus capture, or "-" for stdin
+    std::string out;           ///< pcapng file, or "-" for stdout
+    PcapngSession session{};   ///< addresses, ports, segment size
+    bool non_contour = false;  ///< the client's command is 140 instead of 21
+};
+/// Converts a raw capture into a pcapng of one TCP session. 0 ok, 1 error (unreadable input,
+/// write failure, or no radar message in the input).
+int to_pcapng(const PcapngOptions &o);
 
 } // namespace sl::replay

@@ -3,6 +3,7 @@
 //   sl-replay serve CAPTURE [--port P] [--bind ADDR] [--rate realtime|max] [--loop] ...
 //   sl-replay record --radar HOST:PORT --out FILE [--duration S] [--non-contour]
 //   sl-replay from-oxford DIR --out FILE [--bin-size-m 0.0432]
+//   sl-replay to-pcapng RAW --out FILE.pcapng [--mss N] ...
 #include "replay.h"
 
 #include "capture.h"
@@ -78,7 +79,13 @@ void usage()
         "      --silence-ms N      reconnect when nothing arrives for N ms (default 3000)\n"
         "  sl-replay from-oxford DIR --out FILE [--bin-size-m 0.0432]\n"
         "      DIR/radar/*.png (or DIR/*.png), Oxford Radar RobotCar polar PNGs\n"
-        "      --encoder-size N --rotation-mhz N --packet-rate N (defaults 5600 4000 1600)\n");
+        "      --encoder-size N --rotation-mhz N --packet-rate N (defaults 5600 4000 1600)\n"
+        "  sl-replay to-pcapng RAW --out FILE.pcapng [options]\n"
+        "      a raw capture (or - for stdin) as one TCP session radar:6317 -> client, as\n"
+        "      tcpdump records it (handshake, Start FFT, MSS segments, ACKs, FIN); every\n"
+        "      byte kept; time from the FFT timestamps; --out - writes to stdout\n"
+        "      --mss N (1448) --radar-ip A (192.168.0.1) --client-ip A (192.168.0.2)\n"
+        "      --radar-port P (6317) --client-port P (50000) --non-contour (140, not 21)\n");
 }
 
 bool parse_u64(const char *s, uint64_t &v)
@@ -319,6 +326,57 @@ int cmd_from_oxford(int argc, char **argv)
     return 0;
 }
 
+bool parse_ipv4(const char *s, uint32_t &ip)
+{
+    unsigned a, b, c, d;
+    char tail;
+    if (std::sscanf(s, "%u.%u.%u.%u%c", &a, &b, &c, &d, &tail) != 4 || a > 255 || b > 255 ||
+        c > 255 || d > 255)
+        return false;
+    ip = a << 24 | b << 16 | c << 8 | d;
+    return true;
+}
+
+int cmd_to_pcapng(int argc, char **argv)
+{
+    PcapngOptions o;
+    for (int i = 2; i < argc; ++i) {
+        const std::string a = argv[i];
+        uint64_t v = 0;
+        if (a == "--out") {
+            NEED_ARG();
+            o.out = argv[++i];
+        } else if (a == "--mss") {
+            NEED_ARG();
+            if (!parse_u64(argv[++i], v) || v == 0 || v > 65495) return usage(), 2;
+            o.session.mss = static_cast<uint32_t>(v);
+        } else if (a == "--radar-ip" || a == "--client-ip") {
+            NEED_ARG();
+            if (!parse_ipv4(argv[++i], a == "--radar-ip" ? o.session.radar_ip : o.session.client_ip)) {
+                std::fprintf(stderr, "sl-replay to-pcapng: bad IPv4 address %s\n", argv[i]);
+                return 2;
+            }
+        } else if (a == "--radar-port" || a == "--client-port") {
+            NEED_ARG();
+            if (!parse_u64(argv[++i], v) || v == 0 || v > 65535) return usage(), 2;
+            (a == "--radar-port" ? o.session.radar_port : o.session.client_port) =
+                static_cast<uint16_t>(v);
+        } else if (a == "--non-contour") {
+            o.non_contour = true;
+        } else if (a.size() > 1 && a[0] == '-') {
+            std::fprintf(stderr, "sl-replay to-pcapng: unknown option %s\n", a.c_str());
+            return 2;
+        } else if (o.input.empty()) {
+            o.input = a;
+        } else {
+            return usage(), 2;
+        }
+    }
+    if (o.input.empty() || o.out.empty()) return usage(), 2;
+    install_signal_handlers();
+    return to_pcapng(o);
+}
+
 } // namespace
 
 int main(int argc, char **argv)
@@ -331,6 +389,7 @@ int main(int argc, char **argv)
     if (cmd == "serve") return cmd_serve(argc, argv);
     if (cmd == "record") return cmd_record(argc, argv);
     if (cmd == "from-oxford") return cmd_from_oxford(argc, argv);
+    if (cmd == "to-pcapng") return cmd_to_pcapng(argc, argv);
     if (cmd == "-h" || cmd == "--help") {
         usage();
         return 0;
