@@ -27,6 +27,10 @@
 
 static const double PI = 3.14159265358979323846;
 
+// Digest of the noise-free sweep's results (see digest_result), from x86-64; must match on
+// every target.
+#define RESULTS_DIGEST 0xc659fcff94e42981ULL
+
 static double rad(double d) { return d * PI / 180.0; }
 static double deg(double r) { return r * 180.0 / PI; }
 static uint32_t bam(double d) { return (uint32_t)(uint64_t)llround(d / 360.0 * 4294967296.0); }
@@ -287,6 +291,25 @@ static scene_t base_scene(void)
     return sc;
 }
 
+// FNV-1a over every result of the noise-free sweep: the same value on every target
+// (x86-64, aarch64, big-endian s390x) proves the fixed-point fit bit-identical.
+static uint64_t digest = 14695981039346656037ULL;
+static void digest_i32(int32_t v)
+{
+    for (int i = 0; i < 4; ++i) {
+        digest ^= (uint8_t)((uint32_t)v >> (8 * i));
+        digest *= 1099511628211ULL;
+    }
+}
+static void digest_result(const sl_tilt_result_t *r)
+{
+    const int32_t f[] = {r->quality, r->n_obs, r->n_mirrored, (int32_t)r->mirrored_mask,
+                         r->tx_q24, r->ty_q24, r->psi_cdeg, r->phi_cdeg, r->psi_sigma_cdeg,
+                         r->phi_sigma_cdeg, r->base_x_um, r->base_y_um, (int32_t)r->chi2_q8,
+                         (int32_t)r->chi2_other_q8};
+    for (size_t i = 0; i < sizeof f / sizeof f[0]; ++i) digest_i32(f[i]);
+}
+
 static double worst_t;    // largest |fixed - double| of a tilt component seen
 static double worst_base; // ... of the base position, m
 
@@ -367,12 +390,15 @@ static void test_noise_free_drive_bys_recover_tilt_direction_and_base(void **sta
                     sc.v = 1.0 + (double)((o + p + f) % 3);
                     sc.seconds = 12.0 / sc.v;
                     const sl_tilt_result_t r = check_scene(&sc, 1.0, 10.0, 0.05, 1);
+                    digest_result(&r);
                     mirrored_cases += r.n_mirrored > 0;
                     ++cases;
                 }
     printf("%u drive-bys, %u with measurements read across the fold; fixed vs double: "
            "max |dt| %.2g, base %.2g m\n", cases, mirrored_cases, worst_t, worst_base);
     assert_true(mirrored_cases >= 10); // poles leaning away beyond the fold were among them
+    printf("results digest %016llx\n", (unsigned long long)digest);
+    assert_true(digest == RESULTS_DIGEST);
 }
 
 static void test_pole_leaning_away_beyond_the_fold_gets_its_true_direction(void **state)
