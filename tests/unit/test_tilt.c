@@ -1,0 +1,566 @@
+// Unit tests for sl_tilt.h: 3D pole tilt from the in-plane inclinations of a drive-by.
+//
+// Drive-bys are simulated here in double precision, independently of the module: a pole
+// P(z) = B + z (tan psi cos phi, tan psi sin phi, 1), a radar at height H moving on a straight
+// or curved path at 4 rotations per second; on each rotation the pole is "seen" when its
+// point at radar height is 1.5..5 m away; the radar reports the bearing of the azimuth cell
+// (0.9 deg cells) and the in-plane inclination alpha = atan(-(t . e)) (MATH.md s.5) as the
+// estimator would read it: folded to beta - theta - alpha when the pole leans away beyond the
+// fold, with branch 2 when alpha < beta; r1 from the in-plane geometry.
+//
+// Checked: sine/cosine and odometry against libm; the fixed-point fit against a plain double
+// implementation of the same estimator (same two starts, same reassignment rule, same
+// weights); the fit against the simulated truth (tilt, direction, base) for straight and
+// curved paths, both sides of the path, tilts 3-20 deg, directions all around, poles leaning
+// away beyond the fold; noise; and the safety property: a direction that is wrong by more
+// than 30 deg is never reported as FITTED.
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "shadowlean/sl_tilt.h"
+
+static const double PI = 3.14159265358979323846;
+
+// Digest of the noise-free sweep's results (see digest_result), from x86-64; must match on
+// every target.
+#define RESULTS_DIGEST 0xc659fcff94e42981ULL
+
+static double rad(double d) { return d * PI / 180.0; }
+static double deg(double r) { return r * 180.0 / PI; }
+static uint32_t bam(double d) { return (uint32_t)(uint64_t)llround(d / 360.0 * 4294967296.0); }
+static double bam_deg(uint32_t b) { return (double)(int32_t)b * 360.0 / 4294967296.0; }
+static double wrap180(double d)
+{
+    while (d > 180.0) d -= 360.0;
+    while (d <= -180.0) d += 360.0;
+    return d;
+}
+
+// Deterministic Gaussian noise (xorshift + Box-Muller): same numbers on every target.
+static uint64_t rng = 88172645463325252ULL;
+static double urand(void)
+{
+    rng ^= rng << 13;
+    rng ^= rng >> 7;
+    rng ^= rng << 17;
+    return ((double)(rng >> 11) + 0.5) / 9007199254740992.0;
+}
+static double grand(void)
+{
+    return sqrt(-2.0 * log(urand())) * cos(2.0 * PI * urand());
+}
+
+// ---------------------------------------------------------------------------------------
+static sl_tilt_work_t work;
+
+static void test_sincos_matches_libm(void **state)
+{
+    (void)state;
+    double worst = 0;
+    for (int i = 0; i <= 100000; ++i) {
+        const double d = -720.0 + 1440.0 * i / 100000.0;
+        sl_q30_t s, c;
+        sl_tilt_sincos_q30(bam(d), &s, &c);
+        const double es = fabs(s / 1073741824.0 - sin(rad(d)));
+        const double ec = fabs(c / 1073741824.0 - cos(rad(d)));
+        worst = fmax(worst, fmax(es, ec));
+    }
+    printf("sincos: max |error| %.3g\n", worst);
+    assert_true(worst <= 5e-6);
+}
+
+static void test_odometry_follows_straight_and_circular_paths(void **state)
+{
+    (void)state;
+    // 10 s straight at 2 m/s heading 30 deg, 25 ms steps.
+    sl_tilt_odom_t o = {0, 0, bam(30.0)};
+    for (int k = 0; k < 400; ++k) sl_tilt_odom_step(&o, 2000, 0, 25000);
+    assert_true(fabs(o.x_um * 1e-6 - 20.0 * cos(rad(30))) < 5e-4); // 5e-6 trig error
+    assert_true(fabs(o.y_um * 1e-6 - 20.0 * sin(rad(30))) < 5e-4);
+    // 1 m/s at 10 deg/s: a circle of radius 5.7296 m; a quarter turn (9 s) then the full
+    // turn (36 s) closes on the start.
+    sl_tilt_odom_t c = {0, 0, 0};
+    const double R = 1.0 / rad(10.0);
+    for (int k = 0; k < 360; ++k) sl_tilt_odom_step(&c, 1000, 10000, 25000);
+    printf("quarter: %.6f %.6f yaw %.4f\n", c.x_um * 1e-6, c.y_um * 1e-6, bam_deg(c.yaw));
+    assert_true(fabs(c.x_um * 1e-6 - R) < 1e-3);
+    assert_true(fabs(c.y_um * 1e-6 - R) < 1e-3);
+    assert_true(fabs(bam_deg(c.yaw) - 90.0) < 1e-3);
+    for (int k = 0; k < 1080; ++k) sl_tilt_odom_step(&c, 1000, 10000, 25000);
+    assert_true(fabs(c.x_um * 1e-6) < 2e-3 && fabs(c.y_um * 1e-6) < 2e-3);
+    assert_true(fabs(wrap180(bam_deg(c.yaw))) < 2e-3);
+    // A stale gap is clamped to 1 s; NULL is ignored.
+    sl_tilt_odom_t g = {0, 0, 0};
+    sl_tilt_odom_step(&g, 1000, 0, 60000000U);
+    assert_int_equal(g.x_um, 1000000);
+    sl_tilt_odom_step(NULL, 1000, 0, 1000);
+}
+
+// ---------------------------------------------------------------------------------------
+// Drive-by simulation.
+
+typedef struct scene {
+    double H;          // radar height, m
+    double theta, beta; // deg (one theta for every azimuth: paper-sim)
+    double bx, by;     // pole base, m
+    double psi, phi;   // tilt and direction (deg, CCW from +x, odometry frame)
+    double v;          // speed, m/s
+    double yaw_rate;   // deg/s
+    double x0;         // start x (the path starts at (x0, 0) heading +x)
+    double seconds;    // duration
+    double alpha_noise; // deg, 1-sigma added to alpha
+    double sigma_cdeg; // stated sigma of alpha
+} scene_t;
+
+typedef struct sim {
+    sl_tilt_obs_t obs[SL_TILT_MAX_OBS];
+    size_t n;
+    // doubles of the same measurements, for the oracle
+    double rx[SL_TILT_MAX_OBS], ry[SL_TILT_MAX_OBS], a[SL_TILT_MAX_OBS];
+    double tan_m[SL_TILT_MAX_OBS], tan_f[SL_TILT_MAX_OBS], sig[SL_TILT_MAX_OBS];
+    double r1[SL_TILT_MAX_OBS];
+    int mirrorable[SL_TILT_MAX_OBS];
+    sl_incline_geom_t geom;
+    sl_tilt_params_t prm;
+} sim_t;
+
+static void simulate(const scene_t *sc, sim_t *s)
+{
+    memset(s, 0, sizeof *s);
+    s->geom.theta_bam32 = bam(sc->theta);
+    s->geom.beta_bam32 = bam(sc->beta);
+    s->prm.radar_height_um = (uint32_t)llround(sc->H * 1e6);
+    s->prm.cos_beta_q30 = (int32_t)llround(cos(rad(sc->beta)) * 1073741824.0);
+    s->prm.sin_beta_q30 = (int32_t)llround(sin(rad(sc->beta)) * 1073741824.0);
+    const double tt = tan(rad(sc->psi));
+    const double tx = tt * cos(rad(sc->phi)), ty = tt * sin(rad(sc->phi));
+    const double qx = sc->bx + sc->H * tx, qy = sc->by + sc->H * ty; // point at radar height
+    double x = sc->x0, y = 0, yaw = 0;
+    const double dt = 0.25;
+    const double fold = (sc->beta - sc->theta) / 2.0;
+    for (double t = 0; t <= sc->seconds + 1e-9 && s->n < SL_TILT_MAX_OBS; t += dt) {
+        const double dx = qx - x, dy = qy - y;
+        const double d0 = hypot(dx, dy);
+        const double dbase = hypot(sc->bx - x, sc->by - y);
+        if (d0 >= 1.3 && dbase <= sc->H / tan(rad(sc->theta))) {
+            // bearing of the azimuth cell the pole falls in (0.9 deg cells, radar-relative)
+            const double rel = fmod(deg(atan2(dy, dx)) - deg(yaw) + 720.0, 360.0);
+            const double cell = (floor(rel / 0.9) + 0.5) * 0.9;
+            const double a_meas = rad(cell) + yaw;
+            const double a_true = atan2(dy, dx);
+            const double alpha = deg(atan(-(tx * cos(a_true) + ty * sin(a_true))));
+            const double p = d0 * cos(rad(alpha)); // perpendicular foot
+            const double r1 = (alpha >= sc->beta) ? p / cos(rad(sc->beta - alpha)) : p;
+            double read = (alpha < fold) ? sc->beta - sc->theta - alpha : alpha;
+            read += sc->alpha_noise * grand();
+            const int branch = (read >= sc->beta) ? 1 : 2;
+            const size_t k = s->n;
+            assert_true(sl_tilt_obs_make(&s->obs[k], (int32_t)llround(x * 1e6),
+                                         (int32_t)llround(y * 1e6), bam(deg(a_meas)),
+                                         (uint32_t)llround(r1 * 1e6), bam(read),
+                                         (uint16_t)sc->sigma_cdeg, (uint8_t)branch, &s->geom));
+            // The oracle takes exactly what the module stores (Q12 tan, Q15 direction,
+            // Q16 sigma, um), so the comparison measures the arithmetic alone.
+            const sl_tilt_obs_t *o = &s->obs[k];
+            s->rx[k] = o->radar_x_um * 1e-6;
+            s->ry[k] = o->radar_y_um * 1e-6;
+            s->a[k] = atan2(o->sin_a_q15, o->cos_a_q15);
+            s->r1[k] = o->r1_um * 1e-6;
+            s->tan_m[k] = o->tan_q12 / 4096.0;
+            s->tan_f[k] = o->tan_mirror_q12 / 4096.0;
+            s->mirrorable[k] = o->mirrorable;
+            s->sig[k] = o->sigma_q16 / 65536.0;
+            // and the stored values are what the simulation meant
+            assert_true(fabs(s->a[k] - a_meas) < 1e-4 || fabs(fabs(s->a[k] - a_meas) - 2 * PI) < 1e-4);
+            assert_true(fabs(s->tan_m[k] - tan(rad(read))) <= 1.3e-4);
+            assert_int_equal(o->mirrorable,
+                             branch == 2 || read - sc->beta < 2.0 * sc->sigma_cdeg / 100.0);
+            if (o->mirrorable)
+                assert_true(fabs(s->tan_f[k] - tan(rad(sc->beta - sc->theta - read))) <= 1.3e-4);
+            assert_true(fabs(s->sig[k] - fmax(rad(sc->sigma_cdeg / 100.0) *
+                                                  (1 + s->tan_m[k] * s->tan_m[k]),
+                                              SL_TILT_SIGMA_MIN_Q16 / 65536.0)) < 1e-4);
+            s->n++;
+        }
+        // advance the vehicle (midpoint rule, like the module's odometry)
+        const double ym = yaw + rad(sc->yaw_rate) * dt / 2;
+        x += sc->v * dt * cos(ym);
+        y += sc->v * dt * sin(ym);
+        yaw += rad(sc->yaw_rate) * dt;
+    }
+}
+
+// The same estimator in double precision.
+typedef struct dfit {
+    double tx, ty, chi2, chi2_other, bx, by;
+    int ok, ambiguous;
+} dfit_t;
+
+// Interval candidates in bearing order, each solved and scored directly.
+static void dsolve(const sim_t *s, uint64_t ch, double *tx, double *ty, double *det)
+{
+    double A = 0, B = 0, C = 0, U = 0, V = 0, W = 0, w0 = 1e300;
+    for (size_t k = 0; k < s->n; ++k) w0 = fmin(w0, s->sig[k]);
+    for (size_t k = 0; k < s->n; ++k) {
+        const double w = (w0 / s->sig[k]) * (w0 / s->sig[k]);
+        const double c = cos(s->a[k]), sn = sin(s->a[k]);
+        const double t = ((ch >> k) & 1) ? s->tan_f[k] : s->tan_m[k];
+        A += w * c * c; B += w * c * sn; C += w * sn * sn; U += w * c * t; V += w * sn * t;
+        W += w;
+    }
+    A /= W; B /= W; C /= W; U /= W; V /= W;
+    *det = A * C - B * B;
+    *tx = -(C * U - B * V) / *det;
+    *ty = -(A * V - B * U) / *det;
+}
+
+static double dchi2(const sim_t *s, uint64_t ch, double tx, double ty)
+{
+    double x2 = 0;
+    for (size_t k = 0; k < s->n; ++k) {
+        const double t = ((ch >> k) & 1) ? s->tan_f[k] : s->tan_m[k];
+        const double r = t + tx * cos(s->a[k]) + ty * sin(s->a[k]);
+        x2 += (r / s->sig[k]) * (r / s->sig[k]);
+    }
+    return x2;
+}
+
+static void dfit(const sim_t *s, const scene_t *sc, dfit_t *f)
+{
+    memset(f, 0, sizeof *f);
+    size_t ord[SL_TILT_MAX_OBS], m = 0;
+    double mc = 0, ms = 0;
+    for (size_t k = 0; k < s->n; ++k)
+        if (s->mirrorable[k]) { ord[m++] = k; mc += cos(s->a[k]); ms += sin(s->a[k]); }
+    const double ref = atan2(ms, mc);
+    for (size_t i = 1; i < m; ++i) // sort by bearing around the mean
+        for (size_t j = i; j > 0 && remainder(s->a[ord[j - 1]] - ref, 2 * PI) >
+                                    remainder(s->a[ord[j]] - ref, 2 * PI); --j) {
+            const size_t t = ord[j]; ord[j] = ord[j - 1]; ord[j - 1] = t;
+        }
+    double det, btx = 0, bty = 0, bx2 = 1e300;
+    dsolve(s, 0, &btx, &bty, &det);
+    f->ok = det >= SL_TILT_MIN_SPREAD_Q30 / 1073741824.0;
+    if (!f->ok) return;
+    // every circular interval (start, len) of the mirrorable ones
+    static double ctx[SL_TILT_MAX_OBS * SL_TILT_MAX_OBS + 2], cty[SL_TILT_MAX_OBS * SL_TILT_MAX_OBS + 2],
+        cx2[SL_TILT_MAX_OBS * SL_TILT_MAX_OBS + 2];
+    size_t nc = 0;
+    for (size_t len = 0; len <= m; ++len) {
+        const size_t starts = (len == 0 || len == m) ? 1 : m;
+        for (size_t i = 0; i < starts; ++i) {
+            uint64_t ch = 0;
+            for (size_t j = 0; j < len; ++j) ch |= (uint64_t)1 << ord[(i + j) % m];
+            double tx, ty;
+            dsolve(s, ch, &tx, &ty, &det);
+            ctx[nc] = tx; cty[nc] = ty; cx2[nc] = dchi2(s, ch, tx, ty);
+            if (cx2[nc] < bx2) { bx2 = cx2[nc]; btx = tx; bty = ty; }
+            ++nc;
+        }
+    }
+    f->tx = btx;
+    f->ty = bty;
+    f->chi2 = bx2;
+    const double distinct = fmax(0.035, 0.3 * hypot(btx, bty));
+    f->chi2_other = 1e300;
+    for (size_t c = 0; c < nc; ++c)
+        if (hypot(ctx[c] - btx, cty[c] - bty) > distinct) f->chi2_other = fmin(f->chi2_other, cx2[c]);
+    f->ambiguous = f->chi2_other < bx2 + 9.0;
+    double sx = 0, sy = 0;
+    for (size_t k = 0; k < s->n; ++k) {
+        const double p = -(f->tx * cos(s->a[k]) + f->ty * sin(s->a[k]));
+        const double d0 = (p >= tan(rad(sc->beta)))
+                              ? s->r1[k] * (cos(rad(sc->beta)) + sin(rad(sc->beta)) * p)
+                              : s->r1[k] * sqrt(1 + p * p);
+        sx += s->rx[k] + d0 * cos(s->a[k]);
+        sy += s->ry[k] + d0 * sin(s->a[k]);
+    }
+    f->bx = sx / (double)s->n - sc->H * f->tx;
+    f->by = sy / (double)s->n - sc->H * f->ty;
+}
+
+static scene_t base_scene(void)
+{
+    scene_t sc = {2.58, 26.0, 0.0, 0.0, 3.0, 10.0, 0.0, 1.0, 0.0, -6.0, 12.0, 0.0, 20.0};
+    return sc;
+}
+
+// FNV-1a over every result of the noise-free sweep: the same value on every target
+// (x86-64, aarch64, big-endian s390x) proves the fixed-point fit bit-identical.
+static uint64_t digest = 14695981039346656037ULL;
+static void digest_i32(int32_t v)
+{
+    for (int i = 0; i < 4; ++i) {
+        digest ^= (uint8_t)((uint32_t)v >> (8 * i));
+        digest *= 1099511628211ULL;
+    }
+}
+static void digest_result(const sl_tilt_result_t *r)
+{
+    const int32_t f[] = {r->quality, r->n_obs, r->n_mirrored, (int32_t)r->mirrored_mask,
+                         r->tx_q24, r->ty_q24, r->psi_cdeg, r->phi_cdeg, r->psi_sigma_cdeg,
+                         r->phi_sigma_cdeg, r->base_x_um, r->base_y_um, (int32_t)r->chi2_q8,
+                         (int32_t)r->chi2_other_q8};
+    for (size_t i = 0; i < sizeof f / sizeof f[0]; ++i) digest_i32(f[i]);
+}
+
+static double worst_t;    // largest |fixed - double| of a tilt component seen
+static double worst_base; // ... of the base position, m
+
+// One drive-by: fixed vs double, and both vs truth. Returns the fit.
+static sl_tilt_result_t check_scene(const scene_t *sc, double tol_psi, double tol_phi,
+                                    double tol_base_m, int expect_fitted)
+{
+    static sim_t s;
+    simulate(sc, &s);
+    sl_tilt_result_t r;
+    assert_int_equal(sl_tilt_fit(s.obs, s.n, &s.prm, &work, &r), SL_OK);
+    dfit_t d;
+    dfit(&s, sc, &d);
+    const double tx = r.tx_q24 / 16777216.0, ty = r.ty_q24 / 16777216.0;
+    const double psi = r.psi_cdeg / 100.0, phi = r.phi_cdeg / 100.0;
+    const double dpsi = deg(atan(hypot(d.tx, d.ty))), dphi = deg(atan2(d.ty, d.tx));
+    (void)dpsi;
+    (void)dphi;
+    if (expect_fitted && r.quality != SL_TILT_FITTED) {
+        printf("quality %u for psi %.1f phi %.1f base (%.2f, %.2f) v %.1f: n %u chi2 %.1f/%.1f\n",
+               r.quality, sc->psi, sc->phi, sc->bx, sc->by, sc->v, r.n_obs, r.chi2_q8 / 256.0,
+               r.chi2_other_q8 / 256.0);
+    }
+    if (expect_fitted) assert_int_equal(r.quality, SL_TILT_FITTED);
+    // fixed point == double implementation of the same estimator
+    assert_int_equal(d.ok, 1);
+    assert_int_equal(d.ambiguous, r.quality == SL_TILT_AMBIGUOUS);
+    // The same reading of the fold, or a tie (near-fold measurements read either way fit
+    // alike: then the double solution for the module's reading must be as good).
+    double ftx, fty, fdet;
+    dsolve(&s, r.mirrored_mask, &ftx, &fty, &fdet);
+    const double fx2 = dchi2(&s, r.mirrored_mask, ftx, fty);
+    if (fx2 > d.chi2 * 1.001 + 0.05) printf("module chi2 %.3f (its reading, double) vs best %.3f; mask %x n %zu\n", fx2, d.chi2, r.mirrored_mask, s.n);
+    assert_true(fx2 <= d.chi2 * 1.001 + 0.05);
+    if (fabs(tx - ftx) > 2e-5 || fabs(ty - fty) > 2e-5) {
+        printf("fixed (%.6f, %.6f) double (%.6f, %.6f)\n", tx, ty, ftx, fty);
+    }
+    worst_t = fmax(worst_t, fmax(fabs(tx - ftx), fabs(ty - fty)));
+    assert_true(fabs(tx - ftx) <= 2e-5 && fabs(ty - fty) <= 2e-5);
+    const double fpsi = deg(atan(hypot(ftx, fty))), fphi = deg(atan2(fty, ftx));
+    assert_true(fabs(psi - fpsi) <= 0.01);
+    if (fpsi >= 1.0) assert_true(fabs(wrap180(phi - fphi)) <= 0.01 * 10.0 / fpsi + 0.01);
+    worst_base = fmax(worst_base, hypot(r.base_x_um * 1e-6 - d.bx, r.base_y_um * 1e-6 - d.by));
+    assert_true(hypot(r.base_x_um * 1e-6 - d.bx, r.base_y_um * 1e-6 - d.by) < 0.002);
+    // ... and against the truth
+    const double epsi = psi - sc->psi, ephi = wrap180(phi - sc->phi);
+    const double ebase = hypot(r.base_x_um * 1e-6 - sc->bx, r.base_y_um * 1e-6 - sc->by);
+    if (fabs(epsi) > tol_psi || fabs(ephi) > tol_phi || ebase > tol_base_m) {
+        printf("psi %.2f (true %.2f) phi %.2f (true %.2f) base err %.3f m, n %u mirrored %u "
+               "chi2 %.1f other %.1f q %u\n",
+               psi, sc->psi, phi, sc->phi, ebase, r.n_obs, r.n_mirrored, r.chi2_q8 / 256.0,
+               r.chi2_other_q8 / 256.0, r.quality);
+    }
+    assert_true(fabs(epsi) <= tol_psi);
+    assert_true(fabs(ephi) <= tol_phi);
+    assert_true(ebase <= tol_base_m);
+    return r;
+}
+
+static void test_noise_free_drive_bys_recover_tilt_direction_and_base(void **state)
+{
+    (void)state;
+    // paper-sim (theta 26, beta 0) and a beta = 3 deg radar; 1-3 m/s; offsets 2-4 m on both
+    // sides; tilt 5-20 deg in 8 directions.
+    const double betas[2] = {0.0, 3.0};
+    const double offs[4] = {-4.0, -2.0, 2.0, 3.5};
+    const double psis[3] = {5.0, 10.0, 20.0};
+    unsigned cases = 0, mirrored_cases = 0;
+    for (int b = 0; b < 2; ++b)
+        for (int o = 0; o < 4; ++o)
+            for (int p = 0; p < 3; ++p)
+                for (int f = 0; f < 8; ++f) {
+                    scene_t sc = base_scene();
+                    sc.beta = betas[b];
+                    sc.by = offs[o];
+                    sc.psi = psis[p];
+                    sc.phi = f * 45.0 + 10.0;
+                    sc.v = 1.0 + (double)((o + p + f) % 3);
+                    sc.seconds = 12.0 / sc.v;
+                    const sl_tilt_result_t r = check_scene(&sc, 1.0, 10.0, 0.05, 1);
+                    digest_result(&r);
+                    mirrored_cases += r.n_mirrored > 0;
+                    ++cases;
+                }
+    printf("%u drive-bys, %u with measurements read across the fold; fixed vs double: "
+           "max |dt| %.2g, base %.2g m\n", cases, mirrored_cases, worst_t, worst_base);
+    assert_true(mirrored_cases >= 10); // poles leaning away beyond the fold were among them
+    printf("results digest %016llx\n", (unsigned long long)digest);
+    assert_true(digest == RESULTS_DIGEST);
+}
+
+static void test_pole_leaning_away_beyond_the_fold_gets_its_true_direction(void **state)
+{
+    (void)state;
+    // Leaning 20 deg straight away from the path (pole at +y, top towards +y): every single
+    // rotation reads it as its mirror (about -6 deg instead of -20); the pass resolves it.
+    scene_t sc = base_scene();
+    sc.by = 3.0;
+    sc.psi = 20.0;
+    sc.phi = 90.0;
+    const sl_tilt_result_t r = check_scene(&sc, 1.0, 10.0, 0.05, 1);
+    assert_true(r.n_mirrored >= r.n_obs / 2);
+    assert_true(r.chi2_other_q8 > r.chi2_q8 + SL_TILT_AMBIGUITY_CHI2_Q8);
+}
+
+static void test_curved_path_at_10_deg_per_second(void **state)
+{
+    (void)state;
+    const double phis[4] = {0.0, 100.0, 200.0, 300.0};
+    for (int f = 0; f < 4; ++f) {
+        scene_t sc = base_scene();
+        sc.yaw_rate = 10.0;
+        sc.x0 = -5.0;
+        sc.by = 3.0;
+        sc.psi = 12.0;
+        sc.phi = phis[f];
+        sc.seconds = 10.0;
+        check_scene(&sc, 1.0, 10.0, 0.05, 1);
+    }
+}
+
+static void test_noisy_alpha_within_2_deg_and_20_deg(void **state)
+{
+    (void)state;
+    // 1 deg (1-sigma) of noise on every alpha, stated as such; 40 random poles.
+    rng = 0x9E3779B97F4A7C15ULL;
+    double worst_psi = 0, worst_phi = 0;
+    for (int i = 0; i < 40; ++i) {
+        scene_t sc = base_scene();
+        sc.psi = 5.0 + 15.0 * urand();
+        sc.phi = 360.0 * urand();
+        sc.by = (urand() < 0.5 ? -1.0 : 1.0) * (2.0 + 2.0 * urand());
+        sc.v = 1.0 + 2.0 * urand();
+        sc.seconds = 12.0 / sc.v;
+        sc.alpha_noise = 1.0;
+        sc.sigma_cdeg = 100.0;
+        static sim_t s;
+        simulate(&sc, &s);
+        sl_tilt_result_t r;
+        assert_int_equal(sl_tilt_fit(s.obs, s.n, &s.prm, &work, &r), SL_OK);
+        if (r.quality == SL_TILT_AMBIGUOUS) continue; // reported as such: allowed
+        assert_true(r.quality == SL_TILT_FITTED);
+        const double epsi = fabs(r.psi_cdeg / 100.0 - sc.psi);
+        const double ephi = fabs(wrap180(r.phi_cdeg / 100.0 - sc.phi));
+        worst_psi = fmax(worst_psi, epsi);
+        worst_phi = fmax(worst_phi, ephi);
+        // the stated sigmas cover the error (4 sigma)
+        assert_true(epsi <= 4.0 * r.psi_sigma_cdeg / 100.0 + 0.2);
+        assert_true(ephi <= 4.0 * r.phi_sigma_cdeg / 100.0 + 2.0);
+    }
+    printf("noisy: worst |psi error| %.2f deg, |phi error| %.1f deg\n", worst_psi, worst_phi);
+    assert_true(worst_psi <= 2.0);
+    assert_true(worst_phi <= 20.0);
+}
+
+static void test_never_a_confident_wrong_direction(void **state)
+{
+    (void)state;
+    // Short and long passes, random poles, 0.5 deg noise: FITTED implies the direction is
+    // within 30 deg (psi >= 5); otherwise the fit must say AMBIGUOUS or INSUFFICIENT_MOTION.
+    rng = 12345;
+    unsigned fitted = 0, ambiguous = 0, other = 0;
+    for (int i = 0; i < 300; ++i) {
+        scene_t sc = base_scene();
+        sc.psi = 5.0 + 15.0 * urand();
+        sc.phi = 360.0 * urand();
+        sc.by = (urand() < 0.5 ? -1.0 : 1.0) * (2.0 + 2.0 * urand());
+        sc.x0 = -1.0 - 5.0 * urand();
+        sc.seconds = 1.5 + 8.0 * urand();
+        sc.alpha_noise = 0.5;
+        sc.sigma_cdeg = 50.0;
+        static sim_t s;
+        simulate(&sc, &s);
+        sl_tilt_result_t r;
+        assert_int_equal(sl_tilt_fit(s.obs, s.n, &s.prm, &work, &r), SL_OK);
+        if (r.quality == SL_TILT_FITTED) {
+            ++fitted;
+            const double ephi = fabs(wrap180(r.phi_cdeg / 100.0 - sc.phi));
+            if (ephi > 30.0) {
+                printf("wrong: psi %.1f phi %.1f -> %.1f / %.1f n %u chi2 %.1f other %.1f\n", sc.psi,
+                       sc.phi, r.psi_cdeg / 100.0, r.phi_cdeg / 100.0, r.n_obs, r.chi2_q8 / 256.0,
+                       r.chi2_other_q8 / 256.0);
+                printf("scene by %.2f x0 %.2f secs %.2f\n", sc.by, sc.x0, sc.seconds);
+                for (size_t k = 0; k < s.n; ++k) {
+                    const double tx = r.tx_q24 / 16777216.0, ty = r.ty_q24 / 16777216.0;
+                    const double tt = tan(rad(sc.psi));
+                    const double ttx = tt * cos(rad(sc.phi)), tty = tt * sin(rad(sc.phi));
+                    printf("  a %7.2f tan %6.3f mir %6.3f m%d fit %6.3f true %6.3f sig %.4f\n",
+                           deg(s.a[k]), s.tan_m[k], s.tan_f[k], s.mirrorable[k],
+                           -(tx * cos(s.a[k]) + ty * sin(s.a[k])),
+                           -(ttx * cos(s.a[k]) + tty * sin(s.a[k])), s.sig[k]);
+                }
+            }
+            assert_true(ephi <= 30.0);
+        } else if (r.quality == SL_TILT_AMBIGUOUS) {
+            ++ambiguous;
+        } else {
+            ++other;
+        }
+    }
+    printf("fitted %u, ambiguous %u, too few / insufficient motion %u\n", fitted, ambiguous, other);
+    assert_true(fitted >= 150);
+}
+
+static void test_degenerate_inputs(void **state)
+{
+    (void)state;
+    static sim_t s;
+    scene_t sc = base_scene();
+    simulate(&sc, &s);
+    sl_tilt_result_t r;
+    assert_int_equal(sl_tilt_fit(NULL, 3, &s.prm, &work, &r), SL_ERR_ARG);
+    assert_int_equal(sl_tilt_fit(s.obs, s.n, NULL, &work, &r), SL_ERR_ARG);
+    assert_int_equal(sl_tilt_fit(s.obs, s.n, &s.prm, &work, NULL), SL_ERR_ARG);
+    assert_int_equal(sl_tilt_fit(s.obs, SL_TILT_MAX_OBS + 1U, &s.prm, &work, &r), SL_ERR_ARG);
+    assert_int_equal(sl_tilt_fit(s.obs, SL_TILT_MIN_OBS - 1U, &s.prm, &work, &r), SL_OK);
+    assert_int_equal(r.quality, SL_TILT_TOO_FEW);
+    // Parked: the same bearing every rotation.
+    sl_tilt_obs_t same[10];
+    for (int k = 0; k < 10; ++k) same[k] = s.obs[0];
+    assert_int_equal(sl_tilt_fit(same, 10, &s.prm, &work, &r), SL_OK);
+    assert_int_equal(r.quality, SL_TILT_INSUFFICIENT_MOTION);
+    assert_int_equal(r.psi_cdeg, 0);
+    // Measurements that cannot be: rejected by obs_make.
+    sl_tilt_obs_t o;
+    assert_false(sl_tilt_obs_make(&o, 0, 0, 0, 0, 0, 10, 1, &s.geom));              // r1 = 0
+    assert_false(sl_tilt_obs_make(&o, 0, 0, 0, 2000000, bam(85.0), 10, 1, &s.geom)); // |alpha|
+    assert_false(sl_tilt_obs_make(&o, 0, 0, 0, 2000000, 0, 10, 1, NULL));
+    assert_false(sl_tilt_obs_make(NULL, 0, 0, 0, 2000000, 0, 10, 1, &s.geom));
+    // Inconsistent: alpha that no straight pole produces (alternating +-15 deg).
+    for (size_t k = 0; k < s.n; ++k) {
+        assert_true(sl_tilt_obs_make(&s.obs[k], s.obs[k].radar_x_um, s.obs[k].radar_y_um,
+                                     bam(deg(atan2(s.obs[k].sin_a_q15, s.obs[k].cos_a_q15))),
+                                     s.obs[k].r1_um, bam((k & 1U) ? 15.0 : -15.0 + 13.0), 20, 1,
+                                     &s.geom));
+    }
+    assert_int_equal(sl_tilt_fit(s.obs, s.n, &s.prm, &work, &r), SL_OK);
+    assert_int_equal(r.quality, SL_TILT_INCONSISTENT);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_sincos_matches_libm),
+        cmocka_unit_test(test_odometry_follows_straight_and_circular_paths),
+        cmocka_unit_test(test_noise_free_drive_bys_recover_tilt_direction_and_base),
+        cmocka_unit_test(test_pole_leaning_away_beyond_the_fold_gets_its_true_direction),
+        cmocka_unit_test(test_curved_path_at_10_deg_per_second),
+        cmocka_unit_test(test_noisy_alpha_within_2_deg_and_20_deg),
+        cmocka_unit_test(test_never_a_confident_wrong_direction),
+        cmocka_unit_test(test_degenerate_inputs),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
