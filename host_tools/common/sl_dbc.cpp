@@ -96,8 +96,7 @@ const std::map<std::string, std::string> kMessageComments = {
                       "rate with E2E protection; CRC errors and counter jumps are counted."},
     {"Health", "Sent right after every Status: why the output may be degraded or blind. "
                "Any Fault bit set means do not trust an absent warning. A bit is set when "
-               "its condition held since the previous Health frame or still holds. "
-               "Data ID 0x54 is also VehicleMotion's (opposite direction); ids tell them apart."},
+               "its condition held since the previous Health frame or still holds."},
 };
 
 // key "Message.Signal"

@@ -100,7 +100,7 @@
 ///
 /// | start | len | signal            | type | range    | note |
 /// |------:|----:|-------------------|------|----------|------|
-/// |  0 | 8  | Crc               | u | 0..255   | E2E, Data ID 0x54 |
+/// |  0 | 8  | Crc               | u | 0..255   | E2E, Data ID 0x55 |
 /// |  8 | 4  | Counter           | u | 0..14    | E2E |
 /// | 12 | 4  | (reserved)        |   | 0        | |
 /// | 16 | 16 | Fault             | u | bitfield | SL_CAN_FAULT_* below, one bit per condition |
@@ -130,8 +130,6 @@
 ///   radar). Sustained: 48 frames x ~130 bits per 100 ms, under 13 % of a 500 kbit/s bus;
 ///   in any 100 ms at most (SL_CAN_BURST_WINDOWS + 1) x 48 frames, whatever the input.
 /// - bit8 TARGET_SLOTS_OVERFLOW: detection had more candidates than target slots.
-/// Note: Data ID 0x54 is also VehicleMotion's (received, opposite direction); the two are
-/// told apart by their CAN ids only.
 ///
 /// ## VehicleMotion (board `can.id_vehicle_motion`, VEHICLE -> SHADOWLEAN, input)
 ///
@@ -216,7 +214,7 @@ typedef enum sl_can_msg {
 #define SL_CAN_DATA_ID_LEAN_WARNING 0x52U
 #define SL_CAN_DATA_ID_STATUS 0x53U
 #define SL_CAN_DATA_ID_VEHICLE_MOTION 0x54U
-#define SL_CAN_DATA_ID_HEALTH 0x54U ///< same value as VehicleMotion's (fixed layout, see Health)
+#define SL_CAN_DATA_ID_HEALTH 0x55U ///< every message has its own Data ID
 
 #define SL_CAN_COUNTER_MODULO 15U ///< counters run 0..14; 15 is invalid on the wire
 

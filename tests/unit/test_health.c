@@ -505,7 +505,7 @@ static void test_health_frame_round_trip(void **state)
     const sl_can_message_desc_t *m = sl_can_layout(SL_CAN_MSG_HEALTH);
     assert_non_null(m);
     assert_string_equal(m->name, "Health");
-    assert_int_equal(m->data_id, 0x54);
+    assert_int_equal(m->data_id, 0x55);
 }
 
 static int setup(void **state)
