@@ -92,10 +92,10 @@ head -3 "$OUT/can.log" | sed 's/^/     /'
 echo
 echo "== 4. The CAN log decoded with $DBC (python3-canmatrix)"
 echo "   Every Status frame (collapsed), with the rotation's LeanWarning:"
-"$PY" tests/daemon/sl_can_decode.py "$DBC" "$OUT/can.log" --summary | sed 's/^/   /'
+"$PY" scripts/sl_can_decode.py "$DBC" "$OUT/can.log" --summary | sed 's/^/   /'
 echo
 echo "   The PoleLean frames of the last rotation (warning = the LeanWarning's target):"
-"$PY" tests/daemon/sl_can_decode.py "$DBC" "$OUT/can.log" --table --last 1 | sed 's/^/   /'
+"$PY" scripts/sl_can_decode.py "$DBC" "$OUT/can.log" --table --last 1 | sed 's/^/   /'
 
 echo
 echo "== 5. Decoded leans against the simulator's truth (per pole: the last rotation it was reported)"

@@ -28,7 +28,7 @@
 #include "can_sink.h"
 #include "can_socketcan.h"
 #include "capture_reader.h"
-#include "daemon_candump.h"
+#include "candump.h"
 #include "daemon_log.h"
 #include "daemon_motion.h"
 #include "daemon_opts.h"
@@ -45,18 +45,19 @@
 #define FAST_MSGS_PER_TURN 512U   // capture messages fed per loop turn in --fast mode
 #define MAX_PLAY_GAP_US 5000000U  // --realtime: longer timestamp gaps are shortened to this
 #define DRAIN_MS 500U             // at exit: wait at most this long for queued frames
-#define PIPE_REASM_HOST (1U << 20) // pacer decoder limit (host captures)
 
-#define LEAD_MAX (1U << 20)        // capture bytes held until the first FFT timestamp is known
-#define IX_CAP ((LEAD_MAX + SL_PORT_CAPTURE_CHUNK) / SL_PROTO_HEADER_BYTES + 16U)
+#define HOLD_SLICE 4096U           // --realtime: stream bytes decoded at a time
+#define HOLD_MSGS 8192U            // --realtime: messages held (copied) at most
+#define HOLD_LEAD_BYTES (1U << 20) // payload bytes held at most before the data clock starts
 
-/// One queued capture event: a message (where it ends in the stream, its FFT timestamp or
-/// 0 = not FFT data) or a discontinuity (the pipeline's decoder is finished there).
-typedef struct msg_ix {
-    uint64_t end;
-    uint64_t t_us;
+/// --realtime: one message decoded ahead and held (payload copied) until it is due, or a
+/// discontinuity (the pipeline's stream is finished there).
+typedef struct held_msg {
+    sl_proto_msg_t m;  ///< payload.data re-pointed into the hold buffer when delivered
+    size_t off;        ///< payload offset in the hold buffer
+    uint64_t t_us;     ///< FFT timestamp, 0 = not FFT data
     bool brk;
-} msg_ix_t;
+} held_msg_t;
 
 typedef struct daemon {
     sld_opts_t o;
@@ -93,26 +94,25 @@ typedef struct daemon {
     bool had_fft;               // any FFT data since start
     sl_radar_state_t last_radar_state;
 
-    // input: capture, streamed (bounded memory): pieces from the port's reader are decoded
-    // once by the pacer (message ends + FFT timestamps, queued in ix) and fed to the
-    // pipeline message by message; bytes before the first FFT timestamp are held in `lead`
-    // (the data clock starts there).
+    // input: capture, streamed (bounded memory): each byte is decoded once, by `pacer`,
+    // whose messages go to sl_pipeline_on_msg: at once with --fast; with --realtime they
+    // are held (copied, a few KiB ahead) until due. Messages before the first FFT timestamp
+    // are held too: the data clock starts there.
     sl_port_capture_t *cr;
     sl_proto_t pacer;
     uint8_t *pacer_reasm;
-    msg_ix_t *ix;
-    size_t n_ix, next_ix;
-    const uint8_t *view;        // stream bytes [view_base, view_base + view_len) not yet all fed
-    uint64_t view_base;
-    size_t view_len;
-    uint8_t *lead;
-    size_t lead_len;
-    sl_port_capture_piece_t pend_piece; // read, not yet taken (the lead is fed first)
-    bool have_pend_piece;
+    bool decode_once;           // --fast: the pacer hands messages over at once
+    held_msg_t *held;
+    size_t n_held, next_held;
+    uint8_t *hold;
+    size_t hold_len, hold_cap;
+    sl_port_capture_piece_t piece; // DATA piece being decoded (--realtime)
+    size_t piece_pos;
+    bool have_piece;
     bool clock_known;           // data_us started (first FFT seen, or given up waiting)
     bool cap_end;               // the reader returned END or ERROR
     bool cap_error;
-    uint64_t fed;               // stream bytes fed to the pipeline
+    uint64_t fed;               // stream bytes decoded
     uint64_t n_msgs, n_fft, n_breaks;
     bool cap_done;
     uint64_t play_wall0, play_us, play_prev_t;
@@ -245,15 +245,18 @@ static void fixed_motion(const daemon_t *d, uint64_t now_us)
 
 static void radar_on_bytes(void *ctx, const uint8_t *data, size_t len, uint64_t now_us)
 {
+    (void)data;
+    (void)len;
     daemon_t *d = ctx;
     d->fed_since_finish = true;
     fixed_motion(d, now_us);
-    sl_pipeline_feed(&g_pipe, data, len, now_us);
 }
 
+/// Decode once: the radar client's decoder hands every message to the pipeline.
 static void radar_on_msg(void *ctx, const sl_proto_msg_t *msg, uint64_t now_us)
 {
     daemon_t *d = ctx;
+    sl_pipeline_on_msg(&g_pipe, msg, now_us);
     if (msg->id == SL_PROTO_ID_FFT_DATA || msg->id == SL_PROTO_ID_FFT_DATA_16) {
         // Liveness is usable data, not the message id: a malformed or empty FFT message
         // does not keep the link STREAMING.
@@ -373,12 +376,13 @@ static int radar_setup(daemon_t *d)
     cfg.non_contour = d->o.non_contour;
     cfg.reasm_buf = d->radar_reasm;
     cfg.reasm_size = reasm;
-    cfg.max_payload_bytes = (uint32_t)reasm;
+    cfg.max_payload_bytes = d->board->max_message_bytes; // the pipeline decoder's limit
     cfg.on_msg = radar_on_msg;
     cfg.on_bytes = radar_on_bytes;
     cfg.on_event = radar_on_event;
     cfg.ctx = d;
     const sl_err_t e = sl_radar_client_init(&d->radar, &cfg);
+    sl_pipeline_set_decoder_stats(&g_pipe, &d->radar.proto.stats); // Status.DecoderResyncs
     if (e != SL_OK) {
         sld_log(SLD_LOG_ERR, "radar %s:%u: %s", d->o.radar_host, (unsigned)d->o.radar_port,
                 e == SL_ERR_PORT ? "cannot resolve the name" : sl_err_str(e));
@@ -393,21 +397,40 @@ static int radar_setup(daemon_t *d)
 static void pacer_on_msg(void *ctx, const sl_proto_msg_t *msg)
 {
     daemon_t *d = ctx;
-    if (d->n_ix >= IX_CAP) { // cannot happen: a piece holds at most IX_CAP headers
-        return;
-    }
-    msg_ix_t m = {msg->stream_offset + SL_PROTO_HEADER_BYTES + msg->payload.size, 0, false};
+    uint64_t t = 0;
     sl_proto_fft_t fft;
     if ((msg->id == SL_PROTO_ID_FFT_DATA || msg->id == SL_PROTO_ID_FFT_DATA_16) &&
         sl_proto_parse_fft(msg, &fft) == SL_OK) {
-        m.t_us = sl_proto_fft_time_us(&fft);
+        t = sl_proto_fft_time_us(&fft);
         if (!d->clock_known && d->n_fft == 0) {
-            d->data_us = m.t_us; // the data clock starts at the first FFT message
+            d->data_us = t; // the data clock starts at the first FFT message
         }
         d->n_fft++;
     }
     d->n_msgs++;
-    d->ix[d->n_ix++] = m;
+    if (d->decode_once) {
+        // --fast: straight to the pipeline at its data clock.
+        if (t > d->data_us) {
+            d->data_us = t;
+        }
+        fixed_motion(d, pipe_now(d));
+        sl_pipeline_on_msg(&g_pipe, msg, pipe_now(d));
+        return;
+    }
+    // --realtime: hold a copy until it is due (bounded: see capture_step).
+    if (d->n_held >= HOLD_MSGS || d->hold_len + msg->payload.size > d->hold_cap) {
+        sld_log(SLD_LOG_ERR, "internal: capture hold buffer full, message dropped"); // not reached
+        return;
+    }
+    held_msg_t *h = &d->held[d->n_held++];
+    h->m = *msg;
+    h->off = d->hold_len;
+    h->t_us = t;
+    h->brk = false;
+    if (msg->payload.size > 0) {
+        memcpy(d->hold + d->hold_len, msg->payload.data, msg->payload.size);
+        d->hold_len += msg->payload.size;
+    }
 }
 
 /// Open the capture (path or "-"): nothing is read beyond the format sniff.
@@ -419,159 +442,167 @@ static int capture_setup(daemon_t *d)
         sld_log(SLD_LOG_ERR, "--input: %s", err);
         return -1;
     }
-    d->pacer_reasm = malloc(PIPE_REASM_HOST);
-    d->ix = malloc(IX_CAP * sizeof *d->ix);
-    d->lead = malloc(LEAD_MAX);
-    if (d->pacer_reasm == NULL || d->ix == NULL || d->lead == NULL) {
+    d->decode_once = !d->o.realtime;
+    size_t reasm = d->board->max_message_bytes;
+    if (reasm < 65536U) {
+        reasm = 65536U;
+    }
+    d->pacer_reasm = malloc(reasm);
+    d->hold_cap = HOLD_LEAD_BYTES + HOLD_SLICE + reasm;
+    if (!d->decode_once) {
+        d->hold = malloc(d->hold_cap);
+        d->held = malloc(HOLD_MSGS * sizeof *d->held);
+    }
+    if (d->pacer_reasm == NULL || (!d->decode_once && (d->hold == NULL || d->held == NULL))) {
         sld_log(SLD_LOG_ERR, "out of memory");
         return -1;
     }
-    const sl_proto_cfg_t pc = {.reasm_buf = d->pacer_reasm, .reasm_size = PIPE_REASM_HOST,
-                              .max_payload_bytes = PIPE_REASM_HOST, .truncate_long = false,
+    // The pipeline decoder's limit: both accept and reject the same headers.
+    const sl_proto_cfg_t pc = {.reasm_buf = d->pacer_reasm, .reasm_size = reasm,
+                              .max_payload_bytes = d->board->max_message_bytes, .truncate_long = false,
                               .on_msg = pacer_on_msg, .ctx = d};
     sl_proto_init(&d->pacer, &pc);
+    sl_pipeline_set_decoder_stats(&g_pipe, &d->pacer.stats); // Status.DecoderResyncs
     sld_log(SLD_LOG_INFO, "input %s (%s)", d->o.capture,
             sl_port_capture_format_name(sl_port_capture_report(d->cr)->format));
     return 0;
 }
 
-static void capture_feed_to(daemon_t *d, uint64_t end)
+/// End of input (END or ERROR piece).
+static void capture_end(daemon_t *d, const sl_port_capture_piece_t *pc)
 {
-    if (end > d->fed) {
-        fixed_motion(d, pipe_now(d));
-        sl_pipeline_feed(&g_pipe, d->view + (d->fed - d->view_base), (size_t)(end - d->fed), pipe_now(d));
-        d->fed = end;
-    }
-}
-
-static void queue_break(daemon_t *d, uint64_t at)
-{
-    sl_proto_finish(&d->pacer);
-    if (d->n_ix < IX_CAP) {
-        d->ix[d->n_ix++] = (msg_ix_t){at, 0, true};
-    }
-    d->n_breaks++;
-}
-
-/// Pull the next piece from the reader into the queue (all queued events fed, all of the
-/// view fed, unless the data clock is still unknown and the bytes go to `lead`).
-static void capture_pull(daemon_t *d)
-{
-    sl_port_capture_piece_t pc;
-    if (d->have_pend_piece) {
-        pc = d->pend_piece;
-        d->have_pend_piece = false;
-    } else {
-        sl_port_capture_next(d->cr, &pc);
-    }
-    if (pc.kind == SL_PORT_CAPTURE_DATA) {
-        if (!d->clock_known && d->lead_len + pc.size > LEAD_MAX) {
-            // No FFT timestamp in the first LEAD_MAX bytes: run on the wall clock. The
-            // lead is fed first (capture_step), then this piece (still valid: the reader
-            // is not called before).
-            d->clock_known = true;
-            d->data_us = realtime_us();
-            d->pend_piece = pc;
-            d->have_pend_piece = true;
-            return;
-        }
-        if (d->clock_known) {
-            d->n_ix = d->next_ix = 0;
-            d->view = pc.data;
-            d->view_base = pc.output_offset;
-            d->view_len = pc.size;
-            sl_proto_feed(&d->pacer, pc.data, pc.size, 0);
-            return;
-        }
-        memcpy(d->lead + d->lead_len, pc.data, pc.size);
-        d->lead_len += pc.size;
-        sl_proto_feed(&d->pacer, pc.data, pc.size, 0);
-        if (d->n_fft > 0) {
-            d->clock_known = true;
-        }
-        d->view = d->lead;
-        d->view_base = 0;
-        d->view_len = d->lead_len;
-        return;
-    }
-    if (pc.kind == SL_PORT_CAPTURE_BREAK) {
-        queue_break(d, pc.output_offset);
-        return;
-    }
-    // END or ERROR
     sl_proto_finish(&d->pacer);
     d->cap_end = true;
-    d->clock_known = true;
-    if (d->n_fft == 0 && d->data_us == 0) {
-        d->data_us = realtime_us();
+    if (!d->clock_known) {
+        d->clock_known = true;
+        if (d->n_fft == 0) {
+            d->data_us = realtime_us();
+        }
     }
-    if (pc.kind == SL_PORT_CAPTURE_ERROR) {
+    if (pc->kind == SL_PORT_CAPTURE_ERROR) {
         d->cap_error = true;
         sld_log(SLD_LOG_ERR, "--input %s: %s", d->o.capture, sl_port_capture_error(d->cr));
+    }
+}
+
+/// --fast, decode once: the reader's pieces go through the pacer straight into the pipeline.
+static void capture_step_fast(daemon_t *d)
+{
+    for (unsigned turn = 0; turn < 16U && !d->cap_done && !d->stop; turn++) {
+        sl_port_capture_piece_t pc;
+        sl_port_capture_next(d->cr, &pc);
+        if (pc.kind == SL_PORT_CAPTURE_DATA) {
+            sl_proto_feed(&d->pacer, pc.data, pc.size, 0);
+            d->fed += pc.size;
+        } else if (pc.kind == SL_PORT_CAPTURE_BREAK) {
+            sl_proto_finish(&d->pacer);
+            sl_pipeline_finish(&g_pipe, pipe_now(d));
+            d->n_breaks++;
+        } else {
+            capture_end(d, &pc);
+            sl_pipeline_finish(&g_pipe, pipe_now(d));
+            d->cap_done = true;
+        }
+    }
+}
+
+/// --realtime: decode the next slice (or take the next piece) into the hold queue.
+static void capture_decode_more(daemon_t *d)
+{
+    if (!d->have_piece) {
+        sl_port_capture_next(d->cr, &d->piece);
+        if (d->piece.kind == SL_PORT_CAPTURE_DATA) {
+            d->have_piece = true;
+            d->piece_pos = 0;
+        } else if (d->piece.kind == SL_PORT_CAPTURE_BREAK) {
+            sl_proto_finish(&d->pacer);
+            d->held[d->n_held++] = (held_msg_t){.brk = true};
+            d->n_breaks++;
+            return;
+        } else {
+            capture_end(d, &d->piece);
+            return;
+        }
+    }
+    size_t k = d->piece.size - d->piece_pos;
+    k = k < HOLD_SLICE ? k : HOLD_SLICE;
+    sl_proto_feed(&d->pacer, d->piece.data + d->piece_pos, k, 0);
+    d->piece_pos += k;
+    d->fed += k;
+    if (d->piece_pos == d->piece.size) {
+        d->have_piece = false;
     }
 }
 
 /// Feed what is due. @return the monotonic time of the next due message (0 = now / done).
 static uint64_t capture_step(daemon_t *d)
 {
+    if (d->decode_once) {
+        capture_step_fast(d);
+        return 0;
+    }
     unsigned budget = FAST_MSGS_PER_TURN;
     while (!d->cap_done && !d->stop && budget-- > 0) {
         if (!d->clock_known) {
-            capture_pull(d);
+            // Hold until the first FFT timestamp (or give up after HOLD_LEAD_BYTES /
+            // about HOLD_MSGS messages: the wall clock then).
+            if (d->n_fft > 0) {
+                d->clock_known = true;
+            } else if (d->hold_len > HOLD_LEAD_BYTES || d->n_held + 2U * HOLD_SLICE / SL_PROTO_HEADER_BYTES > HOLD_MSGS) {
+                d->clock_known = true;
+                d->data_us = realtime_us();
+            } else if (!d->cap_end) {
+                capture_decode_more(d);
+            }
             continue;
         }
-        if (d->next_ix >= d->n_ix) {
-            // Every queued event fed: hand the rest of the view (a partial message or
-            // junk) to the pipeline, then read on.
-            capture_feed_to(d, d->view_base + d->view_len);
+        if (d->next_held >= d->n_held) {
+            d->n_held = d->next_held = 0;
+            d->hold_len = 0;
             if (d->cap_end) {
                 sl_pipeline_finish(&g_pipe, pipe_now(d));
                 d->cap_done = true;
                 break;
             }
-            if (d->view == d->lead) {
-                d->lead_len = 0;
-            }
-            d->n_ix = d->next_ix = 0;
-            capture_pull(d);
+            capture_decode_more(d);
             continue;
         }
-        const msg_ix_t *m = &d->ix[d->next_ix];
-        if (m->brk) {
-            capture_feed_to(d, m->end);
+        held_msg_t *h = &d->held[d->next_held];
+        if (h->brk) {
             sl_pipeline_finish(&g_pipe, pipe_now(d));
-            d->next_ix++;
+            d->next_held++;
             continue;
         }
-        if (m->t_us != 0) {
-            if (d->o.realtime) {
-                if (!d->play_started) {
-                    d->play_started = true;
-                    d->play_wall0 = d->mono_us;
-                    d->play_prev_t = m->t_us;
-                    // The idle-Status clock starts with the data, not with the set-up
-                    // (opening a gs_usb device in a slow VM took > 1 s: an idle Status
-                    // before the first rotation).
-                    d->last_status_mono = d->mono_us;
-                } else {
-                    uint64_t dt = m->t_us > d->play_prev_t ? m->t_us - d->play_prev_t : 0;
-                    if (dt > MAX_PLAY_GAP_US) {
-                        dt = MAX_PLAY_GAP_US;
-                    }
-                    const uint64_t due = d->play_wall0 + d->play_us + dt;
-                    if (due > d->mono_us) {
-                        return due; // not yet (play_us/prev_t unchanged until it is fed)
-                    }
-                    d->play_us += dt;
-                    d->play_prev_t = m->t_us;
+        if (h->t_us != 0) {
+            if (!d->play_started) {
+                d->play_started = true;
+                d->play_wall0 = d->mono_us;
+                d->play_prev_t = h->t_us;
+                // The idle-Status clock starts with the data, not with the set-up
+                // (opening a gs_usb device in a slow VM took > 1 s: an idle Status
+                // before the first rotation).
+                d->last_status_mono = d->mono_us;
+            } else {
+                uint64_t dt = h->t_us > d->play_prev_t ? h->t_us - d->play_prev_t : 0;
+                if (dt > MAX_PLAY_GAP_US) {
+                    dt = MAX_PLAY_GAP_US;
                 }
+                const uint64_t due = d->play_wall0 + d->play_us + dt;
+                if (due > d->mono_us) {
+                    return due; // not yet (play_us/prev_t unchanged until it is fed)
+                }
+                d->play_us += dt;
+                d->play_prev_t = h->t_us;
             }
-            if (m->t_us > d->data_us) {
-                d->data_us = m->t_us;
+            if (h->t_us > d->data_us) {
+                d->data_us = h->t_us;
             }
         }
-        capture_feed_to(d, m->end);
-        d->next_ix++;
+        sl_proto_msg_t m = h->m;
+        m.payload.data = m.payload.size > 0 ? d->hold + h->off : NULL;
+        fixed_motion(d, pipe_now(d));
+        sl_pipeline_on_msg(&g_pipe, &m, pipe_now(d));
+        d->next_held++;
     }
     return 0;
 }
@@ -936,7 +967,9 @@ int main(int argc, char **argv)
     d->link_state = d->is_radar ? SL_CAN_LINK_CONNECTING : SL_CAN_LINK_STREAMING;
     sl_pipeline_set_link_state(&g_pipe, d->link_state);
     // A live radar gets a Status frame at once (CONNECTING); a capture replayed in real time
-    // only when a rotation is late, so --realtime and --fast write the same frames.
+    // only when a rotation is late, so --realtime and --fast write the same frames. The
+    // clock is read again here: opening the outputs (a gs_usb adapter) may take a while.
+    d->mono_us = sl_port_now_us();
     d->last_status_mono = d->is_radar ? d->mono_us - (uint64_t)d->o.status_period_ms * 1000U : d->mono_us;
     d->next_stats_mono = d->o.stats_every_ms != 0 ? d->mono_us + (uint64_t)d->o.stats_every_ms * 1000U : UINT64_MAX;
     const uint64_t end_mono = d->o.duration_ms != 0 ? d->mono_us + (uint64_t)d->o.duration_ms * 1000U : UINT64_MAX;
@@ -1115,8 +1148,8 @@ int main(int argc, char **argv)
         exit_rc = 3;
     }
     sl_port_capture_close(d->cr);
-    free(d->ix);
-    free(d->lead);
+    free(d->held);
+    free(d->hold);
     free(d->pacer_reasm);
     free(d->radar_reasm);
     sld_log_close();

@@ -208,7 +208,7 @@ uint16_t sl_pipeline_faults(const sl_pipeline_t *p)
     if (!rows_fresh(p) && (connected || fft_seen)) {
         f |= (uint16_t)SL_CAN_FAULT_NO_USABLE_ROWS;
     }
-    if (p->proto.stats.resyncs != p->snap.resyncs || p->scan.stats.malformed != p->snap.malformed ||
+    if (p->decoder_stats->resyncs != p->snap.resyncs || p->scan.stats.malformed != p->snap.malformed ||
         p->scan.stats.bad_azimuth != p->snap.bad_azimuth ||
         p->scan.stats.empty_rows != p->snap.empty_rows) {
         f |= (uint16_t)SL_CAN_FAULT_MALFORMED_DATA;
@@ -242,7 +242,7 @@ static void emit_status(sl_pipeline_t *p)
         .link_state = link,
         .rotations = p->stats.rotations,
         .azimuths_missing = p->stats.azimuths_missing,
-        .decoder_resyncs = p->proto.stats.resyncs,
+        .decoder_resyncs = p->decoder_stats->resyncs,
         .can_dropped = p->stats.can_dropped,
     };
     // Status and its Health pass the ceiling together (a Health never goes missing alone).
@@ -270,7 +270,7 @@ static void emit_status(sl_pipeline_t *p)
     p->fault_latched = 0U;
     p->rows_since_health = 0U;
     p->snap.fft = p->scan.stats.fft;
-    p->snap.resyncs = p->proto.stats.resyncs;
+    p->snap.resyncs = p->decoder_stats->resyncs;
     p->snap.malformed = p->scan.stats.malformed;
     p->snap.bad_azimuth = p->scan.stats.bad_azimuth;
     p->snap.empty_rows = p->scan.stats.empty_rows;
@@ -678,6 +678,7 @@ sl_err_t sl_pipeline_init(sl_pipeline_t *p, const sl_board_t *board,
         .ctx = p,
     };
     e = sl_proto_init(&p->proto, &pc);
+    p->decoder_stats = &p->proto.stats;
     if (e != SL_OK) {
         set_err(p, e, (uint8_t)SL_PIPELINE_STAGE_INIT, "sl_proto_init failed");
         return e;
@@ -699,6 +700,23 @@ sl_err_t sl_pipeline_feed(sl_pipeline_t *p, const uint8_t *data, size_t len, uin
     }
     p->now_us = now_us;
     return sl_proto_feed(&p->proto, data, len, now_us);
+}
+
+sl_err_t sl_pipeline_on_msg(sl_pipeline_t *p, const sl_proto_msg_t *msg, uint64_t now_us)
+{
+    if (p == NULL || msg == NULL || !p->ready) {
+        return SL_ERR_ARG;
+    }
+    p->now_us = now_us;
+    on_msg(p, msg);
+    return SL_OK;
+}
+
+void sl_pipeline_set_decoder_stats(sl_pipeline_t *p, const sl_proto_stats_t *stats)
+{
+    if (p != NULL) {
+        p->decoder_stats = stats != NULL ? stats : &p->proto.stats;
+    }
 }
 
 sl_err_t sl_pipeline_finish(sl_pipeline_t *p, uint64_t now_us)

@@ -14,7 +14,9 @@
 // digits, and a trailing " R"/" T" direction token (python-can's writer adds it). CAN FD
 // lines ("123##1...") are rejected with a clear message: the module is classic CAN only.
 //
-// Timestamps are microseconds: t_us = sec x 1e6 + usec.
+// Timestamps are microseconds: t_us = sec x 1e6 + usec. Parsing and formatting are the
+// port's C module (firmware/port/linux/candump.h); interface names are limited to 15
+// characters (IFNAMSIZ).
 #pragma once
 
 #include <cstdint>
@@ -23,7 +25,7 @@
 #include <string>
 #include <vector>
 
-#include "../../firmware/port/linux/can_sink.h"
+#include "can_sink.h"
 #include "shadowlean/sl_can.h"
 
 namespace sl {
@@ -55,7 +57,7 @@ bool parse_candump_line(const std::string &line, CandumpRecord *out, std::string
 std::vector<CandumpRecord> read_candump_log(const std::string &path);
 
 /// Appends frames to a log file as candump -L would print them. Also usable as a CAN sink
-/// (`sink()`), e.g. next to the SocketCAN sink in the daemon. Not thread-safe.
+/// (`sink()`). (The daemon's sink is the port's C one, sld_candump_t.) Not thread-safe.
 class CandumpWriter {
 public:
     CandumpWriter() = default;

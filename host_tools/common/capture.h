@@ -18,8 +18,11 @@
 // the radar (reconnections) are concatenated in time order, with a discontinuity between
 // them; sessions that overlap in time a session already taken are counted and ignored.
 //
-// Memory: the whole stream is held in memory (raw: the file size; pcap: the payload of the
-// selected direction). Cost: O(bytes + segments log segments).
+// Reading, sniffing and reassembly are the port's streaming reader
+// (firmware/port/linux/capture_reader.h: "-" = stdin, pipes and FIFOs work, the streaming
+// session rules are described there); load_capture collects its pieces. Memory: the whole
+// stream is held in memory (raw: the file size; pcap: the payload of the selected
+// direction); tools that can stream should use the reader directly. Cost: O(bytes).
 #pragma once
 
 #include <cstdint>

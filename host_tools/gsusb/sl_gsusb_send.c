@@ -9,7 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "candump_text.h"
+#include "candump.h"
 #include "gsusb_sink.h"
 #include "sl_port_linux.h"
 

@@ -215,7 +215,7 @@ int main(int argc, char **argv)
         } else if (a == "-h" || a == "--help") {
             usage();
             return 0;
-        } else if (!a.empty() && a[0] == '-') {
+        } else if (a.size() > 1 && a[0] == '-') { // "-" is stdin
             usage();
             return 2;
         } else if (path.empty()) {

@@ -214,7 +214,7 @@ int cmd_serve(int argc, char **argv)
             if (!parse_double(argv[++i], o.timeout_s) || o.timeout_s < 0) return usage(), 2;
         } else if (a == "-v") {
             o.verbose = true;
-        } else if (!a.empty() && a[0] == '-') {
+        } else if (a.size() > 1 && a[0] == '-') { // "-" is stdin
             std::fprintf(stderr, "sl-replay serve: unknown option %s\n", a.c_str());
             return 2;
         } else if (o.capture.empty()) {

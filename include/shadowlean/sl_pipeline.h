@@ -14,6 +14,7 @@
 ///
 /// ## Inputs (all push-driven; time is passed in, the core never reads a clock)
 /// - `sl_pipeline_feed()`: any chunking of the radar's TCP stream (or a capture file).
+/// - `sl_pipeline_on_msg()`: or messages already decoded by the caller (decode once).
 /// - `sl_pipeline_on_can_rx()`: frames from the vehicle bus; VehicleMotion (board id) is
 ///   E2E-checked and used, other ids are counted and ignored.
 /// - `sl_pipeline_set_motion()`: the same motion input without CAN (direct setter).
@@ -137,6 +138,7 @@
 #include "shadowlean/sl_detect.h"
 #include "shadowlean/sl_err.h"
 #include "shadowlean/sl_mask.h"
+#include "shadowlean/sl_port.h"
 #include "shadowlean/sl_proto.h"
 #include "shadowlean/sl_scan.h"
 #include "shadowlean/sl_thresh.h"
@@ -169,17 +171,7 @@ typedef enum sl_pipeline_reason {
     SL_PIPELINE_STAGE_INIT = 6,       ///< a stage's init rejected the board (see err)
 } sl_pipeline_reason_t;
 
-/// Output port: a const vtable + context (copied at init). Both callbacks are optional.
-typedef struct sl_pipeline_rotation sl_pipeline_rotation_t;
-typedef struct sl_port {
-    /// Send one CAN frame (borrowed for the call). Must not block: return SL_ERR_BUSY when
-    /// the bus/queue cannot take it (counted as a drop); SL_OK when queued/sent.
-    sl_err_t (*can_tx)(void *ctx, const sl_can_frame_t *f);
-    /// One completed rotation (borrowed for the call; every pointer in it is valid only
-    /// until the callback returns).
-    void (*on_rotation)(void *ctx, const sl_pipeline_rotation_t *r);
-    void *ctx;
-} sl_port_t;
+/// Output port: sl_port_t (shadowlean/sl_port.h).
 
 /// Pipeline configuration. Get defaults from sl_pipeline_cfg_default(), change fields,
 /// pass to sl_pipeline_init() (copied).
@@ -295,6 +287,8 @@ typedef struct sl_pipeline {
     bool motion_set;             ///< the setter was used
     // stages
     sl_proto_t proto;
+    const sl_proto_stats_t *decoder_stats; ///< counters Status reports: &proto.stats, or the
+                                           ///< caller's decoder (sl_pipeline_set_decoder_stats)
     sl_scan_t scan;
     sl_mask_t mask;
     sl_detect_t detect;
@@ -366,6 +360,23 @@ sl_err_t sl_pipeline_init(sl_pipeline_t *p, const sl_board_t *board,
 /// @return SL_OK, or SL_ERR_ARG (NULL p, NULL data with len > 0). Stream errors are
 /// counted in the stage stats, never returned.
 sl_err_t sl_pipeline_feed(sl_pipeline_t *p, const uint8_t *data, size_t len, uint64_t now_us);
+
+/// Decode once: one message the caller's own sl_proto decoder produced (its on_msg
+/// callback), processed exactly as if the pipeline's decoder had produced it from the same
+/// bytes with sl_pipeline_feed(): same rows, rotations, callbacks and CAN frames. For a port
+/// that decodes the stream anyway (the Linux radar client and capture reader, for their
+/// state machine and pacing); the MCU path keeps sl_pipeline_feed(). Call from inside the
+/// caller's on_msg (the payload view ends there). Do not mix with sl_pipeline_feed() in one
+/// stream; sl_pipeline_finish() still ends a stream (call it where the caller finishes its
+/// decoder). The caller's decoder may keep whole payloads (no truncate_long): only the
+/// region of interest is read. Status.DecoderResyncs: see sl_pipeline_set_decoder_stats().
+/// @return SL_OK, or SL_ERR_ARG (NULL p or msg, not initialised). O(1) + the stages' cost.
+sl_err_t sl_pipeline_on_msg(sl_pipeline_t *p, const sl_proto_msg_t *msg, uint64_t now_us);
+
+/// Which decoder's counters Status frames report (DecoderResyncs): `stats` (borrowed; the
+/// caller's decoder used with sl_pipeline_on_msg(), must outlive its use), or NULL for the
+/// pipeline's own decoder (the default after init). O(1).
+void sl_pipeline_set_decoder_stats(sl_pipeline_t *p, const sl_proto_stats_t *stats);
 
 /// End of stream (EOF, connection lost, before reconnecting): drops a partial message,
 /// completes and reports the partial rotation if any. The next byte fed starts a new

@@ -5,7 +5,8 @@ every signal with the encoder inputs written by can_gen_frames.
     check_dbc_decode.py BOARD.dbc FRAMES.log FRAMES.expect
 
 Independent of the C code on purpose: the log is read with python-can's CanutilsLogReader,
-the layout comes only from the DBC, the CRC is recomputed here, and the expected raw
+the layout comes only from the DBC, frames are decoded and their CRC recomputed by the
+project's Python DBC decoder (scripts/sl_can_decode.py, canmatrix), and the expected raw
 values are derived from the inputs with exact Decimal arithmetic. Checks per frame:
 - the DBC knows the id, DLC 8;
 - every signal: decoded physical value within one LSB of the (clamped) input, and the
@@ -16,30 +17,17 @@ values are derived from the inputs with exact Decimal arithmetic. Checks per fra
 - canmatrix re-encodes the decoded raw values to exactly the same 8 bytes.
 Exit status 0 when all frames pass; prints the first mismatches otherwise.
 """
-import contextlib
 import decimal
-import io
+import os
 import sys
 from decimal import Decimal as D
 
-with contextlib.redirect_stderr(io.StringIO()):  # "arxml is not supported" etc.
-    import canmatrix
-    import canmatrix.formats
 import can
 
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "..", "scripts"))
+import sl_can_decode as scd  # noqa: E402
+
 decimal.getcontext().prec = 40
-
-
-def crc8_j1850(data):
-    reg = 0xFF
-    for b in data:
-        reg ^= b
-        for _ in range(8):
-            reg = ((reg << 1) ^ 0x1D) & 0xFF if reg & 0x80 else (reg << 1) & 0xFF
-    return reg ^ 0xFF
-
-
-assert crc8_j1850(b"123456789") == 0x4B
 
 
 def round_half_up(x):
@@ -124,7 +112,7 @@ def main():
     if len(sys.argv) != 4:
         print(__doc__)
         return 2
-    db = canmatrix.formats.loadp_flat(sys.argv[1])
+    db = scd.load_dbc(sys.argv[1])
     msgs = list(can.CanutilsLogReader(sys.argv[2]))
     with open(sys.argv[3]) as fh:
         expects = [line.split() for line in fh if line.strip()]
@@ -138,11 +126,7 @@ def main():
     for i, (msg, ex) in enumerate(zip(msgs, expects)):
         name, inputs = ex[0], dict(kv.split("=", 1) for kv in ex[1:])
         where = f"frame {i + 1} ({name} id 0x{msg.arbitration_id:X})"
-        try:
-            fr = db.frame_by_id(canmatrix.ArbitrationId(msg.arbitration_id,
-                                                        extended=msg.is_extended_id))
-        except Exception:  # canmatrix raises when unknown in some versions
-            fr = None
+        fr = scd.frame_of(db, msg.arbitration_id, msg.is_extended_id)
         if fr is None or fr.name != name:
             errors.append(f"{where}: DBC has {fr.name if fr else 'no frame'} for this id")
             continue
@@ -150,16 +134,14 @@ def main():
         if msg.dlc != 8 or len(data) != 8:
             errors.append(f"{where}: dlc {msg.dlc}")
             continue
-        dsig = fr.decode(data)
+        d = scd.decode(db, msg.arbitration_id, msg.is_extended_id, data)
         # E2E
-        data_id = int(fr.attributes["SlE2EDataId"])
-        crc = crc8_j1850(bytes([data_id]) + data[1:])
-        if dsig["Crc"].raw_value != crc or data[0] != crc:
-            errors.append(f"{where}: Crc {dsig['Crc'].raw_value:#x}, recomputed {crc:#x}")
+        if not d.crc_ok:
+            errors.append(f"{where}: Crc {data[0]:#x} does not match the recomputed CRC-8")
         n = counters.get(name, 0)
         counters[name] = n + 1
-        if dsig["Counter"].raw_value != n % 15:
-            errors.append(f"{where}: Counter {dsig['Counter'].raw_value}, want {n % 15}")
+        if d.raw["Counter"] != n % 15:
+            errors.append(f"{where}: Counter {d.raw['Counter']}, want {n % 15}")
         # signals
         any_clamped = False
         has_target = name != "LeanWarning" or inputs["has_target"] == "1"
@@ -174,12 +156,11 @@ def main():
                 value = D(int(inputs[key])) / scale
                 want_raw, cl = expected_raw(sig, kind, value)
             any_clamped |= cl
-            got = dsig[sname]
-            if int(got.raw_value) != want_raw:
-                errors.append(f"{where}: {sname} raw {got.raw_value}, want {want_raw} "
+            if d.raw[sname] != want_raw:
+                errors.append(f"{where}: {sname} raw {d.raw[sname]}, want {want_raw} "
                               f"(input {inputs.get(key)})")
                 continue
-            phys = dec(got.phys_value)
+            phys = dec(d.phys[sname])
             if kind in ("num", "angle"):
                 ref = value
                 if kind == "angle":
@@ -193,14 +174,13 @@ def main():
                     errors.append(f"{where}: {sname} = {phys}, input {ref}: more than one LSB")
                 lsb_max[(name, sname)] = max(lsb_max.get((name, sname), D(0)), diff / f)
         if name in FLAG:
-            got_flag = dsig[FLAG[name]].raw_value
+            got_flag = d.raw[FLAG[name]]
             if got_flag != int(any_clamped):
                 errors.append(f"{where}: {FLAG[name]} = {got_flag}, want {int(any_clamped)}")
         nclamped += int(any_clamped)
         # canmatrix packs the decoded raw values back to the same bytes
-        again = fr.encode({s: d.raw_value for s, d in dsig.items()})
-        if bytes(again) != data:
-            errors.append(f"{where}: canmatrix re-encodes {bytes(again).hex()} != {data.hex()}")
+        if not d.reencode_ok:
+            errors.append(f"{where}: canmatrix does not re-encode the decoded values to {data.hex()}")
         if len(errors) > 20:
             break
     for e in errors[:20]:

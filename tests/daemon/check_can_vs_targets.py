@@ -29,7 +29,7 @@ Prints a summary; exit 0 when everything matches.
 import json
 import sys
 
-sys.path.insert(0, __import__("os").path.dirname(__file__))
+sys.path.insert(0, __import__("os").path.join(__import__("os").path.dirname(__file__), "..", "..", "scripts"))
 import sl_can_decode as scd  # noqa: E402
 
 # Ranges are rounded once on the way to CAN (sl_can.h takes um; the encoder rounds to the

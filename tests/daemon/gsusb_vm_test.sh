@@ -37,7 +37,7 @@ fi
 [ "$(cat "$OUT/rc_daemon" 2>/dev/null)" = 0 ] || { echo "FAIL: shadowleand exit $(cat "$OUT/rc_daemon" 2>/dev/null)"; exit 1; }
 "$PY" - "$OUT" "$SRC/tests/daemon" <<'PY'
 import os, sys
-sys.path.insert(0, sys.argv[2])
+sys.path.insert(0, sys.argv[2] + "/../../scripts")
 import sl_can_decode as scd
 out = sys.argv[1]
 dev = scd.read_candump(os.path.join(out, "dev_daemon.log"))

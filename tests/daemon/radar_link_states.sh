@@ -22,7 +22,7 @@ count() { # PATTERN FILE: matching lines (0 when none or no file)
 states() { # LOG: "LinkState values of the Status frames" and "last Rotations"
     "$PY" - "$DBC" "$1" "$SRC" <<'PY'
 import sys
-sys.path.insert(0, sys.argv[3])
+sys.path.insert(0, sys.argv[3] + "/../../scripts")
 import sl_can_decode as scd
 st = [d for _, d in scd.decode_log(sys.argv[1], sys.argv[2]) if d is not None and d.name == "Status"]
 print(" ".join(str(d.raw["LinkState"]) for d in st), "|", st[-1].raw["Rotations"] if st else -1)

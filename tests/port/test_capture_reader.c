@@ -318,6 +318,11 @@ static void test_capture_pcap_file_reassembles_damaged_sessions(void **state)
     collect(c, &got);
     check_pcap_result(&got, sl_port_capture_report(c), s, n);
     assert_int_equal(sl_port_capture_report(c)->bytes_in, w.n);
+    sl_port_capture_flow_t fl[4];
+    assert_int_equal(sl_port_capture_flows(c, fl, 4), 2); // the two radar-side sessions
+    assert_string_equal(fl[0].src, "10.0.0.2:6317");
+    assert_string_equal(fl[0].dst, "10.0.0.1:40001");
+    assert_true(fl[0].selected && fl[1].selected && fl[0].syn && fl[0].fin);
     char line[512];
     sl_port_capture_report_line(c, line, sizeof line);
     assert_non_null(strstr(line, "1 gaps (1000 bytes)"));

@@ -7,6 +7,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #define SNIFF_BYTES 4u
@@ -32,6 +34,8 @@ typedef struct flow {
     bool syn, fin, rst, had_payload;
     int64_t syn_rel, fin_rel;
     uint64_t first_ts_us, last_ts_us;
+    uint64_t packets, payload_bytes;
+    bool was_selected;
     int role;       // ROLE_*
 } flow_t;
 
@@ -71,6 +75,10 @@ struct sl_port_capture {
     uint64_t out_off;   // bytes delivered in total
 
     // raw
+    bool mapped;        // regular file: read through a sliding read-only mapping (no copy)
+    uint64_t file_size, map_off;
+    void *map;
+    size_t map_len;
     uint8_t *buf;
     size_t prefix_len;  // sniffed bytes at buf[0..prefix_len) not yet handed on
     size_t prefix_pos;
@@ -91,7 +99,19 @@ struct sl_port_capture {
     bool brk_pending;
     sl_port_capture_piece_t brk;
     uint8_t *tail;      // last SL_PORT_CAPTURE_TAIL delivered bytes of the selected session (ring)
+    // Payload seen before the radar port is known (auto-detection), replayed into the
+    // session of the flow that turns out to be the radar's.
+    struct held_seg {
+        int flow;
+        int64_t data_rel;
+        uint32_t len;
+        uint8_t *data;
+    } *pre;
+    size_t n_pre, pre_bytes;
 };
+
+#define PRE_SEGS 4096u
+#define PRE_BYTES (4u << 20)
 
 // ---------------------------------------------------------------------------------------
 // helpers
@@ -280,7 +300,9 @@ static void set_gap(sl_port_capture_t *c, uint64_t missing)
 {
     c->brk_pending = true;
     c->brk = (sl_port_capture_piece_t){.kind = SL_PORT_CAPTURE_BREAK, .brk = SL_PORT_CAPTURE_GAP,
-                                       .output_offset = c->out_off, .missing_bytes = missing};
+                                       .output_offset = c->out_off, .missing_bytes = missing,
+                                       .stream_offset = (uint64_t)c->sel.cursor,
+                                       .session = c->rep.sessions > 0 ? (uint32_t)(c->rep.sessions - 1) : 0u};
     c->rep.gaps++;
     c->rep.gap_bytes += missing;
 }
@@ -341,6 +363,37 @@ static flow_t *flow_find(sl_port_capture_t *c, const uint8_t *src, const uint8_t
     return &c->flows[found];
 }
 
+/// Count one selected-session segment [a, a+len) against what was seen before.
+static void classify(sl_port_capture_t *c, sess_t *s, int64_t a, const uint8_t *d, uint32_t len)
+{
+    const int64_t b = a + (int64_t)len;
+    c->rep.segments++;
+    c->rep.payload_bytes += len;
+    const int64_t cov = sess_covered(s, a, b);
+    if (cov == (int64_t)len) {
+        c->rep.retransmitted_segments++;
+    } else {
+        if (cov > 0) {
+            c->rep.partial_overlap_segments++;
+        }
+        const int64_t lim = b < s->max_end ? b : s->max_end;
+        if (a < lim && sess_covered(s, a, lim) < lim - a) {
+            c->rep.out_of_order_segments++;
+        }
+    }
+    c->rep.retransmitted_bytes += (uint64_t)cov;
+    if (s->max_end < b) {
+        s->max_end = b;
+    }
+    // Re-sent bytes already delivered: compare with the tail still held.
+    const int64_t lo = a > s->cursor - (int64_t)SL_PORT_CAPTURE_TAIL ? a : s->cursor - (int64_t)SL_PORT_CAPTURE_TAIL;
+    const int64_t hi = b < s->cursor ? b : s->cursor;
+    for (int64_t k = lo; k < hi; k++) {
+        c->rep.retransmit_mismatch_bytes +=
+            c->tail[(uint64_t)k % SL_PORT_CAPTURE_TAIL] != d[k - a] ? 1u : 0u;
+    }
+}
+
 /// Segment of the selected session. @return 1 with `pc` set (DATA), 0 consumed, -1 retry
 /// after the hole before the held bytes is declared a gap and they are delivered.
 static int sel_segment(sl_port_capture_t *c, sl_port_capture_piece_t *pc)
@@ -372,31 +425,7 @@ static int sel_segment(sl_port_capture_t *c, sl_port_capture_piece_t *pc)
     const int64_t b = a + (int64_t)len;
     if (!ps->counted) {
         ps->counted = true;
-        c->rep.segments++;
-        c->rep.payload_bytes += len;
-        const int64_t cov = sess_covered(s, a, b);
-        if (cov == (int64_t)len) {
-            c->rep.retransmitted_segments++;
-        } else {
-            if (cov > 0) {
-                c->rep.partial_overlap_segments++;
-            }
-            const int64_t lim = b < s->max_end ? b : s->max_end;
-            if (a < lim && sess_covered(s, a, lim) < lim - a) {
-                c->rep.out_of_order_segments++;
-            }
-        }
-        c->rep.retransmitted_bytes += (uint64_t)cov;
-        if (s->max_end < b) {
-            s->max_end = b;
-        }
-        // Re-sent bytes already delivered: compare with the tail still held.
-        const int64_t lo = a > s->cursor - (int64_t)SL_PORT_CAPTURE_TAIL ? a : s->cursor - (int64_t)SL_PORT_CAPTURE_TAIL;
-        const int64_t hi = b < s->cursor ? b : s->cursor;
-        for (int64_t k = lo; k < hi; k++) {
-            c->rep.retransmit_mismatch_bytes +=
-                c->tail[(uint64_t)k % SL_PORT_CAPTURE_TAIL] != d[k - a] ? 1u : 0u;
-        }
+        classify(c, s, a, d, len);
     }
     if (b <= s->cursor) {
         return 0;
@@ -444,6 +473,78 @@ static void cand_segment(sl_port_capture_t *c)
     if (sess_full(s, 65536u)) {
         c->sel.closing = true;
     }
+}
+
+static void pre_free(sl_port_capture_t *c)
+{
+    for (size_t i = 0; i < c->n_pre; i++) {
+        free(c->pre[i].data);
+    }
+    c->n_pre = 0;
+    c->pre_bytes = 0;
+}
+
+/// Before the radar port is known: keep a copy (bounded; beyond, the bytes are lost and
+/// show as a gap or a later start if that flow is the radar's).
+static void pre_store(sl_port_capture_t *c, int flow, int64_t data_rel, const uint8_t *d, size_t n)
+{
+    if (c->pre == NULL || c->n_pre >= PRE_SEGS || c->pre_bytes + n > PRE_BYTES) {
+        return;
+    }
+    uint8_t *copy = malloc(n);
+    if (copy == NULL) {
+        return;
+    }
+    memcpy(copy, d, n);
+    c->pre[c->n_pre++] = (struct held_seg){flow, data_rel, (uint32_t)n, copy};
+    c->pre_bytes += n;
+}
+
+/// The radar's flow is known and selected: its payload seen before goes into the session.
+static void pre_replay(sl_port_capture_t *c, int flow, int64_t cur_rel)
+{
+    sess_t *s = &c->sel;
+    const flow_t *f = &c->flows[flow];
+    bool any = false;
+    int64_t lo = cur_rel;
+    for (size_t i = 0; i < c->n_pre; i++) {
+        if (c->pre[i].flow == flow) {
+            any = true;
+            lo = c->pre[i].data_rel < lo ? c->pre[i].data_rel : lo;
+        }
+    }
+    if (any) {
+        s->have_base = true;
+        if (f->syn) {
+            s->base = f->syn_rel + 1;
+        } else {
+            s->base = lo;
+            c->rep.started_mid_stream = true;
+        }
+        for (size_t i = 0; i < c->n_pre; i++) {
+            const struct held_seg *h = &c->pre[i];
+            if (h->flow != flow) {
+                continue;
+            }
+            int64_t a = h->data_rel - s->base;
+            const uint8_t *d = h->data;
+            uint32_t len = h->len;
+            if (a < 0) {
+                const int64_t cut = -a < (int64_t)len ? -a : (int64_t)len;
+                d += cut;
+                len -= (uint32_t)cut;
+                a = 0;
+            }
+            if (len == 0) {
+                continue;
+            }
+            classify(c, s, a, d, len);
+            (void)sess_insert(c, s, a, d, len);
+        }
+    }
+    pre_free(c);
+    free(c->pre);
+    c->pre = NULL;
 }
 
 /// Parse one packet; set c->ps when it carries payload of a session. @return false when
@@ -606,6 +707,8 @@ static void on_packet(sl_port_capture_t *c, const struct pcap_pkthdr *h, const u
         return;
     }
     f->last_ts_us = ts;
+    f->packets++;
+    f->payload_bytes += payload_cap;
     if (!f->have_seq) {
         f->have_seq = true;
         f->last_seq = seq;
@@ -649,6 +752,9 @@ static void on_packet(sl_port_capture_t *c, const struct pcap_pkthdr *h, const u
             c->port_locked = true;
             c->rep.radar_port = sport;
             c->rep.port_auto_detected = true;
+        } else if (!c->opt.port_explicit) {
+            pre_store(c, fi, data_rel, payload, payload_cap);
+            return;
         }
     }
     if (!c->port_locked || sport != c->radar_port) {
@@ -660,11 +766,16 @@ static void on_packet(sl_port_capture_t *c, const struct pcap_pkthdr *h, const u
                 c->brk_pending = true;
                 c->brk = (sl_port_capture_piece_t){.kind = SL_PORT_CAPTURE_BREAK,
                                                    .brk = SL_PORT_CAPTURE_NEW_SESSION,
-                                                   .output_offset = c->out_off};
+                                                   .output_offset = c->out_off,
+                                                   .session = (uint32_t)c->rep.sessions};
             }
             sess_reset(&c->sel, fi);
             f->role = ROLE_SELECTED;
+            f->was_selected = true;
             c->rep.sessions++;
+            if (c->pre != NULL) {
+                pre_replay(c, fi, data_rel);
+            }
         } else if (!c->cand.active) {
             sess_reset(&c->cand, fi);
             f->role = ROLE_CANDIDATE;
@@ -714,6 +825,23 @@ sl_port_capture_t *sl_port_capture_open(const char *path, const sl_port_capture_
         sl_port_capture_close(c);
         return NULL;
     }
+    // A regular file is sniffed with pread (nothing consumed) and, when raw, mapped window
+    // by window. Anything else (pipe, FIFO, terminal, device) is read sequentially: the
+    // sniffed bytes are kept and handed on first.
+    struct stat st;
+    if (fstat(c->fd, &st) == 0 && S_ISREG(st.st_mode)) {
+        uint8_t m[4] = {0, 0, 0, 0};
+        const ssize_t n = pread(c->fd, m, sizeof m, 0);
+        const bool pcap_magic = n == 4 && (be32(m) == 0xa1b2c3d4u || be32(m) == 0xd4c3b2a1u ||
+                                           be32(m) == 0xa1b23c4du || be32(m) == 0x4d3cb2a1u ||
+                                           be32(m) == 0x0a0d0d0au);
+        if (n >= 0 && !pcap_magic) {
+            c->mapped = true;
+            c->file_size = (uint64_t)st.st_size;
+            c->rep.format = SL_PORT_CAPTURE_RAW;
+            return c;
+        }
+    }
     // Sniff: read until SNIFF_BYTES are there or the input ends; keep them.
     while (c->prefix_len < SNIFF_BYTES) {
         const ssize_t n = read(c->fd, c->buf + c->prefix_len, SL_PORT_CAPTURE_CHUNK - c->prefix_len);
@@ -747,6 +875,7 @@ sl_port_capture_t *sl_port_capture_open(const char *path, const sl_port_capture_
     c->sel.pend = malloc(SL_PORT_CAPTURE_PENDING_SEGS * sizeof(seg_t));
     c->cand.pend = malloc(SL_PORT_CAPTURE_PENDING_SEGS * sizeof(seg_t));
     c->tail = malloc(SL_PORT_CAPTURE_TAIL);
+    c->pre = c->opt.port_explicit ? NULL : malloc(PRE_SEGS * sizeof *c->pre);
     c->sel.flow = c->cand.flow = -1;
     const cookie_io_functions_t io = {.read = cookie_read, .close = cookie_close};
     c->fp = (c->sel.pend && c->cand.pend && c->tail) ? fopencookie(c, "r", io) : NULL;
@@ -780,8 +909,39 @@ static void finish(sl_port_capture_t *c, sl_port_capture_piece_t *pc, sl_port_ca
     *pc = (sl_port_capture_piece_t){.kind = k, .output_offset = c->out_off};
 }
 
+#define MAP_WINDOW (16u << 20) // bytes mapped at a time (a multiple of the page size)
+
+static void next_mapped(sl_port_capture_t *c, sl_port_capture_piece_t *pc)
+{
+    if (c->map != NULL) {
+        munmap(c->map, c->map_len);
+        c->map = NULL;
+        c->map_off += c->map_len;
+    }
+    if (c->map_off >= c->file_size) {
+        finish(c, pc, SL_PORT_CAPTURE_END);
+        return;
+    }
+    const uint64_t left = c->file_size - c->map_off;
+    c->map_len = left < MAP_WINDOW ? (size_t)left : MAP_WINDOW;
+    c->map = mmap(NULL, c->map_len, PROT_READ, MAP_PRIVATE | MAP_POPULATE, c->fd, (off_t)c->map_off);
+    if (c->map == MAP_FAILED) {
+        c->map = NULL;
+        snprintf(c->err, sizeof c->err, "mmap: %s", strerror(errno));
+        finish(c, pc, SL_PORT_CAPTURE_ERROR);
+        return;
+    }
+    (void)madvise(c->map, c->map_len, MADV_SEQUENTIAL);
+    c->rep.bytes_in += c->map_len;
+    data_piece(c, pc, c->map, c->map_len);
+}
+
 static void next_raw(sl_port_capture_t *c, sl_port_capture_piece_t *pc)
 {
+    if (c->mapped) {
+        next_mapped(c, pc);
+        return;
+    }
     if (c->prefix_pos < c->prefix_len) {
         const size_t n = c->prefix_len - c->prefix_pos;
         c->rep.bytes_in += n;
@@ -874,6 +1034,7 @@ static void next_pcap(sl_port_capture_t *c, sl_port_capture_piece_t *pc)
             s->closing = false;
             c->cand = (sess_t){.pend = sp, .flow = -1};
             c->flows[s->flow].role = ROLE_SELECTED;
+            c->flows[s->flow].was_selected = true;
             if (!c->flows[s->flow].syn) {
                 c->rep.started_mid_stream = true;
                 if (s->n_pend > 0) { // mid-stream: start at the first byte held
@@ -889,7 +1050,8 @@ static void next_pcap(sl_port_capture_t *c, sl_port_capture_piece_t *pc)
             c->brk_pending = true;
             c->brk = (sl_port_capture_piece_t){.kind = SL_PORT_CAPTURE_BREAK,
                                                .brk = SL_PORT_CAPTURE_NEW_SESSION,
-                                               .output_offset = c->out_off};
+                                               .output_offset = c->out_off,
+                                               .session = (uint32_t)(c->rep.sessions - 1)};
             continue;
         }
         if (c->eof) {
@@ -948,6 +1110,48 @@ void sl_port_capture_next(sl_port_capture_t *c, sl_port_capture_piece_t *pc)
     }
 }
 
+static void addr_str(char *out, size_t size, const uint8_t *a, uint8_t alen, uint16_t port)
+{
+    if ((alen & 0x7Fu) == 4u) {
+        snprintf(out, size, "%u.%u.%u.%u:%u", a[0], a[1], a[2], a[3], (unsigned)port);
+        return;
+    }
+    size_t k = (size_t)snprintf(out, size, "[");
+    for (unsigned i = 0; i < 16 && k < size; i += 2) {
+        k += (size_t)snprintf(out + k, size - k, "%s%x", i ? ":" : "", (unsigned)be16(a + i));
+    }
+    if (k < size) {
+        snprintf(out + k, size - k, "]:%u", (unsigned)port);
+    }
+}
+
+size_t sl_port_capture_flows(const sl_port_capture_t *c, sl_port_capture_flow_t *out, size_t max)
+{
+    size_t n = 0;
+    for (size_t i = 0; i < c->n_flows; i++) {
+        const flow_t *f = &c->flows[i];
+        if (!c->port_locked || f->sport != c->radar_port || !f->had_payload) {
+            continue;
+        }
+        if (n < max) {
+            sl_port_capture_flow_t *o = &out[n];
+            memset(o, 0, sizeof *o);
+            addr_str(o->src, sizeof o->src, f->src, f->alen, f->sport);
+            addr_str(o->dst, sizeof o->dst, f->dst, f->alen, f->dport);
+            o->packets = f->packets;
+            o->payload_bytes = f->payload_bytes;
+            o->first_ts_us = f->first_ts_us;
+            o->last_ts_us = f->last_ts_us;
+            o->syn = f->syn;
+            o->fin = f->fin;
+            o->rst = f->rst;
+            o->selected = f->was_selected;
+        }
+        n++;
+    }
+    return n;
+}
+
 const sl_port_capture_report_t *sl_port_capture_report(const sl_port_capture_t *c) { return &c->rep; }
 
 const char *sl_port_capture_error(const sl_port_capture_t *c) { return c->err; }
@@ -983,6 +1187,11 @@ void sl_port_capture_close(sl_port_capture_t *c)
     } else if (c->fp != NULL) {
         fclose(c->fp);
     }
+    if (c->map != NULL) {
+        munmap(c->map, c->map_len);
+    }
+    pre_free(c);
+    free(c->pre);
     free(c->held);
     if (c->sel.pend != NULL) {
         sess_free(&c->sel);

@@ -19,8 +19,13 @@
 /// order), BREAK (bytes are missing here, or a new TCP session starts: a decoder must be
 /// finished before the next DATA so it does not glue two half messages), END, ERROR.
 ///
+/// A raw capture in a regular file is sniffed with pread() and read through a read-only
+/// mapping that slides over the file 16 MiB at a time (no copy; the size is taken at open,
+/// so bytes appended later are not read; truncating the file while it is read is not
+/// supported).
+///
 /// Memory: bounded whatever the capture's size. Raw: one SL_PORT_CAPTURE_CHUNK read
-/// buffer. Pcap: libpcap's packet buffer, plus out-of-order segments held until the hole
+/// buffer, or one 16 MiB mapped window. Pcap: libpcap's packet buffer, plus out-of-order segments held until the hole
 /// before them fills, at most SL_PORT_CAPTURE_PENDING_MAX bytes per reassembled session
 /// (the selected one and at most one candidate successor); a hole still open when that
 /// bound is reached is declared a gap. Flows are tracked in a fixed table of
@@ -81,6 +86,9 @@ typedef struct sl_port_capture_piece {
     sl_port_capture_break_kind_t brk;  ///< BREAK only
     uint64_t output_offset;            ///< stream offset (bytes delivered so far) of this piece
     uint64_t missing_bytes;            ///< GAP only: bytes absent from the capture
+    uint64_t stream_offset;            ///< GAP only: TCP stream offset of the hole (from the
+                                       ///< session's first byte, ISN + 1)
+    uint32_t session;                  ///< BREAK: index of the session after it (0-based)
 } sl_port_capture_piece_t;
 
 /// Everything counted so far (final after END). Counts refer to the reassembled (selected)
@@ -133,6 +141,20 @@ const sl_port_capture_report_t *sl_port_capture_report(const sl_port_capture_t *
 
 /// The error message after ERROR ("" otherwise).
 const char *sl_port_capture_error(const sl_port_capture_t *c);
+
+/// One direction of one TCP connection from the radar port (pcap), as tracked so far.
+typedef struct sl_port_capture_flow {
+    char src[64], dst[64];       ///< "addr:port" ("[v6]:port" for IPv6)
+    uint64_t packets;            ///< packets of this direction
+    uint64_t payload_bytes;      ///< TCP payload bytes captured (with retransmissions)
+    uint64_t first_ts_us, last_ts_us; ///< capture timestamps (UNIX microseconds)
+    bool syn, fin, rst;
+    bool selected;               ///< part of the reassembled stream
+} sl_port_capture_flow_t;
+
+/// The radar-side flows that carried payload (pcap), in order of appearance: up to `max`
+/// into `out`. @return their number (may exceed `max`). O(SL_PORT_CAPTURE_MAX_FLOWS).
+size_t sl_port_capture_flows(const sl_port_capture_t *c, sl_port_capture_flow_t *out, size_t max);
 
 /// "raw", "pcap", "pcapng".
 const char *sl_port_capture_format_name(sl_port_capture_format_t f);

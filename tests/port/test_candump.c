@@ -1,13 +1,17 @@
-// Unit tests for host_tools/gsusb/candump_text.h: can-utils frame text and candump -L lines,
-// both ways (the sl-gsusb-send log input and its --tx-log/--rx-log output).
+// Unit tests for firmware/port/linux/candump.h: can-utils frame text and candump -L lines,
+// both ways (the sl-gsusb-send log input and its --tx-log/--rx-log output), and the log
+// file sink of the daemon's --can-log (lines read back with the parser).
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 #include <cmocka.h>
 
-#include "candump_text.h"
+#include "candump.h"
 
 static void test_candump_parses_sff_eff_rtr_and_error_frames(void **state)
 {
@@ -88,6 +92,61 @@ static void test_candump_formats_like_candump_and_round_trips(void **state)
                         "(0000000000.000005) can0 123#AB");
 }
 
+static void test_candump_sink_writes_lines_the_parser_reads_back(void **state)
+{
+    (void)state;
+    char path[] = "/tmp/sl_candump_XXXXXX";
+    const int fd = mkstemp(path);
+    assert_true(fd >= 0);
+    close(fd);
+    sld_candump_t c;
+    assert_int_equal(sld_candump_open(&c, path, "can0"), SL_OK);
+    sl_can_sink_t sink = sld_candump_sink(&c);
+    const sl_can_frame_t good[3] = {
+        {.id = 0x620, .dlc = 8, .data = {1, 2, 3, 4, 5, 6, 7, 8}},
+        {.id = 0x1ABCDE0F, .dlc = 2, .flags = SL_CAN_FLAG_EFF, .data = {0xAA, 0x55}},
+        {.id = 0x10F, .dlc = 3, .flags = SL_CAN_FLAG_RTR},
+    };
+    for (unsigned i = 0; i < 3; i++) {
+        c.stamp_us = 1700000000000000ULL + i;
+        assert_int_equal(sink.send(sink.ctx, &good[i], 0), SL_OK);
+    }
+    const sl_can_frame_t bad = {.id = 0x800, .dlc = 1}; // 12 bits in an 11-bit id
+    assert_int_equal(sink.send(sink.ctx, &bad, 0), SL_ERR_ARG);
+    sink.poll(sink.ctx, 0);
+    sl_can_sink_stats_t st;
+    sink.get_stats(sink.ctx, &st);
+    assert_int_equal(st.sent, 3);
+    assert_int_equal(st.dropped, 1);
+    sld_candump_close(&c);
+    sld_candump_close(&c); // idempotent
+
+    FILE *f = fopen(path, "r");
+    assert_non_null(f);
+    char line[128];
+    unsigned n = 0;
+    while (fgets(line, sizeof line, f) != NULL) {
+        assert_true(n < 3);
+        char want[32];
+        snprintf(want, sizeof want, "(1700000000.%06u) can0 ", n);
+        assert_memory_equal(line, want, strlen(want));
+        sl_can_frame_t back;
+        const char *why = NULL;
+        assert_int_equal(sl_candump_parse_line(line, &back, &why), SL_OK);
+        assert_int_equal(back.id, good[n].id);
+        assert_int_equal(back.dlc, good[n].dlc);
+        assert_int_equal(back.flags, good[n].flags);
+        if ((good[n].flags & SL_CAN_FLAG_RTR) == 0U) {
+            assert_memory_equal(back.data, good[n].data, good[n].dlc);
+        }
+        n++;
+    }
+    fclose(f);
+    assert_int_equal(n, 3);
+    unlink(path);
+    assert_int_equal(sld_candump_open(&c, path, "bad iface"), SL_ERR_ARG);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -95,6 +154,7 @@ int main(void)
         cmocka_unit_test(test_candump_rejects_malformed_frames_with_a_reason),
         cmocka_unit_test(test_candump_lines_with_timestamp_interface_and_markers),
         cmocka_unit_test(test_candump_formats_like_candump_and_round_trips),
+        cmocka_unit_test(test_candump_sink_writes_lines_the_parser_reads_back),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -1,8 +1,10 @@
 #!/usr/bin/python3
 """Decode shadowlean CAN frames from a candump log with a board's generated DBC
-(Debian python3-canmatrix), independently of the C code.
+(Debian python3-canmatrix), independently of the C code. The project's one Python DBC
+decoder: the daemon tests, the DBC layout check (tests/can/check_dbc_decode.py) and
+scripts/demo.sh all use it.
 
-Library (imported by the daemon tests and scripts/demo.sh):
+Library:
     db = load_dbc(path)
     frames = read_candump(path)            # [(t_s, iface, can_id, is_eff, bytes)]
     d = decode(db, can_id, is_eff, data)   # Decoded(name, phys{}, raw{}, named{}, crc_ok, ...)
