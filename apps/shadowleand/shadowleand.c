@@ -46,16 +46,18 @@
 #define MAX_PLAY_GAP_US 5000000U  // --realtime: longer timestamp gaps are shortened to this
 #define DRAIN_MS 500U             // at exit: wait at most this long for queued frames
 
-#define LEAD_MAX (1U << 20)        // capture bytes held until the first FFT timestamp is known
-#define IX_CAP ((LEAD_MAX + SL_PORT_CAPTURE_CHUNK) / SL_PROTO_HEADER_BYTES + 16U)
+#define HOLD_SLICE 4096U           // --realtime: stream bytes decoded at a time
+#define HOLD_MSGS 8192U            // --realtime: messages held (copied) at most
+#define HOLD_LEAD_BYTES (1U << 20) // payload bytes held at most before the data clock starts
 
-/// One queued capture event: a message (where it ends in the stream, its FFT timestamp or
-/// 0 = not FFT data) or a discontinuity (the pipeline's decoder is finished there).
-typedef struct msg_ix {
-    uint64_t end;
-    uint64_t t_us;
+/// --realtime: one message decoded ahead and held (payload copied) until it is due, or a
+/// discontinuity (the pipeline's stream is finished there).
+typedef struct held_msg {
+    sl_proto_msg_t m;  ///< payload.data re-pointed into the hold buffer when delivered
+    size_t off;        ///< payload offset in the hold buffer
+    uint64_t t_us;     ///< FFT timestamp, 0 = not FFT data
     bool brk;
-} msg_ix_t;
+} held_msg_t;
 
 typedef struct daemon {
     sld_opts_t o;
@@ -92,27 +94,25 @@ typedef struct daemon {
     bool had_fft;               // any FFT data since start
     sl_radar_state_t last_radar_state;
 
-    // input: capture, streamed (bounded memory): pieces from the port's reader are decoded
-    // once by the pacer (message ends + FFT timestamps, queued in ix) and fed to the
-    // pipeline message by message; bytes before the first FFT timestamp are held in `lead`
-    // (the data clock starts there).
+    // input: capture, streamed (bounded memory): each byte is decoded once, by `pacer`,
+    // whose messages go to sl_pipeline_on_msg: at once with --fast; with --realtime they
+    // are held (copied, a few KiB ahead) until due. Messages before the first FFT timestamp
+    // are held too: the data clock starts there.
     sl_port_capture_t *cr;
     sl_proto_t pacer;
     uint8_t *pacer_reasm;
-    msg_ix_t *ix;
-    size_t n_ix, next_ix;
-    const uint8_t *view;        // stream bytes [view_base, view_base + view_len) not yet all fed
-    uint64_t view_base;
-    size_t view_len;
-    uint8_t *lead;
-    size_t lead_len;
-    sl_port_capture_piece_t pend_piece; // read, not yet taken (the lead is fed first)
-    bool have_pend_piece;
+    bool decode_once;           // --fast: the pacer hands messages over at once
+    held_msg_t *held;
+    size_t n_held, next_held;
+    uint8_t *hold;
+    size_t hold_len, hold_cap;
+    sl_port_capture_piece_t piece; // DATA piece being decoded (--realtime)
+    size_t piece_pos;
+    bool have_piece;
     bool clock_known;           // data_us started (first FFT seen, or given up waiting)
-    bool decode_once;           // --fast: the pacer hands messages to the pipeline
     bool cap_end;               // the reader returned END or ERROR
     bool cap_error;
-    uint64_t fed;               // stream bytes fed to the pipeline
+    uint64_t fed;               // stream bytes decoded
     uint64_t n_msgs, n_fft, n_breaks;
     bool cap_done;
     uint64_t play_wall0, play_us, play_prev_t;
@@ -397,37 +397,40 @@ static int radar_setup(daemon_t *d)
 static void pacer_on_msg(void *ctx, const sl_proto_msg_t *msg)
 {
     daemon_t *d = ctx;
-    if (d->decode_once) {
-        // --fast: every message straight to the pipeline at its data clock.
-        sl_proto_fft_t fft;
-        if ((msg->id == SL_PROTO_ID_FFT_DATA || msg->id == SL_PROTO_ID_FFT_DATA_16) &&
-            sl_proto_parse_fft(msg, &fft) == SL_OK) {
-            const uint64_t t = sl_proto_fft_time_us(&fft);
-            if (d->n_fft == 0 || t > d->data_us) {
-                d->data_us = t;
-            }
-            d->n_fft++;
-        }
-        d->n_msgs++;
-        fixed_motion(d, pipe_now(d));
-        sl_pipeline_on_msg(&g_pipe, msg, pipe_now(d));
-        return;
-    }
-    if (d->n_ix >= IX_CAP) { // cannot happen: a piece holds at most IX_CAP headers
-        return;
-    }
-    msg_ix_t m = {msg->stream_offset + SL_PROTO_HEADER_BYTES + msg->payload.size, 0, false};
+    uint64_t t = 0;
     sl_proto_fft_t fft;
     if ((msg->id == SL_PROTO_ID_FFT_DATA || msg->id == SL_PROTO_ID_FFT_DATA_16) &&
         sl_proto_parse_fft(msg, &fft) == SL_OK) {
-        m.t_us = sl_proto_fft_time_us(&fft);
+        t = sl_proto_fft_time_us(&fft);
         if (!d->clock_known && d->n_fft == 0) {
-            d->data_us = m.t_us; // the data clock starts at the first FFT message
+            d->data_us = t; // the data clock starts at the first FFT message
         }
         d->n_fft++;
     }
     d->n_msgs++;
-    d->ix[d->n_ix++] = m;
+    if (d->decode_once) {
+        // --fast: straight to the pipeline at its data clock.
+        if (t > d->data_us) {
+            d->data_us = t;
+        }
+        fixed_motion(d, pipe_now(d));
+        sl_pipeline_on_msg(&g_pipe, msg, pipe_now(d));
+        return;
+    }
+    // --realtime: hold a copy until it is due (bounded: see capture_step).
+    if (d->n_held >= HOLD_MSGS || d->hold_len + msg->payload.size > d->hold_cap) {
+        sld_log(SLD_LOG_ERR, "internal: capture hold buffer full, message dropped"); // not reached
+        return;
+    }
+    held_msg_t *h = &d->held[d->n_held++];
+    h->m = *msg;
+    h->off = d->hold_len;
+    h->t_us = t;
+    h->brk = false;
+    if (msg->payload.size > 0) {
+        memcpy(d->hold + d->hold_len, msg->payload.data, msg->payload.size);
+        d->hold_len += msg->payload.size;
+    }
 }
 
 /// Open the capture (path or "-"): nothing is read beyond the format sniff.
@@ -439,112 +442,44 @@ static int capture_setup(daemon_t *d)
         sld_log(SLD_LOG_ERR, "--input: %s", err);
         return -1;
     }
-    // Decode once as fast as possible; with --realtime the pacer only indexes (message
-    // ends, FFT timestamps) and the pipeline decodes the bytes when they are due.
     d->decode_once = !d->o.realtime;
     size_t reasm = d->board->max_message_bytes;
     if (reasm < 65536U) {
         reasm = 65536U;
     }
     d->pacer_reasm = malloc(reasm);
-    d->ix = malloc(IX_CAP * sizeof *d->ix);
-    d->lead = malloc(LEAD_MAX);
-    if (d->pacer_reasm == NULL || d->ix == NULL || d->lead == NULL) {
+    d->hold_cap = HOLD_LEAD_BYTES + HOLD_SLICE + reasm;
+    if (!d->decode_once) {
+        d->hold = malloc(d->hold_cap);
+        d->held = malloc(HOLD_MSGS * sizeof *d->held);
+    }
+    if (d->pacer_reasm == NULL || (!d->decode_once && (d->hold == NULL || d->held == NULL))) {
         sld_log(SLD_LOG_ERR, "out of memory");
         return -1;
     }
-    // The pipeline decoder's limit: both decoders accept and reject the same headers.
+    // The pipeline decoder's limit: both accept and reject the same headers.
     const sl_proto_cfg_t pc = {.reasm_buf = d->pacer_reasm, .reasm_size = reasm,
                               .max_payload_bytes = d->board->max_message_bytes, .truncate_long = false,
                               .on_msg = pacer_on_msg, .ctx = d};
     sl_proto_init(&d->pacer, &pc);
-    if (d->decode_once) {
-        sl_pipeline_set_decoder_stats(&g_pipe, &d->pacer.stats); // Status.DecoderResyncs
-    }
+    sl_pipeline_set_decoder_stats(&g_pipe, &d->pacer.stats); // Status.DecoderResyncs
     sld_log(SLD_LOG_INFO, "input %s (%s)", d->o.capture,
             sl_port_capture_format_name(sl_port_capture_report(d->cr)->format));
     return 0;
 }
 
-static void capture_feed_to(daemon_t *d, uint64_t end)
+/// End of input (END or ERROR piece).
+static void capture_end(daemon_t *d, const sl_port_capture_piece_t *pc)
 {
-    if (end > d->fed) {
-        fixed_motion(d, pipe_now(d));
-        sl_pipeline_feed(&g_pipe, d->view + (d->fed - d->view_base), (size_t)(end - d->fed), pipe_now(d));
-        d->fed = end;
-    }
-}
-
-static void queue_break(daemon_t *d, uint64_t at)
-{
-    sl_proto_finish(&d->pacer);
-    if (d->n_ix < IX_CAP) {
-        d->ix[d->n_ix++] = (msg_ix_t){at, 0, true};
-    }
-    d->n_breaks++;
-}
-
-/// Pull the next piece from the reader into the queue (all queued events fed, all of the
-/// view fed, unless the data clock is still unknown and the bytes go to `lead`).
-static void capture_pull(daemon_t *d)
-{
-    sl_port_capture_piece_t pc;
-    if (d->have_pend_piece) {
-        pc = d->pend_piece;
-        d->have_pend_piece = false;
-    } else {
-        sl_port_capture_next(d->cr, &pc);
-    }
-    if (pc.kind == SL_PORT_CAPTURE_DATA) {
-        // At most LEAD_MAX bytes go to the lead, at most one chunk to the view: the rest of
-        // the piece waits (still valid: the reader is not called before it is taken).
-        const size_t room = d->clock_known ? SL_PORT_CAPTURE_CHUNK : LEAD_MAX - d->lead_len;
-        if (room == 0) {
-            // No FFT timestamp in the first LEAD_MAX bytes: run on the wall clock; the lead
-            // is fed first (capture_step), then this piece.
-            d->clock_known = true;
-            d->data_us = realtime_us();
-            d->pend_piece = pc;
-            d->have_pend_piece = true;
-            return;
-        }
-        const size_t k = pc.size < room ? pc.size : room;
-        if (k < pc.size) {
-            d->pend_piece = pc;
-            d->pend_piece.data += k;
-            d->pend_piece.size -= k;
-            d->pend_piece.output_offset += k;
-            d->have_pend_piece = true;
-        }
-        sl_proto_feed(&d->pacer, pc.data, k, 0);
-        if (d->clock_known) {
-            d->view = pc.data;
-            d->view_base = pc.output_offset;
-            d->view_len = k;
-            return;
-        }
-        memcpy(d->lead + d->lead_len, pc.data, k);
-        d->lead_len += k;
-        if (d->n_fft > 0) {
-            d->clock_known = true;
-        }
-        d->view = d->lead;
-        d->view_base = 0;
-        d->view_len = d->lead_len;
-        return;
-    }
-    if (pc.kind == SL_PORT_CAPTURE_BREAK) {
-        queue_break(d, pc.output_offset);
-        return;
-    }
-    // END or ERROR
     sl_proto_finish(&d->pacer);
     d->cap_end = true;
-    d->clock_known = true;
-    if (d->n_fft == 0 && d->data_us == 0) {
-        d->data_us = realtime_us();
+    if (!d->clock_known) {
+        d->clock_known = true;
+        if (d->n_fft == 0) {
+            d->data_us = realtime_us();
+        }
     }
-    if (pc.kind == SL_PORT_CAPTURE_ERROR) {
+    if (pc->kind == SL_PORT_CAPTURE_ERROR) {
         d->cap_error = true;
         sld_log(SLD_LOG_ERR, "--input %s: %s", d->o.capture, sl_port_capture_error(d->cr));
     }
@@ -564,17 +499,38 @@ static void capture_step_fast(daemon_t *d)
             sl_pipeline_finish(&g_pipe, pipe_now(d));
             d->n_breaks++;
         } else {
-            sl_proto_finish(&d->pacer);
-            if (d->n_fft == 0) {
-                d->data_us = realtime_us();
-            }
+            capture_end(d, &pc);
             sl_pipeline_finish(&g_pipe, pipe_now(d));
-            if (pc.kind == SL_PORT_CAPTURE_ERROR) {
-                d->cap_error = true;
-                sld_log(SLD_LOG_ERR, "--input %s: %s", d->o.capture, sl_port_capture_error(d->cr));
-            }
             d->cap_done = true;
         }
+    }
+}
+
+/// --realtime: decode the next slice (or take the next piece) into the hold queue.
+static void capture_decode_more(daemon_t *d)
+{
+    if (!d->have_piece) {
+        sl_port_capture_next(d->cr, &d->piece);
+        if (d->piece.kind == SL_PORT_CAPTURE_DATA) {
+            d->have_piece = true;
+            d->piece_pos = 0;
+        } else if (d->piece.kind == SL_PORT_CAPTURE_BREAK) {
+            sl_proto_finish(&d->pacer);
+            d->held[d->n_held++] = (held_msg_t){.brk = true};
+            d->n_breaks++;
+            return;
+        } else {
+            capture_end(d, &d->piece);
+            return;
+        }
+    }
+    size_t k = d->piece.size - d->piece_pos;
+    k = k < HOLD_SLICE ? k : HOLD_SLICE;
+    sl_proto_feed(&d->pacer, d->piece.data + d->piece_pos, k, 0);
+    d->piece_pos += k;
+    d->fed += k;
+    if (d->piece_pos == d->piece.size) {
+        d->have_piece = false;
     }
 }
 
@@ -588,61 +544,65 @@ static uint64_t capture_step(daemon_t *d)
     unsigned budget = FAST_MSGS_PER_TURN;
     while (!d->cap_done && !d->stop && budget-- > 0) {
         if (!d->clock_known) {
-            capture_pull(d);
+            // Hold until the first FFT timestamp (or give up after HOLD_LEAD_BYTES /
+            // about HOLD_MSGS messages: the wall clock then).
+            if (d->n_fft > 0) {
+                d->clock_known = true;
+            } else if (d->hold_len > HOLD_LEAD_BYTES || d->n_held + 2U * HOLD_SLICE / SL_PROTO_HEADER_BYTES > HOLD_MSGS) {
+                d->clock_known = true;
+                d->data_us = realtime_us();
+            } else if (!d->cap_end) {
+                capture_decode_more(d);
+            }
             continue;
         }
-        if (d->next_ix >= d->n_ix) {
-            // Every queued event fed: hand the rest of the view (a partial message or
-            // junk) to the pipeline, then read on.
-            capture_feed_to(d, d->view_base + d->view_len);
+        if (d->next_held >= d->n_held) {
+            d->n_held = d->next_held = 0;
+            d->hold_len = 0;
             if (d->cap_end) {
                 sl_pipeline_finish(&g_pipe, pipe_now(d));
                 d->cap_done = true;
                 break;
             }
-            if (d->view == d->lead) {
-                d->lead_len = 0;
-            }
-            d->n_ix = d->next_ix = 0;
-            capture_pull(d);
+            capture_decode_more(d);
             continue;
         }
-        const msg_ix_t *m = &d->ix[d->next_ix];
-        if (m->brk) {
-            capture_feed_to(d, m->end);
+        held_msg_t *h = &d->held[d->next_held];
+        if (h->brk) {
             sl_pipeline_finish(&g_pipe, pipe_now(d));
-            d->next_ix++;
+            d->next_held++;
             continue;
         }
-        if (m->t_us != 0) {
-            if (d->o.realtime) {
-                if (!d->play_started) {
-                    d->play_started = true;
-                    d->play_wall0 = d->mono_us;
-                    d->play_prev_t = m->t_us;
-                    // The idle-Status clock starts with the data, not with the set-up
-                    // (opening a gs_usb device in a slow VM took > 1 s: an idle Status
-                    // before the first rotation).
-                    d->last_status_mono = d->mono_us;
-                } else {
-                    uint64_t dt = m->t_us > d->play_prev_t ? m->t_us - d->play_prev_t : 0;
-                    if (dt > MAX_PLAY_GAP_US) {
-                        dt = MAX_PLAY_GAP_US;
-                    }
-                    const uint64_t due = d->play_wall0 + d->play_us + dt;
-                    if (due > d->mono_us) {
-                        return due; // not yet (play_us/prev_t unchanged until it is fed)
-                    }
-                    d->play_us += dt;
-                    d->play_prev_t = m->t_us;
+        if (h->t_us != 0) {
+            if (!d->play_started) {
+                d->play_started = true;
+                d->play_wall0 = d->mono_us;
+                d->play_prev_t = h->t_us;
+                // The idle-Status clock starts with the data, not with the set-up
+                // (opening a gs_usb device in a slow VM took > 1 s: an idle Status
+                // before the first rotation).
+                d->last_status_mono = d->mono_us;
+            } else {
+                uint64_t dt = h->t_us > d->play_prev_t ? h->t_us - d->play_prev_t : 0;
+                if (dt > MAX_PLAY_GAP_US) {
+                    dt = MAX_PLAY_GAP_US;
                 }
+                const uint64_t due = d->play_wall0 + d->play_us + dt;
+                if (due > d->mono_us) {
+                    return due; // not yet (play_us/prev_t unchanged until it is fed)
+                }
+                d->play_us += dt;
+                d->play_prev_t = h->t_us;
             }
-            if (m->t_us > d->data_us) {
-                d->data_us = m->t_us;
+            if (h->t_us > d->data_us) {
+                d->data_us = h->t_us;
             }
         }
-        capture_feed_to(d, m->end);
-        d->next_ix++;
+        sl_proto_msg_t m = h->m;
+        m.payload.data = m.payload.size > 0 ? d->hold + h->off : NULL;
+        fixed_motion(d, pipe_now(d));
+        sl_pipeline_on_msg(&g_pipe, &m, pipe_now(d));
+        d->next_held++;
     }
     return 0;
 }
@@ -1194,8 +1154,8 @@ int main(int argc, char **argv)
         exit_rc = 3;
     }
     sl_port_capture_close(d->cr);
-    free(d->ix);
-    free(d->lead);
+    free(d->held);
+    free(d->hold);
     free(d->pacer_reasm);
     free(d->radar_reasm);
     sld_log_close();

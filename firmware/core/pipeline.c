@@ -210,7 +210,7 @@ uint16_t sl_pipeline_faults(const sl_pipeline_t *p)
     if (!rows_fresh(p) && (connected || fft_seen)) {
         f |= (uint16_t)SL_CAN_FAULT_NO_USABLE_ROWS;
     }
-    if (p->proto.stats.resyncs != p->snap.resyncs || p->scan.stats.malformed != p->snap.malformed ||
+    if (p->decoder_stats->resyncs != p->snap.resyncs || p->scan.stats.malformed != p->snap.malformed ||
         p->scan.stats.bad_azimuth != p->snap.bad_azimuth ||
         p->scan.stats.empty_rows != p->snap.empty_rows) {
         f |= (uint16_t)SL_CAN_FAULT_MALFORMED_DATA;
@@ -272,7 +272,7 @@ static void emit_status(sl_pipeline_t *p)
     p->fault_latched = 0U;
     p->rows_since_health = 0U;
     p->snap.fft = p->scan.stats.fft;
-    p->snap.resyncs = p->proto.stats.resyncs;
+    p->snap.resyncs = p->decoder_stats->resyncs;
     p->snap.malformed = p->scan.stats.malformed;
     p->snap.bad_azimuth = p->scan.stats.bad_azimuth;
     p->snap.empty_rows = p->scan.stats.empty_rows;

@@ -270,8 +270,13 @@ sl_err_t sl_proto_feed(sl_proto_t *p, const uint8_t *data, size_t len, uint64_t 
             // it cannot repeat without progress.
             i -= p->sig_got;
             p->sig_got = 0;
-            bool found;
-            const size_t j = sig_search(data, i, len, &found);
+            bool found = true;
+            size_t j = i;
+            // Aligned stream (the common case): the signature is right here.
+            if (data[i] != 0x00U ||
+                memcmp(data + i, sl_proto_signature, SL_PROTO_SIGNATURE_BYTES) != 0) {
+                j = sig_search(data, i, len, &found);
+            }
             skip(p, j - i);
             i = j;
             if (!found) {

@@ -107,9 +107,7 @@
 ///
 /// | configuration (400 azimuths, 32 targets)              | x86-64    | Cortex-M0 |
 /// |--------------------------------------------------------|-----------|-----------|
-/// | firmware: SL_CFG_MASK_BINS 160, SL_CFG_MASK_FRAMES_MAX 16 | 54,952 B  | (not re-measured; 52,712 B before sl_profile's 2.1 KB) |
-/// | SL_CFG_MASK_BINS 192, SL_CFG_MASK_FRAMES_MAX 16          | 60,912 B  | 60,816 B  |
-/// | host default: mask bins 512 (whole ROI), n <= 32          | 167,552 B | 167,456 B |
+/// | firmware: SL_CFG_MASK_BINS 160, SL_CFG_MASK_FRAMES_MAX 16 | (re-measured below) | |
 ///
 /// The boards carried today need 135 (paper-sim), 119 (paper-bench) and 141 (robotcar-leaf)
 /// masked bins (sl_detect_bins_needed(), rounded up to 160).

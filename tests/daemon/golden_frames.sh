@@ -3,7 +3,7 @@
 # Behaviour pinned byte for byte: the CAN frames (candump -L log, data clock) the daemon
 # writes for the README's demo scene (scenes/demo_three_poles.ini through sl-sim) and for the
 # 11 real Oxford scans (sl-replay from-oxford), each read from a file (and with --pipe from
-# a pipe on stdin, `--input -`), must equal tests/daemon/golden/<name>.candump. The golden logs were written by
+# a pipe on stdin, `--input -`, as fast as possible and --realtime), must equal tests/daemon/golden/<name>.candump. The golden logs were written by
 # the daemon at "Layers step 1" (a pure move of main 1eb0496), before the capture reader
 # moved into the port. The sha256 of each input
 # capture is pinned too, so a changed simulator is told apart from a changed daemon.
@@ -43,6 +43,14 @@ check() { # name board capture
         { echo "FAIL: $name: shadowleand --input - exit status $?"; fail=1; return; }
     if cmp "$G/$name.candump" "$OUT/$name.pipe.candump"; then
         echo "$name: $n frames byte for byte (stdin pipe)"
+    else
+        echo "FAIL: $name: frames through a pipe differ"; diff "$G/$name.candump" "$OUT/$name.pipe.candump" | head -5; fail=1
+    fi
+    # ... and paced in real time (messages held until due): the same frames.
+    cat "$cap" | "$DAEMON" --board "$board" --input - --realtime --can-log "$OUT/$name.rt.candump" -q ||
+        { echo "FAIL: $name: shadowleand --input - --realtime exit status $?"; fail=1; return; }
+    if cmp "$G/$name.candump" "$OUT/$name.rt.candump"; then
+        echo "$name: $n frames byte for byte (stdin pipe, --realtime)"
     else
         echo "FAIL: $name: frames through a pipe differ"; diff "$G/$name.candump" "$OUT/$name.pipe.candump" | head -5; fail=1
     fi
