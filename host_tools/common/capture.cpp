@@ -58,46 +58,10 @@ CaptureFormat sniff_capture_format(const std::string &path)
     return CaptureFormat::Raw;
 }
 
-// The port's streaming reader (firmware/port/linux/capture_reader.h) does the reading, the
-// format sniffing (once, on bytes already read: pipes and stdin "-" work) and the TCP
-// reassembly; this collects its pieces into memory for the tools that want the whole stream.
-bool load_capture(const std::string &path, Capture &out, std::string &err, const PcapOptions &opt)
+namespace {
+// Format, pcap report and flows of reader `c` into `out` (not the bytes).
+void fill_report(const sl_port_capture_t *c, Capture &out)
 {
-    out = Capture{};
-    sl_port_capture_opts_t o{};
-    o.radar_port = static_cast<uint16_t>(opt.radar_port);
-    o.port_explicit = opt.port_explicit;
-    char e[512] = {0};
-    sl_port_capture_t *c = sl_port_capture_open(path.c_str(), &o, e, sizeof e);
-    if (c == nullptr) {
-        err = e;
-        return false;
-    }
-    bool ok = true;
-    for (;;) {
-        sl_port_capture_piece_t p;
-        sl_port_capture_next(c, &p);
-        if (p.kind == SL_PORT_CAPTURE_DATA) {
-            out.bytes.insert(out.bytes.end(), p.data, p.data + p.size);
-        } else if (p.kind == SL_PORT_CAPTURE_BREAK) {
-            Discontinuity d;
-            d.kind = p.brk == SL_PORT_CAPTURE_GAP ? Discontinuity::Kind::Gap : Discontinuity::Kind::NewSession;
-            d.output_offset = p.output_offset;
-            d.stream_offset = p.stream_offset;
-            d.missing_bytes = p.missing_bytes;
-            d.session = p.session;
-            out.discontinuities.push_back(d);
-            if (d.kind == Discontinuity::Kind::Gap) {
-                out.pcap.gap_list.push_back(d);
-            }
-        } else {
-            if (p.kind == SL_PORT_CAPTURE_ERROR) {
-                err = path + ": " + sl_port_capture_error(c);
-                ok = false;
-            }
-            break;
-        }
-    }
     const sl_port_capture_report_t *r = sl_port_capture_report(c);
     switch (r->format) {
     case SL_PORT_CAPTURE_RAW: out.format = CaptureFormat::Raw; break;
@@ -148,6 +112,106 @@ bool load_capture(const std::string &path, Capture &out, std::string &err, const
             rep.flows.push_back(f);
         }
     }
+}
+} // namespace
+
+// The port's streaming reader (firmware/port/linux/capture_reader.h) does the reading, the
+// format sniffing (once, on bytes already read: pipes and stdin "-" work) and the TCP
+// reassembly; this collects its pieces into memory for the tools that want the whole stream.
+bool load_capture(const std::string &path, Capture &out, std::string &err, const PcapOptions &opt)
+{
+    out = Capture{};
+    sl_port_capture_opts_t o{};
+    o.radar_port = static_cast<uint16_t>(opt.radar_port);
+    o.port_explicit = opt.port_explicit;
+    char e[512] = {0};
+    sl_port_capture_t *c = sl_port_capture_open(path.c_str(), &o, e, sizeof e);
+    if (c == nullptr) {
+        err = e;
+        return false;
+    }
+    bool ok = true;
+    for (;;) {
+        sl_port_capture_piece_t p;
+        sl_port_capture_next(c, &p);
+        if (p.kind == SL_PORT_CAPTURE_DATA) {
+            out.bytes.insert(out.bytes.end(), p.data, p.data + p.size);
+        } else if (p.kind == SL_PORT_CAPTURE_BREAK) {
+            Discontinuity d;
+            d.kind = p.brk == SL_PORT_CAPTURE_GAP ? Discontinuity::Kind::Gap : Discontinuity::Kind::NewSession;
+            d.output_offset = p.output_offset;
+            d.stream_offset = p.stream_offset;
+            d.missing_bytes = p.missing_bytes;
+            d.session = p.session;
+            out.discontinuities.push_back(d);
+            if (d.kind == Discontinuity::Kind::Gap) {
+                out.pcap.gap_list.push_back(d);
+            }
+        } else {
+            if (p.kind == SL_PORT_CAPTURE_ERROR) {
+                err = path + ": " + sl_port_capture_error(c);
+                ok = false;
+            }
+            break;
+        }
+    }
+    fill_report(c, out);
+    sl_port_capture_close(c);
+    return ok;
+}
+
+bool stream_capture(const std::string &path, sl_proto_t *p, size_t chunk, Capture &info, uint64_t &bytes,
+                    std::string &err, const PcapOptions &opt)
+{
+    info = Capture{};
+    bytes = 0;
+    sl_port_capture_opts_t o{};
+    o.radar_port = static_cast<uint16_t>(opt.radar_port);
+    o.port_explicit = opt.port_explicit;
+    char e[512] = {0};
+    sl_port_capture_t *c = sl_port_capture_open(path.c_str(), &o, e, sizeof e);
+    if (c == nullptr) {
+        err = e;
+        return false;
+    }
+    bool ok = true;
+    for (;;) {
+        sl_port_capture_piece_t pc;
+        sl_port_capture_next(c, &pc);
+        if (pc.kind == SL_PORT_CAPTURE_DATA) {
+            for (size_t off = 0; off < pc.size;) {
+                size_t n = pc.size - off;
+                if (chunk > 0 && n > chunk) {
+                    n = chunk;
+                }
+                (void)sl_proto_feed(p, pc.data + off, n, 0);
+                off += n;
+            }
+            bytes += pc.size;
+        } else if (pc.kind == SL_PORT_CAPTURE_BREAK) {
+            (void)sl_proto_finish(p);
+            Discontinuity d;
+            d.kind = pc.brk == SL_PORT_CAPTURE_GAP ? Discontinuity::Kind::Gap : Discontinuity::Kind::NewSession;
+            d.output_offset = pc.output_offset;
+            d.stream_offset = pc.stream_offset;
+            d.missing_bytes = pc.missing_bytes;
+            d.session = pc.session;
+            info.discontinuities.push_back(d);
+            if (d.kind == Discontinuity::Kind::Gap) {
+                info.pcap.gap_list.push_back(d);
+            }
+        } else {
+            (void)sl_proto_finish(p);
+            if (pc.kind == SL_PORT_CAPTURE_ERROR) {
+                err = path + ": " + sl_port_capture_error(c);
+                ok = false;
+            }
+            break;
+        }
+    }
+    std::vector<Discontinuity> gaps = info.pcap.gap_list;
+    fill_report(c, info);
+    info.pcap.gap_list = gaps;
     sl_port_capture_close(c);
     return ok;
 }

@@ -123,6 +123,14 @@ bool load_capture(const std::string &path, Capture &out, std::string &err,
 bool load_pcap(const std::string &path, Capture &out, std::string &err,
                const PcapOptions &opt = PcapOptions{});
 
+/// Streams `path` ("-" = stdin) through decoder `p` in bounded memory: what load_capture +
+/// feed_capture do, without holding the stream (`chunk` > 0: at most that many bytes per
+/// sl_proto_feed). `info` receives the format, discontinuities and pcap report (its `bytes`
+/// stay empty); `bytes` the stream size. false + `err` when the capture cannot be opened
+/// or ends with an error (the part read before it has been fed).
+bool stream_capture(const std::string &path, sl_proto_t *p, size_t chunk, Capture &info, uint64_t &bytes,
+                    std::string &err, const PcapOptions &opt = PcapOptions{});
+
 /// Feeds the whole capture to decoder `p` (which must be freshly initialised so that its
 /// stream offsets equal indexes into `cap.bytes`): one sl_proto_feed() per continuous piece,
 /// sl_proto_finish() at every discontinuity (a partial message before a gap is dropped and

@@ -230,13 +230,6 @@ int main(int argc, char **argv)
         return 2;
     }
 
-    sl::Capture cap;
-    std::string err;
-    if (!sl::load_capture(path, cap, err, popt)) {
-        std::fprintf(stderr, "sl-inspect: %s\n", err.c_str());
-        return 1;
-    }
-
     auto in = std::make_unique<Inspect>();
     auto frame = std::make_unique<sl_scan_frame_t>();
     sl_scan_cfg_t sc{};
@@ -257,7 +250,14 @@ int main(int argc, char **argv)
     pc.ctx = in.get();
     sl_proto_t proto;
     sl_proto_init(&proto, &pc);
-    sl::feed_capture(cap, &proto, chunk);
+    // Streamed through the port's reader: bounded memory whatever the capture's size.
+    sl::Capture cap;
+    uint64_t cap_bytes = 0;
+    std::string err;
+    if (!sl::stream_capture(path, &proto, chunk, cap, cap_bytes, err, popt)) {
+        std::fprintf(stderr, "sl-inspect: %s\n", err.c_str());
+        return 1;
+    }
     sl_scan_flush(&in->scan);
     const sl_proto_stats_t &ps = proto.stats;
     const sl_scan_stats_t &ss = in->scan.stats;
@@ -265,7 +265,7 @@ int main(int argc, char **argv)
     json j;
     j["file"] = path;
     j["format"] = sl::capture_format_name(cap.format);
-    j["bytes"] = cap.bytes.size();
+    j["bytes"] = cap_bytes;
     if (in->have_config) {
         const auto &c = in->config;
         json jc;
@@ -360,7 +360,7 @@ int main(int argc, char **argv)
     }
 
     // Text report.
-    std::printf("%s: %s, %zu bytes\n", path.c_str(), sl::capture_format_name(cap.format), cap.bytes.size());
+    std::printf("%s: %s, %" PRIu64 " bytes\n", path.c_str(), sl::capture_format_name(cap.format), cap_bytes);
     if (cap.has_pcap_report) {
         const auto &r = cap.pcap;
         std::printf("pcap: link %s, %" PRIu64 " packets (%" PRIu64 " undecoded, %" PRIu64

@@ -186,7 +186,8 @@ static void tcp_packet(pcapw_t *w, uint16_t sport, uint16_t dport, uint32_t seq,
 #define NONE ((size_t)1 << 30) // no such segment
 
 /// Session of `s` (n bytes) from the radar port: SYN, segments of SEG bytes with segment
-/// `rtx` sent twice, `swap` and swap+1 exchanged, `drop` missing; FIN.
+/// `rtx` sent twice, `swap` and swap+1 exchanged, `drop` missing; FIN. build_pcap adds a
+/// second, clean session and a late retransmission of the first one.
 static void session(pcapw_t *w, uint16_t cport, const uint8_t *s, size_t n, size_t rtx, size_t swap,
                     size_t drop)
 {
@@ -217,6 +218,8 @@ static void build_pcap(pcapw_t *w, const uint8_t *s, size_t n)
     pcap_header(w);
     session(w, 40001, s, n, 5, 10, 20);
     session(w, 40002, s, n, NONE, NONE, NONE);
+    // a late retransmission of the first session: ignored, no third session
+    tcp_packet(w, 6317, 40001, ISN + 1u, 0x18, s, SEG);
 }
 
 static void check_pcap_result(const collected_t *got, const sl_port_capture_report_t *r, const uint8_t *s,

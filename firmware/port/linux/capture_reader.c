@@ -39,6 +39,7 @@ typedef struct flow {
     int role;       // ROLE_*
 } flow_t;
 
+// DONE: a session already reassembled; its late packets (retransmissions) are ignored.
 enum { ROLE_NONE = 0, ROLE_SELECTED, ROLE_CANDIDATE, ROLE_IGNORED, ROLE_DONE };
 
 typedef struct sess {
@@ -325,7 +326,7 @@ static flow_t *flow_find(sl_port_capture_t *c, const uint8_t *src, const uint8_t
     for (size_t k = 0; k < c->n_flows; k++) {
         const size_t i = (c->last_flow + k) % c->n_flows;
         const flow_t *f = &c->flows[i];
-        if (f->sport == sport && f->dport == dport && f->alen == alen && f->role != ROLE_DONE &&
+        if (f->sport == sport && f->dport == dport && f->alen == alen &&
             memcmp(f->src, src, alen) == 0 && memcmp(f->dst, dst, alen) == 0) {
             found = (int)i;
             break;

@@ -25,11 +25,19 @@
 /// supported).
 ///
 /// Memory: bounded whatever the capture's size. Raw: one SL_PORT_CAPTURE_CHUNK read
-/// buffer, or one 16 MiB mapped window. Pcap: libpcap's packet buffer, plus out-of-order segments held until the hole
-/// before them fills, at most SL_PORT_CAPTURE_PENDING_MAX bytes per reassembled session
-/// (the selected one and at most one candidate successor); a hole still open when that
-/// bound is reached is declared a gap. Flows are tracked in a fixed table of
-/// SL_PORT_CAPTURE_MAX_FLOWS entries (more are counted, not tracked).
+/// buffer, or one 16 MiB mapped window. Pcap: libpcap's packet buffer, plus out-of-order
+/// segments held until the hole before them fills, at most SL_PORT_CAPTURE_PENDING_MAX
+/// bytes per reassembled session (the selected one and at most one candidate successor); a
+/// hole still open when that bound is reached is declared a gap. While the radar port is
+/// not known yet (auto-detection), payload is kept (at most 4 MiB) and replayed into the
+/// session of the flow that turns out to be the radar's. Flows are tracked in a fixed
+/// table of SL_PORT_CAPTURE_MAX_FLOWS entries (more are counted, not tracked); late
+/// packets of a session already reassembled are ignored.
+///
+/// Differences from reading the whole file first (the host tools' reader before): the
+/// radar port is auto-detected from the first flow carrying radar messages (not the best
+/// score over the file); a mid-stream session starts at the lowest sequence number seen
+/// before its first delivered byte; re-sent bytes older than the held tail are not compared.
 ///
 /// Reassembly (same contract as the host tools' reader, streamed): retransmissions (full or
 /// partial) are dropped and counted; re-sent bytes are compared with the first copy when
