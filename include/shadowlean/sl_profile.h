@@ -103,7 +103,8 @@ typedef enum sl_profile_fail {
     SL_PROFILE_NO_RUN = 3,    ///< nothing above the threshold near the mask's first bin
     SL_PROFILE_TAIL_CUT = 4,  ///< the run reaches the profile's end
     SL_PROFILE_NO_TAIL = 5,   ///< no plausible tail slope (self fit or calibration)
-    SL_PROFILE_FAIL_COUNT = 6
+    SL_PROFILE_FEW_FRAMES = 6, ///< fewer than cfg.min_frames rows summed (moving: reset)
+    SL_PROFILE_FAIL_COUNT = 7
 } sl_profile_fail_t;
 
 /// Where the slope of an extraction came from.
@@ -115,6 +116,10 @@ typedef struct sl_profile_cfg {
     uint16_t max_frames; ///< halve the sums at this many frames (2..257, default 128)
     uint8_t lead_bins;   ///< bins kept before the first occupied bin at claim (default 6)
     uint8_t max_idle;    ///< rotations without evidence before a slot is freed (default 4)
+    uint8_t min_frames;  ///< rows a profile needs before it replaces the mask's bounds
+                         ///< (default 2: one row carries one rotation's speckle in full and
+                         ///< is no better than the mask; while moving the sums are reset
+                         ///< every rotation, so the mask's bounds are used)
 } sl_profile_cfg_t;
 
 void sl_profile_cfg_default(sl_profile_cfg_t *cfg);
