@@ -59,7 +59,7 @@
 ///
 /// ## Ownership, memory, cost
 /// Caller-owned `sl_profile_t`, no allocation. RAM: SL_CFG_MAX_AZIMUTHS bytes + slots x
-/// (2 x SL_CFG_PROFILE_BINS + 12) (400 + 12 x 140 = 2,080 B with the defaults).
+/// (2 x SL_CFG_PROFILE_BINS + 10) + ~60 B (2,140 B with the defaults on x86-64).
 /// sl_profile_row: an unwatched azimuth costs one table read and a scan of the window's
 /// words for the first occupied bit; a watched one SL_CFG_PROFILE_BINS additions.
 /// sl_profile_extract: O(bins) with a 6- or 8-point integer fit per walked bin, 64-bit
