@@ -19,6 +19,7 @@ void sl_profile_cfg_default(sl_profile_cfg_t *cfg)
     cfg->max_frames = 128U;
     cfg->lead_bins = 6U;
     cfg->max_idle = 4U;
+    cfg->min_frames = 2U;
 }
 
 sl_err_t sl_profile_init(sl_profile_t *pr, uint16_t azimuths, uint16_t near_bins,
@@ -354,6 +355,10 @@ uint8_t sl_profile_refine(sl_profile_t *pr, const sl_board_t *board, uint32_t th
         return why;
     }
     const sl_profile_slot_t *s = &pr->slot[si];
+    if (s->frames < pr->cfg.min_frames) {
+        pr->stats.fallback[SL_PROFILE_FEW_FRAMES]++;
+        return (uint8_t)SL_PROFILE_FEW_FRAMES;
+    }
     const sl_profile_bounds_t pb =
         sl_profile_extract(s->sum, SL_CFG_PROFILE_BINS, s->frames, threshold,
                            (uint32_t)t->bin_first - s->bin0, pr->slope_q8);

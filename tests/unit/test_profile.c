@@ -284,6 +284,53 @@ static void test_profile_slots_follow_the_targets(void **state)
     assert_int_equal(pr.n_live, SL_CFG_PROFILE_SLOTS);
 }
 
+// A profile replaces the mask's bounds only with >= cfg.min_frames rows (a single row, e.g.
+// while moving, is no better than the mask); then r1/r2 are the profile's bin centres,
+// the smear removed, and the target is flagged.
+static void test_profile_refines_a_target_after_min_frames(void **state)
+{
+    (void)state;
+    assert_int_equal(sl_profile_init(&pr, 400, 0, NULL), SL_OK);
+    sl_board_t board;
+    memset(&board, 0, sizeof board);
+    board.bin_size_um = 43800;
+    uint16_t syn[NB];
+    double own[6];
+    for (int i = 0; i < 6; i++) {
+        own[i] = 70.0;
+    }
+    g_decay_db = 3.3;
+    synth(syn, 1, 10, 15, own, k_exp); // own bins 10..15, tail behind
+    uint8_t row[NB];
+    for (int k = 0; k < NB; k++) {
+        row[k] = (uint8_t)syn[k];
+    }
+    uint32_t bits[2] = {0U, 0U};
+    for (int k = 0; k < NB; k++) {
+        if (row[k] >= 40) {
+            bits[k >> 5] |= 1U << (k & 31);
+        }
+    }
+    sl_profile_row(&pr, 7, row, NB, bits, NB);
+    sl_target_t t;
+    memset(&t, 0, sizeof t);
+    t.az = 7;
+    t.bin_first = 10;
+    t.bin_last = 26; // where the tail crosses the threshold (the mask's end)
+    t.r1_um = (uint32_t)((2 * 10 + 1) * 43800 / 2);
+    t.r2_um = (uint32_t)((2 * 26 + 1) * 43800 / 2);
+    assert_int_equal(sl_profile_refine(&pr, &board, 40, &t), SL_PROFILE_FEW_FRAMES);
+    assert_int_equal(t.flags & SL_TARGET_PROFILE, 0);
+    sl_profile_row(&pr, 7, row, NB, bits, NB);
+    assert_int_equal(sl_profile_refine(&pr, &board, 40, &t), SL_PROFILE_OK);
+    assert_true((t.flags & SL_TARGET_PROFILE) != 0U);
+    assert_int_equal(t.r1_um, (2 * 10 + 1) * 43800 / 2);
+    assert_int_equal(t.r2_um, (2 * 15 + 1) * 43800 / 2);
+    assert_int_equal(t.elong_um, 11 * 43800);
+    assert_int_equal(pr.stats.extracted, 1);
+    assert_int_equal(pr.stats.fallback[SL_PROFILE_FEW_FRAMES], 1);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -294,6 +341,7 @@ int main(void)
         cmocka_unit_test(test_profile_reports_why_it_cannot_extract),
         cmocka_unit_test(test_profile_keeps_the_own_bins_of_a_return_without_smear),
         cmocka_unit_test(test_profile_slots_follow_the_targets),
+        cmocka_unit_test(test_profile_refines_a_target_after_min_frames),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
