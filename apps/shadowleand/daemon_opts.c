@@ -21,6 +21,7 @@ void sld_opts_defaults(sld_opts_t *o)
     o->silent_ms = 1000;
     o->verbosity = SLD_LOG_INFO;
     o->status_period_ms = 1000;
+    o->gs_usb_max_age_ms = 200; // as sl_gsusb_sink_default_cfg(): a late warning is worse than none
     o->log_time = SLD_LOG_TIME_AUTO;
 }
 
@@ -220,6 +221,9 @@ static int apply(sld_opts_t *o, const char *section, const char *key, const char
         }
     } else if (IS("can", "bitrate")) {
         if (parse_u32(val, &o->bitrate) != 0 || o->bitrate > 1000000U) BAD("expected bit/s <= 1000000");
+    } else if (IS("can", "gs_usb_max_age_ms")) {
+        if (parse_u32(val, &o->gs_usb_max_age_ms) != 0 || o->gs_usb_max_age_ms > 60000U)
+            BAD("expected ms <= 60000 (0 = frames never expire)");
     } else if (IS("can", "motion_interface")) {
         if (strcmp(val, "none") == 0 || strcmp(val, "off") == 0) {
             o->motion_off = true;
@@ -361,6 +365,7 @@ static const cli_opt_t k_cli[] = {
     {"--log-time", "can", "log_time", 1, NULL},
     {"--gs-usb", "can", "gs_usb", 2, "any"},
     {"--bitrate", "can", "bitrate", 1, NULL},
+    {"--gs-usb-max-age-ms", "can", "gs_usb_max_age_ms", 1, NULL},
     {"--motion-can", "can", "motion_interface", 1, NULL},
     {"--targets-out", "output", "targets", 1, NULL},
     {"--config", NULL, "config", 1, NULL},
@@ -396,6 +401,7 @@ void sld_opts_usage(void *fpv)
         "                                                     (auto: data for --input, wall for --radar)\n"
         "  --gs-usb [VID:PID|BUS-PORT] [can] gs_usb           gs_usb/candleLight adapter via libusb (any = first)\n"
         "  --bitrate B              [can] bitrate             gs_usb bit rate (default: the board's)\n"
+        "  --gs-usb-max-age-ms N    [can] gs_usb_max_age_ms   drop a gs_usb frame queued longer (200; 0 = never)\n"
         "  --motion-can IFACE|none  [can] motion_interface    read VehicleMotion here (default: the --can interface)\n"
         "  --targets-out FILE       [output] targets          JSON lines, one per rotation: targets and tracks\n"
         "  --user NAME              [daemon] user             drop root privileges after opening everything\n"
@@ -603,6 +609,7 @@ void sld_opts_print(const sld_opts_t *o, void *fpv)
     fprintf(fp, "log_time = %s\n", lt[o->log_time]);
     fprintf(fp, "gs_usb = %s\n", !o->gs_usb ? "false" : o->gs_usb_sel[0] != '\0' ? o->gs_usb_sel : "any");
     fprintf(fp, "bitrate = %u\n", (unsigned)o->bitrate);
+    fprintf(fp, "gs_usb_max_age_ms = %u\n", (unsigned)o->gs_usb_max_age_ms);
     if (o->motion_off) {
         fprintf(fp, "motion_interface = none\n");
     } else if (o->motion_iface[0] != '\0') {

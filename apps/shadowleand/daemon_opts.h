@@ -9,7 +9,8 @@
 ///                status_period_ms
 ///     [input]    radar (HOST:PORT) | capture (FILE), realtime, non_contour,
 ///                connect_timeout_ms, silence_timeout_ms, silent_ms, motion
-///     [can]      interface, log, log_iface, log_time, gs_usb, bitrate, motion_interface
+///     [can]      interface, log, log_iface, log_time, gs_usb, bitrate, gs_usb_max_age_ms,
+///                motion_interface
 ///     [output]   targets
 ///
 /// Booleans accept true/false, yes/no, on/off, 1/0. Unknown sections or keys and bad
@@ -62,6 +63,7 @@ typedef struct sld_opts {
     bool gs_usb;                       ///< --gs-usb [SEL]                    [can] gs_usb
     char gs_usb_sel[48];               ///< selector, "" = first known adapter
     uint32_t bitrate;                  ///< --bitrate B (0 = board's)         [can] bitrate
+    uint32_t gs_usb_max_age_ms;        ///< --gs-usb-max-age-ms (200; 0 = never) [can] gs_usb_max_age_ms
     char motion_iface[SLD_IFACE_CHARS];///< --motion-can IFACE|none           [can] motion_interface
     bool motion_off;                   ///< motion input disabled ("none")
     bool fixed_motion;                 ///< --motion SPEED[,YAW]: constant motion [input] motion

@@ -679,6 +679,7 @@ static int open_sinks(daemon_t *d)
         sl_gsusb_sink_cfg_t cfg = sl_gsusb_sink_default_cfg();
         cfg.selector = d->o.gs_usb_sel[0] != '\0' ? d->o.gs_usb_sel : NULL;
         cfg.can.bitrate = d->o.bitrate != 0 ? d->o.bitrate : d->board->can_bitrate;
+        cfg.max_age_us = (uint64_t)d->o.gs_usb_max_age_ms * 1000U;
         const sl_err_t e = sl_gsusb_sink_open(&d->gs, &cfg, now);
         if (e == SL_ERR_ARG) {
             sld_log(SLD_LOG_ERR, "--gs-usb %s: %s", d->o.gs_usb_sel, sl_gsusb_sink_last_error(&d->gs));
