@@ -12,10 +12,12 @@ for g in "$@"; do
              gcc-arm-none-eabi libnewlib-arm-none-eabi gcc-aarch64-linux-gnu gcc-s390x-linux-gnu libc6-dev-arm64-cross libc6-dev-s390x-cross
              qemu-user libcmocka-dev:arm64 libcmocka-dev:s390x
              libpcap-dev:arm64 libusb-1.0-0-dev:arm64 libinih-dev:arm64 libc6:arm64 libc6:s390x
-             python3-canmatrix python3-can python3-numpy can-utils user-mode-linux iproute2 kmod
+             python3-canmatrix python3-lxml python3-xlrd python3-xlsxwriter python3-xlwt python3-yaml
+             python3-can python3-numpy can-utils user-mode-linux iproute2 kmod
              qemu-system-x86 busybox-static cpio usbutils
              qemu-system-arm cppcheck clang-tidy tshark" ;;
-    demo) pkgs="$pkgs python3-canmatrix can-utils" ;;
+    demo) pkgs="$pkgs python3-canmatrix python3-lxml python3-xlrd python3-xlsxwriter python3-xlwt
+             python3-yaml can-utils" ;;
     *) echo "deps.sh: unknown group '$g'" >&2; exit 2 ;;
     esac
 done

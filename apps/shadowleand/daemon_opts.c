@@ -11,6 +11,7 @@
 
 #include "daemon_log.h"
 #include "shadowlean/sl_board.h"
+#include "shadowlean/sl_can.h"
 
 void sld_opts_defaults(sld_opts_t *o)
 {
@@ -20,7 +21,7 @@ void sld_opts_defaults(sld_opts_t *o)
     o->silence_timeout_ms = 3000;
     o->silent_ms = 1000;
     o->verbosity = SLD_LOG_INFO;
-    o->status_period_ms = 1000;
+    o->status_period_ms = SL_CAN_IDLE_CYCLE_MS_STATUS; // the DBC's SlIdleCycleTime
     o->gs_usb_max_age_ms = 200; // as sl_gsusb_sink_default_cfg(): a late warning is worse than none
     o->log_time = SLD_LOG_TIME_AUTO;
 }

@@ -116,13 +116,16 @@ static const sl_can_signal_desc_t health_sigs[H_N] = {
 };
 
 static const sl_can_message_desc_t messages[SL_CAN_MSG_COUNT] = {
-    {"PoleLean", SL_CAN_DATA_ID_POLE_LEAN, SL_CAN_CYCLE_MS_POLE_LEAN, false, pole_sigs, P_N},
-    {"LeanWarning", SL_CAN_DATA_ID_LEAN_WARNING, SL_CAN_CYCLE_MS_LEAN_WARNING, false, warn_sigs,
-     W_N},
-    {"Status", SL_CAN_DATA_ID_STATUS, SL_CAN_CYCLE_MS_STATUS, false, status_sigs, T_N},
-    {"VehicleMotion", SL_CAN_DATA_ID_VEHICLE_MOTION, SL_CAN_CYCLE_MS_VEHICLE_MOTION, true,
-     motion_sigs, M_N},
-    {"Health", SL_CAN_DATA_ID_HEALTH, SL_CAN_CYCLE_MS_HEALTH, false, health_sigs, H_N},
+    {"PoleLean", SL_CAN_DATA_ID_POLE_LEAN, SL_CAN_CYCLE_MS_POLE_LEAN, 0U,
+     (uint8_t)SL_CAN_SEND_CYCLIC_IF_ACTIVE, false, pole_sigs, P_N},
+    {"LeanWarning", SL_CAN_DATA_ID_LEAN_WARNING, SL_CAN_CYCLE_MS_LEAN_WARNING, 0U,
+     (uint8_t)SL_CAN_SEND_CYCLIC, false, warn_sigs, W_N},
+    {"Status", SL_CAN_DATA_ID_STATUS, SL_CAN_CYCLE_MS_STATUS, SL_CAN_IDLE_CYCLE_MS_STATUS,
+     (uint8_t)SL_CAN_SEND_CYCLIC, false, status_sigs, T_N},
+    {"VehicleMotion", SL_CAN_DATA_ID_VEHICLE_MOTION, SL_CAN_CYCLE_MS_VEHICLE_MOTION, 0U,
+     (uint8_t)SL_CAN_SEND_CYCLIC, true, motion_sigs, M_N},
+    {"Health", SL_CAN_DATA_ID_HEALTH, SL_CAN_CYCLE_MS_HEALTH, SL_CAN_IDLE_CYCLE_MS_STATUS,
+     (uint8_t)SL_CAN_SEND_CYCLIC, false, health_sigs, H_N},
 };
 
 const sl_can_message_desc_t *sl_can_layout(sl_can_msg_t m)

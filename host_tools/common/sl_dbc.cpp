@@ -84,14 +84,16 @@ const char *kNetworkComment =
 
 const std::map<std::string, std::string> kMessageComments = {
     {"PoleLean",
-     "One frame per target and radar rotation: the in-plane lean of a slender object "
+     "One frame per confirmed target and radar rotation (GenMsgSendType CyclicIfActive): the in-plane lean of a slender object "
      "(pole, post, trunk) inside the vehicle's radar shadow. Lean and LeanSigma are "
      "meaningful only when Quality is VALID or FILTERED."},
     {"LeanWarning",
      "Once per rotation: the warning level and the most severe target (largest lean "
      "towards the vehicle). HasTarget = 0: no target; the target fields are 0."},
-    {"Status", "Module health, nominally once per second. Counters are totals since start "
-               "and stop at their maximum (Saturated = 1)."},
+    {"Status", "Module health: once per radar rotation while data arrives (GenMsgCycleTime, "
+               "250 ms at 4 Hz), every SlIdleCycleTime (1 s, the daemon's status_period_ms) "
+               "without data. Counters are totals since start and stop at their maximum "
+               "(Saturated = 1)."},
     {"VehicleMotion", "Input from the vehicle for the motion-aware masks: speed and yaw "
                       "rate with E2E protection; CRC errors and counter jumps are counted."},
     {"Health", "Sent right after every Status: why the output may be degraded or blind. "
@@ -282,11 +284,19 @@ std::string make_dbc(const BoardSpec &b)
     o << "BA_DEF_  \"DBName\" STRING ;\n";
     o << "BA_DEF_  \"Baudrate\" INT 10000 1000000;\n";
     o << "BA_DEF_ BO_  \"GenMsgCycleTime\" INT 0 65535;\n";
+    // Vector's value table: the index is what the layout's send_type holds.
+    o << "BA_DEF_ BO_  \"GenMsgSendType\" ENUM  \"Cyclic\",\"Spontaneous\",\"CyclicIfActive\","
+         "\"SpontaneousWithDelay\",\"CyclicAndSpontaneous\",\"CyclicAndSpontaneousWithDelay\","
+         "\"SpontaneousWithRepetition\",\"CyclicIfActiveAndSpontaneous\","
+         "\"CyclicIfActiveAndSpontaneousWithDelay\",\"NoMsgSendType\";\n";
+    o << "BA_DEF_ BO_  \"SlIdleCycleTime\" INT 0 65535;\n";
     o << "BA_DEF_ BO_  \"SlE2EDataId\" INT 0 255;\n";
     o << "BA_DEF_DEF_  \"BusType\" \"CAN\";\n";
     o << "BA_DEF_DEF_  \"DBName\" \"\";\n";
     o << "BA_DEF_DEF_  \"Baudrate\" 500000;\n";
     o << "BA_DEF_DEF_  \"GenMsgCycleTime\" 0;\n";
+    o << "BA_DEF_DEF_  \"GenMsgSendType\" \"NoMsgSendType\";\n";
+    o << "BA_DEF_DEF_  \"SlIdleCycleTime\" 0;\n";
     o << "BA_DEF_DEF_  \"SlE2EDataId\" 0;\n";
     o << "BA_ \"BusType\" \"CAN\";\n";
     o << "BA_ \"DBName\" " << q(db_name(b.name)) << ";\n";
@@ -294,6 +304,10 @@ std::string make_dbc(const BoardSpec &b)
     for (unsigned mi = 0; mi < SL_CAN_MSG_COUNT; mi++) {
         const sl_can_message_desc_t &m = *sl_can_layout(static_cast<sl_can_msg_t>(mi));
         o << "BA_ \"GenMsgCycleTime\" BO_ " << ids.id[mi] << " " << m.cycle_ms << ";\n";
+        o << "BA_ \"GenMsgSendType\" BO_ " << ids.id[mi] << " " << unsigned(m.send_type) << ";\n";
+        if (m.idle_cycle_ms != 0) {
+            o << "BA_ \"SlIdleCycleTime\" BO_ " << ids.id[mi] << " " << m.idle_cycle_ms << ";\n";
+        }
         o << "BA_ \"SlE2EDataId\" BO_ " << ids.id[mi] << " " << unsigned(m.data_id) << ";\n";
     }
 

@@ -83,7 +83,7 @@
 /// | 55 | 6  | LeanSigma | u | 0.1  | 0..6.3          | deg | |
 /// | 61 | 3  | Quality   | u | 1    | 0..4            |     | sl_can_quality_t |
 ///
-/// ## Status (board `can.id_status`, SHADOWLEAN -> VEHICLE, nominally 1 Hz)
+/// ## Status (board `can.id_status`, SHADOWLEAN -> VEHICLE, once per rotation while data arrives, every SL_CAN_IDLE_CYCLE_MS_STATUS without)
 ///
 /// | start | len | signal          | type | range        | note |
 /// |------:|----:|-----------------|------|--------------|------|
@@ -218,13 +218,24 @@ typedef enum sl_can_msg {
 
 #define SL_CAN_COUNTER_MODULO 15U ///< counters run 0..14; 15 is invalid on the wire
 
-/// Nominal cycle times (DBC GenMsgCycleTime): PoleLean and LeanWarning once per radar
-/// rotation (CTS350-X: 4 Hz), Status 1 Hz, VehicleMotion as expected from the vehicle.
+/// Nominal cycle times (DBC GenMsgCycleTime): every sent message goes out once per radar
+/// rotation while data arrives (CTS350-X: 4 Hz, 250 ms); VehicleMotion as expected from the
+/// vehicle. Without data, Status + Health go out every SL_CAN_IDLE_CYCLE_MS_STATUS (DBC
+/// attribute SlIdleCycleTime; the daemon's default status_period_ms).
 #define SL_CAN_CYCLE_MS_POLE_LEAN 250U
 #define SL_CAN_CYCLE_MS_LEAN_WARNING 250U
-#define SL_CAN_CYCLE_MS_STATUS 1000U
+#define SL_CAN_CYCLE_MS_STATUS 250U
 #define SL_CAN_CYCLE_MS_VEHICLE_MOTION 20U
-#define SL_CAN_CYCLE_MS_HEALTH 1000U
+#define SL_CAN_CYCLE_MS_HEALTH 250U
+#define SL_CAN_IDLE_CYCLE_MS_STATUS 1000U
+
+/// How a message is sent: the DBC attribute GenMsgSendType, whose value table is Vector's
+/// (0 Cyclic ... 9 NoMsgSendType), so the numbers are the DBC's.
+typedef enum sl_can_send_type {
+    SL_CAN_SEND_CYCLIC = 0,           ///< every cycle (LeanWarning, Status, Health, VehicleMotion)
+    SL_CAN_SEND_CYCLIC_IF_ACTIVE = 2, ///< every cycle while its object exists (PoleLean: one
+                                      ///< per confirmed track and rotation)
+} sl_can_send_type_t;
 
 // ---------------------------------------------------------------------------------------
 // Value tables
@@ -542,7 +553,9 @@ typedef struct sl_can_signal_desc {
 typedef struct sl_can_message_desc {
     const char *name;         ///< DBC message name, e.g. "PoleLean"
     uint8_t data_id;          ///< E2E Data ID
-    uint16_t cycle_ms;        ///< nominal cycle time
+    uint16_t cycle_ms;        ///< nominal cycle time (GenMsgCycleTime)
+    uint16_t idle_cycle_ms;   ///< cycle without radar data (SlIdleCycleTime); 0 = not sent then
+    uint8_t send_type;        ///< sl_can_send_type_t (GenMsgSendType)
     bool to_shadowlean;       ///< true: received (VehicleMotion); false: sent
     const sl_can_signal_desc_t *signals;
     uint8_t n_signals;
