@@ -12,6 +12,7 @@
 #include "daemon_log.h"
 #include "shadowlean/sl_board.h"
 #include "shadowlean/sl_can.h"
+#include "shadowlean/sl_version.h"
 
 void sld_opts_defaults(sld_opts_t *o)
 {
@@ -438,7 +439,7 @@ int sld_opts_parse(sld_opts_t *o, int argc, char **argv, char *err, size_t err_s
             return 1;
         }
         if (strcmp(a, "--version") == 0) {
-            printf("shadowleand 0.1.0\n");
+            printf("shadowleand %s\n", SL_VERSION_STRING);
             return 1;
         }
         if (strcmp(a, "--list-boards") == 0) {
