@@ -1,0 +1,133 @@
+# SlInstall.cmake: `cmake --install` and the Debian packages (CPack).
+#
+# What a user gets (GNUInstallDirs under the prefix, /usr for the .debs):
+#   component sdk:    include/shadowlean/*.h (+ sl_version.h, boards/sl_board_<b>.h),
+#                     lib/libsl_core.a (core + the configured boards' tables + registry),
+#                     lib/cmake/shadowlean (find_package(shadowlean): shadowlean::core and
+#                     shadowlean::board_<b>), lib/pkgconfig/shadowlean-core.pc
+#   component daemon: sbin/shadowleand, lib/systemd/system/shadowleand.service,
+#                     share/shadowlean/{shadowleand.conf,dbc/<board>.dbc}, man8 page
+#   component tools:  bin/sl-* host tools, man1 pages, share/shadowlean/wireshark/colossus.lua
+# Every component carries the licence (share/doc/<package>/copyright).
+include(GNUInstallDirs)
+include(CMakePackageConfigHelpers)
+
+# ---- SDK: core library, headers, CMake package, pkg-config
+set_target_properties(sl_core PROPERTIES EXPORT_NAME core)
+add_library(shadowlean::core ALIAS sl_core)
+install(TARGETS sl_core EXPORT shadowleanTargets
+  ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT sdk)
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/include/shadowlean DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}
+  COMPONENT sdk FILES_MATCHING PATTERN "*.h")
+install(FILES ${PROJECT_BINARY_DIR}/include/shadowlean/sl_version.h
+  DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/shadowlean COMPONENT sdk)
+foreach(b ${SL_BOARDS})
+  string(REPLACE "-" "_" c ${b})
+  set(_h ${PROJECT_SOURCE_DIR}/boards/${b}/sl_board_${c}.h)
+  if(NOT EXISTS ${_h})
+    continue()
+  endif()
+  install(FILES ${_h} DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/shadowlean/boards COMPONENT sdk)
+  # shadowlean::board_<b>: the board's header (extern const sl_board_t sl_board_<b>) on top of
+  # the core, whose archive holds the configured boards' tables.
+  add_library(sl_board_${c} INTERFACE)
+  set_target_properties(sl_board_${c} PROPERTIES EXPORT_NAME board_${c})
+  target_include_directories(sl_board_${c} INTERFACE
+    $<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}/boards/${b}>
+    $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}/shadowlean/boards>)
+  target_link_libraries(sl_board_${c} INTERFACE sl_core)
+  install(TARGETS sl_board_${c} EXPORT shadowleanTargets COMPONENT sdk)
+endforeach()
+install(EXPORT shadowleanTargets NAMESPACE shadowlean::
+  DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/shadowlean COMPONENT sdk)
+configure_package_config_file(${PROJECT_SOURCE_DIR}/cmake/shadowleanConfig.cmake.in
+  ${PROJECT_BINARY_DIR}/shadowleanConfig.cmake
+  INSTALL_DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/shadowlean)
+# 0.x: a minor version may change the API.
+write_basic_package_version_file(${PROJECT_BINARY_DIR}/shadowleanConfigVersion.cmake
+  COMPATIBILITY SameMinorVersion)
+install(FILES ${PROJECT_BINARY_DIR}/shadowleanConfig.cmake
+  ${PROJECT_BINARY_DIR}/shadowleanConfigVersion.cmake
+  DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/shadowlean COMPONENT sdk)
+# pkg-config: prefix-relative, so a relocated install (cmake --install --prefix) works.
+file(RELATIVE_PATH SL_PC_PREFIX_REL "/p/${CMAKE_INSTALL_LIBDIR}/pkgconfig" "/p")
+configure_file(${PROJECT_SOURCE_DIR}/cmake/shadowlean-core.pc.in
+  ${PROJECT_BINARY_DIR}/shadowlean-core.pc @ONLY)
+install(FILES ${PROJECT_BINARY_DIR}/shadowlean-core.pc
+  DESTINATION ${CMAKE_INSTALL_LIBDIR}/pkgconfig COMPONENT sdk)
+
+# ---- daemon
+if(TARGET shadowleand)
+  install(TARGETS shadowleand RUNTIME DESTINATION ${CMAKE_INSTALL_SBINDIR} COMPONENT daemon)
+  install(FILES ${PROJECT_SOURCE_DIR}/packaging/shadowleand.conf
+    DESTINATION ${CMAKE_INSTALL_DATADIR}/shadowlean COMPONENT daemon)
+  foreach(b ${SL_BOARDS})
+    if(EXISTS ${PROJECT_SOURCE_DIR}/boards/${b}/shadowlean.dbc)
+      install(FILES ${PROJECT_SOURCE_DIR}/boards/${b}/shadowlean.dbc
+        DESTINATION ${CMAKE_INSTALL_DATADIR}/shadowlean/dbc RENAME ${b}.dbc COMPONENT daemon)
+    endif()
+  endforeach()
+  # The unit names the installed daemon: paths follow the prefix given at install time.
+  install(CODE "
+    file(READ \"${PROJECT_SOURCE_DIR}/packaging/shadowleand.service\" _u)
+    string(REPLACE \"/usr/local/sbin/\" \"\${CMAKE_INSTALL_PREFIX}/${CMAKE_INSTALL_SBINDIR}/\" _u \"\${_u}\")
+    string(REPLACE \"/usr/local/share/doc/shadowlean/\" \"\${CMAKE_INSTALL_PREFIX}/${CMAKE_INSTALL_DATADIR}/doc/shadowleand/\" _u \"\${_u}\")
+    set(_d \"\$ENV{DESTDIR}\${CMAKE_INSTALL_PREFIX}/lib/systemd/system\")
+    file(MAKE_DIRECTORY \"\${_d}\")
+    file(WRITE \"\${_d}/shadowleand.service\" \"\${_u}\")
+    message(STATUS \"Installing: \${_d}/shadowleand.service\")
+  " COMPONENT daemon)
+endif()
+
+find_program(SL_GZIP gzip REQUIRED)
+
+# ---- man pages, generated from each program's --help and --version (help2man, Debian)
+find_program(SL_HELP2MAN help2man)
+function(sl_man_page target section component description)
+  if(NOT SL_HELP2MAN OR CMAKE_CROSSCOMPILING OR NOT TARGET ${target})
+    return()
+  endif()
+  set(page ${PROJECT_BINARY_DIR}/man/man${section}/${target}.${section})
+  set(out ${page}.gz) # compressed, as Debian policy wants (gzip -9n: reproducible)
+  add_custom_command(OUTPUT ${out}
+    COMMAND ${CMAKE_COMMAND} -E make_directory ${PROJECT_BINARY_DIR}/man/man${section}
+    COMMAND ${SL_HELP2MAN} --no-info --no-discard-stderr --section=${section}
+            --name=${description} --output=${page} $<TARGET_FILE:${target}>
+    COMMAND ${SL_GZIP} -9nf ${page}
+    DEPENDS ${target} VERBATIM)
+  add_custom_target(man_${target} ALL DEPENDS ${out})
+  install(FILES ${out} DESTINATION ${CMAKE_INSTALL_MANDIR}/man${section} COMPONENT ${component})
+endfunction()
+sl_man_page(shadowleand 8 daemon "pole-lean warnings on CAN from a Navtech radar's chassis shadow")
+
+# ---- host tools
+foreach(t sl-tables sl-dbc sl-alpha sl-replay sl-inspect sl-sim sl-eval sl-view sl-calib
+          sl-bench sl-bench-proto sl-bench-junk sl-gsusb-send)
+  if(TARGET ${t})
+    install(TARGETS ${t} RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR} COMPONENT tools)
+  endif()
+endforeach()
+if(SL_BUILD_HOST_TOOLS)
+  install(FILES ${PROJECT_SOURCE_DIR}/packaging/wireshark/colossus.lua
+    DESTINATION ${CMAKE_INSTALL_DATADIR}/shadowlean/wireshark COMPONENT tools)
+endif()
+
+# The Debian changelog, compressed as policy wants it (gzip -9n: reproducible).
+add_custom_command(OUTPUT ${PROJECT_BINARY_DIR}/changelog.gz
+  COMMAND ${SL_GZIP} -9nc ${PROJECT_SOURCE_DIR}/packaging/debian/changelog > ${PROJECT_BINARY_DIR}/changelog.gz
+  DEPENDS ${PROJECT_SOURCE_DIR}/packaging/debian/changelog VERBATIM)
+add_custom_target(sl_changelog ALL DEPENDS ${PROJECT_BINARY_DIR}/changelog.gz)
+
+# ---- licence and README in every component's doc folder (Debian: copyright)
+# (doc folder = the Debian package's name, cmake/SlPackage.cmake)
+foreach(pair "sdk:shadowlean-dev" "daemon:shadowleand" "tools:shadowlean-tools")
+  string(REPLACE ":" ";" pair ${pair})
+  list(GET pair 0 comp)
+  list(GET pair 1 pkg)
+  install(FILES ${PROJECT_SOURCE_DIR}/LICENSE DESTINATION ${CMAKE_INSTALL_DATADIR}/doc/${pkg}
+    RENAME copyright COMPONENT ${comp})
+  install(FILES ${PROJECT_BINARY_DIR}/changelog.gz DESTINATION ${CMAKE_INSTALL_DATADIR}/doc/${pkg}
+    COMPONENT ${comp})
+endforeach()
+install(FILES ${PROJECT_SOURCE_DIR}/README.md
+  DESTINATION ${CMAKE_INSTALL_DATADIR}/doc/shadowleand COMPONENT daemon)
