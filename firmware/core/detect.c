@@ -407,22 +407,49 @@ static uint32_t allowed_span(const sl_detect_t *d, uint32_t r1_um)
 
 // ---- clutter rejection and slots by evidence (stage 4 clutter tests, stage 4b)
 
+// rho of the run as measured: r2 before the board's elongation model d(r2) was subtracted.
+// Smear only lengthens a return, so this is an upper bound of the true ratio whatever the
+// actual smear; d is a model (tabulated for one sensor setting, or not calibrated at all)
+// and may overcorrect by many bins. Never below the corrected rho (a negative d).
+static uint64_t rho_measured_q28(const sl_target_t *t, uint32_t rho_q28)
+{
+    uint64_t rho = rho_q28;
+    if ((t->elong_um > 0) && (t->r1_um != 0U)) {
+        const uint64_t r2m = (uint64_t)t->r2_um + (uint64_t)(uint32_t)t->elong_um;
+        const uint64_t m = (r2m << 28) / t->r1_um;
+        rho = (m > rho) ? m : rho;
+    }
+    return rho;
+}
+
 int sl_detect_clutter_reason(const sl_board_t *board, const sl_target_t *t, uint32_t rho_q28)
 {
     SL_ASSERT(board != NULL && t != NULL);
     if (t->bin_last <= t->bin_first) {
         return SL_DETECT_REJ_SHORT;
     }
-    if (t->incline_flag == (uint8_t)SL_INCLINE_INVALID ||
-        t->incline_flag == (uint8_t)SL_INCLINE_OUT_OF_DOMAIN) {
-        return board->geom != NULL ? SL_DETECT_REJ_RHO : -1; // no tables: no model to test
+    if (board->geom == NULL) {
+        return -1; // no tables: no model to test
     }
-    if (t->incline_flag == (uint8_t)SL_INCLINE_AMBIGUOUS && board->geom != NULL &&
-        t->r1_um != 0U) {
+    if (t->incline_flag == (uint8_t)SL_INCLINE_OUT_OF_DOMAIN) {
+        return SL_DETECT_REJ_RHO;
+    }
+    if (t->incline_flag == (uint8_t)SL_INCLINE_INVALID ||
+        t->incline_flag == (uint8_t)SL_INCLINE_AMBIGUOUS) {
+        if (t->r1_um == 0U) {
+            return SL_DETECT_REJ_RHO;
+        }
+        // The test is on the measured run, not on the elongation-corrected r2: a return
+        // whose corrected r2 falls at or below r1 (INVALID) or below the fold may still be
+        // a pole leaning away, smeared less than the model says (EXTRACTION.md).
+        const uint64_t rho = rho_measured_q28(t, rho_q28);
+        if ((t->incline_flag == (uint8_t)SL_INCLINE_INVALID) && (rho <= ((uint64_t)1U << 28))) {
+            return SL_DETECT_REJ_RHO; // r1 >= r2 even as measured
+        }
         // One bin of quantisation below the fold, in UQ4.28: b / r1 * 2^28.
         const uint64_t tol = ((uint64_t)board->bin_size_um << 28) / t->r1_um;
         const uint64_t amb = board->geom[t->az].rho_amb_q28;
-        if ((uint64_t)rho_q28 + tol < amb) {
+        if ((rho + tol) < amb) {
             return SL_DETECT_REJ_RHO;
         }
     }

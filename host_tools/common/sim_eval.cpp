@@ -571,6 +571,11 @@ std::map<int, PipeEval> PipelineEval::result() const
         std::fprintf(stderr, "profile: claims %u full %u released %u extracted %u fallback slot/lead/norun/tailcut/notail %u/%u/%u/%u/%u slope %u/256 (n %u)\n",
                      ps.claims, ps.claim_full, ps.released, ps.extracted, ps.fallback[1], ps.fallback[2], ps.fallback[3],
                      ps.fallback[4], ps.fallback[5], p.prof.slope_q8, p.prof.cal_n);
+        const sl_detect_stats_t &ds = p.detect.stats;
+        std::fprintf(stderr, "detect: groups %u targets %u rejected near/shadow/wide/broken/short/rho/weak %u/%u/%u/%u/%u/%u/%u\n",
+                     ds.groups, ds.targets, ds.rejected[SL_DETECT_REJ_NEAR], ds.rejected[SL_DETECT_REJ_SHADOW],
+                     ds.rejected[SL_DETECT_REJ_WIDE], ds.rejected[SL_DETECT_REJ_BROKEN], ds.rejected[SL_DETECT_REJ_SHORT],
+                     ds.rejected[SL_DETECT_REJ_RHO], ds.rejected[SL_DETECT_REJ_WEAK]);
     }
     int unmatched = 0;
     for (const auto &kv : used) {

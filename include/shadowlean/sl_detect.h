@@ -42,11 +42,17 @@
 ///    BROKEN (the representative run has a gap);
 ///    then the clutter tests (sl_detect_clutter_reason(), after the corrections and alpha):
 ///    SHORT (the representative run is one bin: a speck of gravel or a noise spike, no
-///    extent to measure); RHO (the incline flag is INVALID (r1 >= r2) or OUT_OF_DOMAIN, or
-///    AMBIGUOUS with rho below the model's minimum rho_amb of that azimuth by more than the
-///    quantisation can explain: rho < rho_amb - b / r1, b the bin size; a run of n bins
-///    measures (n - 1) b between its bin centres and the true extent is < n b, so a real
-///    pole near the fold reads at most b / r1 below rho_amb); WEAK (checked before SHORT,
+///    extent to measure); RHO (the incline flag is OUT_OF_DOMAIN, or INVALID / AMBIGUOUS
+///    and the run AS MEASURED is below the model's minimum rho_amb of that azimuth by more
+///    than the quantisation can explain: rho_m < rho_amb - b / r1, b the bin size, rho_m =
+///    (r2 + elong_um) / r1, r2 before the board's elongation model d(r2) was subtracted
+///    (INVALID: rejected when r1 >= r2 + elong_um). A run of n bins measures (n - 1) b
+///    between its bin centres and the true extent is < n b, so a real pole near the fold
+///    reads at most b / r1 below rho_amb; smear only lengthens a return, so rho_m bounds the
+///    true ratio from above whatever the actual smear, whereas d is a model that can
+///    overcorrect by many bins (a smear steeper than tabulated, a board not calibrated) and
+///    would push a pole leaning away below the fold or to r2 <= r1; sl_profile then
+///    measures its bounds); WEAK (checked before SHORT,
 ///    only when amplitude rows were given: sl_detect_set_amplitude()): no run of the group
 ///    is clearly above its local floor, i.e. for every run its peak power is below
 ///    threshold + `cfg.weak_margin` AND below floor + `cfg.weak_contrast`, the floor being
@@ -156,8 +162,9 @@ typedef enum sl_detect_reject {
     SL_DETECT_REJ_WIDE = 2,   ///< too wide in azimuth for a slender pole at its range
     SL_DETECT_REJ_BROKEN = 3, ///< a gap inside the run on the representative azimuth
     SL_DETECT_REJ_SHORT = 4,  ///< the representative run is a single bin (no extent: no rho)
-    SL_DETECT_REJ_RHO = 5,    ///< rho outside what the model gives on this azimuth (below
-                              ///< the fold by more than one bin, above the domain, r1 >= r2)
+    SL_DETECT_REJ_RHO = 5,    ///< rho outside what the model gives on this azimuth (the
+                              ///< run as measured, before d(r2): below the fold by more than
+                              ///< one bin, or r1 >= r2; above the domain)
     SL_DETECT_REJ_WEAK = 6,   ///< no run of the group rises clearly above its local floor
                               ///< (needs the amplitude row: sl_detect_set_amplitude)
     SL_DETECT_REJ_COUNT = 7
@@ -326,7 +333,8 @@ void sl_detect_hints_clear(sl_detect_t *d);
 void sl_detect_hint(sl_detect_t *d, uint16_t az, uint16_t half_width);
 
 /// Clutter tests of stage 4 (SHORT, RHO) on a finished target `t` (bin_first/bin_last,
-/// r1_um, incline flag and rho set) on azimuth `t->az`: the rejection reason, or -1 when the
+/// r1_um, r2_um, elong_um, incline flag and rho of r1_um/r2_um set) on azimuth `t->az`:
+/// the rejection reason, or -1 when the
 /// target may take a slot. Pure; O(1) (one 64-bit division).
 int sl_detect_clutter_reason(const sl_board_t *board, const sl_target_t *t, uint32_t rho_q28);
 

@@ -387,6 +387,25 @@ static void test_detect_rejects_clutter_before_it_takes_a_slot(void **state)
     assert_int_equal(sl_detect_clutter_reason(&board, &t, amb - tol - 1U), SL_DETECT_REJ_RHO);
     t.incline_flag = SL_INCLINE_INVALID;
     assert_int_equal(sl_detect_clutter_reason(&board, &t, 0), SL_DETECT_REJ_RHO);
+    // The rule reads the run as measured, before the elongation model d(r2): a pole leaning
+    // away whose corrected r2 the model pulled to the fold, or to r1, is not clutter when
+    // its measured extent (r2 + d) reaches the fold within one bin.
+    t.r2_um = 3001000U;
+    const uint32_t rho_c = (uint32_t)(((uint64_t)t.r2_um << 28) / t.r1_um);
+    t.incline_flag = SL_INCLINE_AMBIGUOUS;
+    t.elong_um = 0;
+    assert_int_equal(sl_detect_clutter_reason(&board, &t, rho_c), SL_DETECT_REJ_RHO);
+    t.elong_um = 700000;
+    assert_int_equal(sl_detect_clutter_reason(&board, &t, rho_c), -1);
+    t.elong_um = 2000; // measured rho 1.001: still far below the fold
+    assert_int_equal(sl_detect_clutter_reason(&board, &t, rho_c), SL_DETECT_REJ_RHO);
+    t.incline_flag = SL_INCLINE_INVALID;
+    t.r2_um = 2900000U;
+    t.elong_um = 700000;
+    assert_int_equal(sl_detect_clutter_reason(&board, &t, 0), -1);
+    t.elong_um = 100000; // r2 + d = r1: r1 >= r2 as measured
+    assert_int_equal(sl_detect_clutter_reason(&board, &t, 0), SL_DETECT_REJ_RHO);
+    t.elong_um = 0;
     t.incline_flag = SL_INCLINE_VALID;
     assert_int_equal(sl_detect_clutter_reason(&board, &t, amb + 1000U), -1);
     t.bin_last = 68;
