@@ -27,20 +27,24 @@ enum { ST_SIG = 0, ST_HDR = 1, ST_PAY = 2 };
 // A whole signature at d (16 readable bytes), compared a word at a time: the aligned
 // stream's per-message check, which a byte-wise library memcmp makes ~120 instructions
 // on Cortex-M (once per azimuth). Words assembled from bytes: alignment-safe, one load
-// where the target has unaligned loads.
-static inline uint32_t word_at(const uint8_t *b)
+// where the target has unaligned loads (forced inline: -Os otherwise calls it).
+#if defined(__GNUC__)
+#define SL_ALWAYS_INLINE inline __attribute__((always_inline))
+#else
+#define SL_ALWAYS_INLINE inline
+#endif
+static SL_ALWAYS_INLINE uint32_t word_at(const uint8_t *b)
 {
     return (uint32_t)b[0] | ((uint32_t)b[1] << 8) | ((uint32_t)b[2] << 16) |
            ((uint32_t)b[3] << 24);
 }
 
+// The signature as little-endian words (the table above, bytes 0-3, 4-7, 8-11, 12-15):
+// literals, so they are not re-read byte by byte from the table.
 static bool sig_at(const uint8_t *d)
 {
-    uint32_t diff = 0U;
-    for (size_t k = 0; k < SL_PROTO_SIGNATURE_BYTES; k += 4U) {
-        diff |= word_at(d + k) ^ word_at(sl_proto_signature + k);
-    }
-    return diff == 0U;
+    return ((word_at(d) ^ 0x03030100U) | (word_at(d + 4) ^ 0x0F0F0707U) |
+            (word_at(d + 8) ^ 0x3F3F1F1FU) | (word_at(d + 12) ^ 0xFEFE7F7FU)) == 0U;
 }
 
 enum { HDR_OK = 0, HDR_BAD_VERSION, HDR_OVERSIZE, HDR_TOO_BIG };
