@@ -41,10 +41,16 @@ static SL_ALWAYS_INLINE uint32_t word_at(const uint8_t *b)
 
 // The signature as little-endian words (the table above, bytes 0-3, 4-7, 8-11, 12-15):
 // literals, so they are not re-read byte by byte from the table.
+// Hosts whose compilers expand a 16-byte memcmp inline (x86-64 GCC: two 8-byte compares)
+// keep it.
 static bool sig_at(const uint8_t *d)
 {
+#if defined(__arm__) || defined(__thumb__)
     return ((word_at(d) ^ 0x03030100U) | (word_at(d + 4) ^ 0x0F0F0707U) |
             (word_at(d + 8) ^ 0x3F3F1F1FU) | (word_at(d + 12) ^ 0xFEFE7F7FU)) == 0U;
+#else
+    return memcmp(d, sl_proto_signature, SL_PROTO_SIGNATURE_BYTES) == 0;
+#endif
 }
 
 enum { HDR_OK = 0, HDR_BAD_VERSION, HDR_OVERSIZE, HDR_TOO_BIG };
