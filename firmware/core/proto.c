@@ -39,6 +39,13 @@ static SL_ALWAYS_INLINE uint32_t word_at(const uint8_t *b)
            ((uint32_t)b[3] << 24);
 }
 
+// The per-message field reads (header length, FFT timestamp): sl_get_be32/le32 forced
+// inline here, where -Os on Cortex-M otherwise calls them (~4 calls per azimuth).
+static SL_ALWAYS_INLINE uint32_t msg_be32(const uint8_t *b)
+{
+    return ((uint32_t)b[0] << 24) | ((uint32_t)b[1] << 16) | ((uint32_t)b[2] << 8) | (uint32_t)b[3];
+}
+
 // The signature as little-endian words (the table above, bytes 0-3, 4-7, 8-11, 12-15):
 // literals, so they are not re-read byte by byte from the table.
 // Hosts whose compilers expand a 16-byte memcmp inline (x86-64 GCC: two 8-byte compares)
@@ -180,7 +187,7 @@ static void sig_byte(sl_proto_t *p, uint8_t b)
 // Header tail = version, id, length (BE). Counts the rejection reason.
 static int check_header(sl_proto_t *p, const uint8_t *tail)
 {
-    const uint32_t len = sl_get_be32(tail + 2);
+    const uint32_t len = msg_be32(tail + 2);
     if (tail[0] != SL_PROTO_VERSION) {
         p->stats.bad_version++;
         return HDR_BAD_VERSION;
@@ -320,7 +327,7 @@ sl_err_t sl_proto_feed(sl_proto_t *p, const uint8_t *data, size_t len, uint64_t 
                     i++;
                     continue;
                 }
-                const uint32_t plen = sl_get_be32(tail + 2);
+                const uint32_t plen = msg_be32(tail + 2);
                 p->hunting = false;
                 p->msg_offset = base + i;
                 p->payload_bytes = plen;
@@ -588,8 +595,8 @@ sl_err_t sl_proto_parse_fft(const sl_proto_msg_t *msg, sl_proto_fft_t *out)
     out->data_offset = off;
     out->sweep_counter = sl_get_be16(d + 2);
     out->azimuth_ticks = sl_get_be16(d + 4);
-    out->seconds = sl_get_le32(d + 6);
-    out->split_ns = sl_get_le32(d + 10);
+    out->seconds = word_at(d + 6);
+    out->split_ns = word_at(d + 10);
     out->bins = (uint32_t)(nbytes >> bpb_log2);
     out->bin_data = d + off;
     return SL_OK;
