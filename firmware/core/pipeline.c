@@ -14,6 +14,14 @@
 
 #include "shadowlean/sl_pipeline.h"
 
+// Keeps a helper's locals out of its caller's frame (stack budget: the deepest chain runs
+// from sl_pipeline_feed through on_rot into detection; tests/build/stack_budget.py).
+#if defined(__GNUC__)
+#define SL_NOINLINE __attribute__((noinline))
+#else
+#define SL_NOINLINE
+#endif
+
 #define ROTATION_US_MIN 50000U   // plausible radar rotation periods for the measured T
 #define ROTATION_US_MAX 2000000U
 
@@ -450,6 +458,51 @@ static void measure_period(sl_pipeline_t *p, const sl_scan_rot_t *rot)
     p->last_t_last_us = rot->stats.valid != 0U ? rot->t_last_us : 0U;
 }
 
+// Tracker gates follow the ego motion of one rotation.
+static SL_NOINLINE void set_track_motion(sl_pipeline_t *p)
+{
+    uint32_t disp_um = 0, yaw_bam = 0;
+    if (p->motion_valid) {
+        const uint64_t v = (uint64_t)(p->speed_mm_s < 0 ? -(int64_t)p->speed_mm_s
+                                                        : (int64_t)p->speed_mm_s);
+        const uint64_t w = (uint64_t)(p->yaw_cdeg_s < 0 ? -(int64_t)p->yaw_cdeg_s
+                                                        : (int64_t)p->yaw_cdeg_s);
+        const uint64_t d = (v * p->rotation_us + 999U) / 1000U;
+        // w [cdeg/s] x T [us] / 1e6 = cdeg per rotation; x 2^32 / 36000 (~119305) = bam32.
+        const uint64_t cd_e6 = w * p->rotation_us; // cdeg x 1e6, < 2^37
+        const uint64_t bam = (cd_e6 * 119305U + 999999U) / 1000000U;
+        disp_um = d > UINT32_MAX ? UINT32_MAX : (uint32_t)d;
+        yaw_bam = bam > UINT32_MAX ? UINT32_MAX : (uint32_t)bam;
+    }
+    sl_track_set_motion(&p->tracker, disp_um, yaw_bam);
+}
+
+// The port's per-rotation report.
+static SL_NOINLINE void report_rotation(sl_pipeline_t *p, const sl_scan_rot_t *rot,
+                                        uint32_t n_targets)
+{
+    const sl_pipeline_rotation_t r = {
+        .rotation = p->stats.rotations - 1U,
+        .now_us = p->now_us,
+        .t_first_us = rot->t_first_us,
+        .t_last_us = rot->t_last_us,
+        .azimuths = rot->azimuths,
+        .valid = rot->stats.valid,
+        .missing = rot->stats.missing,
+        .end = rot->end,
+        .frames_eff = p->frames_eff,
+        .motion_valid = p->motion_valid,
+        .speed_mm_s = p->speed_mm_s,
+        .yaw_rate_cdeg_s = p->yaw_cdeg_s,
+        .targets = p->detect.targets,
+        .n_targets = (uint16_t)n_targets,
+        .tracks = p->tracker.tracks,
+        .n_track_slots = SL_CFG_MAX_TARGETS,
+        .level = (uint8_t)sl_track_max_level(&p->tracker),
+    };
+    p->cfg.port.on_rotation(p->cfg.port.ctx, &r);
+}
+
 static void on_rot(void *ctx, const sl_scan_rot_t *rot)
 {
     sl_pipeline_t *p = ctx;
@@ -477,47 +530,14 @@ static void on_rot(void *ctx, const sl_scan_rot_t *rot)
         sl_profile_end_rotation(&p->prof, p->frames_eff < p->cfg.mask_frames);
     }
     measure_period(p, rot);
-    // Tracker gates follow the ego motion of one rotation.
-    uint32_t disp_um = 0, yaw_bam = 0;
-    if (p->motion_valid) {
-        const uint64_t v = (uint64_t)(p->speed_mm_s < 0 ? -(int64_t)p->speed_mm_s
-                                                        : (int64_t)p->speed_mm_s);
-        const uint64_t w = (uint64_t)(p->yaw_cdeg_s < 0 ? -(int64_t)p->yaw_cdeg_s
-                                                        : (int64_t)p->yaw_cdeg_s);
-        const uint64_t d = (v * p->rotation_us + 999U) / 1000U;
-        // w [cdeg/s] x T [us] / 1e6 = cdeg per rotation; x 2^32 / 36000 (~119305) = bam32.
-        const uint64_t cd_e6 = w * p->rotation_us; // cdeg x 1e6, < 2^37
-        const uint64_t bam = (cd_e6 * 119305U + 999999U) / 1000000U;
-        disp_um = d > UINT32_MAX ? UINT32_MAX : (uint32_t)d;
-        yaw_bam = bam > UINT32_MAX ? UINT32_MAX : (uint32_t)bam;
-    }
-    sl_track_set_motion(&p->tracker, disp_um, yaw_bam);
+    set_track_motion(p);
     sl_track_set_reverse(&p->tracker, p->motion_valid && p->speed_mm_s < 0);
     sl_track_update(&p->tracker, p->detect.targets, n_targets, p->now_us);
     p->stats.rotations++;
     p->stats.azimuths_missing += rot->stats.missing;
     p->stats.targets += n_targets;
     if (p->cfg.port.on_rotation != NULL) {
-        const sl_pipeline_rotation_t r = {
-            .rotation = p->stats.rotations - 1U,
-            .now_us = p->now_us,
-            .t_first_us = rot->t_first_us,
-            .t_last_us = rot->t_last_us,
-            .azimuths = rot->azimuths,
-            .valid = rot->stats.valid,
-            .missing = rot->stats.missing,
-            .end = rot->end,
-            .frames_eff = p->frames_eff,
-            .motion_valid = p->motion_valid,
-            .speed_mm_s = p->speed_mm_s,
-            .yaw_rate_cdeg_s = p->yaw_cdeg_s,
-            .targets = p->detect.targets,
-            .n_targets = (uint16_t)n_targets,
-            .tracks = p->tracker.tracks,
-            .n_track_slots = SL_CFG_MAX_TARGETS,
-            .level = (uint8_t)sl_track_max_level(&p->tracker),
-        };
-        p->cfg.port.on_rotation(p->cfg.port.ctx, &r);
+        report_rotation(p, rot, n_targets);
     }
     emit_can(p);
     p->in_rotation = 0U;
@@ -535,25 +555,53 @@ static void use_bin_size(sl_pipeline_t *p, uint32_t um)
         return;
     }
     const sl_board_t *b = p->board;
-    sl_board_t nb = *b;
-    nb.bin_size_um = um;
-    const uint64_t near_um = (uint64_t)b->near_exclusion_bins * b->bin_size_um;
-    const uint64_t near = (near_um + um - 1U) / um;
-    nb.near_exclusion_bins = (uint16_t)(near > nb.roi_bins ? nb.roi_bins : near);
-    nb.shadow_bins = NULL; // in the board's bins; detection uses shadow_um
     if (b->shadow_um == NULL) {
         return; // no micrometre shadow table: cannot move to other bins
     }
-    const sl_board_t keep = p->det_board;
-    p->det_board = nb;
+    // det_board is the board but for the three fields set here (sl_pipeline_init copies
+    // it): built in place and put back field by field, no board-sized copies on the stack
+    // (this runs under on_msg, on the FFT path's deepest chain).
+    const uint32_t keep_um = p->det_board.bin_size_um;
+    const uint16_t keep_near = p->det_board.near_exclusion_bins;
+    const uint16_t *const keep_shadow = p->det_board.shadow_bins;
+    const uint64_t near_um = (uint64_t)b->near_exclusion_bins * b->bin_size_um;
+    const uint64_t near = (near_um + um - 1U) / um;
+    p->det_board = *b;
+    p->det_board.bin_size_um = um;
+    p->det_board.near_exclusion_bins = (uint16_t)(near > b->roi_bins ? b->roi_bins : near);
+    p->det_board.shadow_bins = NULL; // in the board's bins; detection uses shadow_um
     if (sl_detect_init(&p->detect, &p->det_board, &p->cfg.detect) != SL_OK ||
         sl_detect_bins_needed(&p->detect) > p->mask_bins) {
-        p->det_board = keep;
+        p->det_board.bin_size_um = keep_um;
+        p->det_board.near_exclusion_bins = keep_near;
+        p->det_board.shadow_bins = keep_shadow;
         (void)sl_detect_init(&p->detect, &p->det_board, &p->cfg.detect);
         p->stats.bin_size_unserved++;
         return;
     }
     p->stats.bin_size_changes++;
+}
+
+// A Configuration message (its parsed form stays out of on_msg's frame, which the FFT
+// path's deepest chain goes through).
+static SL_NOINLINE void on_config(sl_pipeline_t *p, const sl_proto_msg_t *m)
+{
+    sl_proto_config_t c;
+    if (sl_proto_parse_config(m, &c) == SL_OK) {
+        // The board's bin size is the expected one; > 1 % off is flagged (ranges and
+        // leans would be scaled wrong by that much).
+        const uint32_t um = sl_proto_config_bin_size_um(&c);
+        const uint64_t b = p->board->bin_size_um;
+        const uint64_t diff = (um > b) ? um - b : b - um;
+        p->radar_bin_um = um;
+        p->bin_size_bad = um == 0U || diff * 100U > b;
+        if (p->bin_size_bad) {
+            p->stats.bin_size_mismatch++;
+            set_err(p, SL_ERR_RANGE, (uint8_t)SL_PIPELINE_OK,
+                    "radar bin size differs from the board's by more than 1 %");
+        }
+        use_bin_size(p, um);
+    }
 }
 
 static void on_msg(void *ctx, const sl_proto_msg_t *m)
@@ -575,22 +623,7 @@ static void on_msg(void *ctx, const sl_proto_msg_t *m)
         p->stats.blind_rotations += p->scan.stats.blind_rotations - blind;
     }
     if (m->id == (uint8_t)SL_PROTO_ID_CONFIGURATION) {
-        sl_proto_config_t c;
-        if (sl_proto_parse_config(m, &c) == SL_OK) {
-            // The board's bin size is the expected one; > 1 % off is flagged (ranges and
-            // leans would be scaled wrong by that much).
-            const uint32_t um = sl_proto_config_bin_size_um(&c);
-            const uint64_t b = p->board->bin_size_um;
-            const uint64_t diff = (um > b) ? um - b : b - um;
-            p->radar_bin_um = um;
-            p->bin_size_bad = um == 0U || diff * 100U > b;
-            if (p->bin_size_bad) {
-                p->stats.bin_size_mismatch++;
-                set_err(p, SL_ERR_RANGE, (uint8_t)SL_PIPELINE_OK,
-                        "radar bin size differs from the board's by more than 1 %");
-            }
-            use_bin_size(p, um);
-        }
+        on_config(p, m);
     }
     if (p->scan.stats.config_rejected != rejected) {
         // Rows of this radar would be mapped with the board's geometry: drop them until a

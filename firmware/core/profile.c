@@ -160,25 +160,35 @@ void sl_profile_end_rotation(sl_profile_t *pr, bool reset)
 }
 
 // Least-squares slope (decay, > 0 for a falling tail) of sum[e-m+1 .. e], per frame, Q8.
-// 0 when the bins rise.
+// 0 when the bins rise. 32-bit only (no 64-bit division helper on v6-M, whose frames sat on
+// the deepest stack chain), exact for every input the 64-bit form took: with m <= FIT_BINS
+// (8) and uint16 sums, num = m * sum((m-1)/2 - x) y <= 64 * 65535, so num * 256 < 2^31, and
+// d = m sxx - sx^2 <= 336; the denominator d * frames is formed only when it fits 32 bits
+// (num * 256 + den / 2 < 2^32 then), else the rounded quotient is 0 (2 num 256 < 2^32 <= den).
 static uint32_t fit_slope_q8(const uint16_t *sum, uint32_t e, uint32_t m, uint32_t frames)
 {
-    int64_t sx = 0, sy = 0, sxx = 0, sxy = 0;
+    SL_ASSERT(m >= 2U && m <= FIT_BINS);
+    uint32_t sx = 0, sy = 0, sxx = 0, sxy = 0;
     for (uint32_t x = 0; x < m; x++) {
-        const int64_t y = sum[e + 1U - m + x];
-        sx += (int64_t)x;
+        const uint32_t y = sum[e + 1U - m + x];
+        sx += x;
         sy += y;
-        sxx += (int64_t)x * (int64_t)x;
-        sxy += (int64_t)x * y;
+        sxx += x * x;
+        sxy += x * y;
     }
-    const int64_t mm = (int64_t)m;
-    const int64_t num = sx * sy - mm * sxy; // = -(m sxy - sx sy): decay
-    const int64_t den = (mm * sxx - sx * sx) * (int64_t)frames;
-    if (num <= 0 || den <= 0) {
+    // num = sx sy - m sxy (decay); both products < 2^24
+    const uint32_t a = sx * sy, b = m * sxy;
+    const uint32_t d = m * sxx - sx * sx;
+    if (a <= b || d == 0U || frames == 0U) {
         return 0U;
     }
-    const int64_t q = (num * 256 + den / 2) / den;
-    return q > 0xFFFF ? 0xFFFFU : (uint32_t)q;
+    const uint32_t num = a - b;
+    if (frames > UINT32_MAX / d) {
+        return 0U;
+    }
+    const uint32_t den = d * frames;
+    const uint32_t q = (num * 256U + den / 2U) / den;
+    return q > 0xFFFFU ? 0xFFFFU : q;
 }
 
 // One extraction; `fit_bins` != 0 fixes the size of the tail fit (bins ending at e).

@@ -23,6 +23,43 @@ const uint8_t sl_proto_signature[SL_PROTO_SIGNATURE_BYTES] = {
 };
 
 enum { ST_SIG = 0, ST_HDR = 1, ST_PAY = 2 };
+
+// A whole signature at d (16 readable bytes), compared a word at a time: the aligned
+// stream's per-message check, which a byte-wise library memcmp makes ~120 instructions
+// on Cortex-M (once per azimuth). Words assembled from bytes: alignment-safe, one load
+// where the target has unaligned loads (forced inline: -Os otherwise calls it).
+#if defined(__GNUC__)
+#define SL_ALWAYS_INLINE inline __attribute__((always_inline))
+#else
+#define SL_ALWAYS_INLINE inline
+#endif
+static SL_ALWAYS_INLINE uint32_t word_at(const uint8_t *b)
+{
+    return (uint32_t)b[0] | ((uint32_t)b[1] << 8) | ((uint32_t)b[2] << 16) |
+           ((uint32_t)b[3] << 24);
+}
+
+// The per-message field reads (header length, FFT timestamp): sl_get_be32/le32 forced
+// inline here, where -Os on Cortex-M otherwise calls them (~4 calls per azimuth).
+static SL_ALWAYS_INLINE uint32_t msg_be32(const uint8_t *b)
+{
+    return ((uint32_t)b[0] << 24) | ((uint32_t)b[1] << 16) | ((uint32_t)b[2] << 8) | (uint32_t)b[3];
+}
+
+// The signature as little-endian words (the table above, bytes 0-3, 4-7, 8-11, 12-15):
+// literals, so they are not re-read byte by byte from the table.
+// Hosts whose compilers expand a 16-byte memcmp inline (x86-64 GCC: two 8-byte compares)
+// keep it.
+static bool sig_at(const uint8_t *d)
+{
+#if defined(__arm__) || defined(__thumb__)
+    return ((word_at(d) ^ 0x03030100U) | (word_at(d + 4) ^ 0x0F0F0707U) |
+            (word_at(d + 8) ^ 0x3F3F1F1FU) | (word_at(d + 12) ^ 0xFEFE7F7FU)) == 0U;
+#else
+    return memcmp(d, sl_proto_signature, SL_PROTO_SIGNATURE_BYTES) == 0;
+#endif
+}
+
 enum { HDR_OK = 0, HDR_BAD_VERSION, HDR_OVERSIZE, HDR_TOO_BIG };
 
 // ---------------------------------------------------------------------------------- decoder
@@ -150,7 +187,7 @@ static void sig_byte(sl_proto_t *p, uint8_t b)
 // Header tail = version, id, length (BE). Counts the rejection reason.
 static int check_header(sl_proto_t *p, const uint8_t *tail)
 {
-    const uint32_t len = sl_get_be32(tail + 2);
+    const uint32_t len = msg_be32(tail + 2);
     if (tail[0] != SL_PROTO_VERSION) {
         p->stats.bad_version++;
         return HDR_BAD_VERSION;
@@ -273,8 +310,7 @@ sl_err_t sl_proto_feed(sl_proto_t *p, const uint8_t *data, size_t len, uint64_t 
             bool found = true;
             size_t j = i;
             // Aligned stream (the common case): the signature is right here.
-            if (data[i] != 0x00U ||
-                memcmp(data + i, sl_proto_signature, SL_PROTO_SIGNATURE_BYTES) != 0) {
+            if (data[i] != 0x00U || !sig_at(data + i)) {
                 j = sig_search(data, i, len, &found);
             }
             skip(p, j - i);
@@ -291,7 +327,7 @@ sl_err_t sl_proto_feed(sl_proto_t *p, const uint8_t *data, size_t len, uint64_t 
                     i++;
                     continue;
                 }
-                const uint32_t plen = sl_get_be32(tail + 2);
+                const uint32_t plen = msg_be32(tail + 2);
                 p->hunting = false;
                 p->msg_offset = base + i;
                 p->payload_bytes = plen;
@@ -559,8 +595,8 @@ sl_err_t sl_proto_parse_fft(const sl_proto_msg_t *msg, sl_proto_fft_t *out)
     out->data_offset = off;
     out->sweep_counter = sl_get_be16(d + 2);
     out->azimuth_ticks = sl_get_be16(d + 4);
-    out->seconds = sl_get_le32(d + 6);
-    out->split_ns = sl_get_le32(d + 10);
+    out->seconds = word_at(d + 6);
+    out->split_ns = word_at(d + 10);
     out->bins = (uint32_t)(nbytes >> bpb_log2);
     out->bin_data = d + off;
     return SL_OK;

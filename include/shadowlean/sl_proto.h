@@ -269,14 +269,31 @@ static inline uint16_t sl_proto_fft_bin16(const sl_proto_fft_t *f, uint32_t i)
     return (uint16_t)((uint16_t)f->bin_data[2U * i] | (uint16_t)(f->bin_data[2U * i + 1U] << 8));
 }
 
+/// 32 x 32 -> 64-bit product. ARMv6-M has no widening multiply and the compiler calls the
+/// 64 x 64 library helper (__aeabi_lmul, ~45 instructions); there it is formed from four
+/// 16 x 16 products (exact: each < 2^32, the middle sum < 2^18 + 2 x 2^16 before its shift).
+static inline uint64_t sl_mul_u32_wide(uint32_t a, uint32_t b)
+{
+#if defined(__ARM_ARCH_6M__)
+    const uint32_t al = a & 0xFFFFU, ah = a >> 16, bl = b & 0xFFFFU, bh = b >> 16;
+    const uint32_t ll = al * bl, lh = al * bh, hl = ah * bl, hh = ah * bh;
+    const uint32_t mid = (ll >> 16) + (lh & 0xFFFFU) + (hl & 0xFFFFU);
+    const uint32_t hi = hh + (lh >> 16) + (hl >> 16) + (mid >> 16);
+    const uint32_t lo = (mid << 16) | (ll & 0xFFFFU);
+    return ((uint64_t)hi << 32) | lo;
+#else
+    return (uint64_t)a * b;
+#endif
+}
+
 /// FFT timestamp as UNIX microseconds: seconds * 1e6 + split_ns / 1000 (truncated). O(1).
 static inline uint64_t sl_proto_fft_time_us(const sl_proto_fft_t *f)
 {
     // split_ns / 1000 as a multiply (once per azimuth; no division helper on ARMv6-M):
     // m = ceil(2^38 / 1000) = 274877907, m x 1000 - 2^38 = 56 and 56 x 2^32 < 2^38, so
     // (x m) >> 38 == x / 1000 for every 32-bit x.
-    return (uint64_t)f->seconds * 1000000U +
-           (((uint64_t)f->split_ns * 274877907U) >> 38);
+    return sl_mul_u32_wide(f->seconds, 1000000U) +
+           (sl_mul_u32_wide(f->split_ns, 274877907U) >> 38);
 }
 
 // ------------------------------------------------------------------------------------------
