@@ -334,8 +334,8 @@ static uint32_t chi2_direct_q8(const fit_ctx_t *f, uint64_t choice, int32_t tx, 
     uint64_t sum_q16 = 0;
     for (size_t k = 0; k < f->n; ++k) {
         const sl_tilt_obs_t *o = &f->obs[k];
-        const int16_t t = ((choice >> k) & 1U) != 0U ? o->tan_mirror_q12 : o->tan_q12;
-        const int64_t r = (int64_t)t - predict_q12(o, tx, ty);   // Q12
+        const int64_t t = ((choice >> k) & 1U) != 0U ? o->tan_mirror_q12 : o->tan_q12;
+        const int64_t r = t - predict_q12(o, tx, ty);            // Q12
         const int64_t z = div_round(r * 4096, (int64_t)obs_sigma(o)); // Q8
         sum_q16 += (uint64_t)(z * z);
     }
@@ -381,6 +381,7 @@ static int64_t var_factor_q20(const fit_ctx_t *f, sl_q30_t p1, sl_q30_t p2)
 static void report(const fit_ctx_t *f, const sl_tilt_params_t *prm, uint64_t choice, int32_t tx32,
                    int32_t ty32, uint32_t chi2_q8, sl_tilt_result_t *out)
 {
+    SL_ASSERT(f->n >= SL_TILT_MIN_OBS); // sl_tilt_fit's gate: dof = n - 2 > 0, mean over n
     out->tx_q24 = tx32;
     out->ty_q24 = ty32;
     out->chi2_q8 = chi2_q8;
@@ -652,17 +653,17 @@ void sl_tilt_odom_step(sl_tilt_odom_t *o, int32_t speed_mm_s, int32_t yaw_rate_m
         return;
     }
     const uint32_t dt = (dt_us > ODOM_DT_MAX_US) ? ODOM_DT_MAX_US : dt_us;
-    const int64_t v = (speed_mm_s > ODOM_SPEED_MAX_MM_S) ? ODOM_SPEED_MAX_MM_S
+    const int32_t v = (speed_mm_s > ODOM_SPEED_MAX_MM_S) ? ODOM_SPEED_MAX_MM_S
                       : (speed_mm_s < -ODOM_SPEED_MAX_MM_S) ? -ODOM_SPEED_MAX_MM_S : speed_mm_s;
-    const int64_t w = (yaw_rate_mdeg_s > ODOM_RATE_MAX_MDEG_S) ? ODOM_RATE_MAX_MDEG_S
+    const int32_t w = (yaw_rate_mdeg_s > ODOM_RATE_MAX_MDEG_S) ? ODOM_RATE_MAX_MDEG_S
                       : (yaw_rate_mdeg_s < -ODOM_RATE_MAX_MDEG_S) ? -ODOM_RATE_MAX_MDEG_S
                                                                   : yaw_rate_mdeg_s;
-    const int64_t dyaw = sl_fx_rshift_round64(w * (int64_t)dt * BAM_PER_MDEG_US_Q24, 24U);
+    const int64_t dyaw = sl_fx_rshift_round64((int64_t)w * (int64_t)dt * BAM_PER_MDEG_US_Q24, 24U);
     const sl_bam32_t mid = o->yaw + (sl_bam32_t)(int32_t)(dyaw / 2);
     sl_q30_t s;
     sl_q30_t c;
     sl_tilt_sincos_q30(mid, &s, &c);
-    const int64_t dist_um = div_round(v * (int64_t)dt, 1000);
+    const int64_t dist_um = div_round((int64_t)v * (int64_t)dt, 1000);
     o->x_um += sl_fx_rshift_round64(dist_um * c, 30U);
     o->y_um += sl_fx_rshift_round64(dist_um * s, 30U);
     o->yaw += (sl_bam32_t)(int32_t)dyaw;
