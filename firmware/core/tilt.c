@@ -103,6 +103,11 @@ static int16_t tan_q12(sl_bam32_t a)
 }
 
 #define BAM_80_DEG 954437177 // 80 / 360 * 2^32
+// Powers of two as constants (not shifts of a signed one: MISRA 10.1).
+#define P2_24 ((int64_t)0x1000000)    // 2^24
+#define P2_29 ((int64_t)0x20000000)   // 2^29
+#define P2_30 ((int64_t)0x40000000)   // 2^30
+#define P2_32 ((int64_t)4294967296LL) // 2^32
 #define SIGMA_RAD_Q32_PER_CDEG 749613U // pi / 18000 * 2^32
 #define R1_MAX_UM 1000000000U           // 1 km: beyond it the input is not a shadow target
 
@@ -360,7 +365,7 @@ static uint32_t chi2_of_score_q8(const fit_ctx_t *f, int64_t r_q54)
 // Radians (Q30, >= 0) -> 0.01 deg, rounded, saturated to `max`.
 static uint16_t rad_q30_to_cdeg(int64_t rad_q30, uint16_t max)
 {
-    if (rad_q30 >= ((int64_t)4 << 30)) {
+    if (rad_q30 >= P2_32) {
         return max;
     }
     const int64_t cdeg = sl_fx_rshift_round64(rad_q30 * CDEG_PER_RAD_Q16, 46U);
@@ -397,7 +402,7 @@ static void report(const fit_ctx_t *f, const sl_tilt_params_t *prm, uint64_t cho
     const int64_t ty = ty32;
     const uint32_t tn_q24 = sl_fx_isqrt64((uint64_t)(tx * tx + ty * ty)); // |t|, Q24
     out->psi_cdeg = sl_incline_bam32_to_cdeg(
-        sl_incline_atan2_bam32((int32_t)tn_q24, (int32_t)1 << 24));
+        sl_incline_atan2_bam32((int32_t)tn_q24, (int32_t)P2_24));
     int32_t phi = sl_incline_bam32_to_cdeg(sl_incline_atan2_bam32(ty32, tx32));
     if (phi < 0) {
         phi += 36000;
@@ -418,15 +423,15 @@ static void report(const fit_ctx_t *f, const sl_tilt_params_t *prm, uint64_t cho
     sl_q30_t u1 = SL_Q30_ONE;
     sl_q30_t u2 = 0;
     if (tn_q24 != 0U) {
-        u1 = sl_fx_sat32(div_round(tx * ((int64_t)1 << 30), (int64_t)tn_q24));
-        u2 = sl_fx_sat32(div_round(ty * ((int64_t)1 << 30), (int64_t)tn_q24));
+        u1 = sl_fx_sat32(div_round(tx * P2_30, (int64_t)tn_q24));
+        u2 = sl_fx_sat32(div_round(ty * P2_30, (int64_t)tn_q24));
     }
     int64_t sig_q30[2];
     const sl_q30_t dir[2][2] = {{u1, u2}, {(sl_q30_t)-u2, u1}}; // along t, across t
     for (unsigned i = 0; i < 2U; ++i) {
         int64_t f_q20 = var_factor_q20(f, dir[i][0], dir[i][1]);
-        if (f_q20 > ((int64_t)1 << 29)) {
-            f_q20 = (int64_t)1 << 29;
+        if (f_q20 > P2_29) {
+            f_q20 = P2_29;
         }
         if (f_q20 < 0) {
             f_q20 = 0;
@@ -439,7 +444,7 @@ static void report(const fit_ctx_t *f, const sl_tilt_params_t *prm, uint64_t cho
         sig_q30[i] = (int64_t)sl_fx_isqrt64(var_q30 << 30);
     }
     // d psi = d|t| / (1 + |t|^2); d phi = d(across) / |t|.
-    const int64_t sec2_q24 = ((int64_t)1 << 24) + (int64_t)(((uint64_t)tn_q24 * tn_q24) >> 24);
+    const int64_t sec2_q24 = P2_24 + (int64_t)(((uint64_t)tn_q24 * tn_q24) >> 24);
     out->psi_sigma_cdeg = rad_q30_to_cdeg(div_round(sig_q30[0] << 24, sec2_q24), UINT16_MAX);
     out->phi_sigma_cdeg = (tn_q24 == 0U) ? 18000U
         : rad_q30_to_cdeg(div_round(sig_q30[1] << 24, (int64_t)tn_q24), 18000U);
@@ -615,7 +620,7 @@ sl_err_t sl_tilt_fit(const sl_tilt_obs_t *obs, size_t n, const sl_tilt_params_t 
     alt.ty_q24 = ty;
     {
         const int64_t tn = (int64_t)sl_fx_isqrt64((uint64_t)((int64_t)tx * tx + (int64_t)ty * ty));
-        const int64_t d_min = ((int64_t)1 << 24) * 35 / 1000; // 0.035 (2 deg)
+        const int64_t d_min = P2_24 * 35 / 1000; // 0.035 (2 deg)
         const int64_t d_rel = tn * 3 / 10;
         alt.distinct_q24 = (d_rel > d_min) ? d_rel : d_min;
     }
