@@ -195,7 +195,7 @@ static int64_t get_sig(const uint8_t d[8], const sl_can_signal_desc_t *s)
 
 /// round(x / d) with halves rounded up (towards +infinity); d > 0. Exact for the int64
 /// range used here (|x| < 2^33).
-static int64_t div_round(int64_t x, int64_t d)
+static int64_t div_round_half_up(int64_t x, int64_t d)
 {
     const int64_t n = 2 * x + d; // floor((2x + d) / 2d) = floor(x/d + 1/2)
     const int64_t dd = 2 * d;
@@ -224,7 +224,7 @@ static int64_t clamp_raw(const sl_can_signal_desc_t *s, int64_t raw, bool *clamp
 static void put_phys(uint8_t d[8], const sl_can_signal_desc_t *s, int64_t phys, int64_t per_lsb,
                      bool *clamped)
 {
-    put_sig(d, s, clamp_raw(s, div_round(phys, per_lsb), clamped));
+    put_sig(d, s, clamp_raw(s, div_round_half_up(phys, per_lsb), clamped));
 }
 
 /// An angle in 0.01 deg, any value -> raw steps of `per_lsb` in [0, 36000 / per_lsb).
@@ -236,7 +236,7 @@ static void put_azimuth(uint8_t d[8], const sl_can_signal_desc_t *s, int32_t az_
         a += 36000;
     }
     // 359.95 deg rounds to 360.0 = 0: reduce the raw value modulo a full turn as well.
-    const int64_t raw = div_round(a, per_lsb) % (36000 / per_lsb);
+    const int64_t raw = div_round_half_up(a, per_lsb) % (36000 / per_lsb);
     put_sig(d, s, raw);
 }
 

@@ -46,7 +46,7 @@ sl_err_t sl_profile_init(sl_profile_t *pr, uint16_t azimuths, uint16_t near_bins
 }
 
 // Count of trailing zeros of a non-zero word (portable de Bruijn, as in detect.c).
-static uint32_t ctz32(uint32_t v)
+static uint32_t profile_ctz32(uint32_t v)
 {
     static const uint8_t tab[32] = {0,  1,  28, 2,  29, 14, 24, 3,  30, 22, 20,
                                     15, 25, 17, 4,  8,  31, 27, 13, 23, 21, 19,
@@ -64,7 +64,7 @@ static uint32_t first_set(const uint32_t *bits, uint32_t lo, uint32_t hi)
             pos = (pos | 31U) + 1U;
             continue;
         }
-        pos += ctz32(w);
+        pos += profile_ctz32(w);
         return pos < hi ? pos : hi;
     }
     return hi;
@@ -191,10 +191,10 @@ static uint32_t fit_slope_q8(const uint16_t *sum, uint32_t e, uint32_t m, uint32
     return q > 0xFFFFU ? 0xFFFFU : q;
 }
 
-// One extraction; `fit_bins` != 0 fixes the size of the tail fit (bins ending at e).
+// One extraction; `fit_max` (<= FIT_BINS) caps the size of the tail fit (bins ending at e).
 static sl_profile_bounds_t extract_once(const uint16_t *sum, uint32_t n, uint32_t frames,
                                         uint32_t threshold, uint32_t hint, uint32_t cal_slope_q8,
-                                        uint32_t fit_bins)
+                                        uint32_t fit_max)
 {
     sl_profile_bounds_t r;
     memset(&r, 0, sizeof r);
@@ -241,10 +241,7 @@ static sl_profile_bounds_t extract_once(const uint16_t *sum, uint32_t n, uint32_
     }
     // 3. tail slope: self fit, else the calibration
     uint32_t m = e - i1 + 1U;
-    m = m > FIT_BINS ? FIT_BINS : m;
-    if (fit_bins != 0U && fit_bins < m) {
-        m = fit_bins;
-    }
+    m = m > fit_max ? fit_max : m;
     uint32_t s = m >= FIT_MIN_BINS ? fit_slope_q8(sum, e, m, frames) : 0U;
     r.slope_src = SL_PROFILE_SLOPE_FIT;
     if (s < SLOPE_MIN_Q8 || s > SLOPE_MAX_Q8) {
@@ -318,9 +315,9 @@ static sl_profile_bounds_t extract_once(const uint16_t *sum, uint32_t n, uint32_
 sl_profile_bounds_t sl_profile_extract(const uint16_t *sum, uint32_t n, uint32_t frames,
                                        uint32_t threshold, uint32_t hint, uint32_t cal_slope_q8)
 {
-    sl_profile_bounds_t r = extract_once(sum, n, frames, threshold, hint, cal_slope_q8, 0U);
+    sl_profile_bounds_t r = extract_once(sum, n, frames, threshold, hint, cal_slope_q8, FIT_BINS);
     // The first fit may reach into the pole's own bins when the tail is short: refit on the
-    // tail the walk found (when it has >= FIT_MIN_BINS bins) and walk again.
+    // tail the walk found (when it has >= FIT_MIN_BINS and < FIT_BINS bins) and walk again.
     if (r.fail == (uint8_t)SL_PROFILE_OK && r.slope_src == SL_PROFILE_SLOPE_FIT &&
         (uint32_t)r.i2 + FIT_BINS > r.e && (uint32_t)r.e >= (uint32_t)r.i2 + FIT_MIN_BINS) {
         const sl_profile_bounds_t r2 =

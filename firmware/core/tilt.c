@@ -103,6 +103,11 @@ static int16_t tan_q12(sl_bam32_t a)
 }
 
 #define BAM_80_DEG 954437177 // 80 / 360 * 2^32
+// Powers of two as constants (not shifts of a signed one: MISRA 10.1).
+#define P2_24 ((int64_t)0x1000000)    // 2^24
+#define P2_29 ((int64_t)0x20000000)   // 2^29
+#define P2_30 ((int64_t)0x40000000)   // 2^30
+#define P2_32 ((int64_t)4294967296LL) // 2^32
 #define SIGMA_RAD_Q32_PER_CDEG 749613U // pi / 18000 * 2^32
 #define R1_MAX_UM 1000000000U           // 1 km: beyond it the input is not a shadow target
 
@@ -334,8 +339,8 @@ static uint32_t chi2_direct_q8(const fit_ctx_t *f, uint64_t choice, int32_t tx, 
     uint64_t sum_q16 = 0;
     for (size_t k = 0; k < f->n; ++k) {
         const sl_tilt_obs_t *o = &f->obs[k];
-        const int16_t t = ((choice >> k) & 1U) != 0U ? o->tan_mirror_q12 : o->tan_q12;
-        const int64_t r = (int64_t)t - predict_q12(o, tx, ty);   // Q12
+        const int64_t t = ((choice >> k) & 1U) != 0U ? o->tan_mirror_q12 : o->tan_q12;
+        const int64_t r = t - predict_q12(o, tx, ty);            // Q12
         const int64_t z = div_round(r * 4096, (int64_t)obs_sigma(o)); // Q8
         sum_q16 += (uint64_t)(z * z);
     }
@@ -360,7 +365,7 @@ static uint32_t chi2_of_score_q8(const fit_ctx_t *f, int64_t r_q54)
 // Radians (Q30, >= 0) -> 0.01 deg, rounded, saturated to `max`.
 static uint16_t rad_q30_to_cdeg(int64_t rad_q30, uint16_t max)
 {
-    if (rad_q30 >= ((int64_t)4 << 30)) {
+    if (rad_q30 >= P2_32) {
         return max;
     }
     const int64_t cdeg = sl_fx_rshift_round64(rad_q30 * CDEG_PER_RAD_Q16, 46U);
@@ -381,6 +386,7 @@ static int64_t var_factor_q20(const fit_ctx_t *f, sl_q30_t p1, sl_q30_t p2)
 static void report(const fit_ctx_t *f, const sl_tilt_params_t *prm, uint64_t choice, int32_t tx32,
                    int32_t ty32, uint32_t chi2_q8, sl_tilt_result_t *out)
 {
+    SL_ASSERT(f->n >= SL_TILT_MIN_OBS); // sl_tilt_fit's gate: dof = n - 2 > 0, mean over n
     out->tx_q24 = tx32;
     out->ty_q24 = ty32;
     out->chi2_q8 = chi2_q8;
@@ -396,7 +402,7 @@ static void report(const fit_ctx_t *f, const sl_tilt_params_t *prm, uint64_t cho
     const int64_t ty = ty32;
     const uint32_t tn_q24 = sl_fx_isqrt64((uint64_t)(tx * tx + ty * ty)); // |t|, Q24
     out->psi_cdeg = sl_incline_bam32_to_cdeg(
-        sl_incline_atan2_bam32((int32_t)tn_q24, (int32_t)1 << 24));
+        sl_incline_atan2_bam32((int32_t)tn_q24, (int32_t)P2_24));
     int32_t phi = sl_incline_bam32_to_cdeg(sl_incline_atan2_bam32(ty32, tx32));
     if (phi < 0) {
         phi += 36000;
@@ -417,15 +423,15 @@ static void report(const fit_ctx_t *f, const sl_tilt_params_t *prm, uint64_t cho
     sl_q30_t u1 = SL_Q30_ONE;
     sl_q30_t u2 = 0;
     if (tn_q24 != 0U) {
-        u1 = sl_fx_sat32(div_round(tx * ((int64_t)1 << 30), (int64_t)tn_q24));
-        u2 = sl_fx_sat32(div_round(ty * ((int64_t)1 << 30), (int64_t)tn_q24));
+        u1 = sl_fx_sat32(div_round(tx * P2_30, (int64_t)tn_q24));
+        u2 = sl_fx_sat32(div_round(ty * P2_30, (int64_t)tn_q24));
     }
     int64_t sig_q30[2];
     const sl_q30_t dir[2][2] = {{u1, u2}, {(sl_q30_t)-u2, u1}}; // along t, across t
     for (unsigned i = 0; i < 2U; ++i) {
         int64_t f_q20 = var_factor_q20(f, dir[i][0], dir[i][1]);
-        if (f_q20 > ((int64_t)1 << 29)) {
-            f_q20 = (int64_t)1 << 29;
+        if (f_q20 > P2_29) {
+            f_q20 = P2_29;
         }
         if (f_q20 < 0) {
             f_q20 = 0;
@@ -438,7 +444,7 @@ static void report(const fit_ctx_t *f, const sl_tilt_params_t *prm, uint64_t cho
         sig_q30[i] = (int64_t)sl_fx_isqrt64(var_q30 << 30);
     }
     // d psi = d|t| / (1 + |t|^2); d phi = d(across) / |t|.
-    const int64_t sec2_q24 = ((int64_t)1 << 24) + (int64_t)(((uint64_t)tn_q24 * tn_q24) >> 24);
+    const int64_t sec2_q24 = P2_24 + (int64_t)(((uint64_t)tn_q24 * tn_q24) >> 24);
     out->psi_sigma_cdeg = rad_q30_to_cdeg(div_round(sig_q30[0] << 24, sec2_q24), UINT16_MAX);
     out->phi_sigma_cdeg = (tn_q24 == 0U) ? 18000U
         : rad_q30_to_cdeg(div_round(sig_q30[1] << 24, (int64_t)tn_q24), 18000U);
@@ -614,7 +620,7 @@ sl_err_t sl_tilt_fit(const sl_tilt_obs_t *obs, size_t n, const sl_tilt_params_t 
     alt.ty_q24 = ty;
     {
         const int64_t tn = (int64_t)sl_fx_isqrt64((uint64_t)((int64_t)tx * tx + (int64_t)ty * ty));
-        const int64_t d_min = ((int64_t)1 << 24) * 35 / 1000; // 0.035 (2 deg)
+        const int64_t d_min = P2_24 * 35 / 1000; // 0.035 (2 deg)
         const int64_t d_rel = tn * 3 / 10;
         alt.distinct_q24 = (d_rel > d_min) ? d_rel : d_min;
     }
@@ -652,17 +658,17 @@ void sl_tilt_odom_step(sl_tilt_odom_t *o, int32_t speed_mm_s, int32_t yaw_rate_m
         return;
     }
     const uint32_t dt = (dt_us > ODOM_DT_MAX_US) ? ODOM_DT_MAX_US : dt_us;
-    const int64_t v = (speed_mm_s > ODOM_SPEED_MAX_MM_S) ? ODOM_SPEED_MAX_MM_S
+    const int32_t v = (speed_mm_s > ODOM_SPEED_MAX_MM_S) ? ODOM_SPEED_MAX_MM_S
                       : (speed_mm_s < -ODOM_SPEED_MAX_MM_S) ? -ODOM_SPEED_MAX_MM_S : speed_mm_s;
-    const int64_t w = (yaw_rate_mdeg_s > ODOM_RATE_MAX_MDEG_S) ? ODOM_RATE_MAX_MDEG_S
+    const int32_t w = (yaw_rate_mdeg_s > ODOM_RATE_MAX_MDEG_S) ? ODOM_RATE_MAX_MDEG_S
                       : (yaw_rate_mdeg_s < -ODOM_RATE_MAX_MDEG_S) ? -ODOM_RATE_MAX_MDEG_S
                                                                   : yaw_rate_mdeg_s;
-    const int64_t dyaw = sl_fx_rshift_round64(w * (int64_t)dt * BAM_PER_MDEG_US_Q24, 24U);
+    const int64_t dyaw = sl_fx_rshift_round64((int64_t)w * (int64_t)dt * BAM_PER_MDEG_US_Q24, 24U);
     const sl_bam32_t mid = o->yaw + (sl_bam32_t)(int32_t)(dyaw / 2);
     sl_q30_t s;
     sl_q30_t c;
     sl_tilt_sincos_q30(mid, &s, &c);
-    const int64_t dist_um = div_round(v * (int64_t)dt, 1000);
+    const int64_t dist_um = div_round((int64_t)v * (int64_t)dt, 1000);
     o->x_um += sl_fx_rshift_round64(dist_um * c, 30U);
     o->y_um += sl_fx_rshift_round64(dist_um * s, 30U);
     o->yaw += (sl_bam32_t)(int32_t)dyaw;

@@ -144,7 +144,7 @@ void sl_track_predict_static(const sl_board_t *board, uint16_t az, uint32_t r_um
         return;
     }
     // Keep |x|, |y| < 2^31 so that the squares below fit (1 km is far beyond any shadow).
-    const uint32_t lim = 1U << 30;
+    const uint32_t lim = 0x40000000U; // 2^30
     r_um = r_um > lim ? lim : r_um;
     disp_um = disp_um > lim ? lim : disp_um;
     // Bearing from vehicle forward, clockwise, bam32.
