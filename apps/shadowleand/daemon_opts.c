@@ -482,7 +482,7 @@ int sld_opts_parse(sld_opts_t *o, int argc, char **argv, char *err, size_t err_s
         const size_t nlen = eq != NULL ? (size_t)(eq - a) : strlen(a);
         const cli_opt_t *c = strncmp(a, "--", 2) == 0 ? find_cli(a, nlen) : NULL;
         if (c == NULL) {
-            snprintf(err, err_size, "unknown option or stray argument '%s' (see --help)", a);
+            snprintf(err, err_size, a[0] == '-' ? "unknown option '%s'" : "unexpected argument '%s'", a);
             return -1;
         }
         const char *val = c->fixed;

@@ -891,7 +891,13 @@ int main(int argc, char **argv)
     if (pr > 0) {
         return 0;
     }
-    if (pr < 0 || sld_opts_validate(&d->o, err, sizeof err) != 0) {
+    if (pr < 0) {
+        // The tools' convention: the offending option named, then the usage, on stderr.
+        fprintf(stderr, "shadowleand: %s\n", err);
+        sld_opts_usage(stderr);
+        return 2;
+    }
+    if (sld_opts_validate(&d->o, err, sizeof err) != 0) {
         fprintf(stderr, "shadowleand: %s\n", err);
         return 2;
     }

@@ -35,6 +35,7 @@
 #include <string>
 #include <vector>
 
+#include "sl_cli.h"
 #include "sl_geom.h"
 #include "shadowlean/sl_incline.h"
 
@@ -101,25 +102,24 @@ int main(int argc, char **argv)
     double sigma_theta_deg = 0.0;
     bool with_sigma = false;
     bool quiet = false;
+    const int info = sl_cli_info(argc, argv, "sl-alpha", usage);
+    if (info != SL_CLI_CONTINUE) {
+        return info;
+    }
     for (int i = 1; i < argc; i++) {
         const std::string a = argv[i];
-        if ((a == "--sigma-r" || a == "--sigma-theta") && i + 1 < argc) {
+        if (a == "--sigma-r" || a == "--sigma-theta") {
             double v = 0.0;
-            if (!parse_double(argv[i + 1], &v) || v < 0.0) {
-                std::fprintf(stderr, "sl-alpha: %s needs a non-negative number\n", a.c_str());
-                return 2;
+            if (i + 1 >= argc || !parse_double(argv[i + 1], &v) || v < 0.0) {
+                return sl_cli_bad_value("sl-alpha", a.c_str(), "needs a non-negative number", usage);
             }
             (a == "--sigma-r" ? sigma_r_m : sigma_theta_deg) = v;
             with_sigma = true;
             i++;
         } else if (a == "--quiet" || a == "-q") {
             quiet = true;
-        } else if (a == "--help" || a == "-h") {
-            usage(stdout);
-            return 0;
         } else {
-            usage(stderr);
-            return 2;
+            return sl_cli_unknown("sl-alpha", argv[i], usage);
         }
     }
     const double st_cdeg = std::llround(sigma_theta_deg * 100.0);

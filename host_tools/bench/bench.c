@@ -39,6 +39,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "sl_cli.h"
 #include "shadowlean/sl_pipeline.h"
 
 #ifdef SL_HAVE_CALLGRIND_H
@@ -120,12 +121,29 @@ typedef struct opts {
     bool quiet;
 } opts_t;
 
-static int usage(void)
+// sl-bench and sl-bench-host are the same source: each names itself.
+#ifndef SL_BENCH_PROG
+#define SL_BENCH_PROG "sl-bench"
+#endif
+
+static void usage(FILE *out)
 {
-    fprintf(stderr, "usage: sl-bench CAPTURE [--board NAME] [--chunk BYTES] [--repeat N] "
-                    "[--loop N] [--n N] [--beam-cdeg N] [--threshold T] [--speed-mm-s V] [--no-profile] "
-                    "[--callgrind run|latency] [--quiet]\n");
-    return 2;
+    fprintf(out, "usage: " SL_BENCH_PROG " CAPTURE [--board NAME] [--chunk BYTES] [--repeat N] "
+                 "[--loop N] [--n N] [--beam-cdeg N] [--threshold T] [--speed-mm-s V] [--no-profile] "
+                 "[--callgrind run|latency] [--quiet]\n");
+}
+
+static bool takes_value(const char *a)
+{
+    static const char *const with_value[] = {"--board", "--chunk", "--repeat", "--loop", "--n",
+                                             "--beam-cdeg", "--threshold", "--speed-mm-s",
+                                             "--callgrind"};
+    for (size_t k = 0; k < sizeof with_value / sizeof with_value[0]; k++) {
+        if (strcmp(a, with_value[k]) == 0) {
+            return true;
+        }
+    }
+    return false;
 }
 
 static uint8_t *read_file(const char *path, size_t *n)
@@ -232,6 +250,10 @@ int main(int argc, char **argv)
 {
     opts_t o = {.board = "paper-sim", .chunk = 65536, .repeat = 5, .loop = 1, .threshold = -1,
                 .speed_mm_s = -1};
+    const int info = sl_cli_info(argc, argv, SL_BENCH_PROG, usage);
+    if (info != SL_CLI_CONTINUE) {
+        return info;
+    }
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         const char *v = i + 1 < argc ? argv[i + 1] : NULL;
@@ -257,14 +279,25 @@ int main(int argc, char **argv)
             o.callgrind = v, i++;
         } else if (strcmp(a, "--quiet") == 0) {
             o.quiet = true;
+        } else if (takes_value(a) && v == NULL) {
+            return sl_cli_bad_value(SL_BENCH_PROG, a, "needs a value", usage);
         } else if (a[0] == '-' || o.capture != NULL) {
-            return usage();
+            return sl_cli_unknown(SL_BENCH_PROG, a, usage);
         } else {
             o.capture = a;
         }
     }
-    if (o.capture == NULL || o.chunk == 0 || o.repeat < 1 || o.loop < 1) {
-        return usage();
+    if (o.capture == NULL) {
+        return sl_cli_usage_error(SL_BENCH_PROG, "missing CAPTURE", usage);
+    }
+    if (o.chunk == 0) {
+        return sl_cli_bad_value(SL_BENCH_PROG, "--chunk", "must be at least 1", usage);
+    }
+    if (o.repeat < 1) {
+        return sl_cli_bad_value(SL_BENCH_PROG, "--repeat", "must be at least 1", usage);
+    }
+    if (o.loop < 1) {
+        return sl_cli_bad_value(SL_BENCH_PROG, "--loop", "must be at least 1", usage);
     }
     const sl_board_t *board = sl_board_find(o.board);
     if (board == NULL) {
@@ -312,7 +345,7 @@ int main(int argc, char **argv)
     const bool cg_run = o.callgrind != NULL && strcmp(o.callgrind, "run") == 0;
     const bool cg_lat = o.callgrind != NULL && strcmp(o.callgrind, "latency") == 0;
     if (o.callgrind != NULL && !cg_run && !cg_lat) {
-        return usage();
+        return sl_cli_bad_value(SL_BENCH_PROG, "--callgrind", "must be run or latency", usage);
     }
 
     // --- throughput: whole capture in chunks

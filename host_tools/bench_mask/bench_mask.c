@@ -18,6 +18,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "sl_cli.h"
 #include "shadowlean/sl_board.h"
 #include "shadowlean/sl_detect.h"
 #include "shadowlean/sl_mask.h"
@@ -57,6 +58,16 @@ static uint32_t rnd(void)
     return (uint32_t)(rng >> 11);
 }
 
+#define SL_STR2(x) #x
+#define SL_STR(x) SL_STR2(x)
+#define PROG "sl-bench-mask-n" SL_STR(SL_CFG_MASK_FRAMES_MAX)
+
+static void usage(FILE *out)
+{
+    fprintf(out, "usage: " PROG " [--board NAME] [--rotations MEASURED] [--detect-bins] "
+                 "[--collect thresh|mask|detect|track|all]\n");
+}
+
 static const struct {
     uint16_t az, first, last;
 } poles[6] = {{30, 68, 83}, {95, 60, 72}, {150, 80, 100}, {210, 70, 79}, {300, 66, 90},
@@ -66,8 +77,8 @@ static void make_scene(uint32_t rotations)
 {
     power = malloc((size_t)rotations * NAZ * NBINS);
     if (power == NULL) {
-        fprintf(stderr, "sl-bench-mask: out of memory\n");
-        exit(2);
+        fprintf(stderr, PROG ": out of memory\n");
+        exit(SL_EXIT_ERROR);
     }
     for (uint32_t r = 0; r < rotations; r++) {
         for (uint32_t a = 0; a < NAZ; a++) {
@@ -147,7 +158,17 @@ int main(int argc, char **argv)
     int collect = C_NONE;
     uint32_t measured = 16;
     int detect_bins = 0;
+    const int info = sl_cli_info(argc, argv, PROG, usage);
+    if (info != SL_CLI_CONTINUE) {
+        return info;
+    }
     for (int i = 1; i < argc; i++) {
+        const int has_value = i + 1 < argc;
+        if ((strcmp(argv[i], "--board") == 0 || strcmp(argv[i], "--rotations") == 0 ||
+             strcmp(argv[i], "--collect") == 0) &&
+            !has_value) {
+            return sl_cli_bad_value(PROG, argv[i], "needs a value", usage);
+        }
         if (strcmp(argv[i], "--board") == 0 && i + 1 < argc) {
             board_name = argv[++i];
         } else if (strcmp(argv[i], "--rotations") == 0 && i + 1 < argc) {
@@ -163,34 +184,32 @@ int main(int argc, char **argv)
                       : strcmp(s, "all") == 0    ? C_ALL
                                                  : -1;
             if (collect < 0) {
-                fprintf(stderr, "sl-bench-mask: --collect thresh|mask|detect|track|all\n");
-                return 2;
+                return sl_cli_bad_value(PROG, "--collect", "must be thresh|mask|detect|track|all",
+                                        usage);
             }
         } else {
-            fprintf(stderr, "usage: %s [--board NAME] [--rotations MEASURED] [--detect-bins] "
-                            "[--collect thresh|mask|detect|track|all]\n", argv[0]);
-            return 2;
+            return sl_cli_unknown(PROG, argv[i], usage);
         }
     }
     board = sl_board_find(board_name);
     if (board == NULL || board->azimuths != NAZ || board->roi_bins < NBINS) {
-        fprintf(stderr, "sl-bench-mask: board '%s' missing or not 400 x >= 512\n", board_name);
-        return 2;
+        fprintf(stderr, PROG ": --board: board '%s' missing or not 400 x >= 512\n", board_name);
+        return SL_EXIT_USAGE;
     }
     const uint8_t n = SL_CFG_MASK_FRAMES_MAX;
     const uint32_t warmup = n + 4U;
     const uint32_t rotations = warmup + measured;
     make_scene(rotations);
     if (sl_detect_init(&det, board, NULL) != SL_OK || sl_track_init(&trk, board, NULL) != SL_OK) {
-        fprintf(stderr, "sl-bench-mask: init failed\n");
-        return 2;
+        fprintf(stderr, PROG ": init failed\n");
+        return SL_EXIT_ERROR;
     }
     if (detect_bins) {
         nbins = SL_BITS_WORDS(sl_detect_bins_needed(&det)) * 32U;
     }
     if (sl_mask_init(&mask, NAZ, (uint16_t)nbins, n, SL_MASK_MAX_MISSED_DEFAULT) != SL_OK) {
-        fprintf(stderr, "sl-bench-mask: mask init failed\n");
-        return 2;
+        fprintf(stderr, PROG ": mask init failed\n");
+        return SL_EXIT_ERROR;
     }
     double t_th = 0, t_mk = 0, t_dt = 0, t_tr = 0;
     sl_ssize_t targets = 0;

@@ -14,6 +14,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "sl_cli.h"
 #include "shadowlean/sl_proto.h"
 
 static uint8_t g_reasm[4096];
@@ -69,23 +70,48 @@ static int fill(uint8_t *b, size_t n, const char *kind)
     return 0;
 }
 
+static void usage(FILE *out)
+{
+    fprintf(out, "usage: sl-bench-junk zero|fe|random|prefix1..prefix15|badsig [BYTES [CHUNK]]\n");
+}
+
 int main(int argc, char **argv)
 {
-    if (argc < 2 || argc > 4) {
-        fprintf(stderr, "usage: sl-bench-junk zero|fe|random|prefix1..prefix15|badsig [BYTES [CHUNK]]\n");
-        return 2;
+    const int info = sl_cli_info(argc, argv, "sl-bench-junk", usage);
+    if (info != SL_CLI_CONTINUE) {
+        return info;
+    }
+    for (int i = 1; i < argc; i++) {
+        if (argv[i][0] == '-') {
+            return sl_cli_unknown("sl-bench-junk", argv[i], usage);
+        }
+    }
+    if (argc < 2) {
+        return sl_cli_usage_error("sl-bench-junk", "missing KIND", usage);
+    }
+    if (argc > 4) {
+        return sl_cli_unknown("sl-bench-junk", argv[4], usage);
     }
     const size_t n = (argc > 2) ? (size_t)strtoull(argv[2], NULL, 10) : ((size_t)1 << 20);
     const size_t chunk = (argc > 3) ? (size_t)strtoull(argv[3], NULL, 10) : 65536U;
     uint8_t *b = malloc(n ? n : 1);
-    if (b == NULL || chunk == 0 || fill(b, n, argv[1]) != 0) {
-        fprintf(stderr, "sl-bench-junk: bad arguments\n");
-        return 2;
+    if (b == NULL) {
+        fprintf(stderr, "sl-bench-junk: out of memory\n");
+        return SL_EXIT_ERROR;
+    }
+    if (chunk == 0) {
+        free(b);
+        return sl_cli_bad_value("sl-bench-junk", "CHUNK", "must be at least 1", usage);
+    }
+    if (fill(b, n, argv[1]) != 0) {
+        free(b);
+        return sl_cli_bad_value("sl-bench-junk", "KIND", "unknown kind", usage);
     }
     const sl_proto_cfg_t cfg = {.reasm_buf = g_reasm, .reasm_size = sizeof g_reasm,
                                 .max_payload_bytes = sizeof g_reasm, .on_msg = on_msg};
     if (sl_proto_init(&g_p, &cfg) != SL_OK) {
-        return 2;
+        free(b);
+        return SL_EXIT_ERROR;
     }
     sl_bench_junk_run(b, n, chunk);
     printf("kind: %s\nchunk: %zu\nbytes: %zu\nskipped: %llu\nbuffered: %llu\nmessages: %llu\n",

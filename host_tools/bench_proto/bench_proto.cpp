@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "capture.h"
+#include "sl_cli.h"
 #include "shadowlean/sl_proto.h"
 #include "shadowlean/sl_scan.h"
 #include "sl_golden.h"
@@ -119,9 +120,9 @@ extern "C" __attribute__((noinline)) void sl_bench_run(const uint8_t *data, size
     out->counter = g_counter;
 }
 
-static void usage()
+static void usage(FILE *out)
 {
-    std::fprintf(stderr,
+    std::fprintf(out,
                  "usage: sl-bench-proto [capture] [--rotations N] [--azimuths N] [--bins N]\n"
                  "       [--width 1|2] [--roi N] [--chunk B[,B...]] [--repeat N] [--mode scan|proto]\n");
 }
@@ -136,12 +137,15 @@ int main(int argc, char **argv)
     unsigned repeat = 5;
     bool with_scan = true;
     std::vector<size_t> chunks = {1448, 16384, 65536, 0};
+    const int info = sl_cli_info(argc, argv, "sl-bench-proto", usage);
+    if (info != SL_CLI_CONTINUE) {
+        return info;
+    }
     for (int i = 1; i < argc; i++) {
         const std::string a = argv[i];
         auto next = [&]() -> const char * {
             if (i + 1 >= argc) {
-                usage();
-                std::exit(2);
+                std::exit(sl_cli_bad_value("sl-bench-proto", a.c_str(), "needs a value", usage));
             }
             return argv[++i];
         };
@@ -171,19 +175,17 @@ int main(int argc, char **argv)
                 }
                 pos = comma + 1;
             }
-        } else if (a == "-h" || a == "--help") {
-            usage();
-            return 0;
-        } else if (!a.empty() && a[0] != '-') {
+        } else if (!a.empty() && a[0] != '-' && capture.empty()) {
             capture = a;
         } else {
-            usage();
-            return 2;
+            return sl_cli_unknown("sl-bench-proto", argv[i], usage);
         }
     }
-    if (roi == 0 || roi > SL_CFG_ROI_BINS || repeat == 0) {
-        usage();
-        return 2;
+    if (roi == 0 || roi > SL_CFG_ROI_BINS) {
+        return sl_cli_bad_value("sl-bench-proto", "--roi", "must be 1..SL_CFG_ROI_BINS", usage);
+    }
+    if (repeat == 0) {
+        return sl_cli_bad_value("sl-bench-proto", "--repeat", "must be at least 1", usage);
     }
 
     std::vector<uint8_t> bytes;

@@ -23,13 +23,15 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <initializer_list>
 #include <string>
 
 #include "calib_cmds.h"
+#include "sl_cli.h"
 
 namespace {
 
-void usage()
+void usage(FILE *out)
 {
     std::fputs(
         "usage:\n"
@@ -39,7 +41,19 @@ void usage()
         "  sl-calib elongation CAPTURE... --truth FILE [--truth FILE...] [--board NAME]\n"
         "      [--out-ini FILE] [--png FILE] [--csv FILE] [--points N] [--mask-frames N]\n"
         "      [--threshold T] [--bin-size-m M]      (default board: paper-bench)\n",
-        stderr);
+        out);
+}
+
+// An argument no branch took: a value option with a missing or bad value, or unknown.
+int bad_arg(const std::string &o, bool has, const char *arg,
+            std::initializer_list<const char *> with_value)
+{
+    for (const char *known : with_value) {
+        if (o == known) {
+            return sl_cli_bad_value("sl-calib", known, has ? "bad value" : "needs a value", usage);
+        }
+    }
+    return sl_cli_unknown("sl-calib", arg, usage);
 }
 
 bool num(const char *s, double &v)
@@ -53,11 +67,21 @@ bool num(const char *s, double &v)
 
 int main(int argc, char **argv)
 {
+    // --help/--version at top level (argv[1]) and after a subcommand (its own arguments).
+    const int info = sl_cli_info(argc < 2 ? argc : 2, argv, "sl-calib", usage);
+    if (info != SL_CLI_CONTINUE) {
+        return info;
+    }
     if (argc < 2) {
-        usage();
-        return 2;
+        return sl_cli_usage_error("sl-calib", "missing command (shadow or elongation)", usage);
     }
     const std::string cmd = argv[1];
+    if (cmd == "shadow" || cmd == "elongation") {
+        const int sub = sl_cli_info(argc - 1, argv + 1, "sl-calib", usage);
+        if (sub != SL_CLI_CONTINUE) {
+            return sub;
+        }
+    }
     if (cmd == "shadow") {
         sl::calib::ShadowArgs a;
         for (int i = 2; i < argc; i++) {
@@ -93,14 +117,17 @@ int main(int argc, char **argv)
             } else if (o[0] != '-' && a.input.empty()) {
                 a.input = o;
             } else {
-                std::fprintf(stderr, "sl-calib: bad argument '%s'\n", o.c_str());
-                usage();
-                return 2;
+                return bad_arg(o, has, argv[i],
+                               {"--board", "--out-ini", "--png", "--csv", "--bin-size-m",
+                                "--height-m", "--az-window", "--search-max-m", "--edge",
+                                "--ground-window-m"});
             }
         }
-        if (a.input.empty() || a.board.empty()) {
-            usage();
-            return 2;
+        if (a.input.empty()) {
+            return sl_cli_usage_error("sl-calib", "shadow: missing CAPTURE|OXFORD_DIR", usage);
+        }
+        if (a.board.empty()) {
+            return sl_cli_usage_error("sl-calib", "shadow: missing --board NAME", usage);
         }
         return sl::calib::cmd_shadow(a);
     }
@@ -136,14 +163,16 @@ int main(int argc, char **argv)
             } else if (o[0] != '-') {
                 a.captures.push_back(o);
             } else {
-                std::fprintf(stderr, "sl-calib: bad argument '%s'\n", o.c_str());
-                usage();
-                return 2;
+                return bad_arg(o, has, argv[i],
+                               {"--board", "--truth", "--out-ini", "--png", "--csv", "--bin-size-m",
+                                "--points", "--mask-frames", "--threshold"});
             }
         }
-        if (a.captures.empty() || a.truth.empty()) {
-            usage();
-            return 2;
+        if (a.captures.empty()) {
+            return sl_cli_usage_error("sl-calib", "elongation: missing CAPTURE", usage);
+        }
+        if (a.truth.empty()) {
+            return sl_cli_usage_error("sl-calib", "elongation: missing --truth FILE", usage);
         }
         if (a.board.empty()) {
             a.board = "paper-bench";
@@ -151,6 +180,5 @@ int main(int argc, char **argv)
         return sl::calib::cmd_elongation(a);
     }
 #endif
-    usage();
-    return 2;
+    return sl_cli_unknown("sl-calib", argv[1], usage);
 }

@@ -11,35 +11,40 @@
 #include <string>
 
 #include "sl_board_spec.h"
+#include "sl_cli.h"
 #include "sl_dbc.h"
 
 namespace {
-int usage()
+void usage(FILE *f)
 {
-    std::cerr << "usage: sl-dbc BOARD [--out FILE]\n"
-                 "  BOARD: a board name under boards/ or a path to a board.ini\n";
-    return 2;
+    std::fputs("usage: sl-dbc BOARD [--out FILE]\n"
+               "  BOARD: a board name under boards/ or a path to a board.ini\n",
+               f);
 }
 } // namespace
 
 int main(int argc, char **argv)
 {
     std::string board, out;
+    const int info = sl_cli_info(argc, argv, "sl-dbc", usage);
+    if (info != SL_CLI_CONTINUE) {
+        return info;
+    }
     for (int i = 1; i < argc; i++) {
         const std::string a = argv[i];
-        if (a == "--out" && i + 1 < argc) {
+        if (a == "--out") {
+            if (i + 1 >= argc) {
+                return sl_cli_bad_value("sl-dbc", "--out", "needs a value", usage);
+            }
             out = argv[++i];
-        } else if (a == "-h" || a == "--help") {
-            usage();
-            return 0;
         } else if (!a.empty() && a[0] != '-' && board.empty()) {
             board = a;
         } else {
-            return usage();
+            return sl_cli_unknown("sl-dbc", argv[i], usage);
         }
     }
     if (board.empty()) {
-        return usage();
+        return sl_cli_usage_error("sl-dbc", "missing BOARD", usage);
     }
     try {
         const sl::BoardSpec b = sl::load_board(board);

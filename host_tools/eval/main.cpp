@@ -9,13 +9,14 @@
 #include <string>
 
 #include "sim_eval.h"
+#include "sl_cli.h"
 #include "sim_render.h"
 
 namespace {
 
-void usage()
+void usage(FILE *out)
 {
-    std::fprintf(stderr,
+    std::fprintf(out,
                  "usage:\n"
                  "  sl-eval table1 [--rotations N] [--quick] [--json] [--json-out FILE] [--plot FILE.png]\n"
                  "                [--threads N] [--range-bins N] [--extract bbox|pipeline|both]\n"
@@ -41,6 +42,20 @@ void usage()
                  "      Evaluates one capture made by sl-sim against its ground truth. --extract pipeline:\n"
                  "      the core pipeline (beam, threshold and speed from --scene, or the options).\n"
                  "--quiet silences the progress lines on stderr.\n");
+}
+
+// The last argument of table1/realistic: a value option without its value, or unknown.
+int bad_arg(const std::string &a, int i, int argc, char **argv)
+{
+    static const char *const with_value[] = {"--rotations", "--range-bins", "--json-out", "--plot",
+                                             "--threads", "--extract", "--positions", "--reps",
+                                             "--calib", "--frames", "--smear-decay", "--pipe-last"};
+    for (const char *o : with_value) {
+        if (a == o && i + 1 >= argc) {
+            return sl_cli_bad_value("sl-eval", o, "needs a value", usage);
+        }
+    }
+    return sl_cli_unknown("sl-eval", argv[i], usage);
 }
 
 bool write_text(const std::string &path, const std::string &text)
@@ -88,12 +103,10 @@ int cmd_table1(int argc, char **argv)
                 o.extract = sl::Extract::Pipeline;
                 o.bbox_table = true;
             } else {
-                usage();
-                return 2;
+                return sl_cli_bad_value("sl-eval", "--extract", "must be bbox, pipeline or both", usage);
             }
         } else {
-            usage();
-            return 2;
+            return bad_arg(a, i, argc, argv);
         }
     }
     if (o.extract == sl::Extract::Pipeline && !o.bbox_table) {
@@ -168,12 +181,10 @@ int cmd_realistic(int argc, char **argv)
                 o.extract = sl::Extract::Pipeline;
                 o.bbox_table = true;
             } else {
-                usage();
-                return 2;
+                return sl_cli_bad_value("sl-eval", "--extract", "must be bbox, pipeline or both", usage);
             }
         } else {
-            usage();
-            return 2;
+            return bad_arg(a, i, argc, argv);
         }
     }
     const sl::RealisticResult r = sl::run_realistic(o);
@@ -207,12 +218,21 @@ int cmd_run(int argc, char **argv)
     double beam_deg = -1, speed = -1;
     for (int i = 0; i < argc; i++) {
         const std::string a = argv[i];
-        auto next = [&]() -> std::string { return i + 1 < argc ? argv[++i] : ""; };
+        bool missing = false;
+        auto next = [&]() -> std::string {
+            if (i + 1 < argc) {
+                return argv[++i];
+            }
+            missing = true;
+            return "";
+        };
         if (a == "--extract") {
             const std::string m = next();
+            if (missing) {
+                return sl_cli_bad_value("sl-eval", "--extract", "needs a value", usage);
+            }
             if (m != "pipeline" && m != "bbox") {
-                usage();
-                return 2;
+                return sl_cli_bad_value("sl-eval", "--extract", "must be bbox or pipeline", usage);
             }
             pipeline = m == "pipeline";
         } else if (a == "--beam-deg") {
@@ -237,18 +257,19 @@ int cmd_run(int argc, char **argv)
             bounds = sl::Proc::Bounds::Raw;
         } else if (a == "--half-bin") {
             bounds = sl::Proc::Bounds::HalfBin;
-        } else if (cap.empty()) {
+        } else if (!a.empty() && a[0] != '-' && cap.empty()) {
             cap = a;
-        } else if (gtp.empty()) {
+        } else if (!a.empty() && a[0] != '-' && gtp.empty()) {
             gtp = a;
         } else {
-            usage();
-            return 2;
+            return sl_cli_unknown("sl-eval", argv[i], usage);
+        }
+        if (missing) {
+            return sl_cli_bad_value("sl-eval", a.c_str(), "needs a value", usage);
         }
     }
     if (cap.empty() || gtp.empty()) {
-        usage();
-        return 2;
+        return sl_cli_usage_error("sl-eval", "run needs CAPTURE and GT.csv", usage);
     }
     std::vector<sl::GtRow> gt;
     std::string err;
@@ -359,11 +380,21 @@ int cmd_run(int argc, char **argv)
 
 int main(int argc, char **argv)
 {
+    // --help/--version at top level (argv[1]) and after a subcommand (its own arguments).
+    const int info = sl_cli_info(argc < 2 ? argc : 2, argv, "sl-eval", usage);
+    if (info != SL_CLI_CONTINUE) {
+        return info;
+    }
     if (argc < 2) {
-        usage();
-        return 2;
+        return sl_cli_usage_error("sl-eval", "missing command (table1, realistic or run)", usage);
     }
     const std::string cmd = argv[1];
+    if (cmd == "table1" || cmd == "realistic" || cmd == "run") {
+        const int sub = sl_cli_info(argc - 1, argv + 1, "sl-eval", usage);
+        if (sub != SL_CLI_CONTINUE) {
+            return sub;
+        }
+    }
     try {
         if (cmd == "table1") {
             return cmd_table1(argc - 2, argv + 2);
@@ -378,6 +409,5 @@ int main(int argc, char **argv)
         std::fprintf(stderr, "sl-eval: %s\n", e.what());
         return 1;
     }
-    usage();
-    return 2;
+    return sl_cli_unknown("sl-eval", argv[1], usage);
 }

@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "candump.h"
+#include "sl_cli.h"
 #include "gsusb_sink.h"
 #include "sl_port_linux.h"
 
@@ -240,8 +241,13 @@ int main(int argc, char **argv)
         {"help", no_argument, NULL, O_HELP},
         {NULL, 0, NULL, 0},
     };
+    const int info = sl_cli_info(argc, argv, "sl-gsusb-send", usage);
+    if (info != SL_CLI_CONTINUE) {
+        return info;
+    }
     int c;
-    while ((c = getopt_long(argc, argv, "h", opts, NULL)) != -1) {
+    opterr = 0; // unknown options and missing values are reported below, naming the option
+    while ((c = getopt_long(argc, argv, ":h", opts, NULL)) != -1) {
         bool ok = true;
         switch (c) {
         case O_BITRATE: ok = parse_u32(optarg, &cfg.can.bitrate) && cfg.can.bitrate > 0U; break;
@@ -273,7 +279,8 @@ int main(int argc, char **argv)
         case O_EXPECT_RX: ok = parse_u32(optarg, &expect_rx); break;
         case 'h':
         case O_HELP: usage(stdout); return 0;
-        default: usage(stderr); return 2;
+        case ':': return sl_cli_bad_value("sl-gsusb-send", argv[optind - 1], "needs a value", usage);
+        default: return sl_cli_unknown("sl-gsusb-send", argv[optind - 1], usage);
         }
         if (!ok) {
             fprintf(stderr, "sl-gsusb-send: bad value for --%s: '%s'\n", opts[c - O_BITRATE].name, optarg);
@@ -281,8 +288,7 @@ int main(int argc, char **argv)
         }
     }
     if (optind + 1 < argc) {
-        usage(stderr);
-        return 2;
+        return sl_cli_unknown("sl-gsusb-send", argv[optind + 1], usage);
     }
     cfg.selector = optind < argc ? argv[optind] : NULL;
     if (!linger_given) {

@@ -3,9 +3,10 @@
 //
 //   sl-inspect CAPTURE [--json] [--rotations] [--port P] [--chunk N]
 //
-// Exit status: 0 decoded (whatever the damage, which is reported), 1 unreadable input,
-// 2 usage error.
+// Exit status: 0 decoded (whatever the damage, which is reported), 1 unreadable input or
+// no radar message in it (the report is still printed), 2 usage error.
 #include "capture.h"
+#include "sl_cli.h"
 
 #include "shadowlean/sl_proto.h"
 #include "shadowlean/sl_scan.h"
@@ -177,9 +178,9 @@ json pcap_json(const sl::PcapReport &r)
     return j;
 }
 
-void usage()
+void usage(FILE *out)
 {
-    std::fprintf(stderr,
+    std::fprintf(out,
                  "usage: sl-inspect CAPTURE [--json] [--rotations] [--port P] [--chunk N]\n"
                  "  CAPTURE      raw .colossus stream or pcap/pcapng (sniffed by content)\n"
                  "  --json       print one JSON object instead of text\n"
@@ -197,8 +198,15 @@ int main(int argc, char **argv)
     bool as_json = false, rotations = false;
     sl::PcapOptions popt;
     size_t chunk = 0;
+    const int info = sl_cli_info(argc, argv, "sl-inspect", usage);
+    if (info != SL_CLI_CONTINUE) {
+        return info;
+    }
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
+        if ((a == "--port" || a == "--chunk") && i + 1 >= argc) {
+            return sl_cli_bad_value("sl-inspect", a.c_str(), "needs a value", usage);
+        }
         if (a == "--json") {
             as_json = true;
         } else if (a == "--rotations") {
@@ -207,27 +215,20 @@ int main(int argc, char **argv)
             popt.radar_port = std::atoi(argv[++i]);
             popt.port_explicit = true;
             if (popt.radar_port <= 0 || popt.radar_port > 65535) {
-                usage();
-                return 2;
+                return sl_cli_bad_value("sl-inspect", "--port", "must be 1..65535", usage);
             }
         } else if (a == "--chunk" && i + 1 < argc) {
             chunk = static_cast<size_t>(std::strtoull(argv[++i], nullptr, 10));
-        } else if (a == "-h" || a == "--help") {
-            usage();
-            return 0;
         } else if (a.size() > 1 && a[0] == '-') { // "-" is stdin
-            usage();
-            return 2;
+            return sl_cli_unknown("sl-inspect", argv[i], usage);
         } else if (path.empty()) {
             path = a;
         } else {
-            usage();
-            return 2;
+            return sl_cli_unknown("sl-inspect", argv[i], usage);
         }
     }
     if (path.empty()) {
-        usage();
-        return 2;
+        return sl_cli_usage_error("sl-inspect", "missing CAPTURE", usage);
     }
 
     auto in = std::make_unique<Inspect>();
@@ -354,9 +355,14 @@ int main(int argc, char **argv)
         j["pcap"] = pcap_json(cap.pcap);
     }
 
+    // A capture without a single radar message is an error (the report is printed anyway).
+    const int status = ps.messages > 0 ? SL_EXIT_OK : SL_EXIT_ERROR;
+    if (status != SL_EXIT_OK) {
+        std::fprintf(stderr, "sl-inspect: %s: no radar message\n", path.c_str());
+    }
     if (as_json) {
         std::printf("%s\n", j.dump(2).c_str());
-        return 0;
+        return status;
     }
 
     // Text report.
@@ -436,5 +442,5 @@ int main(int argc, char **argv)
                 "(bad version %u, oversize %u, too big %u), %u truncated\n",
                 ps.bytes_in, ps.bytes_delivered, ps.bytes_skipped, ps.resyncs, ps.bad_version,
                 ps.oversize, ps.too_big, ps.truncated);
-    return 0;
+    return status;
 }

@@ -8,6 +8,7 @@
 
 #include "capture.h"
 #include "oxford.h"
+#include "sl_cli.h"
 
 #include <cinttypes>
 #include <cstdio>
@@ -41,9 +42,9 @@ namespace {
 
 using namespace sl::replay;
 
-void usage()
+void usage(FILE *out)
 {
-    std::fprintf(stderr,
+    std::fprintf(out,
         "usage:\n"
         "  sl-replay serve CAPTURE [options]   emulate a radar on TCP, replaying CAPTURE\n"
         "      --port P            TCP port (default 6317; 0 = any free port, printed)\n"
@@ -135,10 +136,12 @@ bool split_host_port(const std::string &hp, std::string &host, uint16_t &port)
 #define NEED_ARG()                                                                           \
     do {                                                                                     \
         if (i + 1 >= argc) {                                                                 \
-            std::fprintf(stderr, "sl-replay: %s needs a value\n", a.c_str());               \
-            return 2;                                                                        \
+            return sl_cli_bad_value("sl-replay", a.c_str(), "needs a value", usage);         \
         }                                                                                    \
     } while (0)
+
+// The value of option `a` was given but is out of range or does not parse.
+#define BAD_VALUE() sl_cli_bad_value("sl-replay", a.c_str(), "bad value", usage)
 
 int cmd_serve(int argc, char **argv)
 {
@@ -148,7 +151,7 @@ int cmd_serve(int argc, char **argv)
         uint64_t v = 0;
         if (a == "--port") {
             NEED_ARG();
-            if (!parse_u64(argv[++i], v) || v > 65535) return usage(), 2;
+            if (!parse_u64(argv[++i], v) || v > 65535) return BAD_VALUE();
             o.port = static_cast<int>(v);
         } else if (a == "--bind") {
             NEED_ARG();
@@ -158,80 +161,79 @@ int cmd_serve(int argc, char **argv)
             const std::string r = argv[++i];
             if (r == "realtime") o.realtime = true;
             else if (r == "max") o.realtime = false;
-            else return usage(), 2;
+            else return BAD_VALUE();
         } else if (a == "--loop") {
             o.loop = true;
         } else if (a == "--keepalive-ms") {
             NEED_ARG();
-            if (!parse_u64(argv[++i], v) || v > 3600000) return usage(), 2;
+            if (!parse_u64(argv[++i], v) || v > 3600000) return BAD_VALUE();
             o.keepalive_ms = static_cast<uint32_t>(v);
         } else if (a == "--max-clients") {
             NEED_ARG();
-            if (!parse_u64(argv[++i], v) || v == 0 || v > 1000) return usage(), 2;
+            if (!parse_u64(argv[++i], v) || v == 0 || v > 1000) return BAD_VALUE();
             o.max_clients = static_cast<unsigned>(v);
         } else if (a == "--queue-bytes") {
             NEED_ARG();
-            if (!parse_u64(argv[++i], v) || v < 65536) return usage(), 2;
+            if (!parse_u64(argv[++i], v) || v < 65536) return BAD_VALUE();
             o.queue_bytes = static_cast<size_t>(v);
         } else if (a == "--max-gap-ms") {
             NEED_ARG();
-            if (!parse_u64(argv[++i], v) || v > 3600000) return usage(), 2;
+            if (!parse_u64(argv[++i], v) || v > 3600000) return BAD_VALUE();
             o.max_gap_ms = static_cast<uint32_t>(v);
         } else if (a == "--junk-every") {
             NEED_ARG();
-            if (!parse_u64(argv[++i], v)) return usage(), 2;
+            if (!parse_u64(argv[++i], v)) return BAD_VALUE();
             o.junk_every = v;
         } else if (a == "--split") {
             NEED_ARG();
-            if (!parse_u64(argv[++i], v) || v > 64) return usage(), 2;
+            if (!parse_u64(argv[++i], v) || v > 64) return BAD_VALUE();
             o.split = static_cast<unsigned>(v);
         } else if (a == "--cut-after" || a == "--rst-after") {
             NEED_ARG();
-            if (!parse_u64(argv[++i], v) || v == 0) return usage(), 2;
+            if (!parse_u64(argv[++i], v) || v == 0) return BAD_VALUE();
             o.cut_after = v;
             o.cut_rst = a == "--rst-after";
         } else if (a == "--keepalive-only") {
             o.keepalive_only = true;
         } else if (a == "--trickle-bps") {
             NEED_ARG();
-            if (!parse_u64(argv[++i], v) || v == 0 || v > 1000000) return usage(), 2;
+            if (!parse_u64(argv[++i], v) || v == 0 || v > 1000000) return BAD_VALUE();
             o.trickle_bps = static_cast<uint32_t>(v);
         } else if (a == "--config-azimuths" || a == "--config-encoder") {
             NEED_ARG();
-            if (!parse_u64(argv[++i], v) || v > 65535) return usage(), 2;
+            if (!parse_u64(argv[++i], v) || v > 65535) return BAD_VALUE();
             (a == "--config-azimuths" ? o.config_azimuths : o.config_encoder) = static_cast<int>(v);
         } else if (a == "--config-bin-size-m") {
             NEED_ARG();
             if (!parse_double(argv[++i], o.config_bin_size_m) || !(o.config_bin_size_m > 0) ||
-                o.config_bin_size_m > 6.5) return usage(), 2;
+                o.config_bin_size_m > 6.5) return BAD_VALUE();
         } else if (a == "--shuffle") {
             NEED_ARG();
-            if (!parse_u64(argv[++i], v) || v < 2 || v > 100000) return usage(), 2;
+            if (!parse_u64(argv[++i], v) || v < 2 || v > 100000) return BAD_VALUE();
             o.shuffle = static_cast<unsigned>(v);
         } else if (a == "--close-after") {
             NEED_ARG();
-            if (!parse_u64(argv[++i], v)) return usage(), 2;
+            if (!parse_u64(argv[++i], v)) return BAD_VALUE();
             o.close_after = v;
         } else if (a == "--stall-after") {
             NEED_ARG();
-            if (!parse_u64(argv[++i], v)) return usage(), 2;
+            if (!parse_u64(argv[++i], v)) return BAD_VALUE();
             o.stall_after = v;
         } else if (a == "--timeout") {
             NEED_ARG();
-            if (!parse_double(argv[++i], o.timeout_s) || o.timeout_s < 0) return usage(), 2;
+            if (!parse_double(argv[++i], o.timeout_s) || o.timeout_s < 0) return BAD_VALUE();
         } else if (a == "-v") {
             o.verbose = true;
         } else if (a.size() > 1 && a[0] == '-') { // "-" is stdin
-            std::fprintf(stderr, "sl-replay serve: unknown option %s\n", a.c_str());
-            return 2;
+            return sl_cli_unknown("sl-replay", argv[i], usage);
         } else if (o.capture.empty()) {
             o.capture = a;
         } else {
-            return usage(), 2;
+            return sl_cli_unknown("sl-replay", argv[i], usage);
         }
     }
     if (o.capture.empty()) {
-        return usage(), 2;
+        return sl_cli_usage_error("sl-replay", "serve: missing CAPTURE", usage);
     }
     install_signal_handlers();
     return serve(o);
@@ -252,22 +254,27 @@ int cmd_record(int argc, char **argv)
             o.out = argv[++i];
         } else if (a == "--duration") {
             NEED_ARG();
-            if (!parse_double(argv[++i], o.duration_s) || o.duration_s < 0) return usage(), 2;
+            if (!parse_double(argv[++i], o.duration_s) || o.duration_s < 0) return BAD_VALUE();
         } else if (a == "--non-contour") {
             o.non_contour = true;
         } else if (a == "--silence-ms") {
             NEED_ARG();
-            if (!parse_u64(argv[++i], v) || v > 3600000) return usage(), 2;
+            if (!parse_u64(argv[++i], v) || v > 3600000) return BAD_VALUE();
             o.silence_ms = static_cast<uint32_t>(v);
         } else if (a == "-v") {
             o.verbose = true;
         } else {
-            std::fprintf(stderr, "sl-replay record: unexpected %s\n", a.c_str());
-            return 2;
+            return sl_cli_unknown("sl-replay", argv[i], usage);
         }
     }
-    if (radar.empty() || o.out.empty() || !split_host_port(radar, o.host, o.port)) {
-        return usage(), 2;
+    if (radar.empty()) {
+        return sl_cli_usage_error("sl-replay", "record: missing --radar HOST:PORT", usage);
+    }
+    if (o.out.empty()) {
+        return sl_cli_usage_error("sl-replay", "record: missing --out FILE", usage);
+    }
+    if (!split_host_port(radar, o.host, o.port)) {
+        return sl_cli_bad_value("sl-replay", "--radar", "needs HOST:PORT", usage);
     }
     install_signal_handlers();
     return record(o);
@@ -285,23 +292,25 @@ int cmd_from_oxford(int argc, char **argv)
             out = argv[++i];
         } else if (a == "--bin-size-m") {
             NEED_ARG();
-            if (!parse_double(argv[++i], opt.bin_size_m)) return usage(), 2;
+            if (!parse_double(argv[++i], opt.bin_size_m)) return BAD_VALUE();
         } else if (a == "--encoder-size" || a == "--rotation-mhz" || a == "--packet-rate") {
             NEED_ARG();
-            if (!parse_u64(argv[++i], v) || v == 0 || v > 65535) return usage(), 2;
+            if (!parse_u64(argv[++i], v) || v == 0 || v > 65535) return BAD_VALUE();
             (a == "--encoder-size" ? opt.encoder_size : a == "--rotation-mhz" ? opt.rotation_mhz : opt.packet_rate) =
                 static_cast<uint16_t>(v);
         } else if (!a.empty() && a[0] == '-') {
-            std::fprintf(stderr, "sl-replay from-oxford: unknown option %s\n", a.c_str());
-            return 2;
+            return sl_cli_unknown("sl-replay", argv[i], usage);
         } else if (dir.empty()) {
             dir = a;
         } else {
-            return usage(), 2;
+            return sl_cli_unknown("sl-replay", argv[i], usage);
         }
     }
-    if (dir.empty() || out.empty()) {
-        return usage(), 2;
+    if (dir.empty()) {
+        return sl_cli_usage_error("sl-replay", "from-oxford: missing OXFORD_DIR", usage);
+    }
+    if (out.empty()) {
+        return sl_cli_usage_error("sl-replay", "from-oxford: missing --out FILE", usage);
     }
     std::vector<uint8_t> bytes;
     sl::OxfordReport rep;
@@ -348,31 +357,34 @@ int cmd_to_pcapng(int argc, char **argv)
             o.out = argv[++i];
         } else if (a == "--mss") {
             NEED_ARG();
-            if (!parse_u64(argv[++i], v) || v == 0 || v > 65495) return usage(), 2;
+            if (!parse_u64(argv[++i], v) || v == 0 || v > 65495) return BAD_VALUE();
             o.session.mss = static_cast<uint32_t>(v);
         } else if (a == "--radar-ip" || a == "--client-ip") {
             NEED_ARG();
             if (!parse_ipv4(argv[++i], a == "--radar-ip" ? o.session.radar_ip : o.session.client_ip)) {
-                std::fprintf(stderr, "sl-replay to-pcapng: bad IPv4 address %s\n", argv[i]);
-                return 2;
+                return sl_cli_bad_value("sl-replay", a.c_str(), "bad IPv4 address", usage);
             }
         } else if (a == "--radar-port" || a == "--client-port") {
             NEED_ARG();
-            if (!parse_u64(argv[++i], v) || v == 0 || v > 65535) return usage(), 2;
+            if (!parse_u64(argv[++i], v) || v == 0 || v > 65535) return BAD_VALUE();
             (a == "--radar-port" ? o.session.radar_port : o.session.client_port) =
                 static_cast<uint16_t>(v);
         } else if (a == "--non-contour") {
             o.non_contour = true;
         } else if (a.size() > 1 && a[0] == '-') {
-            std::fprintf(stderr, "sl-replay to-pcapng: unknown option %s\n", a.c_str());
-            return 2;
+            return sl_cli_unknown("sl-replay", argv[i], usage);
         } else if (o.input.empty()) {
             o.input = a;
         } else {
-            return usage(), 2;
+            return sl_cli_unknown("sl-replay", argv[i], usage);
         }
     }
-    if (o.input.empty() || o.out.empty()) return usage(), 2;
+    if (o.input.empty()) {
+        return sl_cli_usage_error("sl-replay", "to-pcapng: missing CAPTURE", usage);
+    }
+    if (o.out.empty()) {
+        return sl_cli_usage_error("sl-replay", "to-pcapng: missing --out FILE", usage);
+    }
     install_signal_handlers();
     return to_pcapng(o);
 }
@@ -381,19 +393,25 @@ int cmd_to_pcapng(int argc, char **argv)
 
 int main(int argc, char **argv)
 {
+    // --help/--version at top level (argv[1]) and after a subcommand (its own arguments).
+    const int info = sl_cli_info(argc < 2 ? argc : 2, argv, "sl-replay", usage);
+    if (info != SL_CLI_CONTINUE) {
+        return info;
+    }
     if (argc < 2) {
-        usage();
-        return 2;
+        return sl_cli_usage_error("sl-replay", "missing command (serve, record, from-oxford or to-pcapng)",
+                                  usage);
     }
     const std::string cmd = argv[1];
+    if (cmd != "serve" && cmd != "record" && cmd != "from-oxford" && cmd != "to-pcapng") {
+        return sl_cli_unknown("sl-replay", argv[1], usage);
+    }
+    const int sub = sl_cli_info(argc - 1, argv + 1, "sl-replay", usage);
+    if (sub != SL_CLI_CONTINUE) {
+        return sub;
+    }
     if (cmd == "serve") return cmd_serve(argc, argv);
     if (cmd == "record") return cmd_record(argc, argv);
     if (cmd == "from-oxford") return cmd_from_oxford(argc, argv);
-    if (cmd == "to-pcapng") return cmd_to_pcapng(argc, argv);
-    if (cmd == "-h" || cmd == "--help") {
-        usage();
-        return 0;
-    }
-    usage();
-    return 2;
+    return cmd_to_pcapng(argc, argv);
 }

@@ -8,14 +8,15 @@
 #include <string>
 
 #include "sim_render.h"
+#include "sl_cli.h"
 #include "sim_scene.h"
 #include "sim_truth.h"
 
 namespace {
 
-void usage()
+void usage(FILE *out)
 {
-    std::fprintf(stderr,
+    std::fprintf(out,
                  "usage: sl-sim SCENE.ini -o OUT.colossus [--gt OUT.csv] [--rotations N]\n"
                  "              [--first K] [--seed S] [--threads N] [--quiet]\n"
                  "  Simulates SCENE (format: scenes/README.md) into a raw Colossus capture and a\n"
@@ -31,12 +32,15 @@ int main(int argc, char **argv)
     int rotations = -1, threads = 0, first = 0;
     long long seed = -1;
     bool quiet = false;
+    const int info = sl_cli_info(argc, argv, "sl-sim", usage);
+    if (info != SL_CLI_CONTINUE) {
+        return info;
+    }
     for (int i = 1; i < argc; i++) {
         const std::string a = argv[i];
         auto next = [&]() -> std::string {
             if (i + 1 >= argc) {
-                usage();
-                std::exit(2);
+                std::exit(sl_cli_bad_value("sl-sim", a.c_str(), "needs a value", usage));
             }
             return argv[++i];
         };
@@ -54,23 +58,19 @@ int main(int argc, char **argv)
             threads = std::atoi(next().c_str());
         } else if (a == "--quiet" || a == "-q") {
             quiet = true;
-        } else if (a == "-h" || a == "--help") {
-            usage();
-            return 0;
         } else if (!a.empty() && a[0] == '-') {
-            std::fprintf(stderr, "sl-sim: unknown option %s\n", a.c_str());
-            usage();
-            return 2;
+            return sl_cli_unknown("sl-sim", argv[i], usage);
         } else if (scene_path.empty()) {
             scene_path = a;
         } else {
-            usage();
-            return 2;
+            return sl_cli_unknown("sl-sim", argv[i], usage);
         }
     }
-    if (scene_path.empty() || out.empty()) {
-        usage();
-        return 2;
+    if (scene_path.empty()) {
+        return sl_cli_usage_error("sl-sim", "missing SCENE.ini", usage);
+    }
+    if (out.empty()) {
+        return sl_cli_usage_error("sl-sim", "missing -o OUT.colossus", usage);
     }
     if (gt_path.empty()) {
         gt_path = out;

@@ -26,6 +26,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "sl_board_spec.h"
+#include "sl_cli.h"
 #include "sl_dbc.h"
 #include "sl_geom.h"
 #include "sl_paths.h"
@@ -341,11 +342,12 @@ int generate(const std::string &board, std::string out_dir, std::string png, boo
     return 0;
 }
 
-void usage()
+void usage(FILE *f)
 {
-    std::cerr << "usage: sl-tables BOARD [--out DIR] [--png FILE] [--no-png]\n"
-                 "       sl-tables --all [--no-png]\n"
-                 "BOARD: a name under boards/ or a path to a board.ini\n";
+    std::fputs("usage: sl-tables BOARD [--out DIR] [--png FILE] [--no-png]\n"
+               "       sl-tables --all [--no-png]\n"
+               "BOARD: a name under boards/ or a path to a board.ini\n",
+               f);
 }
 
 } // namespace
@@ -354,8 +356,15 @@ int main(int argc, char **argv)
 {
     std::string board, out, png;
     bool all = false, no_png = false;
+    const int info = sl_cli_info(argc, argv, "sl-tables", usage);
+    if (info != SL_CLI_CONTINUE) {
+        return info;
+    }
     for (int i = 1; i < argc; i++) {
         const std::string a = argv[i];
+        if ((a == "--out" || a == "--png") && i + 1 >= argc) {
+            return sl_cli_bad_value("sl-tables", a.c_str(), "needs a value", usage);
+        }
         if (a == "--out" && i + 1 < argc) {
             out = argv[++i];
         } else if (a == "--png" && i + 1 < argc) {
@@ -364,14 +373,10 @@ int main(int argc, char **argv)
             no_png = true;
         } else if (a == "--all") {
             all = true;
-        } else if (a == "-h" || a == "--help") {
-            usage();
-            return 0;
         } else if (!a.empty() && a[0] != '-' && board.empty()) {
             board = a;
         } else {
-            usage();
-            return 2;
+            return sl_cli_unknown("sl-tables", argv[i], usage);
         }
     }
     try {
@@ -389,8 +394,7 @@ int main(int argc, char **argv)
             return 0;
         }
         if (board.empty()) {
-            usage();
-            return 2;
+            return sl_cli_usage_error("sl-tables", "missing BOARD (or --all)", usage);
         }
         return generate(board, out, png, no_png);
     } catch (const std::exception &e) {

@@ -45,6 +45,7 @@
 #include <opencv2/videoio.hpp>
 
 #include "calib_shadow.h"
+#include "sl_cli.h"
 #include "shadowlean/sl_board.h"
 #include "shadowlean/sl_detect.h"
 #include "shadowlean/sl_mask.h"
@@ -68,14 +69,14 @@ struct Args {
     int mask_frames = 0, threshold = -1;
 };
 
-void usage()
+void usage(FILE *out)
 {
     std::fputs(
         "usage: sl-view CAPTURE|OXFORD_DIR --board NAME --out FILE.png|FILE.mp4|FILE.avi\n"
         "               [--rotation K | --all] [--truth GT.csv] [--calib CALIB.ini]\n"
         "               [--roi-m M] [--mask-frames N] [--threshold T] [--vmax V] [--fps F]\n"
         "               [--bin-size-m M] [--elongation D.ini] [--title TEXT]\n",
-        stderr);
+        out);
 }
 
 std::string fmt(const char *f, double v)
@@ -403,6 +404,14 @@ cv::Mat render(const Scene &sc, const RotationView &rv)
 int main(int argc, char **argv)
 {
     Args a;
+    const int info = sl_cli_info(argc, argv, "sl-view", usage);
+    if (info != SL_CLI_CONTINUE) {
+        return info;
+    }
+    static const char *const with_value[] = {"--board", "--out", "--truth", "--calib",
+                                             "--elongation", "--title", "--rotation", "--roi-m",
+                                             "--vmax", "--fps", "--bin-size-m", "--mask-frames",
+                                             "--threshold"};
     for (int i = 1; i < argc; i++) {
         const std::string o = argv[i];
         const bool has = i + 1 < argc;
@@ -446,14 +455,23 @@ int main(int argc, char **argv)
         } else if (o[0] != '-' && a.input.empty()) {
             a.input = o;
         } else {
-            std::fprintf(stderr, "sl-view: bad argument '%s'\n", o.c_str());
-            usage();
-            return 2;
+            for (const char *known : with_value) {
+                if (o == known) {
+                    return sl_cli_bad_value("sl-view", known, has ? "bad value" : "needs a value",
+                                            usage);
+                }
+            }
+            return sl_cli_unknown("sl-view", argv[i], usage);
         }
     }
-    if (a.input.empty() || a.board.empty() || a.out.empty()) {
-        usage();
-        return 2;
+    if (a.input.empty()) {
+        return sl_cli_usage_error("sl-view", "missing CAPTURE|OXFORD_DIR", usage);
+    }
+    if (a.board.empty()) {
+        return sl_cli_usage_error("sl-view", "missing --board NAME", usage);
+    }
+    if (a.out.empty()) {
+        return sl_cli_usage_error("sl-view", "missing --out FILE", usage);
     }
     Scene sc;
     try {
