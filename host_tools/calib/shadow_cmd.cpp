@@ -2,6 +2,7 @@
 #include "calib_cmds.h"
 
 #include <cmath>
+#include <filesystem>
 #include <cstdio>
 #include <fstream>
 #include <limits>
@@ -371,8 +372,14 @@ int cmd_shadow(const ShadowArgs &a)
         std::printf("  wrote %s\n", a.csv.c_str());
     }
     if (!a.png.empty()) {
+        // The input's name only: a picture must not carry the path of the machine it was
+        // made on.
+        const std::string input_name =
+            std::filesystem::path(a.input).lexically_normal().filename().empty()
+                ? std::filesystem::path(a.input).lexically_normal().parent_path().filename().string()
+                : std::filesystem::path(a.input).lexically_normal().filename().string();
         const std::string title = "sl-calib shadow: " + board.name + ", " +
-                                  std::to_string(c.frames) + " rotations of " + a.input;
+                                  std::to_string(c.frames) + " rotations of " + input_name;
         double rmax = 2.0 * median_of(gs);
         if (!std::isfinite(rmax)) rmax = 8;
         rmax = std::clamp(std::ceil(rmax), 4.0, so.search_max_m);

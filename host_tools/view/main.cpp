@@ -38,6 +38,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <memory>
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -571,7 +572,9 @@ int main(int argc, char **argv)
                        std::to_string(N) + " rotations)";
         sc.mask_n = std::max(1, N);
     }
-    sc.title = a.title.empty() ? "sl-view  " + a.input : a.title;
+    // Default title: the input's file name, never the path of the machine it was made on.
+    sc.title = a.title.empty() ? "sl-view  " + std::filesystem::path(a.input).filename().string()
+                               : a.title;
     // Truth.
     std::vector<std::vector<TruthMark>> truth_by_rot;
     if (!a.truth.empty()) {
