@@ -15,7 +15,7 @@ for g in "$@"; do
              python3-canmatrix python3-lxml python3-xlrd python3-xlsxwriter python3-xlwt python3-yaml
              python3-can python3-numpy can-utils user-mode-linux iproute2 kmod
              qemu-system-x86 busybox-static cpio usbutils
-             qemu-system-arm cppcheck clang-tidy tshark" ;;
+             qemu-system-arm cppcheck clang-tidy tshark help2man lintian" ;;
     demo) pkgs="$pkgs python3-canmatrix python3-lxml python3-xlrd python3-xlsxwriter python3-xlwt
              python3-yaml can-utils" ;;
     *) echo "deps.sh: unknown group '$g'" >&2; exit 2 ;;
