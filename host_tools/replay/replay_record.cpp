@@ -120,6 +120,13 @@ int record(const RecordOptions &o)
                 s.keep_alives, p.resyncs, p.bytes_skipped, p.truncated, s.connects, s.reconnects,
                 s.connect_failures + s.connect_timeouts, s.disconnects_eof, s.disconnects_error,
                 s.silence_timeouts, s.stops_sent);
+    if (status == 0 && s.messages == 0) {
+        // Nothing recorded is a failure, whatever the reason (no radar, refused, silent).
+        std::fprintf(stderr, "sl-replay record: no radar message received from %s:%u (%u connects, %u "
+                     "connect failures)\n", o.host.c_str(), static_cast<unsigned>(o.port), s.connects,
+                     s.connect_failures + s.connect_timeouts);
+        status = 1;
+    }
     sl_radar_client_deinit(client.get());
     return status;
 }
