@@ -61,6 +61,7 @@ echo "   $OUT/scene.colossus ($(wc -c < "$OUT/scene.colossus") bytes, $ROTS rota
 
 echo
 echo "== 2. Serve it as a radar on 127.0.0.1 (sl-replay serve, real time, any free port)"
+: > "$OUT/replay.out" # exists before the server writes its port line into it
 "$BIN/replay/sl-replay" serve "$OUT/scene.colossus" --port 0 > "$OUT/replay.out" 2> "$OUT/replay.err" &
 REPLAY_PID=$!
 PORT=""
