@@ -3,6 +3,8 @@
 #include <string.h>
 
 #include "shadowlean/sl_detect.h"
+
+#include "bits.h"
 #include "shadowlean/sl_fx.h"
 
 #define CF_NEAR 0x01U
@@ -40,43 +42,7 @@ void sl_detect_cfg_default(sl_detect_cfg_t *cfg)
     cfg->weak_contrast = 20U;
 }
 
-// ---- bit scanning (portable: de Bruijn count of trailing zeros)
-
-static unsigned ctz32(uint32_t v)
-{
-    static const uint8_t tab[32] = {0,  1,  28, 2,  29, 14, 24, 3,  30, 22, 20,
-                                    15, 25, 17, 4,  8,  31, 27, 13, 23, 21, 19,
-                                    16, 7,  26, 12, 18, 6,  11, 5,  10, 9};
-    return tab[((v & (0U - v)) * 0x077CB531U) >> 27];
-}
-
-// First set bin in [pos, end), or end.
-static uint32_t next_set(const uint32_t *b, uint32_t pos, uint32_t end)
-{
-    while (pos < end) {
-        const uint32_t w = b[pos >> 5] >> (pos & 31U);
-        if (w != 0U) {
-            pos += ctz32(w);
-            return pos < end ? pos : end;
-        }
-        pos = (pos | 31U) + 1U;
-    }
-    return end;
-}
-
-// First clear bin in [pos, end), or end.
-static uint32_t next_clear(const uint32_t *b, uint32_t pos, uint32_t end)
-{
-    while (pos < end) {
-        const uint32_t w = ~b[pos >> 5] >> (pos & 31U);
-        if (w != 0U) {
-            pos += ctz32(w);
-            return pos < end ? pos : end;
-        }
-        pos = (pos | 31U) + 1U;
-    }
-    return end;
-}
+// ---- bit scanning: bits.h (shared with the range profiles)
 
 // ---- geometry helpers
 
@@ -354,7 +320,7 @@ static void add_run(sl_detect_t *d, uint32_t a, uint32_t f, uint32_t l, uint32_t
     for (uint32_t w = 0; w < OPEN_WORDS; w++) {
         uint32_t bits = d->open_bits[w]; // snapshot: merges only clear bits
         while (bits != 0U) {
-            const uint32_t i = w * 32U + ctz32(bits);
+            const uint32_t i = w * 32U + sl_bits_ctz32(bits);
             bits &= bits - 1U;
             sl_detect_cand_t *c = &d->cand[i];
             if (!linkable(d, c, a, f, l)) {
@@ -658,7 +624,7 @@ static void close_before(sl_detect_t *d, uint32_t a)
     for (uint32_t w = 0; w < OPEN_WORDS; w++) {
         uint32_t bits = d->open_bits[w];
         while (bits != 0U) {
-            const uint32_t i = w * 32U + ctz32(bits);
+            const uint32_t i = w * 32U + sl_bits_ctz32(bits);
             bits &= bits - 1U;
             sl_detect_cand_t *c = &d->cand[i];
             if ((uint32_t)c->az_last + 1U >= a) {
@@ -756,7 +722,7 @@ sl_err_t sl_detect_row(sl_detect_t *d, uint16_t az, const uint32_t *occ, uint32_
     const uint32_t gap = d->cfg.gap_bins;
     uint32_t pos = near;
     while (pos < win) {
-        const uint32_t s = next_set(occ, pos, win);
+        const uint32_t s = sl_bits_next_set(occ, pos, win);
         if (s >= win) {
             break;
         }
@@ -764,16 +730,16 @@ sl_err_t sl_detect_row(sl_detect_t *d, uint16_t az, const uint32_t *occ, uint32_
         if (s == near && near > 0U && sl_bits_get(occ, near - 1U)) {
             rf |= CF_NEAR;
         }
-        uint32_t e = next_clear(occ, s, limit); // one past the last occupied bin
+        uint32_t e = sl_bits_next_clear(occ, s, limit); // one past the last occupied bin
         uint32_t count = e - s;
         while (e < limit) {
             // Bridge gaps of up to `gap` free bins (the run is then broken).
             const uint32_t stop = (e + gap + 1U) < limit ? (e + gap + 1U) : limit;
-            const uint32_t s2 = next_set(occ, e, stop);
+            const uint32_t s2 = sl_bits_next_set(occ, e, stop);
             if (s2 >= stop) {
                 break;
             }
-            const uint32_t e2 = next_clear(occ, s2, limit);
+            const uint32_t e2 = sl_bits_next_clear(occ, s2, limit);
             count += e2 - s2;
             e = e2;
         }

@@ -4,6 +4,8 @@
 
 #include "shadowlean/sl_fx.h"
 #include "shadowlean/sl_profile.h"
+
+#include "bits.h"
 #include "shadowlean/sl_thresh.h"
 
 #define SLOPE_MIN_Q8 128U   // 0.5 value per bin
@@ -45,31 +47,6 @@ sl_err_t sl_profile_init(sl_profile_t *pr, uint16_t azimuths, uint16_t near_bins
     return SL_OK;
 }
 
-// Count of trailing zeros of a non-zero word (portable de Bruijn, as in detect.c).
-static uint32_t profile_ctz32(uint32_t v)
-{
-    static const uint8_t tab[32] = {0,  1,  28, 2,  29, 14, 24, 3,  30, 22, 20,
-                                    15, 25, 17, 4,  8,  31, 27, 13, 23, 21, 19,
-                                    16, 7,  26, 12, 18, 6,  11, 5,  10, 9};
-    return tab[((v & (0U - v)) * 0x077CB531U) >> 27];
-}
-
-// First set bit in [lo, hi) of `bits`, or hi.
-static uint32_t first_set(const uint32_t *bits, uint32_t lo, uint32_t hi)
-{
-    uint32_t pos = lo;
-    while (pos < hi) {
-        const uint32_t w = bits[pos >> 5] >> (pos & 31U);
-        if (w == 0U) {
-            pos = (pos | 31U) + 1U;
-            continue;
-        }
-        pos += profile_ctz32(w);
-        return pos < hi ? pos : hi;
-    }
-    return hi;
-}
-
 static void slot_add(const sl_profile_t *pr, sl_profile_slot_t *s, const uint8_t *power,
                      uint32_t n)
 {
@@ -95,7 +72,7 @@ void sl_profile_row(sl_profile_t *pr, uint16_t az, const uint8_t *power, uint32_
         return;
     }
     const uint32_t hi = win < n ? win : n;
-    const uint32_t first = pr->near_bins < hi ? first_set(bits, pr->near_bins, hi) : hi;
+    const uint32_t first = pr->near_bins < hi ? sl_bits_next_set(bits, pr->near_bins, hi) : hi;
     const uint8_t si = pr->slot_of[az];
     if (si != SL_PROFILE_NONE) {
         sl_profile_slot_t *s = &pr->slot[si];
