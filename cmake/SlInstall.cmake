@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 # SlInstall.cmake: `cmake --install` and the Debian packages (CPack).
 #
 # What a user gets (GNUInstallDirs under the prefix, /usr for the .debs):

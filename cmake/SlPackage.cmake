@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 # SlPackage.cmake: Debian packages with CPack (`cpack -G DEB` in the build tree).
 #   shadowlean-dev    the SDK: headers, libsl_core.a, CMake package, pkg-config (component sdk)
 #   shadowleand       the daemon, its systemd unit, example config, DBCs (component daemon)

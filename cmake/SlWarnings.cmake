@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 # Warning sets, applied per target (never globally).
 add_library(sl_warnings INTERFACE)
 target_compile_options(sl_warnings INTERFACE

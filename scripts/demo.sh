@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: MIT
 # demo.sh: the whole chain on this machine, from a fresh Debian (installs what is missing):
 #
 #   sl-sim (a bundled scene) -> capture + truth

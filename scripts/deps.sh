@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: MIT
 # deps.sh GROUP...: install the Debian packages a group needs, only when missing.
 # Groups: build (host build + tools), test (cross + qemu-user + fuzz + CAN/VM tests), demo.
 # Needs root (or sudo) only when something is missing.

@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: MIT
 # test.sh: the whole test suite, from a fresh Debian machine (installs what is missing).
 #   host       Debug build: unit, build/symbol checks, tables, tools, integration tests
 #   host-asan  ASan + UBSan build of the same tests, plus the bounded fuzz run

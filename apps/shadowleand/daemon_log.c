@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // daemon_log.c: stderr / syslog logging of shadowleand (see daemon_log.h).
 #include "daemon_log.h"
 

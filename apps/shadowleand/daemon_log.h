@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /// @file daemon_log.h
 /// @brief Logging of the shadowleand daemon: stderr (default) or syslog, four levels.
 ///

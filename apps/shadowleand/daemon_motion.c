@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // daemon_motion.c: VehicleMotion reader on SocketCAN (see daemon_motion.h).
 #include "daemon_motion.h"
 

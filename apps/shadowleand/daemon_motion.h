@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /// @file daemon_motion.h
 /// @brief VehicleMotion input of the daemon: a SocketCAN raw socket that receives only
 ///        the board's VehicleMotion id (kernel filter), non-blocking.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // daemon_opts.c: defaults, INI config file (inih) and command line of shadowleand.
 #include "daemon_opts.h"
 

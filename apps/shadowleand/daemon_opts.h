@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /// @file daemon_opts.h
 /// @brief Settings of the shadowleand daemon: defaults, config file (inih), command line.
 ///

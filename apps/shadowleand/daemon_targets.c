@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // daemon_targets.c: JSON-lines side file of targets and tracks (see daemon_targets.h).
 #include "daemon_targets.h"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /// @file daemon_targets.h
 /// @brief `--targets-out`: the pipeline's per-rotation results as JSON lines, the side
 ///        file tests compare the CAN output with.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // shadowleand.c: the shadowlean daemon. Radar TCP stream or capture file in, pole-lean
 // CAN frames out (SocketCAN, candump log, gs_usb), one sl_pipeline_t in between.
 //

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 # aarch64 Linux (the usual companion computer); tests run under qemu-user with Debian's
 # multiarch libc and cmocka (-L / : see shared TOOLCHAIN_NOTES).
 set(CMAKE_SYSTEM_NAME Linux)

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 # Bare-metal Cortex-M4F (ARMv7E-M, single-precision FPU, hard-float ABI).
 set(CMAKE_SYSTEM_NAME Generic)
 set(CMAKE_SYSTEM_PROCESSOR arm)

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 # s390x Linux: the big-endian target Debian 12 still ships; catches wire-endianness bugs.
 set(CMAKE_SYSTEM_NAME Linux)
 set(CMAKE_SYSTEM_PROCESSOR s390x)

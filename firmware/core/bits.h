@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /// @file bits.h
 /// @brief Bit scanning over packed bit rows (one bit per range bin, 32-bit little-endian
 /// words of bins: bit k of word w is bin 32 w + k), shared by detection and the range

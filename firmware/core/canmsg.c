@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // CAN message layouts, encoders and decoders (sl_can.h). The layout tables below are the
 // single description of every signal: the encoders and decoders read positions and raw
 // limits from them, and the host DBC generator prints them.

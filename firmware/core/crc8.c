@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // CRC-8 SAE J1850 (poly 0x1D, init 0xFF, xorout 0xFF, no reflection) and the E2E CRC of
 // sl_can.h. Bitwise, no table: 8 bytes per frame make a 256-byte table not worth its flash.
 #include "shadowlean/sl_can.h"

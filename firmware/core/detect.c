@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Pole extraction inside the shadow, grouping over azimuths, corrections (sl_detect.h).
 #include <stdint.h>
 #include <string.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "shadowlean/sl_err.h"
 
 const char *sl_err_str(sl_err_t err)

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "shadowlean/sl_fx.h"
 
 uint32_t sl_fx_isqrt64(uint64_t x)

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Inclination estimator (sl_incline.h): integer-only, no state, no float.
 //
 // Q formats used inside (also listed in sl_incline.h):

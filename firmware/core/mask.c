@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // n-frame consistency mask with bit-sliced count-down run counters (sl_mask.h).
 #include <stdbool.h>
 #include <stdint.h>

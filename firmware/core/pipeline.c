@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The detection pipeline (sl_pipeline.h): decoder -> frame-less scan -> threshold -> mask
 // (window shortened with speed) -> streaming detection -> tracker -> CAN frames.
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Range profiles beside the bit mask and smear-aware bounds from them (sl_profile.h).
 #include <stdint.h>
 #include <string.h>

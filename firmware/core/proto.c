@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Colossus protocol: incremental decoder, typed parsers and encoders (sl_proto.h).
 //
 // Decoder: a three-state machine (signature, header tail, payload). The signature is

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Scan assembly (sl_scan.h): FFT messages -> rows of one rotation, with gap, duplicate and
 // reorder bookkeeping. Rows are written exactly once per rotation: on arrival (ROI copy +
 // zero fill of a short row) or, for rows never received, zero-filled at completion.

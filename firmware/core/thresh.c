@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Thresholding into bit rows (sl_thresh.h): SWAR byte compares, multiply gather.
 #include <stdint.h>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /// @file tilt.c
 /// @brief 3D pole tilt from in-plane inclinations over the vehicle's motion (sl_tilt.h).
 #include "shadowlean/sl_tilt.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Tracks over rotations: gated association, 1-D Kalman on alpha, warning hysteresis.
 #include <stdint.h>
 #include <string.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // sl-alpha: run the core's fixed-point inclination estimator (sl_incline_estimate) on lines
 // of text.
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // sl-bench: the whole detection pipeline (sl_pipeline_feed) over a capture file.
 //
 //   sl-bench CAPTURE [--board NAME] [--chunk BYTES] [--repeat N] [--loop N] [--n N]

@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: MIT
 # callgrind.sh [BUILD_DIR] CAPTURE [sl-bench args...]
 #
 # Instructions of the whole pipeline (sl_pipeline_feed over CAPTURE, 64 KiB chunks unless

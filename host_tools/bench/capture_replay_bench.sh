@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: MIT
 # capture_replay_bench.sh SHADOWLEAND SL_REPLAY OXFORD_DIR OUT_DIR [MIN_MB]
 #
 # Whole-process capture replay, side by side in one run on the same file: the daemon

@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: MIT
 # compare.sh [BUILD_DIR] CAPTURE [--board NAME] [--loop N] [--repeat N] [sl-bench args...]
 #
 # Side by side in one run, on the same capture (read whole into memory by both, then

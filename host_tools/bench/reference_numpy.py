@@ -1,4 +1,5 @@
 #!/usr/bin/python3
+# SPDX-License-Identifier: MIT
 """reference_numpy.py: a straightforward NumPy implementation of the detection front end,
 the side-by-side reference for sl-bench (host_tools/bench/compare.sh).
 

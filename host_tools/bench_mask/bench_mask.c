@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // sl-bench-mask: cost of threshold + consistency mask + detection + tracking on synthetic
 // CTS350-X-like rotations (400 azimuths x 512 ROI bins), for the n this variant was built
 // with (SL_CFG_MASK_FRAMES_MAX, one executable per n; see CMakeLists.txt).

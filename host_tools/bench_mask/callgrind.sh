@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: MIT
 # callgrind.sh [BUILD_DIR] [extra sl-bench-mask args...]
 #
 # Instructions per azimuth and per rotation of each detection stage (threshold, mask update

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // sl-bench-junk: instructions per junk byte of the Colossus decoder's resynchronisation.
 //
 //   sl-bench-junk KIND [BYTES [CHUNK]]

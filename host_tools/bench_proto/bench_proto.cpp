@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // sl-bench-proto: throughput of the Colossus decoder (sl_proto) + scan assembly (sl_scan).
 //
 //   sl-bench-proto [capture] [--rotations N] [--azimuths N] [--bins N] [--width 1|2]

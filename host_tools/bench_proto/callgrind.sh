@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: MIT
 # callgrind.sh [BENCH] [extra sl-bench-proto args...]
 #
 # Instructions per azimuth of the decoder + scan assembly (and of the decoder alone),

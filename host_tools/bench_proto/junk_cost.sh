@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: MIT
 # junk_cost.sh BENCH_JUNK [MAX]: instructions per junk byte of the decoder's resync, counted
 # by valgrind's callgrind over sl_bench_junk_run only (1 MiB per kind, 64 KiB and 1448-byte
 # chunks). With MAX, exits 1 when zero fill, random bytes or a repeated signature prefix

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // calib_cmds.h: the subcommands of sl-calib (main.cpp parses the arguments).
 #pragma once
 

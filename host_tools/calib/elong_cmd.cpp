@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // elong_cmd.cpp: `sl-calib elongation` (see main.cpp and README.md).
 #include "calib_cmds.h"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // sl-calib: calibration of a board from recorded (or simulated) radar data.
 //
 //   sl-calib shadow CAPTURE|OXFORD_DIR --board NAME [--out-ini FILE] [--png FILE] [--csv FILE]

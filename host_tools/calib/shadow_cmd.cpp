@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // shadow_cmd.cpp: `sl-calib shadow` (see main.cpp for the usage text).
 #include "calib_cmds.h"
 

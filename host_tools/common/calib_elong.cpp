@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // calib_elong.cpp: see calib_elong.h.
 #include "calib_elong.h"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // calib_elong.h: the elongation bias d (MATH.md s.4, paper Sec. V-B "Calibration of d")
 // measured from a target at known distances (sl-calib elongation). Host only.
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // calib_shadow.cpp: per-azimuth shadow calibration (see calib_shadow.h).
 #include "calib_shadow.h"
 

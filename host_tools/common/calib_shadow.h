@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // calib_shadow.h: the chassis shadow measured from many rotations (sl-calib shadow).
 //
 // Per azimuth the rotations (and +-az_half_window neighbouring azimuths) are averaged into a

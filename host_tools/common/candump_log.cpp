@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // candump_log.cpp: can-utils log format for the host tools (see candump_log.h), over the
 // port's C module firmware/port/linux/candump.h.
 #include "candump_log.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // candump_log.h: writer and reader of the can-utils log format (`candump -L`, `candump -l`,
 // canplayer, log2long, python-can CanutilsLogReader):
 //

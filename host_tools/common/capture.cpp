@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // capture.cpp: capture I/O for the host tools (see capture.h): a thin C++ wrapper over the
 // port's streaming reader (firmware/port/linux/capture_reader.h) plus raw capture writers.
 #include "capture.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // capture.h: reading and writing radar captures (host only, C++17).
 //
 // Two kinds of capture hold the radar -> client byte stream of the Colossus protocol:

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // oxford.cpp: Oxford polar PNG -> Colossus capture (see oxford.h).
 #include "oxford.h"
 

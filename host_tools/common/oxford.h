@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // oxford.h: Oxford Radar RobotCar polar PNGs -> Colossus messages (host only, C++17).
 //
 // PNG layout (NAVTECH_PROTOCOL.md s.9): one 8-bit grey PNG per rotation, one row per

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // sim_eval.cpp: see sim_eval.h.
 #include "sim_eval.h"
 

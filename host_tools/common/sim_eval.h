@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // sim_eval.h: accuracy evaluation of the inclination estimator on simulated captures.
 //
 // Chain: Colossus bytes -> core decoder (sl_proto_feed / sl_proto_parse_fft) -> the bins of

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // sim_geom.cpp: see sim_geom.h.
 #include "sim_geom.h"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // sim_geom.h: exact geometry of the scene simulator (host only, double precision).
 //
 // Conventions (sim_scene.h): world x, y horizontal, z up, ground z = 0, world angles CCW

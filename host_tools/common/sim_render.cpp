@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // sim_render.cpp: see sim_render.h.
 #include "sim_render.h"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // sim_render.h: the scene simulator. A Scene becomes the byte stream a CTS350-X would send
 // (Colossus Configuration message, then one 8-bit FFT Data message per azimuth) plus a
 // ground-truth table (sim_truth.h). Host only (C++17), double precision.

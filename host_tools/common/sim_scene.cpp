@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // sim_scene.cpp: scene files (INI, parsed with inih) -> sl::Scene, with validation.
 #include "sim_scene.h"
 

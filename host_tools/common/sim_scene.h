@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // sim_scene.h: the scene a simulation runs (scenes/README.md is the file format's manual).
 //
 // A scene is a board (the vehicle + radar installation, boards/<name>/board.ini), a vehicle

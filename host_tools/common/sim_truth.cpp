@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // sim_truth.cpp: ground-truth CSV (see sim_truth.h).
 #include "sim_truth.h"
 

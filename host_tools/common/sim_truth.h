@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // sim_truth.h: the simulator's ground truth, one row per (rotation, pole, azimuth on which
 // the pole is visible), and its CSV file format (scenes/README.md documents every column).
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Board files: parsed with inih (ini_parse), validated field by field, and the chassis
 // shadow geometry derived from them (MATH.md s.1).
 #include "sl_board_spec.h"

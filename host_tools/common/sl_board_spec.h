@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // sl_board_spec.h: a board file (boards/<name>/board.ini) parsed into doubles, and the
 // chassis-shadow geometry derived from it. Host-only (C++17); the core sees the generated
 // integer tables (sl_board.h) instead. The INI is read with inih's INIReader, never by hand.

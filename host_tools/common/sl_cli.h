@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /* sl_cli.h: the command-line conventions shared by every shadowlean executable
  * (README "Exit statuses and conventions"). Header-only, C11 and C++17.
  *

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // sl_dbc.cpp: DBC generation from the core's CAN layout table (see sl_dbc.h).
 #include "sl_dbc.h"
 

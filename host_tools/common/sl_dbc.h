@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // sl_dbc.h: the DBC file of a board's CAN interface, generated from the core's layout table
 // (sl_can_layout() in include/shadowlean/sl_can.h) and the board's [can] section.
 //

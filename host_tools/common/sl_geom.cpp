@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // sl_geom.cpp: see sl_geom.h.
 #include "sl_geom.h"
 

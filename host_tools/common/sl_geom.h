@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // sl_geom.h: the host's single code path from (theta, beta) in degrees to the core's
 // integer geometry entry (sl_incline_geom_t), and double-precision oracles of the
 // inclination estimator (MATH.md s.2-3). Used by the board table generator (sl-tables) and

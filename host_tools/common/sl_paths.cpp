@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "sl_paths.h"
 
 #include <cstdlib>

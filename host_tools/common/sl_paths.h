@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // sl_paths.h: where host tools find the project's files (boards, shared data).
 #pragma once
 #include <string>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // view_draw.cpp: see view_draw.h.
 #include "view_draw.h"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // view_draw.h: drawing helpers shared by sl-view and sl-calib (OpenCV, BGR 8-bit images).
 //
 // Panels:

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // view_frames.cpp: capture / Oxford folder -> rotations, through sl_proto and sl_scan.
 #include "view_frames.h"
 

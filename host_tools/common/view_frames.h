@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // view_frames.h: a capture (raw .colossus, pcap/pcapng) or an Oxford PNG folder decoded into
 // whole rotations, for the host tools that look at images (sl-view, sl-calib). Host only.
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // sl-dbc: the DBC file of a board's CAN interface.
 //
 //   sl-dbc BOARD [--out FILE]

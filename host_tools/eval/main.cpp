@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // sl-eval: runs the core decoder and the core estimator on simulated captures and compares
 // with the ground truth. Until the detection pipeline lands, bounds come from a bounding box
 // on the pole's ground-truth azimuth ("bbox extraction (detection pipeline not used)").

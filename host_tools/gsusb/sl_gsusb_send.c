@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // sl-gsusb-send: open a gs_usb (candleLight) adapter through libusb and send CAN frames,
 // generated or from a candump log, printing each confirmation (the adapter's echo).
 // Uses the same sink as the daemon (firmware/port/linux/gsusb_sink.h).

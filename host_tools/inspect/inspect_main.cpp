@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // sl-inspect: decode a capture (.colossus raw stream or pcap/pcapng, sniffed by content)
 // through the core decoder (sl_proto) and scan assembly (sl_scan) and report what is in it.
 //

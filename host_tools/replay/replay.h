@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // replay.h: the sl-replay subcommands (serve, record, from-oxford, to-pcapng).
 #pragma once
 

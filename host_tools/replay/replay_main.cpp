@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // sl-replay: radar emulator, recorder and Oxford converter.
 //
 //   sl-replay serve CAPTURE [--port P] [--bind ADDR] [--rate realtime|max] [--loop] ...

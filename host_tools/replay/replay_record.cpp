@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // replay_record.cpp: `sl-replay record`, a radar client that writes the raw stream to a file.
 //
 // Connects with the Linux radar client (handshake: Configuration, then Start FFT), writes

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // replay_serve.cpp: `sl-replay serve`, a radar emulator that replays a capture.
 //
 // Behaves like a Navtech radar (NAVTECH_PROTOCOL.md s.1): sends the capture's Configuration

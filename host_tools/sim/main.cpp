@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // sl-sim: simulate a scene (scenes/README.md) into a raw Colossus capture -- exactly the
 // bytes a CTS350-X sends: one Configuration message, then one 8-bit FFT Data message per
 // azimuth -- and a ground-truth CSV (one row per rotation, pole and azimuth it is seen on).

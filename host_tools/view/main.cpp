@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // sl-view: what the module sees, as pictures.
 //
 //   sl-view CAPTURE|OXFORD_DIR --board NAME --out FILE.png|FILE.mp4|FILE.avi

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /// @file sl_board.h
 /// @brief One installation (vehicle + radar): constants and generated per-azimuth tables.
 ///

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /// @file sl_bytes.h
 /// @brief Wire byte order, byte by byte: the one set of helpers every encoder and parser
 /// uses (Colossus is big-endian with little-endian timestamps; gs_usb and CAN signals are

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /// @file sl_can.h
 /// @brief CAN messages of shadowlean: frame type, message layouts, E2E protection,
 ///        encoders and decoders (integer only, endian-clean, no allocation).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /// @file sl_config.h
 /// @brief Compile-time capacities of the core (`SL_CFG_*`).
 ///

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /// @file sl_detect.h
 /// @brief Pole extraction inside the chassis shadow, corrections of MATH.md s.4, alpha.
 ///

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /// @file sl_err.h
 /// @brief Error codes shared by every shadowlean module.
 ///

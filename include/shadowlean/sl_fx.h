@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /// @file sl_fx.h
 /// @brief Fixed-point types and the only narrowing helpers the core uses.
 ///

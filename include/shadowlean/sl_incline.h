@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /// @file sl_incline.h
 /// @brief Inclination estimator (MATH.md s.2-3): (r1, r2, per-azimuth geometry) -> alpha.
 ///

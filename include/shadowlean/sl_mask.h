@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /// @file sl_mask.h
 /// @brief Bit-packed n-frame consistency mask (paper Sec. III-C, MATH.md s.4).
 ///

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /// @file sl_pipeline.h
 /// @brief The detection pipeline: radar bytes in, targets, tracks and CAN frames out.
 ///

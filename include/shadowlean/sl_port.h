@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /// @file sl_port.h
 /// @brief The core's output seam: what a port (Linux daemon, MCU firmware, test double)
 ///        gives the pipeline to receive its results. House style s.6: a const vtable plus a

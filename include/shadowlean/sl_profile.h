@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /// @file sl_profile.h
 /// @brief Range profiles beside the bit mask: amplitude kept where a pole is, smear-aware
 /// bounds from it (EXTRACTION.md D1-D3).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /// @file sl_proto.h
 /// @brief Navtech Colossus TCP protocol: incremental decoder, typed parsers, encoders.
 ///

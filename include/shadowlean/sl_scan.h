@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /// @file sl_scan.h
 /// @brief Scan assembly: FFT messages -> per-azimuth rows of one rotation (a frame).
 ///

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /// @file sl_thresh.h
 /// @brief Thresholding of one azimuth's region of interest into one bit per range bin.
 ///

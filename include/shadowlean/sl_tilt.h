@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /// @file sl_tilt.h
 /// @brief 3D pole tilt from the in-plane inclinations seen while driving (MATH.md s.5).
 ///

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /// @file sl_track.h
 /// @brief Targets over rotations: association, filtered alpha, warning level with hysteresis.
 ///

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: MIT
 """Black-box check of sl-alpha against an independent oracle (Python standard library only).
 
 Generates N seeded random input lines (valid cases over the whole supported domain, cases

@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: MIT
 # bench_smoke.sh SL_SIM SL_BENCH SCENE WORKDIR: a 14-rotation simulated pass at 1 m/s through
 # sl-bench with the motion input (1000 mm/s) and the simulator's beam spread; checks the
 # report's fields, the 64 KiB RAM budget of the firmware build and that targets are found.

@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: MIT
 # check_core_no_vfp.sh OBJDUMP ARCHIVE
 #
 # Fails (exit 1) when any object of a Cortex-M core archive contains a VFP or NEON

@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: MIT
 # check_core_symbols.sh NM ARCHIVE [--no-softfloat|--sanitized]
 #
 # Fails (exit 1) when the portable core references anything outside the freestanding set:

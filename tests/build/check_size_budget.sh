@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: MIT
 # check_size_budget.sh SIZE CPU BUDGET_FILE FILE...
 # Compares the footprint of every object of a core archive (and of a linked image) with
 # firmware/size_budget.txt: per object text, rodata, data, bss in bytes for the firmware

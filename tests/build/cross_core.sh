@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: MIT
 # cross_core.sh SRC_DIR BUILD_DIR TOOLCHAIN BOARD [CMAKE_ARG...]: configure + build the core
 # alone for a bare-metal target in the firmware configuration (as the cross presets do) so
 # ctest can check its symbols, instructions, stack and size. Extra arguments are passed to

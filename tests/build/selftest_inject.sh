@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: MIT
 # selftest_inject.sh CHECKER NM AR CC CFLAGS ARCHIVE SRC SYMBOL_REGEX [--no-softfloat]
 # (CHECKER is called as CHECKER NM ARCHIVE [MODE]; the VFP check takes objdump as NM.)
 # Proves the symbol check can fail: copies the real core archive, adds one object compiled

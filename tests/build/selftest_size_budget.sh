@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: MIT
 # selftest_size_budget.sh CHECK SIZE CPU BUDGET_FILE ARCHIVE
 # Proves the size check can fail: the real archive must pass the real budget, and fail
 # (exit 1, naming mask.c) against a copy whose mask.c text budget is cut to 1 byte.

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 # size -A FILE -> "object text rodata data bss" per object: for an archive every member
 # ("x.c.obj (ex lib.a):"), for a linked image one row "image" (flash = code + constants
 # without the .capture test data; RAM = .data + .bss, the stack reserve not included).

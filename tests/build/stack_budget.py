@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: MIT
 """stack_budget.py: worst-case stack depth of the core from its call graph.
 
 usage: stack_budget.py --ci-dir DIR --elf IMAGE.elf --objdump OBJDUMP --archive LIB.a

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // gen_scans.cpp: see gen_scans.h.
 #include "gen_scans.h"
 

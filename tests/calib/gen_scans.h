@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // gen_scans.h: synthetic radar captures with KNOWN shadow and elongation, for the
 // calibration tests (tests/calib) and the sl-view pictures. Written through the core's
 // encoders (sl_proto_encode_config / sl_proto_encode_fft8), decoded by the tools like any

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // test_calib.cpp: calibration tests on generated captures with known theta and d
 // (gen_scans.h), and the helpers the CLI tests (CMakeLists.txt) use.
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // can_gen_frames: encode many random messages with the core's encoders for one board and
 // write them as a candump log plus a list of the encoder INPUTS (physical integer units),
 // so check_dbc_decode.py can decode the log with the generated DBC (python3-canmatrix)

@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: MIT
 # candump_external.sh ROUNDTRIP_EXE PYTHON SRC_DIR OUT_DIR
 # The candump log writer/reader round trip, then the written file through can-utils'
 # log2long (must accept every line: it exits 1 on the first line it cannot parse) and

@@ -1,4 +1,5 @@
 #!/usr/bin/python3
+# SPDX-License-Identifier: MIT
 """Decode a candump log with a generated DBC (Debian python3-canmatrix 0.9.5) and compare
 every signal with the encoder inputs written by can_gen_frames.
 

@@ -1,4 +1,5 @@
 #!/usr/bin/python3
+# SPDX-License-Identifier: MIT
 """Read a candump log with python-can's CanutilsLogReader (Debian python3-can 4.1) and
 compare it field by field with the frame list candump_roundtrip wrote.
 

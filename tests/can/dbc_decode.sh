@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: MIT
 # dbc_decode.sh SL_DBC GEN_FRAMES PYTHON SRC_DIR BOARD OUT_DIR N SEED
 # Generate the board's DBC, encode N random messages with the core into a candump log,
 # decode every frame with python3-canmatrix and compare with the encoder's inputs.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // socketcan_offline: the SocketCAN sink's paths that need no CAN interface (runs on any
 // host, also one whose kernel has no CAN at all): argument checks, an interface that does
 // not exist (every frame dropped and counted as "down", SL_ERR_PORT, never blocking,

@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: MIT
 # uml_run.sh OUTDIR COMMAND [ARG...]
 #
 # Run COMMAND as root inside Debian's user-mode Linux kernel (package user-mode-linux) with

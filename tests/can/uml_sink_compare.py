@@ -1,4 +1,5 @@
 #!/usr/bin/python3
+# SPDX-License-Identifier: MIT
 """Compare what candump recorded on vcan0 with what the SocketCAN sink says it sent.
 
     uml_sink_compare.py CANDUMP.log SENT.log PRODUCED_A.log

@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: MIT
 # uml_sink_guest.sh EXE OUTDIR: runs INSIDE user-mode Linux (via uml_run.sh, vcan0 up).
 # Records the bus with `candump -L any` (survives the interface being deleted and
 # re-created in phase G) while vcan_sink_check drives the SocketCAN sink. Marker frames

@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: MIT
 # uml_sink_test.sh UML_RUN EXE PYTHON SRC_DIR OUT_DIR
 # The SocketCAN sink inside user-mode Linux (uml_sink_guest.sh), then the host-side
 # comparison of candump's recording with the sink's logs. Exit 77 (skip) without linux.uml.

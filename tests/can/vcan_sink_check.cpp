@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // vcan_sink_check: the SocketCAN sink on a real kernel CAN stack (run inside user-mode
 // Linux by uml_sink_guest.sh, as root, with vcan0 up, sch_plug loaded and `candump -L any`
 // recording).

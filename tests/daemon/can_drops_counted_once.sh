@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: MIT
 # can_drops_counted_once.sh SL_SIM SHADOWLEAND PYTHON SRC_DIR OUT_DIR
 # Status.CanDropped counts every lost frame exactly once: shadowleand with a SocketCAN sink
 # on a missing interface (every frame refused at send: the pipeline counts it from can_tx's

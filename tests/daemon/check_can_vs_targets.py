@@ -1,4 +1,5 @@
 #!/usr/bin/python3
+# SPDX-License-Identifier: MIT
 """Every CAN frame shadowleand wrote decodes with the board's generated DBC
 (python3-canmatrix) and carries exactly what the pipeline computed (--targets-out).
 

@@ -1,4 +1,5 @@
 #!/usr/bin/python3
+# SPDX-License-Identifier: MIT
 """Per pole, the rotations with a PoleLean at the pole's bearing; PoleLean frames where no
 pole stands. Decoded with the board's DBC (python3-canmatrix), independently of the C code.
 

@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: MIT
 # clutter_driveby.sh SL_SIM SHADOWLEAND PYTHON SRC_DIR OUT_DIR
 # Issue 18, "clutter never hides a pole", measured on what the daemon sends (CAN log decoded
 # with the board's DBC by clutter_count.py, independently of the C code):

@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: MIT
 # config_cli.sh SHADOWLEAND SRC_DIR OUT_DIR
 # Settings: the example config file parses; the command line overrides it key by key;
 # --print-config output reads back to the same settings; bad files and options are

@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: MIT
 # decode_matches_targets.sh SL_SIM SHADOWLEAND PYTHON SRC_DIR OUT_DIR
 # Item 4: shadowleand --input (simulated capture) --can-log --targets-out; every frame
 # decodes with boards/paper-sim/shadowlean.dbc (python3-canmatrix) and matches the

@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: MIT
 # e2e_loopback.sh SL_SIM SL_REPLAY SHADOWLEAND PYTHON SRC_DIR OUT_DIR
 # End to end on loopback: sl-sim (tests/daemon/scenes/static_four_poles.ini) -> sl-replay
 # serve on 127.0.0.1 (free port, parsed) -> shadowleand --radar -> candump log + targets

@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: MIT
 # exit_statuses.sh SL_SIM SHADOWLEAND PYTHON SRC_DIR OUT_DIR
 # Capture mode exit statuses (README "Exit statuses"), each with what CAN says:
 #   0 ok; 1 unreadable input; 2 bad options; 3 no usable rotation or a configuration fault

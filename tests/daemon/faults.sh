@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: MIT
 # faults.sh SL_SIM SL_REPLAY SHADOWLEAND PYTHON SRC_DIR OUT_DIR
 # Issue 14: every fault a radar or its network can inject (sl-replay serve fault options) is
 # visible to a CAN consumer, decoded with the board's DBC only (health_summary.py): the

@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: MIT
 # fixed_motion.sh SL_SIM SHADOWLEAND PYTHON SRC_DIR OUT_DIR
 # --motion V: a constant vehicle motion instead of VehicleMotion frames (benches, replays
 # without a vehicle bus). The static test scene driven at 1 m/s (the same file with

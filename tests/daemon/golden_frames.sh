@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: MIT
 # golden_frames.sh SL_SIM SL_REPLAY SHADOWLEAND SRC_DIR OUT_DIR OXFORD_DIR [--pipe|--regen]
 # Behaviour pinned byte for byte: the CAN frames (candump -L log, data clock) the daemon
 # writes for the README's demo scene (scenes/demo_three_poles.ini through sl-sim) and for the

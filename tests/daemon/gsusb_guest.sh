@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 # gsusb_guest.sh: runs INSIDE the gs_usb test VM (tests/gsusb/build_vm.sh image: chroot on
 # the host's read-only root, $OUT writable, $KMOD the extracted kernel modules). Presents the
 # fake candleLight of tests/gsusb (dummy_hcd + configfs + FunctionFS, echo + reply mode) and

@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: MIT
 # gsusb_vm_test.sh SOURCE_DIR CACHE_DIR OUT_DIR SHADOWLEAND SL_SIM PYTHON
 # shadowleand's --gs-usb output against a fake candleLight in a QEMU VM (the image and the
 # fake device of tests/gsusb: build_vm.sh, fake_candlelight.py; same cache directory, so

@@ -1,4 +1,5 @@
 #!/usr/bin/python3
+# SPDX-License-Identifier: MIT
 """health_summary.py BOARD.dbc CAN.log: what a CAN consumer sees of the module's health,
 decoded with the board's generated DBC only (python3-canmatrix, CRC checked):
 

@@ -1,4 +1,5 @@
 #!/usr/bin/python3
+# SPDX-License-Identifier: MIT
 """Decoded leans against the simulator's truth.
 
     lean_vs_truth.py BOARD.dbc CAN.log TRUTH.gt.csv [--tol DEG] [--az-tol DEG]

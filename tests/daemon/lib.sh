@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 # lib.sh: helpers for the daemon tests (sourced). POSIX sh.
 # start_replay LOGFILE CAPTURE [ARGS...]: `sl-replay serve` on 127.0.0.1, any free port;
 # sets REPLAY_PID and REPLAY_PORT (parsed from its "listening on" line).

@@ -1,4 +1,5 @@
 #!/usr/bin/python3
+# SPDX-License-Identifier: MIT
 """Wrap a raw Colossus capture into a pcap of one TCP session (radar 10.0.0.2:6317 ->
 client 10.0.0.1:40000, Ethernet/IPv4), the way tcpdump would have recorded it, with
 the usual damage of a real recording: every 50th segment retransmitted, every 37th pair

@@ -1,4 +1,5 @@
 #!/usr/bin/python3
+# SPDX-License-Identifier: MIT
 """VehicleMotion frames with faults, as cansend arguments (one per line), from the board's
 DBC (python3-canmatrix encodes, the CRC is computed here). One cycle of 30 lines:
 - good frames: Speed 0.05 m/s, E2E counters that advance by 1, except a jump of 3 every

@@ -1,4 +1,5 @@
 #!/usr/bin/python3
+# SPDX-License-Identifier: MIT
 """VehicleMotion frames as cansend arguments (one per line), E2E counters 0..14, from the
 board's DBC (python3-canmatrix encodes the raw values; the CRC is computed here).
 

@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: MIT
 # oxford_status.sh SL_REPLAY SHADOWLEAND PYTHON SRC_DIR OUT_DIR OXFORD_DIR
 # Must show: the 11 real Oxford RobotCar scans, converted by `sl-replay from-oxford`, through
 # `shadowleand --board robotcar-leaf --input X --can-log -`: no errors, and its Status

@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: MIT
 # radar_link_states.sh SL_SIM SL_REPLAY SHADOWLEAND PYTHON SRC_DIR OUT_DIR
 # The Status frames without data and the clean shutdown, on loopback:
 # 1. no radar (a closed port): Status frames keep coming (--status-period-ms 200) with

@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: MIT
 # realtime_equals_fast.sh SL_SIM SHADOWLEAND OUT_DIR SRC_DIR
 # --realtime (paced by the FFT timestamps: 20 rotations at 4 Hz, ~5 s) writes exactly the
 # frames and targets of the as-fast-as-possible run: the pipeline runs on the radar's clock.

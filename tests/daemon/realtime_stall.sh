@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: MIT
 # realtime_stall.sh SL_SIM SHADOWLEAND PYTHON SRC_DIR OUT_DIR
 # Root cause of the flaky daemon_gs_usb_output_in_vm ("Status frame outside a rotation
 # group" under CPU load), reproduced deterministically: a --realtime capture replay whose

@@ -1,4 +1,5 @@
 #!/usr/bin/python3
+# SPDX-License-Identifier: MIT
 """Host side of the user-mode Linux test: candump's recording of vcan0 against the
 daemon's own --can-log of the same runs, field by field (id, 11/29-bit, DLC, data, order;
 not the timestamps), plus the VehicleMotion input of the real-time run.

@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: MIT
 # uml_guest.sh DAEMON CAPTURE SHORT_CAPTURE MOTION_FRAMES OUTDIR: runs INSIDE user-mode Linux
 # (tests/can/uml_run.sh, vcan0 up). `candump -L vcan0` records the bus while:
 #   run 1: shadowleand --input CAPTURE --can vcan0 --can-log daemon_fast.log (as fast as

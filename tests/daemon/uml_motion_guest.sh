@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: MIT
 # uml_motion_guest.sh DAEMON CAPTURE MOTION_FRAMES OUTDIR: runs INSIDE user-mode Linux
 # (tests/can/uml_run.sh, vcan0 up). shadowleand replays CAPTURE in real time with --can vcan0
 # (VehicleMotion read from vcan0) while MOTION_FRAMES (motion_fault_frames.py: good frames,

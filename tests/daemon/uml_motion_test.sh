@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: MIT
 # uml_motion_test.sh UML_RUN SHADOWLEAND SL_SIM PYTHON SRC_DIR OUT_DIR
 # Issue 14: VehicleMotion with bad CRCs, repeated counters, counter jumps and a reception
 # timeout over a real vcan0 inside user-mode Linux (uml_motion_guest.sh). On the host:

@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: MIT
 # uml_test.sh UML_RUN SHADOWLEAND SL_SIM PYTHON SRC_DIR OUT_DIR
 # Real SocketCAN inside user-mode Linux (tests/can/uml_run.sh): shadowleand --input CAPTURE
 # --can vcan0 --can-log OUT while `candump -L vcan0` records (uml_guest.sh); on the host:

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // fuzz_proto: libFuzzer entry point for the Colossus decoder + scan assembly.
 //
 // Input layout: 4 control bytes, then the stream.

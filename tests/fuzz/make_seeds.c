@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // make_seeds: writes the committed seed corpus of fuzz_proto (tests/fuzz/corpus/).
 // Usage: fuzz_make_seeds <dir>. Deterministic; re-run only when the input layout of
 // fuzz_proto.c changes. Each file = 4 control bytes (see fuzz_proto.c) + a stream.

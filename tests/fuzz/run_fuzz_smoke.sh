@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: MIT
 # run_fuzz_smoke.sh FUZZER CORPUS_DIR SECONDS ARTIFACT_DIR
 # Bounded libFuzzer run on a temporary copy of the committed corpus (the committed corpus
 # is never modified). Exit status: the fuzzer's (non-zero on a crash or invariant failure;

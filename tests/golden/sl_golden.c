@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Deterministic Colossus streams (sl_golden.h), built with the core's encoders.
 #include "sl_golden.h"
 

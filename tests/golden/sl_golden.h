@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /// @file sl_golden.h
 /// @brief Deterministic Colossus streams for tests, fuzz seeds and benchmarks.
 ///

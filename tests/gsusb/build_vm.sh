@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: MIT
 # build_vm.sh CACHE_DIR [SOURCE_DIR]: prepare (once, cached) the throw-away test VM for the
 # gs_usb integration test: a stock Debian kernel (only vmlinuz + the ~25 modules the test
 # needs are extracted from the linux-image .deb) and a busybox initramfs whose /init mounts

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: MIT
 """check_results.py OUT_DIR TEST_DIR: judge one run of the gs_usb VM test (host side).
 
 Compares, field by field (id, 11/29-bit, remote, dlc, data), the frames the fake device

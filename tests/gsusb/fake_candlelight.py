@@ -1,4 +1,5 @@
 #!/usr/bin/python3 -u
+# SPDX-License-Identifier: MIT
 """Fake gs_usb (candleLight) USB device on Linux FunctionFS, for the gs_usb VM test.
 
 Usage: fake_candlelight.py FFS_DIR OUT_DIR CTL_FILE UDC_FILE UDC_NAME

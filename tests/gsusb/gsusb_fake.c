@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // In-process fake candleLight (see gsusb_fake.h).
 #include "gsusb_fake.h"
 

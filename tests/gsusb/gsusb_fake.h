@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /// @file gsusb_fake.h
 /// @brief In-process fake candleLight behind the gs_usb transport seam (unit tests only).
 ///

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 # guest.sh: runs INSIDE the test VM (chroot on the host's read-only root, $OUT writable).
 # Presents a fake candleLight through dummy_hcd + configfs + FunctionFS and runs every
 # scenario of the gs_usb integration test in one boot. It only runs things and records

@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: MIT
 # run_vm_test.sh SOURCE_DIR CACHE_DIR SENDER: the gs_usb integration test.
 # One QEMU boot (TCG; this machine's /dev/kvm cannot boot a stock kernel) of a Debian
 # kernel whose guest presents a fake candleLight (dummy_hcd + configfs + FunctionFS) and

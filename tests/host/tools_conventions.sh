@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: MIT
 # tools_conventions.sh VERSION WORKDIR EXE[@SUBCOMMAND]...
 # The command-line conventions of README "Exit statuses and conventions", for every
 # executable given (tests/host/CMakeLists.txt lists every EXECUTABLE target):

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // link_test: integration tests of the radar link (capture files, pcap reassembly, sl-inspect,
 // sl-replay serve/record, the Linux radar client). One executable, one ctest per mode:
 //

@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: MIT
 # build_without_host_tools.sh SOURCE_DIR OUT_DIR
 # -DSL_BUILD_HOST_TOOLS=OFF configures and builds core + port + daemon with no C++ and no
 # OpenCV: CMake never enables C++ (no CMAKE_CXX_COMPILER in the cache), never looks for

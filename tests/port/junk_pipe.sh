@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: MIT
 # junk_pipe.sh SHADOWLEAND MIB OUT_DIR [EMULATOR...]
 # MIB MiB of junk (half zeros, half text: no Colossus message) through a pipe into
 # `shadowleand --input -`: memory stays constant (peak RSS <= 64 MiB, /usr/bin/time -v),

@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: MIT
 # stream_file_equals_pipe.sh MAKE_STREAM SHADOWLEAND OUT_DIR [EMULATOR...]
 # A generated Colossus stream (24 rotations) through `shadowleand --input FILE` and through
 # a pipe (`--input -`): the same CAN frames byte for byte, with Status frames for every

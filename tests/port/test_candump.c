@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Unit tests for firmware/port/linux/candump.h: can-utils frame text and candump -L lines,
 // both ways (the sl-gsusb-send log input and its --tx-log/--rx-log output), and the log
 // file sink of the daemon's --can-log (lines read back with the parser).

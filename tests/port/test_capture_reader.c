@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // test_capture_reader.c: the port's streaming capture reader (firmware/port/linux/capture_reader.c).
 // Raw and pcap captures from regular files and from pipes (/dev/fd/N, the format sniffed
 // from bytes already read), TCP reassembly of a damaged session (retransmission, reordering,

@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: MIT
 # sl-sim -> capture + truth -> sl-eval run (core decoder + estimator); and the realistic
 # experiment at its smallest size. Usage: cli_roundtrip.sh SL_SIM SL_EVAL SCENES_DIR WORKDIR
 set -eu

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Simulator tests against closed-form geometry (MATH.md s.1, s.2, s.5), the capture format
 // (NAVTECH_PROTOCOL.md s.4-5, decoded by the core decoder), the noise floor of the real
 // sensor (REAL_SCANS.md s.1) and determinism. Black-box tests of the host simulator API.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Smear-robust extraction through the CORE PIPELINE (range profiles, sl_profile.h) on the
 // realistic bench (paper Table II condition, sl-eval realistic --extract pipeline) and its
 // variations, with one and the same configuration (no constant refitted per condition):

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The Table I real-resolution passes through the CORE PIPELINE (sl-eval --extract pipeline):
 // simulator bytes -> sl_pipeline_feed (paper-sim) with the pass's speed (sl_pipeline_set_motion)
 // and the simulated beam as the detection beam width -> per-rotation targets associated with

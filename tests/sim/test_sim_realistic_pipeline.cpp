@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The realistic bench (paper Table II condition) through the CORE PIPELINE
 // (sl-eval realistic --extract pipeline): simulator bytes (static bench, smear, speckle,
 // noise floor, leakage, 16 frames) -> sl_pipeline_feed (paper-bench, speed 0: the board's

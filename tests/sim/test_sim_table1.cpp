@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // A short Table I run (MATH.md s.6) through the whole chain -- simulator, Colossus bytes,
 // core decoder, bbox extraction, core estimator -- asserting what the reproduction must
 // show: the raw quantisation bias of 1-2 deg, its removal by the half-bin correction, the

@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: MIT
 # expect_fail.sh PATTERN COMMAND...: the command must exit 1 and print PATTERN (a checker
 # run on an injected defect), proving the checker can fail.
 set -u

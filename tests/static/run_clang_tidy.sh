@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: MIT
 # run_clang_tidy.sh CLANG_TIDY CONFIG INCLUDE_DIR SRC...: every core source with the
 # checks in CONFIG, firmware configuration; exit 1 on any finding (printed).
 set -eu

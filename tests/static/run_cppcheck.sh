@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: MIT
 # run_cppcheck.sh CPPCHECK SUPPRESSIONS INCLUDE_DIR SRC...: warning, style, performance and
 # portability checks on the core, firmware configuration, as GCC compiles it (__GNUC__:
 # SL_ASSERT traps with __builtin_trap, which cppcheck knows does not return); exit 1 on any

@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: MIT
 # run_misra.sh CPPCHECK RECORD INCLUDE_DIR SRC...
 # MISRA C:2012 with cppcheck's misra addon on the core (firmware configuration). Every rule
 # the addon reports must have a row in the deviation record RECORD (docs/MISRA.md:

@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: MIT
 # selftest_misra.sh RUN_MISRA CPPCHECK RECORD INCLUDE_DIR SRC...: the MISRA check must fail
 # (exit 1, naming the rule) when the record lacks the row of a rule the code breaks (10.4).
 set -eu

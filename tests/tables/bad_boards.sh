@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: MIT
 # bad_boards.sh SL_TABLES BAD_DIR WORK: every bad/*.ini must be rejected (exit 1) with a
 # message containing the text in its first line "; expect: <text>".
 set -eu

@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: MIT
 # check_tables.sh SL_TABLES BOARDS_DIR WORK: regenerate every board's tables into WORK and
 # fail on any difference from the committed boards/<name>/sl_board_*.{c,h}.
 set -eu

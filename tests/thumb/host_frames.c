@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // host_frames CAPTURE [BOARD]: the example firmware's application (firmware/targets/common/
 // fw_app.c) on the host, over a capture file: the same text lines the Thumb images print
 // under qemu-system-arm, for run_thumb.sh to compare.

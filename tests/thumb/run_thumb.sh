@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: MIT
 # run_thumb.sh CPU MACHINE ELF HOST_FRAMES CAPTURE BOARD MAX_INSTR_PER_AZIMUTH [PSRAM_BOARD_INDEX [CHUNK]]
 # Runs the example firmware (capture linked into its flash) under qemu-system-arm with
 # -icount shift=0 and semihosting, runs the same application on the host over the same

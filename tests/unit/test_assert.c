@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // SL_ASSERT is overridable for the whole build: this test compiles a core source
 // (firmware/core/thresh.c, see test_assert.cmake) with SL_ASSERT overridden (user header) to a
 // recorder, and checks that a caller bug inside the core reaches the override (instead of

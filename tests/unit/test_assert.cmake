@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 # test_assert: thresh.c compiled into the test with SL_ASSERT overridden through the user
 # configuration header (tests/unit/assert_user/sl_config_user.h, SL_CFG_USER_HEADER); the
 # library's own thresh.c object is not linked (every symbol is defined by this copy).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Unit tests for the generated board tables and the board registry (sl_board.h).
 // The expected values are recomputed here in double precision from the geometry the
 // board files state (MATH.md s.1), independently of the generator.

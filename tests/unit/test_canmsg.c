@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Unit tests for sl_can.h: CRC, E2E, layout table, encoders/decoders, VehicleMotion rx.
 // Byte-level expectations only (the suite also runs on big-endian s390x under qemu).
 #include <setjmp.h>

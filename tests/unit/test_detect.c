@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Unit tests for sl_detect.h: pole extraction on hand-made stable-occupied rows, the
 // rejections, the corrections of MATH.md s.4 and alpha. The board is built here (theta =
 // 26 deg, beta = 0, the paper-sim geometry) with its geometry entry computed with libm.

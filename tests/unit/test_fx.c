@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Unit tests for sl_fx.h: narrowing helpers and the integer square root.
 #include <setjmp.h>
 #include <stdarg.h>

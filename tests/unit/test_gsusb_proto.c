@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Unit tests for the gs_usb protocol layer (firmware/port/linux/gsusb_proto.h) against the
 // in-process fake candleLight (tests/gsusb/gsusb_fake.h): request bytes, the start-up
 // sequence, bit timing (fixed points from the kernel and a brute-force oracle), frame

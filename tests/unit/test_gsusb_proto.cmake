@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 # test_gsusb_proto: the gs_usb protocol layer (firmware/port/linux/gsusb_proto.c, no libusb)
 # and the in-process fake candleLight (tests/gsusb/gsusb_fake.c). Only these two extra
 # sources, so the test also builds for the cross presets (aarch64, big-endian s390x).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Unit tests of the pipeline's honest health (issue 14): every fault a radar, a network or a
 // CAN bus can cause is visible in the Status and Health frames, decoded with the core's own
 // decoders (the layout table the DBC is generated from). Streams are built here with the

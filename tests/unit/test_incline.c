@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Unit tests for sl_incline.h: the fixed-point inclination estimator against a plain libm
 // double oracle written here (MATH.md s.2-3). The geometry entries are built here with
 // libm too, with the same rounding rule as sl::make_geom (llround of each exact value), so

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Unit tests for sl_mask.h: the bit-sliced counters against a naive reference that stores
 // the last n rows of every azimuth and intersects them, for every n in 1..32.
 #include <setjmp.h>

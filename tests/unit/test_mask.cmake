@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 # test_mask, plus test_mask_swar32: the same tests against the 32-bit lane kernels (what a
 # 32-bit MCU runs), compiled here with SL_CFG_SWAR_BITS=32 (see test_thresh.cmake).
 sl_add_unit_test(mask)

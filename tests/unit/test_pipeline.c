@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Unit tests for sl_pipeline.h: the whole core end to end on streams built here with the
 // core encoders (sl_proto_encode_*), from a small geometric scene renderer (double
 // precision, the oracle) for the paper-sim board. Covers: poles at -10/0/+10 deg, the

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 # test_pipeline, plus test_pipeline_fw: the same tests against a core built in the firmware
 # configuration (masked bins capped at 160, n <= 16: sizeof(sl_pipeline_t) <= 64 KiB is then
 # a static_assert in sl_pipeline.h). The variant compiles every core source itself with the

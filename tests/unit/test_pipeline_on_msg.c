@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Unit tests for sl_pipeline_on_msg() (decode once): a caller's own decoder handing every
 // message to the pipeline gives the same rotations and the same CAN frames, byte for byte,
 // as sl_pipeline_feed() on the same bytes: a CTS350-X-like stream (tests/golden/sl_golden.c,

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Unit tests for sl_profile.h: the per-azimuth accumulator against a naive sum (claims,
 // idle release, reset, halving), and the smear-aware extraction on synthetic profiles whose
 // own bins are known: a pole's own power convolved with smear kernels of several shapes

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Unit tests for sl_scan.h: azimuth index, rotation boundaries, missing / duplicate /
 // out-of-order azimuths, contoured rows, 16-bit reduction, ROI copy, timestamps, double
 // buffering, and the whole chain bytes -> sl_proto -> sl_scan under random chunkings.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Unit tests for sl_thresh.h: SWAR thresholds against a one-bin-at-a-time reference.
 #include <setjmp.h>
 #include <stdarg.h>

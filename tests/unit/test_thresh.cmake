@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 # test_thresh, plus test_thresh_swar32: the same tests against the 32-bit SWAR kernels
 # (what a 32-bit MCU runs), compiled here on 64-bit hosts with SL_CFG_SWAR_BITS=32. The
 # variant compiles thresh.c itself; sl_core's copy is then never pulled in.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Unit tests for sl_tilt.h: 3D pole tilt from the in-plane inclinations of a drive-by.
 //
 // Drive-bys are simulated here in double precision, independently of the module: a pole

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Unit tests for sl_track.h: association gates, the fixed-point Kalman filter against a
 // double-precision one, warning levels with confirmations and hysteresis, timeouts.
 #include <setjmp.h>

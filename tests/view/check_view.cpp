@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // check_view.cpp: checks on sl-view's output (tests/view).
 //
 //   check_view png FILE [--size W H] [--min COLOUR N]...   COLOUR: amber magenta red cyan green

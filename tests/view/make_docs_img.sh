@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: MIT
 # Regenerates the README pictures in docs/img from a host build:
 #   tests/view/make_docs_img.sh BUILD_DIR [OUT_DIR=docs/img] [WORK_DIR=BUILD_DIR/docs-img-work]
 # Needs sl-sim, sl-calib, sl-view in BUILD_DIR and the Oxford scans in

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /// @file can_sink.h
 /// @brief A CAN frame sink: a const vtable + context, so the daemon can send every frame
 ///        to several outputs (SocketCAN, a candump log file, later gs_usb over libusb).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // SocketCAN raw sink (can_socketcan.h). Non-blocking socket + MSG_DONTWAIT everywhere.
 #include "can_socketcan.h"
 

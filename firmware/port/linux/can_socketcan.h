@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /// @file can_socketcan.h
 /// @brief SocketCAN raw sink: non-blocking transmit with a small bounded retry queue,
 ///        error-frame monitoring (bus-off, error passive, restarts), interface down/gone.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // candump.c: the candump text format (frames, -L lines, both ways) and the log file sink (see candump.h).
 #include "candump.h"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /// @file candump.h
 /// @brief The candump text format in one place (Linux port): can-utils frames
 ///        ("123#DEADBEEF", "1ABCDE0F#0102", "123#R", error frames) and candump -L log lines

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // capture_reader.c: streaming raw / pcap / pcapng capture reader (see capture_reader.h).
 #include "capture_reader.h"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /// @file capture_reader.h
 /// @brief Streaming reader of radar captures (Linux port, C11 + POSIX + libpcap).
 ///

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // libusb-1.0 transport for gs_usb adapters (see gsusb_libusb.h).
 #include "gsusb_libusb.h"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /// @file gsusb_libusb.h
 /// @brief libusb-1.0 transport for gs_usb (candleLight) adapters: finds, claims and talks to
 ///        the device behind the `sl_gsusb_transport_t` seam of gsusb_proto.h.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // gs_usb protocol layer and driver logic (no libusb: see gsusb_proto.h).
 #include "gsusb_proto.h"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /// @file gsusb_proto.h
 /// @brief gs_usb (candleLight) protocol layer and driver logic, behind a transport seam.
 ///

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // gs_usb CAN sink: libusb transport + driver + queue + reopen (see gsusb_sink.h).
 #include "gsusb_sink.h"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /// @file gsusb_sink.h
 /// @brief CAN sink (can_sink.h) for a gs_usb / candleLight USB adapter driven through libusb:
 ///        the daemon's `--gs-usb` output. Wraps the libusb transport (gsusb_libusb.h) and

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // port_clock.c: the Linux port's clock (CLOCK_MONOTONIC, microseconds).
 #include "sl_port_linux.h"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // radar_client.c: non-blocking Colossus TCP client (see radar_client.h).
 #include "radar_client.h"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /// @file radar_client.h
 /// @brief Linux TCP client for a Navtech Colossus radar (or `sl-replay serve`).
 ///

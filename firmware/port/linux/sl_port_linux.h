@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /// @file sl_port_linux.h
 /// @brief Linux port helpers shared by the port modules (clock).
 ///

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The example firmware's application (see fw_app.h).
 #include "fw_app.h"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /// @file fw_app.h
 /// @brief The example firmware's application: runs the core pipeline over a capture held in
 /// memory (flash on the target), the way a port feeds it from a TCP socket, and reports

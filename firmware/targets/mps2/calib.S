@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* mps2_calib_loop(n): exactly 2 n instructions (subs + bne per iteration) + bx lr, the
    reference the SysTick instruction counter is calibrated against (main.c). Valid
    for ARMv6-M and ARMv7-M. */

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The example firmware's main (QEMU MPS2 boards): calibrates SysTick against a loop of known
 // instruction count, runs the core pipeline over the capture linked into flash (fw_app.c)
 // or, when QEMU placed one in the board's 16 MB PSRAM, over that one (a capture too

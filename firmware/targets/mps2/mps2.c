@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Board support (mps2.h): Arm semihosting (BKPT 0xAB; available on v6-M and v7-M) and SysTick.
 #include "mps2.h"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Board support for the example firmware on QEMU's MPS2 models: semihosting output and exit,
 // SysTick as an instruction counter (with -icount shift=0 one instruction = 1 ns of
 // virtual time; SysTick counts the 25 MHz CPU clock, i.e. one tick per 40 instructions,

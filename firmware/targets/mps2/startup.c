@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Startup for the Arm MPS2 FPGA boards as QEMU models them (mps2-an385: Cortex-M3,
 // mps2-an386: Cortex-M4): vector table, reset handler (copy .data, zero .bss, paint the
 // stack for the high-water measurement), fault handlers that report over semihosting.

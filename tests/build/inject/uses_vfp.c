@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Injected on purpose by the VFP check's self test: compiled for the hard-float ABI without
 // -mgeneral-regs-only, float arithmetic and a 64-bit value live in VFP registers.
 #include <stdint.h>

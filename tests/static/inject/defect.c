@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Injected on purpose by the static-analysis self tests: an out-of-bounds read and a
 // division by zero that cppcheck and clang-tidy must report.
 #include <stdint.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // test_assert's user configuration header (SL_CFG_USER_HEADER): overrides SL_ASSERT for the
 // core sources compiled into the test, the way an integrator does for a product.
 #ifndef TEST_ASSERT_SL_CONFIG_USER_H
