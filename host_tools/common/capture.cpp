@@ -114,6 +114,23 @@ void fill_report(const sl_port_capture_t *c, Capture &out)
         }
     }
 }
+
+// A break reported by the port's reader, as a Discontinuity: appended to `all`, and to
+// `gaps` when bytes are missing (a new session is not a gap).
+void record_break(const sl_port_capture_piece_t &p, std::vector<Discontinuity> &all,
+                  std::vector<Discontinuity> &gaps)
+{
+    Discontinuity d;
+    d.kind = p.brk == SL_PORT_CAPTURE_GAP ? Discontinuity::Kind::Gap : Discontinuity::Kind::NewSession;
+    d.output_offset = p.output_offset;
+    d.stream_offset = p.stream_offset;
+    d.missing_bytes = p.missing_bytes;
+    d.session = p.session;
+    all.push_back(d);
+    if (d.kind == Discontinuity::Kind::Gap) {
+        gaps.push_back(d);
+    }
+}
 } // namespace
 
 // The port's streaming reader (firmware/port/linux/capture_reader.h) does the reading, the
@@ -138,16 +155,7 @@ bool load_capture(const std::string &path, Capture &out, std::string &err, const
         if (p.kind == SL_PORT_CAPTURE_DATA) {
             out.bytes.insert(out.bytes.end(), p.data, p.data + p.size);
         } else if (p.kind == SL_PORT_CAPTURE_BREAK) {
-            Discontinuity d;
-            d.kind = p.brk == SL_PORT_CAPTURE_GAP ? Discontinuity::Kind::Gap : Discontinuity::Kind::NewSession;
-            d.output_offset = p.output_offset;
-            d.stream_offset = p.stream_offset;
-            d.missing_bytes = p.missing_bytes;
-            d.session = p.session;
-            out.discontinuities.push_back(d);
-            if (d.kind == Discontinuity::Kind::Gap) {
-                out.pcap.gap_list.push_back(d);
-            }
+            record_break(p, out.discontinuities, out.pcap.gap_list);
         } else {
             if (p.kind == SL_PORT_CAPTURE_ERROR) {
                 err = path + ": " + sl_port_capture_error(c);
@@ -191,16 +199,7 @@ bool stream_capture(const std::string &path, sl_proto_t *p, size_t chunk, Captur
             bytes += pc.size;
         } else if (pc.kind == SL_PORT_CAPTURE_BREAK) {
             (void)sl_proto_finish(p);
-            Discontinuity d;
-            d.kind = pc.brk == SL_PORT_CAPTURE_GAP ? Discontinuity::Kind::Gap : Discontinuity::Kind::NewSession;
-            d.output_offset = pc.output_offset;
-            d.stream_offset = pc.stream_offset;
-            d.missing_bytes = pc.missing_bytes;
-            d.session = pc.session;
-            info.discontinuities.push_back(d);
-            if (d.kind == Discontinuity::Kind::Gap) {
-                info.pcap.gap_list.push_back(d);
-            }
+            record_break(pc, info.discontinuities, info.pcap.gap_list);
         } else {
             (void)sl_proto_finish(p);
             if (pc.kind == SL_PORT_CAPTURE_ERROR) {
