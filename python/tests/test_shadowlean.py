@@ -1,0 +1,285 @@
+# SPDX-License-Identifier: MIT
+"""Unit tests of the shadowlean Python package (unittest, Debian's /usr/bin/python3).
+
+Input: the boards' generated DBCs and the candump logs the daemon wrote for the demo scene
+and the real Oxford scans (tests/daemon/golden). Environment: SL_SOURCE_DIR (the checkout),
+SL_PYTHON_PATH (where the package is imported from: the source tree or an install root)."""
+import contextlib
+import io
+import os
+import subprocess
+import sys
+import tempfile
+import unittest
+
+SRC = os.environ.get("SL_SOURCE_DIR") or os.path.join(os.path.dirname(__file__), "..", "..")
+PYPATH = os.environ.get("SL_PYTHON_PATH") or os.path.join(SRC, "python")
+sys.path.insert(0, PYPATH)
+
+import shadowlean as sl  # noqa: E402
+from shadowlean.__main__ import main as cli  # noqa: E402
+
+GOLDEN = os.path.join(SRC, "tests", "daemon", "golden")
+LOGS = {  # log -> board whose DBC the daemon used
+    "demo_three_poles.candump": "paper-sim",
+    "oxford_robotcar.candump": "robotcar-leaf",
+}
+
+
+def dbc_of(board):
+    return os.path.join(SRC, "boards", board, "shadowlean.dbc")
+
+
+def run_cli(argv):
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        try:
+            rc = cli(argv)
+        except SystemExit as e:  # argparse: --help, --version, usage errors
+            rc = e.code
+    return rc, out.getvalue(), err.getvalue()
+
+
+def with_crc(db, name, data):
+    """data with byte 0 set to the E2E CRC of message `name` (for crafted frames)."""
+    fr = next(f for f in db.frames if f.name == name)
+    data = bytearray(data)
+    data[0] = sl.e2e_crc(int(fr.attributes["SlE2EDataId"]), data)
+    return bytes(data)
+
+
+class Crc(unittest.TestCase):
+    def test_check_value(self):
+        self.assertEqual(sl.crc8_j1850(b"123456789"), 0x4B)
+
+    def test_worked_example_of_sl_can_h(self):
+        # Status, Data ID 0x53, bytes 1..7 = 30 02 00 00 00 00 00 -> CRC 0x95.
+        self.assertEqual(sl.e2e_crc(0x53, bytes.fromhex("0030020000000000")), 0x95)
+
+    def test_data_id_changes_the_crc(self):
+        frame = bytes.fromhex("0030020000000000")
+        self.assertNotEqual(sl.e2e_crc(0x53, frame), sl.e2e_crc(0x51, frame))
+
+
+class Candump(unittest.TestCase):
+    def test_formats(self):
+        f = sl.parse_candump_line("(1700000000.250000) can0 621#0400000000000060\n")
+        self.assertEqual(f, sl.Frame(1700000000.25, "can0", 0x621, False, bytes.fromhex("0400000000000060")))
+        f = sl.parse_candump_line("(1.5) vcan1 1ABCDEF0#01.02")
+        self.assertEqual((f.can_id, f.is_eff, f.data, f.t), (0x1ABCDEF0, True, b"\x01\x02", 1.5))
+        f = sl.parse_candump_line("(2.000001) can0 300#R")
+        self.assertIsNone(f.data)
+        self.assertIsNone(sl.parse_candump_line("   \n"))
+
+    def test_bad_line_names_file_and_line(self):
+        with tempfile.NamedTemporaryFile("w", suffix=".log", delete=False) as fh:
+            fh.write("(1.0) can0 621#0400000000000060\nthis is not candump\n")
+        try:
+            with self.assertRaisesRegex(ValueError, r":2: not a candump -L line"):
+                sl.read_candump(fh.name)
+            rc, _, err = run_cli(["decode", fh.name, "--dbc", dbc_of("paper-sim")])
+            self.assertEqual(rc, 1)
+            self.assertIn(":2:", err)
+        finally:
+            os.unlink(fh.name)
+
+
+class GoldenLogs(unittest.TestCase):
+    """The daemon's own frames: every one known to the board's DBC, CRC and counters clean."""
+
+    def test_every_frame_decodes_and_verifies(self):
+        for log, board in LOGS.items():
+            with self.subTest(log=log):
+                db = sl.load_dbc(dbc_of(board))
+                frames = sl.read_candump(os.path.join(GOLDEN, log))
+                self.assertGreater(len(frames), 10)
+                mon = sl.E2EMonitor(db)
+                counters = {}
+                for f, d in sl.decode_frames(db, frames):
+                    self.assertIsNotNone(d, f"{log}: id {f.can_id:X} not in the DBC")
+                    self.assertTrue(d.length_ok and d.crc_ok and d.reencode_ok, f"{log}: {f}")
+                    self.assertEqual(mon.check(d, f.data), "ok")
+                    # counters run 0, 1, ... per message from the daemon's start, modulo 15
+                    n = counters.get(d.name, 0)
+                    self.assertEqual(d.counter, n % 15, f"{log}: {d.name} #{n}")
+                    counters[d.name] = n + 1
+                self.assertEqual(mon.errors(), 0)
+                # one Status per rotation, each followed by its Health
+                self.assertEqual(counters.get("Status"), counters.get("Health"))
+                self.assertGreaterEqual(counters.get("Status", 0), 5)
+
+    def test_demo_scene_warns_of_the_right_pole(self):
+        decoded = sl.decode_log(dbc_of("paper-sim"), os.path.join(GOLDEN, "demo_three_poles.candump"))
+        st, warn, poles = sl.groups(decoded)[-1]
+        self.assertEqual(sl.LINK[st.raw["LinkState"]], "STREAMING")
+        # scenes/demo_three_poles.ini: +12 deg at 90 deg, +6 at 180, -6 at 270
+        self.assertEqual(sorted(round(p.phys["Azimuth"]) for p in poles), [90, 180, 270])
+        self.assertEqual(warn.named.get("Level", sl.LEVEL[warn.raw["Level"]]), "DANGER")
+        self.assertAlmostEqual(warn.phys["Azimuth"], 90.0, delta=1.0)
+        self.assertAlmostEqual(warn.phys["Lean"], 12.0, delta=2.0)
+
+
+class E2E(unittest.TestCase):
+    def setUp(self):
+        self.db = sl.load_dbc(dbc_of("paper-sim"))
+        self.frames = [f for f in sl.read_candump(os.path.join(GOLDEN, "demo_three_poles.candump"))]
+        self.status = [f for f in self.frames if f.can_id == 0x622]
+
+    def verdicts(self, frames):
+        mon = sl.E2EMonitor(self.db)
+        return [mon.check(sl.decode(self.db, f.can_id, f.is_eff, f.data), f.data) for f in frames], mon
+
+    def test_lost_frame_is_a_jump(self):
+        v, mon = self.verdicts(self.status[:3] + self.status[5:7])
+        self.assertEqual(v, ["ok", "ok", "ok", "jump", "ok"])
+        self.assertEqual(mon.stats["Status"].lost_frames, 2)
+        self.assertEqual(mon.errors(), 2)
+
+    def test_repetition_is_rejected(self):
+        v, mon = self.verdicts(self.status[:3] + [self.status[2]] + self.status[3:4])
+        self.assertEqual(v, ["ok", "ok", "ok", "repeated", "ok"])
+        self.assertEqual(mon.stats["Status"].repeated, 1)
+
+    def test_flipped_bit_fails_the_crc(self):
+        f = self.status[1]
+        bad = f._replace(data=bytes([f.data[0]]) + bytes([f.data[1] ^ 0x40]) + f.data[2:])
+        v, mon = self.verdicts([self.status[0], bad, self.status[2]])
+        self.assertEqual(v, ["ok", "crc", "jump"])
+        self.assertEqual(mon.stats["Status"].crc_errors, 1)
+
+    def test_frame_copied_to_another_id_fails_the_crc(self):
+        # A Status payload sent with the PoleLean id: the Data ID differs, so the CRC fails.
+        f = self.status[1]._replace(can_id=0x620)
+        v, _ = self.verdicts([f])
+        self.assertEqual(v, ["crc"])
+
+    def test_counter_15_is_invalid_even_with_a_good_crc(self):
+        f = self.status[1]
+        data = bytearray(f.data)
+        data[1] = (data[1] & 0xF0) | 15
+        v, mon = self.verdicts([f._replace(data=with_crc(self.db, "Status", data))])
+        self.assertEqual(v, ["counter_invalid"])
+        self.assertEqual(mon.stats["Status"].bad_counter, 1)
+
+    def test_wrong_length_and_unknown_id(self):
+        f = self.status[1]
+        v, mon = self.verdicts([f._replace(data=f.data[:7]), f._replace(can_id=0x7FF), f._replace(data=None)])
+        self.assertEqual(v, ["length", "unknown_id", "length"])
+        self.assertEqual(mon.unknown, 1)
+
+    def test_counter_wraps_modulo_15(self):
+        # 16 Status frames sent in a row: 0..14, 0 -- accepted; the modulo comes from the DBC.
+        msgs = [f for f in self.frames if f.can_id == 0x622][:16]
+        self.assertEqual([sl.decode(self.db, f.can_id, False, f.data).counter for f in msgs][-2:], [14, 0])
+        v, mon = self.verdicts(msgs)
+        self.assertEqual(set(v), {"ok"})
+
+
+class PythonCanBus(unittest.TestCase):
+    """Live decoding through python-can, on its virtual interface (no kernel CAN needed)."""
+
+    def test_virtual_bus_gives_the_same_frames_as_the_log(self):
+        import can
+        log = os.path.join(GOLDEN, "demo_three_poles.candump")
+        frames = sl.read_candump(log)[:60]
+        chan = f"sl-test-{os.getpid()}"
+        with can.Bus(interface="virtual", channel=chan) as tx, \
+                sl.open_bus(chan, interface="virtual") as rx:
+            for f in frames:
+                tx.send(sl.message_from_frame(f))
+            got = list(sl.frames_from_bus(rx, count=len(frames), timeout=0.5, idle_limit=10.0))
+        self.assertEqual([(g.can_id, g.is_eff, g.data) for g in got],
+                         [(f.can_id, f.is_eff, f.data) for f in frames])
+        db = sl.load_dbc(dbc_of("paper-sim"))
+        mon = sl.E2EMonitor(db)
+        for g in got:
+            self.assertEqual(mon.check(sl.decode(db, g.can_id, g.is_eff, g.data), g.data), "ok")
+
+    def test_python_can_reads_the_log_like_the_package(self):
+        import can
+        log = os.path.join(GOLDEN, "oxford_robotcar.candump")
+        ours = sl.read_candump(log)
+        theirs = [sl.frame_from_message(m) for m in can.CanutilsLogReader(log)]
+        self.assertEqual([(f.can_id, f.data) for f in ours], [(f.can_id, f.data) for f in theirs])
+        self.assertEqual([round(f.t, 6) for f in ours], [round(f.t, 6) for f in theirs])
+
+
+class Cli(unittest.TestCase):
+    def test_decode_check_ok(self):
+        rc, out, err = run_cli(["decode", os.path.join(GOLDEN, "demo_three_poles.candump"),
+                                "--dbc", dbc_of("paper-sim"), "--check"])
+        self.assertEqual(rc, 0, err)
+        self.assertIn("crc=ok", out)
+        self.assertNotIn("crc=BAD", out)
+        self.assertRegex(out, r"\nStatus\s+\d+\s+0\s+0\s+0\s+0\s+0\s+0\n")
+
+    def test_decode_check_fails_on_a_corrupt_log(self):
+        lines = open(os.path.join(GOLDEN, "demo_three_poles.candump")).read().splitlines()
+        # drop line 5 (a Status frame: a counter jump) and corrupt a data nibble of line 8
+        del lines[4]
+        head, data = lines[7].rsplit("#", 1)
+        lines[7] = head + "#" + data[:3] + ("0" if data[3] != "0" else "1") + data[4:]
+        with tempfile.NamedTemporaryFile("w", suffix=".log", delete=False) as fh:
+            fh.write("\n".join(lines) + "\n")
+        try:
+            rc, out, err = run_cli(["decode", fh.name, "--dbc", dbc_of("paper-sim"), "--check"])
+        finally:
+            os.unlink(fh.name)
+        self.assertEqual(rc, 1)
+        self.assertIn("crc=BAD", out)
+        self.assertIn("e2e=jump", out)
+        self.assertIn("E2E check failed", err)
+
+    def test_summary_and_table(self):
+        log = os.path.join(GOLDEN, "demo_three_poles.candump")
+        rc, out, _ = run_cli(["decode", log, "--dbc", dbc_of("paper-sim"), "--table", "--last", "1"])
+        self.assertEqual(rc, 0)
+        self.assertEqual(len(out.splitlines()), 4)  # header + the three poles
+        self.assertIn("DANGER", out)
+        rc, out, _ = run_cli(["decode", log, "--dbc", dbc_of("paper-sim"), "--summary"])
+        self.assertEqual(rc, 0)
+        self.assertIn("more rotation(s) alike", out)
+
+    def test_no_frame_of_the_dbc_is_an_error(self):
+        with tempfile.NamedTemporaryFile("w", suffix=".log", delete=False) as fh:
+            fh.write("(1.0) can0 7FF#0011223344556677\n")
+        try:
+            rc, _, err = run_cli(["decode", fh.name, "--dbc", dbc_of("paper-sim")])
+        finally:
+            os.unlink(fh.name)
+        self.assertEqual(rc, 1)
+        self.assertIn("no frame of this DBC", err)
+
+    def test_conventions(self):
+        rc, out, _ = run_cli(["--help"])
+        self.assertEqual(rc, 0)
+        self.assertIn("decode", out)
+        rc, out, _ = run_cli(["--version"])
+        self.assertEqual((rc, out.strip()), (0, f"shadowlean {sl.__version__}"))
+        self.assertRegex(sl.__version__, r"^\d+\.\d+\.\d+$")
+        rc, _, err = run_cli(["decode", "x.log", "--dbc", "y.dbc", "--bogus"])
+        self.assertEqual(rc, 2)
+        self.assertIn("--bogus", err)
+        rc, _, err = run_cli([])
+        self.assertEqual(rc, 2)
+        rc, _, err = run_cli(["decode", "/nonexistent.log", "--dbc", dbc_of("paper-sim")])
+        self.assertEqual(rc, 1)
+        self.assertIn("/nonexistent.log", err)
+        rc, _, err = run_cli(["live", "--dbc", dbc_of("paper-sim"), "--channel", "sl-no-such-can0",
+                              "--count", "1"])
+        self.assertEqual(rc, 1)
+        self.assertIn("cannot open", err)
+
+    def test_module_runs_and_imports_without_noise(self):
+        # python3 -m shadowlean as a user runs it: nothing from canmatrix's import on stderr.
+        env = dict(os.environ, PYTHONPATH=PYPATH)
+        r = subprocess.run([sys.executable, "-m", "shadowlean", "decode",
+                            os.path.join(GOLDEN, "oxford_robotcar.candump"), "--dbc",
+                            dbc_of("robotcar-leaf"), "--check"], env=env, capture_output=True, text=True)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertEqual(r.stderr, "")
+        self.assertIn("Status", r.stdout)
+
+
+if __name__ == "__main__":
+    unittest.main()
