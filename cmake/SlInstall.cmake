@@ -9,6 +9,8 @@
 #   component daemon: sbin/shadowleand, lib/systemd/system/shadowleand.service,
 #                     share/shadowlean/{shadowleand.conf,dbc/<board>.dbc}, man8 page
 #   component tools:  bin/sl-* host tools, man1 pages, share/shadowlean/wireshark/colossus.lua
+#   component python: lib/python3/dist-packages/shadowlean (the CAN consumer package,
+#                     python/; Debian's python3 path, as python3-* packages install it)
 # Every component carries the licence (share/doc/<package>/copyright).
 include(GNUInstallDirs)
 include(CMakePackageConfigHelpers)
@@ -126,6 +128,18 @@ if(SL_BUILD_HOST_TOOLS)
     DESTINATION ${CMAKE_INSTALL_DATADIR}/shadowlean/wireshark COMPONENT tools)
 endif()
 
+# ---- Python package for CAN consumers (python/shadowlean): pure Python, Debian's path.
+# _version.py is written with the project's version baked in (the source tree's copy reads
+# it from CMakeLists.txt, which is not installed).
+set(SL_PYTHON_DIR lib/python3/dist-packages CACHE STRING
+    "Where the Python package is installed, relative to the prefix (Debian: lib/python3/dist-packages)")
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/python/shadowlean DESTINATION ${SL_PYTHON_DIR}
+  COMPONENT python PATTERN "__pycache__" EXCLUDE PATTERN "*.pyc" EXCLUDE PATTERN "_version.py" EXCLUDE)
+file(WRITE ${PROJECT_BINARY_DIR}/python/_version.py
+  "# SPDX-License-Identifier: MIT\n\"\"\"The package version (written by cmake --install).\"\"\"\n__version__ = \"${PROJECT_VERSION}\"\n")
+install(FILES ${PROJECT_BINARY_DIR}/python/_version.py DESTINATION ${SL_PYTHON_DIR}/shadowlean
+  COMPONENT python)
+
 # The Debian changelog, compressed as policy wants it (gzip -9n: reproducible).
 add_custom_command(OUTPUT ${PROJECT_BINARY_DIR}/changelog.gz
   COMMAND ${SL_GZIP} -9nc ${PROJECT_SOURCE_DIR}/packaging/debian/changelog > ${PROJECT_BINARY_DIR}/changelog.gz
@@ -134,7 +148,8 @@ add_custom_target(sl_changelog ALL DEPENDS ${PROJECT_BINARY_DIR}/changelog.gz)
 
 # ---- licence and README in every component's doc folder (Debian: copyright)
 # (doc folder = the Debian package's name, cmake/SlPackage.cmake)
-foreach(pair "sdk:shadowlean-dev" "daemon:shadowleand" "tools:shadowlean-tools")
+foreach(pair "sdk:shadowlean-dev" "daemon:shadowleand" "tools:shadowlean-tools"
+             "python:python3-shadowlean")
   string(REPLACE ":" ";" pair ${pair})
   list(GET pair 0 comp)
   list(GET pair 1 pkg)

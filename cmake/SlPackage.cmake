@@ -3,6 +3,7 @@
 #   shadowlean-dev    the SDK: headers, libsl_core.a, CMake package, pkg-config (component sdk)
 #   shadowleand       the daemon, its systemd unit, example config, DBCs (component daemon)
 #   shadowlean-tools  the host tools and the Wireshark dissector (component tools)
+#   python3-shadowlean  the Python package for CAN consumers (component python)
 # Run-time dependencies come from dpkg-shlibdeps; the test tests/install/ builds, lists,
 # unpacks and lints them.
 set(CPACK_PACKAGE_NAME shadowlean)
@@ -27,6 +28,12 @@ set(CPACK_DEBIAN_SDK_PACKAGE_SECTION libdevel)
 set(CPACK_DEBIAN_DAEMON_PACKAGE_NAME shadowleand)
 set(CPACK_DEBIAN_DAEMON_PACKAGE_SECTION net)
 set(CPACK_DEBIAN_TOOLS_PACKAGE_NAME shadowlean-tools)
+set(CPACK_DEBIAN_PYTHON_PACKAGE_NAME python3-shadowlean)
+set(CPACK_DEBIAN_PYTHON_PACKAGE_SECTION python)
+set(CPACK_DEBIAN_PYTHON_PACKAGE_ARCHITECTURE all)
+set(CPACK_DEBIAN_PYTHON_PACKAGE_SHLIBDEPS OFF)
+set(CPACK_DEBIAN_PYTHON_PACKAGE_DEPENDS "python3:any, python3-canmatrix")
+set(CPACK_DEBIAN_PYTHON_PACKAGE_RECOMMENDS "python3-can")
 set(CPACK_COMPONENT_SDK_DESCRIPTION "shadowlean SDK: portable fixed-point core\n\
  The pole-lean core (C11, no allocation, no float, no OS) with its headers,\n\
  static library, CMake package and pkg-config file.")
@@ -36,5 +43,9 @@ set(CPACK_COMPONENT_DAEMON_DESCRIPTION "shadowlean daemon: radar TCP stream to C
 set(CPACK_COMPONENT_TOOLS_DESCRIPTION "shadowlean host tools\n\
  Table generator, simulator, replay and record, inspector, viewer,\n\
  calibration, evaluation, benchmarks and a Wireshark dissector.")
-set(CPACK_COMPONENTS_ALL sdk daemon tools)
+set(CPACK_COMPONENT_PYTHON_DESCRIPTION "shadowlean CAN frames in Python: decode and verify\n\
+ Decodes the CAN frames of a shadowlean module with the board's DBC\n\
+ (canmatrix), verifies the E2E CRC and counters, reads candump logs and\n\
+ live SocketCAN buses (python-can); python3 -m shadowlean.")
+set(CPACK_COMPONENTS_ALL sdk daemon tools python)
 include(CPack)

@@ -6,7 +6,9 @@
 #     installed daemon), man pages when help2man is installed;
 #  2. a tiny consumer (tests/install/consumer) built with find_package(shadowlean) and,
 #     separately, with pkg-config; both link the core and a board and run the estimator;
-#  3. cpack -G DEB: three packages, contents listed, unpacked into a scratch root, their
+#     the Python package (lib/python3/dist-packages/shadowlean) imported from the prefix,
+#     its version the project's, decoding and verifying a daemon log with an installed DBC;
+#  3. cpack -G DEB: four packages, contents listed, unpacked into a scratch root, their
 #     dependencies named; lintian (when installed) reports no error.
 set -eu
 BUILD=$(cd "$1" && pwd); SRC=$(cd "$2" && pwd); WORK=$3
@@ -34,6 +36,23 @@ if command -v help2man >/dev/null 2>&1; then
     MANPATH="$P/share/man" MANWIDTH=80 man shadowleand 2>/dev/null | grep -q "shadowleand" ||
         fail "man shadowleand does not render"
 fi
+PY3=/usr/bin/python3
+[ -x "$PY3" ] || PY3=python3
+# The Python package from the prefix alone (not the source tree), as a user runs it.
+check_python() { # ROOT_PYTHON_DIR DBC LABEL
+    (cd "$WORK" && PYTHONPATH="$1" PYTHONDONTWRITEBYTECODE=1 "$PY3" -c \
+        'import shadowlean, sys; print(shadowlean.__file__); print(shadowlean.__version__)') \
+        > "$WORK/py-$3.txt" 2>&1 || { cat "$WORK/py-$3.txt"; fail "$3: import shadowlean"; }
+    case "$(head -1 "$WORK/py-$3.txt")" in "$1"/shadowlean/*) ;; *) fail "$3: shadowlean imported from $(head -1 "$WORK/py-$3.txt")";; esac
+    want=$(sed -n 's/^project(shadowlean VERSION \([0-9.]*\).*/\1/p' "$SRC/CMakeLists.txt")
+    [ "$(sed -n 2p "$WORK/py-$3.txt")" = "$want" ] || fail "$3: shadowlean.__version__ $(sed -n 2p "$WORK/py-$3.txt") != $want"
+    (cd "$WORK" && PYTHONPATH="$1" PYTHONDONTWRITEBYTECODE=1 "$PY3" -m shadowlean decode \
+        "$SRC/tests/daemon/golden/demo_three_poles.candump" --dbc "$2" --check) > "$WORK/py-$3.log" 2>&1 ||
+        { tail -5 "$WORK/py-$3.log"; fail "$3: python3 -m shadowlean decode --check"; }
+    echo "python ($3): shadowlean $want, $(grep -c 'crc=ok' "$WORK/py-$3.log") frames verified"
+}
+check_python "$P/lib/python3/dist-packages" "$P/share/shadowlean/dbc/paper-sim.dbc" prefix
+
 echo "install: $(find "$P" -type f | wc -l) files under the prefix"
 
 # 2. consumers
@@ -55,7 +74,7 @@ echo "$out1" | grep -q "alpha [0-9-]* cdeg (flag 0)" || fail "unexpected consume
 
 # 3. Debian packages
 (cd "$BUILD" && cpack -G DEB -B "$WORK/deb" > "$WORK/cpack.log" 2>&1) || { tail -20 "$WORK/cpack.log"; fail "cpack"; }
-for p in shadowlean-dev shadowleand shadowlean-tools; do
+for p in shadowlean-dev shadowleand shadowlean-tools python3-shadowlean; do
     deb=$(ls "$WORK"/deb/${p}_*.deb 2>/dev/null | head -1)
     [ -n "$deb" ] || fail "no package $p"
     echo "== $(basename "$deb"): $(dpkg-deb -f "$deb" Depends)"
@@ -63,12 +82,14 @@ for p in shadowlean-dev shadowleand shadowlean-tools; do
     dpkg-deb -x "$deb" "$WORK/root"
 done
 for f in usr/sbin/shadowleand usr/lib/systemd/system/shadowleand.service usr/lib/libsl_core.a \
-         usr/include/shadowlean/sl_pipeline.h usr/share/shadowlean/dbc/paper-sim.dbc usr/bin/sl-inspect; do
+         usr/include/shadowlean/sl_pipeline.h usr/share/shadowlean/dbc/paper-sim.dbc usr/bin/sl-inspect \
+         usr/lib/python3/dist-packages/shadowlean/__init__.py; do
     [ -e "$WORK/root/$f" ] || fail "package root lacks $f"
 done
 grep -q "^ExecStart=/usr/sbin/shadowleand " "$WORK/root/usr/lib/systemd/system/shadowleand.service" ||
     fail "packaged unit does not start /usr/sbin/shadowleand"
 "$WORK/root/usr/sbin/shadowleand" --version > /dev/null || fail "packaged daemon does not run"
+check_python "$WORK/root/usr/lib/python3/dist-packages" "$WORK/root/usr/share/shadowlean/dbc/paper-sim.dbc" deb
 if command -v lintian >/dev/null 2>&1; then
     lintian --tag-display-limit 0 "$WORK"/deb/*.deb > "$WORK/lintian.log" 2>&1 || true
     sed 's/^/   lintian: /' "$WORK/lintian.log"
