@@ -8,7 +8,8 @@ int sld_targets_write_header(FILE *fp, const sl_board_t *b, const sl_pipeline_cf
 {
     const int n = fprintf(
         fp,
-        "{\"type\":\"header\",\"board\":\"%s\",\"azimuths\":%u,\"radar_yaw_cdeg\":%" PRId32
+        "{\"type\":\"header\",\"schema\":\"" SLD_TARGETS_SCHEMA "\""
+        ",\"board\":\"%s\",\"azimuths\":%u,\"radar_yaw_cdeg\":%" PRId32
         ",\"confirm_hits\":%u,\"bin_size_um\":%" PRIu32 ",\"threshold\":%u,\"mask_frames\":%u"
         ",\"can_id_pole_lean\":%" PRIu32 ",\"can_id_lean_warning\":%" PRIu32
         ",\"can_id_status\":%" PRIu32 ",\"can_id_vehicle_motion\":%" PRIu32 "}\n",

@@ -3,8 +3,11 @@
 /// @brief `--targets-out`: the pipeline's per-rotation results as JSON lines, the side
 ///        file tests compare the CAN output with.
 ///
+/// Schema: docs/schema/targets.schema.json, documented in docs/JSON_OUTPUTS.md (every field,
+/// units, versioning). The header's "schema" key names the output and its major version.
+///
 /// First line, once:
-///     {"type":"header","board":"paper-sim","azimuths":400,"radar_yaw_cdeg":0,
+///     {"type":"header","schema":"shadowlean-targets/1","board":"paper-sim","azimuths":400,"radar_yaw_cdeg":0,
 ///      "confirm_hits":3,"bin_size_um":43800,"can_id_pole_lean":1568,...}
 /// Then one line per completed rotation (`port.on_rotation`), written BEFORE the CAN
 /// frames of that rotation:
@@ -25,6 +28,9 @@
 #include <stdio.h>
 
 #include "shadowlean/sl_pipeline.h"
+
+/// The header line's "schema": output name / major version (docs/JSON_OUTPUTS.md).
+#define SLD_TARGETS_SCHEMA "shadowlean-targets/1"
 
 #ifdef __cplusplus
 extern "C" {

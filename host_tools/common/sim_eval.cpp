@@ -1061,7 +1061,7 @@ void print_table1(std::FILE *f, const Table1Result &r)
 std::string table1_json(const Table1Result &r)
 {
     std::ostringstream o;
-    o << "{\n  \"experiment\": \"table1\",\n  \"extraction\": \"bbox extraction (detection pipeline not used)\",\n"
+    o << "{\n  \"schema\": \"shadowlean-eval-table1/1\",\n  \"experiment\": \"table1\",\n  \"extraction\": \"bbox extraction (detection pipeline not used)\",\n"
       << "  \"rotations_per_pass\": " << r.rotations << ",\n  \"angles_deg\": [-10, 0, 10],\n  \"rows\": [\n";
     for (size_t i = 0; i < r.rows.size(); i++) {
         const auto &row = r.rows[i];
@@ -1753,7 +1753,7 @@ void print_realistic(std::FILE *f, const RealisticResult &r)
 std::string realistic_json(const RealisticResult &r)
 {
     std::ostringstream o;
-    o << "{\n  \"experiment\": \"realistic\",\n  \"extraction\": \"bbox extraction (detection pipeline not used)\",\n"
+    o << "{\n  \"schema\": \"shadowlean-eval-realistic/1\",\n  \"experiment\": \"realistic\",\n  \"extraction\": \"bbox extraction (detection pipeline not used)\",\n"
       << "  \"frames\": " << r.frames << ", \"positions\": " << r.positions << ", \"reps\": " << r.reps << ",\n"
       << "  \"d_const_m\": " << jnum(r.d_const_m) << ", \"tail_slope\": " << jnum(r.tail_slope)
       << ", \"kernel_a\": " << jnum(r.kernel_a) << ", \"d_resid_m\": " << jnum(r.d_resid_m)

@@ -265,6 +265,7 @@ int main(int argc, char **argv)
     const sl_scan_stats_t &ss = in->scan.stats;
 
     json j;
+    j["schema"] = "shadowlean-inspect/1"; // docs/schema/inspect.schema.json, docs/JSON_OUTPUTS.md
     j["file"] = path;
     j["format"] = sl::capture_format_name(cap.format);
     j["bytes"] = cap_bytes;
