@@ -16,6 +16,7 @@ struct ShadowArgs {
     double bin_size_m = 0;  ///< > 0: override the capture's / board's bin size
     double height_m = 0;    ///< > 0: override the board's radar height
     ShadowCalibOptions opt; ///< estimator knobs (H and b are filled in)
+    bool quiet = false;     ///< no progress on stderr (sl_progress.h)
 };
 int cmd_shadow(const ShadowArgs &a);
 
@@ -28,6 +29,7 @@ struct ElongArgs {
     int points = 0;                   ///< table points (0 = automatic)
     int mask_frames = 0;              ///< consistency window (0 = board's, capped by frames)
     int threshold = -1;               ///< occupancy threshold (-1 = board's)
+    bool quiet = false;               ///< no progress on stderr (sl_progress.h)
 };
 int cmd_elongation(const ElongArgs &a);
 

@@ -17,6 +17,7 @@
 
 #include "calib_elong.h"
 #include "sl_board_spec.h"
+#include "sl_progress.h"
 #include "view_draw.h"
 #include "view_frames.h"
 #ifdef SL_HAVE_SIM_TRUTH
@@ -210,8 +211,10 @@ int cmd_elongation(const ElongArgs &a)
     eo.threshold = a.threshold >= 0 ? a.threshold : board.threshold;
     eo.mask_frames = a.mask_frames > 0 ? a.mask_frames : board.mask_frames;
     std::vector<ElongMeasurement> all;
+    Progress progress("sl-calib", a.quiet);
     for (size_t ci = 0; ci < a.captures.size(); ci++) {
         const std::string &cap = a.captures[ci];
+        progress.update(static_cast<long long>(ci), static_cast<long long>(a.captures.size()), "capture");
         FrameOptions fo;
         fo.azimuths = board.azimuths;
         fo.encoder_size = board.encoder_size;
@@ -282,6 +285,7 @@ int cmd_elongation(const ElongArgs &a)
             all.push_back(m);
         }
     }
+    progress.finish();
     int missing = 0;
     for (const auto &m : all) missing += m.found ? 0 : 1;
     const ElongTable t = fit_elongation(all, a.points);

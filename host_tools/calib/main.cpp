@@ -41,7 +41,8 @@ void usage(FILE *out)
         "      [--search-max-m M] [--edge foot|half] [--ground-window-m M]\n"
         "  sl-calib elongation CAPTURE... --truth FILE [--truth FILE...] [--board NAME]\n"
         "      [--out-ini FILE] [--png FILE] [--csv FILE] [--points N] [--mask-frames N]\n"
-        "      [--threshold T] [--bin-size-m M]      (default board: paper-bench)\n",
+        "      [--threshold T] [--bin-size-m M]      (default board: paper-bench)\n"
+        "  Both take -q/--quiet: no progress on stderr (shown only when it is a terminal).\n",
         out);
 }
 
@@ -89,7 +90,9 @@ int main(int argc, char **argv)
             const std::string o = argv[i];
             const bool has = i + 1 < argc;
             double v = 0;
-            if (o == "--board" && has) {
+            if (o == "--quiet" || o == "-q") {
+                a.quiet = true;
+            } else if (o == "--board" && has) {
                 a.board = argv[++i];
             } else if (o == "--out-ini" && has) {
                 a.out_ini = argv[++i];
@@ -139,7 +142,9 @@ int main(int argc, char **argv)
             const std::string o = argv[i];
             const bool has = i + 1 < argc;
             double v = 0;
-            if (o == "--board" && has) {
+            if (o == "--quiet" || o == "-q") {
+                a.quiet = true;
+            } else if (o == "--board" && has) {
                 a.board = argv[++i];
             } else if (o == "--truth" && has) {
                 a.truth.push_back(argv[++i]);

@@ -16,6 +16,7 @@
 
 #include "calib_shadow.h"
 #include "sl_board_spec.h"
+#include "sl_progress.h"
 #include "view_draw.h"
 #include "view_frames.h"
 
@@ -239,6 +240,8 @@ int cmd_shadow(const ShadowArgs &a)
             fo.bin_size_m = board.bin_size_m;
         }
     }
+    Progress progress("sl-calib", a.quiet); // two steps: read the capture, fit the shadow
+    progress.update(0, 2, "reading the capture");
     if (!load_frames(a.input, fo, fs, err)) {
         std::fprintf(stderr, "sl-calib: %s\n", err.c_str());
         return 1;
@@ -270,12 +273,14 @@ int cmd_shadow(const ShadowArgs &a)
     so.bin_size_m = fs.bin_size_m;
     so.max_theta_deg = board.lower_bound_deg + 3.0;
     ShadowCalib c;
+    progress.update(1, 2, "fitting the shadow");
     try {
         c = calibrate_shadow(frames, valid, so);
     } catch (const std::exception &e) {
         std::fprintf(stderr, "sl-calib: %s\n", e.what());
         return 1;
     }
+    progress.finish();
     std::vector<double> bth(board.azimuths);
     for (int i = 0; i < board.azimuths; i++) {
         bth[i] = board.theta_deg(i);

@@ -11,6 +11,7 @@
 
 #include "sim_eval.h"
 #include "sl_cli.h"
+#include "sl_progress.h"
 #include "sim_render.h"
 
 namespace {
@@ -42,7 +43,7 @@ void usage(FILE *out)
                  "             [--extract bbox|pipeline] [--beam-deg DEG] [--speed M/S] [--no-width-radius]\n"
                  "      Evaluates one capture made by sl-sim against its ground truth. --extract pipeline:\n"
                  "      the core pipeline (beam, threshold and speed from --scene, or the options).\n"
-                 "--quiet silences the progress lines on stderr.\n");
+                 "Progress goes to stderr when it is a terminal; -q/--quiet silences it.\n");
 }
 
 // The last argument of table1/realistic: a value option without its value, or unknown.
@@ -72,6 +73,7 @@ bool write_text(const std::string &path, const std::string &text)
 int cmd_table1(int argc, char **argv)
 {
     sl::Table1Options o;
+    o.progress = sl::progress_wanted(false); // only when stderr is a terminal
     bool json = false;
     std::string plot, json_out;
     for (int i = 0; i < argc; i++) {
@@ -90,7 +92,7 @@ int cmd_table1(int argc, char **argv)
             plot = argv[++i];
         } else if (a == "--threads" && i + 1 < argc) {
             o.threads = std::atoi(argv[++i]);
-        } else if (a == "--quiet") {
+        } else if (a == "--quiet" || a == "-q") {
             o.progress = false;
         } else if (a == "--extract" && i + 1 < argc) {
             const std::string m = argv[++i];
@@ -136,6 +138,7 @@ int cmd_table1(int argc, char **argv)
 int cmd_realistic(int argc, char **argv)
 {
     sl::RealisticOptions o;
+    o.progress = sl::progress_wanted(false);
     bool json = false;
     std::string json_out;
     for (int i = 0; i < argc; i++) {
@@ -160,7 +163,7 @@ int cmd_realistic(int argc, char **argv)
             json = true;
         } else if (a == "--json-out" && i + 1 < argc) {
             json_out = argv[++i];
-        } else if (a == "--quiet") {
+        } else if (a == "--quiet" || a == "-q") {
             o.progress = false;
         } else if (a == "--smear-decay" && i + 1 < argc) {
             o.smear_decay_db = std::atof(argv[++i]);

@@ -2,7 +2,6 @@
 // sl-sim: simulate a scene (scenes/README.md) into a raw Colossus capture -- exactly the
 // bytes a CTS350-X sends: one Configuration message, then one 8-bit FFT Data message per
 // azimuth -- and a ground-truth CSV (one row per rotation, pole and azimuth it is seen on).
-#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -10,6 +9,7 @@
 
 #include "sim_render.h"
 #include "sl_cli.h"
+#include "sl_progress.h"
 #include "sim_scene.h"
 #include "sim_truth.h"
 
@@ -22,7 +22,8 @@ void usage(FILE *out)
                  "              [--first K] [--seed S] [--threads N] [--quiet]\n"
                  "  Simulates SCENE (format: scenes/README.md) into a raw Colossus capture and a\n"
                  "  ground-truth CSV (default: OUT with .gt.csv). --rotations/--seed override the\n"
-                 "  scene's values; --threads 0 = all cores (default).\n");
+                 "  scene's values; --threads 0 = all cores (default). Progress goes to stderr\n"
+                 "  when it is a terminal; -q/--quiet silences it and the summary.\n");
 }
 
 } // namespace
@@ -115,7 +116,7 @@ int main(int argc, char **argv)
         if (!write(cfg.data(), cfg.size())) {
             throw sl::SceneError("write error on " + out);
         }
-        const auto t0 = std::chrono::steady_clock::now();
+        sl::Progress progress("sl-sim", quiet); // stderr, only on a terminal
         size_t gt_rows = 0;
         sl::sim_run(
             sim, first, s.rotations, threads,
@@ -128,19 +129,8 @@ int main(int argc, char **argv)
                 }
                 gt_rows += gt.size();
             },
-            [&](int done, int total) {
-                if (quiet) {
-                    return;
-                }
-                const double el = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-                if (done == total || done % 10 == 0) {
-                    std::fprintf(stderr, "\rsl-sim: rotation %d/%d (%.0f%%) %.1f s, eta %.1f s   ",
-                                 done, total, 100.0 * done / total, el, el / done * (total - done));
-                    if (done == total) {
-                        std::fprintf(stderr, "\n");
-                    }
-                }
-            });
+            [&](int done, int total) { progress.update(done, total, "rotation"); });
+        progress.finish();
         std::fclose(gf);
         if (std::fclose(wf) != 0) {
             std::fprintf(stderr, "sl-sim: write error on %s\n", out.c_str());

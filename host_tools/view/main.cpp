@@ -48,6 +48,7 @@
 
 #include "calib_shadow.h"
 #include "sl_cli.h"
+#include "sl_progress.h"
 #include "shadowlean/sl_board.h"
 #include "shadowlean/sl_detect.h"
 #include "shadowlean/sl_mask.h"
@@ -66,7 +67,7 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 struct Args {
     std::string input, board, out, truth, calib, elongation, title;
     int rotation = -1;
-    bool all = false;
+    bool all = false, quiet = false;
     double roi_m = 0, vmax = 0, fps = 4, bin_size_m = 0;
     int mask_frames = 0, threshold = -1;
 };
@@ -77,7 +78,8 @@ void usage(FILE *out)
         "usage: sl-view CAPTURE|OXFORD_DIR --board NAME --out FILE.png|FILE.mp4|FILE.avi\n"
         "               [--rotation K | --all] [--truth GT.csv] [--calib CALIB.ini]\n"
         "               [--roi-m M] [--mask-frames N] [--threshold T] [--vmax V] [--fps F]\n"
-        "               [--bin-size-m M] [--elongation D.ini] [--title TEXT]\n",
+        "               [--bin-size-m M] [--elongation D.ini] [--title TEXT] [-q|--quiet]\n"
+        "  --all: progress on stderr when it is a terminal (-q/--quiet: none).\n",
         out);
 }
 
@@ -440,6 +442,8 @@ int main(int argc, char **argv)
             a.title = argv[++i];
         } else if (o == "--all") {
             a.all = true;
+        } else if (o == "--quiet" || o == "-q") {
+            a.quiet = true;
         } else if (o == "--rotation" && numv(v)) {
             a.rotation = static_cast<int>(v);
         } else if (o == "--roi-m" && numv(v) && v > 0.5) {
@@ -644,6 +648,7 @@ int main(int argc, char **argv)
     std::vector<uint32_t> bits(SL_ROI_WORDS);
     int written = 0;
     size_t next = 0;
+    sl::Progress progress("sl-view", a.quiet || !a.all); // --all: minutes on a long capture
     for (int k = 0; k < N && next < todo.size(); k++) {
         const auto &fr = fs.frames[k];
         for (int az = 0; az < A; az++) {
@@ -677,6 +682,8 @@ int main(int argc, char **argv)
             rv.truth = truth_by_rot[fr.rotation];
         }
         cv::Mat img = render(sc, rv);
+        progress.update(static_cast<long long>(next), static_cast<long long>(todo.size()),
+                        video ? "video frame" : "picture");
         if (video) {
             if (!vw.isOpened()) {
                 video_path = a.out;
@@ -737,6 +744,7 @@ int main(int argc, char **argv)
             }
         }
     }
+    progress.finish();
     if (video) {
         vw.release();
         std::printf("sl-view: wrote %s (%d frames at %.1f fps)%s\n", video_path.c_str(), written, a.fps,
