@@ -7,8 +7,10 @@
 #                     lib/cmake/shadowlean (find_package(shadowlean): shadowlean::core and
 #                     shadowlean::board_<b>), lib/pkgconfig/shadowlean-core.pc
 #   component daemon: sbin/shadowleand, lib/systemd/system/shadowleand.service,
-#                     share/shadowlean/{shadowleand.conf,dbc/<board>.dbc}, man8 page
-#   component tools:  bin/sl-* host tools, man1 pages, share/shadowlean/wireshark/colossus.lua
+#                     share/shadowlean/{shadowleand.conf,dbc/<board>.dbc,schema/targets.schema.json},
+#                     man8 page
+#   component tools:  bin/sl-* host tools, man1 pages, share/shadowlean/wireshark/colossus.lua,
+#                     share/shadowlean/schema/{inspect,eval}.schema.json
 #   component python: lib/python3/dist-packages/shadowlean (the CAN consumer package,
 #                     python/; Debian's python3 path, as python3-* packages install it)
 # Every component carries the licence (share/doc/<package>/copyright).
@@ -64,6 +66,9 @@ if(TARGET shadowleand)
   install(TARGETS shadowleand RUNTIME DESTINATION ${CMAKE_INSTALL_SBINDIR} COMPONENT daemon)
   install(FILES ${PROJECT_SOURCE_DIR}/packaging/shadowleand.conf
     DESTINATION ${CMAKE_INSTALL_DATADIR}/shadowlean COMPONENT daemon)
+  # The JSON Schema of --targets-out (docs/JSON_OUTPUTS.md).
+  install(FILES ${PROJECT_SOURCE_DIR}/docs/schema/targets.schema.json
+    DESTINATION ${CMAKE_INSTALL_DATADIR}/shadowlean/schema COMPONENT daemon)
   foreach(b ${SL_BOARDS})
     if(EXISTS ${PROJECT_SOURCE_DIR}/boards/${b}/shadowlean.dbc)
       install(FILES ${PROJECT_SOURCE_DIR}/boards/${b}/shadowlean.dbc
@@ -126,6 +131,9 @@ endforeach()
 if(SL_BUILD_HOST_TOOLS)
   install(FILES ${PROJECT_SOURCE_DIR}/packaging/wireshark/colossus.lua
     DESTINATION ${CMAKE_INSTALL_DATADIR}/shadowlean/wireshark COMPONENT tools)
+  install(FILES ${PROJECT_SOURCE_DIR}/docs/schema/inspect.schema.json
+    ${PROJECT_SOURCE_DIR}/docs/schema/eval.schema.json
+    DESTINATION ${CMAKE_INSTALL_DATADIR}/shadowlean/schema COMPONENT tools)
 endif()
 
 # ---- Python package for CAN consumers (python/shadowlean): pure Python, Debian's path.

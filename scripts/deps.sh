@@ -3,6 +3,11 @@
 # deps.sh GROUP...: install the Debian packages a group needs, only when missing.
 # Groups: build (host build + tools), test (cross + qemu-user + fuzz + CAN/VM tests), demo.
 # Needs root (or sudo) only when something is missing.
+# python3-canmatrix's optional formats: lxml (arxml, kcd), xlrd/xlsxwriter/xlwt (xls, xlsx),
+# yaml are installed with it, so importing canmatrix.formats prints only "ldf is not
+# supported": its LDF reader needs ldfparser, which Debian does not package. The Python
+# package (python/shadowlean) and the scripts silence that line; the test
+# python_shadowlean_package checks `python3 -m shadowlean` writes nothing to stderr.
 set -eu
 pkgs=""
 for g in "$@"; do
@@ -14,7 +19,7 @@ for g in "$@"; do
              qemu-user libcmocka-dev:arm64 libcmocka-dev:s390x
              libpcap-dev:arm64 libusb-1.0-0-dev:arm64 libinih-dev:arm64 libc6:arm64 libc6:s390x
              python3-canmatrix python3-lxml python3-xlrd python3-xlsxwriter python3-xlwt python3-yaml
-             python3-can python3-numpy can-utils user-mode-linux iproute2 kmod
+             python3-can python3-numpy python3-jsonschema can-utils user-mode-linux iproute2 kmod
              qemu-system-x86 busybox-static cpio usbutils
              qemu-system-arm cppcheck clang-tidy tshark help2man lintian" ;;
     demo) pkgs="$pkgs python3-canmatrix python3-lxml python3-xlrd python3-xlsxwriter python3-xlwt
