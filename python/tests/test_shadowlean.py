@@ -195,6 +195,35 @@ class PythonCanBus(unittest.TestCase):
         for g in got:
             self.assertEqual(mon.check(sl.decode(db, g.can_id, g.is_eff, g.data), g.data), "ok")
 
+    def test_live_cli_decodes_and_checks_a_bus(self):
+        # `python3 -m shadowlean live` on a python-can virtual bus: the frames are queued on
+        # the receiving bus before the CLI reads it (no timing), then --count stops it.
+        import can
+        import shadowlean.__main__ as m
+        frames = sl.read_candump(os.path.join(GOLDEN, "demo_three_poles.candump"))[:40]
+        chan = f"sl-cli-{os.getpid()}"
+        rx = can.Bus(interface="virtual", channel=chan)
+        with can.Bus(interface="virtual", channel=chan) as tx:
+            for f in frames:
+                tx.send(sl.message_from_frame(f))
+        opened = []
+        real_open = m.open_bus
+        m.open_bus = lambda channel, interface: opened.append((channel, interface)) or rx
+        try:
+            rc, out, err = run_cli(["live", "--dbc", dbc_of("paper-sim"), "--channel", "can7",
+                                    "--count", str(len(frames)), "--check"])
+        finally:
+            m.open_bus = real_open
+        self.assertEqual(opened, [("can7", "socketcan")])
+        self.assertEqual(rc, 0, err)
+        self.assertEqual(sum(1 for x in out.splitlines() if "crc=ok" in x), len(frames))
+        self.assertRegex(out, r"\nStatus\s+\d+\s+0\s+0\s+0\s+0\s+0\s+0\n")
+
+    def test_idle_limit_ends_a_silent_bus(self):
+        chan = f"sl-idle-{os.getpid()}"
+        with sl.open_bus(chan, interface="virtual") as rx:
+            self.assertEqual(list(sl.frames_from_bus(rx, timeout=0.05, idle_limit=0.1)), [])
+
     def test_python_can_reads_the_log_like_the_package(self):
         import can
         log = os.path.join(GOLDEN, "oxford_robotcar.candump")
