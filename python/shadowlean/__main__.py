@@ -46,7 +46,8 @@ def _parser():
     v.add_argument("--channel", default="can0", help="bus channel (default can0)")
     v.add_argument("--interface", default="socketcan",
                    help="python-can interface (default socketcan; virtual for tests)")
-    v.add_argument("--count", type=int, metavar="N", help="stop after N frames")
+    v.add_argument("--count", type=int, metavar="N", help="stop after N frames of the DBC "
+                   "(other ids are printed but not counted)")
     v.add_argument("--idle-exit", type=float, metavar="S", help="stop after S seconds without a frame")
     v.add_argument("--check", action="store_true", help="as for decode")
     return p
@@ -92,11 +93,13 @@ def _live(a):
         return 1
     known = 0
     try:
-        for f in frames_from_bus(bus, count=a.count, timeout=0.2, idle_limit=a.idle_exit):
+        for f in frames_from_bus(bus, timeout=0.2, idle_limit=a.idle_exit):
             d = decode(db, f.can_id, f.is_eff, f.data)
             known += d is not None
             e2e = mon.check(d, f.data) if mon is not None else None
             print(format_frame(f, d, e2e), flush=True)
+            if a.count is not None and known >= a.count:
+                break
     except KeyboardInterrupt:
         pass
     finally:

@@ -203,8 +203,9 @@ class PythonCanBus(unittest.TestCase):
         frames = sl.read_candump(os.path.join(GOLDEN, "demo_three_poles.candump"))[:40]
         chan = f"sl-cli-{os.getpid()}"
         rx = can.Bus(interface="virtual", channel=chan)
+        marker = sl.Frame(0.0, "can0", 0x7FF, False, b"SYNC")  # not in the DBC: not counted
         with can.Bus(interface="virtual", channel=chan) as tx:
-            for f in frames:
+            for f in [marker] + frames + [marker]:
                 tx.send(sl.message_from_frame(f))
         opened = []
         real_open = m.open_bus
@@ -217,6 +218,7 @@ class PythonCanBus(unittest.TestCase):
         self.assertEqual(opened, [("can7", "socketcan")])
         self.assertEqual(rc, 0, err)
         self.assertEqual(sum(1 for x in out.splitlines() if "crc=ok" in x), len(frames))
+        self.assertEqual(sum(1 for x in out.splitlines() if "(unknown id)" in x), 1)  # stops at N
         self.assertRegex(out, r"\nStatus\s+\d+\s+0\s+0\s+0\s+0\s+0\s+0\n")
 
     def test_idle_limit_ends_a_silent_bus(self):
