@@ -36,6 +36,8 @@ def type_of(root, s):
     s = resolve(root, s)
     if "const" in s:
         return f"`{json.dumps(s['const'])}`"
+    if s.get("type") == "string" and re.fullmatch(r"\^[\w./-]+\$", s.get("pattern", "")):
+        return f"`{json.dumps(s['pattern'][1:-1])}`"
     if "enum" in s:
         return " \\| ".join(f"`{json.dumps(e)}`" for e in s["enum"])
     t = s.get("type", "")
