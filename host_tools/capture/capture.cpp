@@ -169,8 +169,8 @@ bool load_capture(const std::string &path, Capture &out, std::string &err, const
     return ok;
 }
 
-bool stream_capture(const std::string &path, sl_proto_t *p, size_t chunk, Capture &info, uint64_t &bytes,
-                    std::string &err, const PcapOptions &opt)
+bool read_capture(const std::string &path, const CaptureDataFn &on_data, const CaptureBreakFn &on_break,
+                  Capture &info, uint64_t &bytes, std::string &err, const PcapOptions &opt)
 {
     info = Capture{};
     bytes = 0;
@@ -188,20 +188,16 @@ bool stream_capture(const std::string &path, sl_proto_t *p, size_t chunk, Captur
         sl_port_capture_piece_t pc;
         sl_port_capture_next(c, &pc);
         if (pc.kind == SL_PORT_CAPTURE_DATA) {
-            for (size_t off = 0; off < pc.size;) {
-                size_t n = pc.size - off;
-                if (chunk > 0 && n > chunk) {
-                    n = chunk;
-                }
-                (void)sl_proto_feed(p, pc.data + off, n, 0);
-                off += n;
-            }
             bytes += pc.size;
+            if (!on_data(pc.data, pc.size)) {
+                break;
+            }
         } else if (pc.kind == SL_PORT_CAPTURE_BREAK) {
-            (void)sl_proto_finish(p);
             record_break(pc, info.discontinuities, info.pcap.gap_list);
+            if (on_break) {
+                on_break(info.discontinuities.back());
+            }
         } else {
-            (void)sl_proto_finish(p);
             if (pc.kind == SL_PORT_CAPTURE_ERROR) {
                 err = path + ": " + sl_port_capture_error(c);
                 ok = false;
@@ -213,6 +209,27 @@ bool stream_capture(const std::string &path, sl_proto_t *p, size_t chunk, Captur
     fill_report(c, info);
     info.pcap.gap_list = gaps;
     sl_port_capture_close(c);
+    return ok;
+}
+
+bool stream_capture(const std::string &path, sl_proto_t *p, size_t chunk, Capture &info, uint64_t &bytes,
+                    std::string &err, const PcapOptions &opt)
+{
+    const bool ok = read_capture(
+        path,
+        [&](const uint8_t *data, size_t size) {
+            for (size_t off = 0; off < size;) {
+                size_t n = size - off;
+                if (chunk > 0 && n > chunk) {
+                    n = chunk;
+                }
+                (void)sl_proto_feed(p, data + off, n, 0);
+                off += n;
+            }
+            return true;
+        },
+        [&](const Discontinuity &) { (void)sl_proto_finish(p); }, info, bytes, err, opt);
+    (void)sl_proto_finish(p);
     return ok;
 }
 

@@ -28,6 +28,7 @@
 
 #include <cstdint>
 #include <cstdio>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -123,6 +124,23 @@ bool load_capture(const std::string &path, Capture &out, std::string &err,
 /// Reassembles a pcap/pcapng file (libpcap reads both). Same contract as load_capture.
 bool load_pcap(const std::string &path, Capture &out, std::string &err,
                const PcapOptions &opt = PcapOptions{});
+
+/// A piece of the radar -> client stream, valid only during the call. Returns false to stop
+/// reading (not an error: the consumer has what it needs).
+using CaptureDataFn = std::function<bool(const uint8_t *data, size_t size)>;
+/// A place where the stream is not continuous (already appended to Capture::discontinuities).
+using CaptureBreakFn = std::function<void(const Discontinuity &d)>;
+
+/// Streams `path` ("-" = stdin, pipes and FIFOs work) in bounded memory, whatever its size:
+/// `on_data` receives the reassembled stream piece by piece, in order; `on_break` (may be
+/// empty) each discontinuity (a gap or a new TCP session) where it falls, so the consumer
+/// resets its decoder there. This is the one way the host tools read a capture. `info`
+/// receives the format, discontinuities and pcap report (its `bytes` stay empty); `bytes` the
+/// stream size. false + `err` when the capture cannot be opened or ends with an error (the
+/// part read before it has been handed over). Memory: the port reader's window (raw) or
+/// its reassembly queue (pcap), not the capture. Cost: O(bytes).
+bool read_capture(const std::string &path, const CaptureDataFn &on_data, const CaptureBreakFn &on_break,
+                  Capture &info, uint64_t &bytes, std::string &err, const PcapOptions &opt = PcapOptions{});
 
 /// Streams `path` ("-" = stdin) through decoder `p` in bounded memory: what load_capture +
 /// feed_capture do, without holding the stream (`chunk` > 0: at most that many bytes per
