@@ -9,6 +9,7 @@
 #include <cerrno>
 #include <cstdlib>
 #include <cstring>
+#include <deque>
 
 namespace sl {
 
@@ -210,6 +211,83 @@ bool read_capture(const std::string &path, const CaptureDataFn &on_data, const C
     info.pcap.gap_list = gaps;
     sl_port_capture_close(c);
     return ok;
+}
+
+struct MessageReader::Impl {
+    sl_port_capture_t *c = nullptr;
+    sl_proto_t p{};
+    std::vector<uint8_t> reasm = std::vector<uint8_t>(kHostMaxPayloadBytes);
+    std::deque<std::pair<uint8_t, std::vector<uint8_t>>> q;
+    bool eof = false;
+    std::string path;
+
+    static void on_msg(void *ctx, const sl_proto_msg_t *m)
+    {
+        auto *self = static_cast<Impl *>(ctx);
+        std::vector<uint8_t> v(SL_PROTO_HEADER_BYTES + m->payload.size);
+        (void)sl_proto_encode_header(v.data(), SL_PROTO_HEADER_BYTES, m->id, static_cast<uint32_t>(m->payload.size));
+        if (m->payload.size > 0) {
+            std::memcpy(v.data() + SL_PROTO_HEADER_BYTES, m->payload.data, m->payload.size);
+        }
+        self->q.emplace_back(m->id, std::move(v));
+    }
+};
+
+MessageReader::MessageReader() : m_(new Impl) {}
+
+MessageReader::~MessageReader()
+{
+    if (m_->c != nullptr) {
+        sl_port_capture_close(m_->c);
+    }
+    delete m_;
+}
+
+bool MessageReader::open(const std::string &path, std::string &err, const PcapOptions &opt)
+{
+    sl_port_capture_opts_t o{};
+    o.radar_port = static_cast<uint16_t>(opt.radar_port);
+    o.port_explicit = opt.port_explicit;
+    char e[512] = {0};
+    m_->c = sl_port_capture_open(path.c_str(), &o, e, sizeof e);
+    if (m_->c == nullptr) {
+        err = e;
+        return false;
+    }
+    sl_proto_cfg_t pc{};
+    pc.reasm_buf = m_->reasm.data();
+    pc.reasm_size = m_->reasm.size();
+    pc.on_msg = Impl::on_msg;
+    pc.ctx = m_;
+    (void)sl_proto_init(&m_->p, &pc);
+    m_->path = path;
+    return true;
+}
+
+bool MessageReader::next(uint8_t &id, std::vector<uint8_t> &msg)
+{
+    while (m_->q.empty() && !m_->eof && m_->c != nullptr) {
+        sl_port_capture_piece_t pc;
+        sl_port_capture_next(m_->c, &pc);
+        if (pc.kind == SL_PORT_CAPTURE_DATA) {
+            (void)sl_proto_feed(&m_->p, pc.data, pc.size, 0);
+        } else if (pc.kind == SL_PORT_CAPTURE_BREAK) {
+            (void)sl_proto_finish(&m_->p);
+        } else {
+            (void)sl_proto_finish(&m_->p);
+            if (pc.kind == SL_PORT_CAPTURE_ERROR) {
+                err_ = m_->path + ": " + sl_port_capture_error(m_->c);
+            }
+            m_->eof = true;
+        }
+    }
+    if (m_->q.empty()) {
+        return false;
+    }
+    id = m_->q.front().first;
+    msg = std::move(m_->q.front().second);
+    m_->q.pop_front();
+    return true;
 }
 
 bool stream_capture(const std::string &path, sl_proto_t *p, size_t chunk, Capture &info, uint64_t &bytes,

@@ -150,6 +150,32 @@ bool read_capture(const std::string &path, const CaptureDataFn &on_data, const C
 bool stream_capture(const std::string &path, sl_proto_t *p, size_t chunk, Capture &info, uint64_t &bytes,
                     std::string &err, const PcapOptions &opt = PcapOptions{});
 
+/// A capture as a sequence of whole messages, pulled one at a time in bounded memory: the
+/// port's streaming reader (as read_capture: "-", FIFOs, pcap reassembly), the core decoder
+/// (1 MiB reassembly buffer, reset at every gap or new TCP session), and the messages of the
+/// piece of the stream being decoded. For tools that need messages rather than bytes
+/// (`sl-replay serve`). Each message is returned whole (22-byte header + payload, the header
+/// re-encoded, which is byte for byte the captured one: a valid header has no free field).
+class MessageReader {
+public:
+    MessageReader();
+    ~MessageReader();
+    MessageReader(const MessageReader &) = delete;
+    MessageReader &operator=(const MessageReader &) = delete;
+
+    /// false + err when `path` cannot be opened.
+    bool open(const std::string &path, std::string &err, const PcapOptions &opt = PcapOptions{});
+    /// The next message (its id and bytes); false at the end of the capture (error() is not
+    /// empty when it ended on a read error).
+    bool next(uint8_t &id, std::vector<uint8_t> &msg);
+    const std::string &error() const { return err_; }
+
+private:
+    struct Impl;
+    Impl *m_;
+    std::string err_;
+};
+
 /// Feeds the whole capture to decoder `p` (which must be freshly initialised so that its
 /// stream offsets equal indexes into `cap.bytes`): one sl_proto_feed() per continuous piece,
 /// sl_proto_finish() at every discontinuity (a partial message before a gap is dropped and
