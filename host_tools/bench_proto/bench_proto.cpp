@@ -7,7 +7,7 @@
 // Without a capture it builds a stream in memory (tests/golden/sl_golden.c: config, then
 // N rotations x azimuths FFT messages of `bins` noisy bins, keep-alives every 400 messages),
 // default 16 x 400 x 3768 8-bit bins (about 24 MB). With a capture (raw .colossus, pcap or
-// pcapng, see host_tools/common/capture.h) it decodes that instead.
+// pcapng, see host_tools/capture/capture.h) it decodes that instead.
 //
 // For each chunk size (default 1448 = one TCP MSS, 16384, 65536 = typical recv() sizes,
 // and 0 = the whole buffer in one call) it feeds the stream from memory to a fresh decoder

@@ -118,7 +118,7 @@ int main(int argc, char **argv)
             } else if (o == "--ground-window-m" && has && num(argv[i + 1], v) && v > 0) {
                 a.opt.ground_window_m = v;
                 i++;
-            } else if (o[0] != '-' && a.input.empty()) {
+            } else if ((o[0] != '-' || o == "-") && a.input.empty()) {
                 a.input = o;
             } else {
                 return bad_arg(o, has, argv[i],
@@ -166,7 +166,7 @@ int main(int argc, char **argv)
             } else if (o == "--threshold" && has && num(argv[i + 1], v) && v >= 0 && v <= 255) {
                 a.threshold = static_cast<int>(v);
                 i++;
-            } else if (o[0] != '-') {
+            } else if (o[0] != '-' || o == "-") {
                 a.captures.push_back(o);
             } else {
                 return bad_arg(o, has, argv[i],

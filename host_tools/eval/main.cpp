@@ -9,6 +9,7 @@
 #include <map>
 #include <string>
 
+#include "capture.h"
 #include "sim_eval.h"
 #include "sl_cli.h"
 #include "sl_progress.h"
@@ -41,7 +42,8 @@ void usage(FILE *out)
                  "  sl-eval run CAPTURE.colossus GT.csv [--board NAME] [--scene SCENE.ini]\n"
                  "             [--threshold T] [--beta DEG] [--raw|--half-bin] [--r1-add M] [--d M]\n"
                  "             [--extract bbox|pipeline] [--beam-deg DEG] [--speed M/S] [--no-width-radius]\n"
-                 "      Evaluates one capture made by sl-sim against its ground truth. --extract pipeline:\n"
+                 "      Evaluates one capture made by sl-sim against its ground truth (raw or pcap, streamed;\n"
+                 "      - = stdin). --extract pipeline:\n"
                  "      the core pipeline (beam, threshold and speed from --scene, or the options).\n"
                  "Progress goes to stderr when it is a terminal; -q/--quiet silences it.\n");
 }
@@ -203,13 +205,21 @@ int cmd_realistic(int argc, char **argv)
     return 0;
 }
 
-bool read_file(const std::string &path, std::vector<uint8_t> &out)
+// Streams CAPTURE (raw or pcap/pcapng; a pipe, FIFO or "-" too) to `on_data`, with
+// `on_break` at each gap or new TCP session (capture.h read_capture: bounded memory).
+bool stream_file(const std::string &path, const sl::CaptureDataFn &on_data, const sl::CaptureBreakFn &on_break)
 {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) {
+    sl::Capture info;
+    uint64_t bytes = 0;
+    std::string err;
+    if (!sl::read_capture(path, on_data, on_break, info, bytes, err)) {
+        std::fprintf(stderr, "sl-eval: %s\n", err.c_str());
         return false;
     }
-    out.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    if (!info.discontinuities.empty()) {
+        std::fprintf(stderr, "sl-eval: %s: %zu discontinuities (gaps or new TCP sessions) in the stream\n",
+                     path.c_str(), info.discontinuities.size());
+    }
     return true;
 }
 
@@ -261,7 +271,7 @@ int cmd_run(int argc, char **argv)
             bounds = sl::Proc::Bounds::Raw;
         } else if (a == "--half-bin") {
             bounds = sl::Proc::Bounds::HalfBin;
-        } else if (!a.empty() && a[0] != '-' && cap.empty()) {
+        } else if (!a.empty() && (a[0] != '-' || a == "-") && cap.empty()) {
             cap = a;
         } else if (!a.empty() && a[0] != '-' && gtp.empty()) {
             gtp = a;
@@ -279,11 +289,6 @@ int cmd_run(int argc, char **argv)
     std::string err;
     if (!sl::gt_read(gtp, gt, err)) {
         std::fprintf(stderr, "sl-eval: %s\n", err.c_str());
-        return 1;
-    }
-    std::vector<uint8_t> bytes;
-    if (!read_file(cap, bytes)) {
-        std::fprintf(stderr, "sl-eval: cannot read %s\n", cap.c_str());
         return 1;
     }
     sl::BoardSpec b;
@@ -317,7 +322,16 @@ int cmd_run(int argc, char **argv)
                 pe.add_truth(g);
             }
         }
-        pe.feed(0, bytes.data(), bytes.size());
+        // The pipeline decodes the bytes itself and resynchronises after a gap.
+        if (!stream_file(
+                cap,
+                [&](const uint8_t *data, size_t n) {
+                    pe.feed(0, data, n);
+                    return true;
+                },
+                nullptr)) {
+            return 1;
+        }
         pe.finish();
         const auto res = pe.result();
         std::printf("%s\n", sl::kPipelineLabel);
@@ -362,7 +376,15 @@ int cmd_run(int argc, char **argv)
                                            proc, nullptr);
         per_pole[g.pole].add(e, g.alpha_deg);
     });
-    dec.feed(bytes.data(), bytes.size());
+    if (!stream_file(
+            cap,
+            [&](const uint8_t *data, size_t n) {
+                dec.feed(data, n);
+                return true;
+            },
+            [&](const sl::Discontinuity &) { dec.finish(); })) {
+        return 1;
+    }
     dec.finish();
     if (dec.have_config()) {
         bin = dec.bin_m();

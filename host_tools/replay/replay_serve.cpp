@@ -13,6 +13,12 @@
 // --max-gap-ms shortened to it, backwards steps sent at once) or as fast as the client reads.
 // Single-threaded, non-blocking, poll(): a slow client only affects itself (bounded queue:
 // realtime drops and counts messages that do not fit, max rate stops producing for it).
+//
+// The capture is streamed, never loaded (capture.h MessageReader): each connection reads its
+// own pass over a regular file (--loop reopens it; --close-after etc. resume by skipping),
+// so memory is bounded whatever the capture's size. A pipe, FIFO or "-" can be read once:
+// one connection at a time plays it, the next continues where the last one stopped, and
+// --loop is refused.
 #include "replay.h"
 
 #include "capture.h"
@@ -33,6 +39,7 @@
 #include <netinet/tcp.h>
 #include <poll.h>
 #include <sys/socket.h>
+#include <sys/stat.h>
 #include <unistd.h>
 #include <vector>
 
@@ -41,21 +48,11 @@ namespace sl::replay {
 namespace {
 
 struct FftEntry {
-    uint64_t offset = 0; // of the whole message in the capture
-    uint32_t size = 0;
+    std::vector<uint8_t> msg; // the whole message (header + payload), as captured
     int64_t ts_ns = 0;   // capture timestamp
     uint16_t sweep = 0;
-    int64_t play_us = 0; // playback time since the first FFT message (gaps clamped)
-};
-
-struct Source {
-    sl::Capture cap;
-    std::vector<uint8_t> config;
-    std::vector<FftEntry> fft;
-    int64_t cycle_play_us = 0; // one pass of the capture, for --loop
-    int64_t cycle_ts_ns = 0;   // timestamp shift per pass
-    uint16_t cycle_sweep = 0;  // sweep counter shift per pass
-    uint64_t not_replayed = 0; // messages other than Configuration and FFT
+    int64_t play_us = 0; // playback time since the pass's first FFT message (gaps clamped)
+    uint64_t pass = 0;   // --loop: which pass over the capture
 };
 
 void put_le32(uint8_t *p, uint32_t v)
@@ -66,51 +63,258 @@ void put_le32(uint8_t *p, uint32_t v)
     p[3] = static_cast<uint8_t>(v >> 24);
 }
 
-bool load_source(const ServeOptions &o, Source &src, std::string &err)
-{
-    if (!sl::load_capture(o.capture, src.cap, err)) {
-        return false;
+// One pass over the capture, message by message (capture.h MessageReader: bounded memory).
+using Pass = sl::MessageReader;
+
+// What every connection shares: the Configuration served, the pacing step.
+struct Source {
+    std::string path;
+    bool regular = true;       // a regular file: each connection reads its own pass
+    std::vector<uint8_t> config;
+    int64_t dt_us = 625;       // one FFT message at the Configuration's packet rate
+};
+
+// The FFT messages one connection plays: passes over the capture (--loop: again and again,
+// timestamps and sweep counters shifted per pass), paced by their timestamps, permuted in
+// blocks by --shuffle. Holds one block (or one message) ahead of what was sent.
+struct Player {
+    const ServeOptions *o = nullptr;
+    const Source *src = nullptr;
+    std::unique_ptr<Pass> pass;
+    uint64_t pass_no = 0;
+    std::deque<FftEntry> ahead;
+    bool pass_started = false;
+    int64_t prev_ts_ns = 0, prev_play_us = 0;
+    // The first pass measured (for --loop): its length, timestamp span, sweep span.
+    bool cycle_known = false;
+    int64_t cycle_play_us = 0, cycle_ts_ns = 0;
+    uint16_t cycle_sweep = 0;
+    FftEntry first, last;      // of the current pass (as sent: after --shuffle)
+    uint64_t pass_fft = 0, not_replayed = 0, passes_done = 0;
+    bool ended = false;        // no more messages (end without --loop, or an error)
+    std::string err;
+
+    bool open_pass(std::string &e)
+    {
+        pass = std::make_unique<Pass>();
+        pass_started = false;
+        pass_fft = 0;
+        return pass->open(src->path, e);
     }
-    const auto msgs = sl::index_capture(src.cap);
-    uint32_t packet_rate = 0;
-    for (const auto &m : msgs) {
-        const uint8_t *p = src.cap.bytes.data() + m.offset;
-        sl_proto_msg_t pm{};
-        pm.id = m.id;
-        pm.payload.data = p + SL_PROTO_HEADER_BYTES;
-        pm.payload.size = m.size - SL_PROTO_HEADER_BYTES;
-        if (m.id == SL_PROTO_ID_CONFIGURATION) {
-            sl_proto_config_t c{};
-            if (src.config.empty() && sl_proto_parse_config(&pm, &c) == SL_OK) {
-                src.config.assign(p, p + m.size);
-                packet_rate = c.packet_rate;
-            }
-        } else if (m.id == SL_PROTO_ID_FFT_DATA || m.id == SL_PROTO_ID_FFT_DATA_16) {
-            sl_proto_fft_t f{};
-            if (sl_proto_parse_fft(&pm, &f) != SL_OK) {
-                ++src.not_replayed;
+
+    // Reads the next FFT message of the pass (others counted); false at the end of the pass.
+    bool read_fft(FftEntry &e)
+    {
+        uint8_t id = 0;
+        std::vector<uint8_t> m;
+        while (pass->next(id, m)) {
+            if (id == SL_PROTO_ID_CONFIGURATION) {
                 continue;
             }
-            FftEntry e;
-            e.offset = m.offset;
-            e.size = m.size;
+            if (id != SL_PROTO_ID_FFT_DATA && id != SL_PROTO_ID_FFT_DATA_16) {
+                ++not_replayed;
+                continue;
+            }
+            sl_proto_msg_t pm{};
+            pm.id = id;
+            pm.payload.data = m.data() + SL_PROTO_HEADER_BYTES;
+            pm.payload.size = m.size() - SL_PROTO_HEADER_BYTES;
+            sl_proto_fft_t f{};
+            if (sl_proto_parse_fft(&pm, &f) != SL_OK) {
+                ++not_replayed;
+                continue;
+            }
             e.ts_ns = static_cast<int64_t>(f.seconds) * 1000000000 + f.split_ns;
             e.sweep = f.sweep_counter;
-            if (!src.fft.empty()) {
-                const FftEntry &prev = src.fft.back();
-                int64_t d_us = (e.ts_ns - prev.ts_ns) / 1000;
-                d_us = std::max<int64_t>(0, std::min<int64_t>(d_us, static_cast<int64_t>(o.max_gap_ms) * 1000));
-                e.play_us = prev.play_us + d_us;
+            e.play_us = 0;
+            if (pass_started) {
+                int64_t d_us = (e.ts_ns - prev_ts_ns) / 1000;
+                d_us = std::max<int64_t>(0, std::min<int64_t>(d_us, static_cast<int64_t>(o->max_gap_ms) * 1000));
+                e.play_us = prev_play_us + d_us;
             }
-            src.fft.push_back(e);
-        } else {
-            ++src.not_replayed;
+            pass_started = true;
+            prev_ts_ns = e.ts_ns;
+            prev_play_us = e.play_us;
+            e.pass = pass_no;
+            e.msg = std::move(m);
+            return true;
         }
-    }
-    if (src.config.empty()) {
-        err = o.capture + ": no valid Configuration message (id 10) in the capture";
+        if (!pass->error().empty()) {
+            err = pass->error();
+        }
         return false;
     }
+
+    // Fills `ahead` with the next block; handles the end of a pass.
+    void refill()
+    {
+        while (ahead.empty() && !ended) {
+            const size_t block = o->shuffle > 1 ? o->shuffle : 1;
+            std::vector<FftEntry> b;
+            FftEntry e;
+            while (b.size() < block && read_fft(e)) {
+                b.push_back(std::move(e));
+                e = FftEntry{};
+            }
+            if (o->shuffle > 1 && b.size() > 1) {
+                // Fault injection: the transport reorders messages within blocks of
+                // `shuffle` (each keeps its own azimuth, sweep counter and timestamp; pacing
+                // by position). Fixed seed per pass: every pass is permuted alike.
+                for (size_t i = b.size() - 1; i > 0; --i) {
+                    shuffle_x ^= shuffle_x << 13;
+                    shuffle_x ^= shuffle_x >> 7;
+                    shuffle_x ^= shuffle_x << 17;
+                    const size_t j = static_cast<size_t>(shuffle_x % (i + 1));
+                    std::swap(b[i].msg, b[j].msg);
+                    std::swap(b[i].ts_ns, b[j].ts_ns);
+                    std::swap(b[i].sweep, b[j].sweep);
+                }
+            }
+            for (auto &x : b) {
+                if (pass_fft == 0) {
+                    first = x;
+                    first.msg.clear();
+                }
+                last = x;
+                last.msg.clear();
+                ++pass_fft;
+                ahead.push_back(std::move(x));
+            }
+            if (b.size() == block) {
+                continue;
+            }
+            // The end of the pass.
+            if (!err.empty() || pass_fft == 0) {
+                if (pass_fft == 0 && err.empty() && passes_done == 0) {
+                    err = src->path + ": no FFT data message in the capture";
+                }
+                ended = ahead.empty();
+                if (!ahead.empty()) {
+                    return; // send what was read first
+                }
+                break;
+            }
+            if (!cycle_known) {
+                cycle_known = true;
+                cycle_play_us = last.play_us + src->dt_us;
+                cycle_ts_ns = std::max<int64_t>(last.ts_ns - first.ts_ns, 0) + src->dt_us * 1000;
+                cycle_sweep = static_cast<uint16_t>(last.sweep - first.sweep + 1u);
+            }
+            ++passes_done;
+            if (o->verbose || passes_done == 1) {
+                std::fprintf(stderr,
+                             "sl-replay: %s: pass %" PRIu64 ": %" PRIu64 " FFT messages, %.3f s, %" PRIu64
+                             " other messages not replayed\n",
+                             src->path.c_str(), pass_no, pass_fft, static_cast<double>(cycle_play_us) * 1e-6,
+                             not_replayed);
+            }
+            if (!o->loop || !src->regular) {
+                if (ahead.empty()) {
+                    ended = true;
+                }
+                return;
+            }
+            ++pass_no;
+            shuffle_x = kShuffleSeed;
+            std::string e2;
+            if (!open_pass(e2)) {
+                err = e2;
+                ended = ahead.empty();
+                return;
+            }
+            if (!ahead.empty()) {
+                return;
+            }
+        }
+    }
+
+    const FftEntry *peek()
+    {
+        refill();
+        return ahead.empty() ? nullptr : &ahead.front();
+    }
+
+    void pop()
+    {
+        if (!ahead.empty()) {
+            ahead.pop_front();
+            ++popped;
+        }
+    }
+
+    uint64_t popped = 0; // FFT messages taken, over all passes
+
+    static constexpr uint64_t kShuffleSeed = 0x9E3779B97F4A7C15ULL;
+    uint64_t shuffle_x = kShuffleSeed;
+};
+
+// Opens a connection's player at FFT message `skip` (a previous connection's fault position).
+bool open_player(const ServeOptions &o, const Source &src, Player &pl, uint64_t skip, std::string &err)
+{
+    pl.o = &o;
+    pl.src = &src;
+    if (!pl.open_pass(err)) {
+        return false;
+    }
+    for (uint64_t i = 0; i < skip && pl.peek() != nullptr; ++i) {
+        pl.pop();
+    }
+    return true;
+}
+
+// Finds the first Configuration (rewritten by the --config-* faults) and checks that the
+// capture holds FFT data, streaming only as far as needed. A pipe or FIFO can be read once:
+// its pass is kept in `shared` for the first connection (and those that resume after it).
+bool load_source(const ServeOptions &o, Source &src, std::unique_ptr<Player> &shared, std::string &err)
+{
+    src.path = o.capture;
+    struct stat st {};
+    src.regular = o.capture != "-" && ::stat(o.capture.c_str(), &st) == 0 && S_ISREG(st.st_mode);
+    if (!src.regular && o.loop) {
+        err = o.capture + ": --loop needs a regular file (a pipe or FIFO can be read only once)";
+        return false;
+    }
+    uint32_t packet_rate = 0;
+    {
+        // Up to the first valid Configuration; for a pipe the pass continues in `shared`.
+        auto probe = std::make_unique<Pass>();
+        if (!probe->open(o.capture, err)) {
+            return false;
+        }
+        uint8_t id = 0;
+        std::vector<uint8_t> m;
+        uint64_t seen = 0;
+        while (src.config.empty() && probe->next(id, m)) {
+            if (id == SL_PROTO_ID_CONFIGURATION) {
+                sl_proto_msg_t pm{};
+                pm.id = id;
+                pm.payload.data = m.data() + SL_PROTO_HEADER_BYTES;
+                pm.payload.size = m.size() - SL_PROTO_HEADER_BYTES;
+                sl_proto_config_t c{};
+                if (sl_proto_parse_config(&pm, &c) == SL_OK) {
+                    src.config = m;
+                    packet_rate = c.packet_rate;
+                }
+            } else if (!src.regular && ++seen > 4096) {
+                err = o.capture + ": no valid Configuration message (id 10) in the first 4096 messages of the stream";
+                return false;
+            }
+        }
+        if (src.config.empty()) {
+            err = probe->error().empty() ? o.capture + ": no valid Configuration message (id 10) in the capture"
+                                         : probe->error();
+            return false;
+        }
+        if (!src.regular) {
+            // FFT messages before the Configuration of a pipe are not replayed (a radar
+            // sends its Configuration first).
+            shared = std::make_unique<Player>();
+            shared->o = &o;
+            shared->src = &src;
+            shared->pass = std::move(probe);
+        }
+    }
+    src.dt_us = packet_rate > 0 ? 1000000 / packet_rate : 625;
     if (o.config_azimuths >= 0 || o.config_encoder >= 0 || o.config_bin_size_m > 0) {
         // Fault injection: serve another geometry than the capture's.
         sl_proto_msg_t pm{};
@@ -141,32 +345,20 @@ bool load_source(const ServeOptions &o, Source &src, std::string &err)
         out.resize(static_cast<size_t>(k));
         src.config = out;
     }
-    if (o.shuffle > 1) {
-        // Fault injection: the transport reorders messages within blocks of `shuffle`
-        // (each keeps its own azimuth, sweep counter and timestamp; pacing by position).
-        uint64_t x = 0x9E3779B97F4A7C15ULL;
-        for (size_t b = 0; b < src.fft.size(); b += o.shuffle) {
-            const size_t e = std::min(src.fft.size(), b + o.shuffle);
-            for (size_t i = e - 1; i > b; --i) {
-                x ^= x << 13;
-                x ^= x >> 7;
-                x ^= x << 17;
-                const size_t j = b + static_cast<size_t>(x % (i - b + 1));
-                std::swap(src.fft[i].offset, src.fft[j].offset);
-                std::swap(src.fft[i].size, src.fft[j].size);
-                std::swap(src.fft[i].ts_ns, src.fft[j].ts_ns);
-                std::swap(src.fft[i].sweep, src.fft[j].sweep);
-            }
+    // FFT data must follow: a regular file is checked now (one message read).
+    if (src.regular) {
+        Player check;
+        if (!open_player(o, src, check, 0, err)) {
+            return false;
         }
-    }
-    if (src.fft.empty()) {
-        err = o.capture + ": no FFT data message in the capture";
+        if (check.peek() == nullptr) {
+            err = check.err.empty() ? o.capture + ": no FFT data message in the capture" : check.err;
+            return false;
+        }
+    } else if (shared->peek() == nullptr) {
+        err = shared->err.empty() ? o.capture + ": no FFT data message in the capture" : shared->err;
         return false;
     }
-    const int64_t dt_us = packet_rate > 0 ? 1000000 / packet_rate : 625;
-    src.cycle_play_us = src.fft.back().play_us + dt_us;
-    src.cycle_ts_ns = std::max<int64_t>(src.fft.back().ts_ns - src.fft.front().ts_ns, 0) + dt_us * 1000;
-    src.cycle_sweep = static_cast<uint16_t>(src.fft.back().sweep - src.fft.front().sweep + 1u);
     return true;
 }
 
@@ -204,7 +396,9 @@ struct Client {
     bool rst_on_close = false;
     uint64_t next_byte_us = 0; // --trickle-bps: when the next byte may go
     const char *why = "";
-    uint64_t cursor = 0; // FFT index over all passes (pass = cursor / N)
+    Player *pl = nullptr;            // the messages this connection plays (nullptr: none)
+    std::unique_ptr<Player> own;     // a regular file: its own pass over the capture
+    uint64_t cursor = 0; // FFT messages played or dropped, over all passes
     uint64_t anchor_wall_us = 0;
     int64_t anchor_play_us = 0;
     uint64_t next_ka_us = 0;
@@ -215,6 +409,8 @@ struct Client {
 struct Server {
     const ServeOptions &o;
     Source &src;
+    std::unique_ptr<Player> shared; // a pipe or FIFO: its one pass, played by one connection at a time
+    const Client *shared_owner = nullptr;
     uint64_t resume = 0; // where the next connection starts (set by injected faults)
     uint64_t accepted = 0, refused = 0, closed_by_fault = 0, stalls = 0;
     uint64_t total_fft = 0, total_dropped = 0;
@@ -222,21 +418,26 @@ struct Server {
     Server(const ServeOptions &opt, Source &s) : o(opt), src(s) {}
 };
 
-uint64_t n_fft(const Client &c) { return c.srv->src.fft.size(); }
+bool has_more(const Client &c) { return c.pl != nullptr && c.pl->peek() != nullptr; }
 
-bool has_more(const Client &c) { return c.srv->o.loop || c.cursor < n_fft(c); }
-
-int64_t play_of(const Client &c, uint64_t cursor)
+// Playback time of the next FFT message (has_more must hold).
+int64_t play_of_next(const Client &c)
 {
-    const Source &s = c.srv->src;
-    const uint64_t n = s.fft.size();
-    return static_cast<int64_t>(cursor / n) * s.cycle_play_us + s.fft[cursor % n].play_us;
+    const FftEntry *e = c.pl->peek();
+    return static_cast<int64_t>(e->pass) * c.pl->cycle_play_us + e->play_us;
 }
 
-uint64_t due_of(const Client &c, uint64_t cursor)
+uint64_t due_of_next(const Client &c)
 {
-    const int64_t d = play_of(c, cursor) - c.anchor_play_us;
+    const int64_t d = play_of_next(c) - c.anchor_play_us;
     return c.anchor_wall_us + static_cast<uint64_t>(std::max<int64_t>(d, 0));
+}
+
+// The next FFT message is done with (sent or dropped).
+void advance(Client &c)
+{
+    c.pl->pop();
+    ++c.cursor;
 }
 
 void enqueue(Client &c, std::vector<uint8_t> bytes)
@@ -277,21 +478,19 @@ void enqueue_config(Client &c)
 
 void enqueue_fft(Client &c)
 {
-    const Source &s = c.srv->src;
-    const uint64_t n = s.fft.size();
-    const uint64_t pass = c.cursor / n;
-    const FftEntry &e = s.fft[c.cursor % n];
-    const uint8_t *p = s.cap.bytes.data() + e.offset;
+    const Player &pr = *c.pl;
+    const FftEntry &e = *c.pl->peek();
+    const uint64_t pass = e.pass;
     if (pass == 0) {
-        enqueue_message(c, p, e.size, c.fft_sent);
+        enqueue_message(c, e.msg.data(), e.msg.size(), c.fft_sent);
     } else {
         // --loop: shift the timestamp (little-endian seconds + ns) and the sweep counter.
-        std::vector<uint8_t> m(p, p + e.size);
-        const int64_t ts = e.ts_ns + static_cast<int64_t>(pass) * s.cycle_ts_ns;
+        std::vector<uint8_t> m = e.msg;
+        const int64_t ts = e.ts_ns + static_cast<int64_t>(pass) * pr.cycle_ts_ns;
         uint8_t *pl = m.data() + SL_PROTO_HEADER_BYTES;
         put_le32(pl + 6, static_cast<uint32_t>(ts / 1000000000));
         put_le32(pl + 10, static_cast<uint32_t>(ts % 1000000000));
-        const uint16_t sw = static_cast<uint16_t>(e.sweep + pass * s.cycle_sweep);
+        const uint16_t sw = static_cast<uint16_t>(e.sweep + pass * pr.cycle_sweep);
         pl[2] = static_cast<uint8_t>(sw >> 8);
         pl[3] = static_cast<uint8_t>(sw);
         enqueue_message(c, m.data(), m.size(), c.fft_sent);
@@ -323,6 +522,9 @@ void kill_client(Client &c, const char *why)
     }
     c.dead = true;
     c.why = why;
+    if (c.srv->shared_owner == &c) {
+        c.srv->shared_owner = nullptr; // the next connection continues the pipe's pass
+    }
     if (c.fd >= 0) {
         close(c.fd);
         c.fd = -1;
@@ -337,10 +539,8 @@ bool check_faults(Client &c)
     if (o.cut_after > 0 && c.fft_sent >= o.cut_after && has_more(c)) {
         // Half of the next message, then the connection ends (FIN or RST); the next
         // connection starts with that message, whole.
-        const Source &s = c.srv->src;
-        const FftEntry &e = s.fft[c.cursor % n_fft(c)];
-        const uint8_t *p = s.cap.bytes.data() + e.offset;
-        enqueue(c, std::vector<uint8_t>(p, p + e.size / 2));
+        const FftEntry &e = *c.pl->peek();
+        enqueue(c, std::vector<uint8_t>(e.msg.begin(), e.msg.begin() + static_cast<long>(e.msg.size() / 2)));
         c.close_when_drained = true;
         c.rst_on_close = o.cut_rst;
         c.srv->resume = c.cursor;
@@ -391,28 +591,28 @@ uint64_t produce(Client &c, uint64_t now)
         return wake;
     }
     if (o.realtime) {
-        while (has_more(c) && due_of(c, c.cursor) <= now) {
-            const FftEntry &e = c.srv->src.fft[c.cursor % n_fft(c)];
-            if (c.q_bytes + e.size > o.queue_bytes) {
+        while (has_more(c) && due_of_next(c) <= now) {
+            const FftEntry &e = *c.pl->peek();
+            if (c.q_bytes + e.msg.size() > o.queue_bytes) {
                 ++c.fft_dropped;
                 ++c.srv->total_dropped;
-                ++c.cursor;
+                advance(c);
                 continue;
             }
             enqueue_fft(c);
-            ++c.cursor;
+            advance(c);
             if (check_faults(c)) {
                 return c.stalled ? UINT64_MAX : wake;
             }
         }
         if (has_more(c)) {
-            wake = std::min(wake, due_of(c, c.cursor));
+            wake = std::min(wake, due_of_next(c));
         }
     } else {
         int budget = 64; // then let poll() serve the others
         while (has_more(c) && c.q_bytes < o.queue_bytes && budget-- > 0) {
             enqueue_fft(c);
-            ++c.cursor;
+            advance(c);
             if (check_faults(c)) {
                 return c.stalled ? UINT64_MAX : wake;
             }
@@ -485,7 +685,7 @@ void on_command(void *ctx, const sl_proto_msg_t *m)
         if (!c.streaming) {
             c.streaming = true;
             c.anchor_wall_us = now;
-            c.anchor_play_us = has_more(c) ? play_of(c, c.cursor) : 0;
+            c.anchor_play_us = has_more(c) ? play_of_next(c) : 0;
         }
         break;
     case SL_PROTO_ID_STOP_FFT:
@@ -566,6 +766,23 @@ void accept_all(Server &s, int lfd, uint64_t now)
         c->serial = ++s.accepted;
         c->peer = peer_name(ss);
         c->cursor = s.resume;
+        if (s.src.regular) {
+            std::string err;
+            c->own = std::make_unique<Player>();
+            if (open_player(s.o, s.src, *c->own, s.resume, err)) {
+                c->pl = c->own.get();
+            } else {
+                std::fprintf(stderr, "sl-replay: client %" PRIu64 ": %s (no FFT data for it)\n", c->serial, err.c_str());
+            }
+        } else if (s.shared_owner == nullptr) {
+            c->pl = s.shared.get();
+            s.shared_owner = c.get();
+            c->cursor = s.shared->popped;
+        } else {
+            std::fprintf(stderr, "sl-replay: client %" PRIu64 ": the input is a pipe, played by client %" PRIu64
+                         " already: this connection gets the Configuration and keep-alives only\n",
+                         c->serial, s.shared_owner->serial);
+        }
         c->next_ka_us = now + static_cast<uint64_t>(s.o.keepalive_ms) * 1000u;
         sl_proto_cfg_t pc{};
         pc.reasm_buf = c->reasm;
@@ -624,7 +841,8 @@ int serve(const ServeOptions &o)
 {
     Source src;
     std::string err;
-    if (!load_source(o, src, err)) {
+    std::unique_ptr<Player> shared;
+    if (!load_source(o, src, shared, err)) {
         std::fprintf(stderr, "sl-replay serve: %s\n", err.c_str());
         return 1;
     }
@@ -634,14 +852,13 @@ int serve(const ServeOptions &o)
         std::fprintf(stderr, "sl-replay serve: %s\n", err.c_str());
         return 1;
     }
-    std::fprintf(stderr,
-                 "sl-replay: %s: %zu FFT messages, %.3f s per pass, %" PRIu64 " other messages not replayed\n",
-                 o.capture.c_str(), src.fft.size(), static_cast<double>(src.cycle_play_us) * 1e-6,
-                 src.not_replayed);
+    std::fprintf(stderr, "sl-replay: %s: streamed (%s), Configuration found, FFT data follows\n",
+                 o.capture.c_str(), src.regular ? "each connection reads its own pass" : "a pipe: read once");
     std::printf("sl-replay: listening on %s\n", bound.c_str());
     std::fflush(stdout);
 
     Server s(o, src);
+    s.shared = std::move(shared);
     const uint64_t t_start = sl_port_now_us();
     const uint64_t t_end = o.timeout_s > 0 ? t_start + static_cast<uint64_t>(o.timeout_s * 1e6) : UINT64_MAX;
     const char *exit_why = "signal";

@@ -458,7 +458,7 @@ int main(int argc, char **argv)
             a.mask_frames = static_cast<int>(v);
         } else if (o == "--threshold" && numv(v) && v >= 0 && v <= 255) {
             a.threshold = static_cast<int>(v);
-        } else if (o[0] != '-' && a.input.empty()) {
+        } else if ((o[0] != '-' || o == "-") && a.input.empty()) {
             a.input = o;
         } else {
             for (const char *known : with_value) {

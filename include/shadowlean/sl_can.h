@@ -4,7 +4,7 @@
 ///        encoders and decoders (integer only, endian-clean, no allocation).
 ///
 /// The wire contract is this header plus the board file's `[can]` section (ids, bit rate).
-/// The DBC file (`sl::make_dbc()`, host_tools/common/sl_dbc.h) is GENERATED from the layout
+/// The DBC file (`sl::make_dbc()`, host_tools/board/sl_dbc.h) is GENERATED from the layout
 /// table below (`sl_can_layout()`), so the encoder, the decoder and the DBC cannot disagree.
 ///
 /// Classic CAN, DLC 8, every signal little-endian (Intel, DBC `@1`): a signal with start

@@ -26,7 +26,7 @@
 /// motion, or a prior, separates the two sides of the fold.
 ///
 /// Everything here is integer-only (no float anywhere in the core); the host builds the
-/// geometry entries with `sl::make_geom()` (host_tools/common/sl_geom.h), which is the only
+/// geometry entries with `sl::make_geom()` (host_tools/board/sl_geom.h), which is the only
 /// code path used by both the board table generator and the `sl-alpha` CLI.
 ///
 /// Units: ranges are plain unsigned integers. The estimator only uses the ratio r2/r1 and
@@ -66,7 +66,7 @@ extern "C" {
 #endif
 
 /// Precomputed geometry of one azimuth (one entry of a board's theta table). Written by the
-/// host (`sl::make_geom()` in host_tools/common/sl_geom.h, used by `sl-tables` and
+/// host (`sl::make_geom()` in host_tools/board/sl_geom.h, used by `sl-tables` and
 /// `sl-alpha`): every field is the exact value rounded ONCE to nearest, ties away from
 /// zero (llround). theta = opening angle of the chassis shadow (depression of the grazing
 /// ray), beta = upper emission bound (elevation). Read-only to the core.

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// Tests of host_tools/common/sl_geom.{h,cpp}: sl::make_geom's rounding rule and limits, the
+// Tests of host_tools/board/sl_geom.{h,cpp}: sl::make_geom's rounding rule and limits, the
 // double oracles against brute-force ray geometry (MATH.md s.2), and the core estimator fed
 // by make_geom against the oracles over the whole supported domain.
 #include <cmath>

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// candump_roundtrip: the candump log writer and reader (host_tools/common/candump_log.h).
+// candump_roundtrip: the candump log writer and reader (host_tools/capture/candump_log.h).
 //
 //   candump_roundtrip OUT.log OUT.expect [N]
 //

@@ -1,7 +1,7 @@
 #!/bin/sh
 # SPDX-License-Identifier: MIT
 # progress_tty.sh SL_SIM SL_EVAL SL_VIEW SL_CALIB SRC OUT: progress of long runs goes to
-# stderr only when it is a terminal (host_tools/common/sl_progress.h), and -q silences it.
+# stderr only when it is a terminal (host_tools/cli/sl_progress.h), and -q silences it.
 # Each tool runs three times on a short job:
 #   1. under script(1), which gives it a pseudo-terminal: its progress line must appear;
 #   2. with stderr to a file (not a terminal): no progress line, no carriage return;

@@ -920,6 +920,43 @@ int test_clients(const std::string &replay, const std::string &work)
     return g_failures ? 1 : 0;
 }
 
+// `serve` streams its capture: from a FIFO (read once, never loaded) a client gets every
+// message byte for byte, as from the file; --loop needs a regular file and says so.
+int test_fifo(const std::string &replay, const std::string &work)
+{
+    mkworkdir(work);
+    const Synth s = make_capture(3);
+    const std::string fifo = work + "/cap.fifo";
+    unlink(fifo.c_str());
+    CHECK(mkfifo(fifo.c_str(), 0600) == 0, "mkfifo");
+    const std::string loop_cmd = replay + " serve " + fifo + " --port 0 --loop > " + work + "/loop.txt 2>&1";
+    const int st = std::system(loop_cmd.c_str());
+    CHECK(WIFEXITED(st) && WEXITSTATUS(st) == 1, "serve --loop on a FIFO: exit status 1");
+    const pid_t writer = fork();
+    if (writer == 0) {
+        const int fd = open(fifo.c_str(), O_WRONLY);
+        size_t off = 0;
+        while (fd >= 0 && off < s.bytes.size()) {
+            const ssize_t n = write(fd, s.bytes.data() + off, std::min<size_t>(4096, s.bytes.size() - off));
+            if (n <= 0) break;
+            off += static_cast<size_t>(n);
+        }
+        _exit(off == s.bytes.size() ? 0 : 1);
+    }
+    ServerProc srv;
+    if (!srv.start(server_args(replay, fifo, {"--rate", "max"}))) return 1;
+    Client cl;
+    if (!cl.init(srv.port)) return 1;
+    run_until(cl, s.fft_offsets.size(), 60);
+    sl_radar_client_stop(cl.c.get(), 500);
+    print_client_stats("client", cl.c.get());
+    check_identical(s, cl.rx, "served from a FIFO");
+    int wst = 0;
+    CHECK(waitpid(writer, &wst, 0) == writer && WIFEXITED(wst) && WEXITSTATUS(wst) == 0, "the writer wrote it all");
+    CHECK_EQ(srv.stop(), 0, "server exit status after SIGTERM");
+    return g_failures ? 1 : 0;
+}
+
 uint64_t le32_at(const std::vector<uint8_t> &m, size_t o)
 {
     return static_cast<uint64_t>(m[o]) | (static_cast<uint64_t>(m[o + 1]) << 8) |
@@ -1170,6 +1207,7 @@ int main(int argc, char **argv)
     else if (mode == "silent" && a.size() == 2) rc = test_fault(a[0], a[1], true);
     else if (mode == "clients" && a.size() == 2) rc = test_clients(a[0], a[1]);
     else if (mode == "loop" && a.size() == 2) rc = test_loop(a[0], a[1]);
+    else if (mode == "fifo" && a.size() == 2) rc = test_fifo(a[0], a[1]);
     else if (mode == "record" && a.size() == 3) rc = test_record(a[0], a[1], a[2]);
     else if (mode == "timeouts" && a.size() == 1) rc = test_client_timeouts(a[0]);
     else std::fprintf(stderr, "link_test: bad mode or arguments\n");

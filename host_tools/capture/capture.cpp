@@ -9,6 +9,7 @@
 #include <cerrno>
 #include <cstdlib>
 #include <cstring>
+#include <deque>
 
 namespace sl {
 
@@ -169,8 +170,8 @@ bool load_capture(const std::string &path, Capture &out, std::string &err, const
     return ok;
 }
 
-bool stream_capture(const std::string &path, sl_proto_t *p, size_t chunk, Capture &info, uint64_t &bytes,
-                    std::string &err, const PcapOptions &opt)
+bool read_capture(const std::string &path, const CaptureDataFn &on_data, const CaptureBreakFn &on_break,
+                  Capture &info, uint64_t &bytes, std::string &err, const PcapOptions &opt)
 {
     info = Capture{};
     bytes = 0;
@@ -188,20 +189,16 @@ bool stream_capture(const std::string &path, sl_proto_t *p, size_t chunk, Captur
         sl_port_capture_piece_t pc;
         sl_port_capture_next(c, &pc);
         if (pc.kind == SL_PORT_CAPTURE_DATA) {
-            for (size_t off = 0; off < pc.size;) {
-                size_t n = pc.size - off;
-                if (chunk > 0 && n > chunk) {
-                    n = chunk;
-                }
-                (void)sl_proto_feed(p, pc.data + off, n, 0);
-                off += n;
-            }
             bytes += pc.size;
+            if (!on_data(pc.data, pc.size)) {
+                break;
+            }
         } else if (pc.kind == SL_PORT_CAPTURE_BREAK) {
-            (void)sl_proto_finish(p);
             record_break(pc, info.discontinuities, info.pcap.gap_list);
+            if (on_break) {
+                on_break(info.discontinuities.back());
+            }
         } else {
-            (void)sl_proto_finish(p);
             if (pc.kind == SL_PORT_CAPTURE_ERROR) {
                 err = path + ": " + sl_port_capture_error(c);
                 ok = false;
@@ -213,6 +210,104 @@ bool stream_capture(const std::string &path, sl_proto_t *p, size_t chunk, Captur
     fill_report(c, info);
     info.pcap.gap_list = gaps;
     sl_port_capture_close(c);
+    return ok;
+}
+
+struct MessageReader::Impl {
+    sl_port_capture_t *c = nullptr;
+    sl_proto_t p{};
+    std::vector<uint8_t> reasm = std::vector<uint8_t>(kHostMaxPayloadBytes);
+    std::deque<std::pair<uint8_t, std::vector<uint8_t>>> q;
+    bool eof = false;
+    std::string path;
+
+    static void on_msg(void *ctx, const sl_proto_msg_t *m)
+    {
+        auto *self = static_cast<Impl *>(ctx);
+        std::vector<uint8_t> v(SL_PROTO_HEADER_BYTES + m->payload.size);
+        (void)sl_proto_encode_header(v.data(), SL_PROTO_HEADER_BYTES, m->id, static_cast<uint32_t>(m->payload.size));
+        if (m->payload.size > 0) {
+            std::memcpy(v.data() + SL_PROTO_HEADER_BYTES, m->payload.data, m->payload.size);
+        }
+        self->q.emplace_back(m->id, std::move(v));
+    }
+};
+
+MessageReader::MessageReader() : m_(new Impl) {}
+
+MessageReader::~MessageReader()
+{
+    if (m_->c != nullptr) {
+        sl_port_capture_close(m_->c);
+    }
+    delete m_;
+}
+
+bool MessageReader::open(const std::string &path, std::string &err, const PcapOptions &opt)
+{
+    sl_port_capture_opts_t o{};
+    o.radar_port = static_cast<uint16_t>(opt.radar_port);
+    o.port_explicit = opt.port_explicit;
+    char e[512] = {0};
+    m_->c = sl_port_capture_open(path.c_str(), &o, e, sizeof e);
+    if (m_->c == nullptr) {
+        err = e;
+        return false;
+    }
+    sl_proto_cfg_t pc{};
+    pc.reasm_buf = m_->reasm.data();
+    pc.reasm_size = m_->reasm.size();
+    pc.on_msg = Impl::on_msg;
+    pc.ctx = m_;
+    (void)sl_proto_init(&m_->p, &pc);
+    m_->path = path;
+    return true;
+}
+
+bool MessageReader::next(uint8_t &id, std::vector<uint8_t> &msg)
+{
+    while (m_->q.empty() && !m_->eof && m_->c != nullptr) {
+        sl_port_capture_piece_t pc;
+        sl_port_capture_next(m_->c, &pc);
+        if (pc.kind == SL_PORT_CAPTURE_DATA) {
+            (void)sl_proto_feed(&m_->p, pc.data, pc.size, 0);
+        } else if (pc.kind == SL_PORT_CAPTURE_BREAK) {
+            (void)sl_proto_finish(&m_->p);
+        } else {
+            (void)sl_proto_finish(&m_->p);
+            if (pc.kind == SL_PORT_CAPTURE_ERROR) {
+                err_ = m_->path + ": " + sl_port_capture_error(m_->c);
+            }
+            m_->eof = true;
+        }
+    }
+    if (m_->q.empty()) {
+        return false;
+    }
+    id = m_->q.front().first;
+    msg = std::move(m_->q.front().second);
+    m_->q.pop_front();
+    return true;
+}
+
+bool stream_capture(const std::string &path, sl_proto_t *p, size_t chunk, Capture &info, uint64_t &bytes,
+                    std::string &err, const PcapOptions &opt)
+{
+    const bool ok = read_capture(
+        path,
+        [&](const uint8_t *data, size_t size) {
+            for (size_t off = 0; off < size;) {
+                size_t n = size - off;
+                if (chunk > 0 && n > chunk) {
+                    n = chunk;
+                }
+                (void)sl_proto_feed(p, data + off, n, 0);
+                off += n;
+            }
+            return true;
+        },
+        [&](const Discontinuity &) { (void)sl_proto_finish(p); }, info, bytes, err, opt);
+    (void)sl_proto_finish(p);
     return ok;
 }
 

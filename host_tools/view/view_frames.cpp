@@ -3,6 +3,7 @@
 #include "view_frames.h"
 
 #include <algorithm>
+#include <functional>
 #include <memory>
 #include <sys/stat.h>
 
@@ -76,7 +77,11 @@ bool is_dir(const std::string &p)
     return ::stat(p.c_str(), &st) == 0 && S_ISDIR(st.st_mode);
 }
 
-bool decode(const Capture &cap, const FrameOptions &opt, FrameSet &out, std::string &err)
+// Hands the stream to decoder `p` (sl_proto_finish at every discontinuity); `stop` turns
+// true once enough frames are kept. false + err on a read error.
+using Feeder = std::function<bool(sl_proto_t *p, const bool &stop, std::string &err)>;
+
+bool decode(const Feeder &feed, const FrameOptions &opt, FrameSet &out, std::string &err)
 {
     if (opt.roi_bins < 1 || opt.roi_bins > SL_CFG_ROI_BINS) {
         err = "roi_bins must be in 1.." + std::to_string(SL_CFG_ROI_BINS);
@@ -108,7 +113,10 @@ bool decode(const Capture &cap, const FrameOptions &opt, FrameSet &out, std::str
     pc.on_msg = on_msg;
     pc.ctx = ctx.get();
     (void)sl_proto_init(&p, &pc);
-    feed_capture(cap, &p);
+    if (!feed(&p, ctx->stop, err)) {
+        return false;
+    }
+    (void)sl_proto_finish(&p);
     sl_scan_flush(&ctx->scan);
     out.proto = p.stats;
     out.scan = ctx->scan.stats;
@@ -151,13 +159,19 @@ bool decode(const Capture &cap, const FrameOptions &opt, FrameSet &out, std::str
 bool decode_frames(const std::vector<uint8_t> &bytes, const FrameOptions &opt, FrameSet &out,
                    std::string &err)
 {
-    Capture cap;
-    cap.format = CaptureFormat::Raw;
-    cap.bytes = bytes;
     if (out.kind.empty()) {
         out.kind = "raw";
     }
-    return decode(cap, opt, out, err);
+    return decode(
+        [&](sl_proto_t *p, const bool &stop, std::string &) {
+            // 1 MiB at a time so a --max-frames stop ends the decoding early.
+            constexpr size_t kStep = 1u << 20;
+            for (size_t off = 0; off < bytes.size() && !stop; off += kStep) {
+                (void)sl_proto_feed(p, bytes.data() + off, std::min(kStep, bytes.size() - off), 0);
+            }
+            return true;
+        },
+        opt, out, err);
 }
 
 bool load_frames(const std::string &path, const FrameOptions &opt, FrameSet &out,
@@ -165,26 +179,41 @@ bool load_frames(const std::string &path, const FrameOptions &opt, FrameSet &out
 {
     out = FrameSet{};
     out.source = path;
-    Capture cap;
     if (is_dir(path)) {
         OxfordOptions oo;
         if (opt.bin_size_m > 0) {
             oo.bin_size_m = opt.bin_size_m;
         }
         OxfordReport rep;
-        cap.format = CaptureFormat::Raw;
-        if (!oxford_to_colossus(path, oo, cap.bytes, rep, err)) {
+        std::vector<uint8_t> bytes;
+        if (!oxford_to_colossus(path, oo, bytes, rep, err)) {
             return false;
         }
         out.kind = "oxford-png";
-    } else {
-        if (!load_capture(path, cap, err)) {
+        if (!decode_frames(bytes, opt, out, err)) {
+            err = path + ": " + err;
             return false;
         }
-        out.kind = capture_format_name(cap.format);
+        return true;
     }
-    if (!decode(cap, opt, out, err)) {
-        err = path + ": " + err;
+    // A capture file, pipe, FIFO or "-": streamed through the port's reader, never loaded.
+    const Feeder stream = [&](sl_proto_t *p, const bool &stop, std::string &e) {
+        Capture info;
+        uint64_t bytes = 0;
+        const bool ok = read_capture(
+            path,
+            [&](const uint8_t *data, size_t size) {
+                (void)sl_proto_feed(p, data, size, 0);
+                return !stop;
+            },
+            [&](const Discontinuity &) { (void)sl_proto_finish(p); }, info, bytes, e);
+        out.kind = capture_format_name(info.format);
+        return ok;
+    };
+    if (!decode(stream, opt, out, err)) {
+        if (err.compare(0, path.size(), path) != 0) {
+            err = path + ": " + err;
+        }
         return false;
     }
     return true;

@@ -2,7 +2,7 @@
 // view_frames.h: a capture (raw .colossus, pcap/pcapng) or an Oxford PNG folder decoded into
 // whole rotations, for the host tools that look at images (sl-view, sl-calib). Host only.
 //
-// Every byte goes through the core: capture.h reads the file, sl_proto_feed() decodes the
+// Every byte goes through the core: capture.h streams the file, sl_proto_feed() decodes the
 // Colossus stream (1 MiB reassembly buffer) and sl_scan assembles rotations (double
 // buffering, nearest-azimuth index, the first `roi_bins` bins of each azimuth). An Oxford
 // folder is first converted with oxford.h (the same converter as `sl-replay from-oxford`)
@@ -15,7 +15,10 @@
 // and counted (an Oxford sequence ends with a one-row frame: its last row, encoder tick 5599,
 // is azimuth index 0 and opens a frame that never fills).
 //
-// Memory: the capture bytes plus one Mat per kept frame (400 x 512 B = 200 KB each).
+// A capture file, pipe, FIFO or "-" is streamed (capture.h read_capture: the port's reader),
+// never loaded, and reading stops once `max_frames` frames are kept.
+// Memory: one Mat per kept frame (400 x 512 B = 200 KB each; bound it with max_frames) plus
+// the reader's window; an Oxford folder's converted stream is held while it is decoded.
 #pragma once
 
 #include <cstdint>

@@ -28,6 +28,7 @@
 
 #include <cstdint>
 #include <cstdio>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -124,6 +125,23 @@ bool load_capture(const std::string &path, Capture &out, std::string &err,
 bool load_pcap(const std::string &path, Capture &out, std::string &err,
                const PcapOptions &opt = PcapOptions{});
 
+/// A piece of the radar -> client stream, valid only during the call. Returns false to stop
+/// reading (not an error: the consumer has what it needs).
+using CaptureDataFn = std::function<bool(const uint8_t *data, size_t size)>;
+/// A place where the stream is not continuous (already appended to Capture::discontinuities).
+using CaptureBreakFn = std::function<void(const Discontinuity &d)>;
+
+/// Streams `path` ("-" = stdin, pipes and FIFOs work) in bounded memory, whatever its size:
+/// `on_data` receives the reassembled stream piece by piece, in order; `on_break` (may be
+/// empty) each discontinuity (a gap or a new TCP session) where it falls, so the consumer
+/// resets its decoder there. This is the one way the host tools read a capture. `info`
+/// receives the format, discontinuities and pcap report (its `bytes` stay empty); `bytes` the
+/// stream size. false + `err` when the capture cannot be opened or ends with an error (the
+/// part read before it has been handed over). Memory: the port reader's window (raw) or
+/// its reassembly queue (pcap), not the capture. Cost: O(bytes).
+bool read_capture(const std::string &path, const CaptureDataFn &on_data, const CaptureBreakFn &on_break,
+                  Capture &info, uint64_t &bytes, std::string &err, const PcapOptions &opt = PcapOptions{});
+
 /// Streams `path` ("-" = stdin) through decoder `p` in bounded memory: what load_capture +
 /// feed_capture do, without holding the stream (`chunk` > 0: at most that many bytes per
 /// sl_proto_feed). `info` receives the format, discontinuities and pcap report (its `bytes`
@@ -131,6 +149,32 @@ bool load_pcap(const std::string &path, Capture &out, std::string &err,
 /// or ends with an error (the part read before it has been fed).
 bool stream_capture(const std::string &path, sl_proto_t *p, size_t chunk, Capture &info, uint64_t &bytes,
                     std::string &err, const PcapOptions &opt = PcapOptions{});
+
+/// A capture as a sequence of whole messages, pulled one at a time in bounded memory: the
+/// port's streaming reader (as read_capture: "-", FIFOs, pcap reassembly), the core decoder
+/// (1 MiB reassembly buffer, reset at every gap or new TCP session), and the messages of the
+/// piece of the stream being decoded. For tools that need messages rather than bytes
+/// (`sl-replay serve`). Each message is returned whole (22-byte header + payload, the header
+/// re-encoded, which is byte for byte the captured one: a valid header has no free field).
+class MessageReader {
+public:
+    MessageReader();
+    ~MessageReader();
+    MessageReader(const MessageReader &) = delete;
+    MessageReader &operator=(const MessageReader &) = delete;
+
+    /// false + err when `path` cannot be opened.
+    bool open(const std::string &path, std::string &err, const PcapOptions &opt = PcapOptions{});
+    /// The next message (its id and bytes); false at the end of the capture (error() is not
+    /// empty when it ended on a read error).
+    bool next(uint8_t &id, std::vector<uint8_t> &msg);
+    const std::string &error() const { return err_; }
+
+private:
+    struct Impl;
+    Impl *m_;
+    std::string err_;
+};
 
 /// Feeds the whole capture to decoder `p` (which must be freshly initialised so that its
 /// stream offsets equal indexes into `cap.bytes`): one sl_proto_feed() per continuous piece,

@@ -1,0 +1,78 @@
+#!/bin/sh
+# SPDX-License-Identifier: MIT
+# The host tools read a capture through the streaming reader (host_tools/capture/capture.h
+# read_capture): a FIFO or stdin ("-") gives exactly what the file gives, and memory does
+# not grow with the capture's size.
+#   tools_stream.sh TOOL BINDIR SRCDIR WORKDIR
+#   TOOL = view | calib | eval | eval-memory | serve-memory
+set -eu
+tool=$1 B=$2 S=$3 d=$4
+rm -rf "$d"; mkdir -p "$d"; cd "$d"
+"$B/sim/sl-sim" "$S/scenes/demo_three_poles.ini" --rotations 20 -o s.colossus --gt s.gt.csv --quiet
+fifo() { rm -f f.fifo; mkfifo f.fifo; cat "$1" > f.fifo & }
+# The tools name their input in their report: compare everything else.
+strip() { sed -e 's#s\.colossus#INPUT#g; s#f\.fifo#INPUT#g; s#s\.pcapng#INPUT#g' -e 's#\([ (]\)-\([ ):]\)#\1INPUT\2#g' \
+              -e 's#; *-$#;   INPUT#' -e 's#[a-z]*\.\(png\|ini\)#OUT#g' "$1"; }
+same() { strip "$1" > "$1.s"; strip "$2" > "$2.s"; diff "$1.s" "$2.s"; }
+case $tool in
+view)
+  "$B/view/sl-view" s.colossus --board paper-sim --title T --out file.png > file.txt
+  grep -q '3 detections' file.txt
+  fifo s.colossus; "$B/view/sl-view" f.fifo --board paper-sim --title T --out fifo.png > fifo.txt
+  cat s.colossus | "$B/view/sl-view" - --board paper-sim --title T --out pipe.png > pipe.txt
+  cmp file.png fifo.png; cmp file.png pipe.png; same file.txt fifo.txt; same file.txt pipe.txt ;;
+calib)
+  "$B/calib/sl-calib" shadow s.colossus --board paper-sim --out-ini file.ini > file.txt
+  cat s.colossus | "$B/calib/sl-calib" shadow - --board paper-sim --out-ini pipe.ini > pipe.txt
+  fifo s.colossus; "$B/calib/sl-calib" shadow f.fifo --board paper-sim --out-ini fifo.ini > fifo.txt
+  grep -q '20 rotations' file.txt
+  same file.ini pipe.ini; same file.txt pipe.txt; same file.ini fifo.ini; same file.txt fifo.txt ;;
+eval)
+  # bbox extraction from a file, stdin and a FIFO; the pipeline from a FIFO and from the
+  # pcapng of the same stream (reassembled now, where the whole file used to be fed raw).
+  "$B/eval/sl-eval" run s.colossus s.gt.csv --board paper-sim > file.txt
+  cat s.colossus | "$B/eval/sl-eval" run - s.gt.csv --board paper-sim > pipe.txt
+  grep -q '20 rotations' file.txt; same file.txt pipe.txt
+  sc="--extract pipeline --scene $S/scenes/demo_three_poles.ini"
+  "$B/eval/sl-eval" run s.colossus s.gt.csv $sc > pfile.txt
+  fifo s.colossus; "$B/eval/sl-eval" run f.fifo s.gt.csv $sc > pfifo.txt
+  "$B/replay/sl-replay" to-pcapng s.colossus --out s.pcapng
+  "$B/eval/sl-eval" run s.pcapng s.gt.csv $sc > ppcap.txt
+  grep -q 'detected' pfile.txt; same pfile.txt pfifo.txt; same pfile.txt ppcap.txt
+  ! "$B/eval/sl-eval" run missing.colossus s.gt.csv 2> err.txt
+  grep -q 'missing.colossus' err.txt ;;
+eval-memory)
+  # 4 vs 15 copies of the capture (17 / 66 MB) through a pipe: peak RSS grows < 8 MiB.
+  for k in 4 15; do
+    i=0; while [ $i -lt $k ]; do cat s.colossus; i=$((i + 1)); done > big$k
+    cat big$k | /usr/bin/time -v -o time$k.txt "$B/eval/sl-eval" run - s.gt.csv --board paper-sim > out$k.txt
+    grep -q "$((k * 20)) rotations" out$k.txt
+  done
+  a=$(sed -n 's/.*Maximum resident set size (kbytes): //p' time4.txt)
+  b=$(sed -n 's/.*Maximum resident set size (kbytes): //p' time15.txt)
+  echo "sl-eval run peak RSS: $a KiB for 17 MB, $b KiB for 66 MB"
+  test $((b - a)) -le 8192 ;;
+serve-memory)
+  # sl-replay serve of 4 vs 15 copies (17 / 66 MB) to a recording client (--rate max) for
+  # at most 4 s: the server's peak RSS grows < 8 MiB (it used to load the whole capture).
+  # However much of it the client gets on a loaded machine, the bound must hold.
+  for k in 4 15; do
+    i=0; while [ $i -lt $k ]; do cat s.colossus; i=$((i + 1)); done > big$k
+    /usr/bin/time -v -o time$k.txt "$B/replay/sl-replay" serve big$k --port 0 --rate max --timeout 4 \
+      > serve$k.txt 2> serve$k.err &
+    pid=$!; port=""; n=0
+    while [ -z "$port" ] && [ $n -lt 300 ]; do
+      port=$(sed -n 's/^sl-replay: listening on 127\.0\.0\.1:\([0-9][0-9]*\)$/\1/p' serve$k.txt 2>/dev/null); n=$((n + 1)); sleep 0.05
+    done
+    test -n "$port"
+    "$B/replay/sl-replay" record --radar 127.0.0.1:$port --out rec$k.colossus --duration 3 > rec$k.txt 2>&1 || true
+    wait $pid
+    test -s rec$k.colossus
+  done
+  a=$(sed -n 's/.*Maximum resident set size (kbytes): //p' time4.txt)
+  b=$(sed -n 's/.*Maximum resident set size (kbytes): //p' time15.txt)
+  echo "sl-replay serve peak RSS: $a KiB for 17 MB, $b KiB for 66 MB"
+  test $((b - a)) -le 8192 ;;
+*) echo "tools_stream.sh: unknown tool $tool" >&2; exit 2 ;;
+esac
+echo "ok: $tool"
