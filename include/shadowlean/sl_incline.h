@@ -162,9 +162,8 @@ typedef struct sl_incline_result {
 /// sl_incline_atan2_bam32(). sigma uses Q56 for Q, Q24 for the derivatives, Q12 cdeg for
 /// the two terms and sl_fx_isqrt64 for the root.
 /// Cost: O(1): 4-5 64-bit divisions, 2 (branch 1) or 3 (branch 2) sl_fx_isqrt64 calls
-/// (the bulk of the time), ~12 64-bit multiplies. Measured with callgrind on x86-64 -O2:
-/// ~700 instructions (branch 1), ~880 (branch 2); on Cortex-M0 (software 64-bit division
-/// and multiplication) an estimate of 4-6k cycles, not measured. Stack: see the file banner.
+/// (the bulk of the time), ~12 64-bit multiplies (measured counts: docs/PERFORMANCE.md,
+/// "Core modules"). Stack: see the file banner.
 /// Pure function: reentrant, no state, callable from any context.
 sl_incline_result_t sl_incline_estimate(uint32_t r1_um, uint32_t r2_um,
                                         const sl_incline_geom_t *geom, uint32_t sigma_r_um,
