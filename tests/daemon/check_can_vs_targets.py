@@ -27,6 +27,7 @@ documented in sl_pipeline.h. Checks:
   LinkState in --link (comma list; default STREAMING = 3).
 Prints a summary; exit 0 when everything matches.
 """
+import argparse
 import json
 import sys
 
@@ -54,25 +55,19 @@ def ang_diff(a, b):
 
 
 def main(argv):
-    args = argv[1:]
-    opts = {"--link": "3", "--rotations": None, "--min-poles": "0"}  # --link: comma list
-    flags = set()
-    pos = []
-    i = 0
-    while i < len(args):
-        if args[i] in opts:
-            opts[args[i]] = args[i + 1]
-            i += 2
-        elif args[i].startswith("--"):
-            flags.add(args[i])
-            i += 1
-        else:
-            pos.append(args[i])
-            i += 1
-    if len(pos) != 3:
-        print(__doc__)
-        return 2
-    dbc, log, jsonl = pos
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("dbc", metavar="BOARD.dbc")
+    ap.add_argument("log", metavar="CAN.log")
+    ap.add_argument("jsonl", metavar="TARGETS.jsonl")
+    ap.add_argument("--link", default="3", help="accepted LinkState values, comma list (default 3)")
+    ap.add_argument("--rotations", type=int, help="exact number of rotation groups")
+    ap.add_argument("--min-poles", type=int, default=0, help="most PoleLean frames in a rotation >= N")
+    ap.add_argument("--idle-ok", action="store_true", help="idle Status + Health pairs may appear")
+    ap.add_argument("--no-fault", action="store_true", help="every Health frame has Fault = 0")
+    a = ap.parse_args(argv[1:])
+    opts = {"--link": a.link, "--rotations": a.rotations, "--min-poles": a.min_poles}
+    flags = {f for f, on in (("--idle-ok", a.idle_ok), ("--no-fault", a.no_fault)) if on}
+    dbc, log, jsonl = a.dbc, a.log, a.jsonl
     db = scd.load_dbc(dbc)
     frames = scd.read_candump(log)
     with open(jsonl) as fh:

@@ -13,6 +13,7 @@ pole of the truth file is visible in that rotation. Prints one line; --json writ
 {"tracked": {pole: rotations}, "truth": {pole: rotations in the truth}, "stray": N,
 "rotations": N, "polelean": N, "candidates_dropped": max CandidatesDropped or null}.
 """
+import argparse
 import csv
 import json
 import os
@@ -28,20 +29,16 @@ def adist(a, b):
 
 
 def main(argv):
-    args = argv[1:]
-    opt = {"--az-tol": 3.0, "--stray-tol": 5.0, "--json": None}
-    pos = []
-    i = 0
-    while i < len(args):
-        if args[i] in opt:
-            opt[args[i]] = args[i + 1] if args[i] == "--json" else float(args[i + 1])
-            i += 2
-        else:
-            pos.append(args[i])
-            i += 1
-    if len(pos) != 3:
-        print(__doc__)
-        return 2
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("dbc", metavar="BOARD.dbc")
+    ap.add_argument("log", metavar="CAN.log")
+    ap.add_argument("truth", metavar="TRUTH.gt.csv")
+    ap.add_argument("--az-tol", type=float, default=3.0, metavar="DEG")
+    ap.add_argument("--stray-tol", type=float, default=5.0, metavar="DEG")
+    ap.add_argument("--json", metavar="OUT")
+    a = ap.parse_args(argv[1:])
+    opt = {"--az-tol": a.az_tol, "--stray-tol": a.stray_tol, "--json": a.json}
+    pos = [a.dbc, a.log, a.truth]
     decoded = scd.decode_log(pos[0], pos[1])
     dropped = None
     for _, d in decoded:

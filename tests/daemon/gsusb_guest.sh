@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: MIT
-# gsusb_guest.sh: runs INSIDE the gs_usb test VM (tests/gsusb/build_vm.sh image: chroot on
+# gsusb_guest.sh: runs INSIDE the gs_usb test VM (tests/support/vm/build_vm.sh image: chroot on
 # the host's read-only root, $OUT writable, $KMOD the extracted kernel modules). Presents the
 # fake candleLight of tests/gsusb (dummy_hcd + configfs + FunctionFS, echo + reply mode) and
 # runs shadowleand --gs-usb 1d50:606f on a capture (24 rotations, 6 s) in real time, next to

@@ -1,40 +1,22 @@
 #!/bin/sh
 # SPDX-License-Identifier: MIT
 # gsusb_vm_test.sh SOURCE_DIR CACHE_DIR OUT_DIR SHADOWLEAND SL_SIM PYTHON
-# shadowleand's --gs-usb output against a fake candleLight in a QEMU VM (the image and the
-# fake device of tests/gsusb: build_vm.sh, fake_candlelight.py; same cache directory, so
+# shadowleand's --gs-usb output against a fake candleLight in the test VM (the harness
+# tests/support/vm/qemu_run.sh, the fake device of tests/gsusb/fake_candlelight.py; the same cache directory, so
 # the kernel package is downloaded once for both tests). On the host afterwards: the frames
 # the device received over USB equal the daemon's --can-log field by field, every one was
 # confirmed (echo), they decode with the DBC and match the targets, and the kernel driver
 # got the device back at exit. Exit 77 when qemu-system-x86_64 is missing.
 set -eu
 SRC=$1; CACHE=$2; OUT=$3; DAEMON=$4; SIM=$5; PY=$6
-if ! command -v qemu-system-x86_64 >/dev/null 2>&1; then
-    echo "SKIP: qemu-system-x86_64 is not installed (sh scripts/deps.sh test installs it)"
-    exit 77
-fi
 GS="$SRC/tests/gsusb"
-sh "$GS/build_vm.sh" "$CACHE" "$SRC"
-KERNEL=$(cat "$CACHE/kernel_path")
-KMOD=$(cat "$CACHE/kmod_path")
 rm -rf "$OUT"; mkdir -p "$OUT"; OUT=$(cd "$OUT" && pwd)
 "$SIM" "$SRC/tests/daemon/scenes/static_four_poles.ini" -o "$OUT/short.colossus" --quiet
 printf 'SL_DAEMON=%s\nSL_GSDIR=%s\nSL_CAPTURE=%s\n' "$DAEMON" "$GS" "$OUT/short.colossus" > "$OUT/vm.env"
-set +e
-timeout -k 5 150 qemu-system-x86_64 -accel tcg,thread=multi -cpu max -m 1024 -smp 2 \
-    -nographic -no-reboot -nic none \
-    -kernel "$KERNEL" -initrd "$CACHE/initrd.gz" \
-    -append "console=ttyS0 quiet panic=-1 sl_out=$OUT sl_guest=$SRC/tests/daemon/gsusb_guest.sh sl_kmod=$KMOD" \
-    -virtfs local,path=/,mount_tag=hostroot,security_model=none,readonly=on,multidevs=remap \
-    -virtfs local,path="$OUT",mount_tag=out,security_model=none \
-    < /dev/null > "$OUT/console.log" 2>&1
-QRC=$?
-set -e
-grep -E "^\[(guest|init)" "$OUT/console.log" || true
+rc=0
+sh "$SRC/tests/support/vm/qemu_run.sh" "$SRC" "$CACHE" "$OUT" "$SRC/tests/daemon/gsusb_guest.sh" || rc=$?
 [ -f "$OUT/daemon.out" ] && sed 's/^/  daemon: /' "$OUT/daemon.out"
-if [ $QRC -eq 124 ] || [ $QRC -eq 137 ]; then
-    echo "FAIL: the VM did not finish within 150 s"; tail -30 "$OUT/console.log"; exit 1
-fi
+[ $rc -eq 0 ] || exit $rc
 [ "$(cat "$OUT/rc_daemon" 2>/dev/null)" = 0 ] || { echo "FAIL: shadowleand exit $(cat "$OUT/rc_daemon" 2>/dev/null)"; exit 1; }
 "$PY" - "$OUT" "$SRC/tests/daemon" <<'PY'
 import os, sys

@@ -11,6 +11,7 @@ azimuth is compared: Quality FILTERED and |Lean - alpha_deg| <= --tol (default 0
 static scene that is the last rotation; for a moving one, the last rotation the pole was
 still in the shadow. Prints a table; exit 0 when every pole is found and within tolerance.
 """
+import argparse
 import csv
 import os
 import sys
@@ -20,23 +21,14 @@ import sl_can_decode as scd  # noqa: E402
 
 
 def main(argv):
-    args = argv[1:]
-    tol, az_tol = 0.5, 3.0
-    pos = []
-    i = 0
-    while i < len(args):
-        if args[i] == "--tol":
-            tol = float(args[i + 1])
-            i += 2
-        elif args[i] == "--az-tol":
-            az_tol = float(args[i + 1])
-            i += 2
-        else:
-            pos.append(args[i])
-            i += 1
-    if len(pos) != 3:
-        print(__doc__)
-        return 2
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("dbc", metavar="BOARD.dbc")
+    ap.add_argument("log", metavar="CAN.log")
+    ap.add_argument("truth", metavar="TRUTH.gt.csv")
+    ap.add_argument("--tol", type=float, default=0.5, metavar="DEG")
+    ap.add_argument("--az-tol", type=float, default=3.0, metavar="DEG")
+    a = ap.parse_args(argv[1:])
+    tol, az_tol, pos = a.tol, a.az_tol, [a.dbc, a.log, a.truth]
     groups = [(st.raw["Rotations"] - 1, poles)
               for st, warn, poles in scd.groups(scd.decode_log(pos[0], pos[1])) if warn is not None]
     with open(pos[2]) as fh:

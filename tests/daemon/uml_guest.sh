@@ -1,7 +1,7 @@
 #!/bin/sh
 # SPDX-License-Identifier: MIT
 # uml_guest.sh DAEMON CAPTURE SHORT_CAPTURE MOTION_FRAMES OUTDIR: runs INSIDE user-mode Linux
-# (tests/can/uml_run.sh, vcan0 up). `candump -L vcan0` records the bus while:
+# (tests/support/vm/uml_run.sh, vcan0 up). `candump -L vcan0` records the bus while:
 #   run 1: shadowleand --input CAPTURE --can vcan0 --can-log daemon_fast.log (as fast as
 #          possible; --motion-can none);
 #   run 2: shadowleand --input SHORT_CAPTURE --realtime --can vcan0 --can-log daemon_rt.log

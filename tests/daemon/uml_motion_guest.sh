@@ -1,7 +1,7 @@
 #!/bin/sh
 # SPDX-License-Identifier: MIT
 # uml_motion_guest.sh DAEMON CAPTURE MOTION_FRAMES OUTDIR: runs INSIDE user-mode Linux
-# (tests/can/uml_run.sh, vcan0 up). shadowleand replays CAPTURE in real time with --can vcan0
+# (tests/support/vm/uml_run.sh, vcan0 up). shadowleand replays CAPTURE in real time with --can vcan0
 # (VehicleMotion read from vcan0) while MOTION_FRAMES (motion_fault_frames.py: good frames,
 # bad CRCs, repetitions, counter jumps) go onto vcan0 every 20 ms, from the daemon's first
 # rotation until 4 rotations used the motion input; then the sender stops (a reception

@@ -1,7 +1,7 @@
 #!/bin/sh
 # SPDX-License-Identifier: MIT
 # uml_test.sh UML_RUN SHADOWLEAND SL_SIM PYTHON SRC_DIR OUT_DIR
-# Real SocketCAN inside user-mode Linux (tests/can/uml_run.sh): shadowleand --input CAPTURE
+# Real SocketCAN inside user-mode Linux (tests/support/vm/uml_run.sh): shadowleand --input CAPTURE
 # --can vcan0 --can-log OUT while `candump -L vcan0` records (uml_guest.sh); on the host:
 # the recording equals the --can-log output field by field, the real-time run took
 # VehicleMotion from vcan0, and the fast run's frames match its targets (DBC decode).

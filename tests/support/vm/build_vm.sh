@@ -12,7 +12,7 @@
 # Missing Debian packages are installed through scripts/deps.sh (group "test").
 set -eu
 CACHE=${1:?usage: build_vm.sh CACHE_DIR [SOURCE_DIR]}
-SRC=${2:-$(cd "$(dirname "$0")/../.." && pwd)}
+SRC=${2:-$(cd "$(dirname "$0")/../../.." && pwd)}
 mkdir -p "$CACHE"
 CACHE=$(cd "$CACHE" && pwd)
 cd "$CACHE"
