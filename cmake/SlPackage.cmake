@@ -3,7 +3,7 @@
 #   shadowlean-dev    the SDK: headers, libsl_core.a, CMake package, pkg-config (component sdk)
 #   shadowleand       the daemon, its systemd unit, example config, DBCs (component daemon)
 #   shadowlean-tools  the host tools and the Wireshark dissector (component tools)
-# Run-time dependencies come from dpkg-shlibdeps; the test tests/install/ builds, lists,
+# Run-time dependencies come from dpkg-shlibdeps; the test tests/system/install/ builds, lists,
 # unpacks and lints them.
 set(CPACK_PACKAGE_NAME shadowlean)
 set(CPACK_PACKAGE_VENDOR "The shadowlean authors")

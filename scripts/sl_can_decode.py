@@ -2,7 +2,7 @@
 # SPDX-License-Identifier: MIT
 """Decode shadowlean CAN frames from a candump log with a board's generated DBC
 (Debian python3-canmatrix), independently of the C code. The project's one Python DBC
-decoder: the daemon tests, the DBC layout check (tests/can/check_dbc_decode.py) and
+decoder: the daemon tests, the DBC layout check (tests/system/can/check_dbc_decode.py) and
 scripts/demo.sh all use it.
 
 Library:

@@ -45,10 +45,10 @@
 /// - ambiguity: the test is `rho_q28 < geom->rho_amb_q28`, exact in integers;
 ///   rho_amb_q28 = round(2^28/cos((t+b)/2)), so the classification matches the real bound to
 ///   one LSB of rho (3.7e-9).
-/// Measured by tests/unit/test_incline.c (201945 points: theta 5..34 deg step 0.5, beta 0..5
+/// Measured by tests/core/test_incline.c (201945 points: theta 5..34 deg step 0.5, beta 0..5
 /// step 1, rho from the ambiguity bound to 10 incl. +-8 LSB around the seam; plus 18000
-/// random micrometre pairs over the whole domain), tests/alpha/test_geom.cpp (191461 random
-/// points over the whole domain) and tests/alpha/check_alpha.py (sl-alpha, 5000 lines).
+/// random micrometre pairs over the whole domain), tests/host/alpha/test_geom.cpp (191461 random
+/// points over the whole domain) and tests/host/alpha/check_alpha.py (sl-alpha, 5000 lines).
 ///
 /// Resources (Cortex-M0, arm-none-eabi-gcc -Os): code + table 2500 bytes of flash (the atan
 /// table is 1028 of them), no RAM; stack <= 200 bytes (sl_incline_estimate's frame 88 B +

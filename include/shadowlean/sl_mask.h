@@ -32,7 +32,7 @@
 /// The first row of an azimuth (after init or a reset) sets `L = X`, `k = n - 1`. Counting
 /// down (rather than up to n) needs one plane fewer: n = 16 uses 4 counter planes, n = 32
 /// uses 5, instead of ceil(log2(n + 1)) = 5 and 6. This is exactly equivalent to storing
-/// the last n rows and intersecting them (tests/unit/test_mask.c checks it bit for bit
+/// the last n rows and intersecting them (tests/core/test_mask.c checks it bit for bit
 /// against that naive reference for every n in 1..32, with missing azimuths).
 ///
 /// ## Frames and missing azimuths

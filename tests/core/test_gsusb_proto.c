@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
 // Unit tests for the gs_usb protocol layer (firmware/port/linux/gsusb_proto.h) against the
-// in-process fake candleLight (tests/gsusb/gsusb_fake.h): request bytes, the start-up
+// in-process fake candleLight (tests/system/gsusb/gsusb_fake.h): request bytes, the start-up
 // sequence, bit timing (fixed points from the kernel and a brute-force oracle), frame
 // encoding both ways, the echo window, timeouts, error frames, and refuse / stall / lost
 // echo / vanish behaviour. No libusb: this also runs on aarch64 and s390x (big-endian).

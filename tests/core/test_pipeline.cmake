@@ -5,7 +5,7 @@
 # defines; only the board tables come from sl_core (they do not depend on these knobs).
 sl_add_unit_test(pipeline)
 file(GLOB _sl_core_srcs CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/firmware/core/*.c)
-add_executable(test_pipeline_fw ${CMAKE_CURRENT_SOURCE_DIR}/unit/test_pipeline.c ${_sl_core_srcs})
+add_executable(test_pipeline_fw ${CMAKE_CURRENT_SOURCE_DIR}/core/test_pipeline.c ${_sl_core_srcs})
 target_compile_definitions(test_pipeline_fw PRIVATE SL_CFG_MASK_BINS=160 SL_CFG_MASK_FRAMES_MAX=16)
 set_target_properties(test_pipeline_fw PROPERTIES C_STANDARD 11 C_EXTENSIONS OFF)
 target_link_libraries(test_pipeline_fw PRIVATE sl_core sl_test_support sl_host_warnings)

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
 // Unit tests for sl_pipeline_on_msg() (decode once): a caller's own decoder handing every
 // message to the pipeline gives the same rotations and the same CAN frames, byte for byte,
-// as sl_pipeline_feed() on the same bytes: a CTS350-X-like stream (tests/golden/sl_golden.c,
+// as sl_pipeline_feed() on the same bytes: a CTS350-X-like stream (tests/support/golden/sl_golden.c,
 // robotcar-leaf geometry) with keep-alives, Health messages and junk cut into a message, fed
 // in odd chunks; Status reports the caller's decoder resyncs (sl_pipeline_set_decoder_stats).
 #include <setjmp.h>

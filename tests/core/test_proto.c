@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
 // Unit tests for sl_proto.h: incremental decoder (chunking invariance, resync, limits,
 // EOF, accounting), typed parsers (wire layout checked against hand-written bytes) and
-// encoders. Streams are built in the test with the encoders (tests/golden/sl_golden.c).
+// encoders. Streams are built in the test with the encoders (tests/support/golden/sl_golden.c).
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// make_seeds: writes the committed seed corpus of fuzz_proto (tests/fuzz/corpus/).
+// make_seeds: writes the committed seed corpus of fuzz_proto (tests/core/fuzz/corpus/).
 // Usage: fuzz_make_seeds <dir>. Deterministic; re-run only when the input layout of
 // fuzz_proto.c changes. Each file = 4 control bytes (see fuzz_proto.c) + a stream.
 #include <stdint.h>

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
 // gen_scans.h: synthetic radar captures with KNOWN shadow and elongation, for the
-// calibration tests (tests/calib) and the sl-view pictures. Written through the core's
+// calibration tests (tests/host/calib) and the sl-view pictures. Written through the core's
 // encoders (sl_proto_encode_config / sl_proto_encode_fft8), decoded by the tools like any
 // capture. Deliberately independent of the scene simulator (sl-sim): a small forward model
 // whose truth is a parameter, not a measurement.

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// check_view.cpp: checks on sl-view's output (tests/view).
+// check_view.cpp: checks on sl-view's output (tests/host/view).
 //
 //   check_view png FILE [--size W H] [--min COLOUR N]...   COLOUR: amber magenta red cyan green
 //   check_view video FILE FRAMES                           (FILE.mp4, or FILE.avi fallback)

@@ -25,7 +25,7 @@ from decimal import Decimal as D
 
 import can
 
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "..", "scripts"))
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "..", "..", "scripts"))
 import sl_can_decode as scd  # noqa: E402
 
 decimal.getcontext().prec = 40

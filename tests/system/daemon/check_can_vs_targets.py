@@ -31,7 +31,7 @@ import argparse
 import json
 import sys
 
-sys.path.insert(0, __import__("os").path.join(__import__("os").path.dirname(__file__), "..", "..", "scripts"))
+sys.path.insert(0, __import__("os").path.join(__import__("os").path.dirname(__file__), "..", "..", "..", "scripts"))
 import sl_can_decode as scd  # noqa: E402
 
 # Ranges are rounded once on the way to CAN (sl_can.h takes um; the encoder rounds to the

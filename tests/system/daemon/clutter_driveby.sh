@@ -13,8 +13,8 @@
 # stands; parked: no confirmed track away from the poles over 100 rotations.
 set -u
 SL_SIM=$1; D=$2; PY=$3; SRC=$4; OUT=$5
-SCENE="$SRC/../../scenes/driveby_two_poles.ini"
-DBC="$SRC/../../boards/paper-sim/shadowlean.dbc"
+SCENE="$SRC/../../../scenes/driveby_two_poles.ini"
+DBC="$SRC/../../../boards/paper-sim/shadowlean.dbc"
 rm -rf "$OUT"; mkdir -p "$OUT"
 cp "$SCENE" "$OUT/clean1.ini"
 sed 's/^enabled = false/enabled = true/' "$SCENE" > "$OUT/clutter1.ini"

@@ -7,7 +7,7 @@
 set -u
 D=$1; SRC=$2; OUT=$3
 rm -rf "$OUT"; mkdir -p "$OUT"
-CONF="$SRC/../../packaging/shadowleand.conf"
+CONF="$SRC/../../../packaging/shadowleand.conf"
 fail() { echo "FAIL: $*"; exit 1; }
 has() { grep -qx -- "$2" "$1" || { echo "--- $1:"; cat "$1"; fail "missing line '$2'"; }; }
 hasnt() { ! grep -q -- "$2" "$1" || { cat "$1"; fail "unexpected '$2'"; }; }

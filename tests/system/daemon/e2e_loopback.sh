@@ -1,7 +1,7 @@
 #!/bin/sh
 # SPDX-License-Identifier: MIT
 # e2e_loopback.sh SL_SIM SL_REPLAY SHADOWLEAND PYTHON SRC_DIR OUT_DIR
-# End to end on loopback: sl-sim (tests/daemon/scenes/static_four_poles.ini) -> sl-replay
+# End to end on loopback: sl-sim (tests/system/daemon/scenes/static_four_poles.ini) -> sl-replay
 # serve on 127.0.0.1 (free port, parsed) -> shadowleand --radar -> candump log + targets
 # -> (1) every frame decodes with the DBC and matches the pipeline's targets
 # (check_can_vs_targets.py) and (2) the decoded leans are within 0.5 deg of the
@@ -21,7 +21,7 @@ echo "sl-replay serving on 127.0.0.1:$REPLAY_PORT"
     --targets-out "$OUT/targets.jsonl" --exit-idle 1.5 --duration 60 --stats-every 1 || {
     echo "FAIL: shadowleand exit status $?"; exit 1; }
 stop_pid "$REPLAY_PID"; REPLAY_PID=""
-DBC="$SRC/../../boards/paper-sim/shadowlean.dbc"
+DBC="$SRC/../../../boards/paper-sim/shadowlean.dbc"
 # LinkState of the rotation Status frames: STREAMING, or SILENT for the last one (flushed
 # when the daemon stops, after --exit-idle of silence).
 "$PY" "$SRC/check_can_vs_targets.py" "$DBC" "$OUT/can.log" "$OUT/targets.jsonl" \

@@ -9,7 +9,7 @@
 set -u
 SL_SIM=$1; DAEMON=$2; PY=$3; SRC=$4; OUT=$5
 rm -rf "$OUT"; mkdir -p "$OUT"
-DBC="$SRC/../../boards/paper-sim/shadowlean.dbc"
+DBC="$SRC/../../../boards/paper-sim/shadowlean.dbc"
 fail() { echo "FAIL: $*"; exit 1; }
 "$SL_SIM" "$SRC/scenes/static_four_poles.ini" -o "$OUT/ok.colossus" --rotations 4 --quiet || exit 1
 # patch FILE OUT FIELD VALUE: rewrite the Configuration (the first message) in a copy.

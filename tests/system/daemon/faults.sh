@@ -11,7 +11,7 @@ set -u
 SL_SIM=$1; SL_REPLAY=$2; DAEMON=$3; PY=$4; SRC=$5; OUT=$6
 . "$SRC/lib.sh"
 rm -rf "$OUT"; mkdir -p "$OUT"
-DBC="$SRC/../../boards/paper-sim/shadowlean.dbc"
+DBC="$SRC/../../../boards/paper-sim/shadowlean.dbc"
 REPLAY_PID=""
 trap 'stop_pid "$REPLAY_PID"' EXIT
 fail() { echo "FAIL: $*"; exit 1; }

@@ -16,7 +16,7 @@ grep -q '^speed_mps = 1.0' "$OUT/moving.ini" || { echo "FAIL: scene edit"; exit 
 "$D" --board paper-sim --input "$OUT/moving.colossus" --can-log "$OUT/still.log" --targets-out "$OUT/still.jsonl" -q || exit 1
 "$D" --board paper-sim --input "$OUT/moving.colossus" --motion 1.0 --can-log "$OUT/moving.log" \
     --targets-out "$OUT/moving.jsonl" -q || exit 1
-DBC="$SRC/../../boards/paper-sim/shadowlean.dbc"
+DBC="$SRC/../../../boards/paper-sim/shadowlean.dbc"
 "$PY" "$SRC/check_can_vs_targets.py" "$DBC" "$OUT/moving.log" "$OUT/moving.jsonl" --rotations 24 --min-poles 3 --no-fault || exit 1
 "$PY" - "$OUT" <<'PY'
 import json, os, sys

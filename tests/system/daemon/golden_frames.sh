@@ -4,7 +4,7 @@
 # Behaviour pinned byte for byte: the CAN frames (candump -L log, data clock) the daemon
 # writes for the README's demo scene (scenes/demo_three_poles.ini through sl-sim) and for the
 # 11 real Oxford scans (sl-replay from-oxford), each read from a file (and with --pipe from
-# a pipe on stdin, `--input -`, as fast as possible and --realtime), must equal tests/daemon/golden/<name>.candump. The golden logs were written by
+# a pipe on stdin, `--input -`, as fast as possible and --realtime), must equal tests/system/daemon/golden/<name>.candump. The golden logs were written by
 # the daemon at "Layers step 1" (a pure move of main 1eb0496), before the capture reader
 # moved into the port. The sha256 of each input
 # capture is pinned too, so a changed simulator is told apart from a changed daemon.
@@ -57,7 +57,7 @@ check() { # name board capture
     fi
 }
 
-"$SL_SIM" "$SRC/../../scenes/demo_three_poles.ini" -o "$OUT/demo.colossus" --threads 1 --quiet || exit 1
+"$SL_SIM" "$SRC/../../../scenes/demo_three_poles.ini" -o "$OUT/demo.colossus" --threads 1 --quiet || exit 1
 check demo_three_poles paper-sim "$OUT/demo.colossus"
 if [ -d "$OX" ]; then
     "$SL_REPLAY" from-oxford "$OX" --out "$OUT/oxford.colossus" > /dev/null || exit 1

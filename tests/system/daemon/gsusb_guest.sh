@@ -1,7 +1,7 @@
 # SPDX-License-Identifier: MIT
 # gsusb_guest.sh: runs INSIDE the gs_usb test VM (tests/support/vm/build_vm.sh image: chroot on
 # the host's read-only root, $OUT writable, $KMOD the extracted kernel modules). Presents the
-# fake candleLight of tests/gsusb (dummy_hcd + configfs + FunctionFS, echo + reply mode) and
+# fake candleLight of tests/system/gsusb (dummy_hcd + configfs + FunctionFS, echo + reply mode) and
 # runs shadowleand --gs-usb 1d50:606f on a capture (24 rotations, 6 s) in real time, next to
 # --can-log.
 # Settings from $OUT/vm.env: SL_DAEMON, SL_GSDIR, SL_CAPTURE.
@@ -35,7 +35,7 @@ wait_for 100 test -e /sys/class/net/can0 || t "can0 did not appear"
 t "fake candleLight bound (kernel gs_usb: can0); starting shadowleand --gs-usb"
 # --gs-usb-max-age-ms 0: a TCG guest on a loaded host can be descheduled for longer than
 # the 200 ms age limit; this test checks the transport and its accounting (every frame
-# logged is confirmed by the device), not the age limit (tests/gsusb: stall scenarios).
+# logged is confirmed by the device), not the age limit (tests/system/gsusb: stall scenarios).
 "$SL_DAEMON" --board paper-sim --input "$SL_CAPTURE" --realtime --gs-usb 1d50:606f --gs-usb-max-age-ms 0 \
     --can-log "$OUT/daemon.log" --targets-out "$OUT/targets.jsonl" > daemon.out 2>&1
 echo $? > rc_daemon

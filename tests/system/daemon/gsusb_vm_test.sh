@@ -2,25 +2,25 @@
 # SPDX-License-Identifier: MIT
 # gsusb_vm_test.sh SOURCE_DIR CACHE_DIR OUT_DIR SHADOWLEAND SL_SIM PYTHON
 # shadowleand's --gs-usb output against a fake candleLight in the test VM (the harness
-# tests/support/vm/qemu_run.sh, the fake device of tests/gsusb/fake_candlelight.py; the same cache directory, so
+# tests/support/vm/qemu_run.sh, the fake device of tests/system/gsusb/fake_candlelight.py; the same cache directory, so
 # the kernel package is downloaded once for both tests). On the host afterwards: the frames
 # the device received over USB equal the daemon's --can-log field by field, every one was
 # confirmed (echo), they decode with the DBC and match the targets, and the kernel driver
 # got the device back at exit. Exit 77 when qemu-system-x86_64 is missing.
 set -eu
 SRC=$1; CACHE=$2; OUT=$3; DAEMON=$4; SIM=$5; PY=$6
-GS="$SRC/tests/gsusb"
+GS="$SRC/tests/system/gsusb"
 rm -rf "$OUT"; mkdir -p "$OUT"; OUT=$(cd "$OUT" && pwd)
-"$SIM" "$SRC/tests/daemon/scenes/static_four_poles.ini" -o "$OUT/short.colossus" --quiet
+"$SIM" "$SRC/tests/system/daemon/scenes/static_four_poles.ini" -o "$OUT/short.colossus" --quiet
 printf 'SL_DAEMON=%s\nSL_GSDIR=%s\nSL_CAPTURE=%s\n' "$DAEMON" "$GS" "$OUT/short.colossus" > "$OUT/vm.env"
 rc=0
-sh "$SRC/tests/support/vm/qemu_run.sh" "$SRC" "$CACHE" "$OUT" "$SRC/tests/daemon/gsusb_guest.sh" || rc=$?
+sh "$SRC/tests/support/vm/qemu_run.sh" "$SRC" "$CACHE" "$OUT" "$SRC/tests/system/daemon/gsusb_guest.sh" || rc=$?
 [ -f "$OUT/daemon.out" ] && sed 's/^/  daemon: /' "$OUT/daemon.out"
 [ $rc -eq 0 ] || exit $rc
 [ "$(cat "$OUT/rc_daemon" 2>/dev/null)" = 0 ] || { echo "FAIL: shadowleand exit $(cat "$OUT/rc_daemon" 2>/dev/null)"; exit 1; }
-"$PY" - "$OUT" "$SRC/tests/daemon" <<'PY'
+"$PY" - "$OUT" "$SRC/tests/system/daemon" <<'PY'
 import os, sys
-sys.path.insert(0, sys.argv[2] + "/../../scripts")
+sys.path.insert(0, sys.argv[2] + "/../../../scripts")
 import sl_can_decode as scd
 out = sys.argv[1]
 dev = scd.read_candump(os.path.join(out, "dev_daemon.log"))
@@ -43,5 +43,5 @@ for e in errs:
     print("FAIL:", e)
 sys.exit(1 if errs else 0)
 PY
-"$PY" "$SRC/tests/daemon/check_can_vs_targets.py" "$SRC/boards/paper-sim/shadowlean.dbc" \
+"$PY" "$SRC/tests/system/daemon/check_can_vs_targets.py" "$SRC/boards/paper-sim/shadowlean.dbc" \
     "$OUT/daemon.log" "$OUT/targets.jsonl" --rotations 24 --min-poles 4

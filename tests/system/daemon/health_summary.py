@@ -13,7 +13,7 @@ once by a Health frame; max_frames_per_s: the most frames in any 1 s of log time
 """
 import sys
 
-sys.path.insert(0, __import__("os").path.join(__import__("os").path.dirname(__file__), "..", "..", "scripts"))
+sys.path.insert(0, __import__("os").path.join(__import__("os").path.dirname(__file__), "..", "..", "..", "scripts"))
 import sl_can_decode as scd  # noqa: E402
 
 

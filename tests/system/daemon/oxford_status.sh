@@ -19,11 +19,11 @@ rc=$?
 cat "$OUT/daemon.err"
 [ $rc -eq 0 ] || { echo "FAIL: exit status $rc"; exit 1; }
 if grep -E "^shadowleand: (error|warning):" "$OUT/daemon.err"; then echo "FAIL: errors or warnings logged"; exit 1; fi
-DBC="$SRC/../../boards/robotcar-leaf/shadowlean.dbc"
+DBC="$SRC/../../../boards/robotcar-leaf/shadowlean.dbc"
 "$PY" "$SRC/check_can_vs_targets.py" "$DBC" "$OUT/can.log" "$OUT/targets.jsonl" --rotations 11 || exit 1
 "$PY" - "$DBC" "$OUT/can.log" "$SRC" <<'PY' || exit 1
 import sys
-sys.path.insert(0, sys.argv[3] + "/../../scripts")
+sys.path.insert(0, sys.argv[3] + "/../../../scripts")
 import sl_can_decode as scd
 st = [d for _, d in scd.decode_log(sys.argv[1], sys.argv[2]) if d is not None and d.name == "Status"]
 rot = [d.raw["Rotations"] for d in st]

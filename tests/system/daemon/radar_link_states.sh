@@ -14,7 +14,7 @@ set -u
 SL_SIM=$1; SL_REPLAY=$2; DAEMON=$3; PY=$4; SRC=$5; OUT=$6
 . "$SRC/lib.sh"
 rm -rf "$OUT"; mkdir -p "$OUT"
-DBC="$SRC/../../boards/paper-sim/shadowlean.dbc"
+DBC="$SRC/../../../boards/paper-sim/shadowlean.dbc"
 REPLAY_PID=""; DPID=""
 trap 'stop_pid "$REPLAY_PID"; stop_pid "$DPID"' EXIT
 count() { # PATTERN FILE: matching lines (0 when none or no file)
@@ -23,7 +23,7 @@ count() { # PATTERN FILE: matching lines (0 when none or no file)
 states() { # LOG: "LinkState values of the Status frames" and "last Rotations"
     "$PY" - "$DBC" "$1" "$SRC" <<'PY'
 import sys
-sys.path.insert(0, sys.argv[3] + "/../../scripts")
+sys.path.insert(0, sys.argv[3] + "/../../../scripts")
 import sl_can_decode as scd
 st = [d for _, d in scd.decode_log(sys.argv[1], sys.argv[2]) if d is not None and d.name == "Status"]
 print(" ".join(str(d.raw["LinkState"]) for d in st), "|", st[-1].raw["Rotations"] if st else -1)

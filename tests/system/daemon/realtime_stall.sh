@@ -10,7 +10,7 @@
 set -u
 SL_SIM=$1; DAEMON=$2; PY=$3; SRC=$4; OUT=$5
 rm -rf "$OUT"; mkdir -p "$OUT"
-DBC="$SRC/../../boards/paper-sim/shadowlean.dbc"
+DBC="$SRC/../../../boards/paper-sim/shadowlean.dbc"
 "$SL_SIM" "$SRC/scenes/static_four_poles.ini" -o "$OUT/s.colossus" --rotations 12 --quiet || exit 1
 "$DAEMON" --board paper-sim --input "$OUT/s.colossus" --realtime --can-log "$OUT/can.log" \
     --targets-out "$OUT/t.jsonl" 2> "$OUT/d.err" &

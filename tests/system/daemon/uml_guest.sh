@@ -9,7 +9,7 @@
 #          counters 0..14) go onto vcan0 every 50 ms; VehicleMotion is read from vcan0 (the
 #          default: the --can interface).
 # Marker frames 7FF#... (SYNC / MID / END) delimit the runs in candump's recording without
-# timing assumptions (the same trick as tests/can/uml_sink_guest.sh).
+# timing assumptions (the same trick as tests/system/can/uml_sink_guest.sh).
 set -u
 daemon=$1; cap=$2; short=$3; motion=$4; out=$5
 candump -L -r 8000000 vcan0 > "$out/candump.log" 2> "$out/candump.err" &

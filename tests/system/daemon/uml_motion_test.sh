@@ -11,7 +11,7 @@
 set -u
 uml_run=$1; daemon=$2; sim=$3; py=$4; src=$(cd "$5" && pwd); out=$6
 rm -rf "$out"; mkdir -p "$out"; out=$(cd "$out" && pwd)
-dbc="$src/../../boards/paper-sim/shadowlean.dbc"
+dbc="$src/../../../boards/paper-sim/shadowlean.dbc"
 # 200 rotations (50 s of radar time): the guest stops the daemon itself (SIGINT) once the
 # fallback has been seen, so a slow guest on a loaded host never runs out of capture.
 "$sim" "$src/scenes/static_four_poles.ini" -o "$out/scene.colossus" --rotations 200 --quiet || exit 1

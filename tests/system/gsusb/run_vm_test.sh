@@ -2,14 +2,14 @@
 # SPDX-License-Identifier: MIT
 # run_vm_test.sh SOURCE_DIR CACHE_DIR SENDER: the gs_usb integration test.
 # One boot of the test VM (tests/support/vm/qemu_run.sh) whose guest presents a fake candleLight (dummy_hcd + configfs + FunctionFS) and
-# runs every scenario (tests/gsusb/guest.sh); then check_results.py compares, on the host,
+# runs every scenario (tests/system/gsusb/guest.sh); then check_results.py compares, on the host,
 # what the fake device received with what the senders logged, and asserts the counters.
 # Exit: 0 pass, 1 fail, 77 skip (only when qemu-system-x86_64 is not installed).
 set -eu
 SRC=${1:?usage: run_vm_test.sh SOURCE_DIR CACHE_DIR SENDER}
 CACHE=${2:?}
 SEND=${3:?}
-HERE="$SRC/tests/gsusb"
+HERE="$SRC/tests/system/gsusb"
 T0=$(date +%s.%N)
 el() { awk -v a="$T0" -v b="$(date +%s.%N)" 'BEGIN { printf "%.1f", b - a }'; }
 [ -x "$SEND" ] || { echo "FAIL: sender $SEND not built"; exit 1; }

@@ -4,7 +4,7 @@
 #  1. cmake --install into a scratch prefix: headers, libsl_core.a, CMake package,
 #     pkg-config file, daemon, tools, DBCs, example config, systemd unit (naming the
 #     installed daemon), man pages when help2man is installed;
-#  2. a tiny consumer (tests/install/consumer) built with find_package(shadowlean) and,
+#  2. a tiny consumer (tests/system/install/consumer) built with find_package(shadowlean) and,
 #     separately, with pkg-config; both link the core and a board and run the estimator;
 #  3. cpack -G DEB: three packages, contents listed, unpacked into a scratch root, their
 #     dependencies named; lintian (when installed) reports no error.
@@ -37,7 +37,7 @@ fi
 echo "install: $(find "$P" -type f | wc -l) files under the prefix"
 
 # 2. consumers
-cmake -S "$SRC/tests/install/consumer" -B "$WORK/consumer-cmake" -DCMAKE_PREFIX_PATH="$P" \
+cmake -S "$SRC/tests/system/install/consumer" -B "$WORK/consumer-cmake" -DCMAKE_PREFIX_PATH="$P" \
     > "$WORK/consumer-cmake.log" 2>&1 || { cat "$WORK/consumer-cmake.log"; fail "find_package(shadowlean)"; }
 cmake --build "$WORK/consumer-cmake" > "$WORK/consumer-build.log" 2>&1 ||
     { cat "$WORK/consumer-build.log"; fail "consumer build (CMake package)"; }
@@ -45,7 +45,7 @@ out1=$("$WORK/consumer-cmake/consumer") || fail "consumer (CMake package) exit $
 echo "find_package: $out1"
 CC=${CC:-cc}
 # shellcheck disable=SC2046
-$CC -std=c11 -Wall -Werror "$SRC/tests/install/consumer/main.c" \
+$CC -std=c11 -Wall -Werror "$SRC/tests/system/install/consumer/main.c" \
     $(PKG_CONFIG_PATH="$P/lib/pkgconfig" pkg-config --cflags --libs shadowlean-core) \
     -o "$WORK/consumer-pc" || fail "consumer build (pkg-config)"
 out2=$("$WORK/consumer-pc") || fail "consumer (pkg-config) exit $?"
