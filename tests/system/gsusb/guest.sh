@@ -5,42 +5,9 @@
 # exit codes and logs in $OUT; check_results.py judges them on the host afterwards.
 # Settings come from $OUT/vm.env (written by run_vm_test.sh): SL_SEND, SL_DIR.
 . "$OUT/vm.env"
-t() { read -r up _ < /proc/uptime; echo "[guest t=${up}s] $*"; }
+. "$SL_DIR/fake_device.sh"
 rc_of() { echo "$2" > "$OUT/rc_$1"; }
-scenario() { # name mode: switch the fake device's behaviour (atomically)
-    printf 'scenario=%s\nmode=%s\n' "$1" "$2" > "$OUT/ctl.tmp" && mv "$OUT/ctl.tmp" "$OUT/ctl"
-}
-wait_for() { # TRIES command...: run command every 0.1 s until it succeeds
-    n=$1; shift
-    while [ "$n" -gt 0 ]; do "$@" && return 0; sleep 0.1; n=$((n - 1)); done
-    return 1
-}
-
-for m in drivers/usb/common/usb-common drivers/usb/core/usbcore drivers/usb/gadget/udc/udc-core \
-         drivers/usb/gadget/udc/dummy_hcd fs/configfs/configfs drivers/usb/gadget/libcomposite \
-         drivers/usb/gadget/function/usb_f_fs net/can/can net/can/can-raw \
-         drivers/net/can/dev/can-dev drivers/net/can/usb/gs_usb; do
-    insmod "$KMOD/$m.ko" || echo "insmod $m FAILED"
-done
-t "modules loaded"
-mount -t configfs none /sys/kernel/config
-G=/sys/kernel/config/usb_gadget/gs
-mkdir $G && cd $G || exit 1
-echo 0x1d50 > idVendor; echo 0x606f > idProduct; echo 0x0200 > bcdUSB
-mkdir strings/0x409
-echo FAKE0001 > strings/0x409/serialnumber
-echo "shadowlean (fake)" > strings/0x409/manufacturer
-echo "candleLight USB to CAN adapter (FunctionFS emulation)" > strings/0x409/product
-mkdir -p configs/c.1/strings/0x409 && echo gs_usb > configs/c.1/strings/0x409/configuration
-mkdir functions/ffs.gs && ln -s functions/ffs.gs configs/c.1/
-mkdir -p /run/ffs-gs && mount -t functionfs gs /run/ffs-gs
-cd "$OUT" || exit 1
-scenario kernel normal
-python3 -S -u "$SL_DIR/fake_candlelight.py" /run/ffs-gs "$OUT" "$OUT/ctl" $G/UDC dummy_udc.0 \
-    > gadget.log 2>&1 &
-wait_for 100 test -e /run/ffs-gs/ep2 || t "gadget did not start"
-echo dummy_udc.0 > $G/UDC
-wait_for 100 test -e /sys/class/net/can0 || t "can0 did not appear"
+fake_candlelight_up "$SL_DIR" kernel normal
 t "gadget bound; net devices: $(ls /sys/class/net | tr '\n' ' ')"
 BUSPORT=$(for d in /sys/bus/usb/devices/*-*; do
     case "$d" in *:*) continue ;; esac
