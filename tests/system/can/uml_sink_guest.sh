@@ -9,21 +9,11 @@ set -u
 exe=$1; out=$2
 M=/usr/lib/uml/modules/$(uname -r)/kernel
 insmod "$M/net/sched/sch_plug.ko" || { echo "cannot load sch_plug"; exit 1; }
-candump -L -r 8000000 any > "$out/candump.log" 2> "$out/candump.err" &
-cdpid=$!
-wait_for() { # pattern frame
-    i=0
-    while ! grep -q "$1" "$out/candump.log" 2>/dev/null; do
-        i=$((i + 1))
-        if [ $i -gt 200 ]; then echo "candump did not record $2"; return 1; fi
-        cansend vcan0 "$2"
-        sleep 0.05
-    done
-}
-wait_for '7FF#53594E43' '7FF#53594E43' || exit 1
+. "$(dirname "$0")/../../support/vm/candump_guest.sh"
+candump_start "$out/candump.log" any
+candump_mark 53594E43 || exit 1
 "$exe" --out "$out" --iface vcan0 --n "${SL_SINK_N:-500}"
 rc=$?
-wait_for '7FF#454E4400' '7FF#454E4400' || rc=1
-kill -INT $cdpid
-wait $cdpid
+candump_mark 454E4400 || rc=1
+candump_stop
 exit $rc

@@ -12,25 +12,16 @@
 # timing assumptions (the same trick as tests/system/can/uml_sink_guest.sh).
 set -u
 daemon=$1; cap=$2; short=$3; motion=$4; out=$5
-candump -L -r 8000000 vcan0 > "$out/candump.log" 2> "$out/candump.err" &
-cdpid=$!
-wait_for() { # hex-marker: resend until candump has recorded it
-    i=0
-    while ! grep -q "7FF#$1" "$out/candump.log" 2>/dev/null; do
-        i=$((i + 1))
-        if [ $i -gt 200 ]; then echo "candump did not record 7FF#$1"; return 1; fi
-        cansend vcan0 "7FF#$1"
-        sleep 0.05
-    done
-}
-wait_for 53594E43 || exit 1                                   # "SYNC"
+. "$(dirname "$0")/../../support/vm/candump_guest.sh"
+candump_start "$out/candump.log" vcan0
+candump_mark 53594E43 || exit 1                               # "SYNC"
 "$daemon" --board paper-sim --input "$cap" --can vcan0 --can-log "$out/daemon_fast.log" \
     --targets-out "$out/targets_fast.jsonl" --motion-can none --stats-every 0 \
     2> "$out/daemon_fast.err"
 rc=$?
 echo "run 1 (fast): exit $rc"; cat "$out/daemon_fast.err"
 [ $rc -eq 0 ] || exit 1
-wait_for 4D4944 || exit 1                                     # "MID"
+candump_mark 4D4944 || exit 1                                 # "MID"
 ( while :; do
       while read -r f; do cansend vcan0 "$f"; sleep 0.05; done < "$motion"
   done ) &
@@ -41,7 +32,6 @@ rc=$?
 kill $sender; wait $sender 2>/dev/null
 echo "run 2 (realtime, VehicleMotion on vcan0): exit $rc"; cat "$out/daemon_rt.err"
 [ $rc -eq 0 ] || exit 1
-wait_for 454E44 || exit 1                                     # "END"
-kill -INT $cdpid
-wait $cdpid
+candump_mark 454E44 || exit 1                                 # "END"
+candump_stop
 exit 0
