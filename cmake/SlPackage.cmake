@@ -4,7 +4,7 @@
 #   shadowleand       the daemon, its systemd unit, example config, DBCs (component daemon)
 #   shadowlean-tools  the host tools and the Wireshark dissector (component tools)
 #   python3-shadowlean  the Python package for CAN consumers (component python)
-# Run-time dependencies come from dpkg-shlibdeps; the test tests/install/ builds, lists,
+# Run-time dependencies come from dpkg-shlibdeps; the test tests/system/install/ builds, lists,
 # unpacks and lints them.
 set(CPACK_PACKAGE_NAME shadowlean)
 set(CPACK_PACKAGE_VENDOR "The shadowlean authors")

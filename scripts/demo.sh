@@ -8,7 +8,7 @@
 #   python3-canmatrix decodes the candump log with the board's generated DBC -> warning table,
 #   decoded leans next to the simulator's truth, and a picture (sl-view) when it is built.
 #
-# Scene: scenes/demo_three_poles.ini when present, else tests/daemon/scenes/static_four_poles.ini
+# Scene: scenes/demo_three_poles.ini when present, else tests/system/daemon/scenes/static_four_poles.ini
 # (or the scene given as the first argument). A moving scene's speed (speed_mps) is passed as
 # --motion (there is no vehicle bus on loopback). Outputs land in out/demo/. About 15 s plus
 # the build (host-release preset, only the targets needed).
@@ -33,7 +33,7 @@ mkdir -p "$OUT"
 SCENE=${1:-}
 if [ -z "$SCENE" ]; then
     SCENE=scenes/demo_three_poles.ini
-    [ -f "$SCENE" ] || SCENE=tests/daemon/scenes/static_four_poles.ini
+    [ -f "$SCENE" ] || SCENE=tests/system/daemon/scenes/static_four_poles.ini
 fi
 BOARD=$(sed -n 's/^[[:space:]]*board[[:space:]]*=[[:space:]]*\([A-Za-z0-9_-]*\).*/\1/p' "$SCENE" | head -1)
 SPEED=$(sed -n 's/^[[:space:]]*speed_mps[[:space:]]*=[[:space:]]*\([-0-9.eE+]*\).*/\1/p' "$SCENE" | head -1)
@@ -105,7 +105,7 @@ echo "   Expected: within ~1.5 deg. A parked vehicle and a noise-free scene quan
 echo "   the same way, so the tracker cannot average the 4.38 cm range bins out: each bound is off"
 echo "   by up to half a bin, worth ~0.8 deg at +12 deg and ~1.5 deg for a pole leaning away"
 echo "   (d alpha / d rho is steepest there; MATH.md s.3)."
-"$PY" tests/daemon/lean_vs_truth.py "$DBC" "$OUT/can.log" "$OUT/scene.gt.csv" --tol 1.5 |
+"$PY" tests/system/daemon/lean_vs_truth.py "$DBC" "$OUT/can.log" "$OUT/scene.gt.csv" --tol 1.5 |
     sed 's/^/   /' || true
 
 echo

@@ -3,7 +3,7 @@
 """Decode shadowlean CAN frames from a candump log with a board's generated DBC: a thin
 wrapper over the Python package `shadowlean` (python/shadowlean, installed by the
 python3-shadowlean package), the project's one DBC decoder. The daemon tests, the DBC
-layout check (tests/can/check_dbc_decode.py) and scripts/demo.sh import it from here.
+layout check (tests/system/can/check_dbc_decode.py) and scripts/demo.sh import it from here.
 
 Library (re-exported from the package):
     db = load_dbc(path)

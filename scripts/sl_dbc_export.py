@@ -14,7 +14,7 @@ therefore names every signal <Message>_<Signal> (PoleLean_Crc, Status_Counter, .
 every format it writes, so one name means one thing whatever the tool; OUT_PREFIX.names.csv
 maps message, DBC signal name and exported name. Layouts, scaling, ranges, units, value
 tables, cycle times and comments are carried over unchanged (what each format can hold;
-tests/can/dbc_export_roundtrip.py reads the files back and compares them with the DBC).
+tests/system/can/dbc_export_roundtrip.py reads the files back and compares them with the DBC).
 ARXML: the integer base types get their BASE-TYPE-ENCODING (2C / NONE), which canmatrix's
 writer leaves out, so signed signals stay signed in AUTOSAR tools.
 """

@@ -21,7 +21,7 @@
 // (= 45 deg = 2^29) is the guard entry for the interpolation. Generated once with:
 //   python3 -c "import math; print([int(math.floor(math.atan(i/256)/(2*math.pi)*2**32+0.5))
 //               for i in range(257)])"
-// and checked entry by entry against libm by tests/unit/test_incline.c. ROM: 1028 bytes.
+// and checked entry by entry against libm by tests/core/test_incline.c. ROM: 1028 bytes.
 static const uint32_t atan_bam32[257] = {
     0U, 2670163U, 5340245U, 8010164U, 10679838U, 13349187U,
     16018129U, 18686582U, 21354465U, 24021698U, 26688200U, 29353889U,

@@ -16,7 +16,7 @@
 #include "shadowlean/sl_pipeline.h"
 
 // Keeps a helper's locals out of its caller's frame (stack budget: the deepest chain runs
-// from sl_pipeline_feed through on_rot into detection; tests/build/stack_budget.py).
+// from sl_pipeline_feed through on_rot into detection; tests/core/build/stack_budget.py).
 #if defined(__GNUC__)
 #define SL_NOINLINE __attribute__((noinline))
 #else

@@ -4,7 +4,7 @@
 //   sl-bench-proto [capture] [--rotations N] [--azimuths N] [--bins N] [--width 1|2]
 //                  [--roi N] [--chunk BYTES[,BYTES...]] [--repeat N] [--mode scan|proto]
 //
-// Without a capture it builds a stream in memory (tests/golden/sl_golden.c: config, then
+// Without a capture it builds a stream in memory (tests/support/golden/sl_golden.c: config, then
 // N rotations x azimuths FFT messages of `bins` noisy bins, keep-alives every 400 messages),
 // default 16 x 400 x 3768 8-bit bins (about 24 MB). With a capture (raw .colossus, pcap or
 // pcapng, see host_tools/capture/capture.h) it decodes that instead.

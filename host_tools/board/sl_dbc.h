@@ -4,7 +4,7 @@
 //
 // The output is a pure function of the board spec and the layout (no time stamps), so a
 // committed boards/<name>/shadowlean.dbc can be regenerated and diffed. It loads in
-// Debian's python3-canmatrix 0.9.5 (tests/can/check_dbc_decode.py decodes frames the core
+// Debian's python3-canmatrix 0.9.5 (tests/system/can/check_dbc_decode.py decodes frames the core
 // encoded and compares every signal with the encoder's input).
 //
 // Contents: VERSION, NS_, BS_, BU_ (SHADOWLEAN, VEHICLE), BO_/SG_ for PoleLean,

@@ -139,34 +139,16 @@ void record_break(const sl_port_capture_piece_t &p, std::vector<Discontinuity> &
 // reassembly; this collects its pieces into memory for the tools that want the whole stream.
 bool load_capture(const std::string &path, Capture &out, std::string &err, const PcapOptions &opt)
 {
-    out = Capture{};
-    sl_port_capture_opts_t o{};
-    o.radar_port = static_cast<uint16_t>(opt.radar_port);
-    o.port_explicit = opt.port_explicit;
-    char e[512] = {0};
-    sl_port_capture_t *c = sl_port_capture_open(path.c_str(), &o, e, sizeof e);
-    if (c == nullptr) {
-        err = e;
-        return false;
-    }
-    bool ok = true;
-    for (;;) {
-        sl_port_capture_piece_t p;
-        sl_port_capture_next(c, &p);
-        if (p.kind == SL_PORT_CAPTURE_DATA) {
-            out.bytes.insert(out.bytes.end(), p.data, p.data + p.size);
-        } else if (p.kind == SL_PORT_CAPTURE_BREAK) {
-            record_break(p, out.discontinuities, out.pcap.gap_list);
-        } else {
-            if (p.kind == SL_PORT_CAPTURE_ERROR) {
-                err = path + ": " + sl_port_capture_error(c);
-                ok = false;
-            }
-            break;
-        }
-    }
-    fill_report(c, out);
-    sl_port_capture_close(c);
+    std::vector<uint8_t> bytes;
+    uint64_t n = 0;
+    const bool ok = read_capture(
+        path,
+        [&](const uint8_t *data, size_t size) {
+            bytes.insert(bytes.end(), data, data + size);
+            return true;
+        },
+        nullptr, out, n, err, opt);
+    out.bytes = std::move(bytes);
     return ok;
 }
 

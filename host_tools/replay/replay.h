@@ -28,7 +28,7 @@ struct ServeOptions {
     uint64_t close_after = 0;        ///< close a connection after N FFT messages (0 = off)
     uint64_t stall_after = 0;        ///< go silent on a connection after N FFT messages
     uint32_t max_gap_ms = 1000;      ///< realtime: longer timestamp gaps are shortened to this
-    // Fault injection (each recovery of the client has a test: tests/daemon/faults.sh)
+    // Fault injection (each recovery of the client has a test: tests/system/daemon/faults.sh)
     uint64_t cut_after = 0;          ///< after N FFT messages: half a message, then close
     bool cut_rst = false;            ///< ... with a TCP RST (SO_LINGER 0) instead of FIN
     bool keepalive_only = false;     ///< accept Start FFT but never send FFT data

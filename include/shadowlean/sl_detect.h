@@ -112,12 +112,9 @@
 /// SL_CFG_DETECT_MAX_CANDIDATES x (14 + 6 x SL_CFG_DETECT_MAX_SPAN) + SL_CFG_MAX_TARGETS x
 /// sizeof(sl_target_t) (52) + 50 bytes of azimuth hints + ~60 bytes (defaults: 8,504 bytes on x86-64).
 /// Cost: sl_detect_row O(words up to the shadow edge + runs x candidates); an azimuth
-/// with nothing occupied in its window exits after one OR per window word. Measured by
-/// host_tools/bench_mask (x86-64 -O2, 400 x 512, 6 poles + walls + clutter): the whole
-/// rotation from the mask (sl_detect_rotation_from_mask: stable rows up to the edge, rows,
-/// 6 targets with corrections and alpha) is ~270 instructions per azimuth (~107 k per
-/// rotation) at n = 16, of which ~120 per azimuth are the mask's stable-row reads.
-/// Per target at sl_detect_end: ~600 (sl_incline_estimate) + ~150 (isqrt) + ~200.
+/// with nothing occupied in its window exits after one OR per window word. Per target at
+/// sl_detect_end: one sl_incline_estimate + one isqrt. Measured instruction counts:
+/// docs/PERFORMANCE.md, "Core modules".
 /// sl_detect_init: one isqrt per azimuth. Not reentrant per instance; no callbacks.
 #ifndef SHADOWLEAN_SL_DETECT_H
 #define SHADOWLEAN_SL_DETECT_H

@@ -50,7 +50,7 @@ const char *sl_err_str(sl_err_t err);
 /// @def SL_ASSERT(x)
 /// Caller-bug check (NULL self, impossible state; never input data). Override it for the
 /// whole build, core included, by defining it before any shadowlean header is read:
-/// - in `sl_config_user.h` (tests/unit/assert_user/ is a working example) (with `SL_CFG_USER_HEADER` defined; sl_config.h includes it
+/// - in `sl_config_user.h` (tests/core/assert_user/ is a working example) (with `SL_CFG_USER_HEADER` defined; sl_config.h includes it
 ///   and this header includes sl_config.h), e.g.
 ///   `#define SL_ASSERT(x) do { if (!(x)) { board_fault(__FILE__, __LINE__); } } while (0)`
 ///   where board_fault() is the application's (it must not return into the core);

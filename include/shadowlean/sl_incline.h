@@ -45,10 +45,10 @@
 /// - ambiguity: the test is `rho_q28 < geom->rho_amb_q28`, exact in integers;
 ///   rho_amb_q28 = round(2^28/cos((t+b)/2)), so the classification matches the real bound to
 ///   one LSB of rho (3.7e-9).
-/// Measured by tests/unit/test_incline.c (201945 points: theta 5..34 deg step 0.5, beta 0..5
+/// Measured by tests/core/test_incline.c (201945 points: theta 5..34 deg step 0.5, beta 0..5
 /// step 1, rho from the ambiguity bound to 10 incl. +-8 LSB around the seam; plus 18000
-/// random micrometre pairs over the whole domain), tests/alpha/test_geom.cpp (191461 random
-/// points over the whole domain) and tests/alpha/check_alpha.py (sl-alpha, 5000 lines).
+/// random micrometre pairs over the whole domain), tests/host/alpha/test_geom.cpp (191461 random
+/// points over the whole domain) and tests/host/alpha/check_alpha.py (sl-alpha, 5000 lines).
 ///
 /// Resources (Cortex-M0, arm-none-eabi-gcc -Os): code + table 2500 bytes of flash (the atan
 /// table is 1028 of them), no RAM; stack <= 200 bytes (sl_incline_estimate's frame 88 B +
@@ -162,9 +162,8 @@ typedef struct sl_incline_result {
 /// sl_incline_atan2_bam32(). sigma uses Q56 for Q, Q24 for the derivatives, Q12 cdeg for
 /// the two terms and sl_fx_isqrt64 for the root.
 /// Cost: O(1): 4-5 64-bit divisions, 2 (branch 1) or 3 (branch 2) sl_fx_isqrt64 calls
-/// (the bulk of the time), ~12 64-bit multiplies. Measured with callgrind on x86-64 -O2:
-/// ~700 instructions (branch 1), ~880 (branch 2); on Cortex-M0 (software 64-bit division
-/// and multiplication) an estimate of 4-6k cycles, not measured. Stack: see the file banner.
+/// (the bulk of the time), ~12 64-bit multiplies (measured counts: docs/PERFORMANCE.md,
+/// "Core modules"). Stack: see the file banner.
 /// Pure function: reentrant, no state, callable from any context.
 sl_incline_result_t sl_incline_estimate(uint32_t r1_um, uint32_t r2_um,
                                         const sl_incline_geom_t *geom, uint32_t sigma_r_um,

@@ -32,7 +32,7 @@
 /// The first row of an azimuth (after init or a reset) sets `L = X`, `k = n - 1`. Counting
 /// down (rather than up to n) needs one plane fewer: n = 16 uses 4 counter planes, n = 32
 /// uses 5, instead of ceil(log2(n + 1)) = 5 and 6. This is exactly equivalent to storing
-/// the last n rows and intersecting them (tests/unit/test_mask.c checks it bit for bit
+/// the last n rows and intersecting them (tests/core/test_mask.c checks it bit for bit
 /// against that naive reference for every n in 1..32, with missing azimuths).
 ///
 /// ## Frames and missing azimuths
@@ -64,11 +64,9 @@
 /// n <= SL_CFG_MASK_FRAMES_MAX; the per-row cost follows its own P.
 ///
 /// Per row: O(words x P) word operations, specialised per P and for n = 2^P (then the reset
-/// to n - 1 is one OR per plane). x86-64 -O2, measured by host_tools/bench_mask under
-/// callgrind (per azimuth, sl_mask_update plus its share of sl_mask_end_rotation):
-/// 512-bin rows n = 4: ~370, n = 16: ~520, n = 32: ~600 instructions; 160-bin rows (what
-/// detection reads on paper-sim) n = 16: ~290. A window of 1 copies the row; a window
-/// between 1 and n adds a second pass for the stable planes (~30 instructions per word).
+/// to n - 1 is one OR per plane). A window of 1 copies the row; a window between 1 and n
+/// adds a second pass for the stable planes (O(words)). Measured instruction counts per
+/// n and row width: docs/PERFORMANCE.md, "Core modules".
 /// sl_mask_end_rotation(): O(azimuths), a few instructions per azimuth.
 /// sl_mask_stable(): O(words x P). Stack: a few words. Not reentrant on the same instance;
 /// distinct instances are independent. Fields are read-only to the application.

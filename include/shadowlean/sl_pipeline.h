@@ -114,20 +114,15 @@
 /// The boards carried today need 135 (paper-sim), 119 (paper-bench) and 141 (robotcar-leaf)
 /// masked bins (sl_detect_bins_needed(), rounded up to 160).
 ///
-/// ## Cost (measured by host_tools/bench: sl-bench + callgrind.sh, x86-64 gcc -O2, firmware
-/// configuration, 64 KiB chunks of whole 3768-bin CTS350-X messages)
-/// - Per azimuth ~1,110 instructions on the Oxford RobotCar capture (n = 16, no target):
-///   threshold of 160 bins ~290, mask update ~310, decoder ~230, scan ~170, detection row
-///   ~70; ~445 k per rotation. Moving (n_eff = 1: every occupied run counts; simulated
-///   1 m/s pass, 31 targets in 36 rotations) ~1,410 per azimuth, ~560 k per rotation.
-/// - Latency (the feed of the message completing a rotation -> on_rotation with its
-///   targets): ~6.8 k instructions static, ~8.9 k with targets (sl_detect_end, tracker).
-///   The rotation is complete when the next rotation's first azimuth arrives (one azimuth
-///   period, 0.625 ms at 1600 Hz, on top).
-/// - Throughput (wall clock, one core, capture in RAM, shared 2-core VM, noisy): 13-16 GB/s
-///   of capture for a 535 MB capture (Oxford x32), 30-50 GB/s when it fits the L3 cache;
-///   a NumPy implementation of the front end (host_tools/bench/reference_numpy.py) does
-///   ~1.2-1.3 GB/s on the same data (compare.sh: 10-12x).
+/// ## Cost
+/// - Per azimuth O(ROI bins / 32 x mask planes): threshold, mask update, decoder, scan and
+///   one detection row; per rotation O(azimuths) plus O(targets) estimates and tracking.
+///   Budgets (firmware/size_budget.txt, the `thumb` tests): 3,000 instructions per azimuth
+///   on Cortex-M0, 1,500 / 1,600 on Cortex-M4F; 2,500 on x86-64 with 8 tracked targets.
+/// - Latency: the rotation is complete when the next rotation's first azimuth arrives (one
+///   azimuth period, 0.625 ms at 1600 Hz), then O(targets) work in that feed call.
+/// - Measured instruction counts, latency and throughput: docs/PERFORMANCE.md ("Core
+///   modules", "Pipeline").
 /// Stack (computed from the call graph by ctest check_stack_cortex_m0/_m4f, libgcc frames
 /// included, Cortex-M -Os firmware configuration): worst case 1,004 B on Cortex-M0 and
 /// 816 B on Cortex-M4F from sl_pipeline_feed(), plus the port callbacks' own stack on top of

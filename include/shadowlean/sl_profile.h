@@ -64,10 +64,8 @@
 /// sl_profile_row: an unwatched azimuth costs one table read and a scan of the window's
 /// words for the first occupied bit; a watched one SL_CFG_PROFILE_BINS additions.
 /// sl_profile_extract: O(bins) with a 6- or 8-point integer fit per walked bin, 64-bit
-/// divisions. Measured (sl-bench under callgrind, x86-64 -O2, firmware configuration,
-/// scenes/bench_eight_poles.ini: 8 targets per rotation): +108 instructions per azimuth
-/// over the pipeline without profiles (1,429 against 1,321); latency +5.6 k instructions per
-/// rotation. Not reentrant per instance.
+/// divisions (measured cost: docs/PERFORMANCE.md, "Core modules"). Not reentrant per
+/// instance.
 #ifndef SHADOWLEAN_SL_PROFILE_H
 #define SHADOWLEAN_SL_PROFILE_H
 

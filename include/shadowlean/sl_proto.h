@@ -57,20 +57,15 @@
 /// - **Junk bound** (per call): at most one O(1) window step per junk byte plus at most one
 ///   14-byte compare per byte that starts a window ending in `7F FE`, plus <= 15 bytewise
 ///   steps at the chunk's end and 6 per rejected header: work <= c * len + 15 * c' per call,
-///   whatever the bytes. Measured (callgrind, x86-64 gcc -O2, `sl-bench-junk`, 1 MiB,
-///   64 KiB / 1448-byte chunks): zero fill 0.47 / 0.71 instructions per byte, random 0.45 /
-///   0.65, repeated signature prefixes of length 1..15 at most 0.88 / 1.11, 0xFE fill 0.86 /
-///   1.03, whole signatures with rejected headers every 22 bytes 3.8 / 4.2 (valid data:
-///   ~0.04).
-///   ctest `bench_junk_cost` fails above 4 for zero, random and prefixes. The Linux port
+///   whatever the bytes (measured per junk kind: docs/PERFORMANCE.md, "Core modules");
+///   ctest `bench_junk_cost` fails above 4 instructions per byte for zero, random and
+///   prefixes. The Linux port
 ///   (radar_client.c) feeds at most SL_RADAR_RX_CHUNK bytes per call and SL_RADAR_RX_BUDGET
 ///   bytes per poll wake-up, so the decoder's work per wake-up is bounded by those sizes.
 /// - Stack: < 128 bytes plus the callback's. RAM: `sizeof(sl_proto_t)` (160 bytes on x86-64,
 ///   asserted <= 192) plus the caller's reassembly buffer. No allocation, no float, no OS.
-/// - Measured (host_tools/bench_proto/callgrind.sh, x86-64 gcc -O2, 3768-bin 8-bit FFT
-///   messages, decoder only): about 160 instructions per message when fed 64 KiB chunks,
-///   about 870 with 1448-byte chunks (every payload then straddles chunks and is copied to
-///   the reassembly buffer); the window resync left these within 1 % (159 / 862 before).
+/// - Per message O(1) when whole in the chunk, O(payload) when it straddles chunks and is
+///   copied (measured per chunk size: docs/PERFORMANCE.md, "Core modules").
 /// - Context: task context; one decoder per stream; not reentrant (the callback must not
 ///   call `sl_proto_feed()` / `sl_proto_finish()` / `sl_proto_init()` on the same decoder).
 #ifndef SHADOWLEAN_SL_PROTO_H

@@ -95,11 +95,9 @@
 /// rows. Stack < 128 bytes plus the callbacks'. RAM: sizeof(sl_scan_t) (624 bytes on x86-64
 /// with 400 azimuths: the rotation bookkeeping keeps one flag byte per azimuth) plus the
 /// caller's frame(s) (sizeof(sl_scan_frame_t) each: 210,848 bytes with the default
-/// 400 azimuths x 512 ROI bins). Measured (host_tools/bench_proto, x86-64 gcc -O2, 512-bin
-/// ROI): 8-bit about 340 instructions per azimuth on top of the decoder's (of which the ROI
-/// memcpy is ~80); 16-bit with the default shift 8 about 1,900 (64-bit SWAR, ~3 per bin).
-/// Frame-less with complete 8-bit rows (no copy): ~170 instructions per azimuth including
-/// the message parse (measured inside sl-bench, host_tools/bench).
+/// 400 azimuths x 512 ROI bins). Per azimuth O(ROI bins): one copy of the region of
+/// interest (8-bit) or a 64-bit SWAR reduction (16-bit); frame-less, no copy (measured:
+/// docs/PERFORMANCE.md, "Core modules").
 /// Task context, not reentrant; callbacks must not feed the same instance.
 #ifndef SHADOWLEAN_SL_SCAN_H
 #define SHADOWLEAN_SL_SCAN_H

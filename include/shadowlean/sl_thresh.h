@@ -19,10 +19,8 @@
 /// transpose; 32-bit lanes gather 4 flags with one 32-bit multiply. Loads are assembled
 /// byte by byte (compilers turn that into one load), so the result is endian-independent.
 ///
-/// Cost (measured by host_tools/bench_mask under callgrind, x86-64 -O2, threshold 40):
-/// sl_thresh_u8 ~800 instructions per 512-bin row (1.56 per bin, including the call);
-/// sl_thresh_u8_table 3.3 per bin; sl_thresh_u16 4.2 per bin; tails (bins % 32) one bin at
-/// a time. Stack: a few words. No state: reentrant, callable from any context. RAM: none
+/// Cost: O(bins), 32 bins per word; tails (bins % 32) one bin at a time (measured per bin:
+/// docs/PERFORMANCE.md, "Core modules"). Stack: a few words. No state: reentrant, callable from any context. RAM: none
 /// (the caller owns the input and output rows).
 ///
 /// Errors: none at run time; NULL pointers with `bins > 0` are caller bugs (SL_ASSERT).

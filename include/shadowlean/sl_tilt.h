@@ -44,7 +44,7 @@
 /// the names: `_q15` int16 value x 2^15, `_q12` int16 value x 2^12 (tan, |tan| < 8),
 /// `_q16` uint16 value x 2^16 (sigma of tan alpha), `_q24` int32 value x 2^24.
 ///
-/// Accuracy (tests/unit/test_tilt.c): given the same stored measurements, the fixed-point
+/// Accuracy (tests/core/test_tilt.c): given the same stored measurements, the fixed-point
 /// tilt vector agrees with a double-precision implementation of the same estimator to
 /// 2e-5 in tan units (0.001 deg; measured 2.6e-6), the base to 2 mm (measured 0.74 mm).
 /// Against simulated drive-bys (bearing quantised to 0.9 deg azimuth cells): tilt within

@@ -2,7 +2,7 @@
 """Unit tests of the shadowlean Python package (unittest, Debian's /usr/bin/python3).
 
 Input: the boards' generated DBCs and the candump logs the daemon wrote for the demo scene
-and the real Oxford scans (tests/daemon/golden). Environment: SL_SOURCE_DIR (the checkout),
+and the real Oxford scans (tests/system/daemon/golden). Environment: SL_SOURCE_DIR (the checkout),
 SL_PYTHON_PATH (where the package is imported from: the source tree or an install root)."""
 import contextlib
 import io
@@ -19,7 +19,7 @@ sys.path.insert(0, PYPATH)
 import shadowlean as sl  # noqa: E402
 from shadowlean.__main__ import main as cli  # noqa: E402
 
-GOLDEN = os.path.join(SRC, "tests", "daemon", "golden")
+GOLDEN = os.path.join(SRC, "tests", "system", "daemon", "golden")
 LOGS = {  # log -> board whose DBC the daemon used
     "demo_three_poles.candump": "paper-sim",
     "oxford_robotcar.candump": "robotcar-leaf",

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// make_stream.c: writes a deterministic Colossus stream (tests/golden/sl_golden.c) to a
+// make_stream.c: writes a deterministic Colossus stream (tests/support/golden/sl_golden.c) to a
 // file: make_stream OUT ROTATIONS. CTS350-X geometry (400 azimuths, 5600 ticks, 3768 bins).
 #include <stdio.h>
 #include <stdlib.h>

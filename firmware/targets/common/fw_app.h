@@ -3,7 +3,7 @@
 /// @brief The example firmware's application: runs the core pipeline over a capture held in
 /// memory (flash on the target), the way a port feeds it from a TCP socket, and reports
 /// every CAN frame and rotation as text lines. The same file is built for the host
-/// (tests/thumb/host_frames.c) so the two outputs can be compared line for line.
+/// (tests/core/thumb/host_frames.c) so the two outputs can be compared line for line.
 ///
 /// Not part of the core: it may use what a bare-metal application has (no heap, no stdio;
 /// numbers are formatted here). Ownership: one static sl_pipeline_t inside fw_app.c.

@@ -1,0 +1,37 @@
+#!/bin/sh
+# SPDX-License-Identifier: MIT
+# uml_guest.sh DAEMON CAPTURE SHORT_CAPTURE MOTION_FRAMES OUTDIR: runs INSIDE user-mode Linux
+# (tests/support/vm/uml_run.sh, vcan0 up). `candump -L vcan0` records the bus while:
+#   run 1: shadowleand --input CAPTURE --can vcan0 --can-log daemon_fast.log (as fast as
+#          possible; --motion-can none);
+#   run 2: shadowleand --input SHORT_CAPTURE --realtime --can vcan0 --can-log daemon_rt.log
+#          while VehicleMotion frames (MOTION_FRAMES: one cansend argument per line, E2E
+#          counters 0..14) go onto vcan0 every 50 ms; VehicleMotion is read from vcan0 (the
+#          default: the --can interface).
+# Marker frames 7FF#... (SYNC / MID / END) delimit the runs in candump's recording without
+# timing assumptions (the same trick as tests/system/can/uml_sink_guest.sh).
+set -u
+daemon=$1; cap=$2; short=$3; motion=$4; out=$5
+. "$(dirname "$0")/../../support/vm/candump_guest.sh"
+candump_start "$out/candump.log" vcan0
+candump_mark 53594E43 || exit 1                               # "SYNC"
+"$daemon" --board paper-sim --input "$cap" --can vcan0 --can-log "$out/daemon_fast.log" \
+    --targets-out "$out/targets_fast.jsonl" --motion-can none --stats-every 0 \
+    2> "$out/daemon_fast.err"
+rc=$?
+echo "run 1 (fast): exit $rc"; cat "$out/daemon_fast.err"
+[ $rc -eq 0 ] || exit 1
+candump_mark 4D4944 || exit 1                                 # "MID"
+( while :; do
+      while read -r f; do cansend vcan0 "$f"; sleep 0.05; done < "$motion"
+  done ) &
+sender=$!
+"$daemon" --board paper-sim --input "$short" --realtime --can vcan0 --can-log "$out/daemon_rt.log" \
+    --targets-out "$out/targets_rt.jsonl" 2> "$out/daemon_rt.err"
+rc=$?
+kill $sender; wait $sender 2>/dev/null
+echo "run 2 (realtime, VehicleMotion on vcan0): exit $rc"; cat "$out/daemon_rt.err"
+[ $rc -eq 0 ] || exit 1
+candump_mark 454E44 || exit 1                                 # "END"
+candump_stop
+exit 0

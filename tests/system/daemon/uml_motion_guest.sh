@@ -1,0 +1,38 @@
+#!/bin/sh
+# SPDX-License-Identifier: MIT
+# uml_motion_guest.sh DAEMON CAPTURE MOTION_FRAMES OUTDIR: runs INSIDE user-mode Linux
+# (tests/support/vm/uml_run.sh, vcan0 up). shadowleand replays CAPTURE in real time with --can vcan0
+# (VehicleMotion read from vcan0) while MOTION_FRAMES (motion_fault_frames.py: good frames,
+# bad CRCs, repetitions, counter jumps) go onto vcan0 every 20 ms, from the daemon's first
+# rotation until 4 rotations used the motion input; then the sender stops (a reception
+# timeout: the window must fall back to the board's n), and 6 rotations later the daemon is
+# stopped with SIGINT (exit 0). Ordering by the daemon's own output files, not by timing.
+set -u
+daemon=$1; cap=$2; motion=$3; out=$4
+"$daemon" --board paper-sim --input "$cap" --realtime --can vcan0 --can-log "$out/motion.log" \
+    --targets-out "$out/motion.jsonl" 2> "$out/motion.err" &
+dpid=$!
+used() { _n=$(grep -c '"motion_valid":true' "$out/motion.jsonl" 2>/dev/null); echo "${_n:-0}"; }
+i=0
+while [ ! -s "$out/motion.jsonl" ] && [ $i -lt 400 ]; do sleep 0.05; i=$((i + 1)); done
+( while :; do
+      while read -r f; do cansend vcan0 "$f"; sleep 0.02; done < "$motion"
+  done ) &
+sender=$!
+i=0
+while [ "$(used)" -lt 4 ] && [ $i -lt 600 ] && kill -0 $dpid 2>/dev/null; do sleep 0.05; i=$((i + 1)); done
+kill $sender; wait $sender 2>/dev/null
+echo "sender stopped after $(used) rotations with motion"
+# The fallback to static: wait (by the daemon's output, not by time) until 6 more rotations
+# are out -- more than the 500 ms motion timeout at 4 Hz -- then stop the daemon cleanly.
+rots() { _n=$(grep -c '"type":"rotation"' "$out/motion.jsonl" 2>/dev/null); echo "${_n:-0}"; }
+r0=$(rots); i=0
+while [ "$(rots)" -lt $((r0 + 6)) ] && [ $i -lt 1200 ] && kill -0 $dpid 2>/dev/null; do
+    sleep 0.05; i=$((i + 1))
+done
+kill -INT $dpid 2>/dev/null
+wait $dpid
+rc=$?
+echo "shadowleand exit $rc"; cat "$out/motion.err"
+echo "$rc" > "$out/motion.rc"
+exit 0
