@@ -534,6 +534,8 @@ static void on_rot(void *ctx, const sl_scan_rot_t *rot)
     set_track_motion(p);
     sl_track_set_reverse(&p->tracker, p->motion_valid && p->speed_mm_s < 0);
     sl_track_update(&p->tracker, p->detect.targets, n_targets, p->now_us);
+    sl_tiltobs_advance(&p->tilt, p->motion_valid, p->speed_mm_s, p->yaw_cdeg_s, p->rotation_us);
+    sl_tiltobs_update(&p->tilt, p->tracker.tracks, p->detect.targets, n_targets);
     p->stats.rotations++;
     p->stats.azimuths_missing += rot->stats.missing;
     p->stats.targets += n_targets;
@@ -710,6 +712,9 @@ sl_err_t sl_pipeline_init(sl_pipeline_t *p, const sl_board_t *board,
     }
     if (e == SL_OK) {
         e = sl_track_init(&p->tracker, board, &c->track);
+    }
+    if (e == SL_OK) {
+        e = sl_tiltobs_init(&p->tilt, board);
     }
     sl_can_ids_t ids;
     if (e == SL_OK) {

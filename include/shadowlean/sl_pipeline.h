@@ -171,6 +171,7 @@
 #include "shadowlean/sl_proto.h"
 #include "shadowlean/sl_scan.h"
 #include "shadowlean/sl_thresh.h"
+#include "shadowlean/sl_tiltobs.h"
 #include "shadowlean/sl_track.h"
 
 #ifdef __cplusplus
@@ -327,6 +328,7 @@ typedef struct sl_pipeline {
     sl_detect_t detect;
     sl_profile_t prof;           ///< range profiles of the azimuths showing something
     sl_tracker_t tracker;
+    sl_tiltobs_t tilt;           ///< per-track observation history + 3D tilt fits (sl_tiltobs.h)
     sl_can_tx_t can;
     sl_pipeline_stats_t stats;
     sl_board_t det_board;        ///< the board as detection uses it: bin size from the radar's
@@ -369,13 +371,17 @@ _Static_assert(sizeof(sl_pipeline_t) <= 65536U, "sl_pipeline_t: 64 KiB RAM budge
 #endif
 #endif
 /// Any azimuth count, bins and n with the default target/candidate capacities: the mask
-/// dominates; everything else stays under 16 KiB.
+/// dominates; everything else except the tilt history (sl_tiltobs_t, sized by
+/// SL_CFG_TILT_TRACKS x SL_CFG_TILT_OBS_PER_TRACK: 2.4 KB firmware, 6.8 KB host) stays under
+/// 16 KiB.
 #if SL_CFG_MAX_TARGETS <= 32 && SL_CFG_DETECT_MAX_CANDIDATES <= 32 && SL_CFG_DETECT_MAX_SPAN <= 24 \
     && SL_CFG_MAX_AZIMUTHS <= 400
 #if defined(__cplusplus)
-static_assert(sizeof(sl_pipeline_t) <= sizeof(sl_mask_t) + 16384U, "sl_pipeline_t budget");
+static_assert(sizeof(sl_pipeline_t) <= sizeof(sl_mask_t) + sizeof(sl_tiltobs_t) + 16384U,
+              "sl_pipeline_t budget");
 #else
-_Static_assert(sizeof(sl_pipeline_t) <= sizeof(sl_mask_t) + 16384U, "sl_pipeline_t budget");
+_Static_assert(sizeof(sl_pipeline_t) <= sizeof(sl_mask_t) + sizeof(sl_tiltobs_t) + 16384U,
+               "sl_pipeline_t budget");
 #endif
 #endif
 
