@@ -33,7 +33,9 @@
 ///    tracks (filtered alpha, sigma, warning level: `sl_track_t`, live slots only matter).
 /// 2. `port.can_tx(ctx, f)` (optional) for: one PoleLean per *confirmed* track (live,
 ///    matched this rotation, `hits >= cfg.confirm_hits` and `confirmed` by the tracker's
-///    static-object evidence, sl_track.h), in slot order; one LeanWarning
+///    static-object evidence, sl_track.h), in slot order, each followed by its PoleTilt
+///    when the track has an observation history with a fit (only while a motion input is
+///    present: see "3D tilt while driving"); one LeanWarning
 ///    (the most severe confirmed track: highest level, then largest |filtered alpha|;
 ///    HasTarget = 0 when there is none); one Status (link state, rotations, missing
 ///    azimuths, decoder resyncs, CAN drops; LinkState STREAMING only while usable rows
@@ -59,6 +61,26 @@
 /// of more than 1 % from the board's (the expected value) raises RANGE_RESOLUTION_MISMATCH.
 /// Ranges: the track's last corrected r1 / r2, passed
 /// in um and rounded once, by the encoder, to the signal's step (0.02 m / 0.01 m).
+///
+/// ## 3D tilt while driving (sl_tiltobs.h, sl_tilt.h)
+/// After the tracker's update, every rotation WITH a motion input advances the fixed-point
+/// odometry by the measured rotation period and adds one observation (radar pose at the
+/// target's azimuth, bearing, r1, alpha, sigma, branch) to the ring of every confirmed
+/// track matched with a VALID alpha; at most SL_CFG_TILT_FITS_PER_ROTATION rings are fitted
+/// per rotation (round robin). A rotation without motion input clears every ring (the
+/// odometry has a hole), so without motion nothing changes on CAN.
+/// PoleTilt: the ring's latest fit in the vehicle frame at the rotation's end (sl_can.h).
+/// LeanWarning and the fitted tilt: for a confirmed track whose fit is FITTED (not
+/// AMBIGUOUS), the warning uses the tilt TOWARDS THE VEHICLE'S PATH instead of the in-plane
+/// alpha: lean = atan(-sign(base_y) t_y) with t the tilt vector and base_y the base's
+/// lateral offset in the vehicle frame (> 0: the top leans over the path, the sign
+/// convention of Lean), its sigma the fit's tilt sigma, its level the board's thresholds
+/// applied to it directly (DANGER at lean >= danger, CAUTION at |lean| (or lean, per
+/// cfg.track.caution_abs) >= caution; no hysteresis: the fit is already an average over the
+/// pass), Quality FILTERED. This is what resolves the fold: a pole leaning away beyond
+/// (theta - beta) / 2 reads as leaning towards on every single rotation, its fit does not.
+/// Other tracks use the tracker's level, filtered alpha and sigma as before. The most
+/// severe track is chosen on these values.
 ///
 /// ## Motion (the paper assumed a static vehicle; see `sl_pipeline_window()`)
 /// The consistency mask needs the same (azimuth, bin) cell occupied in the last n rotations.
