@@ -848,7 +848,9 @@ sl_err_t sl_pipeline_feed(sl_pipeline_t *p, const uint8_t *data, size_t len, uin
         return SL_ERR_ARG;
     }
     p->now_us = now_us;
-    return sl_proto_feed(&p->proto, data, len, now_us);
+    const sl_err_t e = sl_proto_feed(&p->proto, data, len, now_us);
+    sl_tiltobs_fit_pending(&p->tilt); // outside the decoder's call chain (stack)
+    return e;
 }
 
 sl_err_t sl_pipeline_on_msg(sl_pipeline_t *p, const sl_proto_msg_t *msg, uint64_t now_us)
@@ -858,6 +860,7 @@ sl_err_t sl_pipeline_on_msg(sl_pipeline_t *p, const sl_proto_msg_t *msg, uint64_
     }
     p->now_us = now_us;
     on_msg(p, msg);
+    sl_tiltobs_fit_pending(&p->tilt);
     return SL_OK;
 }
 
@@ -876,6 +879,7 @@ sl_err_t sl_pipeline_finish(sl_pipeline_t *p, uint64_t now_us)
     p->now_us = now_us;
     (void)sl_proto_finish(&p->proto);
     sl_scan_flush(&p->scan);
+    sl_tiltobs_fit_pending(&p->tilt);
     p->last_t_last_us = 0U; // the next stream's clock may differ
     return SL_OK;
 }

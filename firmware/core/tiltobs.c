@@ -39,13 +39,21 @@ sl_err_t sl_tiltobs_init(sl_tiltobs_t *o, const sl_board_t *board)
     return SL_OK;
 }
 
+static void free_ring(sl_tiltobs_t *o, sl_tiltobs_ring_t *r)
+{
+    if (r->fresh != 0U && o->pending > 0U) {
+        o->pending--;
+    }
+    memset(r, 0, sizeof *r);
+}
+
 static void clear_rings(sl_tiltobs_t *o)
 {
     bool any = false;
     for (uint32_t i = 0; i < (uint32_t)SL_CFG_TILT_TRACKS; i++) {
         if (o->ring[i].track_id != 0U) {
             any = true;
-            memset(&o->ring[i], 0, sizeof o->ring[i]);
+            free_ring(o, &o->ring[i]);
         }
     }
     if (any) {
@@ -138,7 +146,10 @@ static void observe(sl_tiltobs_t *o, sl_tiltobs_ring_t *r, const sl_target_t *g)
     if (r->count < (uint8_t)SL_CFG_TILT_OBS_PER_TRACK) {
         r->count++;
     }
-    r->fresh = 1U;
+    if (r->fresh == 0U) {
+        r->fresh = 1U;
+        o->pending++;
+    }
     o->stats.observations++;
 }
 
@@ -151,7 +162,7 @@ void sl_tiltobs_update(sl_tiltobs_t *o, const sl_track_t *tracks, const sl_targe
         sl_tiltobs_ring_t *r = &o->ring[i];
         if (r->track_id != 0U && (r->slot >= (uint32_t)SL_CFG_MAX_TARGETS ||
                                   tracks[r->slot].live == 0U || tracks[r->slot].id != r->track_id)) {
-            memset(r, 0, sizeof *r);
+            free_ring(o, r);
         }
     }
     if (!o->moving || o->board->geom == NULL) {
@@ -182,7 +193,15 @@ void sl_tiltobs_update(sl_tiltobs_t *o, const sl_track_t *tracks, const sl_targe
         }
         observe(o, r, g);
     }
-    // Fits: rings with a new observation, round robin, bounded per rotation.
+}
+
+void sl_tiltobs_fit_pending(sl_tiltobs_t *o)
+{
+    SL_ASSERT(o != NULL);
+    if (o->pending == 0U) {
+        return;
+    }
+    // Fits: rings with a new observation, round robin, bounded per call.
     uint32_t done = 0;
     for (uint32_t k = 0; k < (uint32_t)SL_CFG_TILT_TRACKS && done < (uint32_t)SL_CFG_TILT_FITS_PER_ROTATION; k++) {
         const uint32_t idx = ((uint32_t)o->rr + k) % (uint32_t)SL_CFG_TILT_TRACKS;
@@ -192,6 +211,7 @@ void sl_tiltobs_update(sl_tiltobs_t *o, const sl_track_t *tracks, const sl_targe
         }
         (void)sl_tilt_fit(r->obs, r->count, &o->prm, &o->work, &r->res);
         r->fresh = 0U;
+        o->pending--;
         r->fitted = 1U;
         o->stats.fits++;
         done++;
@@ -215,7 +235,7 @@ bool sl_tiltobs_vehicle(const sl_tiltobs_t *o, const sl_tiltobs_ring_t *r,
     sl_q30_t s;
     sl_q30_t c;
     sl_tilt_sincos_q30(o->odom.yaw, &s, &c);
-    int32_t yaw_cdeg = sl_incline_bam32_to_cdeg(o->odom.yaw); // signed
+    const int32_t yaw_cdeg = sl_incline_bam32_to_cdeg(o->odom.yaw); // signed
     int32_t phi = (res->phi_cdeg - yaw_cdeg) % 36000;
     if (phi < 0) {
         phi += 36000;
@@ -235,6 +255,5 @@ bool sl_tiltobs_vehicle(const sl_tiltobs_t *o, const sl_tiltobs_ring_t *r,
     const int64_t towards = (by >= 0) ? -ty_v : ty_v;
     const sl_bam32_t lean = sl_incline_atan2_bam32(sat32(towards), (int32_t)0x1000000);
     out->lean_path_cdeg = sl_incline_bam32_to_cdeg(lean);
-    (void)yaw_cdeg;
     return true;
 }

@@ -19,9 +19,13 @@
 ///    belongs to a track id; a ring whose track is gone (or whose slot now holds another
 ///    id) is freed. The ring keeps the newest SL_CFG_TILT_OBS_PER_TRACK observations.
 ///    Tracks beyond SL_CFG_TILT_TRACKS rings get none (counted in `stats.no_ring`).
-/// 3. The fit (`sl_tilt_fit`) runs on rings that received an observation this rotation, at
-///    most SL_CFG_TILT_FITS_PER_ROTATION per rotation (round robin over the rings; the
-///    others keep their previous result until their turn): never per azimuth.
+/// 3. `sl_tiltobs_fit_pending()`: the fit (`sl_tilt_fit`) runs on rings that received an
+///    observation since their last fit, at most SL_CFG_TILT_FITS_PER_ROTATION per call
+///    (round robin over the rings; the others keep their previous result until their turn):
+///    never per azimuth. The pipeline calls it when control returns from the decoder (end
+///    of sl_pipeline_feed / _on_msg / _finish), not from inside the rotation callback: the
+///    fit's stack (~800 B on Cortex-M0) then does not add to the decoder's call chain. So a
+///    rotation's PoleTilt carries the fit of the observations up to the previous rotation.
 ///
 /// Outputs per ring: `res` (the last fit, odometry frame relative to the anchor) and, via
 /// `sl_tiltobs_vehicle()`, the tilt in the vehicle frame at the current pose (what the
@@ -87,6 +91,7 @@ typedef struct sl_tiltobs {
     sl_tilt_odom_t odom_prev;  ///< ... at its start
     bool moving;               ///< the last rotation had a motion input (poses usable)
     uint8_t rr;                ///< internal: round-robin start of the fits
+    uint8_t pending;           ///< rings with an observation not fitted yet
     sl_tiltobs_stats_t stats;
     sl_tilt_work_t work;       ///< fit scratch
     sl_tiltobs_ring_t ring[SL_CFG_TILT_TRACKS];
@@ -115,11 +120,15 @@ sl_err_t sl_tiltobs_init(sl_tiltobs_t *o, const sl_board_t *board);
 void sl_tiltobs_advance(sl_tiltobs_t *o, bool motion_valid, int32_t speed_mm_s,
                         int32_t yaw_rate_cdeg_s, uint32_t rotation_us);
 
-/// Record this rotation's observations and fit (file comment, 2. and 3.). `tracks`: the
+/// Record this rotation's observations (file comment, 2.). `tracks`: the
 /// tracker's SL_CFG_MAX_TARGETS slots after sl_track_update(); `targets`: the rotation's
 /// targets (the ones the tracker was given). Does nothing while not moving. O(see top).
 void sl_tiltobs_update(sl_tiltobs_t *o, const sl_track_t *tracks, const sl_target_t *targets,
                        uint32_t n_targets);
+
+/// Fit the rings with new observations (file comment, 3.). O(1) when none is pending;
+/// else at most SL_CFG_TILT_FITS_PER_ROTATION sl_tilt_fit() calls.
+void sl_tiltobs_fit_pending(sl_tiltobs_t *o);
 
 /// The ring of track `id`, or NULL. O(rings).
 const sl_tiltobs_ring_t *sl_tiltobs_find(const sl_tiltobs_t *o, uint16_t id);

@@ -20,17 +20,19 @@ rm -rf "$OUT"; mkdir -p "$OUT"
 ROOT="$SRC/../.."
 DBC="$ROOT/boards/paper-sim/shadowlean.dbc"
 fail=0
-run() { # name speed scene
+run() { # name speed scene [--ambiguous-ok]
     "$SL_SIM" "$3" -o "$OUT/$1.colossus" --quiet || return 1
     "$D" --board paper-sim --input "$OUT/$1.colossus" --motion "$2" --can-log "$OUT/$1.log" -q || return 1
     echo "== $1 (--motion $2)"
-    "$PY" "$SRC/tilt_vs_truth.py" "$DBC" "$OUT/$1.log" "$OUT/$1.gt.csv" --psi-tol 4 --phi-tol 30 || return 1
+    "$PY" "$SRC/tilt_vs_truth.py" "$DBC" "$OUT/$1.log" "$OUT/$1.gt.csv" --psi-tol 4 --phi-tol 30 ${4:-} || return 1
 }
 run slow 1.0 "$ROOT/scenes/driveby_two_poles.ini" || fail=1
 sed 's/^speed_mps = 1.0/speed_mps = 3.0/; s/^rotations = 48/rotations = 24/; s/^y_m = -6.0/y_m = -8.0/' \
     "$ROOT/scenes/driveby_two_poles.ini" > "$OUT/fast.ini"
 grep -q '^speed_mps = 3.0' "$OUT/fast.ini" || { echo "FAIL: scene edit"; exit 1; }
-run fast 3.0 "$OUT/fast.ini" || fail=1
+# At 3 m/s the pole leaning away is seen on 8 rotations only: its fit stays AMBIGUOUS (the
+# mirror hypothesis fits as well), which is the right answer; its Tilt is still checked.
+run fast 3.0 "$OUT/fast.ini" --ambiguous-ok || fail=1
 # No motion input: no PoleTilt frame (the demo and Oxford frames stay as they were).
 "$D" --board paper-sim --input "$OUT/slow.colossus" --can-log "$OUT/still.log" -q || fail=1
 n=$(grep -c " 624#" "$OUT/still.log")

@@ -132,6 +132,7 @@ static int drive_by(const pole_t *p, int n, double v, double w, int rotations, s
         }
         seen += ng > 0U ? 1 : 0;
         sl_tiltobs_update(&obs, tracks, g, ng);
+        sl_tiltobs_fit_pending(&obs);
         double x, y, yaw;
         pose_at(&d, 0.25, &x, &y, &yaw);
         d.x = x;
@@ -244,7 +245,9 @@ static void test_fits_are_bounded_per_rotation(void **state)
     // Over two more rotations every ring is fitted (round robin), never more than the bound.
     sl_target_t g[3];
     const uint32_t f0 = obs.stats.fits;
-    sl_tiltobs_update(&obs, tracks, g, 0U); // nothing new: the ring left over is fitted
+    sl_tiltobs_update(&obs, tracks, g, 0U); // nothing new
+    sl_tiltobs_fit_pending(&obs);           // the ring left over is fitted
+    assert_int_equal(obs.pending, 0U);
     assert_true(obs.stats.fits - f0 <= (uint32_t)SL_CFG_TILT_FITS_PER_ROTATION);
     for (uint16_t id = 1; id <= 3; ++id) {
         const sl_tiltobs_ring_t *r = sl_tiltobs_find(&obs, id);
@@ -269,6 +272,7 @@ static void test_lost_motion_and_lost_tracks_clear_history(void **state)
     sl_tiltobs_advance(&obs, false, 0, 0, 250000U);
     assert_null(sl_tiltobs_find(&obs, 1U));
     assert_int_equal(obs.stats.resets, 1U);
+    assert_int_equal(obs.pending, 0U);
     const uint32_t before = obs.stats.observations;
     sl_tiltobs_update(&obs, tracks, NULL, 0U);
     assert_int_equal(obs.stats.observations, before);
@@ -326,6 +330,8 @@ static void test_degenerate_inputs(void **state)
     sl_tiltobs_update(&obs, tracks, &g, 1U);
     assert_int_equal(obs.stats.observations, 0U);
     assert_int_equal(obs.stats.no_target, 1U);
+    sl_tiltobs_fit_pending(&obs); // nothing pending: no fit
+    assert_int_equal(obs.stats.fits, 0U);
     // |alpha| >= 80 deg: refused by sl_tilt_obs_make, counted.
     g.incline_flag = SL_INCLINE_VALID;
     g.alpha_cdeg = 8500;
