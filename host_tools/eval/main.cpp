@@ -9,6 +9,7 @@
 #include <map>
 #include <string>
 
+#include "driveby.h"
 #include "sim_eval.h"
 #include "sl_cli.h"
 #include "sim_render.h"
@@ -42,6 +43,8 @@ void usage(FILE *out)
                  "             [--extract bbox|pipeline] [--beam-deg DEG] [--speed M/S] [--no-width-radius]\n"
                  "      Evaluates one capture made by sl-sim against its ground truth. --extract pipeline:\n"
                  "      the core pipeline (beam, threshold and speed from --scene, or the options).\n"
+                 "  sl-eval driveby [--board NAME] [--quick] [--realistic] [--speeds A,B] [--check]\n"
+                 "      3D tilt (psi, phi, base offset) fitted over simulated drive-bys against the truth.\n"
                  "--quiet silences the progress lines on stderr.\n");
 }
 
@@ -390,7 +393,7 @@ int main(int argc, char **argv)
         return sl_cli_usage_error("sl-eval", "missing command (table1, realistic or run)", usage);
     }
     const std::string cmd = argv[1];
-    if (cmd == "table1" || cmd == "realistic" || cmd == "run") {
+    if (cmd == "table1" || cmd == "realistic" || cmd == "run" || cmd == "driveby") {
         const int sub = sl_cli_info(argc - 1, argv + 1, "sl-eval", usage);
         if (sub != SL_CLI_CONTINUE) {
             return sub;
@@ -405,6 +408,9 @@ int main(int argc, char **argv)
         }
         if (cmd == "run") {
             return cmd_run(argc - 2, argv + 2);
+        }
+        if (cmd == "driveby") {
+            return cmd_driveby(argc - 2, argv + 2);
         }
     } catch (const std::exception &e) {
         std::fprintf(stderr, "sl-eval: %s\n", e.what());
