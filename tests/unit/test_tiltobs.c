@@ -33,6 +33,23 @@ static double wrap180(double d)
 
 static sl_tiltobs_t obs;
 
+// FNV-1a digest of every vehicle-frame result the sweeps check (fixed point only: the same
+// on every target). From x86-64; aarch64 and s390x must match (bit-identical arithmetic).
+// The host and firmware capacities keep different numbers of observations, so two values.
+#if SL_CFG_TILT_OBS_PER_TRACK == 32
+#define RESULTS_DIGEST 0xe14c3b811456fbc0ULL
+#else
+#define RESULTS_DIGEST_FW 0xa7e4e3bdfd5811ccULL
+#endif
+static uint64_t digest = 14695981039346656037ULL;
+static void digest_i32(int32_t v)
+{
+    for (int i = 0; i < 4; ++i) {
+        digest ^= (uint8_t)((uint32_t)v >> (8 * i));
+        digest *= 1099511628211ULL;
+    }
+}
+
 typedef struct pole {
     double bx, by, psi, phi; // base (odometry frame, m), tilt, direction (deg, odometry frame)
 } pole_t;
@@ -169,6 +186,13 @@ static void check_pole(const pole_t *p, double v, double w, int rotations, uint1
     assert_true(sl_tiltobs_vehicle(&obs, r, &out));
     double phi_v, bx, by;
     truth(p, v, w, rotations, &phi_v, &bx, &by);
+    digest_i32(out.psi_cdeg);
+    digest_i32(out.phi_cdeg);
+    digest_i32(out.base_x_um);
+    digest_i32(out.base_y_um);
+    digest_i32(out.lean_path_cdeg);
+    digest_i32(out.psi_sigma_cdeg);
+    digest_i32(out.phi_sigma_cdeg);
     const double e_psi = out.psi_cdeg / 100.0 - p->psi;
     const double e_phi = wrap180(out.phi_cdeg / 100.0 - phi_v);
     const double e_b = hypot(out.base_x_um * 1e-6 - bx, out.base_y_um * 1e-6 - by);
@@ -231,6 +255,18 @@ static void test_curved_path_10_deg_per_second(void **state)
     drive_by(p, 2, 1.5, 10.0, 24, tracks);
     check_pole(&p[0], 1.5, 10.0, 24, 1, 1.0, 10.0);
     check_pole(&p[1], 1.5, 10.0, 24, 2, 1.0, 10.0);
+}
+
+// Runs after the three sweeps above (cmocka runs the tests in order).
+static void test_results_digest_is_target_independent(void **state)
+{
+    (void)state;
+    printf("results digest 0x%016llx\n", (unsigned long long)digest);
+#if SL_CFG_TILT_OBS_PER_TRACK == 32
+    assert_true(digest == RESULTS_DIGEST);
+#else
+    assert_true(digest == RESULTS_DIGEST_FW);
+#endif
 }
 
 static void test_fits_are_bounded_per_rotation(void **state)
@@ -345,6 +381,7 @@ int main(void)
         cmocka_unit_test(test_straight_drive_bys_both_sides_all_directions),
         cmocka_unit_test(test_leaning_away_beyond_the_fold),
         cmocka_unit_test(test_curved_path_10_deg_per_second),
+        cmocka_unit_test(test_results_digest_is_target_independent),
         cmocka_unit_test(test_fits_are_bounded_per_rotation),
         cmocka_unit_test(test_lost_motion_and_lost_tracks_clear_history),
         cmocka_unit_test(test_more_tracks_than_rings_are_counted),
