@@ -117,6 +117,7 @@ void on_rotation(void *ctx, const sl_pipeline_rotation_t *r)
     }
 }
 
+
 double wrap180(double d)
 {
     while (d > 180.0) {
@@ -134,7 +135,7 @@ std::string scene_text(const std::string &board, const Case &k, bool realistic, 
     // Vehicle along world +y (heading 90), starting 6 m before the pole, ending 6 m after.
     const double run_m = 12.0;
     *rotations = static_cast<int>(std::ceil(run_m / k.speed * 4.0));
-    const double lean_world = k.phi_v + 90.0;
+    const double lean_world = wrap180(k.phi_v + 90.0); // heading 90: world = vehicle + 90
     char buf[2048];
     std::snprintf(buf, sizeof buf,
                   "[scene]\nboard = %s\nrotations = %d\nrotation_hz = 4\nseed = %d\nrange_bins = 512\n"
