@@ -67,7 +67,7 @@
 
 /// 3D tilt while driving (sl_tiltobs.h): tracks with an observation history, and the
 /// observations each keeps (<= SL_TILT_MAX_OBS, 32). The firmware configuration (masked bins
-/// <= 192) keeps 4 x 16 (2.4 KB); the host 8 x 32.
+/// <= 192) keeps 4 x 16 (2,472 B); the host 8 x 32 (7,368 B).
 #ifndef SL_CFG_TILT_TRACKS
 #if SL_CFG_MASK_BINS <= 192
 #define SL_CFG_TILT_TRACKS 4

@@ -126,13 +126,13 @@
 /// Dominated by the mask: SL_CFG_MAX_AZIMUTHS x (1 + ceil(log2 SL_CFG_MASK_FRAMES_MAX)) x
 /// SL_CFG_MASK_BINS / 8 bytes; then detection (8,424 B), the tracker (1,864 B), the scan
 /// bookkeeping (624 B), the range profiles (sl_profile.h, 2.1 KB), the 3D tilt history
-/// (sl_tiltobs.h: 2,472 B firmware, 6.8 KB host default), the reassembly buffer
+/// (sl_tiltobs.h: 2,472 B firmware, 7.4 KB host default), the reassembly buffer
 /// (SL_PIPELINE_REASM_BYTES) and a row buffer.
 ///
 /// | configuration (400 azimuths, 32 targets)              | x86-64    | Cortex-M0 |
 /// |--------------------------------------------------------|-----------|-----------|
 /// | firmware: SL_CFG_MASK_BINS 160, SL_CFG_MASK_FRAMES_MAX 16 | 58,256 B  | 58,112 B  |
-/// | host default: mask bins 512 (whole ROI), n <= 32          | 170,520 B |           |
+/// | host default: mask bins 512 (whole ROI), n <= 32          | 177,896 B |           |
 ///
 /// The boards carried today need 135 (paper-sim), 119 (paper-bench) and 141 (robotcar-leaf)
 /// masked bins (sl_detect_bins_needed(), rounded up to 160).
@@ -395,7 +395,7 @@ _Static_assert(sizeof(sl_pipeline_t) <= 65536U, "sl_pipeline_t: 64 KiB RAM budge
 #endif
 /// Any azimuth count, bins and n with the default target/candidate capacities: the mask
 /// dominates; everything else except the tilt history (sl_tiltobs_t, sized by
-/// SL_CFG_TILT_TRACKS x SL_CFG_TILT_OBS_PER_TRACK: 2.4 KB firmware, 6.8 KB host) stays under
+/// SL_CFG_TILT_TRACKS x SL_CFG_TILT_OBS_PER_TRACK: 2.5 KB firmware, 7.4 KB host) stays under
 /// 16 KiB.
 #if SL_CFG_MAX_TARGETS <= 32 && SL_CFG_DETECT_MAX_CANDIDATES <= 32 && SL_CFG_DETECT_MAX_SPAN <= 24 \
     && SL_CFG_MAX_AZIMUTHS <= 400

@@ -34,7 +34,7 @@
 ///
 /// Units: um, bam32 (2^32 per turn), cdeg (0.01 deg). No allocation, no float; every array
 /// is inside the struct. RAM: SL_CFG_TILT_TRACKS x (SL_CFG_TILT_OBS_PER_TRACK x 24 + 72)
-/// + 600 bytes (firmware configuration 4 x 16: 2,432 B; host default 8 x 32: 6,784 B on x86-64).
+/// + 648 bytes (x86-64: firmware configuration 4 x 16: 2,472 B; host default 8 x 32: 7,368 B).
 /// Cost per rotation: O(tracks x targets) for the matching (only for updated confirmed
 /// tracks) + O(1) per observation (three table sine/cosine, two 64-bit divisions) + at most
 /// SL_CFG_TILT_FITS_PER_ROTATION fits (sl_tilt.h: O(n + m^2)). Not reentrant per instance.
