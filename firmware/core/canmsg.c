@@ -13,6 +13,10 @@
 static const sl_can_value_name_t quality_names[] = {
     {0U, "VALID"}, {1U, "AMBIGUOUS"}, {2U, "OUT_OF_MODEL"}, {3U, "INVALID"}, {4U, "FILTERED"},
 };
+static const sl_can_value_name_t tilt_quality_names[] = {
+    {0U, "FITTED"}, {1U, "AMBIGUOUS"}, {2U, "INSUFFICIENT_MOTION"}, {3U, "TOO_FEW"},
+    {4U, "INCONSISTENT"},
+};
 static const sl_can_value_name_t level_names[] = {
     {0U, "NONE"}, {1U, "CAUTION"}, {2U, "DANGER"},
 };
@@ -116,6 +120,27 @@ static const sl_can_signal_desc_t health_sigs[H_N] = {
      (int32_t)SL_CAN_HEALTH_CANDIDATES_DROPPED_MAX, "", NULL, 0U},
 };
 
+enum { L_QUALITY = 2, L_CLAMPED, L_TARGET, L_TILT, L_DIR, L_SIGMA, L_DIR_SIGMA, L_BX, L_BY, L_N };
+static const sl_can_signal_desc_t tilt_sigs[L_N] = {
+    E2E_SIGNALS,
+    {"Quality", 12U, 3U, false, 1, 1, 0, (int32_t)SL_CAN_TILT_QUALITY_MAX, "", tilt_quality_names,
+     NV(tilt_quality_names)},
+    {"Clamped", 15U, 1U, false, 1, 1, 0, 1, "", NULL, 0U},
+    {"TargetId", 16U, 4U, false, 1, 1, 0, (int32_t)SL_CAN_TARGET_ID_MAX, "", NULL, 0U},
+    {"Tilt", 20U, 8U, false, SL_CAN_TILT_CDEG_PER_LSB, 100, 0, SL_CAN_TILT_RAW_MAX, "deg", NULL,
+     0U},
+    {"TiltDirection", 28U, 9U, false, SL_CAN_TILT_DIR_CDEG_PER_LSB, 100, 0,
+     SL_CAN_TILT_DIR_RAW_MAX, "deg", NULL, 0U},
+    {"TiltSigma", 37U, 5U, false, SL_CAN_TILT_SIGMA_CDEG_PER_LSB, 100, 0,
+     SL_CAN_TILT_SIGMA_RAW_MAX, "deg", NULL, 0U},
+    {"DirectionSigma", 42U, 6U, false, SL_CAN_TILT_DIR_SIGMA_CDEG_PER_LSB, 100, 0,
+     SL_CAN_TILT_DIR_SIGMA_RAW_MAX, "deg", NULL, 0U},
+    {"BaseX", 48U, 8U, true, SL_CAN_TILT_BASE_MM_PER_LSB, 1000, SL_CAN_TILT_BASE_RAW_MIN,
+     SL_CAN_TILT_BASE_RAW_MAX, "m", NULL, 0U},
+    {"BaseY", 56U, 8U, true, SL_CAN_TILT_BASE_MM_PER_LSB, 1000, SL_CAN_TILT_BASE_RAW_MIN,
+     SL_CAN_TILT_BASE_RAW_MAX, "m", NULL, 0U},
+};
+
 static const sl_can_message_desc_t messages[SL_CAN_MSG_COUNT] = {
     {"PoleLean", SL_CAN_DATA_ID_POLE_LEAN, SL_CAN_CYCLE_MS_POLE_LEAN, 0U,
      (uint8_t)SL_CAN_SEND_CYCLIC_IF_ACTIVE, false, pole_sigs, P_N},
@@ -127,6 +152,8 @@ static const sl_can_message_desc_t messages[SL_CAN_MSG_COUNT] = {
      (uint8_t)SL_CAN_SEND_CYCLIC, true, motion_sigs, M_N},
     {"Health", SL_CAN_DATA_ID_HEALTH, SL_CAN_CYCLE_MS_HEALTH, SL_CAN_IDLE_CYCLE_MS_STATUS,
      (uint8_t)SL_CAN_SEND_CYCLIC, false, health_sigs, H_N},
+    {"PoleTilt", SL_CAN_DATA_ID_POLE_TILT, SL_CAN_CYCLE_MS_POLE_TILT, 0U,
+     (uint8_t)SL_CAN_SEND_CYCLIC_IF_ACTIVE, false, tilt_sigs, L_N},
 };
 
 const sl_can_message_desc_t *sl_can_layout(sl_can_msg_t m)
@@ -271,6 +298,7 @@ void sl_can_ids_from_board(sl_can_ids_t *ids, const struct sl_board *board)
     ids->id[SL_CAN_MSG_STATUS] = board->can_id_status;
     ids->id[SL_CAN_MSG_VEHICLE_MOTION] = board->can_id_vehicle_motion;
     ids->id[SL_CAN_MSG_HEALTH] = board->can_id_health;
+    ids->id[SL_CAN_MSG_POLE_TILT] = board->can_id_pole_tilt;
 }
 
 sl_err_t sl_can_tx_init(sl_can_tx_t *tx, const sl_can_ids_t *ids)
@@ -372,6 +400,36 @@ sl_err_t sl_can_encode_lean_warning(sl_can_tx_t *tx, const sl_can_lean_warning_t
     }
     put_sig(d, &s[W_CLAMPED], cl ? 1 : 0);
     finish(tx, SL_CAN_MSG_LEAN_WARNING, d, cl, out);
+    return SL_OK;
+}
+
+sl_err_t sl_can_encode_pole_tilt(sl_can_tx_t *tx, const sl_can_pole_tilt_t *in,
+                                 sl_can_frame_t *out)
+{
+    if (tx == NULL || in == NULL || out == NULL) {
+        return SL_ERR_ARG;
+    }
+    const sl_can_signal_desc_t *s = tilt_sigs;
+    uint8_t d[8] = {0};
+    bool cl = false;
+    uint32_t q = in->quality;
+    if (q > SL_CAN_TILT_QUALITY_MAX) {
+        q = SL_CAN_TILT_INCONSISTENT;
+        cl = true;
+    }
+    put_sig(d, &s[L_QUALITY], q);
+    put_sig(d, &s[L_TARGET], clamp_raw(&s[L_TARGET], in->target_id, &cl));
+    if (q == SL_CAN_TILT_FITTED || q == SL_CAN_TILT_AMBIGUOUS) {
+        put_phys(d, &s[L_TILT], in->tilt_cdeg, SL_CAN_TILT_CDEG_PER_LSB, &cl);
+        put_azimuth(d, &s[L_DIR], in->direction_cdeg, SL_CAN_TILT_DIR_CDEG_PER_LSB);
+        put_phys(d, &s[L_SIGMA], in->tilt_sigma_cdeg, SL_CAN_TILT_SIGMA_CDEG_PER_LSB, &cl);
+        put_phys(d, &s[L_DIR_SIGMA], in->direction_sigma_cdeg, SL_CAN_TILT_DIR_SIGMA_CDEG_PER_LSB,
+                 &cl);
+        put_phys(d, &s[L_BX], in->base_x_um, SL_CAN_TILT_BASE_UM_PER_LSB, &cl); // um: one rounding
+        put_phys(d, &s[L_BY], in->base_y_um, SL_CAN_TILT_BASE_UM_PER_LSB, &cl);
+    }
+    put_sig(d, &s[L_CLAMPED], cl ? 1 : 0);
+    finish(tx, SL_CAN_MSG_POLE_TILT, d, cl, out);
     return SL_OK;
 }
 
@@ -577,6 +635,28 @@ sl_err_t sl_can_decode_vehicle_motion(const sl_can_frame_t *f, sl_can_vehicle_mo
     out->yaw_rate_valid = get_sig(d, &s[M_YAW_VALID]) != 0;
     out->speed_mm_s = (int32_t)(get_sig(d, &s[M_SPEED]) * SL_CAN_MOTION_SPEED_MM_S_PER_LSB);
     out->yaw_rate_cdeg_s = (int32_t)(get_sig(d, &s[M_YAW]) * SL_CAN_MOTION_YAW_CDEG_S_PER_LSB);
+    return SL_OK;
+}
+
+sl_err_t sl_can_decode_pole_tilt(const sl_can_frame_t *f, sl_can_pole_tilt_t *out)
+{
+    const sl_err_t e = decode_check(f, out, SL_CAN_MSG_POLE_TILT);
+    if (e != SL_OK) {
+        return e;
+    }
+    const sl_can_signal_desc_t *s = tilt_sigs;
+    const uint8_t *d = f->data;
+    out->counter = (uint8_t)get_sig(d, &s[S_COUNTER]);
+    out->quality = (uint8_t)get_sig(d, &s[L_QUALITY]);
+    out->clamped = get_sig(d, &s[L_CLAMPED]) != 0;
+    out->target_id = (uint8_t)get_sig(d, &s[L_TARGET]);
+    out->tilt_cdeg = (int32_t)(get_sig(d, &s[L_TILT]) * SL_CAN_TILT_CDEG_PER_LSB);
+    out->direction_cdeg = (int32_t)(get_sig(d, &s[L_DIR]) * SL_CAN_TILT_DIR_CDEG_PER_LSB);
+    out->tilt_sigma_cdeg = (uint32_t)(get_sig(d, &s[L_SIGMA]) * SL_CAN_TILT_SIGMA_CDEG_PER_LSB);
+    out->direction_sigma_cdeg =
+        (uint32_t)(get_sig(d, &s[L_DIR_SIGMA]) * SL_CAN_TILT_DIR_SIGMA_CDEG_PER_LSB);
+    out->base_x_um = (int32_t)(get_sig(d, &s[L_BX]) * SL_CAN_TILT_BASE_UM_PER_LSB);
+    out->base_y_um = (int32_t)(get_sig(d, &s[L_BY]) * SL_CAN_TILT_BASE_UM_PER_LSB);
     return SL_OK;
 }
 

@@ -293,23 +293,95 @@ static void emit_status(sl_pipeline_t *p)
     }
 }
 
+// What LeanWarning says about a track (sl_pipeline.h, "LeanWarning and the fitted tilt"):
+// the tracker's level, filtered in-plane alpha and sigma, or, when the track's drive-by fit
+// is FITTED, the tilt towards the vehicle's path, its sigma and the level of that lean.
+typedef struct warn_view {
+    uint8_t level;
+    bool valid;        // a lean number
+    bool fitted;       // from the 3D fit
+    int32_t lean_cdeg;
+    uint16_t sigma_cdeg;
+} warn_view_t;
+
+static uint8_t lean_level(const sl_pipeline_t *p, int32_t a)
+{
+    const sl_board_t *b = p->board;
+    if (b->danger_lean_cdeg > 0 && a >= b->danger_lean_cdeg) {
+        return (uint8_t)SL_WARN_DANGER;
+    }
+    const int32_t m = p->cfg.track.caution_abs ? sl_fx_abs32(a) : a;
+    if (b->caution_lean_cdeg > 0 && m >= b->caution_lean_cdeg) {
+        return (uint8_t)SL_WARN_CAUTION;
+    }
+    return (uint8_t)SL_WARN_NONE;
+}
+
+static SL_NOINLINE void warn_view(const sl_pipeline_t *p, const sl_track_t *t, warn_view_t *v)
+{
+    v->level = t->level;
+    v->valid = t->valid_hits > 0U;
+    v->fitted = false;
+    v->lean_cdeg = t->alpha_cdeg;
+    v->sigma_cdeg = t->sigma_cdeg;
+    if (!p->tilt.moving) {
+        return;
+    }
+    sl_tiltobs_vehicle_t tv;
+    if (sl_tiltobs_vehicle(&p->tilt, sl_tiltobs_find(&p->tilt, t->id), &tv) &&
+        tv.quality == (uint8_t)SL_TILT_FITTED) {
+        v->valid = true;
+        v->fitted = true;
+        v->lean_cdeg = tv.lean_path_cdeg;
+        v->sigma_cdeg = tv.psi_sigma_cdeg;
+        v->level = lean_level(p, tv.lean_path_cdeg);
+    }
+}
+
+// PoleTilt of track `t` when it has an observation history with a fit.
+static SL_NOINLINE void emit_tilt(sl_pipeline_t *p, const sl_track_t *t)
+{
+    sl_tiltobs_vehicle_t tv;
+    if (!p->tilt.moving || !sl_tiltobs_vehicle(&p->tilt, sl_tiltobs_find(&p->tilt, t->id), &tv)) {
+        return;
+    }
+    const sl_can_pole_tilt_t pt = {
+        .target_id = (uint8_t)(t->id & 15U),
+        .quality = tv.quality,
+        .tilt_cdeg = tv.psi_cdeg,
+        .direction_cdeg = tv.phi_cdeg,
+        .tilt_sigma_cdeg = tv.psi_sigma_cdeg,
+        .direction_sigma_cdeg = tv.phi_sigma_cdeg,
+        .base_x_um = tv.base_x_um,
+        .base_y_um = tv.base_y_um,
+    };
+    sl_can_frame_t f;
+    if (sl_can_encode_pole_tilt(&p->can, &pt, &f) == SL_OK) {
+        can_send(p, &f);
+    }
+}
+
 static void emit_can(sl_pipeline_t *p)
 {
     const sl_tracker_t *tr = &p->tracker;
     const uint16_t confirm = p->cfg.confirm_hits == 0U ? 1U : p->cfg.confirm_hits;
     sl_can_frame_t f;
     const sl_track_t *worst = NULL;
+    warn_view_t wv = {0U, false, false, 0, 0U};
     for (uint32_t i = 0; i < SL_CFG_MAX_TARGETS; i++) {
         const sl_track_t *t = &tr->tracks[i];
         if (t->live == 0U || t->hits < confirm || t->confirmed == 0U) {
             continue;
         }
-        // The most severe confirmed track: level, then |filtered alpha| (valid ones first).
-        if (worst == NULL || t->level > worst->level ||
-            (t->level == worst->level &&
-             ((t->valid_hits > 0U && worst->valid_hits == 0U) ||
-              (t->valid_hits > 0U && sl_fx_abs32(t->alpha_cdeg) > sl_fx_abs32(worst->alpha_cdeg))))) {
+        // The most severe confirmed track: level, then |lean| (valid ones first).
+        warn_view_t v;
+        warn_view(p, t, &v);
+        if (worst == NULL || v.level > wv.level ||
+            (v.level == wv.level &&
+             ((v.valid && !wv.valid) ||
+              (v.valid && sl_fx_abs32(v.lean_cdeg) > sl_fx_abs32(wv.lean_cdeg))))) {
             worst = t;
+            wv = v;
         }
         if (t->updated == 0U) {
             continue; // PoleLean only for tracks seen this rotation
@@ -328,20 +400,21 @@ static void emit_can(sl_pipeline_t *p)
         if (sl_can_encode_pole_lean(&p->can, &pl, &f) == SL_OK) {
             can_send(p, &f);
         }
+        emit_tilt(p, t);
     }
     sl_can_lean_warning_t lw;
     memset(&lw, 0, sizeof lw);
     if (worst != NULL) {
-        const uint8_t q = quality_of(worst);
+        const uint8_t q = wv.fitted ? (uint8_t)SL_CAN_QUALITY_FILTERED : quality_of(worst);
         const bool has_lean = q == (uint8_t)SL_CAN_QUALITY_FILTERED;
-        lw.level = worst->level;
+        lw.level = wv.level;
         lw.has_target = true;
         lw.target_id = (uint8_t)(worst->id & 15U);
         lw.quality = q;
         lw.azimuth_cdeg = vehicle_az_cdeg(p, worst->az);
         lw.range_um = worst->r1_um;
-        lw.lean_cdeg = has_lean ? worst->alpha_cdeg : 0;
-        lw.lean_sigma_cdeg = has_lean ? worst->sigma_cdeg : 0U;
+        lw.lean_cdeg = has_lean ? wv.lean_cdeg : 0;
+        lw.lean_sigma_cdeg = has_lean ? wv.sigma_cdeg : 0U;
     }
     if (sl_can_encode_lean_warning(&p->can, &lw, &f) == SL_OK) {
         can_send(p, &f);
@@ -534,6 +607,8 @@ static void on_rot(void *ctx, const sl_scan_rot_t *rot)
     set_track_motion(p);
     sl_track_set_reverse(&p->tracker, p->motion_valid && p->speed_mm_s < 0);
     sl_track_update(&p->tracker, p->detect.targets, n_targets, p->now_us);
+    sl_tiltobs_advance(&p->tilt, p->motion_valid, p->speed_mm_s, p->yaw_cdeg_s, p->rotation_us);
+    sl_tiltobs_update(&p->tilt, p->tracker.tracks, p->detect.targets, n_targets);
     p->stats.rotations++;
     p->stats.azimuths_missing += rot->stats.missing;
     p->stats.targets += n_targets;
@@ -711,6 +786,9 @@ sl_err_t sl_pipeline_init(sl_pipeline_t *p, const sl_board_t *board,
     if (e == SL_OK) {
         e = sl_track_init(&p->tracker, board, &c->track);
     }
+    if (e == SL_OK) {
+        e = sl_tiltobs_init(&p->tilt, board);
+    }
     sl_can_ids_t ids;
     if (e == SL_OK) {
         sl_can_ids_from_board(&ids, board);
@@ -770,7 +848,9 @@ sl_err_t sl_pipeline_feed(sl_pipeline_t *p, const uint8_t *data, size_t len, uin
         return SL_ERR_ARG;
     }
     p->now_us = now_us;
-    return sl_proto_feed(&p->proto, data, len, now_us);
+    const sl_err_t e = sl_proto_feed(&p->proto, data, len, now_us);
+    sl_tiltobs_fit_pending(&p->tilt); // outside the decoder's call chain (stack)
+    return e;
 }
 
 sl_err_t sl_pipeline_on_msg(sl_pipeline_t *p, const sl_proto_msg_t *msg, uint64_t now_us)
@@ -780,6 +860,7 @@ sl_err_t sl_pipeline_on_msg(sl_pipeline_t *p, const sl_proto_msg_t *msg, uint64_
     }
     p->now_us = now_us;
     on_msg(p, msg);
+    sl_tiltobs_fit_pending(&p->tilt);
     return SL_OK;
 }
 
@@ -798,6 +879,7 @@ sl_err_t sl_pipeline_finish(sl_pipeline_t *p, uint64_t now_us)
     p->now_us = now_us;
     (void)sl_proto_finish(&p->proto);
     sl_scan_flush(&p->scan);
+    sl_tiltobs_fit_pending(&p->tilt);
     p->last_t_last_us = 0U; // the next stream's clock may differ
     return SL_OK;
 }

@@ -15,7 +15,8 @@
 // Printed (one `key: value` per line, parsed by callgrind.sh / compare.sh):
 //   - the pipeline's static RAM: sizeof(sl_pipeline_t) for this build's SL_CFG_* (sl-bench is
 //     built in the firmware configuration, sl-bench-host in the host default);
-//   - bytes, messages, azimuths, rotations, targets of one run;
+//   - bytes, messages, azimuths, rotations, targets of one run; the 3D tilt history's
+//     observations and fits (only with --speed-mm-s: a motion input) and its RAM;
 //   - wall-clock MB/s (best of --repeat runs, one thread, one core; 1 MB = 1e6 bytes);
 //   - latency: wall-clock microseconds from the start of the sl_pipeline_feed() call that
 //     hands over the message completing a rotation (the next rotation's first azimuth) to
@@ -394,6 +395,10 @@ int main(int argc, char **argv)
         for (uint32_t a = 0; a < g_pl.detect.azimuths; a++) {
             win_max = g_pl.detect.win_bins[a] > win_max ? g_pl.detect.win_bins[a] : win_max;
         }
+        const sl_tiltobs_stats_t *ts = &g_pl.tilt.stats;
+        printf("tilt: observations %" PRIu32 " fits %" PRIu32 " resets %" PRIu32
+               " no_ring %" PRIu32 " sizeof %zu\n",
+               ts->observations, ts->fits, ts->resets, ts->no_ring, sizeof(sl_tiltobs_t));
         printf("detect_window: near %u win_max %u\n", (unsigned)g_pl.detect.near_bins,
                (unsigned)win_max);
         printf("wall_s: %.6f\n", best);

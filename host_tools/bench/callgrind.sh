@@ -37,7 +37,15 @@ lir=$(awk '/^(summary|totals):/ {print $2; exit}' "$tmp/cg.latency")
 lrot=$(awk '/^latency_rotations:/ {print $2; exit}' "$tmp/log.latency")
 [ -n "$ir" ] && [ -n "$az" ] && [ "$az" -gt 0 ] && [ -n "$rot" ] && [ "$rot" -gt 0 ] || {
     echo "callgrind.sh: could not parse totals ($ir), azimuths ($az), rotations ($rot)" >&2; exit 1; }
-grep -E '^(capture|board|config|sizeof_pipeline|bytes|messages|chunk|targets|missing|detect):' "$tmp/log.run"
+grep -E '^(capture|board|config|sizeof_pipeline|bytes|messages|chunk|targets|missing|detect|tilt):' "$tmp/log.run"
+# Cost per 3D tilt fit: sl_tilt_fit's inclusive instructions / fits (with --speed-mm-s).
+fits=$(awk '/^tilt:/ {print $5; exit}' "$tmp/log.run")
+if [ -n "$fits" ] && [ "$fits" -gt 0 ] && command -v callgrind_annotate >/dev/null; then
+    fit_ir=$(callgrind_annotate --inclusive=yes "$tmp/cg.run" 2>/dev/null |
+        awk '/sl_tilt_fit[^_]/ || /sl_tilt_fit$/ {gsub(",", "", $1); print $1; exit}')
+    [ -n "$fit_ir" ] && awk -v a="$fit_ir" -v f="$fits" -v z="$az" 'BEGIN {
+        printf "tilt_fit_instructions: %.0f per fit (%d fits; %.1f per azimuth on average)\n", a / f, f, a / z }'
+fi
 echo "instructions: $ir"
 awk -v a="$ir" -v z="$az" -v r="$rot" 'BEGIN {
     printf "instructions_per_azimuth: %.0f\n", a / z

@@ -47,7 +47,7 @@ const std::set<std::string> kKnown = {
     "detect.range_sigma_m", "detect.theta_sigma_deg", "detect.caution_lean_deg",
     "detect.danger_lean_deg", "detect.track_timeout_s", "detect.elongation",
     "can.bitrate", "can.id_pole_lean", "can.id_lean_warning", "can.id_status",
-    "can.id_vehicle_motion", "can.id_health",
+    "can.id_vehicle_motion", "can.id_health", "can.id_pole_tilt",
 };
 
 class Reader {
@@ -336,10 +336,16 @@ BoardSpec load_board(const std::string &name_or_path)
         r.fail("can.id_health", "missing (required: the Health message's CAN id, e.g. 0x623)");
     }
     b.can_id_health = can_id("can.id_health", 0x623);
+    if (!r.has("can.id_pole_tilt")) {
+        r.fail("can.id_pole_tilt",
+               "missing (required: the PoleTilt message's CAN id, e.g. 0x624)");
+    }
+    b.can_id_pole_tilt = can_id("can.id_pole_tilt", 0x624);
     const std::set<unsigned> ids = {b.can_id_pole_lean, b.can_id_lean_warning, b.can_id_status,
-                                    b.can_id_vehicle_motion, b.can_id_health};
-    if (ids.size() != 5U) {
-        r.fail("can", "the five CAN ids must differ");
+                                    b.can_id_vehicle_motion, b.can_id_health,
+                                    b.can_id_pole_tilt};
+    if (ids.size() != 6U) {
+        r.fail("can", "the six CAN ids must differ");
     }
 
     for (int i = 0; i < b.azimuths; i++) {

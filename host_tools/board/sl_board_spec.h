@@ -50,7 +50,8 @@ struct BoardSpec {
     // CAN
     int can_bitrate = 500000;
     unsigned can_id_pole_lean = 0x620, can_id_lean_warning = 0x621, can_id_status = 0x622,
-             can_id_vehicle_motion = 0x300, can_id_health = 0x623;
+             can_id_vehicle_motion = 0x300, can_id_health = 0x623,
+             can_id_pole_tilt = 0x624;
 
     /// Opening angle theta (deg) of azimuth index i: the depression of the ray that grazes
     /// the chassis edge. NaN when the chassis does not surround the radar on that azimuth.

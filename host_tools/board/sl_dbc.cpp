@@ -97,6 +97,11 @@ const std::map<std::string, std::string> kMessageComments = {
                "(Saturated = 1)."},
     {"VehicleMotion", "Input from the vehicle for the motion-aware masks: speed and yaw "
                       "rate with E2E protection; CRC errors and counter jumps are counted."},
+    {"PoleTilt",
+     "While driving (a motion input is present): one frame per confirmed target and radar "
+     "rotation that has an observation history (GenMsgSendType CyclicIfActive): the pole's "
+     "3D tilt fitted from its in-plane leans over the drive-by. The values are meaningful "
+     "only when Quality is FITTED or AMBIGUOUS (then the direction may be the mirror image)."},
     {"Health", "Sent right after every Status: why the output may be degraded or blind. "
                "Any Fault bit set means do not trust an absent warning. A bit is set when "
                "its condition held since the previous Health frame or still holds."},
@@ -147,6 +152,21 @@ const std::map<std::string, std::string> kSignalComments = {
     {"Health.Reconnects", "Radar link reconnects since start (saturating at 255)."},
     {"Health.CandidatesDropped", "Detection candidates dropped for lack of target slots since "
                                  "start (saturating at 4095)."},
+    {"PoleTilt.Quality", "Fit quality: FITTED, AMBIGUOUS (mirror hypothesis fits as well), "
+                         "INSUFFICIENT_MOTION (bearings do not spread), TOO_FEW "
+                         "(observations), INCONSISTENT (residuals far above the sigmas)."},
+    {"PoleTilt.Clamped", "1: at least one value hit its range limit."},
+    {"PoleTilt.TargetId", "Tracker id of the target (as in PoleLean)."},
+    {"PoleTilt.Tilt", "Tilt of the pole from vertical (psi)."},
+    {"PoleTilt.TiltDirection", "Direction the top leans towards, in the vehicle frame at "
+                               "this frame's time: counter-clockwise from the vehicle's "
+                               "forward axis seen from above, 0..359."},
+    {"PoleTilt.TiltSigma", "1-sigma uncertainty of Tilt."},
+    {"PoleTilt.DirectionSigma", "1-sigma uncertainty of TiltDirection (63: too small a tilt "
+                                "to orient)."},
+    {"PoleTilt.BaseX", "Pole base on the ground, vehicle frame at this frame's time: "
+                       "forward of the vehicle origin."},
+    {"PoleTilt.BaseY", "Pole base on the ground: left of the vehicle origin."},
     {"VehicleMotion.SpeedValid", "1: Speed is valid."},
     {"VehicleMotion.YawRateValid", "1: YawRate is valid."},
     {"VehicleMotion.Speed", "Vehicle speed over ground; positive forward."},
@@ -193,6 +213,8 @@ uint32_t board_id(const BoardSpec &b, sl_can_msg_t m)
         return b.can_id_vehicle_motion;
     case SL_CAN_MSG_HEALTH:
         return b.can_id_health;
+    case SL_CAN_MSG_POLE_TILT:
+        return b.can_id_pole_tilt;
     case SL_CAN_MSG_COUNT:
         break;
     }
@@ -267,7 +289,8 @@ std::string make_dbc(const BoardSpec &b)
            b.description)
       << ";\n";
     o << "CM_ BU_ " << kVehicle << " "
-      << q("The vehicle: consumes PoleLean, LeanWarning, Status; sends VehicleMotion.")
+      << q("The vehicle: consumes PoleLean, LeanWarning, Status, Health, PoleTilt; sends "
+             "VehicleMotion.")
       << ";\n";
     for (unsigned mi = 0; mi < SL_CAN_MSG_COUNT; mi++) {
         const sl_can_message_desc_t &m = *sl_can_layout(static_cast<sl_can_msg_t>(mi));

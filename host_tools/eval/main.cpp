@@ -10,6 +10,7 @@
 #include <string>
 
 #include "capture.h"
+#include "driveby.h"
 #include "sim_eval.h"
 #include "sl_cli.h"
 #include "sl_progress.h"
@@ -45,6 +46,8 @@ void usage(FILE *out)
                  "      Evaluates one capture made by sl-sim against its ground truth (raw or pcap, streamed;\n"
                  "      - = stdin). --extract pipeline:\n"
                  "      the core pipeline (beam, threshold and speed from --scene, or the options).\n"
+                 "  sl-eval driveby [--board NAME] [--quick] [--realistic] [--speeds A,B] [--check]\n"
+                 "      3D tilt (psi, phi, base offset) fitted over simulated drive-bys against the truth.\n"
                  "Progress goes to stderr when it is a terminal; -q/--quiet silences it.\n");
 }
 
@@ -415,7 +418,7 @@ int main(int argc, char **argv)
         return sl_cli_usage_error("sl-eval", "missing command (table1, realistic or run)", usage);
     }
     const std::string cmd = argv[1];
-    if (cmd == "table1" || cmd == "realistic" || cmd == "run") {
+    if (cmd == "table1" || cmd == "realistic" || cmd == "run" || cmd == "driveby") {
         const int sub = sl_cli_info(argc - 1, argv + 1, "sl-eval", usage);
         if (sub != SL_CLI_CONTINUE) {
             return sub;
@@ -430,6 +433,9 @@ int main(int argc, char **argv)
         }
         if (cmd == "run") {
             return cmd_run(argc - 2, argv + 2);
+        }
+        if (cmd == "driveby") {
+            return cmd_driveby(argc - 2, argv + 2);
         }
     } catch (const std::exception &e) {
         std::fprintf(stderr, "sl-eval: %s\n", e.what());

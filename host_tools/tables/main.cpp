@@ -220,6 +220,7 @@ void write_source(const sl::BoardSpec &b, const Tables &t, const std::string &pa
       << "    .can_id_status = " << b.can_id_status << "u,\n"
       << "    .can_id_vehicle_motion = " << b.can_id_vehicle_motion << "u,\n"
       << "    .can_id_health = " << b.can_id_health << "u,\n"
+      << "    .can_id_pole_tilt = " << b.can_id_pole_tilt << "u,\n"
       << "    .geom = geom,\n"
       << "    .theta_cdeg = theta_cdeg,\n"
       << "    .shadow_um = shadow_um,\n"

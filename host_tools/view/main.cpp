@@ -51,6 +51,7 @@
 #include "sl_progress.h"
 #include "shadowlean/sl_board.h"
 #include "shadowlean/sl_detect.h"
+#include "view_tilt.h"
 #include "shadowlean/sl_mask.h"
 #include "shadowlean/sl_thresh.h"
 #include "sl_board_spec.h"
@@ -70,6 +71,8 @@ struct Args {
     bool all = false, quiet = false;
     double roi_m = 0, vmax = 0, fps = 4, bin_size_m = 0;
     int mask_frames = 0, threshold = -1;
+    bool motion = false;
+    double motion_v = 0, motion_w = 0;
 };
 
 void usage(FILE *out)
@@ -78,8 +81,12 @@ void usage(FILE *out)
         "usage: sl-view CAPTURE|OXFORD_DIR --board NAME --out FILE.png|FILE.mp4|FILE.avi\n"
         "               [--rotation K | --all] [--truth GT.csv] [--calib CALIB.ini]\n"
         "               [--roi-m M] [--mask-frames N] [--threshold T] [--vmax V] [--fps F]\n"
-        "               [--bin-size-m M] [--elongation D.ini] [--title TEXT] [-q|--quiet]\n"
-        "  --all: progress on stderr when it is a terminal (-q/--quiet: none).\n",
+        "               [--bin-size-m M] [--elongation D.ini] [--title TEXT] [--motion V[,W]]\n"
+        "               [-q|--quiet]\n"
+        "  --all: progress on stderr when it is a terminal (-q/--quiet: none).\n"
+        "  --motion V[,W]: run the core pipeline with this constant motion (m/s, deg/s; as\n"
+        "  shadowleand --motion) and draw the fitted 3D tilt of each pole in the top view:\n"
+        "  base, an arrow to the top of a 4 m pole, tilt and direction (CCW from forward).\n",
         out);
 }
 
@@ -110,6 +117,7 @@ struct RotationView {
     std::vector<std::vector<uint32_t>> occ; ///< stable-occupied rows (empty: no history)
     std::vector<sl_target_t> targets;
     std::vector<TruthMark> truth;
+    std::vector<slv::TiltMark> tilt; ///< fitted poles (--motion)
 };
 
 struct Scene {
@@ -338,6 +346,8 @@ cv::Mat render(const Scene &sc, const RotationView &rv)
         const double az_deg = yaw + 360.0 * (t.az + 0.5) / A;
         labels.put(img, lab, ca.px_ra(0.5 * (r1 + r2), az_deg), sl::col::kDetect, 0.55);
     }
+    slv::draw_tilt_marks(img, rv.tilt, sc.board.radar_x_m, sc.board.radar_y_m,
+                         [&](double x, double y) { return ca.px_xy(x, y); });
     for (const auto &t : rv.truth) {
         const double az_deg = yaw + 360.0 * (t.az + 0.5) / A;
         const std::string lab = "truth " + t.name + " " +
@@ -359,6 +369,9 @@ cv::Mat render(const Scene &sc, const RotationView &rv)
     items.push_back({sl::col::kDetect, "detection (core), alpha", 3});
     if (!rv.truth.empty() || !sc.truth_note.empty()) {
         items.push_back({sl::col::kTruth, "ground truth (sl-sim), alpha", 4});
+    }
+    if (!rv.tilt.empty()) {
+        items.push_back({cv::Scalar(0, 140, 255), "fitted 3D tilt (base, lean of a 4 m pole)", 1});
     }
     sl::draw_legend(img, items, cv::Point(ca.rect.x + ca.rect.width - 330, ca.rect.y + 6), 326);
     // --- numbers
@@ -412,7 +425,7 @@ int main(int argc, char **argv)
     if (info != SL_CLI_CONTINUE) {
         return info;
     }
-    static const char *const with_value[] = {"--board", "--out", "--truth", "--calib",
+    static const char *const with_value[] = {"--board", "--out", "--truth", "--calib", "--motion",
                                              "--elongation", "--title", "--rotation", "--roi-m",
                                              "--vmax", "--fps", "--bin-size-m", "--mask-frames",
                                              "--threshold"};
@@ -458,6 +471,19 @@ int main(int argc, char **argv)
             a.mask_frames = static_cast<int>(v);
         } else if (o == "--threshold" && numv(v) && v >= 0 && v <= 255) {
             a.threshold = static_cast<int>(v);
+        } else if (o == "--motion" && has) {
+            const char *s = argv[++i];
+            char *end = nullptr;
+            a.motion_v = std::strtod(s, &end);
+            if (end != s && *end == ',') {
+                const char *s2 = end + 1;
+                a.motion_w = std::strtod(s2, &end);
+                if (end == s2) end = const_cast<char *>(s);
+            }
+            if (end == s || *end != '\0' || !std::isfinite(a.motion_v) || !std::isfinite(a.motion_w)) {
+                return sl_cli_bad_value("sl-view", "--motion", "must be V or V,W (m/s, deg/s)", usage);
+            }
+            a.motion = true;
         } else if ((o[0] != '-' || o == "-") && a.input.empty()) {
             a.input = o;
         } else {
@@ -607,6 +633,18 @@ int main(int argc, char **argv)
         return 1;
 #endif
     }
+    // --motion: the whole core pipeline with that motion, for the fitted 3D tilt.
+    std::vector<std::vector<slv::TiltMark>> tilt_by_rot;
+    if (a.motion) {
+        if (sc.core_board == nullptr) {
+            std::fprintf(stderr, "sl-view: --motion needs a board linked into the core\n");
+            return 1;
+        }
+        if (!slv::tilt_marks(a.input, sc.core_board, a.motion_v, a.motion_w, tilt_by_rot, err)) {
+            std::fprintf(stderr, "sl-view: --motion: %s\n", err.c_str());
+            return 1;
+        }
+    }
     // Core mask + detection over all rotations in order.
     auto mask = std::make_unique<sl_mask_t>();
     // The mask spans the board's region of interest (the detector's rows); captures with
@@ -680,6 +718,9 @@ int main(int argc, char **argv)
         }
         if (static_cast<int>(fr.rotation) < static_cast<int>(truth_by_rot.size())) {
             rv.truth = truth_by_rot[fr.rotation];
+        }
+        if (k < static_cast<int>(tilt_by_rot.size())) {
+            rv.tilt = tilt_by_rot[static_cast<size_t>(k)];
         }
         cv::Mat img = render(sc, rv);
         progress.update(static_cast<long long>(next), static_cast<long long>(todo.size()),

@@ -65,6 +65,7 @@ typedef struct sl_board {
     uint32_t can_id_status;
     uint32_t can_id_vehicle_motion;
     uint32_t can_id_health;        ///< Health message (required board key can.id_health)
+    uint32_t can_id_pole_tilt;     ///< PoleTilt message (required board key can.id_pole_tilt)
     // --- generated per-azimuth tables, `azimuths` entries each
     const sl_incline_geom_t *geom; ///< trig + branch bounds per azimuth
     const int16_t *theta_cdeg;     ///< opening angle theta per azimuth, 0.01 deg

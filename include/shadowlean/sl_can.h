@@ -132,6 +132,32 @@
 ///   in any 100 ms at most (SL_CAN_BURST_WINDOWS + 1) x 48 frames, whatever the input.
 /// - bit8 TARGET_SLOTS_OVERFLOW: detection had more candidates than target slots.
 ///
+/// ## PoleTilt (board `can.id_pole_tilt`, SHADOWLEAN -> VEHICLE, one frame per tracked pole while driving)
+///
+/// The 3D tilt of a confirmed track fitted over the drive-by (sl_tilt.h, sl_tiltobs.h): sent
+/// once per rotation for every confirmed track matched on the rotation that has an
+/// observation history, i.e. only while a motion input is present (never when parked
+/// without VehicleMotion / --motion).
+///
+/// | start | len | signal         | type | factor | range (physical) | unit | note |
+/// |------:|----:|----------------|------|--------|------------------|------|------|
+/// |  0 | 8  | Crc            | u | 1    | 0..255          |     | E2E, Data ID 0x56 |
+/// |  8 | 4  | Counter        | u | 1    | 0..14           |     | E2E |
+/// | 12 | 3  | Quality        | u | 1    | 0..4            |     | sl_can_tilt_quality_t |
+/// | 15 | 1  | Clamped        | u | 1    | 0..1            |     | 1 = a value below hit its range limit |
+/// | 16 | 4  | TargetId       | u | 1    | 0..15           |     | tracker id (as PoleLean) |
+/// | 20 | 8  | Tilt           | u | 0.1  | 0..25.5         | deg | psi, tilt from vertical |
+/// | 28 | 9  | TiltDirection  | u | 1    | 0..359          | deg | direction the top leans towards, CCW from vehicle forward |
+/// | 37 | 5  | TiltSigma      | u | 0.2  | 0..6.2          | deg | 1-sigma of Tilt |
+/// | 42 | 6  | DirectionSigma | u | 1    | 0..63           | deg | 1-sigma of TiltDirection |
+/// | 48 | 8  | BaseX          | s | 0.05 | -6.4..6.35      | m   | pole base, vehicle frame at the frame's time, x forward |
+/// | 56 | 8  | BaseY          | s | 0.05 | -6.4..6.35      | m   | ... y left |
+///
+/// Quality: FITTED (0) and AMBIGUOUS (1: the mirror hypothesis fits as well; the better one
+/// is sent, do not trust the direction) carry numbers; INSUFFICIENT_MOTION (2), TOO_FEW (3)
+/// and INCONSISTENT (4) send every value as 0. The fit runs per rotation on at most
+/// SL_CFG_TILT_FITS_PER_ROTATION tracks; a frame carries the track's latest fit.
+///
 /// ## VehicleMotion (board `can.id_vehicle_motion`, VEHICLE -> SHADOWLEAN, input)
 ///
 /// | start | len | signal       | type | factor | range            | unit  | note |
@@ -208,14 +234,16 @@ typedef enum sl_can_msg {
     SL_CAN_MSG_STATUS = 2,
     SL_CAN_MSG_VEHICLE_MOTION = 3,
     SL_CAN_MSG_HEALTH = 4,
-    SL_CAN_MSG_COUNT = 5,
+    SL_CAN_MSG_POLE_TILT = 5,
+    SL_CAN_MSG_COUNT = 6,
 } sl_can_msg_t;
 
 #define SL_CAN_DATA_ID_POLE_LEAN 0x51U      ///< E2E Data ID (first CRC byte)
 #define SL_CAN_DATA_ID_LEAN_WARNING 0x52U
 #define SL_CAN_DATA_ID_STATUS 0x53U
 #define SL_CAN_DATA_ID_VEHICLE_MOTION 0x54U
-#define SL_CAN_DATA_ID_HEALTH 0x55U ///< every message has its own Data ID
+#define SL_CAN_DATA_ID_HEALTH 0x55U
+#define SL_CAN_DATA_ID_POLE_TILT 0x56U ///< every message has its own Data ID
 
 #define SL_CAN_COUNTER_MODULO 15U ///< counters run 0..14; 15 is invalid on the wire
 
@@ -228,6 +256,7 @@ typedef enum sl_can_msg {
 #define SL_CAN_CYCLE_MS_STATUS 250U
 #define SL_CAN_CYCLE_MS_VEHICLE_MOTION 20U
 #define SL_CAN_CYCLE_MS_HEALTH 250U
+#define SL_CAN_CYCLE_MS_POLE_TILT 250U
 #define SL_CAN_IDLE_CYCLE_MS_STATUS 1000U
 
 /// How a message is sent: the DBC attribute GenMsgSendType, whose value table is Vector's
@@ -252,6 +281,16 @@ typedef enum sl_can_quality {
                                      ///< over rotations (valid)
 } sl_can_quality_t;
 #define SL_CAN_QUALITY_MAX 4U
+
+/// PoleTilt.Quality (the values of sl_tilt_quality_t, sl_tilt.h).
+typedef enum sl_can_tilt_quality {
+    SL_CAN_TILT_FITTED = 0,
+    SL_CAN_TILT_AMBIGUOUS = 1,
+    SL_CAN_TILT_INSUFFICIENT_MOTION = 2,
+    SL_CAN_TILT_TOO_FEW = 3,
+    SL_CAN_TILT_INCONSISTENT = 4,
+} sl_can_tilt_quality_t;
+#define SL_CAN_TILT_QUALITY_MAX 4U
 
 /// LeanWarning.Level.
 typedef enum sl_can_level {
@@ -318,6 +357,19 @@ typedef enum sl_can_link_state {
 #define SL_CAN_WARN_SIGMA_CDEG_PER_LSB 10    ///< 0.1 deg
 #define SL_CAN_WARN_SIGMA_RAW_MAX 63
 
+#define SL_CAN_TILT_CDEG_PER_LSB 10          ///< 0.1 deg
+#define SL_CAN_TILT_RAW_MAX 255
+#define SL_CAN_TILT_DIR_CDEG_PER_LSB 100     ///< 1 deg
+#define SL_CAN_TILT_DIR_RAW_MAX 359
+#define SL_CAN_TILT_SIGMA_CDEG_PER_LSB 20    ///< 0.2 deg
+#define SL_CAN_TILT_SIGMA_RAW_MAX 31
+#define SL_CAN_TILT_DIR_SIGMA_CDEG_PER_LSB 100 ///< 1 deg
+#define SL_CAN_TILT_DIR_SIGMA_RAW_MAX 63
+#define SL_CAN_TILT_BASE_MM_PER_LSB 50       ///< 0.05 m (layout/DBC factor 50/1000)
+#define SL_CAN_TILT_BASE_UM_PER_LSB 50000L   ///< 0.05 m: the encoder's step for um inputs
+#define SL_CAN_TILT_BASE_RAW_MIN (-128)
+#define SL_CAN_TILT_BASE_RAW_MAX 127
+
 #define SL_CAN_STATUS_ROTATIONS_MAX 262143UL ///< 18 bits
 #define SL_CAN_STATUS_AZ_MISSING_MAX 16383UL ///< 14 bits
 #define SL_CAN_STATUS_RESYNCS_MAX 255UL
@@ -363,6 +415,20 @@ typedef struct sl_can_lean_warning {
     bool clamped;             ///< decode only
     uint8_t counter;          ///< decode only
 } sl_can_lean_warning_t;
+
+/// The 3D tilt of one tracked pole (PoleTilt).
+typedef struct sl_can_pole_tilt {
+    uint8_t target_id;          ///< in: 0..15
+    uint8_t quality;            ///< in: sl_can_tilt_quality_t (0..4)
+    int32_t tilt_cdeg;          ///< in: psi, >= 0
+    int32_t direction_cdeg;     ///< in: CCW from vehicle forward; reduced mod 36000
+    uint32_t tilt_sigma_cdeg;   ///< in
+    uint32_t direction_sigma_cdeg; ///< in
+    int32_t base_x_um;          ///< in: vehicle frame, x forward (rounded once, to 0.05 m)
+    int32_t base_y_um;          ///< in: y left
+    bool clamped;               ///< decode only
+    uint8_t counter;            ///< decode only
+} sl_can_pole_tilt_t;
 
 /// Module health (Status). Counters are totals since start; the encoder saturates them.
 typedef struct sl_can_status {
@@ -440,7 +506,7 @@ typedef struct sl_can_ids {
     uint32_t id[SL_CAN_MSG_COUNT]; ///< indexed by sl_can_msg_t
 } sl_can_ids_t;
 
-/// The five ids of a board (`can_id_*` fields). O(1).
+/// The six ids of a board (`can_id_*` fields). O(1).
 void sl_can_ids_from_board(sl_can_ids_t *ids, const struct sl_board *board);
 
 /// Sender state: ids and one E2E counter per message type. Fields read-only.
@@ -469,6 +535,13 @@ sl_err_t sl_can_encode_pole_lean(sl_can_tx_t *tx, const sl_can_pole_lean_t *in,
 sl_err_t sl_can_encode_lean_warning(sl_can_tx_t *tx, const sl_can_lean_warning_t *in,
                                     sl_can_frame_t *out);
 
+/// Encode one PoleTilt frame (same rules as PoleLean: clamped values set Clamped; quality
+/// > 4 is sent as INCONSISTENT with Clamped set; a quality other than FITTED/AMBIGUOUS sends
+/// every value field as 0). The direction is an angle: reduced mod 360 deg, then rounded
+/// (359.6 deg is sent as 0).
+sl_err_t sl_can_encode_pole_tilt(sl_can_tx_t *tx, const sl_can_pole_tilt_t *in,
+                                 sl_can_frame_t *out);
+
 /// Encode one Status frame. Counters saturate at their field maximum (Saturated bit);
 /// link_state > 4 is sent as DISCONNECTED with Saturated set.
 sl_err_t sl_can_encode_status(sl_can_tx_t *tx, const sl_can_status_t *in, sl_can_frame_t *out);
@@ -495,6 +568,7 @@ sl_err_t sl_can_decode_lean_warning(const sl_can_frame_t *f, sl_can_lean_warning
 sl_err_t sl_can_decode_status(const sl_can_frame_t *f, sl_can_status_t *out);
 sl_err_t sl_can_decode_vehicle_motion(const sl_can_frame_t *f, sl_can_vehicle_motion_t *out);
 sl_err_t sl_can_decode_health(const sl_can_frame_t *f, sl_can_health_t *out);
+sl_err_t sl_can_decode_pole_tilt(const sl_can_frame_t *f, sl_can_pole_tilt_t *out);
 
 /// VehicleMotion receiver for the motion-aware masks: id match, E2E check (CRC errors and
 /// counter jumps counted in `e2e.stats`), latest accepted value with its time.

@@ -65,4 +65,29 @@
 #define SL_CFG_MAX_ELONG_POINTS 16
 #endif
 
+/// 3D tilt while driving (sl_tiltobs.h): tracks with an observation history, and the
+/// observations each keeps (<= SL_TILT_MAX_OBS, 32). The firmware configuration (masked bins
+/// <= 192) keeps 4 x 16 (2,472 B); the host 8 x 32 (7,368 B).
+#ifndef SL_CFG_TILT_TRACKS
+#if SL_CFG_MASK_BINS <= 192
+#define SL_CFG_TILT_TRACKS 4
+#else
+#define SL_CFG_TILT_TRACKS 8
+#endif
+#endif
+#ifndef SL_CFG_TILT_OBS_PER_TRACK
+#if SL_CFG_MASK_BINS <= 192
+#define SL_CFG_TILT_OBS_PER_TRACK 16
+#else
+#define SL_CFG_TILT_OBS_PER_TRACK 32
+#endif
+#endif
+#if SL_CFG_TILT_TRACKS < 1 || SL_CFG_TILT_TRACKS > 32 || SL_CFG_TILT_OBS_PER_TRACK < 5
+#error "SL_CFG_TILT_TRACKS must be in [1, 32] and SL_CFG_TILT_OBS_PER_TRACK >= 5"
+#endif
+/// Fits per rotation at most (the rest wait for their turn, round robin).
+#ifndef SL_CFG_TILT_FITS_PER_ROTATION
+#define SL_CFG_TILT_FITS_PER_ROTATION 2
+#endif
+
 #endif // SHADOWLEAN_SL_CONFIG_H

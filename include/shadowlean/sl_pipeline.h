@@ -33,7 +33,9 @@
 ///    tracks (filtered alpha, sigma, warning level: `sl_track_t`, live slots only matter).
 /// 2. `port.can_tx(ctx, f)` (optional) for: one PoleLean per *confirmed* track (live,
 ///    matched this rotation, `hits >= cfg.confirm_hits` and `confirmed` by the tracker's
-///    static-object evidence, sl_track.h), in slot order; one LeanWarning
+///    static-object evidence, sl_track.h), in slot order, each followed by its PoleTilt
+///    when the track has an observation history with a fit (only while a motion input is
+///    present: see "3D tilt while driving"); one LeanWarning
 ///    (the most severe confirmed track: highest level, then largest |filtered alpha|;
 ///    HasTarget = 0 when there is none); one Status (link state, rotations, missing
 ///    azimuths, decoder resyncs, CAN drops; LinkState STREAMING only while usable rows
@@ -59,6 +61,26 @@
 /// of more than 1 % from the board's (the expected value) raises RANGE_RESOLUTION_MISMATCH.
 /// Ranges: the track's last corrected r1 / r2, passed
 /// in um and rounded once, by the encoder, to the signal's step (0.02 m / 0.01 m).
+///
+/// ## 3D tilt while driving (sl_tiltobs.h, sl_tilt.h)
+/// After the tracker's update, every rotation WITH a motion input advances the fixed-point
+/// odometry by the measured rotation period and adds one observation (radar pose at the
+/// target's azimuth, bearing, r1, alpha, sigma, branch) to the ring of every confirmed
+/// track matched with a VALID alpha; at most SL_CFG_TILT_FITS_PER_ROTATION rings are fitted
+/// per rotation (round robin). A rotation without motion input clears every ring (the
+/// odometry has a hole), so without motion nothing changes on CAN.
+/// PoleTilt: the ring's latest fit in the vehicle frame at the rotation's end (sl_can.h).
+/// LeanWarning and the fitted tilt: for a confirmed track whose fit is FITTED (not
+/// AMBIGUOUS), the warning uses the tilt TOWARDS THE VEHICLE'S PATH instead of the in-plane
+/// alpha: lean = atan(-sign(base_y) t_y) with t the tilt vector and base_y the base's
+/// lateral offset in the vehicle frame (> 0: the top leans over the path, the sign
+/// convention of Lean), its sigma the fit's tilt sigma, its level the board's thresholds
+/// applied to it directly (DANGER at lean >= danger, CAUTION at |lean| (or lean, per
+/// cfg.track.caution_abs) >= caution; no hysteresis: the fit is already an average over the
+/// pass), Quality FILTERED. This is what resolves the fold: a pole leaning away beyond
+/// (theta - beta) / 2 reads as leaning towards on every single rotation, its fit does not.
+/// Other tracks use the tracker's level, filtered alpha and sigma as before. The most
+/// severe track is chosen on these values.
 ///
 /// ## Motion (the paper assumed a static vehicle; see `sl_pipeline_window()`)
 /// The consistency mask needs the same (azimuth, bin) cell occupied in the last n rotations.
@@ -103,13 +125,14 @@
 /// ## RAM budget (sizeof(sl_pipeline_t)); asserted below for the firmware configuration
 /// Dominated by the mask: SL_CFG_MAX_AZIMUTHS x (1 + ceil(log2 SL_CFG_MASK_FRAMES_MAX)) x
 /// SL_CFG_MASK_BINS / 8 bytes; then detection (8,424 B), the tracker (1,864 B), the scan
-/// bookkeeping (624 B), the range profiles (sl_profile.h, 2.1 KB), the reassembly buffer
+/// bookkeeping (624 B), the range profiles (sl_profile.h, 2.1 KB), the 3D tilt history
+/// (sl_tiltobs.h: 2,472 B firmware, 7.4 KB host default), the reassembly buffer
 /// (SL_PIPELINE_REASM_BYTES) and a row buffer.
 ///
 /// | configuration (400 azimuths, 32 targets)              | x86-64    | Cortex-M0 |
 /// |--------------------------------------------------------|-----------|-----------|
-/// | firmware: SL_CFG_MASK_BINS 160, SL_CFG_MASK_FRAMES_MAX 16 | 55,776 B  | 55,640 B  |
-/// | host default: mask bins 512 (whole ROI), n <= 32          | 170,520 B |           |
+/// | firmware: SL_CFG_MASK_BINS 160, SL_CFG_MASK_FRAMES_MAX 16 | 58,256 B  | 58,112 B  |
+/// | host default: mask bins 512 (whole ROI), n <= 32          | 177,896 B |           |
 ///
 /// The boards carried today need 135 (paper-sim), 119 (paper-bench) and 141 (robotcar-leaf)
 /// masked bins (sl_detect_bins_needed(), rounded up to 160).
@@ -166,6 +189,7 @@
 #include "shadowlean/sl_proto.h"
 #include "shadowlean/sl_scan.h"
 #include "shadowlean/sl_thresh.h"
+#include "shadowlean/sl_tiltobs.h"
 #include "shadowlean/sl_track.h"
 
 #ifdef __cplusplus
@@ -322,6 +346,7 @@ typedef struct sl_pipeline {
     sl_detect_t detect;
     sl_profile_t prof;           ///< range profiles of the azimuths showing something
     sl_tracker_t tracker;
+    sl_tiltobs_t tilt;           ///< per-track observation history + 3D tilt fits (sl_tiltobs.h)
     sl_can_tx_t can;
     sl_pipeline_stats_t stats;
     sl_board_t det_board;        ///< the board as detection uses it: bin size from the radar's
@@ -364,13 +389,17 @@ _Static_assert(sizeof(sl_pipeline_t) <= 65536U, "sl_pipeline_t: 64 KiB RAM budge
 #endif
 #endif
 /// Any azimuth count, bins and n with the default target/candidate capacities: the mask
-/// dominates; everything else stays under 16 KiB.
+/// dominates; everything else except the tilt history (sl_tiltobs_t, sized by
+/// SL_CFG_TILT_TRACKS x SL_CFG_TILT_OBS_PER_TRACK: 2.5 KB firmware, 7.4 KB host) stays under
+/// 16 KiB.
 #if SL_CFG_MAX_TARGETS <= 32 && SL_CFG_DETECT_MAX_CANDIDATES <= 32 && SL_CFG_DETECT_MAX_SPAN <= 24 \
     && SL_CFG_MAX_AZIMUTHS <= 400
 #if defined(__cplusplus)
-static_assert(sizeof(sl_pipeline_t) <= sizeof(sl_mask_t) + 16384U, "sl_pipeline_t budget");
+static_assert(sizeof(sl_pipeline_t) <= sizeof(sl_mask_t) + sizeof(sl_tiltobs_t) + 16384U,
+              "sl_pipeline_t budget");
 #else
-_Static_assert(sizeof(sl_pipeline_t) <= sizeof(sl_mask_t) + 16384U, "sl_pipeline_t budget");
+_Static_assert(sizeof(sl_pipeline_t) <= sizeof(sl_mask_t) + sizeof(sl_tiltobs_t) + 16384U,
+               "sl_pipeline_t budget");
 #endif
 #endif
 

@@ -15,6 +15,7 @@
 #define ID_STATUS 0x622U
 #define ID_MOTION 0x300U
 #define ID_HEALTH 0x623U
+#define ID_TILT 0x624U
 
 static uint64_t rng_state = 0x9E3779B97F4A7C15ull;
 static uint32_t rnd32(void)
@@ -33,7 +34,7 @@ static int64_t rnd_range(int64_t lo, int64_t hi)
 
 static void tx_setup(sl_can_tx_t *tx)
 {
-    sl_can_ids_t ids = {{ID_POLE, ID_WARN, ID_STATUS, ID_MOTION, ID_HEALTH}};
+    sl_can_ids_t ids = {{ID_POLE, ID_WARN, ID_STATUS, ID_MOTION, ID_HEALTH, ID_TILT}};
     assert_int_equal(sl_can_tx_init(tx, &ids), SL_OK);
 }
 
@@ -129,6 +130,109 @@ static void test_canmsg_pole_lean_golden_bytes(void **state)
     }
     want[0] = sl_can_e2e_crc(SL_CAN_DATA_ID_POLE_LEAN, want);
     assert_memory_equal(f.data, want, 8);
+}
+
+// PoleTilt: the layout fixed for the whole project (sl_can.h), a worked frame, round trips
+// of random values against an independent rounding, clamping, and the non-fitted qualities.
+static void test_canmsg_pole_tilt_layout_encode_decode(void **state)
+{
+    (void)state;
+    const sl_can_message_desc_t *md = sl_can_layout(SL_CAN_MSG_POLE_TILT);
+    assert_non_null(md);
+    assert_string_equal(md->name, "PoleTilt");
+    assert_int_equal(md->data_id, 0x56);
+    static const struct {
+        const char *name;
+        unsigned start, len;
+        bool sgn;
+    } want[] = {{"Crc", 0, 8, false},         {"Counter", 8, 4, false},
+                {"Quality", 12, 3, false},    {"Clamped", 15, 1, false},
+                {"TargetId", 16, 4, false},   {"Tilt", 20, 8, false},
+                {"TiltDirection", 28, 9, false}, {"TiltSigma", 37, 5, false},
+                {"DirectionSigma", 42, 6, false}, {"BaseX", 48, 8, true},
+                {"BaseY", 56, 8, true}};
+    assert_int_equal(md->n_signals, sizeof want / sizeof want[0]);
+    for (unsigned i = 0; i < md->n_signals; i++) {
+        assert_string_equal(md->signals[i].name, want[i].name);
+        assert_int_equal(md->signals[i].start, want[i].start);
+        assert_int_equal(md->signals[i].length, want[i].len);
+        assert_int_equal(md->signals[i].is_signed, want[i].sgn);
+    }
+    sl_can_tx_t tx;
+    tx_setup(&tx);
+    sl_can_frame_t f;
+    // Worked frame: target 5, tilt 12.34 deg, direction 271.6 deg, sigmas 0.5 / 7 deg,
+    // base (1.23, -2.51) m.
+    sl_can_pole_tilt_t in = {.target_id = 5, .quality = SL_CAN_TILT_FITTED, .tilt_cdeg = 1234,
+                             .direction_cdeg = 27160, .tilt_sigma_cdeg = 50,
+                             .direction_sigma_cdeg = 700, .base_x_um = 1230000,
+                             .base_y_um = -2510000};
+    assert_int_equal(sl_can_encode_pole_tilt(&tx, &in, &f), SL_OK);
+    assert_int_equal(f.id, ID_TILT);
+    assert_int_equal(f.dlc, 8);
+    sl_can_pole_tilt_t out;
+    assert_int_equal(sl_can_decode_pole_tilt(&f, &out), SL_OK);
+    assert_int_equal(out.quality, SL_CAN_TILT_FITTED);
+    assert_int_equal(out.target_id, 5);
+    assert_int_equal(out.tilt_cdeg, 1230);      // 123 x 0.1
+    assert_int_equal(out.direction_cdeg, 27200); // 272 deg
+    assert_int_equal(out.tilt_sigma_cdeg, 60);  // 50 / 20 = 2.5 -> 3 x 0.2 (halves up)
+    assert_int_equal(out.direction_sigma_cdeg, 700);
+    assert_int_equal(out.base_x_um, 1250000);   // 24.6 -> 25 x 0.05
+    assert_int_equal(out.base_y_um, -2500000);  // -50.2 -> -50
+    assert_false(out.clamped);
+    assert_int_equal(f.data[0], sl_can_e2e_crc(SL_CAN_DATA_ID_POLE_TILT, f.data));
+    // Random round trips against the reference rounding.
+    for (int k = 0; k < 20000; k++) {
+        in.target_id = (uint8_t)rnd_range(0, 15);
+        in.quality = (uint8_t)rnd_range(0, 1);
+        in.tilt_cdeg = (int32_t)rnd_range(0, 3000);
+        in.direction_cdeg = (int32_t)rnd_range(-72000, 72000);
+        in.tilt_sigma_cdeg = (uint32_t)rnd_range(0, 800);
+        in.direction_sigma_cdeg = (uint32_t)rnd_range(0, 8000);
+        in.base_x_um = (int32_t)rnd_range(-8000000, 8000000);
+        in.base_y_um = (int32_t)rnd_range(-8000000, 8000000);
+        assert_int_equal(sl_can_encode_pole_tilt(&tx, &in, &f), SL_OK);
+        assert_int_equal(sl_can_decode_pole_tilt(&f, &out), SL_OK);
+        bool cl = false;
+        const int64_t tilt = ref_round(in.tilt_cdeg, 10);
+        const int64_t sig = ref_round(in.tilt_sigma_cdeg, 20);
+        const int64_t dsig = ref_round(in.direction_sigma_cdeg, 100);
+        const int64_t bx = ref_round(in.base_x_um, 50000);
+        const int64_t by = ref_round(in.base_y_um, 50000);
+        cl = tilt > 255 || sig > 31 || dsig > 63 || bx > 127 || bx < -128 || by > 127 || by < -128;
+        int64_t dir = ((int64_t)in.direction_cdeg % 36000 + 36000) % 36000;
+        dir = ref_round(dir, 100) % 360;
+        assert_int_equal(out.tilt_cdeg, clamp64(tilt, 0, 255) * 10);
+        assert_int_equal(out.tilt_sigma_cdeg, clamp64(sig, 0, 31) * 20);
+        assert_int_equal(out.direction_sigma_cdeg, clamp64(dsig, 0, 63) * 100);
+        assert_int_equal(out.base_x_um, clamp64(bx, -128, 127) * 50000);
+        assert_int_equal(out.base_y_um, clamp64(by, -128, 127) * 50000);
+        assert_int_equal(out.direction_cdeg, dir * 100);
+        assert_int_equal(out.clamped, cl);
+        assert_int_equal(out.target_id, in.target_id);
+        assert_int_equal(out.quality, in.quality);
+    }
+    // Qualities without numbers send zeros; an unknown quality is INCONSISTENT + Clamped.
+    for (uint8_t q = 2; q <= 5; q++) {
+        in.quality = q;
+        in.tilt_cdeg = 1000;
+        in.base_x_um = 9000000; // would clamp if it were sent
+        assert_int_equal(sl_can_encode_pole_tilt(&tx, &in, &f), SL_OK);
+        assert_int_equal(sl_can_decode_pole_tilt(&f, &out), SL_OK);
+        assert_int_equal(out.quality, q > 4 ? SL_CAN_TILT_INCONSISTENT : q);
+        assert_int_equal(out.tilt_cdeg, 0);
+        assert_int_equal(out.base_x_um, 0);
+        assert_int_equal(out.direction_cdeg, 0);
+        assert_int_equal(out.clamped, q > 4);
+    }
+    // Another message's frame fails the CRC (Data ID 0x56 is PoleTilt's own).
+    in.quality = 0;
+    assert_int_equal(sl_can_encode_pole_tilt(&tx, &in, &f), SL_OK);
+    sl_can_pole_lean_t pl;
+    assert_int_equal(sl_can_decode_pole_lean(&f, &pl), SL_ERR_MALFORMED);
+    assert_int_equal(sl_can_encode_pole_tilt(NULL, &in, &f), SL_ERR_ARG);
+    assert_int_equal(sl_can_decode_pole_tilt(NULL, &out), SL_ERR_ARG);
 }
 
 static void test_canmsg_layout_table_is_consistent(void **state)
@@ -672,7 +776,7 @@ static void test_canmsg_tx_init_validates_ids(void **state)
     assert_int_equal(sl_can_tx_init(&tx, &dup), SL_ERR_ARG);
     sl_can_ids_t eff_bad = {{0x80000000UL | 0x20000000UL, 1U, 2U, 3U}};
     assert_int_equal(sl_can_tx_init(&tx, &eff_bad), SL_ERR_ARG);
-    sl_can_ids_t eff = {{0x80000000UL | 0x18FF1234UL, 0x7FFU, 0U, 0x123U, 0x124U}};
+    sl_can_ids_t eff = {{0x80000000UL | 0x18FF1234UL, 0x7FFU, 0U, 0x123U, 0x124U, 0x125U}};
     assert_int_equal(sl_can_tx_init(&tx, &eff), SL_OK);
     assert_int_equal(sl_can_tx_init(NULL, &eff), SL_ERR_ARG);
     sl_can_frame_t f;
@@ -761,6 +865,7 @@ int main(void)
         cmocka_unit_test(test_canmsg_e2e_detects_every_single_bit_error),
         cmocka_unit_test(test_canmsg_e2e_counts_jumps_and_rejects_repeats),
         cmocka_unit_test(test_canmsg_tx_init_validates_ids),
+        cmocka_unit_test(test_canmsg_pole_tilt_layout_encode_decode),
         cmocka_unit_test(test_canmsg_motion_rx_checks_id_sequence_and_age),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

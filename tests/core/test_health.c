@@ -472,7 +472,7 @@ static void test_health_clean_stream_has_no_fault(void **state)
 static void test_health_frame_round_trip(void **state)
 {
     (void)state;
-    sl_can_ids_t ids = {{0x620U, 0x621U, 0x622U, 0x300U, 0x623U}};
+    sl_can_ids_t ids = {{0x620U, 0x621U, 0x622U, 0x300U, 0x623U, 0x624U}};
     sl_can_tx_t tx;
     assert_int_equal(sl_can_tx_init(&tx, &ids), SL_OK);
     const sl_can_health_t in = {.fault = 0xFFFFU, .reconnects = 1000U, .candidates_dropped = 5000U};

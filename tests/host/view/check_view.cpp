@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
 // check_view.cpp: checks on sl-view's output (tests/host/view).
 //
-//   check_view png FILE [--size W H] [--min COLOUR N]...   COLOUR: amber magenta red cyan green
+//   check_view png FILE [--size W H] [--min COLOUR N]...   COLOUR: amber magenta red cyan green orange
 //   check_view video FILE FRAMES                           (FILE.mp4, or FILE.avi fallback)
 //
 // A colour is counted with a small tolerance on pixels of exactly the tool's overlay colours
@@ -48,7 +48,8 @@ int main(int argc, char **argv)
         const std::map<std::string, cv::Scalar> colours = {
             {"amber", sl::col::kBoardShadow}, {"magenta", sl::col::kCalibShadow},
             {"red", sl::col::kDetect},        {"cyan", sl::col::kTruth},
-            {"blue", sl::col::kNearField}};
+            {"blue", sl::col::kNearField},
+            {"orange", cv::Scalar(0, 140, 255)}}; // fitted 3D tilt (host_tools/view/view_tilt_draw.inl)
         for (int i = 3; i < argc; i++) {
             if (!std::strcmp(argv[i], "--size") && i + 2 < argc) {
                 const int w = std::atoi(argv[i + 1]), h = std::atoi(argv[i + 2]);

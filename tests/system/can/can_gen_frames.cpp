@@ -56,6 +56,7 @@ int main(int argc, char **argv)
         ids.id[SL_CAN_MSG_STATUS] = b.can_id_status;
         ids.id[SL_CAN_MSG_VEHICLE_MOTION] = b.can_id_vehicle_motion;
         ids.id[SL_CAN_MSG_HEALTH] = b.can_id_health;
+        ids.id[SL_CAN_MSG_POLE_TILT] = b.can_id_pole_tilt;
         sl_can_tx_t tx;
         if (sl_can_tx_init(&tx, &ids) != SL_OK) {
             std::cerr << "can_gen_frames: bad ids\n";
@@ -67,7 +68,7 @@ int main(int argc, char **argv)
         uint64_t t_us = 1700000000000000ULL;
         for (long i = 0; i < n; i++) {
             sl_can_frame_t f;
-            const int64_t kind = uni(0, 10);
+            const int64_t kind = uni(0, 11);
             if (kind < 6) {
                 sl_can_pole_lean_t p{};
                 p.target_id = static_cast<uint8_t>(value(0, 15, 0, 255));
@@ -116,6 +117,22 @@ int main(int argc, char **argv)
                 sl_can_encode_health(&tx, &h, &f);
                 ex << "Health fault=" << unsigned(h.fault) << " reconnects=" << h.reconnects
                    << " candidates_dropped=" << h.candidates_dropped << "\n";
+            } else if (kind == 11) {
+                sl_can_pole_tilt_t t{};
+                t.target_id = static_cast<uint8_t>(value(0, 15, 0, 255));
+                t.quality = static_cast<uint8_t>(chance(70) ? uni(0, 1) : value(2, 4, 0, 255));
+                t.tilt_cdeg = static_cast<int32_t>(value(0, 2550, 0, 100000));
+                t.direction_cdeg = static_cast<int32_t>(value(0, 35999, -1000000, 1000000));
+                t.tilt_sigma_cdeg = static_cast<uint32_t>(value(0, 620, 0, 100000));
+                t.direction_sigma_cdeg = static_cast<uint32_t>(value(0, 6300, 0, 100000));
+                t.base_x_um = static_cast<int32_t>(value(-6400000, 6350000, -100000000, 100000000));
+                t.base_y_um = static_cast<int32_t>(value(-6400000, 6350000, -100000000, 100000000));
+                sl_can_encode_pole_tilt(&tx, &t, &f);
+                ex << "PoleTilt target_id=" << unsigned(t.target_id) << " quality=" << unsigned(t.quality)
+                   << " tilt_cdeg=" << t.tilt_cdeg << " direction_cdeg=" << t.direction_cdeg
+                   << " tilt_sigma_cdeg=" << t.tilt_sigma_cdeg
+                   << " direction_sigma_cdeg=" << t.direction_sigma_cdeg << " base_x_um=" << t.base_x_um
+                   << " base_y_um=" << t.base_y_um << "\n";
             } else {
                 sl_can_vehicle_motion_t m{};
                 m.speed_mm_s = static_cast<int32_t>(value(-60000, 60000, -1000000, 1000000));

@@ -72,6 +72,16 @@ MAP = {
         "Reconnects": ("reconnects", 1, "num"),
         "CandidatesDropped": ("candidates_dropped", 1, "num"),
     },
+    "PoleTilt": {
+        "TargetId": ("target_id", 1, "id"),
+        "Quality": ("quality", 1, "tquality"),
+        "Tilt": ("tilt_cdeg", 100, "num"),
+        "TiltDirection": ("direction_cdeg", 100, "angle"),
+        "TiltSigma": ("tilt_sigma_cdeg", 100, "num"),
+        "DirectionSigma": ("direction_sigma_cdeg", 100, "num"),
+        "BaseX": ("base_x_um", 1000000, "num"),
+        "BaseY": ("base_y_um", 1000000, "num"),
+    },
     "VehicleMotion": {
         "Speed": ("speed_mm_s", 1000, "num"),
         "YawRate": ("yaw_rate_cdeg_s", 100, "num"),
@@ -79,7 +89,9 @@ MAP = {
         "YawRateValid": ("yaw_rate_valid", 1, "flag"),
     },
 }
-FLAG = {"PoleLean": "Clamped", "LeanWarning": "Clamped", "Status": "Saturated"}
+FLAG = {"PoleLean": "Clamped", "LeanWarning": "Clamped", "Status": "Saturated", "PoleTilt": "Clamped"}
+# PoleTilt: qualities other than FITTED (0) / AMBIGUOUS (1) carry no numbers (sent as 0).
+TILT_VALUE_FIELDS = {"Tilt", "TiltDirection", "TiltSigma", "DirectionSigma", "BaseX", "BaseY"}
 TARGET_FIELDS = {"TargetId", "Quality", "Azimuth", "Lean", "Range", "LeanSigma"}
 
 
@@ -92,11 +104,11 @@ def expected_raw(sig, kind, value):
         return int(value), False
     if kind == "fault":
         return int(value) & 0x1FF, False  # bits 9..15 reserved: never sent
-    if kind in ("id", "quality", "level", "link"):
+    if kind in ("id", "quality", "level", "link", "tquality"):
         v = int(value)
         if v <= rmax:
             return v, False
-        return {"id": rmax, "quality": 3, "level": 2, "link": 0}[kind], True
+        return {"id": rmax, "quality": 3, "level": 2, "link": 0, "tquality": 4}[kind], True
     if kind == "angle":
         a = value - 360 * (value / 360).to_integral_value(rounding=decimal.ROUND_FLOOR)
         turn = int(D(360) / f)
@@ -149,6 +161,11 @@ def main():
         for sname, (key, scale, kind) in MAP[name].items():
             sig = fr.signal_by_name(sname)
             f = dec(sig.factor)
+            if name == "PoleTilt" and sname in TILT_VALUE_FIELDS and int(inputs["quality"]) not in (0, 1):
+                want_raw, cl, value = 0, False, D(0)
+                if d.raw[sname] != 0:
+                    errors.append(f"{where}: {sname} raw {d.raw[sname]}, want 0 (quality {inputs['quality']})")
+                continue
             if not has_target and sname in TARGET_FIELDS:
                 # no target: every target field 0, Quality INVALID (3) so that nobody
                 # gating on VALID/FILTERED reads a lean

@@ -21,9 +21,9 @@ with contextlib.redirect_stderr(io.StringIO()):
     import canmatrix.formats as cf
 
 SEND_TYPE = {"PoleLean": "CyclicIfActive", "LeanWarning": "Cyclic", "Status": "Cyclic",
-             "Health": "Cyclic", "VehicleMotion": "Cyclic"}
+             "Health": "Cyclic", "VehicleMotion": "Cyclic", "PoleTilt": "CyclicIfActive"}
 CYCLE = {"PoleLean": (250, None), "LeanWarning": (250, None), "Status": (250, 1000),
-         "Health": (250, 1000), "VehicleMotion": (20, None)}
+         "Health": (250, 1000), "VehicleMotion": (20, None), "PoleTilt": (250, None)}
 
 
 def load(path):

@@ -222,6 +222,7 @@ int main(int argc, char **argv)
     ids.id[SL_CAN_MSG_STATUS] = b.can_id_status;
     ids.id[SL_CAN_MSG_VEHICLE_MOTION] = b.can_id_vehicle_motion;
     ids.id[SL_CAN_MSG_HEALTH] = b.can_id_health;
+    ids.id[SL_CAN_MSG_POLE_TILT] = b.can_id_pole_tilt;
     CHECK(sl_can_tx_init(&gen.tx, &ids) == SL_OK);
 
     sl::CandumpWriter produced, sent_log;

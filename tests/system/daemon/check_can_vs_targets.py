@@ -28,6 +28,7 @@ documented in sl_pipeline.h. Checks:
 Prints a summary; exit 0 when everything matches.
 """
 import argparse
+import math
 import json
 import sys
 
@@ -141,13 +142,23 @@ def main(argv):
     missing = 0
     n_poles = 0
     max_poles = 0
+    last_tilt = {}
     for k, (g, r) in enumerate(zip(groups, rots)):
         w = f"rotation {r['rotation']}"
         missing += r["missing"]
         confirmed = [t for t in r["tracks"] if t["hits"] >= confirm and t.get("confirmed", 1)]
         want_pl = [t for t in confirmed if t["updated"]]
         poles = [d for d in g if d.name == "PoleLean"]
-        rest = [d.name for d in g if d.name != "PoleLean"]
+        # PoleTilt (only with a motion input): each right after its track's PoleLean.
+        tilts = {}
+        for i, d in enumerate(g):
+            if d.name == "PoleTilt":
+                if i == 0 or g[i - 1].name != "PoleLean" or g[i - 1].raw["TargetId"] != d.raw["TargetId"]:
+                    errors.append(f"{w}: PoleTilt of target {d.raw['TargetId']} not right after its PoleLean")
+                tilts[d.raw["TargetId"]] = d
+                last_tilt[d.raw["TargetId"]] = d
+        g = [d for d in g if d.name != "PoleTilt"]
+        rest = [d.name for d in g if d.name not in ("PoleLean", "PoleTilt")]
         if rest != ["LeanWarning", "Status", "Health"]:
             errors.append(f"{w}: frames {[d.name for d in g]}, want PoleLean* LeanWarning Status Health")
             continue
@@ -182,7 +193,24 @@ def main(argv):
                     (worst["valid_hits"] == 0 or abs(t["alpha_cdeg"]) > abs(worst["alpha_cdeg"]))):
                 worst = t
         lw = g[-3]
-        if worst is None:
+        # The latest fit of every confirmed track (a track not seen on this rotation keeps
+        # its fit and sends no PoleTilt; straight paths only: the frame's vehicle-frame
+        # values are then still current).
+        live_ids = {t["id"] % 16 for t in confirmed}
+        fitted = {tid: d for tid, d in last_tilt.items() if d.raw["Quality"] == 0 and tid in live_ids}
+        if fitted:
+            # A FITTED drive-by fit replaces the in-plane lean in LeanWarning (sl_pipeline.h):
+            # the tilt towards the vehicle's path, recomputed here from the PoleTilt frame.
+            if lw.raw["HasTarget"] != 1:
+                errors.append(f"{w}: LeanWarning without a target while tracks are fitted")
+            d = fitted.get(lw.raw["TargetId"])
+            if d is not None:
+                ty = math.tan(math.radians(d.phys["Tilt"])) * math.sin(math.radians(d.phys["TiltDirection"]))
+                lean = math.degrees(math.atan(-ty if d.phys["BaseY"] >= 0 else ty))
+                if abs(lw.phys["Lean"] - lean) > 0.6 or lw.raw["Quality"] != 4:
+                    errors.append(f"{w}: LeanWarning Lean {lw.phys['Lean']} quality {lw.raw['Quality']}, "
+                                  f"want the fitted tilt towards the path {lean:.2f} FILTERED")
+        elif worst is None:
             if lw.raw["HasTarget"] != 0 or lw.raw["Level"] != 0:
                 errors.append(f"{w}: LeanWarning HasTarget {lw.raw['HasTarget']} Level {lw.raw['Level']}, want 0 0")
         else:

@@ -1,0 +1,259 @@
+// SPDX-License-Identifier: MIT
+/// @file tiltobs.c
+/// @brief Per-track observation rings, odometry and the per-rotation tilt fits (sl_tiltobs.h).
+#include "shadowlean/sl_tiltobs.h"
+
+#include <string.h>
+
+#include "shadowlean/sl_fx.h"
+#include "shadowlean/sl_incline.h"
+
+#define P2_32 ((int64_t)4294967296LL) // 2^32
+
+// cdeg -> bam32 (two's complement for negative angles), rounded to nearest.
+static sl_bam32_t cdeg_to_bam(int32_t cdeg)
+{
+    const int64_t num = (int64_t)cdeg * P2_32;
+    const int64_t q = (num >= 0) ? (num + 18000) / 36000 : -((-num + 18000) / 36000);
+    return (sl_bam32_t)(uint32_t)(uint64_t)q;
+}
+
+static int32_t sat32(int64_t v)
+{
+    return sl_fx_sat32(v);
+}
+
+sl_err_t sl_tiltobs_init(sl_tiltobs_t *o, const sl_board_t *board)
+{
+    if (o == NULL || board == NULL) {
+        return SL_ERR_ARG;
+    }
+    memset(o, 0, sizeof *o);
+    o->board = board;
+    o->prm.radar_height_um = board->radar_height_um;
+    sl_q30_t s;
+    sl_q30_t c;
+    sl_tilt_sincos_q30(cdeg_to_bam(board->beta_up_cdeg), &s, &c);
+    o->prm.cos_beta_q30 = c;
+    o->prm.sin_beta_q30 = s;
+    return SL_OK;
+}
+
+static void free_ring(sl_tiltobs_t *o, sl_tiltobs_ring_t *r)
+{
+    if (r->fresh != 0U && o->pending > 0U) {
+        o->pending--;
+    }
+    memset(r, 0, sizeof *r);
+}
+
+static void clear_rings(sl_tiltobs_t *o)
+{
+    bool any = false;
+    for (uint32_t i = 0; i < (uint32_t)SL_CFG_TILT_TRACKS; i++) {
+        if (o->ring[i].track_id != 0U) {
+            any = true;
+            free_ring(o, &o->ring[i]);
+        }
+    }
+    if (any) {
+        o->stats.resets++;
+    }
+}
+
+void sl_tiltobs_advance(sl_tiltobs_t *o, bool motion_valid, int32_t speed_mm_s,
+                        int32_t yaw_rate_cdeg_s, uint32_t rotation_us)
+{
+    SL_ASSERT(o != NULL);
+    if (!motion_valid) {
+        clear_rings(o);
+        o->moving = false;
+        o->odom_prev = o->odom;
+        return;
+    }
+    o->odom_prev = o->odom;
+    const int64_t w = (int64_t)yaw_rate_cdeg_s * 10; // mdeg/s
+    sl_tilt_odom_step(&o->odom, speed_mm_s, sat32(w), rotation_us);
+    o->moving = true;
+}
+
+// The ring of `id`, or NULL.
+static sl_tiltobs_ring_t *ring_of(sl_tiltobs_t *o, uint16_t id)
+{
+    for (uint32_t i = 0; i < (uint32_t)SL_CFG_TILT_TRACKS; i++) {
+        if (o->ring[i].track_id == id) {
+            return &o->ring[i];
+        }
+    }
+    return NULL;
+}
+
+const sl_tiltobs_ring_t *sl_tiltobs_find(const sl_tiltobs_t *o, uint16_t id)
+{
+    SL_ASSERT(o != NULL);
+    if (id == 0U) {
+        return NULL;
+    }
+    for (uint32_t i = 0; i < (uint32_t)SL_CFG_TILT_TRACKS; i++) {
+        if (o->ring[i].track_id == id) {
+            return &o->ring[i];
+        }
+    }
+    return NULL;
+}
+
+// The target the tracker associated with `t` on this rotation (the tracker copies its
+// azimuth and corrected bounds), or NULL.
+static const sl_target_t *target_of(const sl_track_t *t, const sl_target_t *targets, uint32_t n)
+{
+    for (uint32_t j = 0; j < n; j++) {
+        const sl_target_t *g = &targets[j];
+        if (g->az == t->az && g->r1_um == t->r1_um && g->r2_um == t->r2_um) {
+            return g;
+        }
+    }
+    return NULL;
+}
+
+// One observation of target `g` into ring `r`.
+static void observe(sl_tiltobs_t *o, sl_tiltobs_ring_t *r, const sl_target_t *g)
+{
+    const sl_board_t *b = o->board;
+    const uint32_t naz = b->azimuths;
+    // Vehicle pose at the target's azimuth: linear between the rotation's start and end.
+    const int64_t f_num = (int64_t)g->az;
+    const int64_t vx = o->odom_prev.x_um + (o->odom.x_um - o->odom_prev.x_um) * f_num / (int64_t)naz;
+    const int64_t vy = o->odom_prev.y_um + (o->odom.y_um - o->odom_prev.y_um) * f_num / (int64_t)naz;
+    const int64_t dyaw = (int64_t)(int32_t)(o->odom.yaw - o->odom_prev.yaw);
+    const sl_bam32_t yaw = o->odom_prev.yaw + (sl_bam32_t)(uint32_t)(uint64_t)(dyaw * f_num / (int64_t)naz);
+    sl_q30_t s;
+    sl_q30_t c;
+    sl_tilt_sincos_q30(yaw, &s, &c);
+    const int64_t rx = vx + sl_fx_rshift_round64((int64_t)b->radar_x_um * c - (int64_t)b->radar_y_um * s, 30U);
+    const int64_t ry = vy + sl_fx_rshift_round64((int64_t)b->radar_x_um * s + (int64_t)b->radar_y_um * c, 30U);
+    // Bearing: clockwise from vehicle forward on the board, counter-clockwise in odometry.
+    const sl_bam32_t cw = (sl_bam32_t)(((uint64_t)g->az << 32) / naz) + cdeg_to_bam(b->radar_yaw_cdeg);
+    const sl_bam32_t bearing = yaw - cw;
+    const sl_bam32_t alpha = cdeg_to_bam(g->alpha_cdeg);
+    sl_tilt_obs_t ob;
+    if (!sl_tilt_obs_make(&ob, sat32(rx - r->anchor_x_um), sat32(ry - r->anchor_y_um), bearing,
+                          g->r1_um, alpha, g->sigma_cdeg, g->incline_branch, &b->geom[g->az])) {
+        o->stats.rejected++;
+        return;
+    }
+    r->obs[r->head] = ob;
+    r->head = (uint8_t)((r->head + 1U) % (uint32_t)SL_CFG_TILT_OBS_PER_TRACK);
+    if (r->count < (uint8_t)SL_CFG_TILT_OBS_PER_TRACK) {
+        r->count++;
+    }
+    if (r->fresh == 0U) {
+        r->fresh = 1U;
+        o->pending++;
+    }
+    o->stats.observations++;
+}
+
+void sl_tiltobs_update(sl_tiltobs_t *o, const sl_track_t *tracks, const sl_target_t *targets,
+                       uint32_t n_targets)
+{
+    SL_ASSERT(o != NULL && tracks != NULL && (targets != NULL || n_targets == 0U));
+    // Rings of tracks that are gone.
+    for (uint32_t i = 0; i < (uint32_t)SL_CFG_TILT_TRACKS; i++) {
+        sl_tiltobs_ring_t *r = &o->ring[i];
+        if (r->track_id != 0U && (r->slot >= (uint32_t)SL_CFG_MAX_TARGETS ||
+                                  tracks[r->slot].live == 0U || tracks[r->slot].id != r->track_id)) {
+            free_ring(o, r);
+        }
+    }
+    if (!o->moving || o->board->geom == NULL) {
+        return;
+    }
+    for (uint32_t i = 0; i < (uint32_t)SL_CFG_MAX_TARGETS; i++) {
+        const sl_track_t *t = &tracks[i];
+        if (t->live == 0U || t->updated == 0U || t->confirmed == 0U) {
+            continue;
+        }
+        const sl_target_t *g = target_of(t, targets, n_targets);
+        if (g == NULL || g->incline_flag != (uint8_t)SL_INCLINE_VALID ||
+            g->az >= o->board->azimuths) {
+            o->stats.no_target++;
+            continue;
+        }
+        sl_tiltobs_ring_t *r = ring_of(o, t->id);
+        if (r == NULL) {
+            r = ring_of(o, 0U);
+            if (r == NULL) {
+                o->stats.no_ring++;
+                continue;
+            }
+            r->track_id = t->id;
+            r->slot = (uint8_t)i;
+            r->anchor_x_um = o->odom.x_um;
+            r->anchor_y_um = o->odom.y_um;
+        }
+        observe(o, r, g);
+    }
+}
+
+void sl_tiltobs_fit_pending(sl_tiltobs_t *o)
+{
+    SL_ASSERT(o != NULL);
+    if (o->pending == 0U) {
+        return;
+    }
+    // Fits: rings with a new observation, round robin, bounded per call.
+    uint32_t done = 0;
+    for (uint32_t k = 0; k < (uint32_t)SL_CFG_TILT_TRACKS && done < (uint32_t)SL_CFG_TILT_FITS_PER_ROTATION; k++) {
+        const uint32_t idx = ((uint32_t)o->rr + k) % (uint32_t)SL_CFG_TILT_TRACKS;
+        sl_tiltobs_ring_t *r = &o->ring[idx];
+        if (r->track_id == 0U || r->fresh == 0U) {
+            continue;
+        }
+        (void)sl_tilt_fit(r->obs, r->count, &o->prm, &o->work, &r->res);
+        r->fresh = 0U;
+        o->pending--;
+        r->fitted = 1U;
+        o->stats.fits++;
+        done++;
+        o->rr = (uint8_t)((idx + 1U) % (uint32_t)SL_CFG_TILT_TRACKS);
+    }
+}
+
+bool sl_tiltobs_vehicle(const sl_tiltobs_t *o, const sl_tiltobs_ring_t *r,
+                        sl_tiltobs_vehicle_t *out)
+{
+    SL_ASSERT(o != NULL && out != NULL);
+    memset(out, 0, sizeof *out);
+    if (r == NULL || r->fitted == 0U) {
+        return false;
+    }
+    const sl_tilt_result_t *res = &r->res;
+    out->quality = res->quality;
+    if (res->quality != (uint8_t)SL_TILT_FITTED && res->quality != (uint8_t)SL_TILT_AMBIGUOUS) {
+        return true;
+    }
+    sl_q30_t s;
+    sl_q30_t c;
+    sl_tilt_sincos_q30(o->odom.yaw, &s, &c);
+    const int32_t yaw_cdeg = sl_incline_bam32_to_cdeg(o->odom.yaw); // signed
+    int32_t phi = (res->phi_cdeg - yaw_cdeg) % 36000;
+    if (phi < 0) {
+        phi += 36000;
+    }
+    out->psi_cdeg = res->psi_cdeg;
+    out->phi_cdeg = phi;
+    out->psi_sigma_cdeg = res->psi_sigma_cdeg;
+    out->phi_sigma_cdeg = res->phi_sigma_cdeg;
+    const int64_t dx = r->anchor_x_um + res->base_x_um - o->odom.x_um;
+    const int64_t dy = r->anchor_y_um + res->base_y_um - o->odom.y_um;
+    const int64_t bx = sl_fx_rshift_round64(dx * c + dy * s, 30U);
+    const int64_t by = sl_fx_rshift_round64(dy * c - dx * s, 30U);
+    out->base_x_um = sat32(bx);
+    out->base_y_um = sat32(by);
+    // Tilt vector's y component in the vehicle frame (Q24), towards the path = -sign(y_b).
+    const int64_t ty_v = sl_fx_rshift_round64((int64_t)res->ty_q24 * c - (int64_t)res->tx_q24 * s, 30U);
+    const int64_t towards = (by >= 0) ? -ty_v : ty_v;
+    const sl_bam32_t lean = sl_incline_atan2_bam32(sat32(towards), (int32_t)0x1000000);
+    out->lean_path_cdeg = sl_incline_bam32_to_cdeg(lean);
+    return true;
+}

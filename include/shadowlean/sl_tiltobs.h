@@ -1,0 +1,146 @@
+// SPDX-License-Identifier: MIT
+/// @file sl_tiltobs.h
+/// @brief Per-track observation history for the 3D tilt fit (sl_tilt.h) while driving.
+///
+/// The pipeline owns one `sl_tiltobs_t`. Once per rotation, after the tracker's update:
+///
+/// 1. `sl_tiltobs_advance()`: the vehicle pose is integrated in fixed point
+///    (`sl_tilt_odom_step`, midpoint rule) over the rotation's period from the motion input
+///    of the rotation (speed, yaw rate). A rotation WITHOUT a valid motion input breaks the
+///    odometry: every history is cleared (observations on either side of the gap would be
+///    placed in inconsistent frames), and nothing is recorded until motion returns.
+/// 2. `sl_tiltobs_update()`: for every live, confirmed track matched on this rotation whose
+///    target has a VALID inclination, one observation (`sl_tilt_obs_t`, 24 bytes) is pushed
+///    into the track's ring: the radar's position and the pole's bearing in the odometry
+///    frame AT THE TARGET'S AZIMUTH (the pose interpolated linearly between the rotation's
+///    start and end by az / azimuths: at 3 m/s a rotation is 0.75 m), r1, alpha, its sigma,
+///    its branch (for the fold). Positions are stored relative to the ring's anchor (the
+///    vehicle position when the ring was opened) so int32 micrometres suffice. A ring
+///    belongs to a track id; a ring whose track is gone (or whose slot now holds another
+///    id) is freed. The ring keeps the newest SL_CFG_TILT_OBS_PER_TRACK observations.
+///    Tracks beyond SL_CFG_TILT_TRACKS rings get none (counted in `stats.no_ring`).
+/// 3. `sl_tiltobs_fit_pending()`: the fit (`sl_tilt_fit`) runs on rings that received an
+///    observation since their last fit, at most SL_CFG_TILT_FITS_PER_ROTATION per call
+///    (round robin over the rings; the others keep their previous result until their turn):
+///    never per azimuth. The pipeline calls it when control returns from the decoder (end
+///    of sl_pipeline_feed / _on_msg / _finish), not from inside the rotation callback: the
+///    fit's stack (~800 B on Cortex-M0) then does not add to the decoder's call chain. So a
+///    rotation's PoleTilt carries the fit of the observations up to the previous rotation.
+///
+/// Outputs per ring: `res` (the last fit, odometry frame relative to the anchor) and, via
+/// `sl_tiltobs_vehicle()`, the tilt in the vehicle frame at the current pose (what the
+/// PoleTilt CAN message carries: direction CCW from forward, base x forward / y left of the
+/// vehicle origin) and the lean towards the vehicle's path (what LeanWarning uses).
+///
+/// Units: um, bam32 (2^32 per turn), cdeg (0.01 deg). No allocation, no float; every array
+/// is inside the struct. RAM: SL_CFG_TILT_TRACKS x (SL_CFG_TILT_OBS_PER_TRACK x 24 + 72)
+/// + 648 bytes (x86-64: firmware configuration 4 x 16: 2,472 B; host default 8 x 32: 7,368 B).
+/// Cost per rotation: O(tracks x targets) for the matching (only for updated confirmed
+/// tracks) + O(1) per observation (three table sine/cosine, two 64-bit divisions) + at most
+/// SL_CFG_TILT_FITS_PER_ROTATION fits (sl_tilt.h: O(n + m^2)). Not reentrant per instance.
+#ifndef SHADOWLEAN_SL_TILTOBS_H
+#define SHADOWLEAN_SL_TILTOBS_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "shadowlean/sl_board.h"
+#include "shadowlean/sl_config.h"
+#include "shadowlean/sl_detect.h"
+#include "shadowlean/sl_tilt.h"
+#include "shadowlean/sl_track.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#if SL_CFG_TILT_OBS_PER_TRACK > SL_TILT_MAX_OBS
+#error "SL_CFG_TILT_OBS_PER_TRACK must be <= SL_TILT_MAX_OBS"
+#endif
+
+/// One track's history. Fields read-only to the application.
+typedef struct sl_tiltobs_ring {
+    int64_t anchor_x_um;    ///< odometry position the stored positions are relative to
+    int64_t anchor_y_um;
+    sl_tilt_result_t res;   ///< last fit (valid when `fitted`), anchor-relative
+    uint16_t track_id;      ///< owning track's id; 0 = free ring
+    uint8_t slot;           ///< owning track's tracker slot
+    uint8_t count;          ///< observations held (<= SL_CFG_TILT_OBS_PER_TRACK)
+    uint8_t head;           ///< next slot written
+    uint8_t fresh;          ///< an observation was added since the last fit
+    uint8_t fitted;         ///< `res` holds a fit of this ring's observations
+    uint8_t reserved;
+    sl_tilt_obs_t obs[SL_CFG_TILT_OBS_PER_TRACK];
+} sl_tiltobs_ring_t;
+
+/// Counters (cumulative; never asserted).
+typedef struct sl_tiltobs_stats {
+    uint32_t observations;  ///< observations stored
+    uint32_t rejected;      ///< VALID targets sl_tilt_obs_make refused (|alpha| >= 80 deg ...)
+    uint32_t no_target;     ///< updated confirmed tracks whose target was not found / not VALID
+    uint32_t no_ring;       ///< observations lost: every ring in use
+    uint32_t fits;          ///< sl_tilt_fit calls
+    uint32_t resets;        ///< histories cleared because the motion input was missing
+} sl_tiltobs_stats_t;
+
+/// The history of every tracked pole plus the odometry. Caller-owned.
+typedef struct sl_tiltobs {
+    const sl_board_t *board;   ///< borrowed (radar mounting, geometry tables)
+    sl_tilt_params_t prm;      ///< fit parameters from the board
+    sl_tilt_odom_t odom;       ///< vehicle origin pose at the end of the last rotation
+    sl_tilt_odom_t odom_prev;  ///< ... at its start
+    bool moving;               ///< the last rotation had a motion input (poses usable)
+    uint8_t rr;                ///< internal: round-robin start of the fits
+    uint8_t pending;           ///< rings with an observation not fitted yet
+    sl_tiltobs_stats_t stats;
+    sl_tilt_work_t work;       ///< fit scratch
+    sl_tiltobs_ring_t ring[SL_CFG_TILT_TRACKS];
+} sl_tiltobs_t;
+
+/// A ring's result in the vehicle frame at the current pose.
+typedef struct sl_tiltobs_vehicle {
+    uint8_t quality;          ///< sl_tilt_quality_t
+    int32_t psi_cdeg;         ///< tilt from vertical, 0..9000
+    int32_t phi_cdeg;         ///< direction the top leans towards, CCW from forward, 0..35999
+    uint16_t psi_sigma_cdeg;
+    uint16_t phi_sigma_cdeg;
+    int32_t base_x_um;        ///< pole base, x forward of the vehicle origin
+    int32_t base_y_um;        ///< y left (saturated to int32)
+    int32_t lean_path_cdeg;   ///< tilt towards the vehicle's path: atan of the tilt
+                              ///< vector's component along -sign(base_y) y (> 0: the top
+                              ///< leans over the path; the sign convention of PoleLean)
+} sl_tiltobs_vehicle_t;
+
+/// Initialise for `board` (borrowed): no history, pose at the origin, heading 0.
+/// @return SL_OK, SL_ERR_ARG (NULL). O(sizeof).
+sl_err_t sl_tiltobs_init(sl_tiltobs_t *o, const sl_board_t *board);
+
+/// One rotation of ego motion (see the file comment, 1.). `motion_valid` false clears every
+/// history (counted in stats.resets when something was held). O(rings).
+void sl_tiltobs_advance(sl_tiltobs_t *o, bool motion_valid, int32_t speed_mm_s,
+                        int32_t yaw_rate_cdeg_s, uint32_t rotation_us);
+
+/// Record this rotation's observations (file comment, 2.). `tracks`: the
+/// tracker's SL_CFG_MAX_TARGETS slots after sl_track_update(); `targets`: the rotation's
+/// targets (the ones the tracker was given). Does nothing while not moving. O(see top).
+void sl_tiltobs_update(sl_tiltobs_t *o, const sl_track_t *tracks, const sl_target_t *targets,
+                       uint32_t n_targets);
+
+/// Fit the rings with new observations (file comment, 3.). O(1) when none is pending;
+/// else at most SL_CFG_TILT_FITS_PER_ROTATION sl_tilt_fit() calls.
+void sl_tiltobs_fit_pending(sl_tiltobs_t *o);
+
+/// The ring of track `id`, or NULL. O(rings).
+const sl_tiltobs_ring_t *sl_tiltobs_find(const sl_tiltobs_t *o, uint16_t id);
+
+/// Result of `r` in the vehicle frame at the current pose. False (and `out` zeroed) when
+/// `r` has no fit yet. Quality other than FITTED/AMBIGUOUS: only `quality` is meaningful.
+/// O(1).
+bool sl_tiltobs_vehicle(const sl_tiltobs_t *o, const sl_tiltobs_ring_t *r,
+                        sl_tiltobs_vehicle_t *out);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif // SHADOWLEAN_SL_TILTOBS_H

@@ -1,0 +1,391 @@
+// SPDX-License-Identifier: MIT
+// Unit tests for sl_tiltobs.h: per-track observation rings, odometry, per-rotation fits and
+// the vehicle-frame result, on the paper-sim board.
+//
+// Drive-bys are generated here in double precision, independently of the module: the vehicle
+// starts at the odometry origin heading +x and moves at v with yaw rate w (4 rotations per
+// second); a pole P(z) = B + z t; on each rotation the pole is seen on the azimuth cell of
+// its bearing from the radar AT THE TIME that azimuth is swept (pose interpolated inside the
+// rotation, as a spinning radar sees it), with alpha = atan(-(t . e)) read as the estimator
+// would (folded to beta - theta - alpha beyond the fold) and r1 from the in-plane geometry.
+// The module receives these as tracker slots and targets, exactly as the pipeline hands them.
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "shadowlean/sl_board.h"
+#include "shadowlean/sl_tiltobs.h"
+
+static const double PI = 3.14159265358979323846;
+static double rad(double d) { return d * PI / 180.0; }
+static double deg(double r) { return r * 180.0 / PI; }
+static double wrap180(double d)
+{
+    while (d > 180.0) d -= 360.0;
+    while (d <= -180.0) d += 360.0;
+    return d;
+}
+
+static sl_tiltobs_t obs;
+
+// FNV-1a digest of every vehicle-frame result the sweeps check (fixed point only: the same
+// on every target). From x86-64; aarch64 and s390x must match (bit-identical arithmetic).
+// The host and firmware capacities keep different numbers of observations, so two values.
+#if SL_CFG_TILT_OBS_PER_TRACK == 32
+#define RESULTS_DIGEST 0xe14c3b811456fbc0ULL
+#else
+#define RESULTS_DIGEST_FW 0xa7e4e3bdfd5811ccULL
+#endif
+static uint64_t digest = 14695981039346656037ULL;
+static void digest_i32(int32_t v)
+{
+    for (int i = 0; i < 4; ++i) {
+        digest ^= (uint8_t)((uint32_t)v >> (8 * i));
+        digest *= 1099511628211ULL;
+    }
+}
+
+typedef struct pole {
+    double bx, by, psi, phi; // base (odometry frame, m), tilt, direction (deg, odometry frame)
+} pole_t;
+
+typedef struct drive {
+    double v, w;             // m/s, deg/s
+    double x, y, yaw;        // pose (rad), start of the current rotation
+} drive_t;
+
+static const sl_board_t *board(void)
+{
+    const sl_board_t *b = sl_board_find("paper-sim");
+    assert_non_null(b);
+    return b;
+}
+
+// Pose at time s (seconds) after the rotation start (midpoint rule over the exact arc).
+static void pose_at(const drive_t *d, double s, double *x, double *y, double *yaw)
+{
+    const double ym = d->yaw + rad(d->w) * s / 2;
+    *x = d->x + d->v * s * cos(ym);
+    *y = d->y + d->v * s * sin(ym);
+    *yaw = d->yaw + rad(d->w) * s;
+}
+
+// The target pole `p` makes on this rotation; false when it is not in the shadow ring.
+static bool see(const sl_board_t *b, const drive_t *d, const pole_t *p, sl_target_t *g)
+{
+    const double H = b->radar_height_um * 1e-6, T = 0.25;
+    const double tt = tan(rad(p->psi));
+    const double tx = tt * cos(rad(p->phi)), ty = tt * sin(rad(p->phi));
+    const double qx = p->bx + H * tx, qy = p->by + H * ty;
+    const int N = b->azimuths;
+    int az = 0;
+    double x = d->x, y = d->y, yaw = d->yaw, s = 0;
+    for (int it = 0; it < 3; ++it) { // the azimuth and the time it is swept agree
+        pose_at(d, s, &x, &y, &yaw);
+        const double rx = x + b->radar_x_um * 1e-6 * cos(yaw) - b->radar_y_um * 1e-6 * sin(yaw);
+        const double ry = y + b->radar_x_um * 1e-6 * sin(yaw) + b->radar_y_um * 1e-6 * cos(yaw);
+        const double cw = -(deg(atan2(qy - ry, qx - rx)) - deg(yaw)) - b->radar_yaw_cdeg / 100.0;
+        const double rel = fmod(cw + 720.0, 360.0);
+        az = (int)floor(rel / (360.0 / N) + 0.5) % N;
+        s = T * az / N;
+    }
+    pose_at(d, s, &x, &y, &yaw);
+    const double rx = x + b->radar_x_um * 1e-6 * cos(yaw) - b->radar_y_um * 1e-6 * sin(yaw);
+    const double ry = y + b->radar_x_um * 1e-6 * sin(yaw) + b->radar_y_um * 1e-6 * cos(yaw);
+    const double d0 = hypot(qx - rx, qy - ry);
+    const double theta = b->geom[az].theta_bam32 * 360.0 / 4294967296.0;
+    const double beta = (double)(int32_t)b->geom[az].beta_bam32 * 360.0 / 4294967296.0;
+    if (d0 < 1.3 || hypot(p->bx - rx, p->by - ry) > H / tan(rad(theta))) {
+        return false;
+    }
+    const double a_true = atan2(qy - ry, qx - rx);
+    const double alpha = deg(atan(-(tx * cos(a_true) + ty * sin(a_true))));
+    const double foot = d0 * cos(rad(alpha));
+    const double r1 = (alpha >= beta) ? foot / cos(rad(beta - alpha)) : foot;
+    const double fold = (beta - theta) / 2.0;
+    const double read = (alpha < fold) ? beta - theta - alpha : alpha;
+    memset(g, 0, sizeof *g);
+    g->az = (uint16_t)az;
+    g->r1_um = (uint32_t)llround(r1 * 1e6);
+    g->r2_um = g->r1_um + 500000U;
+    g->alpha_cdeg = (int32_t)llround(read * 100.0);
+    g->sigma_cdeg = 50U;
+    g->incline_flag = (uint8_t)SL_INCLINE_VALID;
+    g->incline_branch = (uint8_t)((read >= beta) ? SL_INCLINE_BRANCH_1 : SL_INCLINE_BRANCH_2);
+    return true;
+}
+
+// Runs a drive-by of `n` poles (one track each, ids 1..n) for `rotations`; returns the
+// rotations on which at least one pole was seen.
+static int drive_by(const pole_t *p, int n, double v, double w, int rotations, sl_track_t *tracks)
+{
+    const sl_board_t *b = board();
+    assert_int_equal(sl_tiltobs_init(&obs, b), SL_OK);
+    memset(tracks, 0, sizeof(sl_track_t) * SL_CFG_MAX_TARGETS);
+    drive_t d = {v, w, 0, 0, 0};
+    int seen = 0;
+    for (int k = 0; k < rotations; ++k) {
+        sl_tiltobs_advance(&obs, true, (int32_t)llround(v * 1000), (int32_t)llround(w * 100), 250000U);
+        sl_target_t g[8];
+        uint32_t ng = 0;
+        for (int i = 0; i < n; ++i) {
+            sl_track_t *t = &tracks[i];
+            t->updated = 0U;
+            if (see(b, &d, &p[i], &g[ng])) {
+                t->live = 1U;
+                t->confirmed = 1U;
+                t->updated = 1U;
+                t->id = (uint16_t)(i + 1);
+                t->az = g[ng].az;
+                t->r1_um = g[ng].r1_um;
+                t->r2_um = g[ng].r2_um;
+                ng++;
+            }
+        }
+        seen += ng > 0U ? 1 : 0;
+        sl_tiltobs_update(&obs, tracks, g, ng);
+        sl_tiltobs_fit_pending(&obs);
+        double x, y, yaw;
+        pose_at(&d, 0.25, &x, &y, &yaw);
+        d.x = x;
+        d.y = y;
+        d.yaw = yaw;
+    }
+    return seen;
+}
+
+// The vehicle-frame truth at the end of the drive.
+static void truth(const pole_t *p, double v, double w, int rotations, double *phi_v,
+                  double *bx_v, double *by_v)
+{
+    drive_t d = {v, w, 0, 0, 0};
+    for (int k = 0; k < rotations; ++k) {
+        double x, y, yaw;
+        pose_at(&d, 0.25, &x, &y, &yaw);
+        d.x = x;
+        d.y = y;
+        d.yaw = yaw;
+    }
+    *phi_v = wrap180(p->phi - deg(d.yaw));
+    const double dx = p->bx - d.x, dy = p->by - d.y;
+    *bx_v = dx * cos(d.yaw) + dy * sin(d.yaw);
+    *by_v = -dx * sin(d.yaw) + dy * cos(d.yaw);
+}
+
+static void check_pole(const pole_t *p, double v, double w, int rotations, uint16_t id,
+                       double psi_tol, double phi_tol)
+{
+    const sl_tiltobs_ring_t *r = sl_tiltobs_find(&obs, id);
+    assert_non_null(r);
+    sl_tiltobs_vehicle_t out;
+    assert_true(sl_tiltobs_vehicle(&obs, r, &out));
+    double phi_v, bx, by;
+    truth(p, v, w, rotations, &phi_v, &bx, &by);
+    digest_i32(out.psi_cdeg);
+    digest_i32(out.phi_cdeg);
+    digest_i32(out.base_x_um);
+    digest_i32(out.base_y_um);
+    digest_i32(out.lean_path_cdeg);
+    digest_i32(out.psi_sigma_cdeg);
+    digest_i32(out.phi_sigma_cdeg);
+    const double e_psi = out.psi_cdeg / 100.0 - p->psi;
+    const double e_phi = wrap180(out.phi_cdeg / 100.0 - phi_v);
+    const double e_b = hypot(out.base_x_um * 1e-6 - bx, out.base_y_um * 1e-6 - by);
+    // lean towards the path (y = 0 of the vehicle frame)
+    const double tyv = tan(rad(p->psi)) * sin(rad(phi_v));
+    const double lean = deg(atan(by >= 0 ? -tyv : tyv));
+    printf("pole (%.1f, %.1f) psi %.1f phi %.0f: n %u q %u psi %+.2f phi %+.1f base %.3f m "
+           "lean %.2f (truth %.2f)\n",
+           p->bx, p->by, p->psi, p->phi, r->count, out.quality, e_psi, e_phi, e_b,
+           out.lean_path_cdeg / 100.0, lean);
+    assert_int_equal(out.quality, SL_TILT_FITTED);
+    assert_true(fabs(e_psi) <= psi_tol);
+    assert_true(fabs(e_phi) <= phi_tol);
+    assert_true(e_b <= 0.15);
+    assert_true(fabs(out.lean_path_cdeg / 100.0 - lean) <= psi_tol + 0.5);
+}
+
+// ---------------------------------------------------------------------------------------
+
+static void test_straight_drive_bys_both_sides_all_directions(void **state)
+{
+    (void)state;
+    sl_track_t tracks[SL_CFG_MAX_TARGETS];
+    int checked = 0;
+    for (int side = -1; side <= 1; side += 2) {
+        for (double phi = 0; phi < 360; phi += 45) {
+            for (double v = 1.0; v <= 3.0; v += 2.0) {
+                const pole_t p = {v * 4.0, side * 3.0, 8.0, phi};
+                const int rot = 32; // 8 s: the pole is passed half way
+                drive_by(&p, 1, v, 0.0, rot, tracks);
+                check_pole(&p, v, 0.0, rot, 1, 1.0, 10.0);
+                checked++;
+            }
+        }
+    }
+    assert_int_equal(checked, 32);
+    assert_true(obs.stats.fits > 0U);
+}
+
+// Beyond the fold ((beta - theta) / 2 = -13 deg on paper-sim) every single rotation reads the
+// mirror image; the drive-by must still give the true direction.
+static void test_leaning_away_beyond_the_fold(void **state)
+{
+    (void)state;
+    sl_track_t tracks[SL_CFG_MAX_TARGETS];
+    for (int side = -1; side <= 1; side += 2) {
+        for (double psi = 16.0; psi <= 20.0; psi += 4.0) {
+            const pole_t p = {4.0, side * 3.0, psi, side > 0 ? 80.0 : 290.0}; // away from the path
+            drive_by(&p, 1, 1.0, 0.0, 32, tracks);
+            check_pole(&p, 1.0, 0.0, 32, 1, 1.0, 10.0);
+        }
+    }
+}
+
+static void test_curved_path_10_deg_per_second(void **state)
+{
+    (void)state;
+    sl_track_t tracks[SL_CFG_MAX_TARGETS];
+    const pole_t p[2] = {{3.0, 3.0, 10.0, 200.0}, {5.0, -2.5, 12.0, 60.0}};
+    drive_by(p, 2, 1.5, 10.0, 24, tracks);
+    check_pole(&p[0], 1.5, 10.0, 24, 1, 1.0, 10.0);
+    check_pole(&p[1], 1.5, 10.0, 24, 2, 1.0, 10.0);
+}
+
+// Runs after the three sweeps above (cmocka runs the tests in order).
+static void test_results_digest_is_target_independent(void **state)
+{
+    (void)state;
+    printf("results digest 0x%016llx\n", (unsigned long long)digest);
+#if SL_CFG_TILT_OBS_PER_TRACK == 32
+    assert_true(digest == RESULTS_DIGEST);
+#else
+    assert_true(digest == RESULTS_DIGEST_FW);
+#endif
+}
+
+static void test_fits_are_bounded_per_rotation(void **state)
+{
+    (void)state;
+    sl_track_t tracks[SL_CFG_MAX_TARGETS];
+    const pole_t p[3] = {{3.0, 3.0, 8.0, 0.0}, {3.5, -3.0, 8.0, 90.0}, {4.0, 2.5, 8.0, 180.0}};
+    drive_by(p, 3, 0.5, 0.0, 1, tracks);
+    const uint32_t obs1 = obs.stats.observations;
+    assert_int_equal(obs1, 3U);
+    assert_int_equal(obs.stats.fits, (uint32_t)(SL_CFG_TILT_FITS_PER_ROTATION < 3 ? SL_CFG_TILT_FITS_PER_ROTATION : 3));
+    // Over two more rotations every ring is fitted (round robin), never more than the bound.
+    sl_target_t g[3];
+    const uint32_t f0 = obs.stats.fits;
+    sl_tiltobs_update(&obs, tracks, g, 0U); // nothing new
+    sl_tiltobs_fit_pending(&obs);           // the ring left over is fitted
+    assert_int_equal(obs.pending, 0U);
+    assert_true(obs.stats.fits - f0 <= (uint32_t)SL_CFG_TILT_FITS_PER_ROTATION);
+    for (uint16_t id = 1; id <= 3; ++id) {
+        const sl_tiltobs_ring_t *r = sl_tiltobs_find(&obs, id);
+        assert_non_null(r);
+        assert_int_equal(r->fitted, 1U);
+        sl_tiltobs_vehicle_t out;
+        assert_true(sl_tiltobs_vehicle(&obs, r, &out));
+        assert_int_equal(out.quality, SL_TILT_TOO_FEW); // one observation each
+    }
+}
+
+static void test_lost_motion_and_lost_tracks_clear_history(void **state)
+{
+    (void)state;
+    sl_track_t tracks[SL_CFG_MAX_TARGETS];
+    const pole_t p = {3.0, 3.0, 8.0, 0.0};
+    drive_by(&p, 1, 1.0, 0.0, 12, tracks);
+    const sl_tiltobs_ring_t *r = sl_tiltobs_find(&obs, 1U);
+    assert_non_null(r);
+    assert_true(r->count >= 5U);
+    // A rotation without motion: the odometry has a hole, the history goes.
+    sl_tiltobs_advance(&obs, false, 0, 0, 250000U);
+    assert_null(sl_tiltobs_find(&obs, 1U));
+    assert_int_equal(obs.stats.resets, 1U);
+    assert_int_equal(obs.pending, 0U);
+    const uint32_t before = obs.stats.observations;
+    sl_tiltobs_update(&obs, tracks, NULL, 0U);
+    assert_int_equal(obs.stats.observations, before);
+    // Motion again: a new history; then the track dies and its ring is freed.
+    drive_by(&p, 1, 1.0, 0.0, 8, tracks);
+    assert_non_null(sl_tiltobs_find(&obs, 1U));
+    tracks[0].live = 0U;
+    sl_tiltobs_advance(&obs, true, 1000, 0, 250000U);
+    sl_tiltobs_update(&obs, tracks, NULL, 0U);
+    assert_null(sl_tiltobs_find(&obs, 1U));
+}
+
+static void test_more_tracks_than_rings_are_counted(void **state)
+{
+    (void)state;
+    sl_track_t tracks[SL_CFG_MAX_TARGETS];
+    pole_t p[SL_CFG_TILT_TRACKS + 2];
+    for (int i = 0; i < SL_CFG_TILT_TRACKS + 2; ++i) {
+        p[i].bx = 2.0 + 0.3 * i;
+        p[i].by = (i % 2) ? 3.0 : -3.0;
+        p[i].psi = 5.0;
+        p[i].phi = 0.0;
+    }
+    // drive_by handles up to 8 targets per rotation
+    const int n = SL_CFG_TILT_TRACKS + 2 <= 8 ? SL_CFG_TILT_TRACKS + 2 : 8;
+    drive_by(p, n, 0.5, 0.0, 2, tracks);
+    int rings = 0;
+    for (uint16_t id = 1; id <= (uint16_t)n; ++id) rings += sl_tiltobs_find(&obs, id) != NULL;
+    assert_int_equal(rings, n < SL_CFG_TILT_TRACKS ? n : SL_CFG_TILT_TRACKS);
+    if (n > SL_CFG_TILT_TRACKS) assert_true(obs.stats.no_ring > 0U);
+}
+
+static void test_degenerate_inputs(void **state)
+{
+    (void)state;
+    assert_int_equal(sl_tiltobs_init(NULL, board()), SL_ERR_ARG);
+    assert_int_equal(sl_tiltobs_init(&obs, NULL), SL_ERR_ARG);
+    assert_int_equal(sl_tiltobs_init(&obs, board()), SL_OK);
+    sl_tiltobs_vehicle_t out;
+    assert_false(sl_tiltobs_vehicle(&obs, NULL, &out));
+    assert_null(sl_tiltobs_find(&obs, 0U));
+    // Not moving: nothing recorded.
+    sl_track_t tracks[SL_CFG_MAX_TARGETS];
+    memset(tracks, 0, sizeof tracks);
+    sl_target_t g;
+    memset(&g, 0, sizeof g);
+    g.az = 100; g.r1_um = 3000000; g.r2_um = 3500000; g.incline_flag = SL_INCLINE_VALID;
+    tracks[0] = (sl_track_t){.live = 1, .updated = 1, .confirmed = 1, .id = 7, .az = 100,
+                             .r1_um = 3000000, .r2_um = 3500000};
+    sl_tiltobs_update(&obs, tracks, &g, 1U);
+    assert_int_equal(obs.stats.observations, 0U);
+    // Moving, but the target is not VALID: counted, nothing stored.
+    sl_tiltobs_advance(&obs, true, 1000, 0, 250000U);
+    g.incline_flag = SL_INCLINE_AMBIGUOUS;
+    sl_tiltobs_update(&obs, tracks, &g, 1U);
+    assert_int_equal(obs.stats.observations, 0U);
+    assert_int_equal(obs.stats.no_target, 1U);
+    sl_tiltobs_fit_pending(&obs); // nothing pending: no fit
+    assert_int_equal(obs.stats.fits, 0U);
+    // |alpha| >= 80 deg: refused by sl_tilt_obs_make, counted.
+    g.incline_flag = SL_INCLINE_VALID;
+    g.alpha_cdeg = 8500;
+    sl_tiltobs_update(&obs, tracks, &g, 1U);
+    assert_int_equal(obs.stats.rejected, 1U);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_straight_drive_bys_both_sides_all_directions),
+        cmocka_unit_test(test_leaning_away_beyond_the_fold),
+        cmocka_unit_test(test_curved_path_10_deg_per_second),
+        cmocka_unit_test(test_results_digest_is_target_independent),
+        cmocka_unit_test(test_fits_are_bounded_per_rotation),
+        cmocka_unit_test(test_lost_motion_and_lost_tracks_clear_history),
+        cmocka_unit_test(test_more_tracks_than_rings_are_counted),
+        cmocka_unit_test(test_degenerate_inputs),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

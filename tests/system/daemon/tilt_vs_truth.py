@@ -1,0 +1,128 @@
+#!/usr/bin/python3
+# SPDX-License-Identifier: MIT
+"""Decoded PoleTilt frames against the simulator's truth.
+
+    tilt_vs_truth.py BOARD.dbc CAN.log TRUTH.gt.csv [--psi-tol DEG] [--phi-tol DEG]
+                     [--base-tol M] [--min-psi DEG]
+
+Every PoleTilt frame must decode with the board's DBC (scripts/sl_can_decode.py, canmatrix)
+with a good E2E CRC. Rotation k of the capture is the CAN group whose Status says Rotations =
+k + 1. A frame is matched to the pole whose truth base (in the vehicle frame at the frame's
+rotation: the axis point at radar height (-along_m, offset_m) minus H tan(psi) (cos phi,
+sin phi), with the radar at the vehicle origin as on paper-sim) is nearest to (BaseX, BaseY),
+within --base-tol (default 0.5 m). For every pole of the truth file the LAST matched frame
+with Quality FITTED is compared: |Tilt - psi_deg| <= --psi-tol (default 1.0) and, for poles
+with psi_deg >= --min-psi (default 5), the circular |TiltDirection - phi_deg| <= --phi-tol
+(default 10). With --ambiguous-ok a pole without a FITTED frame may instead have AMBIGUOUS
+ones (the fit's honest answer when few observations do not separate the mirror hypotheses):
+the last is checked for Tilt only. Exit 0 when every pole passes.
+"""
+import csv
+import math
+import os
+import sys
+
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "..", "scripts"))
+import sl_can_decode as scd  # noqa: E402
+
+TQ = {0: "FITTED", 1: "AMBIGUOUS", 2: "INSUFFICIENT_MOTION", 3: "TOO_FEW", 4: "INCONSISTENT"}
+
+
+def main(argv):
+    opts = {"--psi-tol": 1.0, "--phi-tol": 10.0, "--base-tol": 0.5, "--min-psi": 5.0,
+            "--height": 2.58}
+    pos, i, args = [], 0, argv[1:]
+    amb_ok = "--ambiguous-ok" in args
+    args = [a for a in args if a != "--ambiguous-ok"]
+    while i < len(args):
+        if args[i] in opts:
+            opts[args[i]] = float(args[i + 1])
+            i += 2
+        else:
+            pos.append(args[i])
+            i += 1
+    if len(pos) != 3:
+        print(__doc__)
+        return 2
+    H = opts["--height"]
+    decoded = scd.decode_log(pos[0], pos[1])
+    # Rotation groups with their PoleTilt frames.
+    groups, tilts = [], []
+    n_tilt = 0
+    for _, d in decoded:
+        if d is None:
+            continue
+        if d.name == "PoleTilt":
+            n_tilt += 1
+            if not d.crc_ok or not d.reencode_ok:
+                print("FAIL: a PoleTilt frame does not pass the DBC's E2E CRC / re-encoding")
+                return 1
+            tilts.append(d)
+        elif d.name == "Status":
+            groups.append((d.raw["Rotations"] - 1, tilts))
+            tilts = []
+    if n_tilt == 0:
+        print("FAIL: no PoleTilt frame in the log")
+        return 1
+    with open(pos[2]) as fh:
+        rows = [r for r in csv.DictReader(fh) if r["nominal"] == "1"]
+    truth = {}  # pole -> {rotation: row}
+    for r in rows:
+        truth.setdefault(r["pole_name"], {})[int(r["rotation"])] = r
+
+    def base_of(r):
+        psi, phi = math.radians(float(r["psi_deg"])), math.radians(float(r["phi_deg"]))
+        return (-float(r["along_m"]) - H * math.tan(psi) * math.cos(phi),
+                float(r["offset_m"]) - H * math.tan(psi) * math.sin(phi))
+
+    # The truth of each pole at any rotation: the nearest rotation it has a row for.
+    def row_at(name, rot):
+        rs = truth[name]
+        k = min(rs, key=lambda q: abs(q - rot))
+        return rs[k], abs(k - rot)
+
+    last, last_amb = {}, {}
+    for rot, frames in groups:
+        for d in frames:
+            best = None
+            for name in truth:
+                r, gap = row_at(name, rot)
+                if gap > 0:
+                    continue  # the pole is not in the shadow on this rotation
+                bx, by = base_of(r)
+                e = math.hypot(d.phys["BaseX"] - bx, d.phys["BaseY"] - by)
+                if best is None or e < best[0]:
+                    best = (e, name, r)
+            if best is None or best[0] > opts["--base-tol"]:
+                continue
+            if d.raw["Quality"] == 0:
+                last[best[1]] = (rot, best[2], d, best[0])
+            elif d.raw["Quality"] == 1:
+                last_amb[best[1]] = (rot, best[2], d, best[0])
+    bad = 0
+    print(f"PoleTilt frames: {n_tilt}")
+    print(f"{'pole':<10} {'rot':>4} {'psi':>6} {'Tilt':>6} {'err':>6} {'phi':>7} {'Dir':>5} {'err':>6} "
+          f"{'base err':>8} quality")
+    for name in sorted(truth):
+        amb = name not in last and amb_ok and name in last_amb
+        if name not in last and not amb:
+            print(f"{name:<10} no FITTED PoleTilt frame near the pole  FAIL")
+            bad += 1
+            continue
+        rot, r, d, eb = last_amb[name] if amb else last[name]
+        psi, phi = float(r["psi_deg"]), float(r["phi_deg"])
+        e_psi = d.phys["Tilt"] - psi
+        e_phi = (d.phys["TiltDirection"] - phi + 180.0) % 360.0 - 180.0
+        ok = abs(e_psi) <= opts["--psi-tol"] + 1e-9 and (
+            amb or psi < opts["--min-psi"] or abs(e_phi) <= opts["--phi-tol"] + 1e-9)
+        bad += 0 if ok else 1
+        print(f"{name:<10} {rot + 1:>4} {psi:>6.2f} {d.phys['Tilt']:>6.1f} {e_psi:>+6.2f} {phi:>7.1f} "
+              f"{d.phys['TiltDirection']:>5.0f} {e_phi:>+6.1f} {eb:>7.2f}m {TQ[d.raw['Quality']]}"
+              f"{'' if ok else '  FAIL'}")
+    print(f"tilt_vs_truth: {len(truth)} poles, {bad} failures (psi {opts['--psi-tol']} deg, "
+          f"direction {opts['--phi-tol']} deg)")
+    return 1 if bad else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv))
