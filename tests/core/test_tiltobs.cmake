@@ -3,7 +3,7 @@
 # 160: 4 rings of 16 observations, sl_config.h).
 sl_add_unit_test(tiltobs)
 file(GLOB _sl_core_srcs CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/firmware/core/*.c)
-add_executable(test_tiltobs_fw ${CMAKE_CURRENT_SOURCE_DIR}/unit/test_tiltobs.c ${_sl_core_srcs})
+add_executable(test_tiltobs_fw ${CMAKE_CURRENT_SOURCE_DIR}/core/test_tiltobs.c ${_sl_core_srcs})
 target_compile_definitions(test_tiltobs_fw PRIVATE SL_CFG_MASK_BINS=160 SL_CFG_MASK_FRAMES_MAX=16)
 set_target_properties(test_tiltobs_fw PROPERTIES C_STANDARD 11 C_EXTENSIONS OFF)
 target_link_libraries(test_tiltobs_fw PRIVATE sl_core sl_test_support sl_host_warnings)

@@ -8,7 +8,7 @@
 # away, both sides) and the same at 3 m/s. Without --motion the same capture gives no
 # PoleTilt frame.
 # Tolerances: |Tilt error| <= 4 deg, direction within 30 deg. These are NOT the issue's
-# 1 deg / 10 deg (which the fit meets on exact measurements: tests/unit/test_tilt.c,
+# 1 deg / 10 deg (which the fit meets on exact measurements: tests/core/test_tilt.c,
 # test_tiltobs.c): end to end, the pipeline's single-rotation alpha while driving (n_eff = 1,
 # profiles cleared every rotation) is biased by 2-4 deg on this scene (runs shortened at
 # both ends: r1 read long, r2 short), and the fit inherits that bias (measured: psi errors

@@ -48,7 +48,7 @@ check_python() { # ROOT_PYTHON_DIR DBC LABEL
     want=$(sed -n 's/^project(shadowlean VERSION \([0-9.]*\).*/\1/p' "$SRC/CMakeLists.txt")
     [ "$(sed -n 2p "$WORK/py-$3.txt")" = "$want" ] || fail "$3: shadowlean.__version__ $(sed -n 2p "$WORK/py-$3.txt") != $want"
     (cd "$WORK" && PYTHONPATH="$1" PYTHONDONTWRITEBYTECODE=1 "$PY3" -m shadowlean decode \
-        "$SRC/tests/daemon/golden/demo_three_poles.candump" --dbc "$2" --check) > "$WORK/py-$3.log" 2>&1 ||
+        "$SRC/tests/system/daemon/golden/demo_three_poles.candump" --dbc "$2" --check) > "$WORK/py-$3.log" 2>&1 ||
         { tail -5 "$WORK/py-$3.log"; fail "$3: python3 -m shadowlean decode --check"; }
     echo "python ($3): shadowlean $want, $(grep -c 'crc=ok' "$WORK/py-$3.log") frames verified"
 }
