@@ -17,7 +17,7 @@
 set -u
 SL_SIM=$1; D=$2; PY=$3; SRC=$4; OUT=$5
 rm -rf "$OUT"; mkdir -p "$OUT"
-ROOT="$SRC/../.."
+ROOT="$SRC/../../.."
 DBC="$ROOT/boards/paper-sim/shadowlean.dbc"
 fail=0
 run() { # name speed scene [--ambiguous-ok]

@@ -22,7 +22,7 @@ import math
 import os
 import sys
 
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "..", "scripts"))
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "..", "..", "scripts"))
 import sl_can_decode as scd  # noqa: E402
 
 TQ = {0: "FITTED", 1: "AMBIGUOUS", 2: "INSUFFICIENT_MOTION", 3: "TOO_FEW", 4: "INCONSISTENT"}
