@@ -30,6 +30,12 @@
 #define ELONG_D_MAX_UM 5000000 // the board parser's bounds: |d| <= 5 m, r <= 200 m
 #define ELONG_R_MAX_UM 200000000U
 #define THETA_SIGMA_MAX_CDEG 1000U
+// Elongation points this build can hold from a blob: the format's slots or the capacity.
+#if SL_CFG_MAX_ELONG_POINTS < 16
+#define ELONG_CAP ((uint32_t)SL_CFG_MAX_ELONG_POINTS)
+#else
+#define ELONG_CAP ((uint32_t)SL_CALBLOB_ELONG_POINTS)
+#endif
 
 // The wire form of the geometry is the struct's ten 32-bit fields in order: zero copy needs
 // the struct to be exactly that (no padding).
@@ -63,6 +69,16 @@ static void put32(uint8_t *b, uint32_t v)
     b[3] = (uint8_t)((v >> 24) & 0xFFU);
 }
 
+// Length of a board name, counted up to SL_CALBLOB_NAME_BYTES (longer names are refused).
+static size_t name_len(const char *s)
+{
+    size_t n = 0U;
+    while (n < SL_CALBLOB_NAME_BYTES && s[n] != '\0') {
+        n++;
+    }
+    return n;
+}
+
 static uint32_t fnv_bytes(uint32_t h, const uint8_t *b, size_t n)
 {
     uint32_t x = h;
@@ -87,7 +103,7 @@ uint32_t sl_calblob_board_id(const sl_board_t *board)
     }
     uint32_t h = 2166136261U;
     if (board->name != NULL) {
-        h = fnv_bytes(h, (const uint8_t *)board->name, strlen(board->name));
+        h = fnv_bytes(h, (const uint8_t *)board->name, name_len(board->name));
     }
     h = fnv32(h, board->azimuths);
     h = fnv32(h, board->encoder_size);
@@ -152,9 +168,8 @@ sl_ssize_t sl_calblob_write(const sl_board_t *board, uint8_t *buf, size_t cap)
 {
     if (board == NULL || buf == NULL || board->name == NULL || board->geom == NULL ||
         board->theta_cdeg == NULL || board->shadow_um == NULL || board->shadow_bins == NULL ||
-        board->azimuths == 0U || strlen(board->name) >= SL_CALBLOB_NAME_BYTES ||
-        board->elong_points > SL_CALBLOB_ELONG_POINTS ||
-        board->elong_points > SL_CFG_MAX_ELONG_POINTS) {
+        board->azimuths == 0U ||
+        name_len(board->name) >= SL_CALBLOB_NAME_BYTES || board->elong_points > ELONG_CAP) {
         return SL_ERR_ARG;
     }
     const size_t az = board->azimuths;
@@ -170,7 +185,7 @@ sl_ssize_t sl_calblob_write(const sl_board_t *board, uint8_t *buf, size_t cap)
     put16(buf + OFF_VERSION, SL_CALBLOB_VERSION);
     put16(buf + OFF_HDR, SL_CALBLOB_HEADER_BYTES);
     put32(buf + OFF_TOTAL, (uint32_t)total);
-    memcpy(buf + OFF_NAME, board->name, strlen(board->name));
+    memcpy(buf + OFF_NAME, board->name, name_len(board->name));
     put32(buf + OFF_ID, sl_calblob_board_id(board));
     put16(buf + OFF_AZ, board->azimuths);
     put32(buf + OFF_HEIGHT, board->radar_height_um);
@@ -183,21 +198,15 @@ sl_ssize_t sl_calblob_write(const sl_board_t *board, uint8_t *buf, size_t cap)
         put32(buf + OFF_ELONG_R + 4U * i, board->elong_range_um[i]);
         put32(buf + OFF_ELONG_D + 4U * i, (uint32_t)board->elong_d_um[i]);
     }
-    uint8_t *p = buf + SL_CALBLOB_HEADER_BYTES;
+    uint8_t *const pg = &buf[SL_CALBLOB_HEADER_BYTES];
+    uint8_t *const ps = &pg[SL_CALBLOB_GEOM_BYTES * az];
+    uint8_t *const pt = &ps[4U * az];
+    uint8_t *const pb = &pt[2U * az];
     for (size_t i = 0; i < az; i++) {
-        geom_put(p + SL_CALBLOB_GEOM_BYTES * i, &board->geom[i]);
-    }
-    p += SL_CALBLOB_GEOM_BYTES * az;
-    for (size_t i = 0; i < az; i++) {
-        put32(p + 4U * i, board->shadow_um[i]);
-    }
-    p += 4U * az;
-    for (size_t i = 0; i < az; i++) {
-        put16(p + 2U * i, (uint32_t)(uint16_t)board->theta_cdeg[i]);
-    }
-    p += 2U * az;
-    for (size_t i = 0; i < az; i++) {
-        put16(p + 2U * i, board->shadow_bins[i]);
+        geom_put(&pg[SL_CALBLOB_GEOM_BYTES * i], &board->geom[i]);
+        put32(&ps[4U * i], board->shadow_um[i]);
+        put16(&pt[2U * i], (uint32_t)(uint16_t)board->theta_cdeg[i]);
+        put16(&pb[2U * i], board->shadow_bins[i]);
     }
     put32(buf + OFF_CRC, blob_crc(buf, total));
     return (sl_ssize_t)total;
@@ -270,7 +279,7 @@ static const char *check_scalars(const uint8_t *b, const sl_board_t *nom, uint32
         return "theta_sigma_cdeg";
     }
     const uint32_t n = b[OFF_ELONG_N];
-    if (n > SL_CALBLOB_ELONG_POINTS || n > SL_CFG_MAX_ELONG_POINTS) {
+    if (n > ELONG_CAP) {
         return "elong_points";
     }
     for (uint32_t i = 0; i < n; i++) {
@@ -333,7 +342,7 @@ sl_err_t sl_calblob_open(const uint8_t *blob, size_t len, const sl_board_t *nomi
     if (blob_crc(blob, total) != get32(blob + OFF_CRC)) {
         return fail(info, SL_ERR_CAL_CRC, "crc", 0U);
     }
-    const size_t nlen = strlen(nominal->name);
+    const size_t nlen = name_len(nominal->name);
     if (nlen >= SL_CALBLOB_NAME_BYTES || memcmp(blob + OFF_NAME, nominal->name, nlen) != 0 ||
         blob[OFF_NAME + nlen] != 0U) {
         return fail(info, SL_ERR_CAL_BOARD, "name", 0U);
@@ -384,7 +393,7 @@ sl_err_t sl_calblob_open(const uint8_t *blob, size_t len, const sl_board_t *nomi
     }
     if (in_place) {
         // Little-endian and aligned: the wire form is the in-memory form (static asserts
-        // above); MISRA 11.3 deviation recorded in docs/MISRA.md.
+        // above); MISRA 11.5 as recorded in docs/MISRA.md.
         v.geom = (const sl_incline_geom_t *)(const void *)pg;
         v.shadow_um = (const uint32_t *)(const void *)ps;
         v.theta_cdeg = (const int16_t *)(const void *)pt;
