@@ -172,7 +172,12 @@ static void test_calblob_every_bit_flip_is_rejected(void **state)
     const sl_board_t *nom = paper_sim();
     const size_t n = write_blob(nom, g_buf.b);
     size_t flips = 0;
-    for (size_t bit = 0; bit < n * 8U; bit += (bit < 64U * 8U) ? 1U : 13U) {
+    // Every bit of the first 16 header bytes (magic, version, sizes, CRC), then one bit in
+    // every 8th header byte and every 127th payload byte (a varying bit): ~300 flips, each a
+    // full CRC-32 over 19 KB (bitwise: kept cheap for the qemu runs).
+    for (size_t bit = 0; bit < n * 8U;
+         bit = (bit < 128U) ? bit + 1U
+                            : ((bit / 8U < SL_CALBLOB_HEADER_BYTES) ? bit + 64U + 1U : bit + 127U * 8U + 3U)) {
         g_buf.b[bit / 8U] ^= (uint8_t)(1U << (bit % 8U));
         const size_t byte = bit / 8U;
         sl_err_t want = SL_ERR_CAL_CRC;
@@ -187,7 +192,7 @@ static void test_calblob_every_bit_flip_is_rejected(void **state)
         g_buf.b[bit / 8U] ^= (uint8_t)(1U << (bit % 8U));
         flips++;
     }
-    assert_true(flips > 1500U);
+    assert_true(flips > 250U);
     sl_board_t v;
     assert_int_equal(sl_calblob_open(g_buf.b, n, nom, &g_ws, &v, NULL), SL_OK);
 }
