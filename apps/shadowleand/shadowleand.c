@@ -747,6 +747,11 @@ static void log_stats(daemon_t *d, int level, const char *what)
             g_pipe.proto.stats.resyncs, d->frames_out, d->status_frames, d->idle_status_frames,
             s->can_dropped, s->motion_accepted, s->motion_rejected,
             g_pipe.detect.stats.target_overflow);
+    const sl_drift_t *dw = &g_pipe.drift;
+    sld_log(SLD_LOG_INFO, "%s: theta drift watch: %s %+.2f deg%s; samples %" PRIu32 ", no ground %" PRIu32
+            ", occupied %" PRIu32 ", outliers %" PRIu32, what, dw->valid ? "estimate" : "no estimate",
+            dw->drift_cdeg / 100.0, dw->fault ? " THETA_DRIFT" : "", dw->stats.samples, dw->stats.no_ground,
+            dw->stats.occupied, dw->stats.outliers);
     if (s->can_rx != 0) {
         const sl_can_e2e_rx_t *e2e = &g_pipe.motion_rx.e2e;
         sld_log(level, "%s: VehicleMotion E2E: %" PRIu32 " accepted, %" PRIu32 " CRC errors, %" PRIu32

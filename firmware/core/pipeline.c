@@ -236,6 +236,9 @@ uint16_t sl_pipeline_faults(const sl_pipeline_t *p)
     if (flapping(p)) {
         f |= (uint16_t)SL_CAN_FAULT_LINK_FLAPPING;
     }
+    if (p->drift.fault) {
+        f |= (uint16_t)SL_CAN_FAULT_THETA_DRIFT;
+    }
     return f;
 }
 
@@ -267,6 +270,7 @@ static void emit_status(sl_pipeline_t *p)
         .fault = faults,
         .reconnects = p->stats.reconnects,
         .candidates_dropped = p->detect.stats.target_overflow,
+        .theta_drift_cdeg = sl_drift_cdeg(&p->drift),
     };
     p->faults_seen |= faults;
     sl_can_frame_t hf;
@@ -431,6 +435,11 @@ static void on_row(void *ctx, const sl_scan_row_t *row)
         sl_profile_row(&p->prof, row->idx, row->power, p->mask_bins, p->bits,
                        p->detect.win_bins[row->idx < p->detect.azimuths ? row->idx : 0U]);
     }
+    if (row->idx == p->drift.watch_az) {
+        // Drift watch: one azimuth per rotation (sl_drift.h).
+        sl_drift_row(&p->drift, &p->det_board, row->idx, row->power, p->mask_bins,
+                     p->det_board.bin_size_um, p->cfg.threshold);
+    }
     if (row->idx >= p->next_az) {
         if (row->idx > p->next_az) {
             feed_held(p, p->next_az, row->idx);
@@ -534,6 +543,7 @@ static void on_rot(void *ctx, const sl_scan_rot_t *rot)
     set_track_motion(p);
     sl_track_set_reverse(&p->tracker, p->motion_valid && p->speed_mm_s < 0);
     sl_track_update(&p->tracker, p->detect.targets, n_targets, p->now_us);
+    sl_drift_end_rotation(&p->drift);
     p->stats.rotations++;
     p->stats.azimuths_missing += rot->stats.missing;
     p->stats.targets += n_targets;
@@ -711,6 +721,7 @@ sl_err_t sl_pipeline_init(sl_pipeline_t *p, const sl_board_t *board,
     if (e == SL_OK) {
         e = sl_track_init(&p->tracker, board, &c->track);
     }
+    sl_drift_init(&p->drift, board);
     sl_can_ids_t ids;
     if (e == SL_OK) {
         sl_can_ids_from_board(&ids, board);

@@ -164,6 +164,7 @@
 #include "shadowlean/sl_can.h"
 #include "shadowlean/sl_config.h"
 #include "shadowlean/sl_detect.h"
+#include "shadowlean/sl_drift.h"
 #include "shadowlean/sl_err.h"
 #include "shadowlean/sl_mask.h"
 #include "shadowlean/sl_port.h"
@@ -327,6 +328,7 @@ typedef struct sl_pipeline {
     sl_detect_t detect;
     sl_profile_t prof;           ///< range profiles of the azimuths showing something
     sl_tracker_t tracker;
+    sl_drift_t drift;            ///< theta drift watch (sl_drift.h): Health.ThetaDrift, THETA_DRIFT
     sl_can_tx_t can;
     sl_pipeline_stats_t stats;
     sl_board_t det_board;        ///< the board as detection uses it: bin size from the radar's
