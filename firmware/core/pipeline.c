@@ -435,11 +435,6 @@ static void on_row(void *ctx, const sl_scan_row_t *row)
         sl_profile_row(&p->prof, row->idx, row->power, p->mask_bins, p->bits,
                        p->detect.win_bins[row->idx < p->detect.azimuths ? row->idx : 0U]);
     }
-    if (row->idx == p->drift.watch_az) {
-        // Drift watch: one azimuth per rotation (sl_drift.h).
-        sl_drift_row(&p->drift, &p->det_board, row->idx, row->power, p->mask_bins,
-                     p->det_board.bin_size_um, p->cfg.threshold);
-    }
     if (row->idx >= p->next_az) {
         if (row->idx > p->next_az) {
             feed_held(p, p->next_az, row->idx);
@@ -543,6 +538,12 @@ static void on_rot(void *ctx, const sl_scan_rot_t *rot)
     set_track_motion(p);
     sl_track_set_reverse(&p->tracker, p->motion_valid && p->speed_mm_s < 0);
     sl_track_update(&p->tracker, p->detect.targets, n_targets, p->now_us);
+    // Drift watch (sl_drift.h): one azimuth per rotation, read from the mask's stable row at
+    // the rotation's end (nothing per azimuth); p->occ is free once detection has ended.
+    if (sl_mask_stable_prefix(&p->mask, p->drift.watch_az, p->mask_words, p->occ, NULL)) {
+        sl_drift_row(&p->drift, &p->det_board, p->drift.watch_az, p->occ, p->mask_bins,
+                     p->det_board.bin_size_um);
+    }
     sl_drift_end_rotation(&p->drift);
     p->stats.rotations++;
     p->stats.azimuths_missing += rot->stats.missing;

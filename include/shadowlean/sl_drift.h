@@ -11,7 +11,8 @@
 /// (the calibration's) theta of that azimuth.
 ///
 /// ## One sample (sl_drift_row, on the watched azimuth only)
-/// On the row's 8-bit power as the pipeline has it: the masked range, which ends at the
+/// On the watched azimuth's stable-occupied row (the consistency mask's, as detection reads
+/// it, taken at the end of the rotation): the masked range, which ends at the
 /// board's shadow edge (sl_detect_bins_needed()), so the ground clutter reaches into the
 /// row's last bins only. Hence the watch is one-sided: it measures theta growing (the body
 /// sinking: a loaded vehicle, a mount tilted down; the ground start moves inwards, about 5
@@ -22,7 +23,9 @@
 ///   that reaches the row's last bin; no such run: no sample ("no ground");
 /// - rejected when any two adjacent bins in [near_exclusion_bins, g - 2) are >= threshold
 ///   (something stands in the shadow on this azimuth: a target, not ground) ("occupied");
-/// - theta_live from the slant range of g's centre, S = (g + 1/2) x bin;
+/// - theta_live - theta from the slant range of g's centre, S = (g + 1/2) x bin, to first
+///   order with the board's trig: (H - S sin(theta)) / (S cos(theta)) (0.02 deg off at a
+///   2 deg drift, 0.3 deg at 8);
 /// - rejected when |theta_live - theta_board| > SL_DRIFT_OUTLIER_CDEG (a pole at the edge
 ///   merged with the ground, a kerb, a wall) ("outlier");
 /// - else the sample d = theta_live - theta_board (0.01 deg) updates its sector (one of
@@ -37,14 +40,18 @@
 /// |drift| <= SL_DRIFT_FAULT_CDEG again in as many. Latency after a step change of theta by
 /// 2 deg: each sector is sampled every 8th rotation and needs two samples past the step
 /// (est = 0.5 then 0.75 of the step: 1.5 deg > 1 deg), so the median moves after ~2 x 8
-/// rotations, plus SL_DRIFT_PERSIST: the fault is raised within 32 rotations (8 s at 4 Hz);
-/// tests/unit/test_drift.c and the daemon test pin this bound.
+/// rotations, plus SL_DRIFT_PERSIST: within 32 rotations of the rows changing
+/// (tests/unit/test_drift.c). In the pipeline the rows are the consistency mask's stable
+/// rows, which show newly lit ground n rotations (the window, 16) after it appears: the
+/// fault is raised within n + 32 = 48 rotations (12 s at 4 Hz) of the step
+/// (calib_drift_theta_step_2deg_raises_theta_drift_within_48_rotations).
 ///
-/// Units: theta and drift in 0.01 deg (Health.ThetaDrift sends 0.1 deg). Cost: one compare
-/// per azimuth (the pipeline's), O(bins) once per rotation for the watched row, O(sectors^2)
-/// per rotation for the median. RAM: sizeof(sl_drift_t) = 44 B. No allocation, no float.
+/// Units: theta and drift in 0.01 deg (Health.ThetaDrift sends 0.1 deg). Cost: nothing per
+/// azimuth; per rotation the mask's row of one azimuth, O(bins / 32) + one 64-bit division once per rotation for the
+/// watched row, O(sectors^2) per rotation for the median. RAM: sizeof(sl_drift_t) = 44 B. No allocation, no float.
 /// Limits: one-sided (above); needs ground returns above the threshold at the shadow edge
-/// (the raw row is read, not the mask, so it also works while moving); walls, kerbs or
+/// (the pipeline reads the consistency mask's stable row of the watched azimuth at the end
+/// of the rotation, so nothing is done per azimuth; moving, the mask's window is short); walls, kerbs or
 /// parked cars at the shadow edge are samples too (outliers beyond 8 deg are dropped, and
 /// the median over sectors ignores a minority of sectors).
 #ifndef SHADOWLEAN_SL_DRIFT_H
@@ -89,11 +96,12 @@ typedef struct sl_drift {
 /// Reset for `board` (azimuths). O(1).
 void sl_drift_init(sl_drift_t *d, const sl_board_t *board);
 
-/// The watched azimuth's row: `power` 8-bit, `bins` of them (bin 0 = range 0), bin size
-/// `bin_um` (the radar's), occupied = power >= `threshold`. Any other azimuth: ignored
-/// (call it only for d->watch_az, the pipeline does). O(bins).
-void sl_drift_row(sl_drift_t *d, const sl_board_t *board, uint16_t az, const uint8_t *power,
-                  uint16_t bins, uint32_t bin_um, uint16_t threshold);
+/// The watched azimuth's occupied row: `bits` (bin k = bit k % 32 of word k / 32, as
+/// sl_thresh_u8 and sl_mask write it), `bins` of them (bin 0 = range 0), bin size `bin_um` (the
+/// radar's). Any other azimuth: ignored (the pipeline calls it for d->watch_az only).
+/// O(bins / 32) word operations + one 64-bit division.
+void sl_drift_row(sl_drift_t *d, const sl_board_t *board, uint16_t az, const uint32_t *bits,
+                  uint16_t bins, uint32_t bin_um);
 
 /// End of a rotation: the estimate, the fault's persistence, the next watched azimuth.
 /// O(SL_DRIFT_SECTORS^2).

@@ -328,7 +328,6 @@ typedef struct sl_pipeline {
     sl_detect_t detect;
     sl_profile_t prof;           ///< range profiles of the azimuths showing something
     sl_tracker_t tracker;
-    sl_drift_t drift;            ///< theta drift watch (sl_drift.h): Health.ThetaDrift, THETA_DRIFT
     sl_can_tx_t can;
     sl_pipeline_stats_t stats;
     sl_board_t det_board;        ///< the board as detection uses it: bin size from the radar's
@@ -357,6 +356,8 @@ typedef struct sl_pipeline {
     uint32_t occ[SL_MASK_WORDS];  ///< stable-occupied row (internal)
     uint8_t row8[SL_CFG_MASK_BINS]; ///< scan's row buffer (16-bit reduction, short rows)
     uint8_t reasm[SL_PIPELINE_REASM_BYTES]; ///< decoder reassembly buffer
+    sl_drift_t drift;            ///< theta drift watch (sl_drift.h): Health.ThetaDrift, THETA_DRIFT
+                                 ///< (last: the hot fields keep their offsets)
 } sl_pipeline_t;
 
 /// RAM budget of the firmware configuration (CTS350-X: 400 azimuths, n <= 16, masked bins

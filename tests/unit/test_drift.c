@@ -13,6 +13,7 @@
 
 #include "shadowlean/sl_board.h"
 #include "shadowlean/sl_drift.h"
+#include "shadowlean/sl_thresh.h"
 
 #define BINS 135U
 #define THR 40U
@@ -44,7 +45,9 @@ static void ground_row(uint8_t *row, double theta_deg, const sl_board_t *b)
 // One rotation: the watched azimuth's row, then the end of the rotation.
 static void rotation(sl_drift_t *d, const sl_board_t *b, const uint8_t *row)
 {
-    sl_drift_row(d, b, d->watch_az, row, BINS, b->bin_size_um, THR);
+    uint32_t bits[(BINS + 31U) / 32U];
+    sl_thresh_u8(row, BINS, THR, bits); // as the pipeline thresholds the row
+    sl_drift_row(d, b, d->watch_az, bits, BINS, b->bin_size_um);
     sl_drift_end_rotation(d);
 }
 
@@ -136,6 +139,13 @@ static void test_drift_rejects_occupied_rows_missing_ground_and_outliers(void **
     rotation(&d, b, row);
     assert_int_equal(d.stats.occupied, 1);
     assert_int_equal(d.stats.samples, 0);
+    // a two-bin return across a word boundary (bins 63, 64) is one too
+    ground_row(row, 26.0, b);
+    row[63] = 50U;
+    row[64] = 50U;
+    rotation(&d, b, row);
+    assert_int_equal(d.stats.occupied, 2);
+    assert_int_equal(d.stats.samples, 0);
     // isolated noise bins in the shadow are not a target
     ground_row(row, 26.0, b);
     row[60] = 50U;
@@ -153,7 +163,9 @@ static void test_drift_rejects_occupied_rows_missing_ground_and_outliers(void **
     assert_int_equal(d.stats.samples, 1);
     // a row of another azimuth than the watched one is ignored
     ground_row(row, 26.0, b);
-    sl_drift_row(&d, b, (uint16_t)((d.watch_az + 1U) % b->azimuths), row, BINS, b->bin_size_um, THR);
+    uint32_t bits[(BINS + 31U) / 32U];
+    sl_thresh_u8(row, BINS, THR, bits);
+    sl_drift_row(&d, b, (uint16_t)((d.watch_az + 1U) % b->azimuths), bits, BINS, b->bin_size_um);
     assert_int_equal(d.stats.samples, 1);
 }
 
