@@ -48,7 +48,7 @@
 ///
 /// Units: theta and drift in 0.01 deg (Health.ThetaDrift sends 0.1 deg). Cost: nothing per
 /// azimuth; per rotation the mask's row of one azimuth, O(bins / 32) + one 64-bit division once per rotation for the
-/// watched row, O(sectors^2) per rotation for the median. RAM: sizeof(sl_drift_t) = 44 B. No allocation, no float.
+/// watched row, O(sectors^2) per rotation for the median. RAM: sizeof(sl_drift_t) = 52 B. No allocation, no float.
 /// Limits: one-sided (above); needs ground returns above the threshold at the shadow edge
 /// (the pipeline reads the consistency mask's stable row of the watched azimuth at the end
 /// of the rotation, so nothing is done per azimuth; moving, the mask's window is short); walls, kerbs or
