@@ -40,8 +40,10 @@ void usage(FILE *out)
                  "  sl-eval run CAPTURE.colossus GT.csv [--board NAME] [--scene SCENE.ini]\n"
                  "             [--threshold T] [--beta DEG] [--raw|--half-bin] [--r1-add M] [--d M]\n"
                  "             [--extract bbox|pipeline] [--beam-deg DEG] [--speed M/S] [--no-width-radius]\n"
+                 "             [--calibration FILE]\n"
                  "      Evaluates one capture made by sl-sim against its ground truth. --extract pipeline:\n"
-                 "      the core pipeline (beam, threshold and speed from --scene, or the options).\n"
+                 "      the core pipeline (beam, threshold and speed from --scene, or the options);\n"
+                 "      --calibration: on the board's calibrated view (a vehicle's INI or blob).\n"
                  "--quiet silences the progress lines on stderr.\n");
 }
 
@@ -212,7 +214,7 @@ bool read_file(const std::string &path, std::vector<uint8_t> &out)
 
 int cmd_run(int argc, char **argv)
 {
-    std::string cap, gtp, board, scene_path;
+    std::string cap, gtp, board, scene_path, calibration;
     double threshold = -1, beta = 0, r1_add = 0, d = 0;
     sl::Proc::Bounds bounds = sl::Proc::Bounds::HalfBin;
     bool pipeline = false, no_width_radius = false;
@@ -244,6 +246,8 @@ int cmd_run(int argc, char **argv)
             no_width_radius = true;
         } else if (a == "--board") {
             board = next();
+        } else if (a == "--calibration") {
+            calibration = next();
         } else if (a == "--scene") {
             scene_path = next();
         } else if (a == "--threshold") {
@@ -296,6 +300,7 @@ int cmd_run(int argc, char **argv)
         } else {
             pc.board = b.name;
         }
+        pc.calibration = calibration; // the vehicle's calibration (INI or blob), if any
         if (beam_deg > 0) {
             pc.beam_deg = beam_deg;
         }

@@ -1,6 +1,6 @@
 #!/bin/sh
 # SPDX-License-Identifier: MIT
-# calib_e2e.sh SL_SIM SL_CALIB SL_TABLES SHADOWLEAND PYTHON SRC_DIR OUT_DIR
+# calib_e2e.sh SL_SIM SL_CALIB SL_TABLES SHADOWLEAND PYTHON SRC_DIR OUT_DIR SL_EVAL SL_VIEW
 # Calibration as data, end to end, with one daemon binary and no rebuild:
 #  1. sl-sim: the vehicle of tests/calib/data/paper-sim-lower-body.ini (its body 9 cm lower
 #     than boards/paper-sim says: true theta 30.01 deg, nominal 26) on empty ground;
@@ -10,9 +10,10 @@
 #     --calibration (the INI, then the blob): every decoded lean within 1.0 deg of the truth,
 #     the same frames from INI and blob; the nominal board alone: NOT within 1.0 deg;
 #  5. the nominal board's own blob gives the nominal frames byte for byte, and a blob with
-#     one flipped bit, a truncated one, or one for another board: exit 1, a clear error.
+#     one flipped bit, a truncated one, or one for another board: exit 1, a clear error;
+#  6. sl-eval and sl-view take the same --calibration (sl-eval: every pole within 1.0 deg).
 set -u
-SL_SIM=$1; SL_CALIB=$2; SL_TABLES=$3; DAEMON=$4; PY=$5; SRC=$6; OUT=$7
+SL_SIM=$1; SL_CALIB=$2; SL_TABLES=$3; DAEMON=$4; PY=$5; SRC=$6; OUT=$7; SL_EVAL=$8; SL_VIEW=$9
 D="$SRC/../calib/data"
 DBC="$SRC/../../boards/paper-sim/shadowlean.dbc"
 LVT="$SRC/../daemon/lean_vs_truth.py"
@@ -68,4 +69,19 @@ reject "$OUT/leaf.bin" SL_ERR_CAL_BOARD
 sed 's/^board = paper-sim/board = paper-bench/' "$OUT/vehicle.ini" > "$OUT/other.ini"
 reject "$OUT/other.ini" "board = 'paper-bench' but the board is 'paper-sim'"
 reject "$OUT/missing.ini" "No such file"
+# The host tools on the same calibration.
+ev() { "$SL_EVAL" run "$OUT/poles.colossus" "$OUT/poles.gt.csv" --board paper-sim --extract pipeline \
+    --beam-deg 2 "$@" 2>/dev/null | grep '^pole' | sed 's/.* max \([0-9.]*\) deg/\1/'; }
+ev --calibration "$OUT/vehicle.bin" > "$OUT/eval_cal.txt"
+ev > "$OUT/eval_nom.txt"
+[ "$(wc -l < "$OUT/eval_cal.txt")" -eq 5 ] || fail "sl-eval: not 5 poles"
+awk '$1 > 1.0 { bad = 1 } END { exit bad }' "$OUT/eval_cal.txt" || fail "sl-eval --calibration: a pole beyond 1.0 deg"
+awk '$1 > 1.0 { bad = 1 } END { exit !bad }' "$OUT/eval_nom.txt" || fail "sl-eval without calibration within 1.0 deg"
+echo "sl-eval max errors: calibrated $(tr '\n' ' ' < "$OUT/eval_cal.txt")/ nominal $(tr '\n' ' ' < "$OUT/eval_nom.txt")"
+"$SL_VIEW" "$OUT/poles.colossus" --board paper-sim --calibration "$OUT/vehicle.ini" --out "$OUT/view.png" > /dev/null ||
+    fail "sl-view --calibration"
+test -s "$OUT/view.png" || fail "sl-view wrote no picture"
+if "$SL_VIEW" "$OUT/poles.colossus" --board paper-sim --calibration "$OUT/flip.bin" --out "$OUT/bad.png" 2> /dev/null; then
+    fail "sl-view accepted a corrupt blob"
+fi
 echo "calibration end to end: OK"
