@@ -104,12 +104,12 @@
 /// Dominated by the mask: SL_CFG_MAX_AZIMUTHS x (1 + ceil(log2 SL_CFG_MASK_FRAMES_MAX)) x
 /// SL_CFG_MASK_BINS / 8 bytes; then detection (8,424 B), the tracker (1,864 B), the scan
 /// bookkeeping (624 B), the range profiles (sl_profile.h, 2.1 KB), the reassembly buffer
-/// (SL_PIPELINE_REASM_BYTES) and a row buffer.
+/// (SL_PIPELINE_REASM_BYTES), a row buffer and the theta drift watch (sl_drift.h, 52 B).
 ///
 /// | configuration (400 azimuths, 32 targets)              | x86-64    | Cortex-M0 |
 /// |--------------------------------------------------------|-----------|-----------|
-/// | firmware: SL_CFG_MASK_BINS 160, SL_CFG_MASK_FRAMES_MAX 16 | 55,776 B  | 55,640 B  |
-/// | host default: mask bins 512 (whole ROI), n <= 32          | 170,520 B |           |
+/// | firmware: SL_CFG_MASK_BINS 160, SL_CFG_MASK_FRAMES_MAX 16 | 55,832 B  | 55,696 B  |
+/// | host default: mask bins 512 (whole ROI), n <= 32          | 170,576 B |           |
 ///
 /// The boards carried today need 135 (paper-sim), 119 (paper-bench) and 141 (robotcar-leaf)
 /// masked bins (sl_detect_bins_needed(), rounded up to 160).
