@@ -69,6 +69,14 @@ reject "$OUT/leaf.bin" SL_ERR_CAL_BOARD
 sed 's/^board = paper-sim/board = paper-bench/' "$OUT/vehicle.ini" > "$OUT/other.ini"
 reject "$OUT/other.ini" "board = 'paper-bench' but the board is 'paper-sim'"
 reject "$OUT/missing.ini" "No such file"
+# sl-tables bakes the calibration into C tables when asked (--out DIR; never boards/).
+"$SL_TABLES" paper-sim --calibration "$OUT/vehicle.ini" --out "$OUT/baked" --no-png > /dev/null ||
+    fail "sl-tables --calibration --out"
+grep -q "Calibrated with vehicle.ini" "$OUT/baked/sl_board_paper_sim.c" || fail "baked tables: no calibration banner"
+grep -q "^    30[0-9][0-9], 30[0-9][0-9]," "$OUT/baked/sl_board_paper_sim.c" || fail "baked tables: theta not ~30 deg"
+if "$SL_TABLES" paper-sim --calibration "$OUT/vehicle.ini" --no-png > /dev/null 2>&1; then
+    fail "sl-tables --calibration without --out would overwrite the committed tables"
+fi
 # The host tools on the same calibration.
 ev() { "$SL_EVAL" run "$OUT/poles.colossus" "$OUT/poles.gt.csv" --board paper-sim --extract pipeline \
     --beam-deg 2 "$@" 2>/dev/null | grep '^pole' | sed 's/.* max \([0-9.]*\) deg/\1/'; }
