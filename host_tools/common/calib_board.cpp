@@ -3,6 +3,9 @@
 #include "calib_board.h"
 
 #include <cstdlib>
+#include <map>
+#include <mutex>
+#include <utility>
 #include <memory>
 #include <stdexcept>
 #include <vector>
@@ -31,7 +34,16 @@ const sl_board_t *core_board(const std::string &name, const std::string &calibra
     if (calibration.empty()) {
         return nominal;
     }
-    static std::vector<std::unique_ptr<Calibrated>> keep; // alive until exit (views borrow)
+    // One view per (board, file), made once and alive until exit (views are borrowed by
+    // pipelines, possibly in several threads: sl-eval's workers).
+    static std::mutex mu;
+    static std::map<std::pair<std::string, std::string>, std::unique_ptr<Calibrated>> keep;
+    std::lock_guard<std::mutex> lock(mu);
+    const auto key = std::make_pair(name, calibration);
+    const auto it = keep.find(key);
+    if (it != keep.end()) {
+        return &it->second->view;
+    }
     std::unique_ptr<Calibrated> c(new Calibrated());
     uint8_t *raw = nullptr;
     size_t len = 0;
@@ -48,8 +60,9 @@ const sl_board_t *core_board(const std::string &name, const std::string &calibra
                                  sl_err_str(e) + " (" + (info.what != nullptr ? info.what : "?") + ", entry " +
                                  std::to_string(info.index) + ")");
     }
-    keep.push_back(std::move(c));
-    return &keep.back()->view;
+    const sl_board_t *v = &c->view;
+    keep[key] = std::move(c);
+    return v;
 }
 
 } // namespace sl

@@ -11,7 +11,7 @@
 namespace sl {
 
 /// The linked board `name` (sl_board_find); with `calibration` non-empty, its calibrated
-/// view. The view and its blob live until the program ends (a few per process at most).
+/// view, made once per (board, file) and kept until the program ends. Thread-safe.
 /// Throws std::runtime_error naming the file and the failed check.
 const sl_board_t *core_board(const std::string &name, const std::string &calibration);
 

@@ -70,6 +70,11 @@ typedef struct ctx {
     bool elong_set;
     double elong_r[SL_CFG_MAX_ELONG_POINTS];
     double elong_d[SL_CFG_MAX_ELONG_POINTS];
+    // the calibrated tables being built (serialised into the blob)
+    sl_incline_geom_t geom[SL_CFG_MAX_AZIMUTHS];
+    int16_t theta[SL_CFG_MAX_AZIMUTHS];
+    uint32_t shadow[SL_CFG_MAX_AZIMUTHS];
+    uint16_t bins[SL_CFG_MAX_AZIMUTHS];
 } ctx_t;
 
 static int bad(ctx_t *c, const char *fmt, ...)
@@ -247,10 +252,10 @@ static int build(const char *path, ctx_t *c, uint8_t **blob, size_t *len, char *
 {
     const sl_board_t *nom = c->nom;
     const size_t az = nom->azimuths;
-    static sl_incline_geom_t geom[SL_CFG_MAX_AZIMUTHS];
-    static int16_t theta[SL_CFG_MAX_AZIMUTHS];
-    static uint32_t shadow[SL_CFG_MAX_AZIMUTHS];
-    static uint16_t bins[SL_CFG_MAX_AZIMUTHS];
+    sl_incline_geom_t *const geom = c->geom; // in the caller's context: reentrant
+    int16_t *const theta = c->theta;
+    uint32_t *const shadow = c->shadow;
+    uint16_t *const bins = c->bins;
     if (az > SL_CFG_MAX_AZIMUTHS) {
         return fail(err, n, "%s: board %s has more azimuths than this build holds", path, nom->name);
     }

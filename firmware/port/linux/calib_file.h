@@ -33,7 +33,7 @@
 ///   R = H / tan(theta) and shadow bins computed exactly as sl-tables computes a board's
 ///   (calib_make_geom() is the C twin of sl::make_geom, compared bit for bit by a test).
 ///
-/// Host/port only (libm, stdio, malloc); not part of the core.
+/// Host/port only (libm, stdio, malloc); not part of the core. Reentrant (no static state).
 #ifndef SHADOWLEAN_CALIB_FILE_H
 #define SHADOWLEAN_CALIB_FILE_H
 
