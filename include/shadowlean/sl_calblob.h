@@ -73,8 +73,9 @@
 ///   elongation table not ascending, r > 200 m, |d| > 5 m (the board file's bounds), or too many points; theta_sigma > 10 deg.
 /// - SL_ERR_CAL_WORKSPACE: zero copy impossible (big-endian or misaligned) and `ws` NULL.
 ///
-/// Cost: O(azimuths) (CRC-32 bitwise over ~19 KB: ~1.5 M instructions once at start; a
-/// 64-bit multiply per azimuth for the shadow check). No state; reentrant.
+/// Cost: O(blob size): the CRC-32 is bitwise (no 1 KB table in flash: 8 shift/xor steps per
+/// byte, 19 KB once at start), plus per azimuth the geometry check and two 64-bit products
+/// for the shadow check. No state; reentrant.
 #ifndef SHADOWLEAN_SL_CALBLOB_H
 #define SHADOWLEAN_SL_CALBLOB_H
 

@@ -382,8 +382,9 @@ _Static_assert(sizeof(sl_pipeline_t) <= sizeof(sl_mask_t) + 16384U, "sl_pipeline
 #endif
 #endif
 
-/// Initialise (or completely reset) for `board` (borrowed, usually static const) with
-/// `cfg` (copied; NULL = sl_pipeline_cfg_default(board)).
+/// Initialise (or completely reset) for `board` (borrowed, usually static const; or a
+/// vehicle's calibrated view from sl_calblob_open(), whose blob must then outlive the
+/// pipeline) with `cfg` (copied; NULL = sl_pipeline_cfg_default(board)).
 /// @return SL_OK; SL_ERR_ARG (NULL, cfg out of range); SL_ERR_RANGE when the board does
 /// not fit the compile-time capacities, in particular when detection needs more bins than
 /// SL_CFG_MASK_BINS (the reason is in `p->reason` / `p->last_err_msg`, e.g. "detection
