@@ -321,6 +321,58 @@ static void test_calblob_out_of_range_values_are_refused(void **state)
     assert_int_equal(v.elong_range_um[2], 4000000U);
 }
 
+// Mutations past the CRC (the CRC made valid again after each one, so the value checks are
+// what stands between the bytes and the pipeline): an accepted blob always satisfies the
+// documented ranges; a rejected one leaves the view untouched. Deterministic (xorshift).
+static void test_calblob_mutations_with_valid_crc_never_yield_out_of_range_tables(void **state)
+{
+    (void)state;
+    const sl_board_t *nom = paper_sim();
+    uint32_t x = 0x2545F491U;
+    unsigned accepted = 0, rejected = 0;
+    for (int k = 0; k < 400; k++) {
+        const size_t n = write_blob(nom, g_buf.b);
+        const int edits = 1 + (int)(k % 4);
+        for (int e = 0; e < edits; e++) {
+            x ^= x << 13;
+            x ^= x >> 17;
+            x ^= x << 5;
+            // header scalars (from the name on) or the tables
+            const size_t at = (k % 2 == 0) ? 16U + x % (SL_CALBLOB_HEADER_BYTES - 16U)
+                                           : SL_CALBLOB_HEADER_BYTES + x % (n - SL_CALBLOB_HEADER_BYTES);
+            g_buf.b[at] ^= (uint8_t)(1U << ((x >> 24) % 8U));
+        }
+        recrc(g_buf.b, n);
+        sl_board_t v, untouched;
+        memset(&v, 0x77, sizeof v);
+        untouched = v;
+        sl_calblob_info_t info;
+        const sl_err_t err = sl_calblob_open(g_buf.b, n, nom, &g_ws, &v, &info);
+        if (err != SL_OK) {
+            assert_memory_equal(&v, &untouched, sizeof v);
+            assert_non_null(info.what);
+            rejected++;
+            continue;
+        }
+        accepted++;
+        assert_true(v.radar_height_um >= 200000U && v.radar_height_um <= 20000000U);
+        assert_true(v.near_exclusion_bins < v.roi_bins);
+        assert_true(v.elong_points <= SL_CFG_MAX_ELONG_POINTS);
+        for (unsigned i = 0; i < v.azimuths; i++) {
+            assert_true(v.theta_cdeg[i] >= SL_INCLINE_THETA_MIN_CDEG);
+            assert_true(v.theta_cdeg[i] <= v.lower_bound_cdeg);
+            assert_true(sl_incline_geom_ok(&v.geom[i]));
+            assert_true(v.shadow_bins[i] < v.roi_bins);
+            // the estimator runs on every accepted entry without surprise
+            const sl_incline_result_t r = sl_incline_estimate(3000000U, 3600000U, &v.geom[i], 12640U, 10U);
+            assert_true(r.flag <= SL_INCLINE_OUT_OF_DOMAIN);
+        }
+    }
+    // both outcomes occur (a flipped low bit of a table value can stay in range)
+    assert_true(accepted > 0U);
+    assert_true(rejected > 100U);
+}
+
 static void test_calblob_writer_arguments(void **state)
 {
     (void)state;
@@ -348,6 +400,7 @@ int main(void)
         cmocka_unit_test(test_calblob_wrong_version_magic_and_truncation),
         cmocka_unit_test(test_calblob_wrong_board_is_refused),
         cmocka_unit_test(test_calblob_out_of_range_values_are_refused),
+        cmocka_unit_test(test_calblob_mutations_with_valid_crc_never_yield_out_of_range_tables),
         cmocka_unit_test(test_calblob_writer_arguments),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
