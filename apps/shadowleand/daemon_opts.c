@@ -137,6 +137,8 @@ static int apply(sld_opts_t *o, const char *section, const char *key, const char
 #define BAD(msg) do { snprintf(why, why_size, "%s.%s = '%s': %s", section, key, val, msg); return -1; } while (0)
     if (IS("daemon", "board")) {
         if (set_str(o->board, sizeof o->board, val) != 0) BAD("too long");
+    } else if (IS("daemon", "calibration")) {
+        if (set_str(o->calibration, sizeof o->calibration, val) != 0) BAD("too long");
     } else if (IS("daemon", "user")) {
         if (set_str(o->user, sizeof o->user, val) != 0) BAD("too long");
     } else if (IS("daemon", "syslog")) {
@@ -344,6 +346,7 @@ typedef struct cli_opt {
 
 static const cli_opt_t k_cli[] = {
     {"--board", "daemon", "board", 1, NULL},
+    {"--calibration", "daemon", "calibration", 1, NULL},
     {"--user", "daemon", "user", 1, NULL},
     {"--syslog", "daemon", "syslog", 0, "true"},
     {"--stderr", "daemon", "syslog", 0, "false"},
@@ -386,6 +389,8 @@ void sld_opts_usage(void *fpv)
         "  option                   config key                meaning\n"
         "  --config FILE                                      INI file; the command line overrides it\n"
         "  --board NAME             [daemon] board            board (see --list-boards)\n"
+        "  --calibration FILE       [daemon] calibration      this vehicle's calibration (INI from sl-calib, or a\n"
+        "                                                     blob from sl-tables --blob); default: the board's tables\n"
         "  --radar HOST[:PORT]      [input] radar             radar TCP stream (port 6317 default)\n"
         "  --input CAPTURE          [input] capture           raw .colossus capture or pcap/pcapng\n"
         "  --realtime | --fast      [input] realtime          capture: pace by FFT timestamps | as fast as possible (default)\n"
@@ -576,6 +581,9 @@ void sld_opts_print(const sld_opts_t *o, void *fpv)
     fprintf(fp, "; shadowleand effective settings%s%s%s\n", o->config[0] != '\0' ? " (config file " : "",
             o->config, o->config[0] != '\0' ? " + command line)" : "");
     fprintf(fp, "[daemon]\nboard = %s\n", o->board);
+    if (o->calibration[0] != '\0') {
+        fprintf(fp, "calibration = %s\n", o->calibration);
+    }
     if (o->user[0] != '\0') {
         fprintf(fp, "user = %s\n", o->user);
     }

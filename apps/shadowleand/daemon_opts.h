@@ -6,7 +6,7 @@
 /// setting has a command-line option and a config-file key (table in `sld_opts_usage()`
 /// and in the README). The config file is an INI file read with inih (`ini_parse`):
 ///
-///     [daemon]   board, user, syslog, verbosity, stats_every, duration, exit_idle,
+///     [daemon]   board, calibration, user, syslog, verbosity, stats_every, duration, exit_idle,
 ///                status_period_ms
 ///     [input]    radar (HOST:PORT) | capture (FILE), realtime, non_contour,
 ///                connect_timeout_ms, silence_timeout_ms, silent_ms, motion
@@ -48,6 +48,7 @@ typedef struct sld_opts {
     char config[SLD_PATH_CHARS];       ///< --config FILE ("" = none)
     bool print_config;                 ///< --print-config: print the settings and exit
     char board[SLD_NAME_CHARS];        ///< --board NAME                      [daemon] board
+    char calibration[SLD_PATH_CHARS];  ///< --calibration FILE (INI or blob; "" = the board's) [daemon] calibration
     char radar_host[256];              ///< --radar HOST[:PORT]               [input] radar
     uint16_t radar_port;               ///< default 6317
     char capture[SLD_PATH_CHARS];      ///< --input FILE                      [input] capture

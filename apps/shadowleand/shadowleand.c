@@ -29,6 +29,7 @@
 #include "can_sink.h"
 #include "can_socketcan.h"
 #include "capture_reader.h"
+#include "calib_file.h"
 #include "candump.h"
 #include "daemon_log.h"
 #include "daemon_motion.h"
@@ -38,6 +39,7 @@
 #include "gsusb_sink.h"
 #include "radar_client.h"
 #include "shadowlean/sl_board.h"
+#include "shadowlean/sl_calblob.h"
 #include "shadowlean/sl_can.h"
 #include "shadowlean/sl_pipeline.h"
 #include "shadowlean/sl_proto.h"
@@ -62,7 +64,9 @@ typedef struct held_msg {
 
 typedef struct daemon {
     sld_opts_t o;
-    const sl_board_t *board;
+    const sl_board_t *board;     // the nominal board, or cal_board (--calibration)
+    sl_board_t cal_board;        // calibrated view (sl_calblob.h) into cal_blob / g_cal_ws
+    uint8_t *cal_blob;           // the calibration blob, kept for the daemon's lifetime
     sl_pipeline_cfg_t pcfg;
     uint32_t status_id; // bare id of the Status frames
     uint8_t status_eff; // SL_CAN_FLAG_EFF or 0
@@ -743,6 +747,11 @@ static void log_stats(daemon_t *d, int level, const char *what)
             g_pipe.proto.stats.resyncs, d->frames_out, d->status_frames, d->idle_status_frames,
             s->can_dropped, s->motion_accepted, s->motion_rejected,
             g_pipe.detect.stats.target_overflow);
+    const sl_drift_t *dw = &g_pipe.drift;
+    sld_log(SLD_LOG_INFO, "%s: theta drift watch: %s %+.2f deg%s; samples %" PRIu32 ", no ground %" PRIu32
+            ", occupied %" PRIu32 ", outliers %" PRIu32, what, dw->valid ? "estimate" : "no estimate",
+            dw->drift_cdeg / 100.0, dw->fault ? " THETA_DRIFT" : "", dw->stats.samples, dw->stats.no_ground,
+            dw->stats.occupied, dw->stats.outliers);
     if (s->can_rx != 0) {
         const sl_can_e2e_rx_t *e2e = &g_pipe.motion_rx.e2e;
         sld_log(level, "%s: VehicleMotion E2E: %" PRIu32 " accepted, %" PRIu32 " CRC errors, %" PRIu32
@@ -792,6 +801,44 @@ static void log_stats(daemon_t *d, int level, const char *what)
                 what, sl_radar_state_str(d->radar.state), r->connects, r->reconnects,
                 r->connect_failures + r->connect_timeouts, r->silence_timeouts, r->fft_messages, r->bytes_rx);
     }
+}
+
+// --calibration FILE: the vehicle's calibration (INI or blob) validated against the nominal
+// board; the pipeline then runs on the calibrated view. Any error: a clear message, exit 1.
+static sl_calblob_ws_t g_cal_ws;
+
+static int load_calibration(daemon_t *d)
+{
+    char err[512];
+    size_t len = 0;
+    if (calib_file_load(d->o.calibration, d->board, &d->cal_blob, &len, err, sizeof err) != 0) {
+        sld_log(SLD_LOG_ERR, "calibration %s", err);
+        return -1;
+    }
+    sl_calblob_info_t info;
+    const sl_err_t e = sl_calblob_open(d->cal_blob, len, d->board, &g_cal_ws, &d->cal_board, &info);
+    if (e != SL_OK) {
+        sld_log(SLD_LOG_ERR, "calibration %s: rejected for board %s: %s (%s, entry %u); not used",
+                d->o.calibration, d->board->name, sl_err_str(e), info.what != NULL ? info.what : "?",
+                (unsigned)info.index);
+        free(d->cal_blob);
+        d->cal_blob = NULL;
+        return -1;
+    }
+    int tmin = INT32_MAX, tmax = INT32_MIN;
+    unsigned changed = 0;
+    for (size_t i = 0; i < d->cal_board.azimuths; i++) {
+        const int t = d->cal_board.theta_cdeg[i];
+        tmin = t < tmin ? t : tmin;
+        tmax = t > tmax ? t : tmax;
+        changed += t != d->board->theta_cdeg[i] ? 1U : 0U;
+    }
+    sld_log(SLD_LOG_INFO, "calibration %s: board %s, theta %.2f .. %.2f deg (%u of %u azimuths differ from "
+            "the board's), radar height %.3f m, crc %08" PRIx32 "%s", d->o.calibration, d->board->name,
+            tmin / 100.0, tmax / 100.0, changed, (unsigned)d->cal_board.azimuths,
+            d->cal_board.radar_height_um / 1e6, info.crc, info.zero_copy ? "" : " (decoded)");
+    d->board = &d->cal_board;
+    return 0;
 }
 
 static int setup_signals(daemon_t *d)
@@ -908,6 +955,9 @@ int main(int argc, char **argv)
     }
     sld_log_setup(d->o.verbosity, d->o.use_syslog);
     d->board = sl_board_find(d->o.board);
+    if (d->o.calibration[0] != '\0' && load_calibration(d) != 0) {
+        return 1;
+    }
     d->is_radar = d->o.radar_host[0] != '\0';
     d->log_time = d->o.log_time != SLD_LOG_TIME_AUTO ? d->o.log_time
                   : d->is_radar                     ? SLD_LOG_TIME_WALL
@@ -1163,6 +1213,7 @@ int main(int argc, char **argv)
     }
     sl_port_capture_close(d->cr);
     free(d->held);
+    free(d->cal_blob);
     free(d->hold);
     free(d->pacer_reasm);
     free(d->radar_reasm);

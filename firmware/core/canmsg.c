@@ -35,6 +35,7 @@ static const sl_can_value_name_t fault_names[] = {
     {SL_CAN_FAULT_AZIMUTH_DISORDER, "AZIMUTH_DISORDER"},
     {SL_CAN_FAULT_CAN_RATE_LIMITED, "CAN_RATE_LIMITED"},
     {SL_CAN_FAULT_TARGET_SLOTS_OVERFLOW, "TARGET_SLOTS_OVERFLOW"},
+    {SL_CAN_FAULT_THETA_DRIFT, "THETA_DRIFT"},
 };
 
 #define NV(a) ((uint8_t)(sizeof(a) / sizeof((a)[0])))
@@ -111,13 +112,15 @@ static const sl_can_signal_desc_t motion_sigs[M_N] = {
      SL_CAN_MOTION_RAW_MAX, "deg/s", NULL, 0U},
 };
 
-enum { H_FAULT = 2, H_RECONNECTS, H_CAND_DROPPED, H_N };
+enum { H_FAULT = 2, H_RECONNECTS, H_CAND_DROPPED, H_DRIFT, H_N };
 static const sl_can_signal_desc_t health_sigs[H_N] = {
     E2E_SIGNALS,
     {"Fault", 16U, 16U, false, 1, 1, 0, 65535, "", fault_names, NV(fault_names)},
     {"Reconnects", 32U, 8U, false, 1, 1, 0, (int32_t)SL_CAN_HEALTH_RECONNECTS_MAX, "", NULL, 0U},
     {"CandidatesDropped", 40U, 12U, false, 1, 1, 0,
      (int32_t)SL_CAN_HEALTH_CANDIDATES_DROPPED_MAX, "", NULL, 0U},
+    {"ThetaDrift", 52U, 8U, true, SL_CAN_HEALTH_DRIFT_CDEG_PER_LSB, 100, SL_CAN_HEALTH_DRIFT_RAW_MIN,
+     SL_CAN_HEALTH_DRIFT_RAW_MAX, "deg", NULL, 0U},
 };
 
 enum { L_QUALITY = 2, L_CLAMPED, L_TARGET, L_TILT, L_DIR, L_SIGMA, L_DIR_SIGMA, L_BX, L_BY, L_N };
@@ -467,6 +470,7 @@ sl_err_t sl_can_encode_health(sl_can_tx_t *tx, const sl_can_health_t *in, sl_can
     put_sig(d, &s[H_FAULT], (int64_t)(in->fault & SL_CAN_FAULT_DEFINED));
     put_sig(d, &s[H_RECONNECTS], clamp_raw(&s[H_RECONNECTS], in->reconnects, &sat));
     put_sig(d, &s[H_CAND_DROPPED], clamp_raw(&s[H_CAND_DROPPED], in->candidates_dropped, &sat));
+    put_phys(d, &s[H_DRIFT], in->theta_drift_cdeg, SL_CAN_HEALTH_DRIFT_CDEG_PER_LSB, &sat);
     finish(tx, SL_CAN_MSG_HEALTH, d, sat, out);
     return SL_OK;
 }
@@ -672,6 +676,7 @@ sl_err_t sl_can_decode_health(const sl_can_frame_t *f, sl_can_health_t *out)
     out->fault = (uint16_t)get_sig(d, &s[H_FAULT]);
     out->reconnects = (uint32_t)get_sig(d, &s[H_RECONNECTS]);
     out->candidates_dropped = (uint32_t)get_sig(d, &s[H_CAND_DROPPED]);
+    out->theta_drift_cdeg = (int16_t)(get_sig(d, &s[H_DRIFT]) * SL_CAN_HEALTH_DRIFT_CDEG_PER_LSB);
     return SL_OK;
 }
 

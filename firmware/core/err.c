@@ -13,6 +13,14 @@ const char *sl_err_str(sl_err_t err)
     case SL_ERR_PORT: return "SL_ERR_PORT";
     case SL_ERR_RANGE: return "SL_ERR_RANGE";
     case SL_ERR_STATE: return "SL_ERR_STATE";
+    case SL_ERR_CAL_SIZE: return "SL_ERR_CAL_SIZE";
+    case SL_ERR_CAL_MAGIC: return "SL_ERR_CAL_MAGIC";
+    case SL_ERR_CAL_VERSION: return "SL_ERR_CAL_VERSION";
+    case SL_ERR_CAL_CRC: return "SL_ERR_CAL_CRC";
+    case SL_ERR_CAL_BOARD: return "SL_ERR_CAL_BOARD";
+    case SL_ERR_CAL_AZIMUTHS: return "SL_ERR_CAL_AZIMUTHS";
+    case SL_ERR_CAL_VALUE: return "SL_ERR_CAL_VALUE";
+    case SL_ERR_CAL_WORKSPACE: return "SL_ERR_CAL_WORKSPACE";
     }
     return "SL_ERR_?";
 }

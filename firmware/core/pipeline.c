@@ -236,6 +236,9 @@ uint16_t sl_pipeline_faults(const sl_pipeline_t *p)
     if (flapping(p)) {
         f |= (uint16_t)SL_CAN_FAULT_LINK_FLAPPING;
     }
+    if (p->drift.fault) {
+        f |= (uint16_t)SL_CAN_FAULT_THETA_DRIFT;
+    }
     return f;
 }
 
@@ -267,6 +270,7 @@ static void emit_status(sl_pipeline_t *p)
         .fault = faults,
         .reconnects = p->stats.reconnects,
         .candidates_dropped = p->detect.stats.target_overflow,
+        .theta_drift_cdeg = sl_drift_cdeg(&p->drift),
     };
     p->faults_seen |= faults;
     sl_can_frame_t hf;
@@ -609,6 +613,13 @@ static void on_rot(void *ctx, const sl_scan_rot_t *rot)
     sl_track_update(&p->tracker, p->detect.targets, n_targets, p->now_us);
     sl_tiltobs_advance(&p->tilt, p->motion_valid, p->speed_mm_s, p->yaw_cdeg_s, p->rotation_us);
     sl_tiltobs_update(&p->tilt, p->tracker.tracks, p->detect.targets, n_targets);
+    // Drift watch (sl_drift.h): one azimuth per rotation, read from the mask's stable row at
+    // the rotation's end (nothing per azimuth); p->occ is free once detection has ended.
+    if (sl_mask_stable_prefix(&p->mask, p->drift.watch_az, p->mask_words, p->occ, NULL)) {
+        sl_drift_row(&p->drift, &p->det_board, p->drift.watch_az, p->occ, p->mask_bins,
+                     p->det_board.bin_size_um);
+    }
+    sl_drift_end_rotation(&p->drift);
     p->stats.rotations++;
     p->stats.azimuths_missing += rot->stats.missing;
     p->stats.targets += n_targets;
@@ -789,6 +800,7 @@ sl_err_t sl_pipeline_init(sl_pipeline_t *p, const sl_board_t *board,
     if (e == SL_OK) {
         e = sl_tiltobs_init(&p->tilt, board);
     }
+    sl_drift_init(&p->drift, board);
     sl_can_ids_t ids;
     if (e == SL_OK) {
         sl_can_ids_from_board(&ids, board);

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 // elong_cmd.cpp: `sl-calib elongation` (see main.cpp and README.md).
 #include "calib_cmds.h"
+#include "calib_ini.h"
 
 #include <algorithm>
 #include <climits>
@@ -310,7 +311,7 @@ int cmd_elongation(const ElongArgs &a)
     const std::string line = elongation_line(t);
     std::printf("  [detect] %s\n", line.c_str());
     if (!a.out_ini.empty()) {
-        std::ofstream o(a.out_ini);
+        std::ostringstream o;
         o << "; sl-calib elongation: " << t.n << " positions from " << a.captures.size()
           << " capture(s), board " << board.name << "\n"
           << "; d = r2 observed (half-bin) - r2 true, keyed by the observed r2 (sl_detect_elong_um)\n"
@@ -320,9 +321,13 @@ int cmd_elongation(const ElongArgs &a)
             o << ";   r2 " << f3(p.r_min_m) << ".." << f3(p.r_max_m) << ": d " << f3(p.d_m) << " +- "
               << f3(p.std_m) << " (n " << p.n << ")\n";
         }
+        o << "; " << sl::calib_tool_version() << ", " << sl::calib_utc_date() << "\n";
         o << "[detect]\n" << line << "\n";
-        if (!o) {
-            std::fprintf(stderr, "sl-calib: cannot write %s\n", a.out_ini.c_str());
+        // One file per vehicle: this command's block replaces its previous one, sl-calib
+        // shadow's [calib] block is kept.
+        std::string why;
+        if (!sl::write_calib_block(a.out_ini, "elongation", o.str(), "[detect]", &why)) {
+            std::fprintf(stderr, "sl-calib: cannot write %s: %s\n", a.out_ini.c_str(), why.c_str());
             return 1;
         }
         std::printf("  wrote %s\n", a.out_ini.c_str());

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 // shadow_cmd.cpp: `sl-calib shadow` (see main.cpp for the usage text).
 #include "calib_cmds.h"
+#include "calib_ini.h"
 
 #include <cmath>
 #include <filesystem>
@@ -348,10 +349,18 @@ int cmd_shadow(const ShadowArgs &a)
                     sct.reason.c_str());
     }
     if (!a.out_ini.empty()) {
-        std::ofstream o(a.out_ini);
-        o << shadow_calib_ini(c, board.name, a.input, bth);
-        if (!o) {
-            std::fprintf(stderr, "sl-calib: cannot write %s\n", a.out_ini.c_str());
+        // One file per vehicle: this command's block ([calib]: theta per azimuth, with
+        // provenance) replaces its previous one, sl-calib elongation's block is kept.
+        std::string text = shadow_calib_ini(c, board.name, a.input, bth);
+        const std::string prov = "version = 1\ntool = " + sl::calib_tool_version() + "\ndate = " +
+                                 sl::calib_utc_date() + "\n";
+        const size_t at = text.find("[calib]\n");
+        if (at != std::string::npos) {
+            text.insert(at + 8, prov);
+        }
+        std::string why;
+        if (!sl::write_calib_block(a.out_ini, "shadow", text, "[calib]", &why)) {
+            std::fprintf(stderr, "sl-calib: cannot write %s: %s\n", a.out_ini.c_str(), why.c_str());
             return 1;
         }
         std::printf("  wrote %s\n", a.out_ini.c_str());

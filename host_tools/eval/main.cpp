@@ -43,9 +43,11 @@ void usage(FILE *out)
                  "  sl-eval run CAPTURE.colossus GT.csv [--board NAME] [--scene SCENE.ini]\n"
                  "             [--threshold T] [--beta DEG] [--raw|--half-bin] [--r1-add M] [--d M]\n"
                  "             [--extract bbox|pipeline] [--beam-deg DEG] [--speed M/S] [--no-width-radius]\n"
+                 "             [--calibration FILE]\n"
                  "      Evaluates one capture made by sl-sim against its ground truth (raw or pcap, streamed;\n"
-                 "      - = stdin). --extract pipeline:\n"
-                 "      the core pipeline (beam, threshold and speed from --scene, or the options).\n"
+                 "      - = stdin). --extract pipeline: the core pipeline (beam, threshold and speed from\n"
+                 "      --scene, or the options); --calibration: on the board's calibrated view (a vehicle's\n"
+                 "      INI or blob).\n"
                  "  sl-eval driveby [--board NAME] [--quick] [--realistic] [--speeds A,B] [--check]\n"
                  "      3D tilt (psi, phi, base offset) fitted over simulated drive-bys against the truth.\n"
                  "Progress goes to stderr when it is a terminal; -q/--quiet silences it.\n");
@@ -228,7 +230,7 @@ bool stream_file(const std::string &path, const sl::CaptureDataFn &on_data, cons
 
 int cmd_run(int argc, char **argv)
 {
-    std::string cap, gtp, board, scene_path;
+    std::string cap, gtp, board, scene_path, calibration;
     double threshold = -1, beta = 0, r1_add = 0, d = 0;
     sl::Proc::Bounds bounds = sl::Proc::Bounds::HalfBin;
     bool pipeline = false, no_width_radius = false;
@@ -260,6 +262,8 @@ int cmd_run(int argc, char **argv)
             no_width_radius = true;
         } else if (a == "--board") {
             board = next();
+        } else if (a == "--calibration") {
+            calibration = next();
         } else if (a == "--scene") {
             scene_path = next();
         } else if (a == "--threshold") {
@@ -307,6 +311,7 @@ int cmd_run(int argc, char **argv)
         } else {
             pc.board = b.name;
         }
+        pc.calibration = calibration; // the vehicle's calibration (INI or blob), if any
         if (beam_deg > 0) {
             pc.beam_deg = beam_deg;
         }

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 // sim_eval.cpp: see sim_eval.h.
 #include "sim_eval.h"
+#include "calib_board.h"
 
 #include <algorithm>
 #include <chrono>
@@ -443,10 +444,12 @@ PipelineEval::PipelineEval(const PipeCfg &c) : m_(new Impl)
 {
     m_->cfg = c;
     m_->period_us = static_cast<uint64_t>(std::llround(1e6 / (c.rotation_hz > 0 ? c.rotation_hz : 4.0)));
-    const sl_board_t *b = sl_board_find(c.board.c_str());
-    if (b == nullptr) {
+    const sl_board_t *b = nullptr;
+    try {
+        b = core_board(c.board, c.calibration); // the linked board, or its calibrated view
+    } catch (...) {
         delete m_;
-        throw std::runtime_error("board " + c.board + " is not linked into the core (sl_board_find)");
+        throw;
     }
     sl_pipeline_cfg_t pc;
     sl_pipeline_cfg_default(&pc, b);

@@ -153,6 +153,7 @@ extern const char *const kPipelineLabel;
 /// Configuration of one pipeline evaluation.
 struct PipeCfg {
     std::string board;          ///< core board (sl_board_find), e.g. "paper-sim"
+    std::string calibration;    ///< the vehicle's calibration file (INI or blob; "" = none)
     double beam_deg = 0;        ///< detection beam width (cfg.detect.beam_width_cdeg); 0 = default 1.8
     int threshold = -1;         ///< occupied = value >= this; < 0 = the board's
     double speed_mps = 0;       ///< vehicle speed given to sl_pipeline_set_motion

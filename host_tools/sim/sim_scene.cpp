@@ -2,6 +2,7 @@
 // sim_scene.cpp: scene files (INI, parsed with inih) -> sl::Scene, with validation.
 #include "sim_scene.h"
 
+#include <filesystem>
 #include <ini.h>
 
 #include <cmath>
@@ -177,6 +178,12 @@ Scene build(const Parsed &p)
             c.fail("board", "missing (required)");
         }
         s.board_name = c.str("board", "");
+        // A board file named by a relative path is found beside the scene file (a test's
+        // vehicle whose true body differs from its nominal board), not in the caller's cwd.
+        const std::filesystem::path bp(s.board_name);
+        if (bp.extension() == ".ini" && bp.is_relative() && !p.file.empty()) {
+            s.board_name = (std::filesystem::path(p.file).parent_path() / bp).lexically_normal().string();
+        }
         s.bin_size_override_m = c.real("bin_size_m", 0, 0.0001, 1.0);
         s.range_bins_override = static_cast<int>(c.integer("range_bins", 0, 32, 65535));
         s.rotations = static_cast<int>(c.integer("rotations", s.rotations, 1, 1000000));

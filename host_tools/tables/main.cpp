@@ -26,6 +26,8 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "calib_file.h"
+#include "shadowlean/sl_calblob.h"
 #include "sl_board_spec.h"
 #include "sl_cli.h"
 #include "sl_dbc.h"
@@ -89,6 +91,8 @@ struct Tables {
     std::vector<int> theta_cdeg;
     std::vector<uint32_t> shadow_um;
     std::vector<unsigned> shadow_bins;
+    std::vector<int16_t> theta_cdeg16;   // the same, in the core's types
+    std::vector<uint16_t> shadow_bins16;
 };
 
 Tables make_tables(const sl::BoardSpec &b)
@@ -103,6 +107,8 @@ Tables make_tables(const sl::BoardSpec &b)
         // Last bin wholly inside the ground shadow: bin k spans [k b, (k+1) b).
         const long long last = static_cast<long long>(std::floor(r / b.bin_size_m)) - 1;
         t.shadow_bins.push_back(static_cast<unsigned>(std::max(0LL, std::min(last, 65535LL))));
+        t.theta_cdeg16.push_back(static_cast<int16_t>(t.theta_cdeg.back()));
+        t.shadow_bins16.push_back(static_cast<uint16_t>(t.shadow_bins.back()));
     }
     return t;
 }
@@ -143,17 +149,66 @@ void write_header(const sl::BoardSpec &b, const std::string &path, const std::st
       << "#ifdef __cplusplus\n}\n#endif\n\n#endif\n";
 }
 
-void write_source(const sl::BoardSpec &b, const Tables &t, const std::string &path,
-                  const std::string &ban)
+// The board as the core sees it (the one mapping from the board file's units to the core's
+// integers): printed by write_source(), serialised by --blob. Arrays point into `t`.
+sl_board_t make_board(const sl::BoardSpec &b, const Tables &t, const std::string &name)
 {
-    const std::string c = c_name(b.name);
+    auto um = [](double m) { return rnd(m * 1e6); };
+    auto cdeg = [](double d) { return rnd(d * 100.0); };
+    sl_board_t v{};
+    v.name = name.c_str();
+    v.radar_height_um = static_cast<uint32_t>(um(b.radar_height_m));
+    v.radar_x_um = static_cast<int32_t>(um(b.radar_x_m));
+    v.radar_y_um = static_cast<int32_t>(um(b.radar_y_m));
+    v.radar_yaw_cdeg = static_cast<int32_t>(cdeg(b.radar_yaw_deg));
+    v.beta_up_cdeg = static_cast<int32_t>(cdeg(b.beta_up_deg));
+    v.lower_bound_cdeg = static_cast<int32_t>(cdeg(b.lower_bound_deg));
+    v.azimuths = static_cast<uint16_t>(b.azimuths);
+    v.encoder_size = static_cast<uint16_t>(b.encoder_size);
+    v.bin_size_um = static_cast<uint32_t>(um(b.bin_size_m));
+    v.range_bins = static_cast<uint16_t>(b.range_bins);
+    v.roi_bins = static_cast<uint16_t>(b.roi_bins);
+    v.max_message_bytes = static_cast<uint32_t>(b.max_message_bytes);
+    v.near_exclusion_bins = static_cast<uint16_t>(std::ceil(b.near_exclusion_m / b.bin_size_m - 1e-9));
+    v.threshold = static_cast<uint16_t>(b.threshold);
+    v.mask_frames = static_cast<uint8_t>(b.mask_frames);
+    v.max_targets = static_cast<uint8_t>(b.max_targets);
+    v.pole_radius_um = static_cast<uint32_t>(um(b.pole_radius_m));
+    v.range_sigma_um = static_cast<uint16_t>(um(b.range_sigma_m));
+    v.theta_sigma_cdeg = static_cast<uint16_t>(cdeg(b.theta_sigma_deg));
+    v.caution_lean_cdeg = static_cast<int32_t>(cdeg(b.caution_lean_deg));
+    v.danger_lean_cdeg = static_cast<int32_t>(cdeg(b.danger_lean_deg));
+    v.track_timeout_us = static_cast<uint32_t>(rnd(b.track_timeout_s * 1e6));
+    v.elong_points = static_cast<uint8_t>(b.elongation.size());
+    for (size_t i = 0; i < b.elongation.size(); i++) {
+        v.elong_range_um[i] = static_cast<uint32_t>(um(b.elongation[i].range_m));
+        v.elong_d_um[i] = static_cast<int32_t>(um(b.elongation[i].d_m));
+    }
+    v.can_bitrate = static_cast<uint32_t>(b.can_bitrate);
+    v.can_id_pole_lean = static_cast<uint32_t>(b.can_id_pole_lean);
+    v.can_id_lean_warning = static_cast<uint32_t>(b.can_id_lean_warning);
+    v.can_id_status = static_cast<uint32_t>(b.can_id_status);
+    v.can_id_vehicle_motion = static_cast<uint32_t>(b.can_id_vehicle_motion);
+    v.can_id_health = static_cast<uint32_t>(b.can_id_health);
+    v.can_id_pole_tilt = static_cast<uint32_t>(b.can_id_pole_tilt);
+    v.geom = t.geom.data();
+    v.theta_cdeg = t.theta_cdeg16.data();
+    v.shadow_um = t.shadow_um.data();
+    v.shadow_bins = t.shadow_bins16.data();
+    return v;
+}
+
+void write_source(const sl_board_t &v, const std::string &path, const std::string &ban)
+{
+    const std::string c = c_name(v.name);
+    const int n = v.azimuths;
     std::ofstream o(path);
     o << ban << "#include \"sl_board_" << c << ".h\"\n\n";
     o << "// Per azimuth: cos/sin theta, cos/sin beta, cos/sin (theta + beta) in Q2.30,\n"
       << "// rho_amb, rho_seam in UQ4.28, theta, beta as 32-bit binary angles.\n";
-    o << "static const sl_incline_geom_t geom[" << b.azimuths << "] = {\n";
-    for (int i = 0; i < b.azimuths; i++) {
-        const sl_incline_geom_t &g = t.geom[static_cast<size_t>(i)];
+    o << "static const sl_incline_geom_t geom[" << n << "] = {\n";
+    for (int i = 0; i < n; i++) {
+        const sl_incline_geom_t &g = v.geom[static_cast<size_t>(i)];
         o << "    {" << g.cos_theta_q30 << ", " << g.sin_theta_q30 << ", " << g.cos_beta_q30 << ", "
           << g.sin_beta_q30 << ", " << g.cos_tb_q30 << ", " << g.sin_tb_q30 << ", "
           << g.rho_amb_q28 << "u, " << g.rho_seam_q28 << "u, " << hex32(g.theta_bam32) << "u, "
@@ -161,66 +216,63 @@ void write_source(const sl::BoardSpec &b, const Tables &t, const std::string &pa
     }
     o << "};\n\n";
     auto arr = [&](const char *type, const char *nm, auto get, int per_line) {
-        o << "static const " << type << " " << nm << "[" << b.azimuths << "] = {";
-        for (int i = 0; i < b.azimuths; i++) {
+        o << "static const " << type << " " << nm << "[" << n << "] = {";
+        for (int i = 0; i < n; i++) {
             if (i % per_line == 0) {
                 o << "\n    ";
             }
-            o << get(static_cast<size_t>(i)) << (i + 1 < b.azimuths ? "," : "");
-            if (i + 1 < b.azimuths && (i + 1) % per_line != 0) {
+            o << get(static_cast<size_t>(i)) << (i + 1 < n ? "," : "");
+            if (i + 1 < n && (i + 1) % per_line != 0) {
                 o << " ";
             }
         }
         o << "\n};\n\n";
     };
-    arr("int16_t", "theta_cdeg", [&](size_t i) { return std::to_string(t.theta_cdeg[i]); }, 10);
-    arr("uint32_t", "shadow_um", [&](size_t i) { return std::to_string(t.shadow_um[i]) + "u"; }, 8);
-    arr("uint16_t", "shadow_bins", [&](size_t i) { return std::to_string(t.shadow_bins[i]) + "u"; }, 12);
+    arr("int16_t", "theta_cdeg", [&](size_t i) { return std::to_string(v.theta_cdeg[i]); }, 10);
+    arr("uint32_t", "shadow_um", [&](size_t i) { return std::to_string(v.shadow_um[i]) + "u"; }, 8);
+    arr("uint16_t", "shadow_bins", [&](size_t i) { return std::to_string(v.shadow_bins[i]) + "u"; }, 12);
 
-    auto um = [](double m) { return rnd(m * 1e6); };
-    auto cdeg = [](double d) { return rnd(d * 100.0); };
-    const unsigned near_bins = static_cast<unsigned>(std::ceil(b.near_exclusion_m / b.bin_size_m - 1e-9));
     o << "const sl_board_t sl_board_" << c << " = {\n"
-      << "    .name = \"" << b.name << "\",\n"
-      << "    .radar_height_um = " << um(b.radar_height_m) << "u,\n"
-      << "    .radar_x_um = " << um(b.radar_x_m) << ",\n"
-      << "    .radar_y_um = " << um(b.radar_y_m) << ",\n"
-      << "    .radar_yaw_cdeg = " << cdeg(b.radar_yaw_deg) << ",\n"
-      << "    .beta_up_cdeg = " << cdeg(b.beta_up_deg) << ",\n"
-      << "    .lower_bound_cdeg = " << cdeg(b.lower_bound_deg) << ",\n"
-      << "    .azimuths = " << b.azimuths << "u,\n"
-      << "    .encoder_size = " << b.encoder_size << "u,\n"
-      << "    .bin_size_um = " << um(b.bin_size_m) << "u,\n"
-      << "    .range_bins = " << b.range_bins << "u,\n"
-      << "    .roi_bins = " << b.roi_bins << "u,\n"
-      << "    .max_message_bytes = " << b.max_message_bytes << "u,\n"
-      << "    .near_exclusion_bins = " << near_bins << "u,\n"
-      << "    .threshold = " << b.threshold << "u,\n"
-      << "    .mask_frames = " << b.mask_frames << "u,\n"
-      << "    .max_targets = " << b.max_targets << "u,\n"
-      << "    .pole_radius_um = " << um(b.pole_radius_m) << "u,\n"
-      << "    .range_sigma_um = " << um(b.range_sigma_m) << "u,\n"
-      << "    .theta_sigma_cdeg = " << cdeg(b.theta_sigma_deg) << "u,\n"
-      << "    .caution_lean_cdeg = " << cdeg(b.caution_lean_deg) << ",\n"
-      << "    .danger_lean_cdeg = " << cdeg(b.danger_lean_deg) << ",\n"
-      << "    .track_timeout_us = " << rnd(b.track_timeout_s * 1e6) << "u,\n"
-      << "    .elong_points = " << b.elongation.size() << "u,\n"
+      << "    .name = \"" << v.name << "\",\n"
+      << "    .radar_height_um = " << v.radar_height_um << "u,\n"
+      << "    .radar_x_um = " << v.radar_x_um << ",\n"
+      << "    .radar_y_um = " << v.radar_y_um << ",\n"
+      << "    .radar_yaw_cdeg = " << v.radar_yaw_cdeg << ",\n"
+      << "    .beta_up_cdeg = " << v.beta_up_cdeg << ",\n"
+      << "    .lower_bound_cdeg = " << v.lower_bound_cdeg << ",\n"
+      << "    .azimuths = " << v.azimuths << "u,\n"
+      << "    .encoder_size = " << v.encoder_size << "u,\n"
+      << "    .bin_size_um = " << v.bin_size_um << "u,\n"
+      << "    .range_bins = " << v.range_bins << "u,\n"
+      << "    .roi_bins = " << v.roi_bins << "u,\n"
+      << "    .max_message_bytes = " << v.max_message_bytes << "u,\n"
+      << "    .near_exclusion_bins = " << v.near_exclusion_bins << "u,\n"
+      << "    .threshold = " << v.threshold << "u,\n"
+      << "    .mask_frames = " << unsigned{v.mask_frames} << "u,\n"
+      << "    .max_targets = " << unsigned{v.max_targets} << "u,\n"
+      << "    .pole_radius_um = " << v.pole_radius_um << "u,\n"
+      << "    .range_sigma_um = " << v.range_sigma_um << "u,\n"
+      << "    .theta_sigma_cdeg = " << v.theta_sigma_cdeg << "u,\n"
+      << "    .caution_lean_cdeg = " << v.caution_lean_cdeg << ",\n"
+      << "    .danger_lean_cdeg = " << v.danger_lean_cdeg << ",\n"
+      << "    .track_timeout_us = " << v.track_timeout_us << "u,\n"
+      << "    .elong_points = " << unsigned{v.elong_points} << "u,\n"
       << "    .elong_range_um = {";
-    for (size_t i = 0; i < b.elongation.size(); i++) {
-        o << (i ? ", " : "") << um(b.elongation[i].range_m) << "u";
+    for (size_t i = 0; i < v.elong_points; i++) {
+        o << (i ? ", " : "") << v.elong_range_um[i] << "u";
     }
-    o << (b.elongation.empty() ? "0u" : "") << "},\n    .elong_d_um = {";
-    for (size_t i = 0; i < b.elongation.size(); i++) {
-        o << (i ? ", " : "") << um(b.elongation[i].d_m);
+    o << (v.elong_points == 0 ? "0u" : "") << "},\n    .elong_d_um = {";
+    for (size_t i = 0; i < v.elong_points; i++) {
+        o << (i ? ", " : "") << v.elong_d_um[i];
     }
-    o << (b.elongation.empty() ? "0" : "") << "},\n"
-      << "    .can_bitrate = " << b.can_bitrate << "u,\n"
-      << "    .can_id_pole_lean = " << b.can_id_pole_lean << "u,\n"
-      << "    .can_id_lean_warning = " << b.can_id_lean_warning << "u,\n"
-      << "    .can_id_status = " << b.can_id_status << "u,\n"
-      << "    .can_id_vehicle_motion = " << b.can_id_vehicle_motion << "u,\n"
-      << "    .can_id_health = " << b.can_id_health << "u,\n"
-      << "    .can_id_pole_tilt = " << b.can_id_pole_tilt << "u,\n"
+    o << (v.elong_points == 0 ? "0" : "") << "},\n"
+      << "    .can_bitrate = " << v.can_bitrate << "u,\n"
+      << "    .can_id_pole_lean = " << v.can_id_pole_lean << "u,\n"
+      << "    .can_id_lean_warning = " << v.can_id_lean_warning << "u,\n"
+      << "    .can_id_status = " << v.can_id_status << "u,\n"
+      << "    .can_id_vehicle_motion = " << v.can_id_vehicle_motion << "u,\n"
+      << "    .can_id_health = " << v.can_id_health << "u,\n"
+      << "    .can_id_pole_tilt = " << v.can_id_pole_tilt << "u,\n"
       << "    .geom = geom,\n"
       << "    .theta_cdeg = theta_cdeg,\n"
       << "    .shadow_um = shadow_um,\n"
@@ -308,9 +360,68 @@ void write_png(const sl::BoardSpec &b, const std::string &path)
     }
 }
 
-int generate(const std::string &board, std::string out_dir, std::string png, bool no_png)
+// The calibrated view of `nominal`: from FILE (INI or blob, calib_file.h) or, without one,
+// the nominal board itself; validated by the core exactly as a firmware would. The blob
+// bytes end up in `bytes` (the view's tables may point into them: keep them alive).
+sl_board_t calibrated(const sl_board_t &nominal, const std::string &calib, std::vector<uint8_t> &bytes)
+{
+    static sl_calblob_ws_t ws;
+    if (calib.empty()) {
+        bytes.assign(SL_CALBLOB_BYTES(nominal.azimuths), 0);
+        const sl_ssize_t n = sl_calblob_write(&nominal, bytes.data(), bytes.size());
+        if (n < 0) {
+            throw std::runtime_error(std::string("blob: ") + sl_err_str(static_cast<sl_err_t>(n)));
+        }
+    } else {
+        uint8_t *raw = nullptr;
+        size_t len = 0;
+        char err[512];
+        if (calib_file_load(calib.c_str(), &nominal, &raw, &len, err, sizeof err) != 0) {
+            throw std::runtime_error(std::string("calibration ") + err);
+        }
+        bytes.assign(raw, raw + len);
+        std::free(raw);
+    }
+    sl_board_t v{};
+    sl_calblob_info_t info{};
+    const sl_err_t e = sl_calblob_open(bytes.data(), bytes.size(), &nominal, &ws, &v, &info);
+    if (e != SL_OK) {
+        throw std::runtime_error("calibration " + calib + " rejected for board " + nominal.name + ": " +
+                                 sl_err_str(e) + " (" + (info.what ? info.what : "?") + ", entry " +
+                                 std::to_string(info.index) + ")");
+    }
+    return v;
+}
+
+int generate(const std::string &board, std::string out_dir, std::string png, bool no_png,
+             const std::string &calib, const std::string &blob_out)
 {
     const sl::BoardSpec b = sl::load_board(board);
+    const Tables t = make_tables(b);
+    const sl_board_t nominal = make_board(b, t, b.name);
+    std::vector<uint8_t> bytes;
+    const sl_board_t v = calibrated(nominal, calib, bytes);
+    const std::string calib_name = std::filesystem::path(calib).filename().string();
+    if (!blob_out.empty()) {
+        std::ofstream f(blob_out, std::ios::binary);
+        f.write(reinterpret_cast<const char *>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+        if (!f) {
+            throw std::runtime_error("cannot write " + blob_out);
+        }
+        int tmin = 1 << 30, tmax = -(1 << 30);
+        for (size_t i = 0; i < v.azimuths; i++) {
+            tmin = std::min(tmin, static_cast<int>(v.theta_cdeg[i]));
+            tmax = std::max(tmax, static_cast<int>(v.theta_cdeg[i]));
+        }
+        std::cout << b.name << ": calibration blob (" << bytes.size() << " bytes, "
+                  << (calib.empty() ? std::string("nominal board") : calib_name) << ", theta "
+                  << tmin / 100.0 << " .. " << tmax / 100.0 << " deg) -> " << blob_out << "\n";
+        return 0;
+    }
+    if (!calib.empty() && out_dir.empty()) {
+        throw std::runtime_error("--calibration bakes calibrated tables: name the directory with --out "
+                                 "(the committed boards/ tables stay nominal), or write --blob OUT");
+    }
     if (out_dir.empty()) {
         out_dir = sl::board_dir(board);
     }
@@ -319,11 +430,18 @@ int generate(const std::string &board, std::string out_dir, std::string png, boo
     }
     std::filesystem::create_directories(out_dir);
     const std::string rel_ini = "boards/" + b.name + "/board.ini";
-    const std::string ban = banner(b, rel_ini, fnv1a64(slurp(b.source_file)));
-    const Tables t = make_tables(b);
+    std::string ban = banner(b, rel_ini, fnv1a64(slurp(b.source_file)));
+    if (!calib.empty()) {
+        std::ostringstream cb;
+        const uint32_t crc = static_cast<uint32_t>(bytes[12]) | static_cast<uint32_t>(bytes[13]) << 8 |
+                             static_cast<uint32_t>(bytes[14]) << 16 | static_cast<uint32_t>(bytes[15]) << 24;
+        cb << "// Calibrated with " << calib_name << " (blob CRC-32 " << hex32(crc)
+           << "): per-vehicle tables baked in.\n";
+        ban += cb.str();
+    }
     const std::string base = out_dir + "/sl_board_" + c_name(b.name);
     write_header(b, base + ".h", ban);
-    write_source(b, t, base + ".c", ban);
+    write_source(v, base + ".c", ban);
     {
         // The CAN interface of the board: the DBC, from the core's own layout table.
         std::ofstream dbc(out_dir + "/shadowlean.dbc");
@@ -347,9 +465,14 @@ int generate(const std::string &board, std::string out_dir, std::string png, boo
 
 void usage(FILE *f)
 {
-    std::fputs("usage: sl-tables BOARD [--out DIR] [--png FILE] [--no-png]\n"
+    std::fputs("usage: sl-tables BOARD [--out DIR] [--png FILE] [--no-png] [--calibration FILE]\n"
+               "       sl-tables BOARD --blob OUT [--calibration FILE]\n"
                "       sl-tables --all [--no-png]\n"
-               "BOARD: a name under boards/ or a path to a board.ini\n",
+               "BOARD: a name under boards/ or a path to a board.ini\n"
+               "--calibration FILE: a vehicle's calibration (INI from sl-calib --out-ini, or a blob),\n"
+               "    validated against BOARD; baked into the tables written to --out DIR\n"
+               "--blob OUT: write the calibration blob the core loads at run time (sl_calblob.h;\n"
+               "    shadowleand --calibration OUT) instead of tables: BOARD's own without --calibration\n",
                f);
 }
 
@@ -357,7 +480,7 @@ void usage(FILE *f)
 
 int main(int argc, char **argv)
 {
-    std::string board, out, png;
+    std::string board, out, png, calib, blob;
     bool all = false, no_png = false;
     const int info = sl_cli_info(argc, argv, "sl-tables", usage);
     if (info != SL_CLI_CONTINUE) {
@@ -365,13 +488,17 @@ int main(int argc, char **argv)
     }
     for (int i = 1; i < argc; i++) {
         const std::string a = argv[i];
-        if ((a == "--out" || a == "--png") && i + 1 >= argc) {
+        if ((a == "--out" || a == "--png" || a == "--calibration" || a == "--blob") && i + 1 >= argc) {
             return sl_cli_bad_value("sl-tables", a.c_str(), "needs a value", usage);
         }
         if (a == "--out" && i + 1 < argc) {
             out = argv[++i];
         } else if (a == "--png" && i + 1 < argc) {
             png = argv[++i];
+        } else if (a == "--calibration" && i + 1 < argc) {
+            calib = argv[++i];
+        } else if (a == "--blob" && i + 1 < argc) {
+            blob = argv[++i];
         } else if (a == "--no-png") {
             no_png = true;
         } else if (a == "--all") {
@@ -392,14 +519,14 @@ int main(int argc, char **argv)
             }
             std::sort(names.begin(), names.end());
             for (const auto &n : names) {
-                generate(n, "", "", no_png);
+                generate(n, "", "", no_png, "", "");
             }
             return 0;
         }
         if (board.empty()) {
             return sl_cli_usage_error("sl-tables", "missing BOARD (or --all)", usage);
         }
-        return generate(board, out, png, no_png);
+        return generate(board, out, png, no_png, calib, blob);
     } catch (const std::exception &e) {
         std::cerr << "sl-tables: " << e.what() << "\n";
         return 1;

@@ -46,6 +46,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
 
+#include "calib_board.h"
 #include "calib_shadow.h"
 #include "sl_cli.h"
 #include "sl_progress.h"
@@ -66,7 +67,7 @@ namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 struct Args {
-    std::string input, board, out, truth, calib, elongation, title;
+    std::string input, board, out, truth, calib, calibration, elongation, title;
     int rotation = -1;
     bool all = false, quiet = false;
     double roi_m = 0, vmax = 0, fps = 4, bin_size_m = 0;
@@ -81,9 +82,11 @@ void usage(FILE *out)
         "usage: sl-view CAPTURE|OXFORD_DIR --board NAME --out FILE.png|FILE.mp4|FILE.avi\n"
         "               [--rotation K | --all] [--truth GT.csv] [--calib CALIB.ini]\n"
         "               [--roi-m M] [--mask-frames N] [--threshold T] [--vmax V] [--fps F]\n"
-        "               [--bin-size-m M] [--elongation D.ini] [--title TEXT] [--motion V[,W]]\n"
-        "               [-q|--quiet]\n"
+        "               [--bin-size-m M] [--elongation D.ini] [--calibration FILE] [--title TEXT]\n"
+        "               [--motion V[,W]] [-q|--quiet]\n"
         "  --all: progress on stderr when it is a terminal (-q/--quiet: none).\n"
+        "  --calibration FILE: detect on the board's calibrated view (a vehicle's calibration INI\n"
+        "  from sl-calib --out-ini, or a blob from sl-tables --blob)\n"
         "  --motion V[,W]: run the core pipeline with this constant motion (m/s, deg/s; as\n"
         "  shadowleand --motion) and draw the fitted 3D tilt of each pole in the top view:\n"
         "  base, an arrow to the top of a 4 m pole, tilt and direction (CCW from forward).\n",
@@ -425,7 +428,7 @@ int main(int argc, char **argv)
     if (info != SL_CLI_CONTINUE) {
         return info;
     }
-    static const char *const with_value[] = {"--board", "--out", "--truth", "--calib", "--motion",
+    static const char *const with_value[] = {"--board", "--out", "--truth", "--calib", "--calibration", "--motion",
                                              "--elongation", "--title", "--rotation", "--roi-m",
                                              "--vmax", "--fps", "--bin-size-m", "--mask-frames",
                                              "--threshold"};
@@ -449,6 +452,8 @@ int main(int argc, char **argv)
             a.truth = argv[++i];
         } else if (o == "--calib" && has) {
             a.calib = argv[++i];
+        } else if (o == "--calibration" && has) {
+            a.calibration = argv[++i];
         } else if (o == "--elongation" && has) {
             a.elongation = argv[++i];
         } else if (o == "--title" && has) {
@@ -513,6 +518,15 @@ int main(int argc, char **argv)
         return 1;
     }
     sc.core_board = sl_board_find(sc.board.name.c_str());
+    if (!a.calibration.empty()) {
+        // --calibration: the detector runs on the board's calibrated view (INI or blob).
+        try {
+            sc.core_board = sl::core_board(sc.board.name, a.calibration);
+        } catch (const std::exception &e) {
+            std::fprintf(stderr, "sl-view: %s\n", e.what());
+            return 1;
+        }
+    }
     // --elongation: the detector runs on a copy of the linked board with this d(r) table
     // (the calibration loop without regenerating the board tables).
     sl_board_t board_copy{};

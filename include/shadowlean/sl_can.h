@@ -107,7 +107,8 @@
 /// | 16 | 16 | Fault             | u | bitfield | SL_CAN_FAULT_* below, one bit per condition |
 /// | 32 | 8  | Reconnects        | u | 0..255   | radar link re-opened since start (saturating) |
 /// | 40 | 12 | CandidatesDropped | u | 0..4095  | detection candidates dropped for lack of target slots (saturating) |
-/// | 52 | 12 | (reserved)        |   | 0        | |
+/// | 52 | 8  | ThetaDrift        | s | -12.8..12.7 deg, 0.1 deg | live theta minus the loaded calibration's (sl_drift.h); 0 while there is no estimate; saturating |
+/// | 60 | 4  | (reserved)        |   | 0        | |
 ///
 /// Fault bits (the DBC carries a value table naming each bit's value): a bit is set in a
 /// Health frame when its condition held at any time since the previous Health frame, or
@@ -131,6 +132,9 @@
 ///   radar). Sustained: 48 frames x ~130 bits per 100 ms, under 13 % of a 500 kbit/s bus;
 ///   in any 100 ms at most (SL_CAN_BURST_WINDOWS + 1) x 48 frames, whatever the input.
 /// - bit8 TARGET_SLOTS_OVERFLOW: detection had more candidates than target slots.
+/// - bit9 THETA_DRIFT: the live ground-return start says theta differs from the loaded
+///   calibration's by more than 1 deg, for SL_DRIFT_PERSIST rotations (sl_drift.h): the
+///   mount moved or the vehicle is loaded; every lean is skewed by about the ThetaDrift value.
 ///
 /// ## PoleTilt (board `can.id_pole_tilt`, SHADOWLEAN -> VEHICLE, one frame per tracked pole while driving)
 ///
@@ -321,7 +325,8 @@ typedef enum sl_can_link_state {
 #define SL_CAN_FAULT_AZIMUTH_DISORDER 0x0040U
 #define SL_CAN_FAULT_CAN_RATE_LIMITED 0x0080U
 #define SL_CAN_FAULT_TARGET_SLOTS_OVERFLOW 0x0100U
-#define SL_CAN_FAULT_DEFINED 0x01FFU ///< bits 9..15 are reserved (sent as 0)
+#define SL_CAN_FAULT_THETA_DRIFT 0x0200U
+#define SL_CAN_FAULT_DEFINED 0x03FFU ///< bits 10..15 are reserved (sent as 0)
 
 /// LINK_FLAPPING: this many reconnects within this window.
 #define SL_CAN_FLAP_RECONNECTS 3U
@@ -376,6 +381,9 @@ typedef enum sl_can_link_state {
 #define SL_CAN_STATUS_DROPPED_MAX 255UL
 #define SL_CAN_HEALTH_RECONNECTS_MAX 255UL
 #define SL_CAN_HEALTH_CANDIDATES_DROPPED_MAX 4095UL
+#define SL_CAN_HEALTH_DRIFT_CDEG_PER_LSB 10   ///< 0.1 deg
+#define SL_CAN_HEALTH_DRIFT_RAW_MIN (-128)
+#define SL_CAN_HEALTH_DRIFT_RAW_MAX 127
 
 #define SL_CAN_MOTION_SPEED_MM_S_PER_LSB 10  ///< 0.01 m/s
 #define SL_CAN_MOTION_YAW_CDEG_S_PER_LSB 1   ///< 0.01 deg/s
@@ -446,6 +454,7 @@ typedef struct sl_can_health {
     uint16_t fault;              ///< in: SL_CAN_FAULT_* bits (reserved bits are sent as 0)
     uint32_t reconnects;         ///< in: radar link reconnects since start (saturates at 255)
     uint32_t candidates_dropped; ///< in: candidates dropped for lack of target slots (4095)
+    int16_t theta_drift_cdeg;    ///< in: ThetaDrift, 0.01 deg (sent in 0.1 deg, saturating)
     uint8_t counter;             ///< decode only
 } sl_can_health_t;
 

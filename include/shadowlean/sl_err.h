@@ -32,6 +32,15 @@ typedef enum sl_err {
     SL_ERR_PORT = -7,      ///< the port (OS, device) reported a failure
     SL_ERR_RANGE = -8,     ///< a value does not fit the target's documented range
     SL_ERR_STATE = -9,     ///< the call is not valid in the object's current state
+    // Calibration blob (sl_calblob.h): one code per failed check.
+    SL_ERR_CAL_SIZE = -10,      ///< blob truncated, or its size fields are inconsistent
+    SL_ERR_CAL_MAGIC = -11,     ///< not a calibration blob (magic)
+    SL_ERR_CAL_VERSION = -12,   ///< a blob format version this core does not read
+    SL_ERR_CAL_CRC = -13,       ///< CRC-32 mismatch: the blob is corrupt
+    SL_ERR_CAL_BOARD = -14,     ///< made for another board (name or identity hash)
+    SL_ERR_CAL_AZIMUTHS = -15,  ///< azimuth count differs from the board's
+    SL_ERR_CAL_VALUE = -16,     ///< a calibrated value is out of its range
+    SL_ERR_CAL_WORKSPACE = -17, ///< cannot be read in place and no workspace was given
 } sl_err_t;
 
 /// Signed size: >= 0 is a count, < 0 is an `sl_err_t`.

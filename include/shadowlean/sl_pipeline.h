@@ -127,12 +127,12 @@
 /// SL_CFG_MASK_BINS / 8 bytes; then detection (8,424 B), the tracker (1,864 B), the scan
 /// bookkeeping (624 B), the range profiles (sl_profile.h, 2.1 KB), the 3D tilt history
 /// (sl_tiltobs.h: 2,472 B firmware, 7.4 KB host default), the reassembly buffer
-/// (SL_PIPELINE_REASM_BYTES) and a row buffer.
+/// (SL_PIPELINE_REASM_BYTES), a row buffer and the theta drift watch (sl_drift.h, 52 B).
 ///
 /// | configuration (400 azimuths, 32 targets)              | x86-64    | Cortex-M0 |
 /// |--------------------------------------------------------|-----------|-----------|
-/// | firmware: SL_CFG_MASK_BINS 160, SL_CFG_MASK_FRAMES_MAX 16 | 58,256 B  | 58,112 B  |
-/// | host default: mask bins 512 (whole ROI), n <= 32          | 177,896 B |           |
+/// | firmware: SL_CFG_MASK_BINS 160, SL_CFG_MASK_FRAMES_MAX 16 | 58,312 B  | 58,168 B  |
+/// | host default: mask bins 512 (whole ROI), n <= 32          | 177,952 B |           |
 ///
 /// The boards carried today need 135 (paper-sim), 119 (paper-bench) and 141 (robotcar-leaf)
 /// masked bins (sl_detect_bins_needed(), rounded up to 160).
@@ -182,6 +182,7 @@
 #include "shadowlean/sl_can.h"
 #include "shadowlean/sl_config.h"
 #include "shadowlean/sl_detect.h"
+#include "shadowlean/sl_drift.h"
 #include "shadowlean/sl_err.h"
 #include "shadowlean/sl_mask.h"
 #include "shadowlean/sl_port.h"
@@ -375,6 +376,8 @@ typedef struct sl_pipeline {
     uint32_t occ[SL_MASK_WORDS];  ///< stable-occupied row (internal)
     uint8_t row8[SL_CFG_MASK_BINS]; ///< scan's row buffer (16-bit reduction, short rows)
     uint8_t reasm[SL_PIPELINE_REASM_BYTES]; ///< decoder reassembly buffer
+    sl_drift_t drift;            ///< theta drift watch (sl_drift.h): Health.ThetaDrift, THETA_DRIFT
+                                 ///< (last: the hot fields keep their offsets)
 } sl_pipeline_t;
 
 /// RAM budget of the firmware configuration (CTS350-X: 400 azimuths, n <= 16, masked bins
@@ -403,8 +406,9 @@ _Static_assert(sizeof(sl_pipeline_t) <= sizeof(sl_mask_t) + sizeof(sl_tiltobs_t)
 #endif
 #endif
 
-/// Initialise (or completely reset) for `board` (borrowed, usually static const) with
-/// `cfg` (copied; NULL = sl_pipeline_cfg_default(board)).
+/// Initialise (or completely reset) for `board` (borrowed, usually static const; or a
+/// vehicle's calibrated view from sl_calblob_open(), whose blob must then outlive the
+/// pipeline) with `cfg` (copied; NULL = sl_pipeline_cfg_default(board)).
 /// @return SL_OK; SL_ERR_ARG (NULL, cfg out of range); SL_ERR_RANGE when the board does
 /// not fit the compile-time capacities, in particular when detection needs more bins than
 /// SL_CFG_MASK_BINS (the reason is in `p->reason` / `p->last_err_msg`, e.g. "detection

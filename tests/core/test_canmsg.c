@@ -598,8 +598,8 @@ static void test_canmsg_health_round_trips_saturates_and_keeps_reserved_bits_zer
         assert_int_equal(out.reconnects, in.reconnects);
         assert_int_equal(out.candidates_dropped, in.candidates_dropped);
         assert_int_equal(f.data[1] & 0xF0U, 0);   // reserved 12|4
-        assert_int_equal(f.data[6] & 0xF0U, 0);   // reserved 52|12
-        assert_int_equal(f.data[7], 0);
+        assert_int_equal(f.data[6] & 0xF0U, 0);   // ThetaDrift 52|8: 0 here
+        assert_int_equal(f.data[7], 0);           // ... and reserved 60|4
         assert_int_equal(f.data[0], sl_can_e2e_crc(SL_CAN_DATA_ID_HEALTH, f.data));
     }
     assert_int_equal(tx.stats.clamped_frames, 0);
@@ -626,10 +626,44 @@ static void test_canmsg_health_round_trips_saturates_and_keeps_reserved_bits_zer
     const sl_can_message_desc_t *md = sl_can_layout(SL_CAN_MSG_HEALTH);
     assert_string_equal(md->name, "Health");
     assert_int_equal(md->data_id, SL_CAN_DATA_ID_HEALTH);
-    assert_int_equal(md->signals[2].n_values, 9);
+    assert_int_equal(md->signals[2].n_values, 10); // bit 9 THETA_DRIFT (sl_drift.h)
     for (unsigned k = 0; k < md->signals[2].n_values; k++) {
         assert_int_equal(md->signals[2].values[k].value, 1U << k);
     }
+}
+
+static void test_canmsg_health_theta_drift_round_trips_and_saturates(void **state)
+{
+    (void)state;
+    sl_can_tx_t tx;
+    tx_setup(&tx);
+    sl_can_frame_t f;
+    sl_can_health_t out;
+    for (int32_t raw = -128; raw <= 127; raw++) {
+        const sl_can_health_t in = {.theta_drift_cdeg = (int16_t)(raw * 10)};
+        assert_int_equal(sl_can_encode_health(&tx, &in, &f), SL_OK);
+        assert_int_equal(sl_can_decode_health(&f, &out), SL_OK);
+        assert_int_equal(out.theta_drift_cdeg, in.theta_drift_cdeg);
+        assert_int_equal(f.data[7] & 0xF0U, 0); // reserved 60|4
+    }
+    assert_int_equal(tx.stats.clamped_frames, 0);
+    // Golden: +2.0 deg = raw 20 = 0x14 at 52|8 (little-endian bit numbering), THETA_DRIFT.
+    const sl_can_health_t g = {.fault = SL_CAN_FAULT_THETA_DRIFT, .theta_drift_cdeg = 200};
+    sl_can_encode_health(&tx, &g, &f);
+    assert_int_equal(f.data[2], 0x00);
+    assert_int_equal(f.data[3], 0x02);
+    assert_int_equal(f.data[6], 0x40);
+    assert_int_equal(f.data[7], 0x01);
+    // 0.05 deg rounds half up to 0.1; -0.05 to 0.0; beyond +-12.8 deg saturates (clamped)
+    const sl_can_health_t h1 = {.theta_drift_cdeg = 5};
+    sl_can_encode_health(&tx, &h1, &f);
+    sl_can_decode_health(&f, &out);
+    assert_int_equal(out.theta_drift_cdeg, 10);
+    const sl_can_health_t big = {.theta_drift_cdeg = -2000};
+    sl_can_encode_health(&tx, &big, &f);
+    sl_can_decode_health(&f, &out);
+    assert_int_equal(out.theta_drift_cdeg, -1280);
+    assert_int_equal(tx.stats.clamped_frames, 1);
 }
 
 static void test_canmsg_vehicle_motion_round_trips_full_range(void **state)
@@ -859,6 +893,7 @@ int main(void)
         cmocka_unit_test(test_canmsg_azimuth_wraps_modulo_a_turn_not_clamped),
         cmocka_unit_test(test_canmsg_lean_warning_round_trips_and_clamps),
         cmocka_unit_test(test_canmsg_status_counters_saturate_and_flag),
+        cmocka_unit_test(test_canmsg_health_theta_drift_round_trips_and_saturates),
         cmocka_unit_test(test_canmsg_vehicle_motion_round_trips_full_range),
         cmocka_unit_test(test_canmsg_health_round_trips_saturates_and_keeps_reserved_bits_zero),
         cmocka_unit_test(test_canmsg_counter_wraps_modulo_15_per_message),

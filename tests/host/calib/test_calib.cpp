@@ -20,9 +20,11 @@
 #include <vector>
 
 #include "calib_elong.h"
+#include "calib_file.h"
 #include "calib_shadow.h"
 #include "gen_scans.h"
 #include "sl_board_spec.h"
+#include "sl_geom.h"
 #include "view_frames.h"
 
 namespace {
@@ -401,6 +403,28 @@ int check_elong_ini(char **argv)
     return g_fail ? 1 : 0;
 }
 
+// The calibration reader (C, calib_file.c: what the daemon runs on a calibration INI) and
+// the board generator (C++, sl::make_geom: what sl-tables runs on a board file) must give
+// the same geometry entry bit for bit, or a calibrated azimuth would differ from a board's.
+void test_calib_file_geom_equals_sl_make_geom()
+{
+    long n = 0, diff = 0;
+    for (double beta : {0.0, 3.0, -5.0, 12.5}) {
+        for (int c = 100; c <= 6000; c++) {
+            const double theta = c / 100.0;
+            const sl_incline_geom_t a = calib_make_geom(theta, beta);
+            const sl_incline_geom_t b = sl::make_geom(theta, beta);
+            n++;
+            if (std::memcmp(&a, &b, sizeof a) != 0) {
+                diff++;
+            }
+        }
+    }
+    std::printf("calib_make_geom vs sl::make_geom: %ld entries, %ld differ\n", n, diff);
+    CHECK(n == 4 * 5901, "entries %ld", n);
+    CHECK(diff == 0, "%ld entries differ", diff);
+}
+
 } // namespace
 
 int main(int argc, char **argv)
@@ -422,6 +446,7 @@ int main(int argc, char **argv)
             {"shadow_reports_no_ground_edge_where_the_platform_hides_the_ground", test_shadow_reports_no_ground_edge_where_the_platform_hides_the_ground},
             {"shadow_ini_round_trips", test_shadow_ini_round_trips},
             {"elongation_recovers_d_within_1cm_over_110_positions", test_elongation_recovers_d_within_1cm_over_110_positions},
+            {"file_geom_equals_sl_make_geom", test_calib_file_geom_equals_sl_make_geom},
         };
         auto it = cases.find(c);
         if (it == cases.end()) {

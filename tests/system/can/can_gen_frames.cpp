@@ -111,12 +111,14 @@ int main(int argc, char **argv)
                    << " can_dropped=" << s.can_dropped << "\n";
             } else if (kind == 10) {
                 sl_can_health_t h{};
-                h.fault = static_cast<uint16_t>(value(0, 0x1FF, 0, 0xFFFF));
+                h.fault = static_cast<uint16_t>(value(0, 0x3FF, 0, 0xFFFF));
                 h.reconnects = static_cast<uint32_t>(value(0, 255, 0, 100000));
                 h.candidates_dropped = static_cast<uint32_t>(value(0, 4095, 0, 1000000));
+                h.theta_drift_cdeg = static_cast<int16_t>(value(-1280, 1270, -30000, 30000));
                 sl_can_encode_health(&tx, &h, &f);
                 ex << "Health fault=" << unsigned(h.fault) << " reconnects=" << h.reconnects
-                   << " candidates_dropped=" << h.candidates_dropped << "\n";
+                   << " candidates_dropped=" << h.candidates_dropped
+                   << " theta_drift_cdeg=" << h.theta_drift_cdeg << "\n";
             } else if (kind == 11) {
                 sl_can_pole_tilt_t t{};
                 t.target_id = static_cast<uint8_t>(value(0, 15, 0, 255));

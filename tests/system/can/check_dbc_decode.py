@@ -71,6 +71,7 @@ MAP = {
         "Fault": ("fault", 1, "fault"),
         "Reconnects": ("reconnects", 1, "num"),
         "CandidatesDropped": ("candidates_dropped", 1, "num"),
+        "ThetaDrift": ("theta_drift_cdeg", 100, "num"),
     },
     "PoleTilt": {
         "TargetId": ("target_id", 1, "id"),
@@ -103,7 +104,7 @@ def expected_raw(sig, kind, value):
     if kind == "flag":
         return int(value), False
     if kind == "fault":
-        return int(value) & 0x1FF, False  # bits 9..15 reserved: never sent
+        return int(value) & 0x3FF, False  # bits 10..15 reserved: never sent
     if kind in ("id", "quality", "level", "link", "tquality"):
         v = int(value)
         if v <= rmax:
