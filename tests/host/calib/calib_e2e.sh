@@ -14,9 +14,9 @@
 #  6. sl-eval and sl-view take the same --calibration (sl-eval: every pole within 1.0 deg).
 set -u
 SL_SIM=$1; SL_CALIB=$2; SL_TABLES=$3; DAEMON=$4; PY=$5; SRC=$6; OUT=$7; SL_EVAL=$8; SL_VIEW=$9
-D="$SRC/../calib/data"
-DBC="$SRC/../../boards/paper-sim/shadowlean.dbc"
-LVT="$SRC/../daemon/lean_vs_truth.py"
+D="$SRC/data"
+DBC="$SRC/../../../boards/paper-sim/shadowlean.dbc"
+LVT="$SRC/../../system/daemon/lean_vs_truth.py"
 rm -rf "$OUT"; mkdir -p "$OUT"
 fail() { echo "FAIL: $*"; exit 1; }
 

@@ -11,7 +11,7 @@
 set -u
 SL_SIM=$1; DAEMON=$2; PY=$3; SRC=$4; OUT=$5
 D="$SRC/data"
-DBC="$SRC/../../boards/paper-sim/shadowlean.dbc"
+DBC="$SRC/../../../boards/paper-sim/shadowlean.dbc"
 rm -rf "$OUT"; mkdir -p "$OUT"
 fail() { echo "FAIL: $*"; exit 1; }
 "$SL_SIM" "$D/drift_a.ini" -o "$OUT/a.colossus" --quiet || fail "sl-sim a"

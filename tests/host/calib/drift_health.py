@@ -13,7 +13,7 @@ With STEP_ROTATION = -1: a capture without a step; passes when THETA_DRIFT is ne
 import os
 import sys
 
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "..", "scripts"))
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "..", "..", "scripts"))
 import sl_can_decode as scd  # noqa: E402
 
 

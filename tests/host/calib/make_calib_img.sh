@@ -5,7 +5,7 @@
 # then sl-calib shadow --png. Run from anywhere; writes only that picture.
 set -eu
 B=$1
-SRC=$(cd "$(dirname "$0")/../.." && pwd)
+SRC=$(cd "$(dirname "$0")/../../.." && pwd)
 T=$(mktemp -d)
 trap 'rm -rf "$T"' EXIT
 "$B/host_tools/sim/sl-sim" "$SRC/tests/host/calib/data/lower_body_empty.ini" -o "$T/lower_body_empty.colossus" --quiet
