@@ -10,8 +10,9 @@ tool=$1 B=$2 S=$3 d=$4
 rm -rf "$d"; mkdir -p "$d"; cd "$d"
 "$B/sim/sl-sim" "$S/scenes/demo_three_poles.ini" --rotations 20 -o s.colossus --gt s.gt.csv --quiet
 fifo() { rm -f f.fifo; mkfifo f.fifo; cat "$1" > f.fifo & }
-# The tools name their input in their report: compare everything else.
-strip() { sed -e 's#s\.colossus#INPUT#g; s#f\.fifo#INPUT#g; s#s\.pcapng#INPUT#g' -e 's#\([ (]\)-\([ ):]\)#\1INPUT\2#g' \
+# The tools name their input in their report, and a calibration file its date of writing:
+# compare everything else.
+strip() { sed -e '/^date = /d' -e 's#s\.colossus#INPUT#g; s#f\.fifo#INPUT#g; s#s\.pcapng#INPUT#g' -e 's#\([ (]\)-\([ ):]\)#\1INPUT\2#g' \
               -e 's#; *-$#;   INPUT#' -e 's#[a-z]*\.\(png\|ini\)#OUT#g' "$1"; }
 same() { strip "$1" > "$1.s"; strip "$2" > "$2.s"; diff "$1.s" "$2.s"; }
 case $tool in
