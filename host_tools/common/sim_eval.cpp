@@ -568,6 +568,13 @@ std::map<int, PipeEval> PipelineEval::result() const
         }
     }
     if (std::getenv("SL_EVAL_PIPE_DEBUG") != nullptr) {
+        for (uint32_t si = 0; si < SL_CFG_PROFILE_SLOTS; si++) {
+            const sl_profile_slot_t &sl = p.prof.slot[si];
+            if (sl.live == 0U || sl.frames == 0U) continue;
+            std::fprintf(stderr, "slot az %u bin0 %u frames %u:", sl.az, sl.bin0, sl.frames);
+            for (uint32_t k = 0; k < 40; k++) std::fprintf(stderr, " %.1f", sl.sum[k] / (double)sl.frames);
+            std::fprintf(stderr, "\n");
+        }
         const sl_profile_stats_t &ps = p.prof.stats;
         std::fprintf(stderr, "profile: claims %u full %u released %u extracted %u fallback slot/lead/norun/tailcut/notail %u/%u/%u/%u/%u slope %u/256 (n %u)\n",
                      ps.claims, ps.claim_full, ps.released, ps.extracted, ps.fallback[1], ps.fallback[2], ps.fallback[3],
@@ -602,6 +609,11 @@ std::vector<PipelineEval::Target> PipelineEval::targets() const
             x.flag = t.incline_flag;
             x.alpha_deg = t.alpha_cdeg / 100.0;
             x.sigma_deg = t.sigma_cdeg / 100.0;
+            x.r1_m = t.r1_um * 1e-6;
+            x.r2_m = t.r2_um * 1e-6;
+            x.bin_first = t.bin_first;
+            x.bin_last = t.bin_last;
+            x.tflags = t.flags;
             out.push_back(x);
         }
     }
@@ -1354,6 +1366,11 @@ void realistic_pipe_add(const PipelineEval &pe, const GtRow &gt, int assoc_az, i
         any = true;
         out.rot_detected++;
         const auto &t = tg[static_cast<size_t>(best)];
+        if (std::getenv("SL_EVAL_PIPE_DEBUG") != nullptr) {
+            std::fprintf(stderr, "  target rot %d az %d/%d bins %d-%d r1 %.4f/%.4f (%+.1f mm) r2 %.4f/%.4f (%+.1f mm) alpha %.2f flag %d tflags 0x%02x\n",
+                         r, t.az, gt.azimuth, t.bin_first, t.bin_last, t.r1_m, gt.r1_m, (t.r1_m - gt.r1_m) * 1e3, t.r2_m,
+                         gt.r2_m, (t.r2_m - gt.r2_m) * 1e3, t.alpha_deg, t.flag, t.tflags);
+        }
         if (t.flag == SL_INCLINE_VALID) {
             out.valid++;
             sum += t.alpha_deg;

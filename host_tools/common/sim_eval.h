@@ -206,6 +206,8 @@ public:
     struct Target {
         int rotation = 0, az = 0, flag = 0;
         double alpha_deg = 0, sigma_deg = 0;
+        double r1_m = 0, r2_m = 0; ///< the target's bounds (axis)
+        int bin_first = 0, bin_last = 0, tflags = 0;
     };
     /// One live tracker slot as reported after a rotation.
     struct Track {

@@ -109,6 +109,28 @@ static void test_extraction_steeper_smear_same_configuration(void **)
     within(r, e, true, 1.5);
 }
 
+// A shallow smear (2.5 dB/bin): the tail of the far positions crosses the shadow edge by
+// more than the board's d(S) allows. The pole is still found at every angle (the run beyond
+// the edge decays like a tail of its inside part: sl_detect.h stage 1, TAIL_EDGE; the
+// refined r2 decides), where the d(S) rule alone rejected it SHADOW (4 of 6 detected at
+// -10/-5/0 deg). The accuracy criterion (<= 1.5 deg) is NOT met at this decay yet (the
+// walk cannot tell the pole's last bins from a 2.5-value tail in integer values): printed.
+static void test_extraction_shallow_smear_found_at_the_shadow_edge(void **)
+{
+    RealisticOptions o = quick();
+    o.smear_decay_db = 2.5;
+    const RealisticResult r = run_realistic(o);
+    double e[5];
+    std::printf("smear 2.5 dB/bin (accuracy printed, detection asserted):\n");
+    within(r, e, false, 1.5);
+    for (int a = 0; a < 5; a++) {
+        const RealisticPipe &p = r.pipe[a];
+        if (p.detected != p.runs) {
+            fail_msg("angle %d: detected %d/%d", r.angles[a], p.detected, p.runs);
+        }
+    }
+}
+
 // Per-frame speckle: the profile is a mean, not the AND's minimum statistic, so the estimate
 // does not drift with n (the mask's r2 shortens with n: EXTRACTION.md s.1 cause 3).
 static void test_extraction_does_not_drift_with_n_under_per_frame_speckle(void **)
@@ -135,6 +157,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_extraction_paper_condition_within_1_deg),
         cmocka_unit_test(test_extraction_steeper_smear_same_configuration),
+        cmocka_unit_test(test_extraction_shallow_smear_found_at_the_shadow_edge),
         cmocka_unit_test(test_extraction_does_not_drift_with_n_under_per_frame_speckle),
     };
     return cmocka_run_group_tests(tests, nullptr, nullptr);
