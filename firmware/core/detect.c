@@ -15,6 +15,10 @@
 #define CF_AMP 0x10U    // an amplitude row was seen for a run of the group
 #define CF_STRONG 0x20U // ... and some run rose clearly above its floor
 #define CF_TAIL 0x40U   // a run's tail crosses the edge within the bound of its own peak
+                        // (the same bit as SL_TARGET_TAIL_EDGE, copied to the target)
+#if CF_TAIL != SL_TARGET_TAIL_EDGE
+#error "CF_TAIL must equal SL_TARGET_TAIL_EDGE"
+#endif
 
 #define ST_FREE 0U
 #define ST_OPEN 1U
@@ -525,9 +529,6 @@ static void finalize(sl_detect_t *d, sl_detect_cand_t *c)
     if ((c->flags & CF_WRAPS) != 0U) {
         t.flags |= SL_TARGET_WRAPS;
     }
-    if ((c->flags & CF_TAIL) != 0U) {
-        t.flags |= SL_TARGET_TAIL_EDGE;
-    }
     const uint32_t r1_hb = t.r1_raw_um + bd->bin_size_um / 2U;
     int reason = -1;
     if ((c->flags & CF_NEAR) != 0U) {
@@ -551,6 +552,7 @@ static void finalize(sl_detect_t *d, sl_detect_cand_t *c)
         d->stats.rejected[reason]++;
         return;
     }
+    t.flags |= (uint8_t)(c->flags & CF_TAIL); // CF_TAIL == SL_TARGET_TAIL_EDGE
     uint32_t rho_q28 = 0U;
     if (bd->geom != NULL) {
         const sl_incline_result_t res = sl_incline_estimate(
@@ -627,30 +629,39 @@ void sl_detect_set_tail_slope(sl_detect_t *d, uint16_t slope_q8)
 // without one, its first half stronger than its second by >= 1/2 value per bin of
 // separation (the profiles' smallest plausible slope). Then TAIL, else SHADOW. Without an
 // amplitude row the d(S) rule: SHADOW when the last bin reaches `edge`.
-static uint8_t edge_rule(const sl_detect_t *d, uint32_t s, uint32_t e, uint32_t win,
-                         uint32_t edge)
+#if defined(__GNUC__)
+#define DETECT_NOINLINE __attribute__((noinline)) // rare path: out of sl_detect_row's loop
+#else
+#define DETECT_NOINLINE
+#endif
+static DETECT_NOINLINE uint8_t edge_rule(const sl_detect_t *d, uint32_t s, uint32_t e,
+                                         uint32_t win, uint32_t edge)
 {
     const uint8_t *p = d->amp;
     if (p == NULL || e > d->amp_bins || s >= win || e <= win) {
         return e - 1U >= edge ? (uint8_t)CF_SHADOW : 0U;
     }
     // (called for runs reaching the d(S) edge only: a shorter one keeps the r2 - d test)
-    uint32_t peak_in = 0U, peak_out = 0U;
+    uint32_t peak_in = 0U;
     for (uint32_t k = s; k < win; k++) {
         peak_in = p[k] > peak_in ? p[k] : peak_in;
-    }
-    for (uint32_t k = win; k < e; k++) {
-        peak_out = p[k] > peak_out ? p[k] : peak_out;
-    }
-    if (peak_out >= peak_in) {
-        return CF_SHADOW;
     }
     const uint32_t o = e - win; // bins beyond the window
     if (d->tail_slope_q8 != 0U) {
         const uint32_t t = d->amp_threshold;
         const uint32_t tail =
             peak_in > t ? ((peak_in - t) * 256U + d->tail_slope_q8 - 1U) / d->tail_slope_q8 : 0U;
-        return o > tail ? (uint8_t)CF_SHADOW : (uint8_t)CF_TAIL;
+        if (o > tail) {
+            return CF_SHADOW;
+        }
+    }
+    for (uint32_t k = win; k < e; k++) {
+        if (p[k] >= peak_in) {
+            return CF_SHADOW; // as strong beyond the edge as inside: not its tail
+        }
+    }
+    if (d->tail_slope_q8 != 0U) {
+        return CF_TAIL;
     }
     const uint32_t h = o / 2U;
     if (h == 0U) {
@@ -800,12 +811,9 @@ sl_err_t sl_detect_row(sl_detect_t *d, uint16_t az, const uint32_t *occ, uint32_
             count += e2 - s2;
             e = e2;
         }
-        if (e >= limit) {
-            rf |= CF_SHADOW;
-        } else if (e - 1U >= edge) {
-            rf |= edge_rule(d, s, e, win, edge);
-        } else {
-            // ends before the d(S) edge: r2 less d(r2) is tested at sl_detect_end
+        if (e >= limit || e - 1U >= edge) {
+            // at the d(S) edge (a run ending before it: r2 less d(r2) tested at the end)
+            rf |= e >= limit ? (uint8_t)CF_SHADOW : edge_rule(d, s, e, win, edge);
         }
         if ((rf & CF_SHADOW) == 0U) { // a SHADOW group is rejected anyway
             rf |= run_strength(d, s, e);

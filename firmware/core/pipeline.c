@@ -508,7 +508,7 @@ static SL_NOINLINE void report_rotation(sl_pipeline_t *p, const sl_scan_rot_t *r
 // sl_detect.h stage 1): decided on the profile's own r2 when the target was refined, else
 // on the mask's r2 less the board's d(r2) (the prior). Rejected targets leave the array
 // (order kept) and are counted as SHADOW. @return the targets left.
-static uint32_t shadow_after_refine(sl_pipeline_t *p, uint32_t n)
+static SL_NOINLINE uint32_t shadow_after_refine(sl_pipeline_t *p, uint32_t n)
 {
     uint32_t k = 0U;
     for (uint32_t i = 0; i < n; i++) {
