@@ -633,6 +633,8 @@ std::vector<PipelineEval::Track> PipelineEval::tracks() const
             x.valid_hits = t.valid_hits;
             x.last_flag = t.last_flag;
             x.alpha_deg = t.alpha_cdeg / 100.0;
+            x.sigma_deg = t.sigma_cdeg / 100.0;
+            x.level = t.level;
             out.push_back(x);
         }
     }
@@ -1393,7 +1395,8 @@ void realistic_pipe_add(const PipelineEval &pe, const GtRow &gt, int assoc_az, i
         (void)pe.result();
     }
     int best_d = assoc_az + 1;
-    double filt = std::nan("");
+    double filt = std::nan(""), filt_sigma = 0;
+    int filt_level = 0;
     for (const auto &t : pe.tracks()) {
         if (t.rotation != r_last || t.valid_hits <= 0) {
             continue;
@@ -1402,10 +1405,15 @@ void realistic_pipe_add(const PipelineEval &pe, const GtRow &gt, int assoc_az, i
         if (d < best_d) {
             best_d = d;
             filt = t.alpha_deg;
+            filt_sigma = t.sigma_deg;
+            filt_level = t.level;
         }
     }
     if (!std::isnan(filt)) {
         out.filt.push_back(filt);
+        out.filt_sigma.push_back(filt_sigma);
+        out.filt_level.push_back(filt_level);
+        out.filt_truth.push_back(gt.alpha_deg);
     }
 }
 
@@ -1565,6 +1573,7 @@ RealisticResult run_realistic(const RealisticOptions &o)
                 Scene s = realistic_scene(dist, res.angles[a], seed, o.frames, o.range_bins);
                 s.smear_decay_db = o.smear_decay_db;
                 s.speckle_static = o.speckle_static;
+                s.rotations += std::max(0, o.track_rotations);
                 std::unique_ptr<PipelineEval> pipe;
                 std::function<void(int, const uint8_t *, size_t)> on_bytes;
                 if (o.extract == Extract::Pipeline) {
