@@ -48,7 +48,8 @@
 /// 4. **Rejections**, counted per reason in `stats.rejected[]`, first match wins:
 ///    NEAR (any run of the group crosses into the near-field band);
 ///    SHADOW (any run flagged SHADOW, or the corrected r2 of the representative run is
-///    >= S(az): the base is not inside the shadow);
+///    >= S(az): the base is not inside the shadow; the r2 test is left to the caller for a
+///    group with a TAIL_EDGE run, stage 1);
 ///    WIDE (the group spans more azimuths than a pole of `cfg.max_pole_diameter_um` at r1
 ///    can: allowed = floor((D / r1 [rad] + beam) / step) + 1 + `cfg.width_slack_az`);
 ///    BROKEN (the representative run has a gap);
