@@ -504,16 +504,18 @@ static SL_NOINLINE void report_rotation(sl_pipeline_t *p, const sl_scan_rot_t *r
     p->cfg.port.on_rotation(p->cfg.port.ctx, &r);
 }
 
-// SHADOW for targets whose smear tail crosses the shadow edge (SL_TARGET_TAIL_EDGE,
-// sl_detect.h stage 1): decided on the profile's own r2 when the target was refined, else
-// on the mask's r2 less the board's d(r2) (the prior). Rejected targets leave the array
-// (order kept) and are counted as SHADOW. @return the targets left.
+// SHADOW on the best r2 there is: the profile's own r2 when the target was refined (the
+// board's d(S) then decides nothing: a d that overcorrects no longer lets a pole whose base
+// is beyond the edge through), else the mask's r2 less d(r2) (the prior; detection already
+// tested it, except for targets whose smear tail crosses the edge, SL_TARGET_TAIL_EDGE,
+// sl_detect.h stage 1). Rejected targets leave the array (order kept) and are counted as
+// SHADOW. @return the targets left.
 static SL_NOINLINE uint32_t shadow_after_refine(sl_pipeline_t *p, uint32_t n)
 {
     uint32_t k = 0U;
     for (uint32_t i = 0; i < n; i++) {
         const sl_target_t *t = &p->detect.targets[i];
-        if ((t->flags & SL_TARGET_TAIL_EDGE) != 0U && t->r2_um >= t->shadow_slant_um) {
+        if (t->r2_um >= t->shadow_slant_um) {
             p->detect.stats.rejected[SL_DETECT_REJ_SHADOW]++;
             continue;
         }

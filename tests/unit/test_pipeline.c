@@ -1368,6 +1368,76 @@ static void test_pipeline_smear_tail_across_the_shadow_edge(void **state)
     assert_true(pl.prof.stats.extracted >= (uint32_t)(20 - first - 1));
 }
 
+// A board whose d(S) overcorrects (0.5 m on paper-sim's geometry) and steep tails (10
+// values per bin) that end before the d(S) edge: detection alone keeps the pole whose own
+// bins end 2 bins beyond the shadow edge (r2 - d is inside); the profile's own r2 rejects
+// it SHADOW, while the pole whose own bins end inside stays, with its own r2.
+static int g_edge_tail_step = 3;
+static void edge_steep_fn(void *ctx, int rot, uint32_t az, uint64_t t, uint8_t *row,
+                          uint32_t bins)
+{
+    (void)ctx;
+    (void)rot;
+    (void)t;
+    memset(row, 0, bins);
+    const uint32_t e = g_edge_bin;
+    for (uint32_t k = 0; k < bins; k++) {
+        int v = 0;
+        const uint32_t k1 = az >= 199U && az <= 201U ? e - 10U : e - 12U;
+        const uint32_t k2 = az >= 199U && az <= 201U ? e + 2U : e - 4U;
+        if ((az >= 99U && az <= 101U) || (az >= 199U && az <= 201U)) {
+            if (k >= k1 && k <= k2) {
+                v = 110 - (int)(k - k1);
+            } else if (k > k2) {
+                v = 110 - (int)(k2 - k1) - g_edge_tail_step * (int)(k - k2);
+            }
+        }
+        row[k] = (uint8_t)(v < 0 ? 0 : v > 255 ? 255 : v);
+    }
+}
+
+static sl_board_t g_board_d;
+static void test_pipeline_overcorrecting_d_does_not_let_a_base_beyond_the_edge_through(void **state)
+{
+    (void)state;
+    g_board_d = *B;
+    g_board_d.elong_points = 1;
+    g_board_d.elong_range_um[0] = 5000000U;
+    g_board_d.elong_d_um[0] = 500000; // 0.5 m: 11.4 bins
+    g_edge_bin = ground_first_bin(100);
+    g_edge_tail_step = 10;
+    stream_t st;
+    st_init(&st, 24u << 20);
+    sopt_t o = sopt_defaults();
+    o.rotations = 20;
+    build(&st, &o, edge_steep_fn, NULL);
+    const int first = B->mask_frames - 1;
+    // Without range profiles, detection's r2 - d keeps both poles.
+    rec_reset(0);
+    sl_pipeline_cfg_t c = cfg_for(&g_board_d);
+    c.profile = false;
+    assert_int_equal(sl_pipeline_init(&pl, &g_board_d, &c), SL_OK);
+    feed_stream(&st, 65536, 0);
+    for (int k = first; k < 20; k++) {
+        assert_int_equal(rec.nt[k], 2);
+    }
+    // With them (the default), the profile's own r2 decides.
+    rec_reset(0);
+    c = cfg_for(&g_board_d);
+    assert_int_equal(sl_pipeline_init(&pl, &g_board_d, &c), SL_OK);
+    feed_stream(&st, 65536, 0);
+    st_free(&st);
+    for (int k = first; k < 20; k++) {
+        assert_int_equal(rec.nt[k], 1);
+        const sl_target_t *t = &rec.tg[k][0];
+        assert_true(t->az >= 99U && t->az <= 101U);
+        assert_true((t->flags & SL_TARGET_PROFILE) != 0U);
+        assert_int_equal(t->flags & SL_TARGET_TAIL_EDGE, 0);
+        assert_int_equal(t->r2_um, (uint32_t)(((2ULL * (g_edge_bin - 4U) + 1U) * B->bin_size_um + 1U) / 2U));
+    }
+    assert_int_equal(pl.detect.stats.rejected[SL_DETECT_REJ_SHADOW], (uint32_t)(20 - first));
+}
+
 static void test_pipeline_slot_overflow_keeps_the_poles_and_is_counted_on_can(void **state)
 {
     (void)state;
@@ -1521,6 +1591,7 @@ int main(void)
         cmocka_unit_test(test_pipeline_rejects_boards_that_need_more_mask_bins),
         cmocka_unit_test(test_pipeline_slot_overflow_keeps_the_poles_and_is_counted_on_can),
         cmocka_unit_test(test_pipeline_smear_tail_across_the_shadow_edge),
+        cmocka_unit_test(test_pipeline_overcorrecting_d_does_not_let_a_base_beyond_the_edge_through),
     };
     const int rc = cmocka_run_group_tests(tests, setup, NULL);
     st_free(&g_static);
