@@ -21,6 +21,7 @@
 #include <cstdio>
 #include <setjmp.h>
 #include <string>
+#include <vector>
 
 extern "C" {
 #include <cmocka.h>
@@ -221,24 +222,45 @@ static void test_extraction_never_a_false_warning(void **)
     assert_true(raised >= 8);
 }
 
-// argv: "--only GLOB" or "--skip GLOB" (cmocka test-name patterns): one executable, two
-// ctest entries that each stay under ~2 min on the loaded machine.
+// argv: "--only SUBSTR" or "--skip SUBSTR" (repeatable): runs the tests whose names contain
+// one of the --only strings (all when none) and none of the --skip strings, so one
+// executable gives several ctest entries that each stay near ~1 min on the loaded machine.
 int main(int argc, char **argv)
 {
-    if (argc == 3 && std::string(argv[1]) == "--only") {
-        cmocka_set_test_filter(argv[2]);
-    } else if (argc == 3 && std::string(argv[1]) == "--skip") {
-        cmocka_set_skip_filter(argv[2]);
-    } else if (argc != 1) {
-        std::fprintf(stderr, "usage: test_sim_extraction [--only GLOB | --skip GLOB]\n");
-        return 2;
-    }
-    const struct CMUnitTest tests[] = {
+    const struct CMUnitTest all[] = {
         cmocka_unit_test(test_extraction_paper_condition_within_1_deg),
         cmocka_unit_test(test_extraction_steeper_smear_same_configuration),
         cmocka_unit_test(test_extraction_shallow_smear_found_at_the_shadow_edge),
         cmocka_unit_test(test_extraction_never_a_false_warning),
         cmocka_unit_test(test_extraction_does_not_drift_with_n_under_per_frame_speckle),
     };
-    return cmocka_run_group_tests(tests, nullptr, nullptr);
+    std::vector<std::string> only, skip;
+    for (int i = 1; i < argc; i++) {
+        const std::string a = argv[i];
+        if ((a == "--only" || a == "--skip") && i + 1 < argc) {
+            (a == "--only" ? only : skip).push_back(argv[++i]);
+        } else {
+            std::fprintf(stderr, "usage: test_sim_extraction [--only SUBSTR]... [--skip SUBSTR]...\n");
+            return 2;
+        }
+    }
+    std::vector<CMUnitTest> run;
+    for (const CMUnitTest &t : all) {
+        const std::string name = t.name;
+        bool in = only.empty();
+        for (const auto &o : only) {
+            in = in || name.find(o) != std::string::npos;
+        }
+        for (const auto &k : skip) {
+            in = in && name.find(k) == std::string::npos;
+        }
+        if (in) {
+            run.push_back(t);
+        }
+    }
+    if (run.empty()) {
+        std::fprintf(stderr, "test_sim_extraction: no test selected\n");
+        return 2;
+    }
+    return _cmocka_run_group_tests("test_sim_extraction", run.data(), run.size(), nullptr, nullptr);
 }
