@@ -14,6 +14,11 @@
 #define CF_WRAPS 0x08U
 #define CF_AMP 0x10U    // an amplitude row was seen for a run of the group
 #define CF_STRONG 0x20U // ... and some run rose clearly above its floor
+#define CF_TAIL 0x40U   // a run's tail crosses the edge within the bound of its own peak
+                        // (the same bit as SL_TARGET_TAIL_EDGE, copied to the target)
+#if CF_TAIL != SL_TARGET_TAIL_EDGE
+#error "CF_TAIL must equal SL_TARGET_TAIL_EDGE"
+#endif
 
 #define ST_FREE 0U
 #define ST_OPEN 1U
@@ -528,7 +533,8 @@ static void finalize(sl_detect_t *d, sl_detect_cand_t *c)
     int reason = -1;
     if ((c->flags & CF_NEAR) != 0U) {
         reason = SL_DETECT_REJ_NEAR;
-    } else if ((c->flags & CF_SHADOW) != 0U || t.r2_um >= t.shadow_slant_um) {
+    } else if ((c->flags & CF_SHADOW) != 0U ||
+               ((c->flags & CF_TAIL) == 0U && t.r2_um >= t.shadow_slant_um)) {
         reason = SL_DETECT_REJ_SHADOW;
     } else if ((c->flags & CF_SPAN) != 0U || span > allowed_span(d, r1_hb)) {
         reason = SL_DETECT_REJ_WIDE;
@@ -546,6 +552,7 @@ static void finalize(sl_detect_t *d, sl_detect_cand_t *c)
         d->stats.rejected[reason]++;
         return;
     }
+    t.flags |= (uint8_t)(c->flags & CF_TAIL); // CF_TAIL == SL_TARGET_TAIL_EDGE
     uint32_t rho_q28 = 0U;
     if (bd->geom != NULL) {
         const sl_incline_result_t res = sl_incline_estimate(
@@ -607,6 +614,66 @@ static uint8_t run_strength(const sl_detect_t *d, uint32_t s, uint32_t e)
     const uint32_t floor_v = cnt != 0U ? sum / cnt : 0U;
     const bool strong = peak >= floor_v + d->cfg.weak_contrast;
     return (uint8_t)(CF_AMP | (strong ? CF_STRONG : 0U));
+}
+
+void sl_detect_set_tail_slope(sl_detect_t *d, uint16_t slope_q8)
+{
+    SL_ASSERT(d != NULL);
+    d->tail_slope_q8 = slope_q8;
+}
+
+// Stage 1 at the shadow edge for a run [s, e) reaching past the window end `win` or the
+// d(S) edge `edge` (sl_detect.h). With an amplitude row the run's part beyond the window
+// must look like a smear tail of its part inside: below the inside peak, and decaying:
+// with a known tail slope, ending within ceil((peak - T) 256 / slope) bins of the window;
+// without one, its first half stronger than its second by >= 1/2 value per bin of
+// separation (the profiles' smallest plausible slope). Then TAIL, else SHADOW. Without an
+// amplitude row the d(S) rule: SHADOW when the last bin reaches `edge`.
+#if defined(__GNUC__)
+#define DETECT_NOINLINE __attribute__((noinline)) // rare path: out of sl_detect_row's loop
+#else
+#define DETECT_NOINLINE
+#endif
+static DETECT_NOINLINE uint8_t edge_rule(const sl_detect_t *d, uint32_t s, uint32_t e,
+                                         uint32_t win, uint32_t edge)
+{
+    const uint8_t *p = d->amp;
+    if (p == NULL || e > d->amp_bins || s >= win || e <= win) {
+        return e - 1U >= edge ? (uint8_t)CF_SHADOW : 0U;
+    }
+    // (called for runs reaching the d(S) edge only: a shorter one keeps the r2 - d test)
+    uint32_t peak_in = 0U;
+    for (uint32_t k = s; k < win; k++) {
+        peak_in = p[k] > peak_in ? p[k] : peak_in;
+    }
+    const uint32_t o = e - win; // bins beyond the window
+    if (d->tail_slope_q8 != 0U) {
+        const uint32_t t = d->amp_threshold;
+        const uint32_t tail =
+            peak_in > t ? ((peak_in - t) * 256U + d->tail_slope_q8 - 1U) / d->tail_slope_q8 : 0U;
+        if (o > tail) {
+            return CF_SHADOW;
+        }
+    }
+    for (uint32_t k = win; k < e; k++) {
+        if (p[k] >= peak_in) {
+            return CF_SHADOW; // as strong beyond the edge as inside: not its tail
+        }
+    }
+    if (d->tail_slope_q8 != 0U) {
+        return CF_TAIL;
+    }
+    const uint32_t h = o / 2U;
+    if (h == 0U) {
+        return CF_TAIL; // one bin beyond, below the peak
+    }
+    uint32_t s1 = 0U, s2 = 0U;
+    for (uint32_t k = 0; k < h; k++) {
+        s1 += p[win + k];
+        s2 += p[e - h + k];
+    }
+    // pairs k, k + (o - h) bins apart: a tail falls >= (o - h) / 2 values over each
+    return s1 >= s2 && 2U * (s1 - s2) >= h * (o - h) ? (uint8_t)CF_TAIL : (uint8_t)CF_SHADOW;
 }
 
 void sl_detect_set_amplitude(sl_detect_t *d, const uint8_t *power, uint16_t bins,
@@ -745,7 +812,8 @@ sl_err_t sl_detect_row(sl_detect_t *d, uint16_t az, const uint32_t *occ, uint32_
             e = e2;
         }
         if (e >= limit || e - 1U >= edge) {
-            rf |= CF_SHADOW;
+            // at the d(S) edge (a run ending before it: r2 less d(r2) tested at the end)
+            rf |= e >= limit ? (uint8_t)CF_SHADOW : edge_rule(d, s, e, win, edge);
         }
         if ((rf & CF_SHADOW) == 0U) { // a SHADOW group is rejected anyway
             rf |= run_strength(d, s, e);

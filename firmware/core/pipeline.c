@@ -581,6 +581,30 @@ static SL_NOINLINE void report_rotation(sl_pipeline_t *p, const sl_scan_rot_t *r
     p->cfg.port.on_rotation(p->cfg.port.ctx, &r);
 }
 
+// SHADOW on the best r2 there is: the profile's own r2 when the target was refined (the
+// board's d(S) then decides nothing: a d that overcorrects no longer lets a pole whose base
+// is beyond the edge through), else the mask's r2 less d(r2) (the prior; detection already
+// tested it, except for targets whose smear tail crosses the edge, SL_TARGET_TAIL_EDGE,
+// sl_detect.h stage 1). Rejected targets leave the array (order kept) and are counted as
+// SHADOW. @return the targets left.
+static SL_NOINLINE uint32_t shadow_after_refine(sl_pipeline_t *p, uint32_t n)
+{
+    uint32_t k = 0U;
+    for (uint32_t i = 0; i < n; i++) {
+        const sl_target_t *t = &p->detect.targets[i];
+        if (t->r2_um >= t->shadow_slant_um) {
+            p->detect.stats.rejected[SL_DETECT_REJ_SHADOW]++;
+            continue;
+        }
+        if (k != i) {
+            p->detect.targets[k] = *t;
+        }
+        k++;
+    }
+    p->detect.n_targets = (uint8_t)k;
+    return k;
+}
+
 static void on_rot(void *ctx, const sl_scan_rot_t *rot)
 {
     sl_pipeline_t *p = ctx;
@@ -598,14 +622,18 @@ static void on_rot(void *ctx, const sl_scan_rot_t *rot)
                                                               : p->mask.azimuths);
     sl_mask_end_rotation(&p->mask);
     const sl_ssize_t nt = sl_detect_end(&p->detect);
-    const uint32_t n_targets = nt > 0 ? (uint32_t)nt : 0U;
+    uint32_t n_targets = nt > 0 ? (uint32_t)nt : 0U;
     if (p->cfg.profile) {
         for (uint32_t i = 0; i < n_targets; i++) {
             (void)sl_profile_refine(&p->prof, p->board, p->cfg.threshold, &p->detect.targets[i]);
         }
+        n_targets = shadow_after_refine(p, n_targets);
         sl_profile_assign(&p->prof, p->detect.targets, n_targets);
         // A profile must not mix positions: cleared every rotation while the window is short.
         sl_profile_end_rotation(&p->prof, p->frames_eff < p->cfg.mask_frames);
+        // The self-calibrated tail replaces the board's d(S) at the shadow edge (sl_detect.h
+        // stage 1) from the next rotation on.
+        sl_detect_set_tail_slope(&p->detect, p->prof.slope_q8);
     }
     measure_period(p, rot);
     set_track_motion(p);

@@ -571,6 +571,13 @@ std::map<int, PipeEval> PipelineEval::result() const
         }
     }
     if (std::getenv("SL_EVAL_PIPE_DEBUG") != nullptr) {
+        for (uint32_t si = 0; si < SL_CFG_PROFILE_SLOTS; si++) {
+            const sl_profile_slot_t &sl = p.prof.slot[si];
+            if (sl.live == 0U || sl.frames == 0U) continue;
+            std::fprintf(stderr, "slot az %u bin0 %u frames %u:", sl.az, sl.bin0, sl.frames);
+            for (uint32_t k = 0; k < 40; k++) std::fprintf(stderr, " %.1f", sl.sum[k] / (double)sl.frames);
+            std::fprintf(stderr, "\n");
+        }
         const sl_profile_stats_t &ps = p.prof.stats;
         std::fprintf(stderr, "profile: claims %u full %u released %u extracted %u fallback slot/lead/norun/tailcut/notail %u/%u/%u/%u/%u slope %u/256 (n %u)\n",
                      ps.claims, ps.claim_full, ps.released, ps.extracted, ps.fallback[1], ps.fallback[2], ps.fallback[3],
@@ -605,6 +612,11 @@ std::vector<PipelineEval::Target> PipelineEval::targets() const
             x.flag = t.incline_flag;
             x.alpha_deg = t.alpha_cdeg / 100.0;
             x.sigma_deg = t.sigma_cdeg / 100.0;
+            x.r1_m = t.r1_um * 1e-6;
+            x.r2_m = t.r2_um * 1e-6;
+            x.bin_first = t.bin_first;
+            x.bin_last = t.bin_last;
+            x.tflags = t.flags;
             out.push_back(x);
         }
     }
@@ -624,6 +636,8 @@ std::vector<PipelineEval::Track> PipelineEval::tracks() const
             x.valid_hits = t.valid_hits;
             x.last_flag = t.last_flag;
             x.alpha_deg = t.alpha_cdeg / 100.0;
+            x.sigma_deg = t.sigma_cdeg / 100.0;
+            x.level = t.level;
             out.push_back(x);
         }
     }
@@ -1357,6 +1371,11 @@ void realistic_pipe_add(const PipelineEval &pe, const GtRow &gt, int assoc_az, i
         any = true;
         out.rot_detected++;
         const auto &t = tg[static_cast<size_t>(best)];
+        if (std::getenv("SL_EVAL_PIPE_DEBUG") != nullptr) {
+            std::fprintf(stderr, "  target rot %d az %d/%d bins %d-%d r1 %.4f/%.4f (%+.1f mm) r2 %.4f/%.4f (%+.1f mm) alpha %.2f flag %d tflags 0x%02x\n",
+                         r, t.az, gt.azimuth, t.bin_first, t.bin_last, t.r1_m, gt.r1_m, (t.r1_m - gt.r1_m) * 1e3, t.r2_m,
+                         gt.r2_m, (t.r2_m - gt.r2_m) * 1e3, t.alpha_deg, t.flag, t.tflags);
+        }
         if (t.flag == SL_INCLINE_VALID) {
             out.valid++;
             sum += t.alpha_deg;
@@ -1379,7 +1398,8 @@ void realistic_pipe_add(const PipelineEval &pe, const GtRow &gt, int assoc_az, i
         (void)pe.result();
     }
     int best_d = assoc_az + 1;
-    double filt = std::nan("");
+    double filt = std::nan(""), filt_sigma = 0;
+    int filt_level = 0;
     for (const auto &t : pe.tracks()) {
         if (t.rotation != r_last || t.valid_hits <= 0) {
             continue;
@@ -1388,10 +1408,15 @@ void realistic_pipe_add(const PipelineEval &pe, const GtRow &gt, int assoc_az, i
         if (d < best_d) {
             best_d = d;
             filt = t.alpha_deg;
+            filt_sigma = t.sigma_deg;
+            filt_level = t.level;
         }
     }
     if (!std::isnan(filt)) {
         out.filt.push_back(filt);
+        out.filt_sigma.push_back(filt_sigma);
+        out.filt_level.push_back(filt_level);
+        out.filt_truth.push_back(gt.alpha_deg);
     }
 }
 
@@ -1551,6 +1576,7 @@ RealisticResult run_realistic(const RealisticOptions &o)
                 Scene s = realistic_scene(dist, res.angles[a], seed, o.frames, o.range_bins);
                 s.smear_decay_db = o.smear_decay_db;
                 s.speckle_static = o.speckle_static;
+                s.rotations += std::max(0, o.track_rotations);
                 std::unique_ptr<PipelineEval> pipe;
                 std::function<void(int, const uint8_t *, size_t)> on_bytes;
                 if (o.extract == Extract::Pipeline) {

@@ -207,11 +207,15 @@ public:
     struct Target {
         int rotation = 0, az = 0, flag = 0;
         double alpha_deg = 0, sigma_deg = 0;
+        double r1_m = 0, r2_m = 0; ///< the target's bounds (axis)
+        int bin_first = 0, bin_last = 0, tflags = 0;
     };
     /// One live tracker slot as reported after a rotation.
     struct Track {
         int rotation = 0, az = 0, id = 0, hits = 0, valid_hits = 0, last_flag = 0;
         double alpha_deg = 0; ///< filtered alpha (meaningful when valid_hits > 0)
+        double sigma_deg = 0; ///< its filtered sigma
+        int level = 0;        ///< warning level (sl_warn_level_t)
     };
     /// All targets reported so far, in rotation order.
     std::vector<Target> targets() const;
@@ -299,6 +303,8 @@ struct RealisticOptions {
     double smear_decay_db = 3.3; ///< exponential smear decay per bin (dB)
     int speckle_static = 1;     ///< 1: speckle frozen over the frames, 0: new every frame
     bool pipe_profile = true;   ///< pipeline: range-profile bounds (false: mask + d(r))
+    int track_rotations = 0;    ///< pipeline: rotations simulated beyond the window's n (the
+                                ///< tracker then sees several rotations of the same pole)
 };
 
 /// Core-pipeline results for one true angle of the realistic bench (one estimate per
@@ -307,6 +313,9 @@ struct RealisticPipe {
     std::vector<double> raw;    ///< per measurement: mean raw target alpha over the last
                                 ///< rotations (ambiguous targets as the bound (beta - theta)/2)
     std::vector<double> filt;   ///< per measurement: tracker's filtered alpha after the last rotation
+    std::vector<double> filt_sigma; ///< ... its filtered sigma (deg), parallel to `filt`
+    std::vector<int> filt_level;    ///< ... its warning level (sl_warn_level_t), parallel
+    std::vector<double> filt_truth; ///< ... the measurement's true alpha, parallel
     int runs = 0;               ///< measurements
     int detected = 0;           ///< ... with >= 1 target at the pole's azimuth in the last rotations
     int rot_checked = 0, rot_detected = 0; ///< last rotations checked / with a matched target

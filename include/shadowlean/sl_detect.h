@@ -25,6 +25,17 @@
 ///      elongation d(S), reaches S) or that reaches the end of the row passed in is flagged
 ///      SHADOW: its far end is at or beyond the shadow edge, so r2 is the ground or the
 ///      pole's base, not the -theta ray. The run is followed past the window to its end.
+///      d(S) is only a prior there: with the amplitude row of the azimuth
+///      (sl_detect_set_amplitude()), a run reaching that edge (but not the end of the row)
+///      is SHADOW only when its part beyond the window end `win_bins[az]` (S) does not look
+///      like the smear tail of its part inside: not below the inside peak, or not decaying
+///      (with the stream's own tail slope s known, sl_detect_set_tail_slope(): longer than
+///      ceil((peak - T) / s) bins, the longest tail the inside peak can leave at threshold
+///      T; without it: its first half not stronger than its second by >= 1/2 value per bin
+///      of separation). Otherwise the run is flagged TAIL_EDGE: its own end may lie inside
+///      the shadow, sl_detect_end skips the r2 >= S test for it and the caller decides on
+///      the refined r2 (the pipeline: the range profile's r2, else r2 - d(r2)). Without an
+///      amplitude row the d(S) rule stays.
 /// 2. **Grouping**. A run on azimuth a joins the group (candidate) that has a run on a - 1
 ///    whose extent overlaps it within `cfg.link_bins` bins; a run touching two groups merges
 ///    them. Azimuth azimuths-1 links to azimuth 0 at the end of the rotation (wrap). A
@@ -37,7 +48,8 @@
 /// 4. **Rejections**, counted per reason in `stats.rejected[]`, first match wins:
 ///    NEAR (any run of the group crosses into the near-field band);
 ///    SHADOW (any run flagged SHADOW, or the corrected r2 of the representative run is
-///    >= S(az): the base is not inside the shadow);
+///    >= S(az): the base is not inside the shadow; the r2 test is left to the caller for a
+///    group with a TAIL_EDGE run, stage 1);
 ///    WIDE (the group spans more azimuths than a pole of `cfg.max_pole_diameter_um` at r1
 ///    can: allowed = floor((D / r1 [rad] + beam) / step) + 1 + `cfg.width_slack_az`);
 ///    BROKEN (the representative run has a gap);
@@ -175,6 +187,8 @@ typedef enum sl_detect_reject {
 #define SL_TARGET_ELONG 0x08U          ///< the elongation table was applied (d != 0)
 #define SL_TARGET_WRAPS 0x10U          ///< the group crosses azimuth 0
 #define SL_TARGET_PROFILE 0x20U        ///< bounds from the range profile (sl_profile.h)
+#define SL_TARGET_TAIL_EDGE 0x40U      ///< a run's smear tail crosses the shadow edge: the
+                                       ///< caller tests the refined r2 against S (stage 1)
 
 /// Detection parameters that are not (yet) board fields.
 typedef struct sl_detect_cfg {
@@ -275,6 +289,7 @@ typedef struct sl_detect {
     const uint8_t *amp;     ///< amplitude row for the next sl_detect_row (borrowed) or NULL
     uint16_t amp_bins;      ///< its length
     uint8_t amp_threshold;  ///< the threshold it was cut at
+    uint16_t tail_slope_q8; ///< self-calibrated smear tail, 1/256 value per bin (0: unknown)
     sl_detect_stats_t stats;
 } sl_detect_t;
 
@@ -320,6 +335,10 @@ uint16_t sl_detect_bins_needed(const sl_detect_t *d);
 /// then forgotten (rows fed without one, e.g. held rows, are not tested). O(1).
 void sl_detect_set_amplitude(sl_detect_t *d, const uint8_t *power, uint16_t bins,
                              uint8_t threshold);
+
+/// The stream's smear tail slope (1/256 value per bin per frame, e.g. sl_profile_t.slope_q8;
+/// 0 = unknown: the board's d(S) decides SHADOW at the edge, stage 1). Kept until changed. O(1).
+void sl_detect_set_tail_slope(sl_detect_t *d, uint16_t slope_q8);
 
 /// Clear every hint (stage 4b). Hints stay until cleared (sl_detect_begin keeps them).
 /// O(azimuths / 32).

@@ -11,7 +11,12 @@
 ///              consistency, window shortened with vehicle speed) -> sl_detect (runs in
 ///              the shadow, corrections, alpha) -> sl_profile (bounds re-extracted from
 ///              the summed 8-bit rows of the azimuths that show something in the shadow,
-///              smear tail removed; cfg.profile) -> sl_track -> CAN (sl_can_tx_t)
+///              smear tail removed; cfg.profile; a target is then rejected SHADOW when
+///              its refined r2 (else, for a target whose tail crosses the shadow edge,
+///              SL_TARGET_TAIL_EDGE, its r2 less d(r2)) reaches the edge, so the board's
+///              d decides nothing once a profile exists; the profiles' calibrated tail
+///              slope goes back to sl_detect for the next rotation's edge rule)
+///              -> sl_track -> CAN (sl_can_tx_t)
 ///
 /// so `sizeof(sl_pipeline_t)` is the whole RAM of the module (see the budget below).
 ///

@@ -449,6 +449,100 @@ static void test_detect_rejects_returns_never_clearly_above_the_floor(void **sta
     }
 }
 
+// Stage 1 at the shadow edge with amplitude rows (d(S) a prior, not the truth): a pole
+// inside the shadow whose smear tail crosses the edge is kept and flagged TAIL_EDGE; ground
+// beyond the edge joined to it (flat, not decaying), a brighter return beyond the edge (a
+// base outside the shadow) and, once the stream's tail slope is known, an overshoot longer
+// than the inside peak's longest tail are SHADOW; without amplitude the d(S) rule stays.
+static int edge_rotation(const uint16_t *azs, int n, bool with_amp)
+{
+    sl_detect_begin(&det);
+    for (int a = 0; a < NAZ; a++) {
+        bool ours = false;
+        for (int i = 0; i < n; i++) {
+            ours = ours || (a >= azs[i] && a < azs[i] + 3);
+        }
+        if (with_amp && ours) {
+            sl_detect_set_amplitude(&det, amp[a], 512, 40);
+        }
+        assert_int_equal(sl_detect_row(&det, (uint16_t)a, rows[a], NW), SL_OK);
+    }
+    return (int)sl_detect_end(&det);
+}
+
+static void edge_case(int az0, uint32_t end, int (*level)(uint32_t k))
+{
+    for (int a = az0; a < az0 + 3; a++) {
+        set_run(a, 110, end);
+        for (uint32_t k = 100; k < 512; k++) {
+            const int v = level(k);
+            amp[a][k] = (uint8_t)(v < 0 ? 0 : v > 255 ? 255 : v);
+        }
+    }
+}
+
+// own bins 110..120 at 110, then a tail falling 3 values per bin (to 40 at bin 144)
+static int lvl_tail(uint32_t k)
+{
+    return k < 110 ? 5 : k <= 120 ? 110 : 110 - 3 * (int)(k - 120);
+}
+// the same pole joined to flat ground at 60 from the edge on
+static int lvl_ground(uint32_t k)
+{
+    return k < 128 ? lvl_tail(k) : 60;
+}
+// a brighter return beyond the edge
+static int lvl_bright(uint32_t k)
+{
+    return k < 110 ? 5 : k < 136 ? 80 : 120 - (int)(k - 136);
+}
+// a slow decay: 1 value per bin from 100 at bin 120 (reaches 40 at bin 180)
+static int lvl_slow(uint32_t k)
+{
+    return k < 110 ? 5 : k <= 120 ? 100 : 100 - (int)(k - 120);
+}
+
+static void test_detect_shadow_edge_tail_is_not_the_ground(void **state)
+{
+    (void)state;
+    assert_int_equal(sl_detect_init(&det, &board, NULL), SL_OK);
+    memset(amp, 0, sizeof amp);
+    const uint32_t s_bin = det.edge_bins[0]; // no elongation table: the edge bin itself
+    assert_int_equal(s_bin, 134U);
+    const uint16_t azs[4] = {50, 100, 150, 200};
+    edge_case(50, 143, lvl_tail);     // tail to bin 143: 9 bins past the edge
+    edge_case(100, 300, lvl_ground);  // joined to the ground
+    edge_case(150, 140, lvl_bright);  // brighter beyond the edge
+    edge_case(200, 179, lvl_slow);    // slow tail, 45 bins past the edge
+    // The d(S) rule without amplitude rows: all four SHADOW.
+    assert_int_equal(edge_rotation(azs, 4, false), 0);
+    assert_int_equal(det.stats.rejected[SL_DETECT_REJ_SHADOW], 4);
+    // With amplitude, no tail slope known yet: the tail and the slow tail pass, flagged.
+    assert_int_equal(edge_rotation(azs, 4, true), 2);
+    assert_int_equal(det.stats.rejected[SL_DETECT_REJ_SHADOW], 6);
+    assert_int_equal(det.targets[0].az_first, 50);
+    assert_int_equal(det.targets[1].az_first, 200);
+    for (int i = 0; i < 2; i++) {
+        assert_true((det.targets[i].flags & SL_TARGET_TAIL_EDGE) != 0U);
+        assert_int_equal(det.targets[i].bin_first, 110);
+    }
+    // The stream's tail is 3 values per bin: the inside peak (110 and 100) leaves at most
+    // ceil(70 / 3) = 24 and 20 bins past the window end (135): the 9-bin tail stays,
+    // the 45-bin slow one is the ground.
+    sl_detect_set_tail_slope(&det, 3U * 256U);
+    assert_int_equal(edge_rotation(azs, 4, true), 1);
+    assert_int_equal(det.targets[0].az_first, 50);
+    assert_int_equal(det.stats.rejected[SL_DETECT_REJ_SHADOW], 9);
+    // A tail slope of 1 value per bin allows the slow one again.
+    sl_detect_set_tail_slope(&det, 256U);
+    assert_int_equal(edge_rotation(azs, 4, true), 2);
+    // Inside the window nothing changes: a run ending before the edge is not flagged.
+    memset(rows, 0, sizeof rows);
+    edge_case(50, 130, lvl_tail);
+    assert_int_equal(edge_rotation(azs, 1, true), 1);
+    assert_int_equal(det.targets[0].flags & SL_TARGET_TAIL_EDGE, 0);
+}
+
 static void test_detect_slots_go_to_the_strongest_not_the_lowest_azimuths(void **state)
 {
     (void)state;
@@ -749,6 +843,7 @@ int main(void)
         cmocka_unit_test_setup(test_detect_handles_empty_saturated_and_misordered_input, setup),
         cmocka_unit_test_setup(test_detect_rejects_clutter_before_it_takes_a_slot, setup),
         cmocka_unit_test_setup(test_detect_rejects_returns_never_clearly_above_the_floor, setup),
+        cmocka_unit_test_setup(test_detect_shadow_edge_tail_is_not_the_ground, setup),
         cmocka_unit_test_setup(test_detect_slots_go_to_the_strongest_not_the_lowest_azimuths, setup),
         cmocka_unit_test_setup(test_detect_correct_half_bin_elongation_and_radius, setup),
         cmocka_unit_test_setup(test_detect_radius_from_the_column_at_the_inner_edge, setup),

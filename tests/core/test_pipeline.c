@@ -1298,6 +1298,146 @@ static void overflow_fn(void *ctx, int rot, uint32_t az, uint64_t t, uint8_t *ro
     }
 }
 
+// Smear tails across the shadow edge (sl_detect.h stage 1, TAIL_EDGE): a pole at azimuth
+// 100 whose own bins end 3 bins inside the edge, with a tail falling 3 values per bin that
+// reaches 20 bins past it, is kept (the d(S) rule alone, which paper-sim has as d = 0,
+// rejects it SHADOW), with its r2 from the profile inside the shadow; a pole at azimuth 200
+// whose own bins (falling 1 value per bin) end 2 bins BEYOND the edge, followed by the same
+// tail, passes the run-level tail rule but is rejected SHADOW on its refined r2.
+static uint32_t g_edge_bin;
+static int edge_level(uint32_t k, uint32_t k1, uint32_t k2, int own0, int own_step)
+{
+    if (k < k1) {
+        return 0;
+    }
+    const int last_own = own0 - own_step * (int)(k2 - k1);
+    if (k <= k2) {
+        return own0 - own_step * (int)(k - k1);
+    }
+    return last_own - 3 * (int)(k - k2);
+}
+
+static void edge_fn(void *ctx, int rot, uint32_t az, uint64_t t, uint8_t *row, uint32_t bins)
+{
+    (void)ctx;
+    (void)rot;
+    (void)t;
+    memset(row, 0, bins);
+    const uint32_t e = g_edge_bin;
+    for (uint32_t k = 0; k < bins; k++) {
+        int v = 0;
+        if (az >= 99U && az <= 101U) {
+            v = edge_level(k, e - 12U, e - 4U, 110, 0); // own end inside the window
+        } else if (az >= 199U && az <= 201U) {
+            v = edge_level(k, e - 10U, e + 2U, 110, 1); // own end beyond the edge
+        }
+        row[k] = (uint8_t)(v < 0 ? 0 : v > 255 ? 255 : v);
+    }
+}
+
+static void test_pipeline_smear_tail_across_the_shadow_edge(void **state)
+{
+    (void)state;
+    g_edge_bin = ground_first_bin(100); // the window end: first bin at or beyond S
+    assert_int_equal(ground_first_bin(200), g_edge_bin);
+    stream_t st;
+    st_init(&st, 24u << 20);
+    sopt_t o = sopt_defaults();
+    o.rotations = 20;
+    build(&st, &o, edge_fn, NULL);
+    rec_reset(0);
+    const sl_pipeline_cfg_t c = cfg_for(B);
+    assert_int_equal(sl_pipeline_init(&pl, B, &c), SL_OK);
+    feed_stream(&st, 65536, 0);
+    st_free(&st);
+    assert_int_equal(rec.rotations, 20);
+    const int first = B->mask_frames - 1;
+    for (int k = first; k < 20; k++) {
+        assert_int_equal(rec.nt[k], 1);
+        const sl_target_t *t = &rec.tg[k][0];
+        assert_true(t->az >= 99U && t->az <= 101U);
+        assert_true((t->flags & SL_TARGET_TAIL_EDGE) != 0U);
+        if (k > first) { // the profile has >= 2 rows from the second rotation on
+            assert_true((t->flags & SL_TARGET_PROFILE) != 0U);
+            assert_int_equal(t->r2_um, (uint32_t)(((2ULL * (g_edge_bin - 4U) + 1U) * B->bin_size_um + 1U) / 2U));
+            assert_true(t->r2_um < t->shadow_slant_um);
+        }
+    }
+    // The pole beyond the edge: rejected SHADOW every rotation from the first.
+    assert_true(pl.detect.stats.rejected[SL_DETECT_REJ_SHADOW] >= (uint32_t)(20 - first));
+    assert_true(pl.prof.stats.extracted >= (uint32_t)(20 - first - 1));
+}
+
+// A board whose d(S) overcorrects (0.5 m on paper-sim's geometry) and steep tails (10
+// values per bin) that end before the d(S) edge: detection alone keeps the pole whose own
+// bins end 2 bins beyond the shadow edge (r2 - d is inside); the profile's own r2 rejects
+// it SHADOW, while the pole whose own bins end inside stays, with its own r2.
+static int g_edge_tail_step = 3;
+static void edge_steep_fn(void *ctx, int rot, uint32_t az, uint64_t t, uint8_t *row,
+                          uint32_t bins)
+{
+    (void)ctx;
+    (void)rot;
+    (void)t;
+    memset(row, 0, bins);
+    const uint32_t e = g_edge_bin;
+    for (uint32_t k = 0; k < bins; k++) {
+        int v = 0;
+        const uint32_t k1 = az >= 199U && az <= 201U ? e - 10U : e - 12U;
+        const uint32_t k2 = az >= 199U && az <= 201U ? e + 2U : e - 4U;
+        if ((az >= 99U && az <= 101U) || (az >= 199U && az <= 201U)) {
+            if (k >= k1 && k <= k2) {
+                v = 110 - (int)(k - k1);
+            } else if (k > k2) {
+                v = 110 - (int)(k2 - k1) - g_edge_tail_step * (int)(k - k2);
+            }
+        }
+        row[k] = (uint8_t)(v < 0 ? 0 : v > 255 ? 255 : v);
+    }
+}
+
+static sl_board_t g_board_d;
+static void test_pipeline_overcorrecting_d_does_not_let_a_base_beyond_the_edge_through(void **state)
+{
+    (void)state;
+    g_board_d = *B;
+    g_board_d.elong_points = 1;
+    g_board_d.elong_range_um[0] = 5000000U;
+    g_board_d.elong_d_um[0] = 500000; // 0.5 m: 11.4 bins
+    g_edge_bin = ground_first_bin(100);
+    g_edge_tail_step = 10;
+    stream_t st;
+    st_init(&st, 24u << 20);
+    sopt_t o = sopt_defaults();
+    o.rotations = 20;
+    build(&st, &o, edge_steep_fn, NULL);
+    const int first = B->mask_frames - 1;
+    // Without range profiles, detection's r2 - d keeps both poles.
+    rec_reset(0);
+    sl_pipeline_cfg_t c = cfg_for(&g_board_d);
+    c.profile = false;
+    assert_int_equal(sl_pipeline_init(&pl, &g_board_d, &c), SL_OK);
+    feed_stream(&st, 65536, 0);
+    for (int k = first; k < 20; k++) {
+        assert_int_equal(rec.nt[k], 2);
+    }
+    // With them (the default), the profile's own r2 decides.
+    rec_reset(0);
+    c = cfg_for(&g_board_d);
+    assert_int_equal(sl_pipeline_init(&pl, &g_board_d, &c), SL_OK);
+    feed_stream(&st, 65536, 0);
+    st_free(&st);
+    for (int k = first; k < 20; k++) {
+        assert_int_equal(rec.nt[k], 1);
+        const sl_target_t *t = &rec.tg[k][0];
+        assert_true(t->az >= 99U && t->az <= 101U);
+        assert_true((t->flags & SL_TARGET_PROFILE) != 0U);
+        assert_int_equal(t->flags & SL_TARGET_TAIL_EDGE, 0);
+        assert_int_equal(t->r2_um, (uint32_t)(((2ULL * (g_edge_bin - 4U) + 1U) * B->bin_size_um + 1U) / 2U));
+    }
+    assert_int_equal(pl.detect.stats.rejected[SL_DETECT_REJ_SHADOW], (uint32_t)(20 - first));
+}
+
 static void test_pipeline_slot_overflow_keeps_the_poles_and_is_counted_on_can(void **state)
 {
     (void)state;
@@ -1450,6 +1590,8 @@ int main(void)
         cmocka_unit_test(test_pipeline_drive_by_detects_the_pole_only_with_motion_input),
         cmocka_unit_test(test_pipeline_rejects_boards_that_need_more_mask_bins),
         cmocka_unit_test(test_pipeline_slot_overflow_keeps_the_poles_and_is_counted_on_can),
+        cmocka_unit_test(test_pipeline_smear_tail_across_the_shadow_edge),
+        cmocka_unit_test(test_pipeline_overcorrecting_d_does_not_let_a_base_beyond_the_edge_through),
     };
     const int rc = cmocka_run_group_tests(tests, setup, NULL);
     st_free(&g_static);

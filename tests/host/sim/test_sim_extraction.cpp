@@ -20,12 +20,19 @@
 #include <cstdint>
 #include <cstdio>
 #include <setjmp.h>
+#include <string>
+#include <vector>
 
 extern "C" {
 #include <cmocka.h>
 }
 
 #include "sim_eval.h"
+
+extern "C" {
+#include "shadowlean/sl_board.h"
+#include "shadowlean/sl_track.h"
+}
 
 using namespace sl;
 
@@ -109,6 +116,28 @@ static void test_extraction_steeper_smear_same_configuration(void **)
     within(r, e, true, 1.5);
 }
 
+// A shallow smear (2.5 dB/bin): the tail of the far positions crosses the shadow edge by
+// more than the board's d(S) allows. The pole is still found at every angle (the run beyond
+// the edge decays like a tail of its inside part: sl_detect.h stage 1, TAIL_EDGE; the
+// refined r2 decides), where the d(S) rule alone rejected it SHADOW (4 of 6 detected at
+// -10/-5/0 deg). The accuracy criterion (<= 1.5 deg) is NOT met at this decay yet (the
+// walk cannot tell the pole's last bins from a 2.5-value tail in integer values): printed.
+static void test_extraction_shallow_smear_found_at_the_shadow_edge(void **)
+{
+    RealisticOptions o = quick();
+    o.smear_decay_db = 2.5;
+    const RealisticResult r = run_realistic(o);
+    double e[5];
+    std::printf("smear 2.5 dB/bin (accuracy printed, detection asserted):\n");
+    within(r, e, false, 1.5);
+    for (int a = 0; a < 5; a++) {
+        const RealisticPipe &p = r.pipe[a];
+        if (p.detected != p.runs) {
+            fail_msg("angle %d: detected %d/%d", r.angles[a], p.detected, p.runs);
+        }
+    }
+}
+
 // Per-frame speckle: the profile is a mean, not the AND's minimum statistic, so the estimate
 // does not drift with n (the mask's r2 shortens with n: EXTRACTION.md s.1 cause 3).
 static void test_extraction_does_not_drift_with_n_under_per_frame_speckle(void **)
@@ -130,12 +159,108 @@ static void test_extraction_does_not_drift_with_n_under_per_frame_speckle(void *
     }
 }
 
-int main(void)
+// Never a false warning: with the pole tracked over several rotations (6 simulated beyond
+// the window), on every condition above (smear 3.3 / 4.5 / 2.5 dB per bin, per-frame
+// speckle at n = 4), the tracker's warning level after the last rotation is never above the
+// level the true lean gives anywhere within the reported sigma (board paper-bench: CAUTION
+// at |alpha| >= 5 deg, DANGER at alpha >= 10 deg). Levels must be raised somewhere (the
+// tracker confirmed the poles), so the check is not vacuous.
+static int level_of(const sl_board_t *b, double a_deg)
 {
-    const struct CMUnitTest tests[] = {
+    const double a = a_deg * 100.0;
+    if (b->danger_lean_cdeg > 0 && a >= b->danger_lean_cdeg) {
+        return SL_WARN_DANGER;
+    }
+    if (b->caution_lean_cdeg > 0 && std::fabs(a) >= b->caution_lean_cdeg) {
+        return SL_WARN_CAUTION;
+    }
+    return SL_WARN_NONE;
+}
+
+static void test_extraction_never_a_false_warning(void **)
+{
+    const sl_board_t *b = sl_board_find("paper-bench");
+    assert_non_null(b);
+    struct Cond {
+        const char *name;
+        double decay;
+        int speckle_static, frames;
+    };
+    const Cond conds[4] = {{"smear 3.3 dB/bin", 3.3, 1, 16},
+                           {"smear 4.5 dB/bin", 4.5, 1, 16},
+                           {"smear 2.5 dB/bin", 2.5, 1, 16},
+                           {"per-frame speckle, n = 4", 3.3, 0, 4}};
+    int raised = 0, checked = 0;
+    for (const Cond &c : conds) {
+        RealisticOptions o = quick();
+        o.positions = 2;
+        o.reps = 1;
+        o.smear_decay_db = c.decay;
+        o.speckle_static = c.speckle_static;
+        o.frames = c.frames;
+        o.track_rotations = 6;
+        const RealisticResult r = run_realistic(o);
+        std::printf("%s:\n", c.name);
+        for (int a = 0; a < 5; a++) {
+            const RealisticPipe &p = r.pipe[a];
+            for (size_t i = 0; i < p.filt.size(); i++) {
+                const double t = p.filt_truth[i], sg = p.filt_sigma[i];
+                const int allowed = std::max(level_of(b, t + sg), level_of(b, t - sg));
+                std::printf("  true %+6.2f filtered %+6.2f sigma %.2f level %d (allowed <= %d)\n", t,
+                            p.filt[i], sg, p.filt_level[i], allowed);
+                checked++;
+                raised += p.filt_level[i] > SL_WARN_NONE ? 1 : 0;
+                if (p.filt_level[i] > allowed) {
+                    fail_msg("%s: true %.2f deg, filtered %.2f sigma %.2f: level %d above %d", c.name, t,
+                             p.filt[i], sg, p.filt_level[i], allowed);
+                }
+            }
+        }
+    }
+    std::printf("tracked measurements %d, with a level raised %d\n", checked, raised);
+    assert_true(checked >= 30);
+    assert_true(raised >= 8);
+}
+
+// argv: "--only SUBSTR" or "--skip SUBSTR" (repeatable): runs the tests whose names contain
+// one of the --only strings (all when none) and none of the --skip strings, so one
+// executable gives several ctest entries that each stay near ~1 min on the loaded machine.
+int main(int argc, char **argv)
+{
+    const struct CMUnitTest all[] = {
         cmocka_unit_test(test_extraction_paper_condition_within_1_deg),
         cmocka_unit_test(test_extraction_steeper_smear_same_configuration),
+        cmocka_unit_test(test_extraction_shallow_smear_found_at_the_shadow_edge),
+        cmocka_unit_test(test_extraction_never_a_false_warning),
         cmocka_unit_test(test_extraction_does_not_drift_with_n_under_per_frame_speckle),
     };
-    return cmocka_run_group_tests(tests, nullptr, nullptr);
+    std::vector<std::string> only, skip;
+    for (int i = 1; i < argc; i++) {
+        const std::string a = argv[i];
+        if ((a == "--only" || a == "--skip") && i + 1 < argc) {
+            (a == "--only" ? only : skip).push_back(argv[++i]);
+        } else {
+            std::fprintf(stderr, "usage: test_sim_extraction [--only SUBSTR]... [--skip SUBSTR]...\n");
+            return 2;
+        }
+    }
+    std::vector<CMUnitTest> run;
+    for (const CMUnitTest &t : all) {
+        const std::string name = t.name;
+        bool in = only.empty();
+        for (const auto &o : only) {
+            in = in || name.find(o) != std::string::npos;
+        }
+        for (const auto &k : skip) {
+            in = in && name.find(k) == std::string::npos;
+        }
+        if (in) {
+            run.push_back(t);
+        }
+    }
+    if (run.empty()) {
+        std::fprintf(stderr, "test_sim_extraction: no test selected\n");
+        return 2;
+    }
+    return _cmocka_run_group_tests("test_sim_extraction", run.data(), run.size(), nullptr, nullptr);
 }
