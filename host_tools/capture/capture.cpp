@@ -202,6 +202,8 @@ struct MessageReader::Impl {
     std::deque<std::pair<uint8_t, std::vector<uint8_t>>> q;
     bool eof = false;
     std::string path;
+    const uint8_t *mem = nullptr; // open_memory: the stream and how far it has been fed
+    size_t mem_size = 0, mem_off = 0;
 
     static void on_msg(void *ctx, const sl_proto_msg_t *m)
     {
@@ -246,8 +248,46 @@ bool MessageReader::open(const std::string &path, std::string &err, const PcapOp
     return true;
 }
 
+void MessageReader::open_memory(const uint8_t *data, size_t size)
+{
+    sl_proto_cfg_t pc{};
+    pc.reasm_buf = m_->reasm.data();
+    pc.reasm_size = m_->reasm.size();
+    pc.on_msg = Impl::on_msg;
+    pc.ctx = m_;
+    (void)sl_proto_init(&m_->p, &pc);
+    m_->mem = data;
+    m_->mem_size = size;
+    m_->path = "(memory)";
+}
+
+const sl_proto_stats_t &MessageReader::stats() const { return m_->p.stats; }
+
+CaptureFormat MessageReader::format() const
+{
+    if (m_->c == nullptr) {
+        return m_->mem != nullptr ? CaptureFormat::Raw : CaptureFormat::Unknown;
+    }
+    switch (sl_port_capture_report(m_->c)->format) {
+    case SL_PORT_CAPTURE_RAW: return CaptureFormat::Raw;
+    case SL_PORT_CAPTURE_PCAP: return CaptureFormat::Pcap;
+    case SL_PORT_CAPTURE_PCAPNG: return CaptureFormat::Pcapng;
+    }
+    return CaptureFormat::Unknown;
+}
+
 bool MessageReader::next(uint8_t &id, std::vector<uint8_t> &msg)
 {
+    while (m_->q.empty() && !m_->eof && m_->mem != nullptr) {
+        // 1 MiB at a time, so that the queue holds one megabyte's messages at most.
+        const size_t n = std::min<size_t>(m_->mem_size - m_->mem_off, 1u << 20);
+        (void)sl_proto_feed(&m_->p, m_->mem + m_->mem_off, n, 0);
+        m_->mem_off += n;
+        if (m_->mem_off == m_->mem_size) {
+            (void)sl_proto_finish(&m_->p);
+            m_->eof = true;
+        }
+    }
     while (m_->q.empty() && !m_->eof && m_->c != nullptr) {
         sl_port_capture_piece_t pc;
         sl_port_capture_next(m_->c, &pc);

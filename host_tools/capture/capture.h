@@ -165,10 +165,16 @@ public:
 
     /// false + err when `path` cannot be opened.
     bool open(const std::string &path, std::string &err, const PcapOptions &opt = PcapOptions{});
+    /// A raw Colossus stream already in memory (borrowed: it must outlive the reader).
+    void open_memory(const uint8_t *data, size_t size);
     /// The next message (its id and bytes); false at the end of the capture (error() is not
     /// empty when it ended on a read error).
     bool next(uint8_t &id, std::vector<uint8_t> &msg);
     const std::string &error() const { return err_; }
+    /// The decoder's counters so far (messages, bytes skipped, resyncs, truncated, ...).
+    const sl_proto_stats_t &stats() const;
+    /// The capture's format (sniffed at open; Raw for open_memory).
+    CaptureFormat format() const;
 
 private:
     struct Impl;
