@@ -66,7 +66,11 @@ serve-memory)
       > serve$k.txt 2> serve$k.err &
     pid=$!; port=""; n=0
     while [ -z "$port" ] && [ $n -lt 600 ] && kill -0 $pid 2>/dev/null; do
-      port=$(sed -n 's/^sl-replay: listening on 127\.0\.0\.1:\([0-9][0-9]*\)$/\1/p' serve$k.txt 2>/dev/null); n=$((n + 1)); sleep 0.05
+      # only a whole line (its newline written): never a port number cut short
+      if [ "$(tail -c 1 serve$k.txt 2>/dev/null | od -An -tx1 | tr -d ' ')" = 0a ]; then
+        port=$(sed -n 's/^sl-replay: listening on 127\.0\.0\.1:\([0-9][0-9]*\)$/\1/p' serve$k.txt)
+      fi
+      n=$((n + 1)); sleep 0.05
     done
     rrc=0
     if [ -n "$port" ]; then
