@@ -51,7 +51,7 @@ void count_msg(void *ctx, const sl_proto_msg_t *m)
 sl_scan_frame_t g_frames[2];
 uint64_t g_rows_seen = 0;
 
-void on_azimuth(void *ctx, const sl_scan_frame_t *f, uint16_t idx)
+void count_azimuth(void *ctx, const sl_scan_frame_t *f, uint16_t idx)
 {
     (void)ctx;
     (void)f;
@@ -85,7 +85,7 @@ static void bench_setup(bool with_scan, uint16_t roi)
         sl_scan_cfg_t sc{};
         sc.roi_bins = roi;
         sc.pow16_shift = 8;
-        sc.on_azimuth = on_azimuth;
+        sc.on_azimuth = count_azimuth;
         if (sl_scan_init(&g_s, &sc, &g_frames[0], &g_frames[1]) != SL_OK) {
             std::abort();
         }

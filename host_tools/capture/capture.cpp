@@ -195,24 +195,33 @@ bool read_capture(const std::string &path, const CaptureDataFn &on_data, const C
     return ok;
 }
 
+MessageDecoder::MessageDecoder(MsgFn on_msg) : fn_(std::move(on_msg)), reasm_(kHostMaxPayloadBytes)
+{
+    sl_proto_cfg_t pc{};
+    pc.reasm_buf = reasm_.data();
+    pc.reasm_size = reasm_.size();
+    pc.on_msg = MessageDecoder::on_msg;
+    pc.ctx = this;
+    (void)sl_proto_init(&p_, &pc);
+}
+
+void MessageDecoder::on_msg(void *ctx, const sl_proto_msg_t *m) { static_cast<MessageDecoder *>(ctx)->fn_(*m); }
+
 struct MessageReader::Impl {
     sl_port_capture_t *c = nullptr;
-    sl_proto_t p{};
-    std::vector<uint8_t> reasm = std::vector<uint8_t>(kHostMaxPayloadBytes);
     std::deque<std::pair<uint8_t, std::vector<uint8_t>>> q;
+    MessageDecoder dec{[this](const sl_proto_msg_t &m) {
+        std::vector<uint8_t> v(SL_PROTO_HEADER_BYTES + m.payload.size);
+        (void)sl_proto_encode_header(v.data(), SL_PROTO_HEADER_BYTES, m.id, static_cast<uint32_t>(m.payload.size));
+        if (m.payload.size > 0) {
+            std::memcpy(v.data() + SL_PROTO_HEADER_BYTES, m.payload.data, m.payload.size);
+        }
+        q.emplace_back(m.id, std::move(v));
+    }};
     bool eof = false;
     std::string path;
-
-    static void on_msg(void *ctx, const sl_proto_msg_t *m)
-    {
-        auto *self = static_cast<Impl *>(ctx);
-        std::vector<uint8_t> v(SL_PROTO_HEADER_BYTES + m->payload.size);
-        (void)sl_proto_encode_header(v.data(), SL_PROTO_HEADER_BYTES, m->id, static_cast<uint32_t>(m->payload.size));
-        if (m->payload.size > 0) {
-            std::memcpy(v.data() + SL_PROTO_HEADER_BYTES, m->payload.data, m->payload.size);
-        }
-        self->q.emplace_back(m->id, std::move(v));
-    }
+    const uint8_t *mem = nullptr; // open_memory: the stream and how far it has been fed
+    size_t mem_size = 0, mem_off = 0;
 };
 
 MessageReader::MessageReader() : m_(new Impl) {}
@@ -236,27 +245,53 @@ bool MessageReader::open(const std::string &path, std::string &err, const PcapOp
         err = e;
         return false;
     }
-    sl_proto_cfg_t pc{};
-    pc.reasm_buf = m_->reasm.data();
-    pc.reasm_size = m_->reasm.size();
-    pc.on_msg = Impl::on_msg;
-    pc.ctx = m_;
-    (void)sl_proto_init(&m_->p, &pc);
     m_->path = path;
     return true;
 }
 
+void MessageReader::open_memory(const uint8_t *data, size_t size)
+{
+    m_->mem = data;
+    m_->mem_size = size;
+    m_->path = "(memory)";
+}
+
+const sl_proto_stats_t &MessageReader::stats() const { return m_->dec.stats(); }
+
+CaptureFormat MessageReader::format() const
+{
+    if (m_->c == nullptr) {
+        return m_->mem != nullptr ? CaptureFormat::Raw : CaptureFormat::Unknown;
+    }
+    switch (sl_port_capture_report(m_->c)->format) {
+    case SL_PORT_CAPTURE_RAW: return CaptureFormat::Raw;
+    case SL_PORT_CAPTURE_PCAP: return CaptureFormat::Pcap;
+    case SL_PORT_CAPTURE_PCAPNG: return CaptureFormat::Pcapng;
+    }
+    return CaptureFormat::Unknown;
+}
+
 bool MessageReader::next(uint8_t &id, std::vector<uint8_t> &msg)
 {
+    while (m_->q.empty() && !m_->eof && m_->mem != nullptr) {
+        // 1 MiB at a time, so that the queue holds one megabyte's messages at most.
+        const size_t n = std::min<size_t>(m_->mem_size - m_->mem_off, 1u << 20);
+        m_->dec.feed(m_->mem + m_->mem_off, n);
+        m_->mem_off += n;
+        if (m_->mem_off == m_->mem_size) {
+            m_->dec.finish();
+            m_->eof = true;
+        }
+    }
     while (m_->q.empty() && !m_->eof && m_->c != nullptr) {
         sl_port_capture_piece_t pc;
         sl_port_capture_next(m_->c, &pc);
         if (pc.kind == SL_PORT_CAPTURE_DATA) {
-            (void)sl_proto_feed(&m_->p, pc.data, pc.size, 0);
+            m_->dec.feed(pc.data, pc.size);
         } else if (pc.kind == SL_PORT_CAPTURE_BREAK) {
-            (void)sl_proto_finish(&m_->p);
+            m_->dec.finish();
         } else {
-            (void)sl_proto_finish(&m_->p);
+            m_->dec.finish();
             if (pc.kind == SL_PORT_CAPTURE_ERROR) {
                 err_ = m_->path + ": " + sl_port_capture_error(m_->c);
             }

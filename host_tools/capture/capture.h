@@ -150,6 +150,28 @@ bool read_capture(const std::string &path, const CaptureDataFn &on_data, const C
 bool stream_capture(const std::string &path, sl_proto_t *p, size_t chunk, Capture &info, uint64_t &bytes,
                     std::string &err, const PcapOptions &opt = PcapOptions{});
 
+/// The core decoder as the host tools use it (1 MiB reassembly buffer, the largest payload
+/// they accept), for bytes pushed in pieces of any size: a capture streamed by read_capture,
+/// a stream rendered in memory. `on_msg` gets every message (valid during the call).
+/// finish() at every discontinuity and at the end. Neither copyable nor movable (the core
+/// decoder keeps a pointer to it).
+class MessageDecoder {
+public:
+    using MsgFn = std::function<void(const sl_proto_msg_t &m)>;
+    explicit MessageDecoder(MsgFn on_msg);
+    MessageDecoder(const MessageDecoder &) = delete;
+    MessageDecoder &operator=(const MessageDecoder &) = delete;
+    void feed(const uint8_t *data, size_t size) { (void)sl_proto_feed(&p_, data, size, 0); }
+    void finish() { (void)sl_proto_finish(&p_); }
+    const sl_proto_stats_t &stats() const { return p_.stats; }
+
+private:
+    static void on_msg(void *ctx, const sl_proto_msg_t *m);
+    MsgFn fn_;
+    std::vector<uint8_t> reasm_;
+    sl_proto_t p_{};
+};
+
 /// A capture as a sequence of whole messages, pulled one at a time in bounded memory: the
 /// port's streaming reader (as read_capture: "-", FIFOs, pcap reassembly), the core decoder
 /// (1 MiB reassembly buffer, reset at every gap or new TCP session), and the messages of the
@@ -165,10 +187,16 @@ public:
 
     /// false + err when `path` cannot be opened.
     bool open(const std::string &path, std::string &err, const PcapOptions &opt = PcapOptions{});
+    /// A raw Colossus stream already in memory (borrowed: it must outlive the reader).
+    void open_memory(const uint8_t *data, size_t size);
     /// The next message (its id and bytes); false at the end of the capture (error() is not
     /// empty when it ended on a read error).
     bool next(uint8_t &id, std::vector<uint8_t> &msg);
     const std::string &error() const { return err_; }
+    /// The decoder's counters so far (messages, bytes skipped, resyncs, truncated, ...).
+    const sl_proto_stats_t &stats() const;
+    /// The capture's format (sniffed at open; Raw for open_memory).
+    CaptureFormat format() const;
 
 private:
     struct Impl;

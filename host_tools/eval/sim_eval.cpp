@@ -26,23 +26,14 @@ namespace sl {
 // ------------------------------------------------------------------------------------------
 // decoding
 
-CaptureRows::CaptureRows(RowFn on_row) : on_row_(std::move(on_row)), reasm_(1U << 20)
+CaptureRows::CaptureRows(RowFn on_row)
+    : on_row_(std::move(on_row)), dec_([this](const sl_proto_msg_t &m) { on_msg(this, &m); })
 {
-    sl_proto_cfg_t c;
-    std::memset(&c, 0, sizeof c);
-    c.reasm_buf = reasm_.data();
-    c.reasm_size = reasm_.size();
-    c.max_payload_bytes = static_cast<uint32_t>(reasm_.size());
-    c.on_msg = &CaptureRows::on_msg;
-    c.ctx = this;
-    if (sl_proto_init(&p_, &c) != SL_OK) {
-        throw std::runtime_error("sl_proto_init failed");
-    }
 }
 
-void CaptureRows::feed(const uint8_t *data, size_t n) { sl_proto_feed(&p_, data, n, 0); }
+void CaptureRows::feed(const uint8_t *data, size_t n) { dec_.feed(data, n); }
 
-void CaptureRows::finish() { sl_proto_finish(&p_); }
+void CaptureRows::finish() { dec_.finish(); }
 
 void CaptureRows::on_msg(void *ctx, const sl_proto_msg_t *m)
 {

@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "capture.h"
 #include "shadowlean/sl_proto.h"
 #include "sim_scene.h"
 #include "sim_truth.h"
@@ -36,15 +37,14 @@ public:
     bool have_config() const { return have_cfg_; }
     const sl_proto_config_t &config() const { return cfg_; }
     double bin_m() const { return bin_um_ * 1e-6; }
-    const sl_proto_stats_t &stats() const { return p_.stats; }
+    const sl_proto_stats_t &stats() const { return dec_.stats(); }
     uint32_t bad_fft() const { return bad_fft_; }
     int rotations_seen() const { return rot_ + 1; }
 
 private:
     static void on_msg(void *ctx, const sl_proto_msg_t *m);
     RowFn on_row_;
-    sl_proto_t p_{};
-    std::vector<uint8_t> reasm_;
+    MessageDecoder dec_;
     sl_proto_config_t cfg_{};
     bool have_cfg_ = false;
     uint32_t bin_um_ = 0;

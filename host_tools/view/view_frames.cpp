@@ -3,7 +3,6 @@
 #include "view_frames.h"
 
 #include <algorithm>
-#include <functional>
 #include <memory>
 #include <sys/stat.h>
 
@@ -77,11 +76,7 @@ bool is_dir(const std::string &p)
     return ::stat(p.c_str(), &st) == 0 && S_ISDIR(st.st_mode);
 }
 
-// Hands the stream to decoder `p` (sl_proto_finish at every discontinuity); `stop` turns
-// true once enough frames are kept. false + err on a read error.
-using Feeder = std::function<bool(sl_proto_t *p, const bool &stop, std::string &err)>;
-
-bool decode(const Feeder &feed, const FrameOptions &opt, FrameSet &out, std::string &err)
+bool decode(MessageReader &rd, const FrameOptions &opt, FrameSet &out, std::string &err)
 {
     if (opt.roi_bins < 1 || opt.roi_bins > SL_CFG_ROI_BINS) {
         err = "roi_bins must be in 1.." + std::to_string(SL_CFG_ROI_BINS);
@@ -105,20 +100,24 @@ bool decode(const Feeder &feed, const FrameOptions &opt, FrameSet &out, std::str
               ", encoder " + std::to_string(opt.encoder_size) + ")";
         return false;
     }
-    std::vector<uint8_t> reasm(kHostMaxPayloadBytes);
-    sl_proto_t p{};
-    sl_proto_cfg_t pc{};
-    pc.reasm_buf = reasm.data();
-    pc.reasm_size = reasm.size();
-    pc.on_msg = on_msg;
-    pc.ctx = ctx.get();
-    (void)sl_proto_init(&p, &pc);
-    if (!feed(&p, ctx->stop, err)) {
+    // The capture's messages, one at a time (capture.h MessageReader: the one way from a
+    // capture's bytes to messages); reading stops once enough frames are kept.
+    uint8_t id = 0;
+    std::vector<uint8_t> m;
+    while (!ctx->stop && rd.next(id, m)) {
+        sl_proto_msg_t pm{};
+        pm.id = id;
+        pm.payload.data = m.data() + SL_PROTO_HEADER_BYTES;
+        pm.payload.size = m.size() - SL_PROTO_HEADER_BYTES;
+        pm.wire_bytes = static_cast<uint32_t>(pm.payload.size);
+        on_msg(ctx.get(), &pm);
+    }
+    if (!rd.error().empty()) {
+        err = rd.error();
         return false;
     }
-    (void)sl_proto_finish(&p);
     sl_scan_flush(&ctx->scan);
-    out.proto = p.stats;
+    out.proto = rd.stats();
     out.scan = ctx->scan.stats;
     out.roi_bins = opt.roi_bins;
     if (opt.bin_size_m > 0) {
@@ -162,16 +161,9 @@ bool decode_frames(const std::vector<uint8_t> &bytes, const FrameOptions &opt, F
     if (out.kind.empty()) {
         out.kind = "raw";
     }
-    return decode(
-        [&](sl_proto_t *p, const bool &stop, std::string &) {
-            // 1 MiB at a time so a --max-frames stop ends the decoding early.
-            constexpr size_t kStep = 1u << 20;
-            for (size_t off = 0; off < bytes.size() && !stop; off += kStep) {
-                (void)sl_proto_feed(p, bytes.data() + off, std::min(kStep, bytes.size() - off), 0);
-            }
-            return true;
-        },
-        opt, out, err);
+    MessageReader rd;
+    rd.open_memory(bytes.data(), bytes.size());
+    return decode(rd, opt, out, err);
 }
 
 bool load_frames(const std::string &path, const FrameOptions &opt, FrameSet &out,
@@ -197,20 +189,14 @@ bool load_frames(const std::string &path, const FrameOptions &opt, FrameSet &out
         return true;
     }
     // A capture file, pipe, FIFO or "-": streamed through the port's reader, never loaded.
-    const Feeder stream = [&](sl_proto_t *p, const bool &stop, std::string &e) {
-        Capture info;
-        uint64_t bytes = 0;
-        const bool ok = read_capture(
-            path,
-            [&](const uint8_t *data, size_t size) {
-                (void)sl_proto_feed(p, data, size, 0);
-                return !stop;
-            },
-            [&](const Discontinuity &) { (void)sl_proto_finish(p); }, info, bytes, e);
-        out.kind = capture_format_name(info.format);
-        return ok;
-    };
-    if (!decode(stream, opt, out, err)) {
+    MessageReader rd;
+    if (!rd.open(path, err)) {
+        err = path + ": " + err;
+        return false;
+    }
+    const bool ok = decode(rd, opt, out, err);
+    out.kind = capture_format_name(rd.format());
+    if (!ok) {
         if (err.compare(0, path.size(), path) != 0) {
             err = path + ": " + err;
         }

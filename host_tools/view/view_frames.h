@@ -2,8 +2,8 @@
 // view_frames.h: a capture (raw .colossus, pcap/pcapng) or an Oxford PNG folder decoded into
 // whole rotations, for the host tools that look at images (sl-view, sl-calib). Host only.
 //
-// Every byte goes through the core: capture.h streams the file, sl_proto_feed() decodes the
-// Colossus stream (1 MiB reassembly buffer) and sl_scan assembles rotations (double
+// Every byte goes through the core: capture.h's MessageReader streams the file through the
+// core decoder (1 MiB reassembly buffer) and sl_scan assembles rotations (double
 // buffering, nearest-azimuth index, the first `roi_bins` bins of each azimuth). An Oxford
 // folder is first converted with oxford.h (the same converter as `sl-replay from-oxford`)
 // into an in-memory Colossus stream, so it is decoded exactly as its converted capture.
