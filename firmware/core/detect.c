@@ -563,11 +563,19 @@ static void finalize(sl_detect_t *d, sl_detect_cand_t *c)
         d->stats.rejected[reason]++;
         return;
     }
-    uint32_t occ_total = 0U, az_runs = 0U;
+    uint32_t occ_total = 0U, az_runs = 0U, ufirst = rep->first, ulast = rep->last;
     for (uint32_t i = 0; i < span && i < SL_CFG_DETECT_MAX_SPAN; i++) {
         occ_total += c->run[i].count;
-        az_runs += c->run[i].count != 0U ? 1U : 0U;
+        if (c->run[i].count != 0U) {
+            az_runs++;
+            ufirst = c->run[i].first < ufirst ? c->run[i].first : ufirst;
+            ulast = c->run[i].last > ulast ? c->run[i].last : ulast;
+        }
     }
+    ufirst = (uint32_t)rep->first - ufirst;
+    ulast -= rep->last;
+    t.ext_grow = (uint8_t)((ufirst < SL_TARGET_EXT_SAT ? ufirst : SL_TARGET_EXT_SAT) |
+                           ((ulast < SL_TARGET_EXT_SAT ? ulast : SL_TARGET_EXT_SAT) << 4));
     t.evidence = sl_detect_evidence(occ_total, az_runs, (uint32_t)rep->last - rep->first + 1U);
     if (((d->hint_bits[az >> 5] >> (az & 31U)) & 1U) != 0U) {
         const uint32_t e = (uint32_t)t.evidence + SL_DETECT_EVIDENCE_TRACK;

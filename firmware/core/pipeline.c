@@ -787,7 +787,7 @@ sl_err_t sl_pipeline_init(sl_pipeline_t *p, const sl_board_t *board,
         e = sl_track_init(&p->tracker, board, &c->track);
     }
     if (e == SL_OK) {
-        e = sl_tiltobs_init(&p->tilt, board);
+        e = sl_tiltobs_init(&p->tilt, &p->det_board); // bin size as detection uses it
     }
     sl_can_ids_t ids;
     if (e == SL_OK) {

@@ -220,8 +220,15 @@ typedef struct sl_target {
     uint8_t incline_flag;   ///< sl_incline_flag_t
     uint8_t incline_branch; ///< sl_incline_branch_t
     uint8_t flags;          ///< SL_TARGET_*
+    uint8_t ext_grow;       ///< the group's union extent (min first / max last bin over all
+                            ///< its azimuths) beyond the representative run, in bins: low
+                            ///< nibble before bin_first, high nibble after bin_last, each
+                            ///< saturating at SL_TARGET_EXT_SAT (3D tilt, sl_tiltobs.h)
     uint16_t evidence;      ///< slot priority (stage 4b), saturating
 } sl_target_t;
+
+/// sl_target_t.ext_grow: a nibble at this value means "this many bins or more".
+#define SL_TARGET_EXT_SAT 15U
 
 /// Counters (cumulative since init; never asserted).
 typedef struct sl_detect_stats {

@@ -37,9 +37,9 @@ static sl_tiltobs_t obs;
 // on every target). From x86-64; aarch64 and s390x must match (bit-identical arithmetic).
 // The host and firmware capacities keep different numbers of observations, so two values.
 #if SL_CFG_TILT_OBS_PER_TRACK == 32
-#define RESULTS_DIGEST 0xe14c3b811456fbc0ULL
+#define RESULTS_DIGEST 0xcb4a828565c4c841ULL
 #else
-#define RESULTS_DIGEST_FW 0xa7e4e3bdfd5811ccULL
+#define RESULTS_DIGEST_FW 0x9d0dc06e8c178549ULL
 #endif
 static uint64_t digest = 14695981039346656037ULL;
 static void digest_i32(int32_t v)
@@ -112,7 +112,13 @@ static bool see(const sl_board_t *b, const drive_t *d, const pole_t *p, sl_targe
     memset(g, 0, sizeof *g);
     g->az = (uint16_t)az;
     g->r1_um = (uint32_t)llround(r1 * 1e6);
-    g->r2_um = g->r1_um + 500000U;
+    // r2 from the model (sl_incline.h) for the alpha as read: branch 1 rho =
+    // cos(a - b) / cos(a + t), branch 2 rho = 1 / cos(a + t).
+    const double rho = (read >= beta) ? cos(rad(read - beta)) / cos(rad(read + theta))
+                                      : 1.0 / cos(rad(read + theta));
+    g->r2_um = (uint32_t)llround(r1 * rho * 1e6);
+    g->az_first = (uint16_t)az;
+    g->az_count = 1U;
     g->alpha_cdeg = (int32_t)llround(read * 100.0);
     g->sigma_cdeg = 50U;
     g->incline_flag = (uint8_t)SL_INCLINE_VALID;
@@ -177,6 +183,13 @@ static void truth(const pole_t *p, double v, double w, int rotations, double *ph
     *by_v = -dx * sin(d.yaw) + dy * cos(d.yaw);
 }
 
+// The fold test with the firmware's 16-observation rings: AMBIGUOUS (right answer, flagged)
+// is accepted for at most two of its four poles (the ring then holds only the half pass after
+// the pole; the value must still be within the bounds). The alpha sigmas are the model's for the
+// union bounds (0.6-1.2 deg near the fold on paper-sim), no longer a fixed 0.5 deg.
+static int ambiguous_ok;
+static int ambiguous_seen;
+
 static void check_pole(const pole_t *p, double v, double w, int rotations, uint16_t id,
                        double psi_tol, double phi_tol)
 {
@@ -203,7 +216,11 @@ static void check_pole(const pole_t *p, double v, double w, int rotations, uint1
            "lean %.2f (truth %.2f)\n",
            p->bx, p->by, p->psi, p->phi, r->count, out.quality, e_psi, e_phi, e_b,
            out.lean_path_cdeg / 100.0, lean);
-    assert_int_equal(out.quality, SL_TILT_FITTED);
+    if (ambiguous_ok && out.quality == SL_TILT_AMBIGUOUS) {
+        ambiguous_seen++;
+    } else {
+        assert_int_equal(out.quality, SL_TILT_FITTED);
+    }
     assert_true(fabs(e_psi) <= psi_tol);
     assert_true(fabs(e_phi) <= phi_tol);
     assert_true(e_b <= 0.15);
@@ -238,6 +255,8 @@ static void test_leaning_away_beyond_the_fold(void **state)
 {
     (void)state;
     sl_track_t tracks[SL_CFG_MAX_TARGETS];
+    ambiguous_ok = SL_CFG_TILT_OBS_PER_TRACK < 32;
+    ambiguous_seen = 0;
     for (int side = -1; side <= 1; side += 2) {
         for (double psi = 16.0; psi <= 20.0; psi += 4.0) {
             const pole_t p = {4.0, side * 3.0, psi, side > 0 ? 80.0 : 290.0}; // away from the path
@@ -245,6 +264,8 @@ static void test_leaning_away_beyond_the_fold(void **state)
             check_pole(&p, 1.0, 0.0, 32, 1, 1.0, 10.0);
         }
     }
+    ambiguous_ok = 0;
+    assert_true(ambiguous_seen <= 2);
 }
 
 static void test_curved_path_10_deg_per_second(void **state)
@@ -368,11 +389,21 @@ static void test_degenerate_inputs(void **state)
     assert_int_equal(obs.stats.no_target, 1U);
     sl_tiltobs_fit_pending(&obs); // nothing pending: no fit
     assert_int_equal(obs.stats.fits, 0U);
-    // |alpha| >= 80 deg: refused by sl_tilt_obs_make, counted.
+    // The group's union extent is unknown (a nibble of ext_grow saturated): refused, counted.
     g.incline_flag = SL_INCLINE_VALID;
-    g.alpha_cdeg = 8500;
+    g.ext_grow = (uint8_t)SL_TARGET_EXT_SAT;
     sl_tiltobs_update(&obs, tracks, &g, 1U);
     assert_int_equal(obs.stats.rejected, 1U);
+    g.ext_grow = (uint8_t)(SL_TARGET_EXT_SAT << 4);
+    sl_tiltobs_update(&obs, tracks, &g, 1U);
+    assert_int_equal(obs.stats.rejected, 2U);
+    // The union bounds give no valid alpha (r2 below r1 here): refused, counted.
+    g.ext_grow = 0U;
+    g.r2_um = 2900000;
+    tracks[0].r2_um = 2900000;
+    sl_tiltobs_update(&obs, tracks, &g, 1U);
+    assert_int_equal(obs.stats.rejected, 3U);
+    assert_int_equal(obs.stats.observations, 0U);
 }
 
 int main(void)
