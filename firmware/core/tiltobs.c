@@ -118,7 +118,13 @@ static const sl_target_t *target_of(const sl_track_t *t, const sl_target_t *targ
 // The group's union extent (sl_target_t.ext_grow: min first / max last bin over all its
 // azimuths) with the corrections of the representative bounds: r1 moves by whole bins (the
 // half-bin and radius terms are constant offsets), r2 too, less the change of the
-// elongation d(r2) over the added bins. False when a nibble saturated (extent unknown).
+// elongation d(r2) over the added bins (none after a profile refinement, which dropped d).
+// A radius estimated from the group's azimuthal width (RADIUS_WIDTH) is removed from both
+// bounds: on a leaning pole seen at an oblique bearing the width holds the lean's own spread
+// in bearing (a 1 cm pole reads as R = 0.15 m, the clamp), which would bias the very
+// inclination measured here; a board radius (RADIUS_BOARD) stays. A thick pole without a
+// board radius then reads from its front surface (R = 0.1 m at 5 m: ~0.3 deg).
+// False when a nibble saturated (extent unknown) or the bounds are not a run.
 static bool union_bounds(const sl_board_t *b, const sl_target_t *g, uint32_t *r1, uint32_t *r2)
 {
     const uint32_t lo = (uint32_t)g->ext_grow & 15U;
@@ -127,12 +133,18 @@ static bool union_bounds(const sl_board_t *b, const sl_target_t *g, uint32_t *r1
         return false;
     }
     const int64_t bin = (int64_t)b->bin_size_um;
-    const int64_t u1 = (int64_t)g->r1_um - (int64_t)lo * bin;
     const int64_t add = (int64_t)hi * bin;
-    const int64_t hb = (int64_t)g->r2_raw_um + add - bin / 2;
-    const int64_t d = hi == 0U ? (int64_t)g->elong_um
-                               : (int64_t)sl_detect_elong_um(b, sl_fx_usat32(hb));
-    const int64_t u2 = (int64_t)g->r2_um + add - (d - (int64_t)g->elong_um);
+    int64_t u1 = (int64_t)g->r1_um - (int64_t)lo * bin;
+    int64_t u2 = (int64_t)g->r2_um + add;
+    // The representative's last half-bin centre (sl_detect.h, 5.).
+    const int64_t r2_hb = ((2 * (int64_t)g->bin_last + 1) * bin + 1) / 2;
+    if (hi != 0U && (g->flags & SL_TARGET_PROFILE) == 0U) {
+        u2 -= (int64_t)sl_detect_elong_um(b, sl_fx_usat32(r2_hb + add)) - (int64_t)g->elong_um;
+    }
+    if ((g->flags & SL_TARGET_RADIUS_WIDTH) != 0U) {
+        u1 -= (int64_t)g->radius_um;
+        u2 -= (int64_t)g->r2_um + (int64_t)g->elong_um - r2_hb;
+    }
     if (u1 <= 0 || u2 <= u1 || u2 > (int64_t)UINT32_MAX) {
         return false;
     }

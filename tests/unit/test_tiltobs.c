@@ -362,6 +362,53 @@ static void test_more_tracks_than_rings_are_counted(void **state)
     if (n > SL_CFG_TILT_TRACKS) assert_true(obs.stats.no_ring > 0U);
 }
 
+// The observation is the group's union extent (ext_grow) with the representative's
+// corrections, at the group's centre azimuth; a width-estimated radius is taken out of both
+// bounds, the elongation re-evaluated at the union's far end.
+static void test_union_extent_is_observed(void **state)
+{
+    (void)state;
+    const sl_board_t *b = board();
+    const int64_t bin = b->bin_size_um;
+    assert_int_equal(sl_tiltobs_init(&obs, b), SL_OK);
+    sl_tiltobs_advance(&obs, true, 1000, 0, 250000U);
+    sl_track_t tracks[SL_CFG_MAX_TARGETS];
+    memset(tracks, 0, sizeof tracks);
+    const uint16_t first = 70U, last = 79U; // representative run, bins
+    const int64_t hb1 = ((2 * first + 1) * bin + 1) / 2, hb2 = ((2 * last + 1) * bin + 1) / 2;
+    sl_target_t g;
+    memset(&g, 0, sizeof g);
+    g.az = 100; g.az_first = 97; g.az_count = 6; // centre 99.5
+    g.bin_first = first; g.bin_last = last;
+    g.r2_raw_um = (uint32_t)((last + 1) * bin);
+    g.radius_um = 40000U;
+    g.elong_um = sl_detect_elong_um(b, (uint32_t)hb2);
+    g.flags = SL_TARGET_RADIUS_WIDTH;
+    g.r1_um = (uint32_t)(hb1 + 40000);
+    g.r2_um = (uint32_t)(hb2 - g.elong_um + 25000);
+    g.ext_grow = (uint8_t)(2U | (3U << 4));
+    g.incline_flag = SL_INCLINE_VALID;
+    tracks[0] = (sl_track_t){.live = 1, .updated = 1, .confirmed = 1, .id = 3, .az = g.az,
+                             .r1_um = g.r1_um, .r2_um = g.r2_um};
+    sl_tiltobs_update(&obs, tracks, &g, 1U);
+    assert_int_equal(obs.stats.observations, 1U);
+    const sl_tiltobs_ring_t *r = sl_tiltobs_find(&obs, 3U);
+    assert_non_null(r);
+    const int64_t u1 = hb1 - 2 * bin;
+    const int64_t u2 = hb2 + 3 * bin - sl_detect_elong_um(b, (uint32_t)(hb2 + 3 * bin));
+    assert_int_equal(r->obs[0].r1_um, (uint32_t)u1);
+    // alpha of the union bounds at the centre azimuth (geometry of azimuth 100 after rounding)
+    const sl_incline_result_t inc = sl_incline_estimate((uint32_t)u1, (uint32_t)u2, &b->geom[100],
+                                                        b->range_sigma_um, b->theta_sigma_cdeg);
+    assert_int_equal(inc.flag, SL_INCLINE_VALID);
+    const double tan_want = tan(inc.alpha_bam32 * (2.0 * PI / 4294967296.0));
+    assert_true(fabs(r->obs[0].tan_q12 / 4096.0 - tan_want) <= 1.0 / 4096.0);
+    // the bearing is the centre's (99.5 azimuths clockwise of forward, plus the radar's yaw)
+    const double want = -rad(99.5 * 360.0 / b->azimuths + b->radar_yaw_cdeg / 100.0);
+    assert_true(fabs(atan2(r->obs[0].sin_a_q15, r->obs[0].cos_a_q15) -
+                     atan2(sin(want), cos(want))) <= 0.002);
+}
+
 static void test_degenerate_inputs(void **state)
 {
     (void)state;
@@ -416,6 +463,7 @@ int main(void)
         cmocka_unit_test(test_fits_are_bounded_per_rotation),
         cmocka_unit_test(test_lost_motion_and_lost_tracks_clear_history),
         cmocka_unit_test(test_more_tracks_than_rings_are_counted),
+        cmocka_unit_test(test_union_extent_is_observed),
         cmocka_unit_test(test_degenerate_inputs),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
