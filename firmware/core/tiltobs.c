@@ -129,26 +129,25 @@ static bool union_bounds(const sl_board_t *b, const sl_target_t *g, uint32_t *r1
 {
     const uint32_t lo = (uint32_t)g->ext_grow & 15U;
     const uint32_t hi = (uint32_t)g->ext_grow >> 4;
-    if (lo >= SL_TARGET_EXT_SAT || hi >= SL_TARGET_EXT_SAT) {
-        return false;
-    }
-    const int64_t bin = (int64_t)b->bin_size_um;
-    const int64_t add = (int64_t)hi * bin;
-    int64_t u1 = (int64_t)g->r1_um - (int64_t)lo * bin;
-    int64_t u2 = (int64_t)g->r2_um + add;
-    // The representative's last half-bin centre (sl_detect.h, 5.).
-    const int64_t r2_hb = ((2 * (int64_t)g->bin_last + 1) * bin + 1) / 2;
+    const uint32_t bin = b->bin_size_um;
+    const bool width = (g->flags & SL_TARGET_RADIUS_WIDTH) != 0U;
+    const uint32_t sub1 = lo * bin + (width ? g->radius_um : 0U);
+    const uint32_t add = hi * bin;
+    // The representative's last half-bin centre (sl_detect.h, 5.): (bin_last + 1/2) b.
+    const uint32_t r2_hb = g->r2_raw_um - bin / 2U;
+    int32_t t2 = 0; // what leaves r2 besides the added bins
     if (hi != 0U && (g->flags & SL_TARGET_PROFILE) == 0U) {
-        u2 -= (int64_t)sl_detect_elong_um(b, sl_fx_usat32(r2_hb + add)) - (int64_t)g->elong_um;
+        t2 = sl_detect_elong_um(b, r2_hb + add) - g->elong_um;
     }
-    if ((g->flags & SL_TARGET_RADIUS_WIDTH) != 0U) {
-        u1 -= (int64_t)g->radius_um;
-        u2 -= (int64_t)g->r2_um + (int64_t)g->elong_um - r2_hb;
+    if (width) {
+        t2 += (int32_t)(g->r2_um - r2_hb) + g->elong_um;
     }
-    if (u1 <= 0 || u2 <= u1 || u2 > (int64_t)UINT32_MAX) {
+    const int64_t u2 = (int64_t)g->r2_um + add - t2;
+    if (lo >= SL_TARGET_EXT_SAT || hi >= SL_TARGET_EXT_SAT || g->r1_um <= sub1 ||
+        u2 <= (int64_t)(g->r1_um - sub1) || u2 > (int64_t)UINT32_MAX) {
         return false;
     }
-    *r1 = (uint32_t)u1;
+    *r1 = g->r1_um - sub1;
     *r2 = (uint32_t)u2;
     return true;
 }

@@ -223,7 +223,8 @@ typedef struct sl_target {
     uint8_t ext_grow;       ///< the group's union extent (min first / max last bin over all
                             ///< its azimuths) beyond the representative run, in bins: low
                             ///< nibble before bin_first, high nibble after bin_last, each
-                            ///< saturating at SL_TARGET_EXT_SAT (3D tilt, sl_tiltobs.h)
+                            ///< saturating at SL_TARGET_EXT_SAT (3D tilt, sl_tiltobs.h);
+                            ///< 0 unless sl_detect_t.union_ext
     uint16_t evidence;      ///< slot priority (stage 4b), saturating
 } sl_target_t;
 
@@ -285,6 +286,9 @@ typedef struct sl_detect {
     const uint8_t *amp;     ///< amplitude row for the next sl_detect_row (borrowed) or NULL
     uint16_t amp_bins;      ///< its length
     uint8_t amp_threshold;  ///< the threshold it was cut at
+    bool union_ext;         ///< fill sl_target_t.ext_grow (else 0): set by the application
+                            ///< before a rotation's rows (the pipeline: while a motion
+                            ///< input is present, for the 3D tilt); O(span) per target
     sl_detect_stats_t stats;
 } sl_detect_t;
 
