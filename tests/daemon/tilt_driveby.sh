@@ -5,7 +5,8 @@
 # (paper-sim, noise-free) emits PoleTilt frames that canmatrix decodes with the board's DBC,
 # and the last FITTED frame of every pole matches the simulator's truth (psi, phi_deg).
 # Scenes: scenes/driveby_two_poles.ini (1 m/s, one pole leaning towards the path, one leaning
-# away, both sides) and the same at 3 m/s. Without --motion the same capture gives no
+# away, both sides), the same at 3 m/s, and scenes/driveby_curve.ini (1.5 m/s turning at
+# 10 deg/s: --motion 1.5,10). Without --motion the same capture gives no
 # PoleTilt frame.
 # Tolerances: the issue's, |Tilt error| <= 1 deg, direction within 10 deg (the observations
 # are the detection group's union extent at its centre azimuth: sl_tiltobs.h).
@@ -28,6 +29,8 @@ grep -q '^speed_mps = 3.0' "$OUT/fast.ini" || { echo "FAIL: scene edit"; exit 1;
 # At 3 m/s the pole leaning away is seen on 8 rotations only: its fit stays AMBIGUOUS (the
 # mirror hypothesis fits as well), which is the right answer; its Tilt is still checked.
 run fast 3.0 "$OUT/fast.ini" --ambiguous-ok || fail=1
+# A curved path (scenes/driveby_curve.ini: 1.5 m/s turning at 10 deg/s), one pole either side.
+run curve 1.5,10 "$ROOT/scenes/driveby_curve.ini" || fail=1
 # No motion input: no PoleTilt frame (the demo and Oxford frames stay as they were).
 "$D" --board paper-sim --input "$OUT/slow.colossus" --can-log "$OUT/still.log" -q || fail=1
 n=$(grep -c " 624#" "$OUT/still.log")
