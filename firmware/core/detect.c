@@ -481,6 +481,23 @@ static void slot_take(sl_detect_t *d, const sl_target_t *t)
     }
 }
 
+// sl_target_t.ext_grow of a group: its union extent (min first / max last bin over all its
+// azimuths) beyond the representative run, two saturating nibbles.
+static uint8_t union_grow(const sl_detect_cand_t *c, const sl_detect_azrun_t *rep, uint32_t span)
+{
+    uint32_t f = rep->first, l = rep->last;
+    for (uint32_t i = 0; i < span && i < SL_CFG_DETECT_MAX_SPAN; i++) {
+        if (c->run[i].count != 0U) {
+            f = c->run[i].first < f ? c->run[i].first : f;
+            l = c->run[i].last > l ? c->run[i].last : l;
+        }
+    }
+    f = (uint32_t)rep->first - f;
+    l -= rep->last;
+    return (uint8_t)((f < SL_TARGET_EXT_SAT ? f : SL_TARGET_EXT_SAT) |
+                     ((l < SL_TARGET_EXT_SAT ? l : SL_TARGET_EXT_SAT) << 4));
+}
+
 static void finalize(sl_detect_t *d, sl_detect_cand_t *c)
 {
     d->stats.groups++;
@@ -576,6 +593,9 @@ static void finalize(sl_detect_t *d, sl_detect_cand_t *c)
         az_runs += c->run[i].count != 0U ? 1U : 0U;
     }
     t.evidence = sl_detect_evidence(occ_total, az_runs, (uint32_t)rep->last - rep->first + 1U);
+    if (d->union_ext) {
+        t.ext_grow = union_grow(c, rep, span);
+    }
     if (((d->hint_bits[az >> 5] >> (az & 31U)) & 1U) != 0U) {
         const uint32_t e = (uint32_t)t.evidence + SL_DETECT_EVIDENCE_TRACK;
         t.evidence = (uint16_t)(e > 0xFFFFU ? 0xFFFFU : e);

@@ -456,6 +456,7 @@ static void begin_rotation(sl_pipeline_t *p)
         p->speed_mm_s = m.speed_valid ? m.speed_mm_s : 0;
         p->yaw_cdeg_s = m.yaw_rate_valid ? m.yaw_rate_cdeg_s : 0;
     }
+    p->detect.union_ext = p->motion_valid; // group extents for the tilt history
     if (p->motion_valid && p->cfg.motion_adapt) {
         w = sl_pipeline_window(p->cfg.mask_frames, p->cfg.min_frames, p->speed_mm_s,
                                p->yaw_cdeg_s, p->rotation_us, p->cfg.motion_budget_um,
@@ -826,7 +827,7 @@ sl_err_t sl_pipeline_init(sl_pipeline_t *p, const sl_board_t *board,
         e = sl_track_init(&p->tracker, board, &c->track);
     }
     if (e == SL_OK) {
-        e = sl_tiltobs_init(&p->tilt, board);
+        e = sl_tiltobs_init(&p->tilt, &p->det_board); // bin size as detection uses it
     }
     sl_drift_init(&p->drift, board);
     sl_can_ids_t ids;

@@ -115,29 +115,87 @@ static const sl_target_t *target_of(const sl_track_t *t, const sl_target_t *targ
     return NULL;
 }
 
-// One observation of target `g` into ring `r`.
+// The group's union extent (sl_target_t.ext_grow: min first / max last bin over all its
+// azimuths) with the corrections of the representative bounds: r1 moves by whole bins (the
+// half-bin and radius terms are constant offsets), r2 too, less the change of the
+// elongation d(r2) over the added bins (none after a profile refinement, which dropped d).
+// A radius estimated from the group's azimuthal width (RADIUS_WIDTH) is removed from both
+// bounds: on a leaning pole seen at an oblique bearing the width holds the lean's own spread
+// in bearing (a 1 cm pole reads as R = 0.15 m, the clamp), which would bias the very
+// inclination measured here; a board radius (RADIUS_BOARD) stays. A thick pole without a
+// board radius then reads from its front surface (R = 0.1 m at 5 m: ~0.3 deg).
+// False when a nibble saturated (extent unknown) or the bounds are not a run.
+static bool union_bounds(const sl_board_t *b, const sl_target_t *g, uint32_t *r1, uint32_t *r2)
+{
+    const uint32_t lo = (uint32_t)g->ext_grow & 15U;
+    const uint32_t hi = (uint32_t)g->ext_grow >> 4;
+    const uint32_t bin = b->bin_size_um;
+    const bool width = (g->flags & SL_TARGET_RADIUS_WIDTH) != 0U;
+    const uint32_t sub1 = lo * bin + (width ? g->radius_um : 0U);
+    const uint32_t add = hi * bin;
+    // The representative's last half-bin centre (sl_detect.h, 5.): (bin_last + 1/2) b.
+    const uint32_t r2_hb = g->r2_raw_um - bin / 2U;
+    int32_t t2 = 0; // what leaves r2 besides the added bins
+    if (hi != 0U && (g->flags & SL_TARGET_PROFILE) == 0U) {
+        t2 = sl_detect_elong_um(b, r2_hb + add) - g->elong_um;
+    }
+    if (width) {
+        t2 += (int32_t)(g->r2_um - r2_hb) + g->elong_um;
+    }
+    const int64_t u2 = (int64_t)g->r2_um + add - t2;
+    if (lo >= SL_TARGET_EXT_SAT || hi >= SL_TARGET_EXT_SAT || g->r1_um <= sub1 ||
+        u2 <= (int64_t)(g->r1_um - sub1) || u2 > (int64_t)UINT32_MAX) {
+        return false;
+    }
+    *r1 = g->r1_um - sub1;
+    *r2 = (uint32_t)u2;
+    return true;
+}
+
+// One observation of target `g` into ring `r`: the group's union extent at the group's
+// centre azimuth (a leaning pole spans several azimuths, each holding a part of it; the
+// representative run alone reads the lean short, and a constant bias becomes a sideways
+// tilt in the fit).
 static void observe(sl_tiltobs_t *o, sl_tiltobs_ring_t *r, const sl_target_t *g)
 {
     const sl_board_t *b = o->board;
     const uint32_t naz = b->azimuths;
-    // Vehicle pose at the target's azimuth: linear between the rotation's start and end.
-    const int64_t f_num = (int64_t)g->az;
-    const int64_t vx = o->odom_prev.x_um + (o->odom.x_um - o->odom_prev.x_um) * f_num / (int64_t)naz;
-    const int64_t vy = o->odom_prev.y_um + (o->odom.y_um - o->odom_prev.y_um) * f_num / (int64_t)naz;
+    // Group centre in half azimuths (az_first + (az_count - 1) / 2), wrapped.
+    // (az_count 0: not from a group; its own azimuth.)
+    const uint32_t az2 = g->az_count == 0U
+                             ? 2U * (uint32_t)g->az
+                             : (2U * (uint32_t)g->az_first + g->az_count - 1U) % (2U * naz);
+    const uint32_t azi = ((az2 + 1U) / 2U) % naz;
+    uint32_t r1u = 0U;
+    uint32_t r2u = 0U;
+    sl_incline_result_t inc;
+    inc.flag = (uint8_t)SL_INCLINE_INVALID;
+    if (union_bounds(b, g, &r1u, &r2u)) {
+        inc = sl_incline_estimate(r1u, r2u, &b->geom[azi], b->range_sigma_um,
+                                  b->theta_sigma_cdeg);
+    }
+    if (inc.flag != (uint8_t)SL_INCLINE_VALID) {
+        o->stats.rejected++;
+        return;
+    }
+    // Vehicle pose at the group's azimuth: linear between the rotation's start and end.
+    const int64_t f_num = (int64_t)az2;
+    const int64_t f_den = 2 * (int64_t)naz;
+    const int64_t vx = o->odom_prev.x_um + (o->odom.x_um - o->odom_prev.x_um) * f_num / f_den;
+    const int64_t vy = o->odom_prev.y_um + (o->odom.y_um - o->odom_prev.y_um) * f_num / f_den;
     const int64_t dyaw = (int64_t)(int32_t)(o->odom.yaw - o->odom_prev.yaw);
-    const sl_bam32_t yaw = o->odom_prev.yaw + (sl_bam32_t)(uint32_t)(uint64_t)(dyaw * f_num / (int64_t)naz);
+    const sl_bam32_t yaw = o->odom_prev.yaw + (sl_bam32_t)(uint32_t)(uint64_t)(dyaw * f_num / f_den);
     sl_q30_t s;
     sl_q30_t c;
     sl_tilt_sincos_q30(yaw, &s, &c);
     const int64_t rx = vx + sl_fx_rshift_round64((int64_t)b->radar_x_um * c - (int64_t)b->radar_y_um * s, 30U);
     const int64_t ry = vy + sl_fx_rshift_round64((int64_t)b->radar_x_um * s + (int64_t)b->radar_y_um * c, 30U);
     // Bearing: clockwise from vehicle forward on the board, counter-clockwise in odometry.
-    const sl_bam32_t cw = (sl_bam32_t)(((uint64_t)g->az << 32) / naz) + cdeg_to_bam(b->radar_yaw_cdeg);
+    const sl_bam32_t cw = (sl_bam32_t)(((uint64_t)az2 << 31) / naz) + cdeg_to_bam(b->radar_yaw_cdeg);
     const sl_bam32_t bearing = yaw - cw;
-    const sl_bam32_t alpha = cdeg_to_bam(g->alpha_cdeg);
     sl_tilt_obs_t ob;
     if (!sl_tilt_obs_make(&ob, sat32(rx - r->anchor_x_um), sat32(ry - r->anchor_y_um), bearing,
-                          g->r1_um, alpha, g->sigma_cdeg, g->incline_branch, &b->geom[g->az])) {
+                          r1u, inc.alpha_bam32, inc.sigma_cdeg, inc.branch, &b->geom[azi])) {
         o->stats.rejected++;
         return;
     }

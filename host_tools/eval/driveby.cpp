@@ -110,7 +110,7 @@ void on_rotation(void *ctx, const sl_pipeline_rotation_t *r)
     o.rotation = static_cast<int>(r->rotation);
     if (o.fitted || !c->last.fitted) {
         c->last = o;
-        if (c->plot != nullptr && o.fitted) {
+        if (c->plot != nullptr) { // the last FITTED fit, else the last AMBIGUOUS one
             c->plot->have = true;
             c->plot->ring = *best;
         }
@@ -255,9 +255,10 @@ bool plot_pass(const std::string &png, const PlotData &d, const Case &k, std::st
         cMeas(40, 40, 220);
     char title[200];
     std::snprintf(title, sizeof title,
-                  "alpha(y): pole %.1f m %s of the path, psi %.0f, phi %.0f deg, %.0f m/s; fitted psi %.2f, phi %.1f deg",
+                  "alpha(y): pole %.1f m %s of the path, psi %.0f, phi %.0f deg, %.0f m/s; fitted psi %.2f, phi %.1f deg%s",
                   std::fabs(k.offset), k.offset > 0 ? "left" : "right", k.psi, k.phi_v, k.speed,
-                  r.res.psi_cdeg / 100.0, r.res.phi_cdeg / 100.0); // straight path: odometry = vehicle frame
+                  r.res.psi_cdeg / 100.0, r.res.phi_cdeg / 100.0,
+                  r.res.quality == SL_TILT_AMBIGUOUS ? " (AMBIGUOUS)" : ""); // straight path: odometry = vehicle frame
     cv::putText(img, title, {10, 22}, cv::FONT_HERSHEY_SIMPLEX, 0.5, black, 1, cv::LINE_AA);
     cv::putText(img, "truth (green), measured per rotation (red; hollow: read as the fold's mirror), "
                      "fitted curve (blue)",
@@ -370,7 +371,7 @@ int cmd_driveby(int argc, char **argv)
         PlotData d;
         const Outcome o = run_case(board, k, realistic, 1, &d);
         if (!d.have) {
-            std::fprintf(stderr, "sl-eval: driveby --plot: the pass has no FITTED result\n");
+            std::fprintf(stderr, "sl-eval: driveby --plot: the pass has no FITTED or AMBIGUOUS result\n");
             return 1;
         }
         std::string err;
@@ -378,8 +379,8 @@ int cmd_driveby(int argc, char **argv)
             std::fprintf(stderr, "sl-eval: %s\n", err.c_str());
             return 1;
         }
-        std::printf("driveby plot: %s (psi %.2f deg, phi %.1f deg; truth 15, 90)\n", plot.c_str(),
-                    o.psi, o.phi);
+        std::printf("driveby plot: %s (%s: psi %.2f deg, phi %.1f deg; truth 15, 90)\n", plot.c_str(),
+                    quality_name(o.quality), o.psi, o.phi);
         return 0;
     }
     std::vector<double> psis = {3.0, 5.0, 10.0, 20.0}, offsets = {2.0, 3.0, 4.0};

@@ -113,11 +113,17 @@ RadarPose radar_pose_at(const Scene &s, double t_s)
 {
     RadarPose r;
     r.t_s = t_s;
-    r.heading_deg = s.heading_deg;
-    const double h = sim_d2r(s.heading_deg);
+    // A circle of radius v / w at yaw rate w (heading h0 + w t), a straight line at w = 0.
+    const double w = sim_d2r(s.yaw_rate_dps), h0 = sim_d2r(s.heading_deg);
+    r.heading_deg = s.heading_deg + s.yaw_rate_dps * t_s;
+    const double h = h0 + w * t_s;
     const double fx = std::cos(h), fy = std::sin(h);
-    const double vx = s.vehicle_x_m + s.speed_mps * t_s * fx;
-    const double vy = s.vehicle_y_m + s.speed_mps * t_s * fy;
+    double vx = s.vehicle_x_m + s.speed_mps * t_s * fx;
+    double vy = s.vehicle_y_m + s.speed_mps * t_s * fy;
+    if (w != 0.0) {
+        vx = s.vehicle_x_m + s.speed_mps / w * (std::sin(h) - std::sin(h0));
+        vy = s.vehicle_y_m - s.speed_mps / w * (std::cos(h) - std::cos(h0));
+    }
     // radar offset in the vehicle frame (x forward, y left)
     r.o.x = vx + s.board.radar_x_m * fx - s.board.radar_y_m * fy;
     r.o.y = vy + s.board.radar_x_m * fy + s.board.radar_y_m * fx;

@@ -277,7 +277,7 @@ Simulator::Simulator(const Scene &scene) : s_(scene)
     }
 
     // static scene: the geometry never changes; compute it once
-    if (s_.speed_mps == 0.0) {
+    if (s_.speed_mps == 0.0 && s_.yaw_rate_dps == 0.0) {
         RotationGeom rg;
         rotation_geom(0, rg);
         static_cols_.resize(static_cast<size_t>(b.azimuths));

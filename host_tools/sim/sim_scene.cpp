@@ -193,11 +193,12 @@ Scene build(const Parsed &p)
     }
     {
         Sec c = sec("vehicle");
-        c.only({"x_m", "y_m", "heading_deg", "speed_mps"});
+        c.only({"x_m", "y_m", "heading_deg", "speed_mps", "yaw_rate_dps"});
         s.vehicle_x_m = c.real("x_m", 0, -1e5, 1e5);
         s.vehicle_y_m = c.real("y_m", 0, -1e5, 1e5);
         s.heading_deg = c.real("heading_deg", s.heading_deg, -360, 360);
         s.speed_mps = c.real("speed_mps", 0, -100, 100);
+        s.yaw_rate_dps = c.real("yaw_rate_dps", 0, -180, 180);
     }
     {
         Sec c = sec("ground");
@@ -467,7 +468,7 @@ bool scene_speckle_static(const Scene &s)
     if (s.speckle_static >= 0) {
         return s.speckle_static == 1;
     }
-    return s.speed_mps == 0.0; // auto: frozen when the vehicle stands still
+    return s.speed_mps == 0.0 && s.yaw_rate_dps == 0.0; // auto: frozen when the vehicle stands still
 }
 
 } // namespace sl

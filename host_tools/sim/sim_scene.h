@@ -62,6 +62,7 @@ struct Scene {
     double start_time_s = 1700000000.0; ///< UNIX time of rotation 0, azimuth 0
     // [vehicle]
     double vehicle_x_m = 0, vehicle_y_m = 0, heading_deg = 90.0, speed_mps = 0;
+    double yaw_rate_dps = 0; ///< constant yaw rate, deg/s CCW (a circular path)
     // objects
     std::vector<ScenePole> poles;
     std::vector<SceneBox> boxes;

@@ -231,8 +231,16 @@ typedef struct sl_target {
     uint8_t incline_flag;   ///< sl_incline_flag_t
     uint8_t incline_branch; ///< sl_incline_branch_t
     uint8_t flags;          ///< SL_TARGET_*
+    uint8_t ext_grow;       ///< the group's union extent (min first / max last bin over all
+                            ///< its azimuths) beyond the representative run, in bins: low
+                            ///< nibble before bin_first, high nibble after bin_last, each
+                            ///< saturating at SL_TARGET_EXT_SAT (3D tilt, sl_tiltobs.h);
+                            ///< 0 unless sl_detect_t.union_ext
     uint16_t evidence;      ///< slot priority (stage 4b), saturating
 } sl_target_t;
+
+/// sl_target_t.ext_grow: a nibble at this value means "this many bins or more".
+#define SL_TARGET_EXT_SAT 15U
 
 /// Counters (cumulative since init; never asserted).
 typedef struct sl_detect_stats {
@@ -290,6 +298,9 @@ typedef struct sl_detect {
     uint16_t amp_bins;      ///< its length
     uint8_t amp_threshold;  ///< the threshold it was cut at
     uint16_t tail_slope_q8; ///< self-calibrated smear tail, 1/256 value per bin (0: unknown)
+    bool union_ext;         ///< fill sl_target_t.ext_grow (else 0): set by the application
+                            ///< before a rotation's rows (the pipeline: while a motion
+                            ///< input is present, for the 3D tilt); O(span) per target
     sl_detect_stats_t stats;
 } sl_detect_t;
 

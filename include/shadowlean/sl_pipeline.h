@@ -70,8 +70,9 @@
 /// ## 3D tilt while driving (sl_tiltobs.h, sl_tilt.h)
 /// After the tracker's update, every rotation WITH a motion input advances the fixed-point
 /// odometry by the measured rotation period and adds one observation (radar pose at the
-/// target's azimuth, bearing, r1, alpha, sigma, branch) to the ring of every confirmed
-/// track matched with a VALID alpha; at most SL_CFG_TILT_FITS_PER_ROTATION rings are fitted
+/// detection group's centre azimuth, bearing, r1, alpha, sigma, branch of the group's union
+/// extent: sl_tiltobs.h; detection fills `ext_grow` only while a motion input is present)
+/// to the ring of every confirmed track matched with a VALID alpha; at most SL_CFG_TILT_FITS_PER_ROTATION rings are fitted
 /// per rotation (round robin). A rotation without motion input clears every ring (the
 /// odometry has a hole), so without motion nothing changes on CAN.
 /// PoleTilt: the ring's latest fit in the vehicle frame at the rotation's end (sl_can.h).

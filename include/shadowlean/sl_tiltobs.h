@@ -12,9 +12,16 @@
 /// 2. `sl_tiltobs_update()`: for every live, confirmed track matched on this rotation whose
 ///    target has a VALID inclination, one observation (`sl_tilt_obs_t`, 24 bytes) is pushed
 ///    into the track's ring: the radar's position and the pole's bearing in the odometry
-///    frame AT THE TARGET'S AZIMUTH (the pose interpolated linearly between the rotation's
-///    start and end by az / azimuths: at 3 m/s a rotation is 0.75 m), r1, alpha, its sigma,
-///    its branch (for the fold). Positions are stored relative to the ring's anchor (the
+///    frame AT THE CENTRE AZIMUTH OF THE TARGET'S DETECTION GROUP (az_first + (az_count -
+///    1) / 2, in half azimuths; the pose interpolated linearly between the rotation's start
+///    and end by that azimuth / azimuths: at 3 m/s a rotation is 0.75 m), and r1, alpha, its
+///    sigma and branch (for the fold) of the group's UNION EXTENT: r1 less `ext_grow`'s low
+///    nibble in bins, r2 plus its high nibble (elongation d(r2) re-evaluated there unless a
+///    profile refined the bounds), a radius estimated from the width (RADIUS_WIDTH) taken
+///    out of both (a leaning pole's bearing spread is not its diameter), alpha, sigma and
+///    branch from sl_incline_estimate() on the geometry of the centre azimuth. A saturated
+///    nibble or bounds without a VALID alpha: not stored, counted in `stats.rejected`.
+///    `board` must be the board detection uses (the pipeline's, with the radar's bin size). Positions are stored relative to the ring's anchor (the
 ///    vehicle position when the ring was opened) so int32 micrometres suffice. A ring
 ///    belongs to a track id; a ring whose track is gone (or whose slot now holds another
 ///    id) is freed. The ring keeps the newest SL_CFG_TILT_OBS_PER_TRACK observations.
@@ -76,7 +83,8 @@ typedef struct sl_tiltobs_ring {
 /// Counters (cumulative; never asserted).
 typedef struct sl_tiltobs_stats {
     uint32_t observations;  ///< observations stored
-    uint32_t rejected;      ///< VALID targets sl_tilt_obs_make refused (|alpha| >= 80 deg ...)
+    uint32_t rejected;      ///< VALID targets not stored: union extent saturated or without a
+                            ///< VALID alpha, or sl_tilt_obs_make refused (|alpha| >= 80 deg ...)
     uint32_t no_target;     ///< updated confirmed tracks whose target was not found / not VALID
     uint32_t no_ring;       ///< observations lost: every ring in use
     uint32_t fits;          ///< sl_tilt_fit calls

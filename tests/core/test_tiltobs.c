@@ -37,9 +37,9 @@ static sl_tiltobs_t obs;
 // on every target). From x86-64; aarch64 and s390x must match (bit-identical arithmetic).
 // The host and firmware capacities keep different numbers of observations, so two values.
 #if SL_CFG_TILT_OBS_PER_TRACK == 32
-#define RESULTS_DIGEST 0xe14c3b811456fbc0ULL
+#define RESULTS_DIGEST 0xcb4a828565c4c841ULL
 #else
-#define RESULTS_DIGEST_FW 0xa7e4e3bdfd5811ccULL
+#define RESULTS_DIGEST_FW 0x9d0dc06e8c178549ULL
 #endif
 static uint64_t digest = 14695981039346656037ULL;
 static void digest_i32(int32_t v)
@@ -112,7 +112,13 @@ static bool see(const sl_board_t *b, const drive_t *d, const pole_t *p, sl_targe
     memset(g, 0, sizeof *g);
     g->az = (uint16_t)az;
     g->r1_um = (uint32_t)llround(r1 * 1e6);
-    g->r2_um = g->r1_um + 500000U;
+    // r2 from the model (sl_incline.h) for the alpha as read: branch 1 rho =
+    // cos(a - b) / cos(a + t), branch 2 rho = 1 / cos(a + t).
+    const double rho = (read >= beta) ? cos(rad(read - beta)) / cos(rad(read + theta))
+                                      : 1.0 / cos(rad(read + theta));
+    g->r2_um = (uint32_t)llround(r1 * rho * 1e6);
+    g->az_first = (uint16_t)az;
+    g->az_count = 1U;
     g->alpha_cdeg = (int32_t)llround(read * 100.0);
     g->sigma_cdeg = 50U;
     g->incline_flag = (uint8_t)SL_INCLINE_VALID;
@@ -177,6 +183,13 @@ static void truth(const pole_t *p, double v, double w, int rotations, double *ph
     *by_v = -dx * sin(d.yaw) + dy * cos(d.yaw);
 }
 
+// The fold test with the firmware's 16-observation rings: AMBIGUOUS (right answer, flagged)
+// is accepted for at most two of its four poles (the ring then holds only the half pass after
+// the pole; the value must still be within the bounds). The alpha sigmas are the model's for the
+// union bounds (0.6-1.2 deg near the fold on paper-sim), no longer a fixed 0.5 deg.
+static int ambiguous_ok;
+static int ambiguous_seen;
+
 static void check_pole(const pole_t *p, double v, double w, int rotations, uint16_t id,
                        double psi_tol, double phi_tol)
 {
@@ -203,7 +216,11 @@ static void check_pole(const pole_t *p, double v, double w, int rotations, uint1
            "lean %.2f (truth %.2f)\n",
            p->bx, p->by, p->psi, p->phi, r->count, out.quality, e_psi, e_phi, e_b,
            out.lean_path_cdeg / 100.0, lean);
-    assert_int_equal(out.quality, SL_TILT_FITTED);
+    if (ambiguous_ok && out.quality == SL_TILT_AMBIGUOUS) {
+        ambiguous_seen++;
+    } else {
+        assert_int_equal(out.quality, SL_TILT_FITTED);
+    }
     assert_true(fabs(e_psi) <= psi_tol);
     assert_true(fabs(e_phi) <= phi_tol);
     assert_true(e_b <= 0.15);
@@ -238,6 +255,8 @@ static void test_leaning_away_beyond_the_fold(void **state)
 {
     (void)state;
     sl_track_t tracks[SL_CFG_MAX_TARGETS];
+    ambiguous_ok = SL_CFG_TILT_OBS_PER_TRACK < 32;
+    ambiguous_seen = 0;
     for (int side = -1; side <= 1; side += 2) {
         for (double psi = 16.0; psi <= 20.0; psi += 4.0) {
             const pole_t p = {4.0, side * 3.0, psi, side > 0 ? 80.0 : 290.0}; // away from the path
@@ -245,6 +264,8 @@ static void test_leaning_away_beyond_the_fold(void **state)
             check_pole(&p, 1.0, 0.0, 32, 1, 1.0, 10.0);
         }
     }
+    ambiguous_ok = 0;
+    assert_true(ambiguous_seen <= 2);
 }
 
 static void test_curved_path_10_deg_per_second(void **state)
@@ -341,6 +362,53 @@ static void test_more_tracks_than_rings_are_counted(void **state)
     if (n > SL_CFG_TILT_TRACKS) assert_true(obs.stats.no_ring > 0U);
 }
 
+// The observation is the group's union extent (ext_grow) with the representative's
+// corrections, at the group's centre azimuth; a width-estimated radius is taken out of both
+// bounds, the elongation re-evaluated at the union's far end.
+static void test_union_extent_is_observed(void **state)
+{
+    (void)state;
+    const sl_board_t *b = board();
+    const int64_t bin = b->bin_size_um;
+    assert_int_equal(sl_tiltobs_init(&obs, b), SL_OK);
+    sl_tiltobs_advance(&obs, true, 1000, 0, 250000U);
+    sl_track_t tracks[SL_CFG_MAX_TARGETS];
+    memset(tracks, 0, sizeof tracks);
+    const uint16_t first = 70U, last = 79U; // representative run, bins
+    const int64_t hb1 = ((2 * first + 1) * bin + 1) / 2, hb2 = ((2 * last + 1) * bin + 1) / 2;
+    sl_target_t g;
+    memset(&g, 0, sizeof g);
+    g.az = 100; g.az_first = 97; g.az_count = 6; // centre 99.5
+    g.bin_first = first; g.bin_last = last;
+    g.r2_raw_um = (uint32_t)((last + 1) * bin);
+    g.radius_um = 40000U;
+    g.elong_um = sl_detect_elong_um(b, (uint32_t)hb2);
+    g.flags = SL_TARGET_RADIUS_WIDTH;
+    g.r1_um = (uint32_t)(hb1 + 40000);
+    g.r2_um = (uint32_t)(hb2 - g.elong_um + 25000);
+    g.ext_grow = (uint8_t)(2U | (3U << 4));
+    g.incline_flag = SL_INCLINE_VALID;
+    tracks[0] = (sl_track_t){.live = 1, .updated = 1, .confirmed = 1, .id = 3, .az = g.az,
+                             .r1_um = g.r1_um, .r2_um = g.r2_um};
+    sl_tiltobs_update(&obs, tracks, &g, 1U);
+    assert_int_equal(obs.stats.observations, 1U);
+    const sl_tiltobs_ring_t *r = sl_tiltobs_find(&obs, 3U);
+    assert_non_null(r);
+    const int64_t u1 = hb1 - 2 * bin;
+    const int64_t u2 = hb2 + 3 * bin - sl_detect_elong_um(b, (uint32_t)(hb2 + 3 * bin));
+    assert_int_equal(r->obs[0].r1_um, (uint32_t)u1);
+    // alpha of the union bounds at the centre azimuth (geometry of azimuth 100 after rounding)
+    const sl_incline_result_t inc = sl_incline_estimate((uint32_t)u1, (uint32_t)u2, &b->geom[100],
+                                                        b->range_sigma_um, b->theta_sigma_cdeg);
+    assert_int_equal(inc.flag, SL_INCLINE_VALID);
+    const double tan_want = tan(inc.alpha_bam32 * (2.0 * PI / 4294967296.0));
+    assert_true(fabs(r->obs[0].tan_q12 / 4096.0 - tan_want) <= 1.0 / 4096.0);
+    // the bearing is the centre's (99.5 azimuths clockwise of forward, plus the radar's yaw)
+    const double want = -rad(99.5 * 360.0 / b->azimuths + b->radar_yaw_cdeg / 100.0);
+    assert_true(fabs(atan2(r->obs[0].sin_a_q15, r->obs[0].cos_a_q15) -
+                     atan2(sin(want), cos(want))) <= 0.002);
+}
+
 static void test_degenerate_inputs(void **state)
 {
     (void)state;
@@ -368,11 +436,21 @@ static void test_degenerate_inputs(void **state)
     assert_int_equal(obs.stats.no_target, 1U);
     sl_tiltobs_fit_pending(&obs); // nothing pending: no fit
     assert_int_equal(obs.stats.fits, 0U);
-    // |alpha| >= 80 deg: refused by sl_tilt_obs_make, counted.
+    // The group's union extent is unknown (a nibble of ext_grow saturated): refused, counted.
     g.incline_flag = SL_INCLINE_VALID;
-    g.alpha_cdeg = 8500;
+    g.ext_grow = (uint8_t)SL_TARGET_EXT_SAT;
     sl_tiltobs_update(&obs, tracks, &g, 1U);
     assert_int_equal(obs.stats.rejected, 1U);
+    g.ext_grow = (uint8_t)(SL_TARGET_EXT_SAT << 4);
+    sl_tiltobs_update(&obs, tracks, &g, 1U);
+    assert_int_equal(obs.stats.rejected, 2U);
+    // The union bounds give no valid alpha (r2 below r1 here): refused, counted.
+    g.ext_grow = 0U;
+    g.r2_um = 2900000;
+    tracks[0].r2_um = 2900000;
+    sl_tiltobs_update(&obs, tracks, &g, 1U);
+    assert_int_equal(obs.stats.rejected, 3U);
+    assert_int_equal(obs.stats.observations, 0U);
 }
 
 int main(void)
@@ -385,6 +463,7 @@ int main(void)
         cmocka_unit_test(test_fits_are_bounded_per_rotation),
         cmocka_unit_test(test_lost_motion_and_lost_tracks_clear_history),
         cmocka_unit_test(test_more_tracks_than_rings_are_counted),
+        cmocka_unit_test(test_union_extent_is_observed),
         cmocka_unit_test(test_degenerate_inputs),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -5,15 +5,11 @@
 # (paper-sim, noise-free) emits PoleTilt frames that canmatrix decodes with the board's DBC,
 # and the last FITTED frame of every pole matches the simulator's truth (psi, phi_deg).
 # Scenes: scenes/driveby_two_poles.ini (1 m/s, one pole leaning towards the path, one leaning
-# away, both sides) and the same at 3 m/s. Without --motion the same capture gives no
+# away, both sides), the same at 3 m/s, and scenes/driveby_curve.ini (1.5 m/s turning at
+# 10 deg/s: --motion 1.5,10). Without --motion the same capture gives no
 # PoleTilt frame.
-# Tolerances: |Tilt error| <= 4 deg, direction within 30 deg. These are NOT the issue's
-# 1 deg / 10 deg (which the fit meets on exact measurements: tests/core/test_tilt.c,
-# test_tiltobs.c): end to end, the pipeline's single-rotation alpha while driving (n_eff = 1,
-# profiles cleared every rotation) is biased by 2-4 deg on this scene (runs shortened at
-# both ends: r1 read long, r2 short), and the fit inherits that bias (measured: psi errors
-# -3.1 / +3.4 deg at 1 m/s, -1.6 / +3.0 at 3 m/s; direction errors 1-5 deg, 25 deg for the
-# 3 m/s pole leaning towards the path). Tighten these when the extraction while driving is.
+# Tolerances: the issue's, |Tilt error| <= 1 deg, direction within 10 deg (the observations
+# are the detection group's union extent at its centre azimuth: sl_tiltobs.h).
 set -u
 SL_SIM=$1; D=$2; PY=$3; SRC=$4; OUT=$5
 rm -rf "$OUT"; mkdir -p "$OUT"
@@ -24,7 +20,7 @@ run() { # name speed scene [--ambiguous-ok]
     "$SL_SIM" "$3" -o "$OUT/$1.colossus" --quiet || return 1
     "$D" --board paper-sim --input "$OUT/$1.colossus" --motion "$2" --can-log "$OUT/$1.log" -q || return 1
     echo "== $1 (--motion $2)"
-    "$PY" "$SRC/tilt_vs_truth.py" "$DBC" "$OUT/$1.log" "$OUT/$1.gt.csv" --psi-tol 4 --phi-tol 30 ${4:-} || return 1
+    "$PY" "$SRC/tilt_vs_truth.py" "$DBC" "$OUT/$1.log" "$OUT/$1.gt.csv" --psi-tol 1 --phi-tol 10 ${4:-} || return 1
 }
 run slow 1.0 "$ROOT/scenes/driveby_two_poles.ini" || fail=1
 sed 's/^speed_mps = 1.0/speed_mps = 3.0/; s/^rotations = 48/rotations = 24/; s/^y_m = -6.0/y_m = -8.0/' \
@@ -33,6 +29,8 @@ grep -q '^speed_mps = 3.0' "$OUT/fast.ini" || { echo "FAIL: scene edit"; exit 1;
 # At 3 m/s the pole leaning away is seen on 8 rotations only: its fit stays AMBIGUOUS (the
 # mirror hypothesis fits as well), which is the right answer; its Tilt is still checked.
 run fast 3.0 "$OUT/fast.ini" --ambiguous-ok || fail=1
+# A curved path (scenes/driveby_curve.ini: 1.5 m/s turning at 10 deg/s), one pole either side.
+run curve 1.5,10 "$ROOT/scenes/driveby_curve.ini" || fail=1
 # No motion input: no PoleTilt frame (the demo and Oxford frames stay as they were).
 "$D" --board paper-sim --input "$OUT/slow.colossus" --can-log "$OUT/still.log" -q || fail=1
 n=$(grep -c " 624#" "$OUT/still.log")
