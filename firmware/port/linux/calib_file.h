@@ -34,8 +34,8 @@
 ///   (calib_make_geom() is the C twin of sl::make_geom, compared bit for bit by a test).
 ///
 /// Host/port only (libm, stdio, malloc); not part of the core. Reentrant (no static state).
-#ifndef SHADOWLEAN_CALIB_FILE_H
-#define SHADOWLEAN_CALIB_FILE_H
+#ifndef SHADOWLEAN_PORT_CALIB_FILE_H
+#define SHADOWLEAN_PORT_CALIB_FILE_H
 
 #include <stddef.h>
 #include <stdint.h>
@@ -61,4 +61,4 @@ int calib_file_load(const char *path, const sl_board_t *nominal, uint8_t **blob,
 }
 #endif
 
-#endif // SHADOWLEAN_CALIB_FILE_H
+#endif // SHADOWLEAN_PORT_CALIB_FILE_H
