@@ -811,7 +811,7 @@ static int load_calibration(daemon_t *d)
 {
     char err[512];
     size_t len = 0;
-    if (calib_file_load(d->o.calibration, d->board, &d->cal_blob, &len, err, sizeof err) != 0) {
+    if (slp_calib_file_load(d->o.calibration, d->board, &d->cal_blob, &len, err, sizeof err) != 0) {
         sld_log(SLD_LOG_ERR, "calibration %s", err);
         return -1;
     }
