@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
 // sl-gsusb-send: open a gs_usb (candleLight) adapter through libusb and send CAN frames,
 // generated or from a candump log, printing each confirmation (the adapter's echo).
-// Uses the same sink as the daemon (firmware/port/linux/gsusb_sink.h).
+// Uses the same sink as the daemon (firmware/port/linux/gsusb/gsusb_sink.h).
 #include <errno.h>
 #include <getopt.h>
 #include <signal.h>
@@ -12,7 +12,7 @@
 
 #include "candump.h"
 #include "sl_cli.h"
-#include "gsusb_sink.h"
+#include "gsusb/gsusb_sink.h"
 #include "port_clock.h"
 
 #define MAX_FRAMES 100000U

@@ -16,7 +16,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "gsusb_proto.h"
+#include "gsusb/gsusb_proto.h"
 
 #define FAKE_MAX_REQS 64U
 #define FAKE_MAX_FRAMES 256U

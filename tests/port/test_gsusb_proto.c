@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// Unit tests for the gs_usb protocol layer (firmware/port/linux/gsusb_proto.h) against the
+// Unit tests for the gs_usb protocol layer (firmware/port/linux/gsusb/gsusb_proto.h) against the
 // in-process fake candleLight (tests/system/gsusb/gsusb_fake.h): request bytes, the start-up
 // sequence, bit timing (fixed points from the kernel and a brute-force oracle), frame
 // encoding both ways, the echo window, timeouts, error frames, and refuse / stall / lost
@@ -13,7 +13,7 @@
 #include <cmocka.h>
 
 #include "gsusb_fake.h"
-#include "gsusb_proto.h"
+#include "gsusb/gsusb_proto.h"
 
 // ---------------------------------------------------------------------------------------
 // Helpers
