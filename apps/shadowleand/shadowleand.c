@@ -47,7 +47,7 @@
 
 #define FAST_MSGS_PER_TURN 512U   // capture messages fed per loop turn in --fast mode
 #define MAX_PLAY_GAP_US 5000000U  // --realtime: longer timestamp gaps are shortened to this
-#define DRAIN_MS 500U             // at exit: wait at most this long for queued frames
+#define DRAIN_STALL_MS 1000U      // at exit: give up when no queued frame moved for this long
 
 #define HOLD_SLICE 4096U           // --realtime: stream bytes decoded at a time
 #define HOLD_MSGS 8192U            // --realtime: messages held (copied) at most
@@ -133,6 +133,7 @@ typedef struct daemon {
     bool idle_status;           // send Status frames when no rotation does
     uint64_t cap_next_due;      // capture: mono time the next message is due (0 = now)
     uint32_t status_frames, idle_status_frames, frames_out, rotations_seen;
+    uint32_t exit_undrained;    // frames the sinks still held when the exit drain gave up
     uint64_t next_stats_mono;
     uint64_t start_mono;
 
@@ -761,6 +762,9 @@ static void log_stats(daemon_t *d, int level, const char *what)
                 e2e->stats.bad_dlc, e2e->stats.counter_jumps, e2e->stats.lost_frames,
                 g_pipe.motion_rx.stats.timeouts, g_pipe.motion_rx.stats.other_ids);
     }
+    if (d->exit_undrained != 0) {
+        sld_log(SLD_LOG_WARN, "%s: CAN: %" PRIu32 " frames undrained at exit (dropped)", what, d->exit_undrained);
+    }
     if (s->motion_set_calls != 0) {
         sld_log(SLD_LOG_DEBUG, "%s: motion setter (--motion): %" PRIu32 " calls", what, s->motion_set_calls);
     }
@@ -873,6 +877,20 @@ static void read_signals(daemon_t *d)
 
 // ---------------------------------------------------------------------------------------
 
+// The exit drain's clock and pause (slp_can_sinks_drain injects them for tests).
+static uint64_t drain_now_us(void *ctx)
+{
+    (void)ctx;
+    return slp_now_us();
+}
+
+static void drain_wait(void *ctx)
+{
+    (void)ctx;
+    struct timespec ts = {0, 2000000};
+    nanosleep(&ts, NULL);
+}
+
 static void shutdown_all(daemon_t *d)
 {
     d->mono_us = slp_now_us();
@@ -886,25 +904,18 @@ static void shutdown_all(daemon_t *d)
     } else if (!d->cap_done) {
         sl_pipeline_finish(&g_pipe, pipe_now(d)); // interrupted: flush the partial rotation
     }
-    // Drain what the sinks still hold (SocketCAN retry queue, gs_usb echo window).
-    const uint64_t until = d->mono_us + DRAIN_MS * 1000U;
-    for (;;) {
-        d->mono_us = slp_now_us();
-        slp_can_sinks_poll(d->sinks, d->n_sinks, d->mono_us);
-        uint32_t queued = 0;
-        for (size_t i = 0; i < d->n_sinks; i++) {
-            slp_can_sink_stats_t st = {0, 0, 0, 0};
-            d->sinks[i].get_stats(d->sinks[i].ctx, &st);
-            queued += st.queued;
-        }
-        if (queued == 0 || d->mono_us >= until) {
-            if (queued != 0) {
-                sld_log(SLD_LOG_WARN, "exit: %" PRIu32 " frames still queued after %u ms, dropped", queued, DRAIN_MS);
-            }
-            break;
-        }
-        struct timespec ts = {0, 2000000};
-        nanosleep(&ts, NULL);
+    // Drain what the sinks still hold (SocketCAN retry queue, gs_usb echo window): until
+    // every queue is empty, or no frame has left any queue for DRAIN_STALL_MS (progress,
+    // not elapsed time: a slow adapter that keeps confirming is waited for).
+    const slp_can_drain_result_t dr = slp_can_sinks_drain(d->sinks, d->n_sinks, (uint64_t)DRAIN_STALL_MS * 1000U,
+                                                          drain_now_us, drain_wait, NULL);
+    d->mono_us = slp_now_us();
+    d->exit_undrained = dr.left;
+    if (dr.left != 0) {
+        sld_log(SLD_LOG_WARN,
+                "exit: %" PRIu32 " frames still queued, dropped (no sink progress for %u ms; %" PRIu32
+                " frames left the queues during the drain)",
+                dr.left, DRAIN_STALL_MS, dr.moved);
     }
     log_stats(d, SLD_LOG_INFO, "exit");
     if (d->is_radar) {

@@ -85,6 +85,26 @@ static inline uint32_t slp_can_sinks_dropped(const slp_can_sink_t *sinks, size_t
     return sum;
 }
 
+/// What slp_can_sinks_drain() did.
+typedef struct slp_can_drain_result {
+    uint32_t left;     ///< frames still queued when it gave up (0: every sink drained)
+    uint32_t moved;    ///< frames that left the queues meanwhile (confirmed or dropped)
+    uint32_t polls;    ///< poll rounds
+    uint64_t stall_us; ///< time since the last progress when it ended
+} slp_can_drain_result_t;
+
+/// Drain at exit: poll the sinks until none holds a frame, or until none has made progress
+/// (a frame sent or dropped, i.e. `sent + dropped` of some sink moved) for `stall_us`.
+/// Progress-based, not bounded by total elapsed time: a slow adapter that keeps confirming
+/// frames is drained completely however long that takes (at most the sinks' queued frames
+/// times `stall_us` in total); an adapter that stops answering costs `stall_us`.
+/// `now_us(ctx)` reads the caller's monotonic clock; `wait(ctx)` sleeps briefly between
+/// rounds (both injected, so tests run on a fake clock). Frames left are NOT counted by the
+/// sinks: the caller reports `left` (the daemon logs and counts them).
+slp_can_drain_result_t slp_can_sinks_drain(const slp_can_sink_t *sinks, size_t n, uint64_t stall_us,
+                                           uint64_t (*now_us)(void *ctx), void (*wait)(void *ctx),
+                                           void *ctx);
+
 #ifdef __cplusplus
 }
 #endif
