@@ -27,7 +27,7 @@
 #include <unistd.h>
 
 #include "can_sink.h"
-#include "can_socketcan.h"
+#include "socketcan.h"
 #include "capture_reader.h"
 #include "calib_file.h"
 #include "candump.h"
@@ -35,7 +35,7 @@
 #include "daemon_motion.h"
 #include "daemon_opts.h"
 #include "daemon_targets.h"
-#include "gsusb/gsusb_libusb.h"
+#include "gsusb/gsusb_usb.h"
 #include "gsusb/gsusb_sink.h"
 #include "radar_client.h"
 #include "shadowlean/sl_board.h"

@@ -8,7 +8,7 @@
 #include <iostream>
 
 #include "can_sink.h"
-#include "can_socketcan.h"
+#include "socketcan.h"
 
 namespace {
 int failures = 0;

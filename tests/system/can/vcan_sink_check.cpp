@@ -37,7 +37,7 @@
 #include <unistd.h>
 
 #include "can_sink.h"
-#include "can_socketcan.h"
+#include "socketcan.h"
 #include "candump_log.h"
 #include "sl_board_spec.h"
 #include "shadowlean/sl_can.h"

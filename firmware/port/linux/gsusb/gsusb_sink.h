@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
 /// @file gsusb_sink.h
 /// @brief CAN sink (can_sink.h) for a gs_usb / candleLight USB adapter driven through libusb:
-///        the daemon's `--gs-usb` output. Wraps the libusb transport (gsusb_libusb.h) and
+///        the daemon's `--gs-usb` output. Wraps the libusb transport (gsusb_usb.h) and
 ///        the driver (gsusb_proto.h), adds a small ordered queue, unplug handling and
 ///        periodic reopening.
 ///
@@ -48,7 +48,7 @@
 #include <stdint.h>
 
 #include "can_sink.h"
-#include "gsusb_libusb.h"
+#include "gsusb_usb.h"
 #include "gsusb_proto.h"
 #include "shadowlean/sl_can.h"
 #include "shadowlean/sl_err.h"

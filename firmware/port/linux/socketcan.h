@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-/// @file can_socketcan.h
+/// @file socketcan.h
 /// @brief SocketCAN raw sink: non-blocking transmit with a small bounded retry queue,
 ///        error-frame monitoring (bus-off, error passive, restarts), interface down/gone.
 ///
@@ -30,8 +30,8 @@
 /// Cost: send/poll are O(queue + error frames read) system calls, bounded by
 /// SLP_SOCKETCAN_QUEUE_MAX + SLP_SOCKETCAN_RX_BURST. RAM: ~sizeof(slp_socketcan_t)
 /// (about 1.7 KiB: the queue array is always SLP_SOCKETCAN_QUEUE_MAX entries). Not thread-safe.
-#ifndef SHADOWLEAN_PORT_CAN_SOCKETCAN_H
-#define SHADOWLEAN_PORT_CAN_SOCKETCAN_H
+#ifndef SHADOWLEAN_PORT_SOCKETCAN_H
+#define SHADOWLEAN_PORT_SOCKETCAN_H
 
 #include <stdbool.h>
 #include <stdint.h>
@@ -134,4 +134,4 @@ slp_can_sink_t slp_socketcan_sink(slp_socketcan_t *s);
 }
 #endif
 
-#endif // SHADOWLEAN_PORT_CAN_SOCKETCAN_H
+#endif // SHADOWLEAN_PORT_SOCKETCAN_H

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-/// @file gsusb_libusb.h
+/// @file gsusb_usb.h
 /// @brief libusb-1.0 transport for gs_usb (candleLight) adapters: finds, claims and talks to
 ///        the device behind the `slp_gsusb_transport_t` seam of gsusb_proto.h.
 ///
@@ -30,8 +30,8 @@
 ///
 /// Memory: slp_gsusb_usb_t is about 6 KB (transfer buffers inside); libusb allocates its
 /// transfer structs at open and frees them at close.
-#ifndef SHADOWLEAN_PORT_GSUSB_LIBUSB_H
-#define SHADOWLEAN_PORT_GSUSB_LIBUSB_H
+#ifndef SHADOWLEAN_PORT_GSUSB_USB_H
+#define SHADOWLEAN_PORT_GSUSB_USB_H
 
 #include <poll.h>
 #include <stdbool.h>
@@ -172,4 +172,4 @@ int slp_gsusb_usb_list(slp_gsusb_usb_t *u, char *buf, size_t cap);
 }
 #endif
 
-#endif // SHADOWLEAN_PORT_GSUSB_LIBUSB_H
+#endif // SHADOWLEAN_PORT_GSUSB_USB_H

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
-// SocketCAN raw sink (can_socketcan.h). Non-blocking socket + MSG_DONTWAIT everywhere.
-#include "can_socketcan.h"
+// SocketCAN raw sink (socketcan.h). Non-blocking socket + MSG_DONTWAIT everywhere.
+#include "socketcan.h"
 
 #include <errno.h>
 #include <linux/can.h>

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
-// libusb-1.0 transport for gs_usb adapters (see gsusb_libusb.h).
-#include "gsusb_libusb.h"
+// libusb-1.0 transport for gs_usb adapters (see gsusb_usb.h).
+#include "gsusb_usb.h"
 
 #include <libusb-1.0/libusb.h>
 #include <stdarg.h>
