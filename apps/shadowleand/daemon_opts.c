@@ -24,7 +24,7 @@ void sld_opts_defaults(sld_opts_t *o)
     o->silent_ms = 1000;
     o->verbosity = SLD_LOG_INFO;
     o->status_period_ms = SL_CAN_IDLE_CYCLE_MS_STATUS; // the DBC's SlIdleCycleTime
-    o->gs_usb_max_age_ms = 200; // as sl_gsusb_sink_default_cfg(): a late warning is worse than none
+    o->gs_usb_max_age_ms = 200; // as slp_gsusb_sink_default_cfg(): a late warning is worse than none
     o->log_time = SLD_LOG_TIME_AUTO;
 }
 

@@ -27,7 +27,7 @@
 #include <unistd.h>
 
 #include "can_sink.h"
-#include "can_socketcan.h"
+#include "socketcan.h"
 #include "capture_reader.h"
 #include "calib_file.h"
 #include "candump.h"
@@ -35,19 +35,19 @@
 #include "daemon_motion.h"
 #include "daemon_opts.h"
 #include "daemon_targets.h"
-#include "gsusb_libusb.h"
-#include "gsusb_sink.h"
+#include "gsusb/gsusb_usb.h"
+#include "gsusb/gsusb_sink.h"
 #include "radar_client.h"
 #include "shadowlean/sl_board.h"
 #include "shadowlean/sl_calblob.h"
 #include "shadowlean/sl_can.h"
 #include "shadowlean/sl_pipeline.h"
 #include "shadowlean/sl_proto.h"
-#include "sl_port_linux.h"
+#include "port_clock.h"
 
 #define FAST_MSGS_PER_TURN 512U   // capture messages fed per loop turn in --fast mode
 #define MAX_PLAY_GAP_US 5000000U  // --realtime: longer timestamp gaps are shortened to this
-#define DRAIN_MS 500U             // at exit: wait at most this long for queued frames
+#define DRAIN_STALL_MS 1000U      // at exit: give up when no queued frame moved for this long
 
 #define HOLD_SLICE 4096U           // --realtime: stream bytes decoded at a time
 #define HOLD_MSGS 8192U            // --realtime: messages held (copied) at most
@@ -72,14 +72,14 @@ typedef struct daemon {
     uint8_t status_eff; // SL_CAN_FLAG_EFF or 0
 
     // sinks
-    sl_can_socketcan_t sc;
+    slp_socketcan_t sc;
     bool sc_on;
-    sld_candump_t log;
+    slp_candump_t log;
     bool log_on;
     bool log_error_logged;
-    sl_gsusb_sink_t gs;
+    slp_gsusb_sink_t gs;
     bool gs_on;
-    sl_can_sink_t sinks[3];
+    slp_can_sink_t sinks[3];
     size_t n_sinks;
     uint32_t sink_drops_seen;   // sum of the sinks' dropped counters already in the pipeline's
                                 // can_dropped (wraps like the counters: differences only)
@@ -91,19 +91,19 @@ typedef struct daemon {
 
     // input: radar
     bool is_radar;
-    sl_radar_client_t radar;
+    slp_radar_client_t radar;
     uint8_t *radar_reasm;
     bool fed_since_finish;
     uint64_t stream_start_mono; // Configuration received (start of streaming)
     uint64_t last_fft_mono;
     bool had_fft;               // any FFT data since start
-    sl_radar_state_t last_radar_state;
+    slp_radar_state_t last_radar_state;
 
     // input: capture, streamed (bounded memory): each byte is decoded once, by `pacer`,
     // whose messages go to sl_pipeline_on_msg: at once with --fast; with --realtime they
     // are held (copied, a few KiB ahead) until due. Messages before the first FFT timestamp
     // are held too: the data clock starts there.
-    sl_port_capture_t *cr;
+    slp_capture_t *cr;
     sl_proto_t pacer;
     uint8_t *pacer_reasm;
     bool decode_once;           // --fast: the pacer hands messages over at once
@@ -111,7 +111,7 @@ typedef struct daemon {
     size_t n_held, next_held;
     uint8_t *hold;
     size_t hold_len, hold_cap;
-    sl_port_capture_piece_t piece; // DATA piece being decoded (--realtime)
+    slp_capture_piece_t piece; // DATA piece being decoded (--realtime)
     size_t piece_pos;
     bool have_piece;
     bool clock_known;           // data_us started (first FFT seen, or given up waiting)
@@ -133,6 +133,7 @@ typedef struct daemon {
     bool idle_status;           // send Status frames when no rotation does
     uint64_t cap_next_due;      // capture: mono time the next message is due (0 = now)
     uint32_t status_frames, idle_status_frames, frames_out, rotations_seen;
+    uint32_t exit_undrained;    // frames the sinks still held when the exit drain gave up
     uint64_t next_stats_mono;
     uint64_t start_mono;
 
@@ -179,9 +180,9 @@ static sl_err_t send_frame(daemon_t *d, const sl_can_frame_t *f)
     if (d->n_sinks == 0) {
         return SL_OK;
     }
-    const uint32_t drops_before = sl_can_sinks_dropped(d->sinks, d->n_sinks);
-    const sl_err_t e = sl_can_sinks_send(d->sinks, d->n_sinks, f, d->mono_us);
-    if (e != SL_OK && sl_can_sinks_dropped(d->sinks, d->n_sinks) != drops_before) {
+    const uint32_t drops_before = slp_can_sinks_dropped(d->sinks, d->n_sinks);
+    const sl_err_t e = slp_can_sinks_send(d->sinks, d->n_sinks, f, d->mono_us);
+    if (e != SL_OK && slp_can_sinks_dropped(d->sinks, d->n_sinks) != drops_before) {
         // The pipeline counts this refused frame itself (can_tx's return value): one of the
         // sinks' new drops is reported that way, the rest by report_sink_drops().
         d->sink_drops_seen++;
@@ -229,7 +230,7 @@ static void send_idle_status(daemon_t *d)
 /// counters not yet reported goes into the pipeline's count (Status.CanDropped).
 static void report_sink_drops(daemon_t *d)
 {
-    const uint32_t now = sl_can_sinks_dropped(d->sinks, d->n_sinks);
+    const uint32_t now = slp_can_sinks_dropped(d->sinks, d->n_sinks);
     const uint32_t fresh = now - d->sink_drops_seen; // modulo 2^32, like the counters
     d->sink_drops_seen = now;
     if (fresh != 0) {
@@ -301,36 +302,36 @@ static void radar_finish(daemon_t *d, uint64_t now_us)
     }
 }
 
-static void radar_on_event(void *ctx, sl_radar_event_t ev, sl_radar_reason_t reason, uint64_t now_us)
+static void radar_on_event(void *ctx, slp_radar_event_t ev, slp_radar_reason_t reason, uint64_t now_us)
 {
     daemon_t *d = ctx;
-    const sl_radar_client_t *c = &d->radar;
+    const slp_radar_client_t *c = &d->radar;
     switch (ev) {
-    case SL_RADAR_EV_CONNECTED:
+    case SLP_RADAR_EV_CONNECTED:
         sld_log(SLD_LOG_INFO, "radar %s:%u connected", d->o.radar_host, (unsigned)d->o.radar_port);
         if (c->stats.connects > 1U) {
             sl_pipeline_add_reconnect(&g_pipe, now_us); // Health.Reconnects, LINK_FLAPPING
         }
         break;
-    case SL_RADAR_EV_CONFIG:
+    case SLP_RADAR_EV_CONFIG:
         d->stream_start_mono = now_us;
         break;
-    case SL_RADAR_EV_DISCONNECTED:
+    case SLP_RADAR_EV_DISCONNECTED:
         sld_log(SLD_LOG_WARN, "radar disconnected (%s%s%s); reconnecting in %" PRIu32 " ms",
-                sl_radar_reason_str(reason), c->stats.last_errno != 0 ? ": " : "",
+                slp_radar_reason_str(reason), c->stats.last_errno != 0 ? ": " : "",
                 c->stats.last_errno != 0 ? strerror(c->stats.last_errno) : "", c->stats.backoff_ms);
         radar_finish(d, now_us);
         break;
-    case SL_RADAR_EV_CONNECT_FAILED:
+    case SLP_RADAR_EV_CONNECT_FAILED:
         // Logged once per failure streak at warning level, then at debug level.
         sld_log(c->stats.connect_failures + c->stats.connect_timeouts <= 1 ? SLD_LOG_WARN : SLD_LOG_DEBUG,
                 "radar %s:%u: connect failed (%s%s%s); retrying", d->o.radar_host,
-                (unsigned)d->o.radar_port, sl_radar_reason_str(reason),
+                (unsigned)d->o.radar_port, slp_radar_reason_str(reason),
                 c->stats.last_errno != 0 ? ": " : "",
                 c->stats.last_errno != 0 ? strerror(c->stats.last_errno) : "");
         radar_finish(d, now_us);
         break;
-    case SL_RADAR_EV_STOPPED:
+    case SLP_RADAR_EV_STOPPED:
         radar_finish(d, now_us);
         break;
     }
@@ -339,14 +340,14 @@ static void radar_on_event(void *ctx, sl_radar_event_t ev, sl_radar_reason_t rea
 static uint8_t radar_link_state(daemon_t *d)
 {
     switch (d->radar.state) {
-    case SL_RADAR_IDLE:
-    case SL_RADAR_BACKOFF:
+    case SLP_RADAR_IDLE:
+    case SLP_RADAR_BACKOFF:
         return SL_CAN_LINK_DISCONNECTED;
-    case SL_RADAR_CONNECTING:
+    case SLP_RADAR_CONNECTING:
         return SL_CAN_LINK_CONNECTING;
-    case SL_RADAR_WAIT_CONFIG:
+    case SLP_RADAR_WAIT_CONFIG:
         return SL_CAN_LINK_WAIT_CONFIG;
-    case SL_RADAR_STREAMING: {
+    case SLP_RADAR_STREAMING: {
         uint64_t ref = d->stream_start_mono;
         if (d->had_fft && d->last_fft_mono > ref) {
             ref = d->last_fft_mono;
@@ -369,8 +370,8 @@ static int radar_setup(daemon_t *d)
         sld_log(SLD_LOG_ERR, "out of memory");
         return -1;
     }
-    sl_radar_client_cfg_t cfg;
-    sl_radar_client_cfg_defaults(&cfg);
+    slp_radar_client_cfg_t cfg;
+    slp_radar_client_cfg_defaults(&cfg);
     cfg.host = d->o.radar_host;
     cfg.port = d->o.radar_port;
     cfg.connect_timeout_ms = d->o.connect_timeout_ms;
@@ -386,7 +387,7 @@ static int radar_setup(daemon_t *d)
     cfg.on_bytes = radar_on_bytes;
     cfg.on_event = radar_on_event;
     cfg.ctx = d;
-    const sl_err_t e = sl_radar_client_init(&d->radar, &cfg);
+    const sl_err_t e = slp_radar_client_init(&d->radar, &cfg);
     sl_pipeline_set_decoder_stats(&g_pipe, &d->radar.proto.stats); // Status.DecoderResyncs
     if (e != SL_OK) {
         sld_log(SLD_LOG_ERR, "radar %s:%u: %s", d->o.radar_host, (unsigned)d->o.radar_port,
@@ -442,7 +443,7 @@ static void pacer_on_msg(void *ctx, const sl_proto_msg_t *msg)
 static int capture_setup(daemon_t *d)
 {
     char err[512];
-    d->cr = sl_port_capture_open(d->o.capture, NULL, err, sizeof err);
+    d->cr = slp_capture_open(d->o.capture, NULL, err, sizeof err);
     if (d->cr == NULL) {
         sld_log(SLD_LOG_ERR, "--input: %s", err);
         return -1;
@@ -469,12 +470,12 @@ static int capture_setup(daemon_t *d)
     sl_proto_init(&d->pacer, &pc);
     sl_pipeline_set_decoder_stats(&g_pipe, &d->pacer.stats); // Status.DecoderResyncs
     sld_log(SLD_LOG_INFO, "input %s (%s)", d->o.capture,
-            sl_port_capture_format_name(sl_port_capture_report(d->cr)->format));
+            slp_capture_format_name(slp_capture_report(d->cr)->format));
     return 0;
 }
 
 /// End of input (END or ERROR piece).
-static void capture_end(daemon_t *d, const sl_port_capture_piece_t *pc)
+static void capture_end(daemon_t *d, const slp_capture_piece_t *pc)
 {
     sl_proto_finish(&d->pacer);
     d->cap_end = true;
@@ -484,9 +485,9 @@ static void capture_end(daemon_t *d, const sl_port_capture_piece_t *pc)
             d->data_us = realtime_us();
         }
     }
-    if (pc->kind == SL_PORT_CAPTURE_ERROR) {
+    if (pc->kind == SLP_CAPTURE_ERROR) {
         d->cap_error = true;
-        sld_log(SLD_LOG_ERR, "--input %s: %s", d->o.capture, sl_port_capture_error(d->cr));
+        sld_log(SLD_LOG_ERR, "--input %s: %s", d->o.capture, slp_capture_error(d->cr));
     }
 }
 
@@ -494,12 +495,12 @@ static void capture_end(daemon_t *d, const sl_port_capture_piece_t *pc)
 static void capture_step_fast(daemon_t *d)
 {
     for (unsigned turn = 0; turn < 16U && !d->cap_done && !d->stop; turn++) {
-        sl_port_capture_piece_t pc;
-        sl_port_capture_next(d->cr, &pc);
-        if (pc.kind == SL_PORT_CAPTURE_DATA) {
+        slp_capture_piece_t pc;
+        slp_capture_next(d->cr, &pc);
+        if (pc.kind == SLP_CAPTURE_DATA) {
             sl_proto_feed(&d->pacer, pc.data, pc.size, 0);
             d->fed += pc.size;
-        } else if (pc.kind == SL_PORT_CAPTURE_BREAK) {
+        } else if (pc.kind == SLP_CAPTURE_BREAK) {
             sl_proto_finish(&d->pacer);
             sl_pipeline_finish(&g_pipe, pipe_now(d));
             d->n_breaks++;
@@ -515,11 +516,11 @@ static void capture_step_fast(daemon_t *d)
 static void capture_decode_more(daemon_t *d)
 {
     if (!d->have_piece) {
-        sl_port_capture_next(d->cr, &d->piece);
-        if (d->piece.kind == SL_PORT_CAPTURE_DATA) {
+        slp_capture_next(d->cr, &d->piece);
+        if (d->piece.kind == SLP_CAPTURE_DATA) {
             d->have_piece = true;
             d->piece_pos = 0;
-        } else if (d->piece.kind == SL_PORT_CAPTURE_BREAK) {
+        } else if (d->piece.kind == SLP_CAPTURE_BREAK) {
             sl_proto_finish(&d->pacer);
             d->held[d->n_held++] = (held_msg_t){.brk = true};
             d->n_breaks++;
@@ -616,12 +617,12 @@ static uint64_t capture_step(daemon_t *d)
 /// with a read error, or held bytes but not one Colossus message (junk: every byte skipped).
 static bool capture_report(daemon_t *d)
 {
-    const sl_port_capture_report_t *r = sl_port_capture_report(d->cr);
+    const slp_capture_report_t *r = slp_capture_report(d->cr);
     char line[512];
-    sl_port_capture_report_line(d->cr, line, sizeof line);
+    slp_capture_report_line(d->cr, line, sizeof line);
     sld_log(SLD_LOG_INFO, "input %s (%s): %" PRIu64 " bytes read, %" PRIu64 " stream bytes, %" PRIu64
             " messages, %" PRIu64 " FFT, %" PRIu64 " discontinuities, %" PRIu64 " bytes skipped%s%s",
-            d->o.capture, sl_port_capture_format_name(r->format), r->bytes_in, r->stream_bytes, d->n_msgs,
+            d->o.capture, slp_capture_format_name(r->format), r->bytes_in, r->stream_bytes, d->n_msgs,
             d->n_fft, d->n_breaks, d->pacer.stats.bytes_skipped, line[0] != '\0' ? "; " : "", line);
     if (d->pacer.stats.resyncs != 0 || d->pacer.stats.truncated != 0) {
         sld_log(SLD_LOG_WARN, "input: %" PRIu32 " decoder resyncs, %" PRIu32 " truncated messages, %" PRIu64
@@ -654,7 +655,7 @@ static int open_sinks(daemon_t *d)
 {
     const uint64_t now = d->mono_us;
     if (d->o.can_iface[0] != '\0') {
-        const sl_err_t e = sl_can_socketcan_open(&d->sc, d->o.can_iface, NULL);
+        const sl_err_t e = slp_socketcan_open(&d->sc, d->o.can_iface, NULL);
         if (e == SL_ERR_ARG) {
             sld_log(SLD_LOG_ERR, "--can %s: bad interface name", d->o.can_iface);
             return -1;
@@ -665,39 +666,39 @@ static int open_sinks(daemon_t *d)
                     strerror(d->sc.last_errno));
         }
         d->sc_on = true;
-        d->sinks[d->n_sinks++] = sl_can_socketcan_sink(&d->sc);
+        d->sinks[d->n_sinks++] = slp_socketcan_sink(&d->sc);
     }
     if (d->o.can_log[0] != '\0') {
         const char *iface = d->o.can_log_iface[0] != '\0' ? d->o.can_log_iface
                             : d->o.can_iface[0] != '\0' ? d->o.can_iface
                                                         : "can0";
-        const sl_err_t e = sld_candump_open(&d->log, d->o.can_log, iface);
+        const sl_err_t e = slp_candump_open(&d->log, d->o.can_log, iface);
         if (e != SL_OK) {
             sld_log(SLD_LOG_ERR, "--can-log %s: %s", d->o.can_log,
                     e == SL_ERR_ARG ? "bad interface name" : strerror(d->log.last_errno));
             return -1;
         }
         d->log_on = true;
-        d->sinks[d->n_sinks++] = sld_candump_sink(&d->log);
+        d->sinks[d->n_sinks++] = slp_candump_sink(&d->log);
     }
     if (d->o.gs_usb) {
-        sl_gsusb_sink_cfg_t cfg = sl_gsusb_sink_default_cfg();
+        slp_gsusb_sink_cfg_t cfg = slp_gsusb_sink_default_cfg();
         cfg.selector = d->o.gs_usb_sel[0] != '\0' ? d->o.gs_usb_sel : NULL;
         cfg.can.bitrate = d->o.bitrate != 0 ? d->o.bitrate : d->board->can_bitrate;
         cfg.max_age_us = (uint64_t)d->o.gs_usb_max_age_ms * 1000U;
-        const sl_err_t e = sl_gsusb_sink_open(&d->gs, &cfg, now);
+        const sl_err_t e = slp_gsusb_sink_open(&d->gs, &cfg, now);
         if (e == SL_ERR_ARG) {
-            sld_log(SLD_LOG_ERR, "--gs-usb %s: %s", d->o.gs_usb_sel, sl_gsusb_sink_last_error(&d->gs));
+            sld_log(SLD_LOG_ERR, "--gs-usb %s: %s", d->o.gs_usb_sel, slp_gsusb_sink_last_error(&d->gs));
             return -1;
         }
         if (e != SL_OK) {
             sld_log(SLD_LOG_WARN, "--gs-usb %s: %s (frames are dropped; retrying every second)",
-                    d->o.gs_usb_sel[0] != '\0' ? d->o.gs_usb_sel : "(any)", sl_gsusb_sink_last_error(&d->gs));
+                    d->o.gs_usb_sel[0] != '\0' ? d->o.gs_usb_sel : "(any)", slp_gsusb_sink_last_error(&d->gs));
         } else {
             sld_log(SLD_LOG_INFO, "gs_usb adapter up at %" PRIu32 " bit/s", cfg.can.bitrate);
         }
         d->gs_on = true;
-        d->sinks[d->n_sinks++] = sl_gsusb_sink_as_sink(&d->gs);
+        d->sinks[d->n_sinks++] = slp_gsusb_sink_as_sink(&d->gs);
     }
     if (d->n_sinks == 0) {
         sld_log(SLD_LOG_WARN, "no CAN output (--can, --can-log, --gs-usb): frames are only counted");
@@ -761,6 +762,9 @@ static void log_stats(daemon_t *d, int level, const char *what)
                 e2e->stats.bad_dlc, e2e->stats.counter_jumps, e2e->stats.lost_frames,
                 g_pipe.motion_rx.stats.timeouts, g_pipe.motion_rx.stats.other_ids);
     }
+    if (d->exit_undrained != 0) {
+        sld_log(SLD_LOG_WARN, "%s: CAN: %" PRIu32 " frames undrained at exit (dropped)", what, d->exit_undrained);
+    }
     if (s->motion_set_calls != 0) {
         sld_log(SLD_LOG_DEBUG, "%s: motion setter (--motion): %" PRIu32 " calls", what, s->motion_set_calls);
     }
@@ -779,13 +783,13 @@ static void log_stats(daemon_t *d, int level, const char *what)
             g_pipe.tracker.stats.confirmations, g_pipe.tracker.stats.inconsistent,
             (unsigned)g_pipe.mask_bins);
     for (size_t i = 0; i < d->n_sinks; i++) {
-        sl_can_sink_stats_t st = {0, 0, 0, 0};
+        slp_can_sink_stats_t st = {0, 0, 0, 0};
         d->sinks[i].get_stats(d->sinks[i].ctx, &st);
         sld_log(level, "%s: sink %s: %" PRIu32 " sent, %" PRIu32 " dropped, %" PRIu32 " queued, %" PRIu32 " errors",
                 what, d->sinks[i].name, st.sent, st.dropped, st.queued, st.errors);
     }
     if (d->sc_on) {
-        const sl_can_socketcan_stats_t *c = &d->sc.stats;
+        const slp_socketcan_stats_t *c = &d->sc.stats;
         sld_log(level + (c->retries + c->bus_off + c->link_down == 0 ? 1 : 0),
                 "%s: socketcan %s: %" PRIu32 " retries (%" PRIu32 " ENOBUFS), bus-off %" PRIu32
                 ", link down %" PRIu32 ", dropped full/stale/down/bus-off/error %" PRIu32 "/%" PRIu32
@@ -794,11 +798,11 @@ static void log_stats(daemon_t *d, int level, const char *what)
                 c->dropped_stale, c->dropped_down, c->dropped_bus_off, c->dropped_error);
     }
     if (d->is_radar) {
-        const sl_radar_client_stats_t *r = &d->radar.stats;
+        const slp_radar_client_stats_t *r = &d->radar.stats;
         sld_log(level,
                 "%s: radar %s: %" PRIu32 " connects (%" PRIu32 " reconnects), %" PRIu32 " failures, %" PRIu32
                 " silence timeouts, %" PRIu32 " FFT messages, %" PRIu64 " bytes",
-                what, sl_radar_state_str(d->radar.state), r->connects, r->reconnects,
+                what, slp_radar_state_str(d->radar.state), r->connects, r->reconnects,
                 r->connect_failures + r->connect_timeouts, r->silence_timeouts, r->fft_messages, r->bytes_rx);
     }
 }
@@ -811,7 +815,7 @@ static int load_calibration(daemon_t *d)
 {
     char err[512];
     size_t len = 0;
-    if (calib_file_load(d->o.calibration, d->board, &d->cal_blob, &len, err, sizeof err) != 0) {
+    if (slp_calib_file_load(d->o.calibration, d->board, &d->cal_blob, &len, err, sizeof err) != 0) {
         sld_log(SLD_LOG_ERR, "calibration %s", err);
         return -1;
     }
@@ -873,12 +877,26 @@ static void read_signals(daemon_t *d)
 
 // ---------------------------------------------------------------------------------------
 
+// The exit drain's clock and pause (slp_can_sinks_drain injects them for tests).
+static uint64_t drain_now_us(void *ctx)
+{
+    (void)ctx;
+    return slp_now_us();
+}
+
+static void drain_wait(void *ctx)
+{
+    (void)ctx;
+    struct timespec ts = {0, 2000000};
+    nanosleep(&ts, NULL);
+}
+
 static void shutdown_all(daemon_t *d)
 {
-    d->mono_us = sl_port_now_us();
+    d->mono_us = slp_now_us();
     if (d->is_radar) {
         const uint32_t stops = d->radar.stats.stops_sent;
-        sl_radar_client_stop(&d->radar, 200); // Stop FFT when streaming; STOPPED -> finish
+        slp_radar_client_stop(&d->radar, 200); // Stop FFT when streaming; STOPPED -> finish
         if (d->radar.stats.stops_sent != stops) {
             sld_log(SLD_LOG_INFO, "Stop FFT sent to the radar");
         }
@@ -886,38 +904,31 @@ static void shutdown_all(daemon_t *d)
     } else if (!d->cap_done) {
         sl_pipeline_finish(&g_pipe, pipe_now(d)); // interrupted: flush the partial rotation
     }
-    // Drain what the sinks still hold (SocketCAN retry queue, gs_usb echo window).
-    const uint64_t until = d->mono_us + DRAIN_MS * 1000U;
-    for (;;) {
-        d->mono_us = sl_port_now_us();
-        sl_can_sinks_poll(d->sinks, d->n_sinks, d->mono_us);
-        uint32_t queued = 0;
-        for (size_t i = 0; i < d->n_sinks; i++) {
-            sl_can_sink_stats_t st = {0, 0, 0, 0};
-            d->sinks[i].get_stats(d->sinks[i].ctx, &st);
-            queued += st.queued;
-        }
-        if (queued == 0 || d->mono_us >= until) {
-            if (queued != 0) {
-                sld_log(SLD_LOG_WARN, "exit: %" PRIu32 " frames still queued after %u ms, dropped", queued, DRAIN_MS);
-            }
-            break;
-        }
-        struct timespec ts = {0, 2000000};
-        nanosleep(&ts, NULL);
+    // Drain what the sinks still hold (SocketCAN retry queue, gs_usb echo window): until
+    // every queue is empty, or no frame has left any queue for DRAIN_STALL_MS (progress,
+    // not elapsed time: a slow adapter that keeps confirming is waited for).
+    const slp_can_drain_result_t dr = slp_can_sinks_drain(d->sinks, d->n_sinks, (uint64_t)DRAIN_STALL_MS * 1000U,
+                                                          drain_now_us, drain_wait, NULL);
+    d->mono_us = slp_now_us();
+    d->exit_undrained = dr.left;
+    if (dr.left != 0) {
+        sld_log(SLD_LOG_WARN,
+                "exit: %" PRIu32 " frames still queued, dropped (no sink progress for %u ms; %" PRIu32
+                " frames left the queues during the drain)",
+                dr.left, DRAIN_STALL_MS, dr.moved);
     }
     log_stats(d, SLD_LOG_INFO, "exit");
     if (d->is_radar) {
-        sl_radar_client_deinit(&d->radar);
+        slp_radar_client_deinit(&d->radar);
     }
     if (d->sc_on) {
-        sl_can_socketcan_close(&d->sc);
+        slp_socketcan_close(&d->sc);
     }
     if (d->log_on) {
-        sld_candump_close(&d->log);
+        slp_candump_close(&d->log);
     }
     if (d->gs_on) {
-        sl_gsusb_sink_close(&d->gs);
+        slp_gsusb_sink_close(&d->gs);
     }
     if (d->motion_on) {
         sld_motion_close(&d->motion);
@@ -964,7 +975,7 @@ int main(int argc, char **argv)
                                                     : SLD_LOG_TIME_DATA;
     d->idle_status = d->is_radar || d->o.realtime;
     d->sfd = -1;
-    d->mono_us = sl_port_now_us();
+    d->mono_us = slp_now_us();
     d->start_mono = d->mono_us;
     sl_can_ids_t ids;
     sl_can_ids_from_board(&ids, d->board);
@@ -1026,14 +1037,14 @@ int main(int argc, char **argv)
             d->motion_on ? ", VehicleMotion from " : "", d->motion_on ? miface : "");
 
     if (d->is_radar) {
-        sl_radar_client_start(&d->radar);
+        slp_radar_client_start(&d->radar);
     }
     d->link_state = d->is_radar ? SL_CAN_LINK_CONNECTING : SL_CAN_LINK_STREAMING;
     sl_pipeline_set_link_state(&g_pipe, d->link_state);
     // A live radar gets a Status frame at once (CONNECTING); a capture replayed in real time
     // only when a rotation is late, so --realtime and --fast write the same frames. The
     // clock is read again here: opening the outputs (a gs_usb adapter) may take a while.
-    d->mono_us = sl_port_now_us();
+    d->mono_us = slp_now_us();
     d->last_status_mono = d->is_radar ? d->mono_us - (uint64_t)d->o.status_period_ms * 1000U : d->mono_us;
     d->next_stats_mono = d->o.stats_every_ms != 0 ? d->mono_us + (uint64_t)d->o.stats_every_ms * 1000U : UINT64_MAX;
     const uint64_t end_mono = d->o.duration_ms != 0 ? d->mono_us + (uint64_t)d->o.duration_ms * 1000U : UINT64_MAX;
@@ -1041,7 +1052,7 @@ int main(int argc, char **argv)
     struct pollfd fds[4 + 8];
     while (!d->stop) {
         // --- wait
-        d->mono_us = sl_port_now_us();
+        d->mono_us = slp_now_us();
         uint64_t wake = end_mono;
         if (d->idle_status) {
             const uint64_t due = d->last_status_mono + (uint64_t)d->o.status_period_ms * 1000U;
@@ -1059,8 +1070,8 @@ int main(int argc, char **argv)
         }
         const nfds_t i_radar = n;
         if (d->is_radar) {
-            fds[n++] = (struct pollfd){sl_radar_client_fd(&d->radar), sl_radar_client_events(&d->radar), 0};
-            const int t = sl_radar_client_timeout_ms(&d->radar, d->mono_us);
+            fds[n++] = (struct pollfd){slp_radar_client_fd(&d->radar), slp_radar_client_events(&d->radar), 0};
+            const int t = slp_radar_client_timeout_ms(&d->radar, d->mono_us);
             if (t >= 0) {
                 const uint64_t due = d->mono_us + (uint64_t)t * 1000U;
                 wake = due < wake ? due : wake;
@@ -1070,7 +1081,7 @@ int main(int argc, char **argv)
                 wake = due < wake ? due : wake;
             }
             // Recompute SILENT on time.
-            if (d->radar.state == SL_RADAR_STREAMING) {
+            if (d->radar.state == SLP_RADAR_STREAMING) {
                 uint64_t ref = d->stream_start_mono > d->last_fft_mono ? d->stream_start_mono : d->last_fft_mono;
                 const uint64_t due = ref + (uint64_t)d->o.silent_ms * 1000U;
                 if (due > d->mono_us && due < wake) {
@@ -1086,8 +1097,8 @@ int main(int argc, char **argv)
                 wake = cap_due < wake ? cap_due : wake;
             }
         }
-        if (d->gs_on && sl_gsusb_sink_is_up(&d->gs)) {
-            n += (nfds_t)sl_gsusb_usb_pollfds(&d->gs.usb, &fds[n], 8);
+        if (d->gs_on && slp_gsusb_sink_is_up(&d->gs)) {
+            n += (nfds_t)slp_gsusb_usb_pollfds(&d->gs.usb, &fds[n], 8);
             const uint64_t due = d->mono_us + 50000U; // echo timeouts, reopen
             wake = due < wake ? due : wake;
         } else if (d->gs_on || d->sc_on) {
@@ -1107,7 +1118,7 @@ int main(int argc, char **argv)
             sld_log(SLD_LOG_ERR, "poll: %s", strerror(errno));
             break;
         }
-        d->mono_us = sl_port_now_us();
+        d->mono_us = slp_now_us();
         // --- work
         if (rc > 0 && (fds[0].revents & POLLIN) != 0) {
             read_signals(d);
@@ -1124,9 +1135,9 @@ int main(int argc, char **argv)
         }
         if (d->is_radar && !d->stop) {
             const short rev = rc > 0 ? fds[i_radar].revents : 0;
-            sl_radar_client_handle(&d->radar, rev, d->mono_us);
+            slp_radar_client_handle(&d->radar, rev, d->mono_us);
             if (d->radar.state != d->last_radar_state) {
-                sld_log(SLD_LOG_DEBUG, "radar state %s", sl_radar_state_str(d->radar.state));
+                sld_log(SLD_LOG_DEBUG, "radar state %s", slp_radar_state_str(d->radar.state));
                 d->last_radar_state = d->radar.state;
             }
             const uint8_t ls = radar_link_state(d);
@@ -1140,7 +1151,7 @@ int main(int argc, char **argv)
                 sl_pipeline_set_link_state(&g_pipe, ls);
             }
         }
-        sl_can_sinks_poll(d->sinks, d->n_sinks, d->mono_us);
+        slp_can_sinks_poll(d->sinks, d->n_sinks, d->mono_us);
         report_sink_drops(d);
         if (d->log_on && d->log.stats.errors != 0U && !d->log_error_logged) {
             d->log_error_logged = true;
@@ -1211,7 +1222,7 @@ int main(int argc, char **argv)
         }
         exit_rc = 3;
     }
-    sl_port_capture_close(d->cr);
+    slp_capture_close(d->cr);
     free(d->held);
     free(d->cal_blob);
     free(d->hold);

@@ -48,7 +48,7 @@ const sl_board_t *core_board(const std::string &name, const std::string &calibra
     uint8_t *raw = nullptr;
     size_t len = 0;
     char err[512];
-    if (calib_file_load(calibration.c_str(), nominal, &raw, &len, err, sizeof err) != 0) {
+    if (slp_calib_file_load(calibration.c_str(), nominal, &raw, &len, err, sizeof err) != 0) {
         throw std::runtime_error(std::string("calibration ") + err);
     }
     c->blob.assign(raw, raw + len);

@@ -18,12 +18,12 @@ std::string format_candump_frame(const sl_can_frame_t &f)
     if (f.dlc > 8) {
         throw CandumpError("DLC above 8");
     }
-    if (!sl_candump_frame_ok(&f)) {
+    if (!slp_candump_frame_ok(&f)) {
         throw CandumpError((f.flags & (SL_CAN_FLAG_EFF | SL_CAN_FLAG_ERR)) != 0U ? "29-bit id above 0x1FFFFFFF"
                                                                                 : "11-bit id above 0x7FF");
     }
     char buf[40];
-    return sl_candump_format_frame(&f, buf, sizeof buf);
+    return slp_candump_format_frame(&f, buf, sizeof buf);
 }
 
 std::string format_candump_line(const CandumpRecord &r)
@@ -37,10 +37,10 @@ std::string format_candump_line(const CandumpRecord &r)
 
 bool parse_candump_line(const std::string &line, CandumpRecord *out, std::string *err)
 {
-    sl_candump_record_t rec;
+    slp_candump_record_t rec;
     const char *why = nullptr;
     if (line.find('\0') != std::string::npos ||
-        sl_candump_parse_record(line.c_str(), &rec, &why) != SL_OK) {
+        slp_candump_parse_record(line.c_str(), &rec, &why) != SL_OK) {
         if (err != nullptr) {
             *err = why != nullptr ? why : "malformed line";
         }
@@ -97,7 +97,7 @@ void CandumpWriter::open(const std::string &path, const std::string &iface)
         own_ = true;
     }
     iface_ = iface;
-    stats_ = sl_can_sink_stats_t{};
+    stats_ = slp_can_sink_stats_t{};
 }
 
 sl_err_t CandumpWriter::write(const sl_can_frame_t &f, uint64_t t_us)
@@ -143,16 +143,16 @@ void CandumpWriter::close()
     own_ = false;
 }
 
-sl_can_sink_t CandumpWriter::sink()
+slp_can_sink_t CandumpWriter::sink()
 {
-    sl_can_sink_t k{};
+    slp_can_sink_t k{};
     k.name = "candump";
     k.ctx = this;
     k.send = [](void *ctx, const sl_can_frame_t *f, uint64_t t_us) -> sl_err_t {
         return static_cast<CandumpWriter *>(ctx)->write(*f, t_us);
     };
     k.poll = [](void *ctx, uint64_t) { static_cast<CandumpWriter *>(ctx)->flush(); };
-    k.get_stats = [](void *ctx, sl_can_sink_stats_t *out) {
+    k.get_stats = [](void *ctx, slp_can_sink_stats_t *out) {
         *out = static_cast<CandumpWriter *>(ctx)->stats();
     };
     return k;

@@ -58,7 +58,7 @@ bool parse_candump_line(const std::string &line, CandumpRecord *out, std::string
 std::vector<CandumpRecord> read_candump_log(const std::string &path);
 
 /// Appends frames to a log file as candump -L would print them. Also usable as a CAN sink
-/// (`sink()`). (The daemon's sink is the port's C one, sld_candump_t.) Not thread-safe.
+/// (`sink()`). (The daemon's sink is the port's C one, slp_candump_t.) Not thread-safe.
 class CandumpWriter {
 public:
     CandumpWriter() = default;
@@ -78,15 +78,15 @@ public:
     /// Flush and close; safe to call twice.
     void close();
     /// Counters: sent = lines written, dropped, errors = I/O errors.
-    const sl_can_sink_stats_t &stats() const { return stats_; }
+    const slp_can_sink_stats_t &stats() const { return stats_; }
     /// This writer as a sink (ctx = this; must outlive the sink). poll() flushes.
-    sl_can_sink_t sink();
+    slp_can_sink_t sink();
 
 private:
     FILE *fp_ = nullptr;
     bool own_ = false;
     std::string iface_;
-    sl_can_sink_stats_t stats_{};
+    slp_can_sink_stats_t stats_{};
 };
 
 } // namespace sl

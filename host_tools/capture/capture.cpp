@@ -62,15 +62,15 @@ CaptureFormat sniff_capture_format(const std::string &path)
 
 namespace {
 // Format, pcap report and flows of reader `c` into `out` (not the bytes).
-void fill_report(const sl_port_capture_t *c, Capture &out)
+void fill_report(const slp_capture_t *c, Capture &out)
 {
-    const sl_port_capture_report_t *r = sl_port_capture_report(c);
+    const slp_capture_report_t *r = slp_capture_report(c);
     switch (r->format) {
-    case SL_PORT_CAPTURE_RAW: out.format = CaptureFormat::Raw; break;
-    case SL_PORT_CAPTURE_PCAP: out.format = CaptureFormat::Pcap; break;
-    case SL_PORT_CAPTURE_PCAPNG: out.format = CaptureFormat::Pcapng; break;
+    case SLP_CAPTURE_RAW: out.format = CaptureFormat::Raw; break;
+    case SLP_CAPTURE_PCAP: out.format = CaptureFormat::Pcap; break;
+    case SLP_CAPTURE_PCAPNG: out.format = CaptureFormat::Pcapng; break;
     }
-    if (r->format != SL_PORT_CAPTURE_RAW) {
+    if (r->format != SLP_CAPTURE_RAW) {
         out.has_pcap_report = true;
         PcapReport &rep = out.pcap;
         rep.link_type = r->link_type;
@@ -93,8 +93,8 @@ void fill_report(const sl_port_capture_t *c, Capture &out)
         rep.flows_ignored = r->flows_ignored;
         rep.started_mid_stream = r->started_mid_stream;
         rep.read_error = r->read_error;
-        std::vector<sl_port_capture_flow_t> fl(SL_PORT_CAPTURE_MAX_FLOWS);
-        const size_t nf = sl_port_capture_flows(c, fl.data(), fl.size());
+        std::vector<slp_capture_flow_t> fl(SLP_CAPTURE_MAX_FLOWS);
+        const size_t nf = slp_capture_flows(c, fl.data(), fl.size());
         for (size_t i = 0; i < nf && i < fl.size(); ++i) {
             PcapFlow f;
             f.src = fl[i].src;
@@ -118,11 +118,11 @@ void fill_report(const sl_port_capture_t *c, Capture &out)
 
 // A break reported by the port's reader, as a Discontinuity: appended to `all`, and to
 // `gaps` when bytes are missing (a new session is not a gap).
-void record_break(const sl_port_capture_piece_t &p, std::vector<Discontinuity> &all,
+void record_break(const slp_capture_piece_t &p, std::vector<Discontinuity> &all,
                   std::vector<Discontinuity> &gaps)
 {
     Discontinuity d;
-    d.kind = p.brk == SL_PORT_CAPTURE_GAP ? Discontinuity::Kind::Gap : Discontinuity::Kind::NewSession;
+    d.kind = p.brk == SLP_CAPTURE_GAP ? Discontinuity::Kind::Gap : Discontinuity::Kind::NewSession;
     d.output_offset = p.output_offset;
     d.stream_offset = p.stream_offset;
     d.missing_bytes = p.missing_bytes;
@@ -157,32 +157,32 @@ bool read_capture(const std::string &path, const CaptureDataFn &on_data, const C
 {
     info = Capture{};
     bytes = 0;
-    sl_port_capture_opts_t o{};
+    slp_capture_opts_t o{};
     o.radar_port = static_cast<uint16_t>(opt.radar_port);
     o.port_explicit = opt.port_explicit;
     char e[512] = {0};
-    sl_port_capture_t *c = sl_port_capture_open(path.c_str(), &o, e, sizeof e);
+    slp_capture_t *c = slp_capture_open(path.c_str(), &o, e, sizeof e);
     if (c == nullptr) {
         err = e;
         return false;
     }
     bool ok = true;
     for (;;) {
-        sl_port_capture_piece_t pc;
-        sl_port_capture_next(c, &pc);
-        if (pc.kind == SL_PORT_CAPTURE_DATA) {
+        slp_capture_piece_t pc;
+        slp_capture_next(c, &pc);
+        if (pc.kind == SLP_CAPTURE_DATA) {
             bytes += pc.size;
             if (!on_data(pc.data, pc.size)) {
                 break;
             }
-        } else if (pc.kind == SL_PORT_CAPTURE_BREAK) {
+        } else if (pc.kind == SLP_CAPTURE_BREAK) {
             record_break(pc, info.discontinuities, info.pcap.gap_list);
             if (on_break) {
                 on_break(info.discontinuities.back());
             }
         } else {
-            if (pc.kind == SL_PORT_CAPTURE_ERROR) {
-                err = path + ": " + sl_port_capture_error(c);
+            if (pc.kind == SLP_CAPTURE_ERROR) {
+                err = path + ": " + slp_capture_error(c);
                 ok = false;
             }
             break;
@@ -191,7 +191,7 @@ bool read_capture(const std::string &path, const CaptureDataFn &on_data, const C
     std::vector<Discontinuity> gaps = info.pcap.gap_list;
     fill_report(c, info);
     info.pcap.gap_list = gaps;
-    sl_port_capture_close(c);
+    slp_capture_close(c);
     return ok;
 }
 
@@ -208,7 +208,7 @@ MessageDecoder::MessageDecoder(MsgFn on_msg) : fn_(std::move(on_msg)), reasm_(kH
 void MessageDecoder::on_msg(void *ctx, const sl_proto_msg_t *m) { static_cast<MessageDecoder *>(ctx)->fn_(*m); }
 
 struct MessageReader::Impl {
-    sl_port_capture_t *c = nullptr;
+    slp_capture_t *c = nullptr;
     std::deque<std::pair<uint8_t, std::vector<uint8_t>>> q;
     MessageDecoder dec{[this](const sl_proto_msg_t &m) {
         std::vector<uint8_t> v(SL_PROTO_HEADER_BYTES + m.payload.size);
@@ -229,18 +229,18 @@ MessageReader::MessageReader() : m_(new Impl) {}
 MessageReader::~MessageReader()
 {
     if (m_->c != nullptr) {
-        sl_port_capture_close(m_->c);
+        slp_capture_close(m_->c);
     }
     delete m_;
 }
 
 bool MessageReader::open(const std::string &path, std::string &err, const PcapOptions &opt)
 {
-    sl_port_capture_opts_t o{};
+    slp_capture_opts_t o{};
     o.radar_port = static_cast<uint16_t>(opt.radar_port);
     o.port_explicit = opt.port_explicit;
     char e[512] = {0};
-    m_->c = sl_port_capture_open(path.c_str(), &o, e, sizeof e);
+    m_->c = slp_capture_open(path.c_str(), &o, e, sizeof e);
     if (m_->c == nullptr) {
         err = e;
         return false;
@@ -263,10 +263,10 @@ CaptureFormat MessageReader::format() const
     if (m_->c == nullptr) {
         return m_->mem != nullptr ? CaptureFormat::Raw : CaptureFormat::Unknown;
     }
-    switch (sl_port_capture_report(m_->c)->format) {
-    case SL_PORT_CAPTURE_RAW: return CaptureFormat::Raw;
-    case SL_PORT_CAPTURE_PCAP: return CaptureFormat::Pcap;
-    case SL_PORT_CAPTURE_PCAPNG: return CaptureFormat::Pcapng;
+    switch (slp_capture_report(m_->c)->format) {
+    case SLP_CAPTURE_RAW: return CaptureFormat::Raw;
+    case SLP_CAPTURE_PCAP: return CaptureFormat::Pcap;
+    case SLP_CAPTURE_PCAPNG: return CaptureFormat::Pcapng;
     }
     return CaptureFormat::Unknown;
 }
@@ -284,16 +284,16 @@ bool MessageReader::next(uint8_t &id, std::vector<uint8_t> &msg)
         }
     }
     while (m_->q.empty() && !m_->eof && m_->c != nullptr) {
-        sl_port_capture_piece_t pc;
-        sl_port_capture_next(m_->c, &pc);
-        if (pc.kind == SL_PORT_CAPTURE_DATA) {
+        slp_capture_piece_t pc;
+        slp_capture_next(m_->c, &pc);
+        if (pc.kind == SLP_CAPTURE_DATA) {
             m_->dec.feed(pc.data, pc.size);
-        } else if (pc.kind == SL_PORT_CAPTURE_BREAK) {
+        } else if (pc.kind == SLP_CAPTURE_BREAK) {
             m_->dec.finish();
         } else {
             m_->dec.finish();
-            if (pc.kind == SL_PORT_CAPTURE_ERROR) {
-                err_ = m_->path + ": " + sl_port_capture_error(m_->c);
+            if (pc.kind == SLP_CAPTURE_ERROR) {
+                err_ = m_->path + ": " + slp_capture_error(m_->c);
             }
             m_->eof = true;
         }

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
 // sl-gsusb-send: open a gs_usb (candleLight) adapter through libusb and send CAN frames,
 // generated or from a candump log, printing each confirmation (the adapter's echo).
-// Uses the same sink as the daemon (firmware/port/linux/gsusb_sink.h).
+// Uses the same sink as the daemon (firmware/port/linux/gsusb/gsusb_sink.h).
 #include <errno.h>
 #include <getopt.h>
 #include <signal.h>
@@ -12,8 +12,8 @@
 
 #include "candump.h"
 #include "sl_cli.h"
-#include "gsusb_sink.h"
-#include "sl_port_linux.h"
+#include "gsusb/gsusb_sink.h"
+#include "port_clock.h"
 
 #define MAX_FRAMES 100000U
 
@@ -26,7 +26,7 @@ static void on_signal(int sig)
 }
 
 typedef struct app {
-    sl_gsusb_sink_t sink;
+    slp_gsusb_sink_t sink;
     FILE *tx_log;
     FILE *rx_log;
     bool quiet;
@@ -66,40 +66,40 @@ static void usage(FILE *to)
             "not be opened/started (the message says which request failed and why) or usage error\n");
 }
 
-static void on_tx_done(void *ctx, const sl_can_frame_t *f, uint32_t tag, sl_gsusb_tx_result_t r,
+static void on_tx_done(void *ctx, const sl_can_frame_t *f, uint32_t tag, slp_gsusb_tx_result_t r,
                        uint64_t latency_us)
 {
     app_t *a = ctx;
     char txt[48];
-    sl_candump_format_frame(f, txt, sizeof txt);
-    if (r == SL_GSUSB_TX_CONFIRMED) {
+    slp_candump_format_frame(f, txt, sizeof txt);
+    if (r == SLP_GSUSB_TX_CONFIRMED) {
         if (a->sink.stats.reopens > 0U) {
             a->confirmed_after_reopen++;
         }
         if (a->tx_log != NULL) {
             char line[96];
-            fprintf(a->tx_log, "%s\n", sl_candump_format_line(f, sl_port_now_us(), "gsusb0", line, sizeof line));
+            fprintf(a->tx_log, "%s\n", slp_candump_format_line(f, slp_now_us(), "gsusb0", line, sizeof line));
         }
         if (!a->quiet) {
             printf("confirmed #%u %s (echo after %lu us)\n", (unsigned)tag, txt, (unsigned long)latency_us);
         }
     } else if (!a->quiet) {
-        printf("%s #%u %s\n", r == SL_GSUSB_TX_TIMEOUT ? "UNCONFIRMED (no echo)" : "DROPPED in flight",
+        printf("%s #%u %s\n", r == SLP_GSUSB_TX_TIMEOUT ? "UNCONFIRMED (no echo)" : "DROPPED in flight",
                (unsigned)tag, txt);
     }
 }
 
-static void on_rx(void *ctx, const sl_can_frame_t *f, const sl_gsusb_rx_info_t *info)
+static void on_rx(void *ctx, const sl_can_frame_t *f, const slp_gsusb_rx_info_t *info)
 {
     app_t *a = ctx;
     char txt[48];
-    sl_candump_format_frame(f, txt, sizeof txt);
+    slp_candump_format_frame(f, txt, sizeof txt);
     if ((f->flags & SL_CAN_FLAG_ERR) == 0U) {
         a->rx_replies++;
     }
     if (a->rx_log != NULL) {
         char line[96];
-        fprintf(a->rx_log, "%s\n", sl_candump_format_line(f, info->now_us, "gsusb0", line, sizeof line));
+        fprintf(a->rx_log, "%s\n", slp_candump_format_line(f, info->now_us, "gsusb0", line, sizeof line));
     }
     if (!a->quiet) {
         printf("rx %s%s%s\n", txt, (f->flags & SL_CAN_FLAG_ERR) != 0U ? " (error frame)" : "",
@@ -150,7 +150,7 @@ static size_t load_log(const char *path, sl_can_frame_t *frames, size_t max, uin
     while (fgets(line, sizeof line, fp) != NULL && n < max && n < limit) {
         lineno++;
         const char *why = NULL;
-        sl_err_t rc = sl_candump_parse_line(line, &frames[n], &why);
+        sl_err_t rc = slp_candump_parse_line(line, &frames[n], &why);
         if (rc == SL_ERR_NEED_MORE) {
             continue;
         }
@@ -170,10 +170,10 @@ static size_t load_log(const char *path, sl_can_frame_t *frames, size_t max, uin
 
 static void write_summary(FILE *to, const app_t *a, size_t frames)
 {
-    const sl_gsusb_sink_stats_t *s = &a->sink.stats;
-    const sl_gsusb_stats_t *d = &a->sink.drv.stats;
-    const sl_gsusb_usb_stats_t *u = &a->sink.usb.stats;
-    const sl_gsusb_bt_result_t *t = &a->sink.drv.timing;
+    const slp_gsusb_sink_stats_t *s = &a->sink.stats;
+    const slp_gsusb_stats_t *d = &a->sink.drv.stats;
+    const slp_gsusb_usb_stats_t *u = &a->sink.usb.stats;
+    const slp_gsusb_bt_result_t *t = &a->sink.drv.timing;
     fprintf(to,
             "frames=%zu\noffered=%u\nsubmitted=%u\nconfirmed=%u\nunconfirmed=%u\n"
             "dropped_in_flight=%u\ndropped_down=%u\ndropped_full=%u\ndropped_stale=%u\n"
@@ -202,7 +202,7 @@ static void write_summary(FILE *to, const app_t *a, size_t frames)
 
 int main(int argc, char **argv)
 {
-    sl_gsusb_sink_cfg_t cfg = sl_gsusb_sink_default_cfg();
+    slp_gsusb_sink_cfg_t cfg = slp_gsusb_sink_default_cfg();
     uint32_t count = 10;
     bool count_given = false;
     uint32_t interval_ms = 0;
@@ -256,7 +256,7 @@ int main(int argc, char **argv)
         case O_LOG: log_path = optarg; break;
         case O_INTERVAL: ok = parse_u32(optarg, &interval_ms); break;
         case O_WINDOW:
-            ok = parse_u32(optarg, &v) && v >= 1U && v <= SL_GSUSB_MAX_IN_FLIGHT;
+            ok = parse_u32(optarg, &v) && v >= 1U && v <= SLP_GSUSB_MAX_IN_FLIGHT;
             cfg.can.max_in_flight = (uint8_t)v;
             break;
         case O_ECHO: ok = parse_u32(optarg, &cfg.can.echo_timeout_ms) && cfg.can.echo_timeout_ms > 0U; break;
@@ -268,8 +268,8 @@ int main(int argc, char **argv)
         case O_TX: tx_path = optarg; break;
         case O_RX: rx_path = optarg; break;
         case O_SUMMARY: summary_path = optarg; break;
-        case O_LOOP: cfg.can.mode_flags |= SL_GSUSB_FEAT_LOOP_BACK; break;
-        case O_LISTEN: cfg.can.mode_flags |= SL_GSUSB_FEAT_LISTEN_ONLY; break;
+        case O_LOOP: cfg.can.mode_flags |= SLP_GSUSB_FEAT_LOOP_BACK; break;
+        case O_LISTEN: cfg.can.mode_flags |= SLP_GSUSB_FEAT_LISTEN_ONLY; break;
         case O_LIST: list = true; break;
         case O_QUIET: app.quiet = true; break;
         case O_SP:
@@ -297,16 +297,16 @@ int main(int argc, char **argv)
     }
 
     if (list) {
-        sl_gsusb_usb_t u;
+        slp_gsusb_usb_t u;
         char buf[2048];
-        if (sl_gsusb_usb_init(&u) != SL_OK) {
+        if (slp_gsusb_usb_init(&u) != SL_OK) {
             fprintf(stderr, "sl-gsusb-send: %s\n", u.err);
             return 2;
         }
-        int n = sl_gsusb_usb_list(&u, buf, sizeof buf);
+        int n = slp_gsusb_usb_list(&u, buf, sizeof buf);
         fputs(buf, stdout);
         printf("%d gs_usb adapter(s)\n", n < 0 ? 0 : n);
-        sl_gsusb_usb_deinit(&u);
+        slp_gsusb_usb_deinit(&u);
         return n > 0 ? 0 : 1;
     }
 
@@ -335,14 +335,14 @@ int main(int argc, char **argv)
     cfg.on_tx_done = on_tx_done;
     cfg.on_rx = on_rx;
     cfg.user = &app;
-    sl_err_t rc = sl_gsusb_sink_open(&app.sink, &cfg, sl_port_now_us());
+    sl_err_t rc = slp_gsusb_sink_open(&app.sink, &cfg, slp_now_us());
     if (rc != SL_OK) {
         fprintf(stderr, "sl-gsusb-send: cannot start the adapter: %s (%s)\n",
-                sl_gsusb_sink_last_error(&app.sink), sl_err_str(rc));
-        sl_gsusb_sink_close(&app.sink);
+                slp_gsusb_sink_last_error(&app.sink), sl_err_str(rc));
+        slp_gsusb_sink_close(&app.sink);
         return 2;
     }
-    const sl_gsusb_t *d = &app.sink.drv;
+    const slp_gsusb_t *d = &app.sink.drv;
     printf("adapter %04x:%04x at %s: %u channel(s), sw %u hw %u, clock %u Hz, features 0x%x, "
            "endpoints 0x%02x/0x%02x%s%s\n",
            (unsigned)app.sink.usb.vid, (unsigned)app.sink.usb.pid, app.sink.usb.where,
@@ -360,45 +360,45 @@ int main(int argc, char **argv)
     for (size_t i = 0; i < n_frames && stop_flag == 0; i++) {
         // Keep the echo window full but do not pile frames into the sink's queue (where
         // they could go stale): wait for a free echo id first.
-        while (stop_flag == 0 && sl_gsusb_sink_is_up(&app.sink) &&
-               sl_gsusb_sink_pending(&app.sink) >= window) {
-            sl_gsusb_sink_wait(&app.sink, 10);
+        while (stop_flag == 0 && slp_gsusb_sink_is_up(&app.sink) &&
+               slp_gsusb_sink_pending(&app.sink) >= window) {
+            slp_gsusb_sink_wait(&app.sink, 10);
         }
-        sl_err_t s = sl_gsusb_sink_send(&app.sink, &frames[i], sl_port_now_us());
+        sl_err_t s = slp_gsusb_sink_send(&app.sink, &frames[i], slp_now_us());
         if (s != SL_OK && !app.quiet) {
             char txt[48];
-            printf("not sent #%zu %s: %s%s\n", i, sl_candump_format_frame(&frames[i], txt, sizeof txt),
-                   sl_err_str(s), sl_gsusb_sink_is_up(&app.sink) ? "" : " (adapter down)");
+            printf("not sent #%zu %s: %s%s\n", i, slp_candump_format_frame(&frames[i], txt, sizeof txt),
+                   sl_err_str(s), slp_gsusb_sink_is_up(&app.sink) ? "" : " (adapter down)");
         }
-        uint64_t until = sl_port_now_us() + (uint64_t)interval_ms * 1000U;
+        uint64_t until = slp_now_us() + (uint64_t)interval_ms * 1000U;
         do {
-            sl_gsusb_sink_wait(&app.sink, interval_ms > 0U ? 5U : 0U);
-        } while (stop_flag == 0 && sl_port_now_us() < until);
+            slp_gsusb_sink_wait(&app.sink, interval_ms > 0U ? 5U : 0U);
+        } while (stop_flag == 0 && slp_now_us() < until);
     }
-    uint64_t until = sl_port_now_us() + (uint64_t)linger_ms * 1000U;
-    while (stop_flag == 0 && sl_port_now_us() < until &&
-           (sl_gsusb_sink_pending(&app.sink) > 0U || !sl_gsusb_sink_is_up(&app.sink))) {
-        sl_gsusb_sink_wait(&app.sink, 10);
-        if (!sl_gsusb_sink_is_up(&app.sink) && app.sink.stats.reopens == 0U &&
+    uint64_t until = slp_now_us() + (uint64_t)linger_ms * 1000U;
+    while (stop_flag == 0 && slp_now_us() < until &&
+           (slp_gsusb_sink_pending(&app.sink) > 0U || !slp_gsusb_sink_is_up(&app.sink))) {
+        slp_gsusb_sink_wait(&app.sink, 10);
+        if (!slp_gsusb_sink_is_up(&app.sink) && app.sink.stats.reopens == 0U &&
             app.sink.stats.down_events == 0U) {
             break;
         }
     }
     // Bus frames can trail the last echo (a reply to the last frame, say).
-    until = sl_port_now_us() + (uint64_t)drain_ms * 1000U;
-    while (stop_flag == 0 && sl_gsusb_sink_is_up(&app.sink) && app.rx_replies < expect_rx &&
-           sl_port_now_us() < until) {
-        sl_gsusb_sink_wait(&app.sink, 10);
+    until = slp_now_us() + (uint64_t)drain_ms * 1000U;
+    while (stop_flag == 0 && slp_gsusb_sink_is_up(&app.sink) && app.rx_replies < expect_rx &&
+           slp_now_us() < until) {
+        slp_gsusb_sink_wait(&app.sink, 10);
     }
-    bool was_up = sl_gsusb_sink_is_up(&app.sink);
-    sl_gsusb_sink_close(&app.sink);
+    bool was_up = slp_gsusb_sink_is_up(&app.sink);
+    slp_gsusb_sink_close(&app.sink);
     if (app.tx_log != NULL) {
         fclose(app.tx_log);
     }
     if (app.rx_log != NULL) {
         fclose(app.rx_log);
     }
-    const sl_gsusb_sink_stats_t *st = &app.sink.stats;
+    const slp_gsusb_sink_stats_t *st = &app.sink.stats;
     printf("summary: frames %zu, confirmed %u, unconfirmed %u, dropped %u (down %u, in flight %u, "
            "full %u, stale %u, error %u), rx %u, error frames %u, down events %u, reopens %u%s\n",
            n_frames, st->confirmed, st->unconfirmed,

@@ -11,7 +11,7 @@
 #include "capture.h"
 
 #include "radar_client.h"
-#include "sl_port_linux.h"
+#include "port_clock.h"
 
 #include <cinttypes>
 #include <cstdio>
@@ -36,23 +36,23 @@ void on_bytes(void *ctx, const uint8_t *d, size_t n, uint64_t)
     }
 }
 
-void on_event(void *ctx, sl_radar_event_t ev, sl_radar_reason_t reason, uint64_t)
+void on_event(void *ctx, slp_radar_event_t ev, slp_radar_reason_t reason, uint64_t)
 {
     auto *rc = static_cast<RecordCtx *>(ctx);
     switch (ev) {
-    case SL_RADAR_EV_CONNECTED:
+    case SLP_RADAR_EV_CONNECTED:
         std::fprintf(stderr, "sl-replay record: connected\n");
         break;
-    case SL_RADAR_EV_CONFIG:
+    case SLP_RADAR_EV_CONFIG:
         if (rc->verbose) std::fprintf(stderr, "sl-replay record: configuration received\n");
         break;
-    case SL_RADAR_EV_DISCONNECTED:
-        std::fprintf(stderr, "sl-replay record: disconnected (%s), reconnecting\n", sl_radar_reason_str(reason));
+    case SLP_RADAR_EV_DISCONNECTED:
+        std::fprintf(stderr, "sl-replay record: disconnected (%s), reconnecting\n", slp_radar_reason_str(reason));
         break;
-    case SL_RADAR_EV_CONNECT_FAILED:
-        if (rc->verbose) std::fprintf(stderr, "sl-replay record: connect failed (%s)\n", sl_radar_reason_str(reason));
+    case SLP_RADAR_EV_CONNECT_FAILED:
+        if (rc->verbose) std::fprintf(stderr, "sl-replay record: connect failed (%s)\n", slp_radar_reason_str(reason));
         break;
-    case SL_RADAR_EV_STOPPED:
+    case SLP_RADAR_EV_STOPPED:
         break;
     }
 }
@@ -71,9 +71,9 @@ int record(const RecordOptions &o)
     rc.w = &w;
     rc.verbose = o.verbose;
     std::vector<uint8_t> reasm(sl::kHostMaxPayloadBytes);
-    auto client = std::make_unique<sl_radar_client_t>();
-    sl_radar_client_cfg_t cfg;
-    sl_radar_client_cfg_defaults(&cfg);
+    auto client = std::make_unique<slp_radar_client_t>();
+    slp_radar_client_cfg_t cfg;
+    slp_radar_client_cfg_defaults(&cfg);
     cfg.host = o.host.c_str();
     cfg.port = o.port;
     cfg.non_contour = o.non_contour;
@@ -85,33 +85,33 @@ int record(const RecordOptions &o)
     cfg.on_bytes = on_bytes;
     cfg.on_event = on_event;
     cfg.ctx = &rc;
-    if (sl_radar_client_init(client.get(), &cfg) != SL_OK) {
+    if (slp_radar_client_init(client.get(), &cfg) != SL_OK) {
         std::fprintf(stderr, "sl-replay record: cannot resolve %s:%u\n", o.host.c_str(), o.port);
         return 1;
     }
-    sl_radar_client_start(client.get());
-    const uint64_t t0 = sl_port_now_us();
+    slp_radar_client_start(client.get());
+    const uint64_t t0 = slp_now_us();
     const uint64_t t_end = o.duration_s > 0 ? t0 + static_cast<uint64_t>(o.duration_s * 1e6) : UINT64_MAX;
     int status = 0;
     while (!g_stop && !rc.write_failed) {
-        const uint64_t now = sl_port_now_us();
+        const uint64_t now = slp_now_us();
         if (now >= t_end) {
             break;
         }
         const uint64_t left_ms = t_end == UINT64_MAX ? 1000 : (t_end - now + 999) / 1000;
-        if (sl_radar_client_poll(client.get(), static_cast<int>(std::min<uint64_t>(left_ms, 1000))) == SL_ERR_PORT) {
+        if (slp_radar_client_poll(client.get(), static_cast<int>(std::min<uint64_t>(left_ms, 1000))) == SL_ERR_PORT) {
             std::fprintf(stderr, "sl-replay record: poll failed\n");
             status = 1;
             break;
         }
     }
-    sl_radar_client_stop(client.get(), 500);
-    const double secs = static_cast<double>(sl_port_now_us() - t0) * 1e-6;
+    slp_radar_client_stop(client.get(), 500);
+    const double secs = static_cast<double>(slp_now_us() - t0) * 1e-6;
     if (!w.close(err) || rc.write_failed) {
         std::fprintf(stderr, "sl-replay record: %s\n", err.empty() ? "write failed" : err.c_str());
         status = 1;
     }
-    const sl_radar_client_stats_t &s = client->stats;
+    const slp_radar_client_stats_t &s = client->stats;
     const sl_proto_stats_t &p = client->proto.stats;
     std::printf("recorded %" PRIu64 " bytes to %s in %.2f s: %u messages (%u configuration, %u FFT, "
                 "%u keep-alive), decoder %u resyncs / %" PRIu64 " bytes skipped / %u truncated; "
@@ -128,7 +128,7 @@ int record(const RecordOptions &o)
                      s.connect_failures + s.connect_timeouts);
         status = 1;
     }
-    sl_radar_client_deinit(client.get());
+    slp_radar_client_deinit(client.get());
     return status;
 }
 

@@ -25,7 +25,7 @@
 
 #include "shadowlean/sl_proto.h"
 
-#include "sl_port_linux.h"
+#include "port_clock.h"
 
 #include <arpa/inet.h>
 #include <cerrno>
@@ -632,7 +632,7 @@ void flush(Client &c)
         size_t len = front.size() - c.q_off;
         if (bps > 0) {
             // --trickle-bps: one byte at a time, at most bps per second.
-            const uint64_t now = sl_port_now_us();
+            const uint64_t now = slp_now_us();
             if (now < c.next_byte_us) {
                 return;
             }
@@ -677,7 +677,7 @@ void on_command(void *ctx, const sl_proto_msg_t *m)
     if (c.dead || c.stalled) {
         return;
     }
-    const uint64_t now = sl_port_now_us();
+    const uint64_t now = slp_now_us();
     switch (m->id) {
     case SL_PROTO_ID_START_FFT:
     case SL_PROTO_ID_START_NONCONTOUR_FFT:
@@ -859,12 +859,12 @@ int serve(const ServeOptions &o)
 
     Server s(o, src);
     s.shared = std::move(shared);
-    const uint64_t t_start = sl_port_now_us();
+    const uint64_t t_start = slp_now_us();
     const uint64_t t_end = o.timeout_s > 0 ? t_start + static_cast<uint64_t>(o.timeout_s * 1e6) : UINT64_MAX;
     const char *exit_why = "signal";
     std::vector<pollfd> pfds;
     while (!g_stop) {
-        uint64_t now = sl_port_now_us();
+        uint64_t now = slp_now_us();
         if (now >= t_end) {
             exit_why = "--timeout";
             break;
@@ -896,7 +896,7 @@ int serve(const ServeOptions &o)
         }
         int timeout = -1;
         if (wake != UINT64_MAX) {
-            now = sl_port_now_us();
+            now = slp_now_us();
             timeout = wake <= now ? 0 : static_cast<int>(std::min<uint64_t>((wake - now + 999) / 1000, 60000));
         }
         const int rc = poll(pfds.data(), pfds.size(), timeout);
@@ -926,7 +926,7 @@ int serve(const ServeOptions &o)
             }
         }
         if (pfds[0].revents & POLLIN) {
-            accept_all(s, lfd, sl_port_now_us());
+            accept_all(s, lfd, slp_now_us());
         }
     }
     for (auto &c : s.clients) {

@@ -376,7 +376,7 @@ sl_board_t calibrated(const sl_board_t &nominal, const std::string &calib, std::
         uint8_t *raw = nullptr;
         size_t len = 0;
         char err[512];
-        if (calib_file_load(calib.c_str(), &nominal, &raw, &len, err, sizeof err) != 0) {
+        if (slp_calib_file_load(calib.c_str(), &nominal, &raw, &len, err, sizeof err) != 0) {
             throw std::runtime_error(std::string("calibration ") + err);
         }
         bytes.assign(raw, raw + len);

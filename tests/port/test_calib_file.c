@@ -49,7 +49,7 @@ static void test_calib_file_ini_changes_measured_azimuths_only(void **state)
     uint8_t *blob = NULL;
     size_t len = 0;
     char err[256] = "";
-    assert_int_equal(calib_file_load(write_tmp("v.ini", ini, sizeof ini - 1U), nom, &blob, &len, err,
+    assert_int_equal(slp_calib_file_load(write_tmp("v.ini", ini, sizeof ini - 1U), nom, &blob, &len, err,
                                      sizeof err), 0);
     assert_int_equal(len, SL_CALBLOB_BYTES(400));
     sl_board_t v;
@@ -81,7 +81,7 @@ static void test_calib_file_blob_is_passed_through(void **state)
     uint8_t *blob = NULL;
     size_t len = 0;
     char err[256] = "";
-    assert_int_equal(calib_file_load(write_tmp("v.bin", (const char *)raw, (size_t)n), nom, &blob, &len,
+    assert_int_equal(slp_calib_file_load(write_tmp("v.bin", (const char *)raw, (size_t)n), nom, &blob, &len,
                                      err, sizeof err), 0);
     assert_int_equal(len, (size_t)n);
     assert_memory_equal(blob, raw, len);
@@ -93,7 +93,7 @@ static void expect_refused(const char *text, const char *why)
     uint8_t *blob = (uint8_t *)1;
     size_t len = 0;
     char err[256] = "";
-    assert_int_equal(calib_file_load(write_tmp("bad.ini", text, strlen(text)), paper_sim(), &blob, &len,
+    assert_int_equal(slp_calib_file_load(write_tmp("bad.ini", text, strlen(text)), paper_sim(), &blob, &len,
                                      err, sizeof err), -1);
     assert_null(blob);
     if (strstr(err, why) == NULL) {
@@ -118,7 +118,7 @@ static void test_calib_file_refuses_bad_files_naming_the_line(void **state)
     uint8_t *blob = NULL;
     size_t len = 0;
     char err[256] = "";
-    assert_int_equal(calib_file_load("/nonexistent/v.ini", paper_sim(), &blob, &len, err, sizeof err), -1);
+    assert_int_equal(slp_calib_file_load("/nonexistent/v.ini", paper_sim(), &blob, &len, err, sizeof err), -1);
     assert_non_null(strstr(err, "/nonexistent/v.ini"));
 }
 

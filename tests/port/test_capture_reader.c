@@ -26,16 +26,16 @@ typedef struct collected {
     uint64_t gap_at[8], gap_missing[8], session_at[8];
 } collected_t;
 
-static void collect(sl_port_capture_t *c, collected_t *out)
+static void collect(slp_capture_t *c, collected_t *out)
 {
     memset(out, 0, sizeof *out);
     size_t cap = 1u << 20;
     out->data = malloc(cap);
     assert_non_null(out->data);
     for (;;) {
-        sl_port_capture_piece_t p;
-        sl_port_capture_next(c, &p);
-        if (p.kind == SL_PORT_CAPTURE_DATA) {
+        slp_capture_piece_t p;
+        slp_capture_next(c, &p);
+        if (p.kind == SLP_CAPTURE_DATA) {
             assert_int_equal(p.output_offset, out->size);
             while (out->size + p.size > cap) {
                 cap *= 2;
@@ -44,19 +44,19 @@ static void collect(sl_port_capture_t *c, collected_t *out)
             }
             memcpy(out->data + out->size, p.data, p.size);
             out->size += p.size;
-        } else if (p.kind == SL_PORT_CAPTURE_BREAK) {
+        } else if (p.kind == SLP_CAPTURE_BREAK) {
             assert_int_equal(p.output_offset, out->size);
-            if (p.brk == SL_PORT_CAPTURE_GAP && out->gaps < 8) {
+            if (p.brk == SLP_CAPTURE_GAP && out->gaps < 8) {
                 out->gap_at[out->gaps] = p.output_offset;
                 out->gap_missing[out->gaps++] = p.missing_bytes;
-            } else if (p.brk == SL_PORT_CAPTURE_NEW_SESSION && out->sessions < 8) {
+            } else if (p.brk == SLP_CAPTURE_NEW_SESSION && out->sessions < 8) {
                 out->session_at[out->sessions++] = p.output_offset;
             }
             out->breaks++;
         } else {
-            assert_int_equal(p.kind, SL_PORT_CAPTURE_END);
-            sl_port_capture_next(c, &p); // END is sticky
-            assert_int_equal(p.kind, SL_PORT_CAPTURE_END);
+            assert_int_equal(p.kind, SLP_CAPTURE_END);
+            slp_capture_next(c, &p); // END is sticky
+            assert_int_equal(p.kind, SLP_CAPTURE_END);
             return;
         }
     }
@@ -223,7 +223,7 @@ static void build_pcap(pcapw_t *w, const uint8_t *s, size_t n)
     tcp_packet(w, 6317, 40001, ISN + 1u, 0x18, s, SEG);
 }
 
-static void check_pcap_result(const collected_t *got, const sl_port_capture_report_t *r, const uint8_t *s,
+static void check_pcap_result(const collected_t *got, const slp_capture_report_t *r, const uint8_t *s,
                               size_t n)
 {
     // session 1 without segment 20, then session 2 complete
@@ -237,7 +237,7 @@ static void check_pcap_result(const collected_t *got, const sl_port_capture_repo
     assert_int_equal(got->gap_missing[0], SEG);
     assert_int_equal(got->sessions, 1);
     assert_int_equal(got->session_at[0], n - SEG);
-    assert_int_equal(r->format, SL_PORT_CAPTURE_PCAP);
+    assert_int_equal(r->format, SLP_CAPTURE_PCAP);
     assert_int_equal(r->sessions, 2);
     assert_int_equal(r->retransmitted_segments, 1);
     assert_int_equal(r->retransmitted_bytes, SEG);
@@ -264,16 +264,16 @@ static void test_capture_raw_file_delivers_every_byte(void **state)
     close(fd);
     write_file(path, s, n);
     char err[256];
-    sl_port_capture_t *c = sl_port_capture_open(path, NULL, err, sizeof err);
+    slp_capture_t *c = slp_capture_open(path, NULL, err, sizeof err);
     assert_non_null(c);
     collected_t got;
     collect(c, &got);
     assert_int_equal(got.size, n);
     assert_memory_equal(got.data, s, n);
     assert_int_equal(got.breaks, 0);
-    assert_int_equal(sl_port_capture_report(c)->bytes_in, n);
-    assert_int_equal(sl_port_capture_report(c)->format, SL_PORT_CAPTURE_RAW);
-    sl_port_capture_close(c);
+    assert_int_equal(slp_capture_report(c)->bytes_in, n);
+    assert_int_equal(slp_capture_report(c)->format, SLP_CAPTURE_RAW);
+    slp_capture_close(c);
     unlink(path);
     free(got.data);
     free(s);
@@ -287,14 +287,14 @@ static void test_capture_raw_pipe_loses_no_byte_to_sniffing(void **state)
     char path[64];
     const pid_t pid = pipe_from_child(s, n, path, sizeof path);
     char err[256];
-    sl_port_capture_t *c = sl_port_capture_open(path, NULL, err, sizeof err);
+    slp_capture_t *c = slp_capture_open(path, NULL, err, sizeof err);
     assert_non_null(c);
     collected_t got;
     collect(c, &got);
     assert_int_equal(got.size, n);
     assert_memory_equal(got.data, s, n);
-    assert_int_equal(sl_port_capture_report(c)->bytes_in, n);
-    sl_port_capture_close(c);
+    assert_int_equal(slp_capture_report(c)->bytes_in, n);
+    slp_capture_close(c);
     finish_child(pid, path);
     free(got.data);
     free(s);
@@ -316,21 +316,21 @@ static void test_capture_pcap_file_reassembles_damaged_sessions(void **state)
         write_file(getenv("SL_TEST_KEEP_PCAP"), w.b, w.n);
     }
     char err[256];
-    sl_port_capture_t *c = sl_port_capture_open(path, NULL, err, sizeof err);
+    slp_capture_t *c = slp_capture_open(path, NULL, err, sizeof err);
     assert_non_null(c);
     collected_t got;
     collect(c, &got);
-    check_pcap_result(&got, sl_port_capture_report(c), s, n);
-    assert_int_equal(sl_port_capture_report(c)->bytes_in, w.n);
-    sl_port_capture_flow_t fl[4];
-    assert_int_equal(sl_port_capture_flows(c, fl, 4), 2); // the two radar-side sessions
+    check_pcap_result(&got, slp_capture_report(c), s, n);
+    assert_int_equal(slp_capture_report(c)->bytes_in, w.n);
+    slp_capture_flow_t fl[4];
+    assert_int_equal(slp_capture_flows(c, fl, 4), 2); // the two radar-side sessions
     assert_string_equal(fl[0].src, "10.0.0.2:6317");
     assert_string_equal(fl[0].dst, "10.0.0.1:40001");
     assert_true(fl[0].selected && fl[1].selected && fl[0].syn && fl[0].fin);
     char line[512];
-    sl_port_capture_report_line(c, line, sizeof line);
+    slp_capture_report_line(c, line, sizeof line);
     assert_non_null(strstr(line, "1 gaps (1000 bytes)"));
-    sl_port_capture_close(c);
+    slp_capture_close(c);
     unlink(path);
     free(got.data);
     free(w.b);
@@ -347,13 +347,13 @@ static void test_capture_pcap_through_a_pipe_equals_the_file(void **state)
     char path[64];
     const pid_t pid = pipe_from_child(w.b, w.n, path, sizeof path);
     char err[256];
-    sl_port_capture_t *c = sl_port_capture_open(path, NULL, err, sizeof err);
+    slp_capture_t *c = slp_capture_open(path, NULL, err, sizeof err);
     assert_non_null(c);
     collected_t got;
     collect(c, &got);
-    check_pcap_result(&got, sl_port_capture_report(c), s, n);
-    assert_int_equal(sl_port_capture_report(c)->bytes_in, w.n);
-    sl_port_capture_close(c);
+    check_pcap_result(&got, slp_capture_report(c), s, n);
+    assert_int_equal(slp_capture_report(c)->bytes_in, w.n);
+    slp_capture_close(c);
     finish_child(pid, path);
     free(got.data);
     free(w.b);
@@ -364,20 +364,20 @@ static void test_capture_empty_input_ends_at_once(void **state)
 {
     (void)state;
     char err[256];
-    sl_port_capture_t *c = sl_port_capture_open("/dev/null", NULL, err, sizeof err);
+    slp_capture_t *c = slp_capture_open("/dev/null", NULL, err, sizeof err);
     assert_non_null(c);
-    sl_port_capture_piece_t p;
-    sl_port_capture_next(c, &p);
-    assert_int_equal(p.kind, SL_PORT_CAPTURE_END);
-    assert_int_equal(sl_port_capture_report(c)->bytes_in, 0);
-    sl_port_capture_close(c);
+    slp_capture_piece_t p;
+    slp_capture_next(c, &p);
+    assert_int_equal(p.kind, SLP_CAPTURE_END);
+    assert_int_equal(slp_capture_report(c)->bytes_in, 0);
+    slp_capture_close(c);
 }
 
 static void test_capture_missing_file_is_an_error_naming_it(void **state)
 {
     (void)state;
     char err[256] = "";
-    assert_null(sl_port_capture_open("/nonexistent/x.colossus", NULL, err, sizeof err));
+    assert_null(slp_capture_open("/nonexistent/x.colossus", NULL, err, sizeof err));
     assert_non_null(strstr(err, "/nonexistent/x.colossus"));
 }
 
@@ -395,13 +395,13 @@ static void test_capture_pcap_without_radar_payload_ends_with_error(void **state
     close(fd);
     write_file(path, w.b, w.n);
     char err[256];
-    sl_port_capture_t *c = sl_port_capture_open(path, NULL, err, sizeof err);
+    slp_capture_t *c = slp_capture_open(path, NULL, err, sizeof err);
     assert_non_null(c);
-    sl_port_capture_piece_t p;
-    sl_port_capture_next(c, &p);
-    assert_int_equal(p.kind, SL_PORT_CAPTURE_ERROR);
-    assert_non_null(strstr(sl_port_capture_error(c), "no TCP payload from port 6317"));
-    sl_port_capture_close(c);
+    slp_capture_piece_t p;
+    slp_capture_next(c, &p);
+    assert_int_equal(p.kind, SLP_CAPTURE_ERROR);
+    assert_non_null(strstr(slp_capture_error(c), "no TCP payload from port 6317"));
+    slp_capture_close(c);
     unlink(path);
     free(w.b);
 }

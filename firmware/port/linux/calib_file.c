@@ -37,7 +37,7 @@ static uint32_t bam(double d)
     return (uint32_t)(uint64_t)llround(d / 360.0 * 4294967296.0);
 }
 
-sl_incline_geom_t calib_make_geom(double theta_deg, double beta_deg)
+sl_incline_geom_t slp_calib_make_geom(double theta_deg, double beta_deg)
 {
     const double t = theta_deg * k_pi / 180.0;
     const double b = beta_deg * k_pi / 180.0;
@@ -274,7 +274,7 @@ static int build(const char *path, ctx_t *c, uint8_t **blob, size_t *len, char *
         }
         const double th = c->have[i] ? c->theta_deg[i] : (double)nom->theta_cdeg[i] / 100.0;
         if (c->have[i]) {
-            geom[i] = calib_make_geom(th, beta);
+            geom[i] = slp_calib_make_geom(th, beta);
             theta[i] = (int16_t)llround(th * 100.0);
         }
         const double r = h / tan(th * k_pi / 180.0);
@@ -323,7 +323,7 @@ static int build(const char *path, ctx_t *c, uint8_t **blob, size_t *len, char *
     return 0;
 }
 
-int calib_file_load(const char *path, const sl_board_t *nominal, uint8_t **blob, size_t *len,
+int slp_calib_file_load(const char *path, const sl_board_t *nominal, uint8_t **blob, size_t *len,
                     char *err, size_t err_size)
 {
     *blob = NULL;

@@ -31,11 +31,11 @@
 ///   outside [1, 60] deg are errors naming the line. The calibrated board is the nominal one
 ///   with these values; each measured azimuth gets its geometry entry, shadow radius
 ///   R = H / tan(theta) and shadow bins computed exactly as sl-tables computes a board's
-///   (calib_make_geom() is the C twin of sl::make_geom, compared bit for bit by a test).
+///   (slp_calib_make_geom() is the C twin of sl::make_geom, compared bit for bit by a test).
 ///
 /// Host/port only (libm, stdio, malloc); not part of the core. Reentrant (no static state).
-#ifndef SHADOWLEAN_CALIB_FILE_H
-#define SHADOWLEAN_CALIB_FILE_H
+#ifndef SHADOWLEAN_PORT_CALIB_FILE_H
+#define SHADOWLEAN_PORT_CALIB_FILE_H
 
 #include <stddef.h>
 #include <stdint.h>
@@ -48,17 +48,17 @@ extern "C" {
 #endif
 
 /// The geometry entry of theta, beta (degrees): the same rounding as sl::make_geom.
-sl_incline_geom_t calib_make_geom(double theta_deg, double beta_deg);
+sl_incline_geom_t slp_calib_make_geom(double theta_deg, double beta_deg);
 
 /// Read `path` (blob or INI) for `nominal` and return a malloc'd blob in `*blob` (`*len`
 /// bytes; free() it). On error returns -1 with a message in `err` (file, line, key) and
 /// `*blob` NULL. The blob is NOT validated here beyond what building it needs: open it with
 /// sl_calblob_open() (a blob file is returned as read).
-int calib_file_load(const char *path, const sl_board_t *nominal, uint8_t **blob, size_t *len,
+int slp_calib_file_load(const char *path, const sl_board_t *nominal, uint8_t **blob, size_t *len,
                     char *err, size_t err_size);
 
 #ifdef __cplusplus
 }
 #endif
 
-#endif // SHADOWLEAN_CALIB_FILE_H
+#endif // SHADOWLEAN_PORT_CALIB_FILE_H

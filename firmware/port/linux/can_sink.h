@@ -15,8 +15,8 @@
 /// Time `t_us` is the caller's monotonic clock in microseconds (the core's convention).
 ///
 /// Thread safety: none; a sink belongs to one thread.
-#ifndef SHADOWLEAN_CAN_SINK_H
-#define SHADOWLEAN_CAN_SINK_H
+#ifndef SHADOWLEAN_PORT_CAN_SINK_H
+#define SHADOWLEAN_PORT_CAN_SINK_H
 
 #include <stddef.h>
 #include <stdint.h>
@@ -29,15 +29,15 @@ extern "C" {
 #endif
 
 /// Counters every sink reports. All totals since open; wrap at 2^32 (not saturating).
-typedef struct sl_can_sink_stats {
+typedef struct slp_can_sink_stats {
     uint32_t sent;    ///< frames written to the medium
     uint32_t dropped; ///< frames lost, all reasons
     uint32_t queued;  ///< frames waiting in the sink right now
     uint32_t errors;  ///< error reports from the medium (bus errors, I/O errors)
-} sl_can_sink_stats_t;
+} slp_can_sink_stats_t;
 
 /// One sink: a vtable and its context. Plain value; the context is borrowed.
-typedef struct sl_can_sink {
+typedef struct slp_can_sink {
     const char *name; ///< short constant name for logs ("socketcan", "candump")
     void *ctx;
     /// Send one frame (see the contract above).
@@ -45,12 +45,12 @@ typedef struct sl_can_sink {
     /// Deferred work; may be NULL.
     void (*poll)(void *ctx, uint64_t t_us);
     /// Common counters.
-    void (*get_stats)(void *ctx, sl_can_sink_stats_t *out);
-} sl_can_sink_t;
+    void (*get_stats)(void *ctx, slp_can_sink_stats_t *out);
+} slp_can_sink_t;
 
 /// Send `f` to each of `n` sinks. @return SL_OK when every sink took it, else the first
 /// error (every sink is still tried). O(n).
-static inline sl_err_t sl_can_sinks_send(const sl_can_sink_t *sinks, size_t n,
+static inline sl_err_t slp_can_sinks_send(const slp_can_sink_t *sinks, size_t n,
                                          const sl_can_frame_t *f, uint64_t t_us)
 {
     sl_err_t first = SL_OK;
@@ -64,7 +64,7 @@ static inline sl_err_t sl_can_sinks_send(const sl_can_sink_t *sinks, size_t n,
 }
 
 /// Poll each sink that has a poll function. O(n).
-static inline void sl_can_sinks_poll(const sl_can_sink_t *sinks, size_t n, uint64_t t_us)
+static inline void slp_can_sinks_poll(const slp_can_sink_t *sinks, size_t n, uint64_t t_us)
 {
     for (size_t i = 0; i < n; i++) {
         if (sinks[i].poll != NULL) {
@@ -74,19 +74,39 @@ static inline void sl_can_sinks_poll(const sl_can_sink_t *sinks, size_t n, uint6
 }
 
 /// Sum of the sinks' dropped counters (for Status.CanDropped). O(n).
-static inline uint32_t sl_can_sinks_dropped(const sl_can_sink_t *sinks, size_t n)
+static inline uint32_t slp_can_sinks_dropped(const slp_can_sink_t *sinks, size_t n)
 {
     uint32_t sum = 0;
     for (size_t i = 0; i < n; i++) {
-        sl_can_sink_stats_t st = {0, 0, 0, 0};
+        slp_can_sink_stats_t st = {0, 0, 0, 0};
         sinks[i].get_stats(sinks[i].ctx, &st);
         sum += st.dropped;
     }
     return sum;
 }
 
+/// What slp_can_sinks_drain() did.
+typedef struct slp_can_drain_result {
+    uint32_t left;     ///< frames still queued when it gave up (0: every sink drained)
+    uint32_t moved;    ///< frames that left the queues meanwhile (confirmed or dropped)
+    uint32_t polls;    ///< poll rounds
+    uint64_t stall_us; ///< time since the last progress when it ended
+} slp_can_drain_result_t;
+
+/// Drain at exit: poll the sinks until none holds a frame, or until none has made progress
+/// (a frame sent or dropped, i.e. `sent + dropped` of some sink moved) for `stall_us`.
+/// Progress-based, not bounded by total elapsed time: a slow adapter that keeps confirming
+/// frames is drained completely however long that takes (at most the sinks' queued frames
+/// times `stall_us` in total); an adapter that stops answering costs `stall_us`.
+/// `now_us(ctx)` reads the caller's monotonic clock; `wait(ctx)` sleeps briefly between
+/// rounds (both injected, so tests run on a fake clock). Frames left are NOT counted by the
+/// sinks: the caller reports `left` (the daemon logs and counts them).
+slp_can_drain_result_t slp_can_sinks_drain(const slp_can_sink_t *sinks, size_t n, uint64_t stall_us,
+                                           uint64_t (*now_us)(void *ctx), void (*wait)(void *ctx),
+                                           void *ctx);
+
 #ifdef __cplusplus
 }
 #endif
 
-#endif // SHADOWLEAN_CAN_SINK_H
+#endif // SHADOWLEAN_PORT_CAN_SINK_H

@@ -25,7 +25,7 @@ static int hexval(char c)
     return -1;
 }
 
-sl_err_t sl_candump_parse_frame(const char *s, sl_can_frame_t *out, const char **why)
+sl_err_t slp_candump_parse_frame(const char *s, sl_can_frame_t *out, const char **why)
 {
     const char *dummy = NULL;
     if (why == NULL) {
@@ -108,7 +108,7 @@ sl_err_t sl_candump_parse_frame(const char *s, sl_can_frame_t *out, const char *
     return SL_OK;
 }
 
-sl_err_t sl_candump_parse_line(const char *line, sl_can_frame_t *out, const char **why)
+sl_err_t slp_candump_parse_line(const char *line, sl_can_frame_t *out, const char **why)
 {
     char buf[256];
     const char *dummy = NULL;
@@ -144,10 +144,10 @@ sl_err_t sl_candump_parse_line(const char *line, sl_can_frame_t *out, const char
         *why = "expected '(timestamp) interface frame'";
         return SL_ERR_MALFORMED;
     }
-    return sl_candump_parse_frame(frame, out, why);
+    return slp_candump_parse_frame(frame, out, why);
 }
 
-char *sl_candump_format_frame(const sl_can_frame_t *f, char *buf, size_t cap)
+char *slp_candump_format_frame(const sl_can_frame_t *f, char *buf, size_t cap)
 {
     int k;
     if ((f->flags & SL_CAN_FLAG_ERR) != 0U) {
@@ -175,16 +175,16 @@ char *sl_candump_format_frame(const sl_can_frame_t *f, char *buf, size_t cap)
     return buf;
 }
 
-char *sl_candump_format_line(const sl_can_frame_t *f, uint64_t t_us, const char *iface, char *buf,
+char *slp_candump_format_line(const sl_can_frame_t *f, uint64_t t_us, const char *iface, char *buf,
                              size_t cap)
 {
     char fr[40];
     (void)snprintf(buf, cap, "(%010lu.%06lu) %s %s", (unsigned long)(t_us / 1000000U),
-                   (unsigned long)(t_us % 1000000U), iface, sl_candump_format_frame(f, fr, sizeof fr));
+                   (unsigned long)(t_us % 1000000U), iface, slp_candump_format_frame(f, fr, sizeof fr));
     return buf;
 }
 
-sl_err_t sl_candump_parse_record(const char *line, sl_candump_record_t *out, const char **why)
+sl_err_t slp_candump_parse_record(const char *line, slp_candump_record_t *out, const char **why)
 {
     const char *dummy = NULL;
     if (why == NULL) {
@@ -279,10 +279,10 @@ sl_err_t sl_candump_parse_record(const char *line, sl_candump_record_t *out, con
     }
     memcpy(frame, tok[1], len[1]);
     frame[len[1]] = '\0';
-    return sl_candump_parse_frame(frame, &out->frame, why);
+    return slp_candump_parse_frame(frame, &out->frame, why);
 }
 
-bool sl_candump_frame_ok(const sl_can_frame_t *f)
+bool slp_candump_frame_ok(const sl_can_frame_t *f)
 {
     const uint32_t lim = (f->flags & (SL_CAN_FLAG_EFF | SL_CAN_FLAG_ERR)) != 0U ? SL_CAN_EFF_MASK : SL_CAN_SFF_MASK;
     return f->dlc <= 8U && f->id <= lim;
@@ -291,7 +291,7 @@ bool sl_candump_frame_ok(const sl_can_frame_t *f)
 // ---------------------------------------------------------------------------------------
 // Log file sink
 
-sl_err_t sld_candump_open(sld_candump_t *c, const char *path, const char *iface)
+sl_err_t slp_candump_open(slp_candump_t *c, const char *path, const char *iface)
 {
     memset(c, 0, sizeof *c);
     const size_t n = iface != NULL ? strlen(iface) : 0;
@@ -313,7 +313,7 @@ sl_err_t sld_candump_open(sld_candump_t *c, const char *path, const char *iface)
     return SL_OK;
 }
 
-static void count_io_error(sld_candump_t *c)
+static void count_io_error(slp_candump_t *c)
 {
     c->last_errno = errno;
     c->stats.errors++;
@@ -322,10 +322,10 @@ static void count_io_error(sld_candump_t *c)
     }
 }
 
-sl_err_t sld_candump_send(sld_candump_t *c, const sl_can_frame_t *f)
+sl_err_t slp_candump_send(slp_candump_t *c, const sl_can_frame_t *f)
 {
     char text[40];
-    if (f == NULL || !sl_candump_frame_ok(f)) {
+    if (f == NULL || !slp_candump_frame_ok(f)) {
         c->stats.dropped++;
         return SL_ERR_ARG;
     }
@@ -333,7 +333,7 @@ sl_err_t sld_candump_send(sld_candump_t *c, const sl_can_frame_t *f)
         c->stats.dropped++;
         return SL_ERR_PORT;
     }
-    (void)sl_candump_format_frame(f, text, sizeof text);
+    (void)slp_candump_format_frame(f, text, sizeof text);
     const uint64_t sec = c->stamp_us / 1000000U;
     const uint64_t usec = c->stamp_us % 1000000U;
     if (fprintf(c->fp, "(%010" PRIu64 ".%06" PRIu64 ") %s %s\n", sec, usec, c->iface, text) < 0) {
@@ -346,7 +346,7 @@ sl_err_t sld_candump_send(sld_candump_t *c, const sl_can_frame_t *f)
     return SL_OK;
 }
 
-void sld_candump_flush(sld_candump_t *c)
+void slp_candump_flush(slp_candump_t *c)
 {
     if (c->fp == NULL || c->broken_pipe) {
         return;
@@ -358,12 +358,12 @@ void sld_candump_flush(sld_candump_t *c)
     c->unflushed = 0;
 }
 
-void sld_candump_close(sld_candump_t *c)
+void slp_candump_close(slp_candump_t *c)
 {
     if (c->fp == NULL) {
         return;
     }
-    sld_candump_flush(c);
+    slp_candump_flush(c);
     if (c->own && fclose(c->fp) != 0) {
         count_io_error(c);
     }
@@ -373,23 +373,23 @@ void sld_candump_close(sld_candump_t *c)
 static sl_err_t sink_send(void *ctx, const sl_can_frame_t *f, uint64_t t_us)
 {
     (void)t_us;
-    return sld_candump_send(ctx, f);
+    return slp_candump_send(ctx, f);
 }
 
 static void sink_poll(void *ctx, uint64_t t_us)
 {
     (void)t_us;
-    sld_candump_flush(ctx);
+    slp_candump_flush(ctx);
 }
 
-static void sink_stats(void *ctx, sl_can_sink_stats_t *out)
+static void sink_stats(void *ctx, slp_can_sink_stats_t *out)
 {
-    const sld_candump_t *c = ctx;
+    const slp_candump_t *c = ctx;
     *out = c->stats;
 }
 
-sl_can_sink_t sld_candump_sink(sld_candump_t *c)
+slp_can_sink_t slp_candump_sink(slp_candump_t *c)
 {
-    sl_can_sink_t s = {"candump", c, sink_send, sink_poll, sink_stats};
+    slp_can_sink_t s = {"candump", c, sink_send, sink_poll, sink_stats};
     return s;
 }

@@ -66,14 +66,14 @@ typedef struct pkt_seg { // the current packet's payload for a session (retryabl
     uint32_t len;
 } pkt_seg_t;
 
-struct sl_port_capture {
+struct slp_capture {
     int fd;
     bool own_fd;
-    sl_port_capture_opts_t opt;
-    sl_port_capture_report_t rep;
+    slp_capture_opts_t opt;
+    slp_capture_report_t rep;
     char err[512];
     bool finished;
-    sl_port_capture_piece_kind_t final_kind;
+    slp_capture_piece_kind_t final_kind;
     uint64_t out_off;   // bytes delivered in total
 
     // raw
@@ -92,15 +92,15 @@ struct sl_port_capture {
     bool eof;
     bool port_locked;
     uint16_t radar_port;
-    flow_t flows[SL_PORT_CAPTURE_MAX_FLOWS];
+    flow_t flows[SLP_CAPTURE_MAX_FLOWS];
     size_t n_flows;
     size_t last_flow;
     sess_t sel, cand;
     pkt_seg_t ps;
     uint8_t *held;      // segment storage handed out by the previous DATA piece
     bool brk_pending;
-    sl_port_capture_piece_t brk;
-    uint8_t *tail;      // last SL_PORT_CAPTURE_TAIL delivered bytes of the selected session (ring)
+    slp_capture_piece_t brk;
+    uint8_t *tail;      // last SLP_CAPTURE_TAIL delivered bytes of the selected session (ring)
     // Payload seen before the radar port is known (auto-detection), replayed into the
     // session of the flow that turns out to be the radar's.
     struct held_seg {
@@ -146,12 +146,12 @@ static int64_t score_payload(const uint8_t *p, size_t n)
     return s;
 }
 
-const char *sl_port_capture_format_name(sl_port_capture_format_t f)
+const char *slp_capture_format_name(slp_capture_format_t f)
 {
     switch (f) {
-    case SL_PORT_CAPTURE_RAW: return "raw";
-    case SL_PORT_CAPTURE_PCAP: return "pcap";
-    case SL_PORT_CAPTURE_PCAPNG: return "pcapng";
+    case SLP_CAPTURE_RAW: return "raw";
+    case SLP_CAPTURE_PCAP: return "pcap";
+    case SLP_CAPTURE_PCAPNG: return "pcapng";
     }
     return "unknown";
 }
@@ -160,7 +160,7 @@ const char *sl_port_capture_format_name(sl_port_capture_format_t f)
 // capture from its first byte without the file being reopened (pipes, FIFOs, stdin).
 static ssize_t cookie_read(void *cookie, char *out, size_t size)
 {
-    sl_port_capture_t *c = cookie;
+    slp_capture_t *c = cookie;
     if (c->prefix_pos < c->prefix_len) {
         size_t n = c->prefix_len - c->prefix_pos;
         if (n > size) {
@@ -185,7 +185,7 @@ static ssize_t cookie_read(void *cookie, char *out, size_t size)
 
 static int cookie_close(void *cookie)
 {
-    (void)cookie; // the fd is closed by sl_port_capture_close
+    (void)cookie; // the fd is closed by slp_capture_close
     return 0;
 }
 
@@ -235,12 +235,12 @@ static int64_t sess_covered(const sess_t *s, int64_t a, int64_t b)
 
 static bool sess_full(const sess_t *s, uint32_t len)
 {
-    return s->n_pend + 2 > SL_PORT_CAPTURE_PENDING_SEGS ||
-           s->pend_bytes + len > SL_PORT_CAPTURE_PENDING_MAX;
+    return s->n_pend + 2 > SLP_CAPTURE_PENDING_SEGS ||
+           s->pend_bytes + len > SLP_CAPTURE_PENDING_MAX;
 }
 
 /// Hold the parts of [a, a+len) not held yet (first copy wins), counting differing re-sends.
-static bool sess_insert(sl_port_capture_t *c, sess_t *s, int64_t a, const uint8_t *d, uint32_t len)
+static bool sess_insert(slp_capture_t *c, sess_t *s, int64_t a, const uint8_t *d, uint32_t len)
 {
     int64_t b = a + (int64_t)len;
     size_t i = 0;
@@ -261,7 +261,7 @@ static bool sess_insert(sl_port_capture_t *c, sess_t *s, int64_t a, const uint8_
         if (i < s->n_pend && s->pend[i].a < stop) {
             stop = s->pend[i].a;
         }
-        if (s->n_pend >= SL_PORT_CAPTURE_PENDING_SEGS) {
+        if (s->n_pend >= SLP_CAPTURE_PENDING_SEGS) {
             return false;
         }
         const size_t n = (size_t)(stop - a);
@@ -280,16 +280,16 @@ static bool sess_insert(sl_port_capture_t *c, sess_t *s, int64_t a, const uint8_
     return true;
 }
 
-static void tail_put(sl_port_capture_t *c, int64_t at, const uint8_t *d, size_t n)
+static void tail_put(slp_capture_t *c, int64_t at, const uint8_t *d, size_t n)
 {
-    if (n > SL_PORT_CAPTURE_TAIL) {
-        at += (int64_t)(n - SL_PORT_CAPTURE_TAIL);
-        d += n - SL_PORT_CAPTURE_TAIL;
-        n = SL_PORT_CAPTURE_TAIL;
+    if (n > SLP_CAPTURE_TAIL) {
+        at += (int64_t)(n - SLP_CAPTURE_TAIL);
+        d += n - SLP_CAPTURE_TAIL;
+        n = SLP_CAPTURE_TAIL;
     }
     for (size_t k = 0; k < n;) {
-        const size_t pos = (size_t)((uint64_t)(at + (int64_t)k) % SL_PORT_CAPTURE_TAIL);
-        size_t run = SL_PORT_CAPTURE_TAIL - pos;
+        const size_t pos = (size_t)((uint64_t)(at + (int64_t)k) % SLP_CAPTURE_TAIL);
+        size_t run = SLP_CAPTURE_TAIL - pos;
         if (run > n - k) {
             run = n - k;
         }
@@ -298,10 +298,10 @@ static void tail_put(sl_port_capture_t *c, int64_t at, const uint8_t *d, size_t 
     }
 }
 
-static void set_gap(sl_port_capture_t *c, uint64_t missing)
+static void set_gap(slp_capture_t *c, uint64_t missing)
 {
     c->brk_pending = true;
-    c->brk = (sl_port_capture_piece_t){.kind = SL_PORT_CAPTURE_BREAK, .brk = SL_PORT_CAPTURE_GAP,
+    c->brk = (slp_capture_piece_t){.kind = SLP_CAPTURE_BREAK, .brk = SLP_CAPTURE_GAP,
                                        .output_offset = c->out_off, .missing_bytes = missing,
                                        .stream_offset = (uint64_t)c->sel.cursor,
                                        .session = c->rep.sessions > 0 ? (uint32_t)(c->rep.sessions - 1) : 0u};
@@ -309,9 +309,9 @@ static void set_gap(sl_port_capture_t *c, uint64_t missing)
     c->rep.gap_bytes += missing;
 }
 
-static void data_piece(sl_port_capture_t *c, sl_port_capture_piece_t *pc, const uint8_t *d, size_t n)
+static void data_piece(slp_capture_t *c, slp_capture_piece_t *pc, const uint8_t *d, size_t n)
 {
-    *pc = (sl_port_capture_piece_t){.kind = SL_PORT_CAPTURE_DATA, .data = d, .size = n,
+    *pc = (slp_capture_piece_t){.kind = SLP_CAPTURE_DATA, .data = d, .size = n,
                                     .output_offset = c->out_off};
     c->out_off += n;
     c->rep.stream_bytes += n;
@@ -320,7 +320,7 @@ static void data_piece(sl_port_capture_t *c, sl_port_capture_piece_t *pc, const 
 // ---------------------------------------------------------------------------------------
 // packets
 
-static flow_t *flow_find(sl_port_capture_t *c, const uint8_t *src, const uint8_t *dst, uint8_t alen,
+static flow_t *flow_find(slp_capture_t *c, const uint8_t *src, const uint8_t *dst, uint8_t alen,
                          uint16_t sport, uint16_t dport, bool syn, uint64_t ts, int *idx)
 {
     int found = -1;
@@ -346,7 +346,7 @@ static flow_t *flow_find(sl_port_capture_t *c, const uint8_t *src, const uint8_t
         found = -1;
     }
     if (found < 0) {
-        if (c->n_flows >= SL_PORT_CAPTURE_MAX_FLOWS) {
+        if (c->n_flows >= SLP_CAPTURE_MAX_FLOWS) {
             c->rep.flows_untracked++;
             return NULL;
         }
@@ -366,7 +366,7 @@ static flow_t *flow_find(sl_port_capture_t *c, const uint8_t *src, const uint8_t
 }
 
 /// Count one selected-session segment [a, a+len) against what was seen before.
-static void classify(sl_port_capture_t *c, sess_t *s, int64_t a, const uint8_t *d, uint32_t len)
+static void classify(slp_capture_t *c, sess_t *s, int64_t a, const uint8_t *d, uint32_t len)
 {
     const int64_t b = a + (int64_t)len;
     c->rep.segments++;
@@ -388,17 +388,17 @@ static void classify(sl_port_capture_t *c, sess_t *s, int64_t a, const uint8_t *
         s->max_end = b;
     }
     // Re-sent bytes already delivered: compare with the tail still held.
-    const int64_t lo = a > s->cursor - (int64_t)SL_PORT_CAPTURE_TAIL ? a : s->cursor - (int64_t)SL_PORT_CAPTURE_TAIL;
+    const int64_t lo = a > s->cursor - (int64_t)SLP_CAPTURE_TAIL ? a : s->cursor - (int64_t)SLP_CAPTURE_TAIL;
     const int64_t hi = b < s->cursor ? b : s->cursor;
     for (int64_t k = lo; k < hi; k++) {
         c->rep.retransmit_mismatch_bytes +=
-            c->tail[(uint64_t)k % SL_PORT_CAPTURE_TAIL] != d[k - a] ? 1u : 0u;
+            c->tail[(uint64_t)k % SLP_CAPTURE_TAIL] != d[k - a] ? 1u : 0u;
     }
 }
 
 /// Segment of the selected session. @return 1 with `pc` set (DATA), 0 consumed, -1 retry
 /// after the hole before the held bytes is declared a gap and they are delivered.
-static int sel_segment(sl_port_capture_t *c, sl_port_capture_piece_t *pc)
+static int sel_segment(slp_capture_t *c, slp_capture_piece_t *pc)
 {
     sess_t *s = &c->sel;
     pkt_seg_t *ps = &c->ps;
@@ -451,7 +451,7 @@ static int sel_segment(sl_port_capture_t *c, sl_port_capture_piece_t *pc)
 }
 
 /// Segment of the candidate session: held until it takes over (or is ignored).
-static void cand_segment(sl_port_capture_t *c)
+static void cand_segment(slp_capture_t *c)
 {
     sess_t *s = &c->cand;
     const flow_t *f = &c->flows[s->flow];
@@ -477,7 +477,7 @@ static void cand_segment(sl_port_capture_t *c)
     }
 }
 
-static void pre_free(sl_port_capture_t *c)
+static void pre_free(slp_capture_t *c)
 {
     for (size_t i = 0; i < c->n_pre; i++) {
         free(c->pre[i].data);
@@ -488,7 +488,7 @@ static void pre_free(sl_port_capture_t *c)
 
 /// Before the radar port is known: keep a copy (bounded; beyond, the bytes are lost and
 /// show as a gap or a later start if that flow is the radar's).
-static void pre_store(sl_port_capture_t *c, int flow, int64_t data_rel, const uint8_t *d, size_t n)
+static void pre_store(slp_capture_t *c, int flow, int64_t data_rel, const uint8_t *d, size_t n)
 {
     if (c->pre == NULL || c->n_pre >= PRE_SEGS || c->pre_bytes + n > PRE_BYTES) {
         return;
@@ -503,7 +503,7 @@ static void pre_store(sl_port_capture_t *c, int flow, int64_t data_rel, const ui
 }
 
 /// The radar's flow is known and selected: its payload seen before goes into the session.
-static void pre_replay(sl_port_capture_t *c, int flow, int64_t cur_rel)
+static void pre_replay(slp_capture_t *c, int flow, int64_t cur_rel)
 {
     sess_t *s = &c->sel;
     const flow_t *f = &c->flows[flow];
@@ -551,9 +551,9 @@ static void pre_replay(sl_port_capture_t *c, int flow, int64_t cur_rel)
 
 /// Parse one packet; set c->ps when it carries payload of a session. @return false when
 /// it is not a TCP packet we can use (counted).
-static void on_packet(sl_port_capture_t *c, const struct pcap_pkthdr *h, const uint8_t *p)
+static void on_packet(slp_capture_t *c, const struct pcap_pkthdr *h, const uint8_t *p)
 {
-    sl_port_capture_report_t *rep = &c->rep;
+    slp_capture_report_t *rep = &c->rep;
     rep->packets_total++;
     c->ps.valid = false;
     const size_t cap = h->caplen;
@@ -766,8 +766,8 @@ static void on_packet(sl_port_capture_t *c, const struct pcap_pkthdr *h, const u
         if (!c->sel.active) {
             if (c->rep.sessions > 0) {
                 c->brk_pending = true;
-                c->brk = (sl_port_capture_piece_t){.kind = SL_PORT_CAPTURE_BREAK,
-                                                   .brk = SL_PORT_CAPTURE_NEW_SESSION,
+                c->brk = (slp_capture_piece_t){.kind = SLP_CAPTURE_BREAK,
+                                                   .brk = SLP_CAPTURE_NEW_SESSION,
                                                    .output_offset = c->out_off,
                                                    .session = (uint32_t)c->rep.sessions};
             }
@@ -798,10 +798,10 @@ static void on_packet(sl_port_capture_t *c, const struct pcap_pkthdr *h, const u
 // ---------------------------------------------------------------------------------------
 // public
 
-sl_port_capture_t *sl_port_capture_open(const char *path, const sl_port_capture_opts_t *opts, char *err,
+slp_capture_t *slp_capture_open(const char *path, const slp_capture_opts_t *opts, char *err,
                                         size_t err_size)
 {
-    sl_port_capture_t *c = calloc(1, sizeof *c);
+    slp_capture_t *c = calloc(1, sizeof *c);
     if (c == NULL) {
         snprintf(err, err_size, "%s: out of memory", path);
         return NULL;
@@ -821,10 +821,10 @@ sl_port_capture_t *sl_port_capture_open(const char *path, const sl_port_capture_
         }
         c->own_fd = true;
     }
-    c->buf = malloc(SL_PORT_CAPTURE_CHUNK);
+    c->buf = malloc(SLP_CAPTURE_CHUNK);
     if (c->buf == NULL) {
         snprintf(err, err_size, "%s: out of memory", path);
-        sl_port_capture_close(c);
+        slp_capture_close(c);
         return NULL;
     }
     // A regular file is sniffed with pread (nothing consumed) and, when raw, mapped window
@@ -840,19 +840,19 @@ sl_port_capture_t *sl_port_capture_open(const char *path, const sl_port_capture_
         if (n >= 0 && !pcap_magic) {
             c->mapped = true;
             c->file_size = (uint64_t)st.st_size;
-            c->rep.format = SL_PORT_CAPTURE_RAW;
+            c->rep.format = SLP_CAPTURE_RAW;
             return c;
         }
     }
     // Sniff: read until SNIFF_BYTES are there or the input ends; keep them.
     while (c->prefix_len < SNIFF_BYTES) {
-        const ssize_t n = read(c->fd, c->buf + c->prefix_len, SL_PORT_CAPTURE_CHUNK - c->prefix_len);
+        const ssize_t n = read(c->fd, c->buf + c->prefix_len, SLP_CAPTURE_CHUNK - c->prefix_len);
         if (n < 0 && errno == EINTR) {
             continue;
         }
         if (n < 0) {
             snprintf(err, err_size, "%s: %s", path, strerror(errno));
-            sl_port_capture_close(c);
+            slp_capture_close(c);
             return NULL;
         }
         if (n == 0) {
@@ -860,30 +860,30 @@ sl_port_capture_t *sl_port_capture_open(const char *path, const sl_port_capture_
         }
         c->prefix_len += (size_t)n;
     }
-    c->rep.format = SL_PORT_CAPTURE_RAW;
+    c->rep.format = SLP_CAPTURE_RAW;
     if (c->prefix_len >= 4) {
         const uint8_t *m = c->buf;
         const uint32_t be = be32(m);
         const uint32_t le = (uint32_t)m[3] << 24 | (uint32_t)m[2] << 16 | (uint32_t)m[1] << 8 | m[0];
         if (be == 0xa1b2c3d4u || le == 0xa1b2c3d4u || be == 0xa1b23c4du || le == 0xa1b23c4du) {
-            c->rep.format = SL_PORT_CAPTURE_PCAP;
+            c->rep.format = SLP_CAPTURE_PCAP;
         } else if (be == 0x0a0d0d0au) {
-            c->rep.format = SL_PORT_CAPTURE_PCAPNG;
+            c->rep.format = SLP_CAPTURE_PCAPNG;
         }
     }
-    if (c->rep.format == SL_PORT_CAPTURE_RAW) {
+    if (c->rep.format == SLP_CAPTURE_RAW) {
         return c;
     }
-    c->sel.pend = malloc(SL_PORT_CAPTURE_PENDING_SEGS * sizeof(seg_t));
-    c->cand.pend = malloc(SL_PORT_CAPTURE_PENDING_SEGS * sizeof(seg_t));
-    c->tail = malloc(SL_PORT_CAPTURE_TAIL);
+    c->sel.pend = malloc(SLP_CAPTURE_PENDING_SEGS * sizeof(seg_t));
+    c->cand.pend = malloc(SLP_CAPTURE_PENDING_SEGS * sizeof(seg_t));
+    c->tail = malloc(SLP_CAPTURE_TAIL);
     c->pre = c->opt.port_explicit ? NULL : malloc(PRE_SEGS * sizeof *c->pre);
     c->sel.flow = c->cand.flow = -1;
     const cookie_io_functions_t io = {.read = cookie_read, .close = cookie_close};
     c->fp = (c->sel.pend && c->cand.pend && c->tail) ? fopencookie(c, "r", io) : NULL;
     if (c->fp == NULL) {
         snprintf(err, err_size, "%s: out of memory", path);
-        sl_port_capture_close(c);
+        slp_capture_close(c);
         return NULL;
     }
     char ebuf[PCAP_ERRBUF_SIZE] = {0};
@@ -891,7 +891,7 @@ sl_port_capture_t *sl_port_capture_open(const char *path, const sl_port_capture_
     if (c->pc == NULL) {
         c->fp = NULL; // closed by libpcap on failure
         snprintf(err, err_size, "%s: %s", path, ebuf);
-        sl_port_capture_close(c);
+        slp_capture_close(c);
         return NULL;
     }
     c->dlt = pcap_datalink(c->pc);
@@ -904,16 +904,16 @@ sl_port_capture_t *sl_port_capture_open(const char *path, const sl_port_capture_
     return c;
 }
 
-static void finish(sl_port_capture_t *c, sl_port_capture_piece_t *pc, sl_port_capture_piece_kind_t k)
+static void finish(slp_capture_t *c, slp_capture_piece_t *pc, slp_capture_piece_kind_t k)
 {
     c->finished = true;
     c->final_kind = k;
-    *pc = (sl_port_capture_piece_t){.kind = k, .output_offset = c->out_off};
+    *pc = (slp_capture_piece_t){.kind = k, .output_offset = c->out_off};
 }
 
 #define MAP_WINDOW (16u << 20) // bytes mapped at a time (a multiple of the page size)
 
-static void next_mapped(sl_port_capture_t *c, sl_port_capture_piece_t *pc)
+static void next_mapped(slp_capture_t *c, slp_capture_piece_t *pc)
 {
     if (c->map != NULL) {
         munmap(c->map, c->map_len);
@@ -921,7 +921,7 @@ static void next_mapped(sl_port_capture_t *c, sl_port_capture_piece_t *pc)
         c->map_off += c->map_len;
     }
     if (c->map_off >= c->file_size) {
-        finish(c, pc, SL_PORT_CAPTURE_END);
+        finish(c, pc, SLP_CAPTURE_END);
         return;
     }
     const uint64_t left = c->file_size - c->map_off;
@@ -930,7 +930,7 @@ static void next_mapped(sl_port_capture_t *c, sl_port_capture_piece_t *pc)
     if (c->map == MAP_FAILED) {
         c->map = NULL;
         snprintf(c->err, sizeof c->err, "mmap: %s", strerror(errno));
-        finish(c, pc, SL_PORT_CAPTURE_ERROR);
+        finish(c, pc, SLP_CAPTURE_ERROR);
         return;
     }
     (void)madvise(c->map, c->map_len, MADV_SEQUENTIAL);
@@ -938,7 +938,7 @@ static void next_mapped(sl_port_capture_t *c, sl_port_capture_piece_t *pc)
     data_piece(c, pc, c->map, c->map_len);
 }
 
-static void next_raw(sl_port_capture_t *c, sl_port_capture_piece_t *pc)
+static void next_raw(slp_capture_t *c, slp_capture_piece_t *pc)
 {
     if (c->mapped) {
         next_mapped(c, pc);
@@ -952,17 +952,17 @@ static void next_raw(sl_port_capture_t *c, sl_port_capture_piece_t *pc)
         return;
     }
     for (;;) {
-        const ssize_t n = read(c->fd, c->buf, SL_PORT_CAPTURE_CHUNK);
+        const ssize_t n = read(c->fd, c->buf, SLP_CAPTURE_CHUNK);
         if (n < 0 && errno == EINTR) {
             continue;
         }
         if (n < 0) {
             snprintf(c->err, sizeof c->err, "read error: %s", strerror(errno));
-            finish(c, pc, SL_PORT_CAPTURE_ERROR);
+            finish(c, pc, SLP_CAPTURE_ERROR);
             return;
         }
         if (n == 0) {
-            finish(c, pc, SL_PORT_CAPTURE_END);
+            finish(c, pc, SLP_CAPTURE_END);
             return;
         }
         c->rep.bytes_in += (uint64_t)n;
@@ -971,7 +971,7 @@ static void next_raw(sl_port_capture_t *c, sl_port_capture_piece_t *pc)
     }
 }
 
-static void next_pcap(sl_port_capture_t *c, sl_port_capture_piece_t *pc)
+static void next_pcap(slp_capture_t *c, slp_capture_piece_t *pc)
 {
     free(c->held);
     c->held = NULL;
@@ -1050,8 +1050,8 @@ static void next_pcap(sl_port_capture_t *c, sl_port_capture_piece_t *pc)
                 c->rep.payload_bytes += s->pend[i].len;
             }
             c->brk_pending = true;
-            c->brk = (sl_port_capture_piece_t){.kind = SL_PORT_CAPTURE_BREAK,
-                                               .brk = SL_PORT_CAPTURE_NEW_SESSION,
+            c->brk = (slp_capture_piece_t){.kind = SLP_CAPTURE_BREAK,
+                                               .brk = SLP_CAPTURE_NEW_SESSION,
                                                .output_offset = c->out_off,
                                                .session = (uint32_t)(c->rep.sessions - 1)};
             continue;
@@ -1075,10 +1075,10 @@ static void next_pcap(sl_port_capture_t *c, sl_port_capture_piece_t *pc)
                          (unsigned)c->radar_port,
                          c->opt.port_explicit ? "" : " and no flow carrying Colossus radar messages",
                          c->rep.read_error[0] ? "; read error: " : "", c->rep.read_error);
-                finish(c, pc, SL_PORT_CAPTURE_ERROR);
+                finish(c, pc, SLP_CAPTURE_ERROR);
                 return;
             }
-            finish(c, pc, SL_PORT_CAPTURE_END);
+            finish(c, pc, SLP_CAPTURE_END);
             return;
         }
         struct pcap_pkthdr *h = NULL;
@@ -1099,13 +1099,13 @@ static void next_pcap(sl_port_capture_t *c, sl_port_capture_piece_t *pc)
     }
 }
 
-void sl_port_capture_next(sl_port_capture_t *c, sl_port_capture_piece_t *pc)
+void slp_capture_next(slp_capture_t *c, slp_capture_piece_t *pc)
 {
     if (c->finished) {
-        *pc = (sl_port_capture_piece_t){.kind = c->final_kind, .output_offset = c->out_off};
+        *pc = (slp_capture_piece_t){.kind = c->final_kind, .output_offset = c->out_off};
         return;
     }
-    if (c->rep.format == SL_PORT_CAPTURE_RAW) {
+    if (c->rep.format == SLP_CAPTURE_RAW) {
         next_raw(c, pc);
     } else {
         next_pcap(c, pc);
@@ -1127,7 +1127,7 @@ static void addr_str(char *out, size_t size, const uint8_t *a, uint8_t alen, uin
     }
 }
 
-size_t sl_port_capture_flows(const sl_port_capture_t *c, sl_port_capture_flow_t *out, size_t max)
+size_t slp_capture_flows(const slp_capture_t *c, slp_capture_flow_t *out, size_t max)
 {
     size_t n = 0;
     for (size_t i = 0; i < c->n_flows; i++) {
@@ -1136,7 +1136,7 @@ size_t sl_port_capture_flows(const sl_port_capture_t *c, sl_port_capture_flow_t 
             continue;
         }
         if (n < max) {
-            sl_port_capture_flow_t *o = &out[n];
+            slp_capture_flow_t *o = &out[n];
             memset(o, 0, sizeof *o);
             addr_str(o->src, sizeof o->src, f->src, f->alen, f->sport);
             addr_str(o->dst, sizeof o->dst, f->dst, f->alen, f->dport);
@@ -1154,14 +1154,14 @@ size_t sl_port_capture_flows(const sl_port_capture_t *c, sl_port_capture_flow_t 
     return n;
 }
 
-const sl_port_capture_report_t *sl_port_capture_report(const sl_port_capture_t *c) { return &c->rep; }
+const slp_capture_report_t *slp_capture_report(const slp_capture_t *c) { return &c->rep; }
 
-const char *sl_port_capture_error(const sl_port_capture_t *c) { return c->err; }
+const char *slp_capture_error(const slp_capture_t *c) { return c->err; }
 
-void sl_port_capture_report_line(const sl_port_capture_t *c, char *buf, size_t size)
+void slp_capture_report_line(const slp_capture_t *c, char *buf, size_t size)
 {
-    const sl_port_capture_report_t *r = &c->rep;
-    if (r->format == SL_PORT_CAPTURE_RAW) {
+    const slp_capture_report_t *r = &c->rep;
+    if (r->format == SLP_CAPTURE_RAW) {
         if (size > 0) {
             buf[0] = '\0';
         }
@@ -1179,7 +1179,7 @@ void sl_port_capture_report_line(const sl_port_capture_t *c, char *buf, size_t s
              r->read_error);
 }
 
-void sl_port_capture_close(sl_port_capture_t *c)
+void slp_capture_close(slp_capture_t *c)
 {
     if (c == NULL) {
         return;

@@ -16,7 +16,7 @@
 /// pcapng block type 0a0d0d0a; anything else is raw), which are then handed on, never
 /// re-read (libpcap reads through a stdio stream that first returns them).
 ///
-/// Output: a sequence of pieces, pulled with sl_port_capture_next(): DATA (stream bytes, in
+/// Output: a sequence of pieces, pulled with slp_capture_next(): DATA (stream bytes, in
 /// order), BREAK (bytes are missing here, or a new TCP session starts: a decoder must be
 /// finished before the next DATA so it does not glue two half messages), END, ERROR.
 ///
@@ -25,14 +25,14 @@
 /// so bytes appended later are not read; truncating the file while it is read is not
 /// supported).
 ///
-/// Memory: bounded whatever the capture's size. Raw: one SL_PORT_CAPTURE_CHUNK read
+/// Memory: bounded whatever the capture's size. Raw: one SLP_CAPTURE_CHUNK read
 /// buffer, or one 16 MiB mapped window. Pcap: libpcap's packet buffer, plus out-of-order
-/// segments held until the hole before them fills, at most SL_PORT_CAPTURE_PENDING_MAX
+/// segments held until the hole before them fills, at most SLP_CAPTURE_PENDING_MAX
 /// bytes per reassembled session (the selected one and at most one candidate successor); a
 /// hole still open when that bound is reached is declared a gap. While the radar port is
 /// not known yet (auto-detection), payload is kept (at most 4 MiB) and replayed into the
 /// session of the flow that turns out to be the radar's. Flows are tracked in a fixed
-/// table of SL_PORT_CAPTURE_MAX_FLOWS entries (more are counted, not tracked); late
+/// table of SLP_CAPTURE_MAX_FLOWS entries (more are counted, not tracked); late
 /// packets of a session already reassembled are ignored.
 ///
 /// Differences from reading the whole file first (the host tools' reader before): the
@@ -42,7 +42,7 @@
 ///
 /// Reassembly (same contract as the host tools' reader, streamed): retransmissions (full or
 /// partial) are dropped and counted; re-sent bytes are compared with the first copy when
-/// it is still held (out-of-order store or the last SL_PORT_CAPTURE_TAIL delivered bytes)
+/// it is still held (out-of-order store or the last SLP_CAPTURE_TAIL delivered bytes)
 /// and differences counted; missing bytes are never invented: each hole is a BREAK. A new
 /// radar-side session is taken when the current one has ended (FIN/RST), or when the
 /// current one sends nothing more for as long as the newcomer fills its out-of-order store
@@ -63,47 +63,47 @@
 extern "C" {
 #endif
 
-#define SL_PORT_CAPTURE_CHUNK (1u << 20)        ///< raw read size, bytes
-#define SL_PORT_CAPTURE_PENDING_MAX (8u << 20)  ///< out-of-order bytes held per session
-#define SL_PORT_CAPTURE_PENDING_SEGS 8192u      ///< out-of-order segments held per session
-#define SL_PORT_CAPTURE_TAIL (64u << 10)        ///< delivered bytes kept to compare re-sends
-#define SL_PORT_CAPTURE_MAX_FLOWS 64u           ///< TCP flow directions tracked
+#define SLP_CAPTURE_CHUNK (1u << 20)        ///< raw read size, bytes
+#define SLP_CAPTURE_PENDING_MAX (8u << 20)  ///< out-of-order bytes held per session
+#define SLP_CAPTURE_PENDING_SEGS 8192u      ///< out-of-order segments held per session
+#define SLP_CAPTURE_TAIL (64u << 10)        ///< delivered bytes kept to compare re-sends
+#define SLP_CAPTURE_MAX_FLOWS 64u           ///< TCP flow directions tracked
 
-typedef enum sl_port_capture_format {
-    SL_PORT_CAPTURE_RAW = 0,
-    SL_PORT_CAPTURE_PCAP,
-    SL_PORT_CAPTURE_PCAPNG,
-} sl_port_capture_format_t;
+typedef enum slp_capture_format {
+    SLP_CAPTURE_RAW = 0,
+    SLP_CAPTURE_PCAP,
+    SLP_CAPTURE_PCAPNG,
+} slp_capture_format_t;
 
-typedef enum sl_port_capture_piece_kind {
-    SL_PORT_CAPTURE_DATA = 0,  ///< `data`/`size`: the next stream bytes
-    SL_PORT_CAPTURE_BREAK,     ///< bytes missing (gap) or a new session starts here
-    SL_PORT_CAPTURE_END,       ///< no more pieces
-    SL_PORT_CAPTURE_ERROR,     ///< read error (message in sl_port_capture_error()); no more pieces
-} sl_port_capture_piece_kind_t;
+typedef enum slp_capture_piece_kind {
+    SLP_CAPTURE_DATA = 0,  ///< `data`/`size`: the next stream bytes
+    SLP_CAPTURE_BREAK,     ///< bytes missing (gap) or a new session starts here
+    SLP_CAPTURE_END,       ///< no more pieces
+    SLP_CAPTURE_ERROR,     ///< read error (message in slp_capture_error()); no more pieces
+} slp_capture_piece_kind_t;
 
-typedef enum sl_port_capture_break_kind {
-    SL_PORT_CAPTURE_GAP = 0,
-    SL_PORT_CAPTURE_NEW_SESSION,
-} sl_port_capture_break_kind_t;
+typedef enum slp_capture_break_kind {
+    SLP_CAPTURE_GAP = 0,
+    SLP_CAPTURE_NEW_SESSION,
+} slp_capture_break_kind_t;
 
-/// One piece of the stream. `data` is valid until the next sl_port_capture_next() call.
-typedef struct sl_port_capture_piece {
-    sl_port_capture_piece_kind_t kind;
+/// One piece of the stream. `data` is valid until the next slp_capture_next() call.
+typedef struct slp_capture_piece {
+    slp_capture_piece_kind_t kind;
     const uint8_t *data;
     size_t size;
-    sl_port_capture_break_kind_t brk;  ///< BREAK only
+    slp_capture_break_kind_t brk;  ///< BREAK only
     uint64_t output_offset;            ///< stream offset (bytes delivered so far) of this piece
     uint64_t missing_bytes;            ///< GAP only: bytes absent from the capture
     uint64_t stream_offset;            ///< GAP only: TCP stream offset of the hole (from the
                                        ///< session's first byte, ISN + 1)
     uint32_t session;                  ///< BREAK: index of the session after it (0-based)
-} sl_port_capture_piece_t;
+} slp_capture_piece_t;
 
 /// Everything counted so far (final after END). Counts refer to the reassembled (selected)
 /// direction unless the name says otherwise. Raw captures only fill bytes_in / stream_bytes.
-typedef struct sl_port_capture_report {
-    sl_port_capture_format_t format;
+typedef struct slp_capture_report {
+    slp_capture_format_t format;
     uint64_t bytes_in;              ///< bytes read from the file (every byte counted)
     uint64_t stream_bytes;          ///< bytes delivered as DATA
     char link_type[32];             ///< libpcap DLT name, e.g. "EN10MB"
@@ -124,55 +124,55 @@ typedef struct sl_port_capture_report {
     uint64_t gap_bytes;             ///< bytes missing in those holes (0 when unknowable)
     uint64_t sessions;              ///< radar-side sessions reassembled
     uint64_t flows_ignored;         ///< radar-side sessions overlapping a selected one
-    uint64_t flows_untracked;       ///< flow directions beyond SL_PORT_CAPTURE_MAX_FLOWS
+    uint64_t flows_untracked;       ///< flow directions beyond SLP_CAPTURE_MAX_FLOWS
     bool started_mid_stream;        ///< a selected session has no SYN
     char read_error[256];           ///< libpcap error that ended reading early ("" if none)
-} sl_port_capture_report_t;
+} slp_capture_report_t;
 
-typedef struct sl_port_capture_opts {
+typedef struct slp_capture_opts {
     uint16_t radar_port;  ///< 0 = 6317
     bool port_explicit;   ///< never auto-detect another port
-} sl_port_capture_opts_t;
+} slp_capture_opts_t;
 
-typedef struct sl_port_capture sl_port_capture_t;
+typedef struct slp_capture slp_capture_t;
 
 /// Open `path` ("-" = stdin) and sniff its format. `opts` may be NULL.
 /// @return the reader (malloc'd, bounded: see above), or NULL with `err` set (an
 /// unreadable path, a pcap libpcap rejects). An empty input is a raw capture that ends at once.
-sl_port_capture_t *sl_port_capture_open(const char *path, const sl_port_capture_opts_t *opts,
+slp_capture_t *slp_capture_open(const char *path, const slp_capture_opts_t *opts,
                                         char *err, size_t err_size);
 
 /// The next piece. After END or ERROR every call returns the same kind again.
-void sl_port_capture_next(sl_port_capture_t *c, sl_port_capture_piece_t *piece);
+void slp_capture_next(slp_capture_t *c, slp_capture_piece_t *piece);
 
 /// Counters so far (final after END).
-const sl_port_capture_report_t *sl_port_capture_report(const sl_port_capture_t *c);
+const slp_capture_report_t *slp_capture_report(const slp_capture_t *c);
 
 /// The error message after ERROR ("" otherwise).
-const char *sl_port_capture_error(const sl_port_capture_t *c);
+const char *slp_capture_error(const slp_capture_t *c);
 
 /// One direction of one TCP connection from the radar port (pcap), as tracked so far.
-typedef struct sl_port_capture_flow {
+typedef struct slp_capture_flow {
     char src[64], dst[64];       ///< "addr:port" ("[v6]:port" for IPv6)
     uint64_t packets;            ///< packets of this direction
     uint64_t payload_bytes;      ///< TCP payload bytes captured (with retransmissions)
     uint64_t first_ts_us, last_ts_us; ///< capture timestamps (UNIX microseconds)
     bool syn, fin, rst;
     bool selected;               ///< part of the reassembled stream
-} sl_port_capture_flow_t;
+} slp_capture_flow_t;
 
 /// The radar-side flows that carried payload (pcap), in order of appearance: up to `max`
-/// into `out`. @return their number (may exceed `max`). O(SL_PORT_CAPTURE_MAX_FLOWS).
-size_t sl_port_capture_flows(const sl_port_capture_t *c, sl_port_capture_flow_t *out, size_t max);
+/// into `out`. @return their number (may exceed `max`). O(SLP_CAPTURE_MAX_FLOWS).
+size_t slp_capture_flows(const slp_capture_t *c, slp_capture_flow_t *out, size_t max);
 
 /// "raw", "pcap", "pcapng".
-const char *sl_port_capture_format_name(sl_port_capture_format_t f);
+const char *slp_capture_format_name(slp_capture_format_t f);
 
 /// One line summarising the pcap reassembly ("" for raw), as the daemon logs it.
-void sl_port_capture_report_line(const sl_port_capture_t *c, char *buf, size_t size);
+void slp_capture_report_line(const slp_capture_t *c, char *buf, size_t size);
 
 /// Close the file (not stdin) and free the reader. NULL is allowed.
-void sl_port_capture_close(sl_port_capture_t *c);
+void slp_capture_close(slp_capture_t *c);
 
 #ifdef __cplusplus
 }

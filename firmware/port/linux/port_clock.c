@@ -1,10 +1,10 @@
 // SPDX-License-Identifier: MIT
 // port_clock.c: the Linux port's clock (CLOCK_MONOTONIC, microseconds).
-#include "sl_port_linux.h"
+#include "port_clock.h"
 
 #include <time.h>
 
-uint64_t sl_port_now_us(void)
+uint64_t slp_now_us(void)
 {
     struct timespec ts;
     (void)clock_gettime(CLOCK_MONOTONIC, &ts);

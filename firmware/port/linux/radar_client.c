@@ -12,17 +12,17 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
-#include "sl_port_linux.h"
+#include "port_clock.h"
 
 static uint64_t default_clock(void *ctx)
 {
     (void)ctx;
-    return sl_port_now_us();
+    return slp_now_us();
 }
 
 static uint64_t ms_to_us(uint32_t ms) { return (uint64_t)ms * 1000U; }
 
-void sl_radar_client_cfg_defaults(sl_radar_client_cfg_t *cfg)
+void slp_radar_client_cfg_defaults(slp_radar_client_cfg_t *cfg)
 {
     if (cfg == NULL) {
         return;
@@ -38,34 +38,34 @@ void sl_radar_client_cfg_defaults(sl_radar_client_cfg_t *cfg)
     cfg->backoff_max_ms = 5000;
 }
 
-const char *sl_radar_state_str(sl_radar_state_t s)
+const char *slp_radar_state_str(slp_radar_state_t s)
 {
     switch (s) {
-    case SL_RADAR_IDLE: return "IDLE";
-    case SL_RADAR_BACKOFF: return "BACKOFF";
-    case SL_RADAR_CONNECTING: return "CONNECTING";
-    case SL_RADAR_WAIT_CONFIG: return "WAIT_CONFIG";
-    case SL_RADAR_STREAMING: return "STREAMING";
+    case SLP_RADAR_IDLE: return "IDLE";
+    case SLP_RADAR_BACKOFF: return "BACKOFF";
+    case SLP_RADAR_CONNECTING: return "CONNECTING";
+    case SLP_RADAR_WAIT_CONFIG: return "WAIT_CONFIG";
+    case SLP_RADAR_STREAMING: return "STREAMING";
     }
     return "?";
 }
 
-const char *sl_radar_reason_str(sl_radar_reason_t r)
+const char *slp_radar_reason_str(slp_radar_reason_t r)
 {
     switch (r) {
-    case SL_RADAR_REASON_NONE: return "NONE";
-    case SL_RADAR_REASON_EOF: return "EOF";
-    case SL_RADAR_REASON_ERROR: return "ERROR";
-    case SL_RADAR_REASON_SILENCE: return "SILENCE";
-    case SL_RADAR_REASON_CONFIG_TIMEOUT: return "CONFIG_TIMEOUT";
-    case SL_RADAR_REASON_CONNECT_TIMEOUT: return "CONNECT_TIMEOUT";
-    case SL_RADAR_REASON_STOP: return "STOP";
-    case SL_RADAR_REASON_NO_DATA: return "NO_DATA";
+    case SLP_RADAR_REASON_NONE: return "NONE";
+    case SLP_RADAR_REASON_EOF: return "EOF";
+    case SLP_RADAR_REASON_ERROR: return "ERROR";
+    case SLP_RADAR_REASON_SILENCE: return "SILENCE";
+    case SLP_RADAR_REASON_CONFIG_TIMEOUT: return "CONFIG_TIMEOUT";
+    case SLP_RADAR_REASON_CONNECT_TIMEOUT: return "CONNECT_TIMEOUT";
+    case SLP_RADAR_REASON_STOP: return "STOP";
+    case SLP_RADAR_REASON_NO_DATA: return "NO_DATA";
     }
     return "?";
 }
 
-static void emit(sl_radar_client_t *c, sl_radar_event_t ev, sl_radar_reason_t reason)
+static void emit(slp_radar_client_t *c, slp_radar_event_t ev, slp_radar_reason_t reason)
 {
     if (c->cfg.on_event != NULL) {
         c->cfg.on_event(c->cfg.ctx, ev, reason, c->now_us);
@@ -73,7 +73,7 @@ static void emit(sl_radar_client_t *c, sl_radar_event_t ev, sl_radar_reason_t re
 }
 
 // Queue a bare command header; it is flushed by try_send().
-static void queue_command(sl_radar_client_t *c, uint8_t id)
+static void queue_command(slp_radar_client_t *c, uint8_t id)
 {
     if (c->tx_len + SL_PROTO_HEADER_BYTES > sizeof c->tx) {
         c->stats.tx_overflow++;
@@ -85,7 +85,7 @@ static void queue_command(sl_radar_client_t *c, uint8_t id)
     }
 }
 
-static void close_socket(sl_radar_client_t *c)
+static void close_socket(slp_radar_client_t *c)
 {
     if (c->fd >= 0) {
         (void)close(c->fd);
@@ -98,14 +98,14 @@ static void close_socket(sl_radar_client_t *c)
 }
 
 // Drop the connection (or failed attempt) and schedule the next attempt after the backoff.
-static void drop(sl_radar_client_t *c, sl_radar_event_t ev, sl_radar_reason_t reason)
+static void drop(slp_radar_client_t *c, slp_radar_event_t ev, slp_radar_reason_t reason)
 {
-    const bool was_connected = c->state == SL_RADAR_WAIT_CONFIG || c->state == SL_RADAR_STREAMING;
+    const bool was_connected = c->state == SLP_RADAR_WAIT_CONFIG || c->state == SLP_RADAR_STREAMING;
     close_socket(c);
     if (was_connected) {
         (void)sl_proto_finish(&c->proto);
     }
-    c->state = SL_RADAR_BACKOFF;
+    c->state = SLP_RADAR_BACKOFF;
     c->deadline_us = c->now_us + ms_to_us(c->stats.backoff_ms);
     uint64_t next = (uint64_t)c->stats.backoff_ms * 2U;
     if (next > c->cfg.backoff_max_ms) {
@@ -115,14 +115,14 @@ static void drop(sl_radar_client_t *c, sl_radar_event_t ev, sl_radar_reason_t re
     emit(c, ev, reason);
 }
 
-static void on_socket_error(sl_radar_client_t *c, int err)
+static void on_socket_error(slp_radar_client_t *c, int err)
 {
     c->stats.last_errno = err;
     c->stats.disconnects_error++;
-    drop(c, SL_RADAR_EV_DISCONNECTED, SL_RADAR_REASON_ERROR);
+    drop(c, SLP_RADAR_EV_DISCONNECTED, SLP_RADAR_REASON_ERROR);
 }
 
-static void try_send(sl_radar_client_t *c)
+static void try_send(slp_radar_client_t *c)
 {
     while (c->fd >= 0 && c->tx_len > 0) {
         const ssize_t n = send(c->fd, c->tx, c->tx_len, MSG_NOSIGNAL | MSG_DONTWAIT);
@@ -143,9 +143,9 @@ static void try_send(sl_radar_client_t *c)
     }
 }
 
-static void on_connected(sl_radar_client_t *c)
+static void on_connected(slp_radar_client_t *c)
 {
-    c->state = SL_RADAR_WAIT_CONFIG;
+    c->state = SLP_RADAR_WAIT_CONFIG;
     c->connected_us = c->now_us;
     c->last_rx_us = c->now_us;
     c->have_config = false;
@@ -154,13 +154,13 @@ static void on_connected(sl_radar_client_t *c)
         c->stats.reconnects++;
     }
     c->stats.connects++;
-    emit(c, SL_RADAR_EV_CONNECTED, SL_RADAR_REASON_NONE);
+    emit(c, SLP_RADAR_EV_CONNECTED, SLP_RADAR_REASON_NONE);
 }
 
 // Decoder callback: bookkeeping, handshake, then the application's callback.
 static void on_proto_msg(void *ctx, const sl_proto_msg_t *msg)
 {
-    sl_radar_client_t *c = (sl_radar_client_t *)ctx;
+    slp_radar_client_t *c = (slp_radar_client_t *)ctx;
     c->stats.messages++;
     switch (msg->id) {
     case SL_PROTO_ID_KEEP_ALIVE:
@@ -187,10 +187,10 @@ static void on_proto_msg(void *ctx, const sl_proto_msg_t *msg)
             queue_command(c, c->cfg.non_contour ? (uint8_t)SL_PROTO_ID_START_NONCONTOUR_FFT
                                                 : (uint8_t)SL_PROTO_ID_START_FFT);
             c->stats.starts_sent++;
-            c->state = SL_RADAR_STREAMING;
+            c->state = SLP_RADAR_STREAMING;
             c->last_data_us = c->now_us; // the watchdog measures from Start FFT
         }
-        emit(c, SL_RADAR_EV_CONFIG, SL_RADAR_REASON_NONE);
+        emit(c, SLP_RADAR_EV_CONFIG, SLP_RADAR_REASON_NONE);
         break;
     default:
         break;
@@ -200,7 +200,7 @@ static void on_proto_msg(void *ctx, const sl_proto_msg_t *msg)
     }
 }
 
-sl_err_t sl_radar_client_init(sl_radar_client_t *c, const sl_radar_client_cfg_t *cfg)
+sl_err_t slp_radar_client_init(slp_radar_client_t *c, const slp_radar_client_cfg_t *cfg)
 {
     if (c == NULL || cfg == NULL || cfg->host == NULL || cfg->port == 0U ||
         cfg->backoff_initial_ms == 0U || cfg->backoff_max_ms < cfg->backoff_initial_ms ||
@@ -213,7 +213,7 @@ sl_err_t sl_radar_client_init(sl_radar_client_t *c, const sl_radar_client_cfg_t 
         c->cfg.clock_us = default_clock;
     }
     c->fd = -1;
-    c->state = SL_RADAR_IDLE;
+    c->state = SLP_RADAR_IDLE;
     c->stats.backoff_ms = cfg->backoff_initial_ms;
 
     sl_proto_cfg_t pc;
@@ -238,7 +238,7 @@ sl_err_t sl_radar_client_init(sl_radar_client_t *c, const sl_radar_client_cfg_t 
     if (getaddrinfo(cfg->host, port, &hints, &res) != 0 || res == NULL) {
         return SL_ERR_PORT;
     }
-    for (const struct addrinfo *ai = res; ai != NULL && c->n_addrs < SL_RADAR_MAX_ADDRS; ai = ai->ai_next) {
+    for (const struct addrinfo *ai = res; ai != NULL && c->n_addrs < SLP_RADAR_MAX_ADDRS; ai = ai->ai_next) {
         if (ai->ai_addrlen <= sizeof c->addrs[0]) {
             memcpy(&c->addrs[c->n_addrs], ai->ai_addr, ai->ai_addrlen);
             c->addr_lens[c->n_addrs] = ai->ai_addrlen;
@@ -249,44 +249,44 @@ sl_err_t sl_radar_client_init(sl_radar_client_t *c, const sl_radar_client_cfg_t 
     return c->n_addrs > 0U ? SL_OK : SL_ERR_PORT;
 }
 
-sl_err_t sl_radar_client_start(sl_radar_client_t *c)
+sl_err_t slp_radar_client_start(slp_radar_client_t *c)
 {
     if (c == NULL) {
         return SL_ERR_ARG;
     }
-    if (c->state != SL_RADAR_IDLE) {
+    if (c->state != SLP_RADAR_IDLE) {
         return SL_ERR_STATE;
     }
-    c->state = SL_RADAR_BACKOFF;
+    c->state = SLP_RADAR_BACKOFF;
     c->deadline_us = 0; // the first attempt is due at once
     return SL_OK;
 }
 
-int sl_radar_client_fd(const sl_radar_client_t *c) { return c != NULL ? c->fd : -1; }
+int slp_radar_client_fd(const slp_radar_client_t *c) { return c != NULL ? c->fd : -1; }
 
-short sl_radar_client_events(const sl_radar_client_t *c)
+short slp_radar_client_events(const slp_radar_client_t *c)
 {
     if (c == NULL || c->fd < 0) {
         return 0;
     }
-    if (c->state == SL_RADAR_CONNECTING) {
+    if (c->state == SLP_RADAR_CONNECTING) {
         return POLLOUT;
     }
     return (short)(POLLIN | (c->tx_len > 0U ? POLLOUT : 0));
 }
 
 // Next deadline of the current state, or UINT64_MAX.
-static uint64_t next_deadline(const sl_radar_client_t *c)
+static uint64_t next_deadline(const slp_radar_client_t *c)
 {
     uint64_t d = UINT64_MAX;
     switch (c->state) {
-    case SL_RADAR_IDLE:
+    case SLP_RADAR_IDLE:
         break;
-    case SL_RADAR_BACKOFF:
-    case SL_RADAR_CONNECTING:
+    case SLP_RADAR_BACKOFF:
+    case SLP_RADAR_CONNECTING:
         d = c->deadline_us;
         break;
-    case SL_RADAR_WAIT_CONFIG:
+    case SLP_RADAR_WAIT_CONFIG:
         if (c->cfg.config_request_ms > 0U && !c->config_requested) {
             const uint64_t t = c->connected_us + ms_to_us(c->cfg.config_request_ms);
             d = t < d ? t : d;
@@ -297,12 +297,12 @@ static uint64_t next_deadline(const sl_radar_client_t *c)
         }
         // fall through: the silence timeout applies in both connected states
         /* FALLTHROUGH */
-    case SL_RADAR_STREAMING:
+    case SLP_RADAR_STREAMING:
         if (c->cfg.silence_timeout_ms > 0U) {
             const uint64_t t = c->last_rx_us + ms_to_us(c->cfg.silence_timeout_ms);
             d = t < d ? t : d;
         }
-        if (c->state == SL_RADAR_STREAMING && c->cfg.data_timeout_ms > 0U) {
+        if (c->state == SLP_RADAR_STREAMING && c->cfg.data_timeout_ms > 0U) {
             const uint64_t t = c->last_data_us + ms_to_us(c->cfg.data_timeout_ms);
             d = t < d ? t : d;
         }
@@ -311,7 +311,7 @@ static uint64_t next_deadline(const sl_radar_client_t *c)
     return d;
 }
 
-int sl_radar_client_timeout_ms(const sl_radar_client_t *c, uint64_t now_us)
+int slp_radar_client_timeout_ms(const slp_radar_client_t *c, uint64_t now_us)
 {
     if (c == NULL) {
         return -1;
@@ -327,7 +327,7 @@ int sl_radar_client_timeout_ms(const sl_radar_client_t *c, uint64_t now_us)
     return ms > (uint64_t)INT32_MAX ? INT32_MAX : (int)ms;
 }
 
-static void start_connect(sl_radar_client_t *c)
+static void start_connect(slp_radar_client_t *c)
 {
     const unsigned i = c->next_addr % c->n_addrs;
     c->next_addr = (i + 1U) % c->n_addrs;
@@ -337,14 +337,14 @@ static void start_connect(sl_radar_client_t *c)
     if (fd < 0) {
         c->stats.last_errno = errno;
         c->stats.connect_failures++;
-        c->state = SL_RADAR_CONNECTING; // so that drop() schedules the backoff
-        drop(c, SL_RADAR_EV_CONNECT_FAILED, SL_RADAR_REASON_ERROR);
+        c->state = SLP_RADAR_CONNECTING; // so that drop() schedules the backoff
+        drop(c, SLP_RADAR_EV_CONNECT_FAILED, SLP_RADAR_REASON_ERROR);
         return;
     }
     const int one = 1;
     (void)setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
     c->fd = fd;
-    c->state = SL_RADAR_CONNECTING;
+    c->state = SLP_RADAR_CONNECTING;
     c->deadline_us = c->now_us + ms_to_us(c->cfg.connect_timeout_ms);
     int rc;
     do {
@@ -355,11 +355,11 @@ static void start_connect(sl_radar_client_t *c)
     } else if (errno != EINPROGRESS) {
         c->stats.last_errno = errno;
         c->stats.connect_failures++;
-        drop(c, SL_RADAR_EV_CONNECT_FAILED, SL_RADAR_REASON_ERROR);
+        drop(c, SLP_RADAR_EV_CONNECT_FAILED, SLP_RADAR_REASON_ERROR);
     }
 }
 
-static void do_read(sl_radar_client_t *c)
+static void do_read(slp_radar_client_t *c)
 {
     size_t budget = SL_RADAR_RX_BUDGET;
     while (c->fd >= 0 && budget > 0U) {
@@ -379,7 +379,7 @@ static void do_read(sl_radar_client_t *c)
             }
         } else if (n == 0) {
             c->stats.disconnects_eof++;
-            drop(c, SL_RADAR_EV_DISCONNECTED, SL_RADAR_REASON_EOF);
+            drop(c, SLP_RADAR_EV_DISCONNECTED, SLP_RADAR_REASON_EOF);
             return;
         } else if (errno == EINTR) {
             continue;
@@ -392,7 +392,7 @@ static void do_read(sl_radar_client_t *c)
     }
 }
 
-sl_err_t sl_radar_client_handle(sl_radar_client_t *c, short revents, uint64_t now_us)
+sl_err_t slp_radar_client_handle(slp_radar_client_t *c, short revents, uint64_t now_us)
 {
     if (c == NULL) {
         return SL_ERR_ARG;
@@ -401,7 +401,7 @@ sl_err_t sl_radar_client_handle(sl_radar_client_t *c, short revents, uint64_t no
     c->stats.handle_calls++;
 
     if (c->fd >= 0 && revents != 0) {
-        if (c->state == SL_RADAR_CONNECTING) {
+        if (c->state == SLP_RADAR_CONNECTING) {
             int err = 0;
             socklen_t len = sizeof err;
             if (getsockopt(c->fd, SOL_SOCKET, SO_ERROR, &err, &len) < 0) {
@@ -412,7 +412,7 @@ sl_err_t sl_radar_client_handle(sl_radar_client_t *c, short revents, uint64_t no
             } else if (err != 0 || (revents & (POLLERR | POLLHUP)) != 0) {
                 c->stats.last_errno = err != 0 ? err : ECONNREFUSED;
                 c->stats.connect_failures++;
-                drop(c, SL_RADAR_EV_CONNECT_FAILED, SL_RADAR_REASON_ERROR);
+                drop(c, SLP_RADAR_EV_CONNECT_FAILED, SLP_RADAR_REASON_ERROR);
             }
         } else {
             if ((revents & (POLLIN | POLLHUP | POLLERR)) != 0) {
@@ -426,24 +426,24 @@ sl_err_t sl_radar_client_handle(sl_radar_client_t *c, short revents, uint64_t no
 
     // Timers.
     switch (c->state) {
-    case SL_RADAR_IDLE:
+    case SLP_RADAR_IDLE:
         break;
-    case SL_RADAR_BACKOFF:
+    case SLP_RADAR_BACKOFF:
         if (now_us >= c->deadline_us) {
             start_connect(c);
         }
         break;
-    case SL_RADAR_CONNECTING:
+    case SLP_RADAR_CONNECTING:
         if (now_us >= c->deadline_us) {
             c->stats.connect_timeouts++;
-            drop(c, SL_RADAR_EV_CONNECT_FAILED, SL_RADAR_REASON_CONNECT_TIMEOUT);
+            drop(c, SLP_RADAR_EV_CONNECT_FAILED, SLP_RADAR_REASON_CONNECT_TIMEOUT);
         }
         break;
-    case SL_RADAR_WAIT_CONFIG:
+    case SLP_RADAR_WAIT_CONFIG:
         if (c->cfg.config_timeout_ms > 0U &&
             now_us >= c->connected_us + ms_to_us(c->cfg.config_timeout_ms)) {
             c->stats.config_timeouts++;
-            drop(c, SL_RADAR_EV_DISCONNECTED, SL_RADAR_REASON_CONFIG_TIMEOUT);
+            drop(c, SLP_RADAR_EV_DISCONNECTED, SLP_RADAR_REASON_CONFIG_TIMEOUT);
             break;
         }
         if (c->cfg.config_request_ms > 0U && !c->config_requested &&
@@ -454,14 +454,14 @@ sl_err_t sl_radar_client_handle(sl_radar_client_t *c, short revents, uint64_t no
             try_send(c);
         }
         /* FALLTHROUGH */
-    case SL_RADAR_STREAMING:
+    case SLP_RADAR_STREAMING:
         if (c->fd >= 0 && c->cfg.silence_timeout_ms > 0U &&
             now_us >= c->last_rx_us + ms_to_us(c->cfg.silence_timeout_ms)) {
             c->stats.silence_timeouts++;
-            drop(c, SL_RADAR_EV_DISCONNECTED, SL_RADAR_REASON_SILENCE);
+            drop(c, SLP_RADAR_EV_DISCONNECTED, SLP_RADAR_REASON_SILENCE);
             break;
         }
-        if (c->fd >= 0 && c->state == SL_RADAR_STREAMING && c->cfg.data_timeout_ms > 0U &&
+        if (c->fd >= 0 && c->state == SLP_RADAR_STREAMING && c->cfg.data_timeout_ms > 0U &&
             now_us >= c->last_data_us + ms_to_us(c->cfg.data_timeout_ms)) {
             if (!c->data_restarted) {
                 // Bytes but no usable rows: ask for the data again, once.
@@ -474,7 +474,7 @@ sl_err_t sl_radar_client_handle(sl_radar_client_t *c, short revents, uint64_t no
                 try_send(c);
             } else {
                 c->stats.data_timeouts++;
-                drop(c, SL_RADAR_EV_DISCONNECTED, SL_RADAR_REASON_NO_DATA);
+                drop(c, SLP_RADAR_EV_DISCONNECTED, SLP_RADAR_REASON_NO_DATA);
             }
         }
         break;
@@ -482,22 +482,22 @@ sl_err_t sl_radar_client_handle(sl_radar_client_t *c, short revents, uint64_t no
     return SL_OK;
 }
 
-sl_err_t sl_radar_client_poll(sl_radar_client_t *c, int timeout_ms)
+sl_err_t slp_radar_client_poll(slp_radar_client_t *c, int timeout_ms)
 {
     if (c == NULL) {
         return SL_ERR_ARG;
     }
-    if (c->state == SL_RADAR_IDLE) {
+    if (c->state == SLP_RADAR_IDLE) {
         return SL_ERR_STATE;
     }
     const uint64_t t0 = c->cfg.clock_us(c->cfg.ctx);
-    int t = sl_radar_client_timeout_ms(c, t0);
+    int t = slp_radar_client_timeout_ms(c, t0);
     if (timeout_ms >= 0 && (t < 0 || timeout_ms < t)) {
         t = timeout_ms;
     }
     struct pollfd pfd;
     pfd.fd = c->fd;
-    pfd.events = sl_radar_client_events(c);
+    pfd.events = slp_radar_client_events(c);
     pfd.revents = 0;
     const int rc = poll(&pfd, c->fd >= 0 ? 1U : 0U, t);
     if (rc < 0) {
@@ -507,16 +507,16 @@ sl_err_t sl_radar_client_poll(sl_radar_client_t *c, int timeout_ms)
         c->stats.last_errno = errno;
         return SL_ERR_PORT;
     }
-    return sl_radar_client_handle(c, rc > 0 ? pfd.revents : 0, c->cfg.clock_us(c->cfg.ctx));
+    return slp_radar_client_handle(c, rc > 0 ? pfd.revents : 0, c->cfg.clock_us(c->cfg.ctx));
 }
 
-sl_err_t sl_radar_client_stop(sl_radar_client_t *c, uint32_t linger_ms)
+sl_err_t slp_radar_client_stop(slp_radar_client_t *c, uint32_t linger_ms)
 {
     if (c == NULL) {
         return SL_ERR_ARG;
     }
     c->now_us = c->cfg.clock_us(c->cfg.ctx);
-    if (c->fd >= 0 && c->state == SL_RADAR_STREAMING) {
+    if (c->fd >= 0 && c->state == SLP_RADAR_STREAMING) {
         queue_command(c, (uint8_t)SL_PROTO_ID_STOP_FFT);
         c->stats.stops_sent++;
         const uint64_t end = c->now_us + ms_to_us(linger_ms);
@@ -538,22 +538,22 @@ sl_err_t sl_radar_client_stop(sl_radar_client_t *c, uint32_t linger_ms)
             (void)shutdown(c->fd, SHUT_WR);
         }
     }
-    const bool was_connected = c->state == SL_RADAR_WAIT_CONFIG || c->state == SL_RADAR_STREAMING;
+    const bool was_connected = c->state == SLP_RADAR_WAIT_CONFIG || c->state == SLP_RADAR_STREAMING;
     close_socket(c);
     if (was_connected) {
         (void)sl_proto_finish(&c->proto);
     }
-    const bool was_idle = c->state == SL_RADAR_IDLE;
-    c->state = SL_RADAR_IDLE;
+    const bool was_idle = c->state == SLP_RADAR_IDLE;
+    c->state = SLP_RADAR_IDLE;
     if (!was_idle) {
-        emit(c, SL_RADAR_EV_STOPPED, SL_RADAR_REASON_STOP);
+        emit(c, SLP_RADAR_EV_STOPPED, SLP_RADAR_REASON_STOP);
     }
     return SL_OK;
 }
 
-void sl_radar_client_deinit(sl_radar_client_t *c)
+void slp_radar_client_deinit(slp_radar_client_t *c)
 {
     if (c != NULL) {
-        (void)sl_radar_client_stop(c, 0);
+        (void)slp_radar_client_stop(c, 0);
     }
 }

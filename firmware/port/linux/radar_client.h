@@ -16,35 +16,35 @@
 ///   holds at least one bin) arrived for `data_timeout_ms` (keep-alives only, a byte
 ///   trickle, malformed FFT messages), sends Start FFT again once (`stats.data_restarts`);
 ///   if still nothing usable after another `data_timeout_ms`, drops the connection
-///   (`SL_RADAR_REASON_NO_DATA`, `stats.data_timeouts`) and reconnects with the backoff;
+///   (`SLP_RADAR_REASON_NO_DATA`, `stats.data_timeouts`) and reconnects with the backoff;
 /// - treats a silent radar (no byte at all, keep-alives included, for `silence_timeout_ms`),
 ///   EOF, socket errors and connect failures alike: close, `sl_proto_finish()` (a partial
 ///   message is counted as truncated), event, then reconnect after a backoff that starts at
 ///   `backoff_initial_ms` and doubles up to `backoff_max_ms`; the backoff returns to its
 ///   initial value each time a usable FFT message arrives (a healthy session; a radar that
 ///   only sends its Configuration and keep-alives keeps backing off);
-/// - on `sl_radar_client_stop()`, sends Stop FFT (22) when streaming and closes.
+/// - on `slp_radar_client_stop()`, sends Stop FFT (22) when streaming and closes.
 /// Everything is counted in `stats` (and the decoder's `proto.stats`).
 ///
 /// ## Two ways to drive it
-/// - Simple: `sl_radar_client_poll(c, timeout_ms)` blocks in poll() for at most
+/// - Simple: `slp_radar_client_poll(c, timeout_ms)` blocks in poll() for at most
 ///   `timeout_ms` (or until the client's own next deadline) and does all the work; time
 ///   comes from `cfg.clock_us` (default CLOCK_MONOTONIC).
-/// - Inside your own poll loop: put `sl_radar_client_fd()` with
-///   `sl_radar_client_events()` in your pollfd set (skip it when the fd is -1), bound your
-///   timeout by `sl_radar_client_timeout_ms()`, then call `sl_radar_client_handle(c,
+/// - Inside your own poll loop: put `slp_radar_client_fd()` with
+///   `slp_radar_client_events()` in your pollfd set (skip it when the fd is -1), bound your
+///   timeout by `slp_radar_client_timeout_ms()`, then call `slp_radar_client_handle(c,
 ///   revents, now_us)` every time round (revents 0 when the fd was not ready): it also runs
 ///   the timers. Time is whatever `now_us` you pass (monotonic microseconds).
 ///
 /// ## Memory and cost
-/// `sl_radar_client_t` is caller-allocated (about 70 KB with its receive buffer; static is
+/// `slp_radar_client_t` is caller-allocated (about 70 KB with its receive buffer; static is
 /// fine). The decoder's reassembly buffer is the caller's (`cfg.reasm_buf`, borrowed until
-/// `sl_radar_client_deinit`). No allocation after init. Per handle call: at most
+/// `slp_radar_client_deinit`). No allocation after init. Per handle call: at most
 /// `SL_RADAR_RX_BUDGET` bytes are read (so one busy radar cannot starve the caller's other
 /// fds), O(bytes) decoding. Not thread-safe; callbacks must not call back into the same
-/// client except `sl_radar_client_stats()`-style reads.
-#ifndef SHADOWLEAN_RADAR_CLIENT_H
-#define SHADOWLEAN_RADAR_CLIENT_H
+/// client except `slp_radar_client_stats()`-style reads.
+#ifndef SHADOWLEAN_PORT_RADAR_CLIENT_H
+#define SHADOWLEAN_PORT_RADAR_CLIENT_H
 
 #include <stdbool.h>
 #include <stddef.h>
@@ -61,54 +61,54 @@ extern "C" {
 
 /// Bytes read per recv() call (the receive buffer inside the client).
 #define SL_RADAR_RX_CHUNK 65536U
-/// Bytes read at most per sl_radar_client_handle() call.
+/// Bytes read at most per slp_radar_client_handle() call.
 #define SL_RADAR_RX_BUDGET (8U * SL_RADAR_RX_CHUNK)
 /// Addresses kept from name resolution; connection attempts cycle through them.
-#define SL_RADAR_MAX_ADDRS 4U
+#define SLP_RADAR_MAX_ADDRS 4U
 
 /// Connection state.
-typedef enum sl_radar_state {
-    SL_RADAR_IDLE = 0,        ///< not started, or stopped
-    SL_RADAR_BACKOFF = 1,     ///< waiting before the next connection attempt
-    SL_RADAR_CONNECTING = 2,  ///< non-blocking connect() in progress
-    SL_RADAR_WAIT_CONFIG = 3, ///< connected, waiting for the Configuration (10)
-    SL_RADAR_STREAMING = 4,   ///< Start FFT sent; FFT data expected
-} sl_radar_state_t;
+typedef enum slp_radar_state {
+    SLP_RADAR_IDLE = 0,        ///< not started, or stopped
+    SLP_RADAR_BACKOFF = 1,     ///< waiting before the next connection attempt
+    SLP_RADAR_CONNECTING = 2,  ///< non-blocking connect() in progress
+    SLP_RADAR_WAIT_CONFIG = 3, ///< connected, waiting for the Configuration (10)
+    SLP_RADAR_STREAMING = 4,   ///< Start FFT sent; FFT data expected
+} slp_radar_state_t;
 
 /// What happened (second argument of `on_event`).
-typedef enum sl_radar_event {
-    SL_RADAR_EV_CONNECTED = 0,       ///< TCP connected
-    SL_RADAR_EV_CONFIG = 1,          ///< Configuration received (Start FFT queued if first)
-    SL_RADAR_EV_DISCONNECTED = 2,    ///< connection closed; `reason` says why
-    SL_RADAR_EV_CONNECT_FAILED = 3,  ///< connect() failed or timed out; `reason` says which
-    SL_RADAR_EV_STOPPED = 4,         ///< sl_radar_client_stop() closed the connection
-} sl_radar_event_t;
+typedef enum slp_radar_event {
+    SLP_RADAR_EV_CONNECTED = 0,       ///< TCP connected
+    SLP_RADAR_EV_CONFIG = 1,          ///< Configuration received (Start FFT queued if first)
+    SLP_RADAR_EV_DISCONNECTED = 2,    ///< connection closed; `reason` says why
+    SLP_RADAR_EV_CONNECT_FAILED = 3,  ///< connect() failed or timed out; `reason` says which
+    SLP_RADAR_EV_STOPPED = 4,         ///< slp_radar_client_stop() closed the connection
+} slp_radar_event_t;
 
 /// Why a connection ended or failed.
-typedef enum sl_radar_reason {
-    SL_RADAR_REASON_NONE = 0,
-    SL_RADAR_REASON_EOF = 1,             ///< the radar closed the connection
-    SL_RADAR_REASON_ERROR = 2,           ///< recv/send/connect error (`stats.last_errno`)
-    SL_RADAR_REASON_SILENCE = 3,         ///< nothing received for silence_timeout_ms
-    SL_RADAR_REASON_CONFIG_TIMEOUT = 4,  ///< no Configuration within config_timeout_ms
-    SL_RADAR_REASON_CONNECT_TIMEOUT = 5, ///< connect() not done within connect_timeout_ms
-    SL_RADAR_REASON_STOP = 6,            ///< the application stopped the client
-    SL_RADAR_REASON_NO_DATA = 7,         ///< bytes but no usable FFT row (data watchdog)
-} sl_radar_reason_t;
+typedef enum slp_radar_reason {
+    SLP_RADAR_REASON_NONE = 0,
+    SLP_RADAR_REASON_EOF = 1,             ///< the radar closed the connection
+    SLP_RADAR_REASON_ERROR = 2,           ///< recv/send/connect error (`stats.last_errno`)
+    SLP_RADAR_REASON_SILENCE = 3,         ///< nothing received for silence_timeout_ms
+    SLP_RADAR_REASON_CONFIG_TIMEOUT = 4,  ///< no Configuration within config_timeout_ms
+    SLP_RADAR_REASON_CONNECT_TIMEOUT = 5, ///< connect() not done within connect_timeout_ms
+    SLP_RADAR_REASON_STOP = 6,            ///< the application stopped the client
+    SLP_RADAR_REASON_NO_DATA = 7,         ///< bytes but no usable FFT row (data watchdog)
+} slp_radar_reason_t;
 
 /// Decoded message callback: same contract as `sl_proto_on_msg_fn` (the message and its
 /// payload are valid until the callback returns). `now_us` is the time of the handle call.
-typedef void (*sl_radar_on_msg_fn)(void *ctx, const sl_proto_msg_t *msg, uint64_t now_us);
+typedef void (*slp_radar_on_msg_fn)(void *ctx, const sl_proto_msg_t *msg, uint64_t now_us);
 /// Raw bytes exactly as received, before decoding (for recording). Valid during the call.
-typedef void (*sl_radar_on_bytes_fn)(void *ctx, const uint8_t *data, size_t len, uint64_t now_us);
+typedef void (*slp_radar_on_bytes_fn)(void *ctx, const uint8_t *data, size_t len, uint64_t now_us);
 /// State event (connected, config, disconnected with reason, ...).
-typedef void (*sl_radar_on_event_fn)(void *ctx, sl_radar_event_t ev, sl_radar_reason_t reason,
+typedef void (*slp_radar_on_event_fn)(void *ctx, slp_radar_event_t ev, slp_radar_reason_t reason,
                                      uint64_t now_us);
 /// Clock: monotonic microseconds.
-typedef uint64_t (*sl_radar_clock_fn)(void *ctx);
+typedef uint64_t (*slp_radar_clock_fn)(void *ctx);
 
-/// Configuration. Start from sl_radar_client_cfg_defaults(), then set host/port/callbacks.
-typedef struct sl_radar_client_cfg {
+/// Configuration. Start from slp_radar_client_cfg_defaults(), then set host/port/callbacks.
+typedef struct slp_radar_client_cfg {
     const char *host;              ///< name or numeric address (resolved once, at init)
     uint16_t port;                 ///< TCP port (radar default 6317)
     uint32_t connect_timeout_ms;   ///< default 2000
@@ -122,15 +122,15 @@ typedef struct sl_radar_client_cfg {
     uint8_t *reasm_buf;            ///< decoder reassembly buffer (caller-owned, borrowed)
     size_t reasm_size;             ///< its size: the largest payload accepted
     uint32_t max_payload_bytes;    ///< board limit; 0 = reasm_size
-    sl_radar_on_msg_fn on_msg;     ///< optional
-    sl_radar_on_bytes_fn on_bytes; ///< optional (raw tap)
-    sl_radar_on_event_fn on_event; ///< optional
-    sl_radar_clock_fn clock_us;    ///< optional; NULL = sl_port_now_us (CLOCK_MONOTONIC)
+    slp_radar_on_msg_fn on_msg;     ///< optional
+    slp_radar_on_bytes_fn on_bytes; ///< optional (raw tap)
+    slp_radar_on_event_fn on_event; ///< optional
+    slp_radar_clock_fn clock_us;    ///< optional; NULL = slp_now_us (CLOCK_MONOTONIC)
     void *ctx;                     ///< passed to every callback
-} sl_radar_client_cfg_t;
+} slp_radar_client_cfg_t;
 
 /// Counters since init. Read-only to the application.
-typedef struct sl_radar_client_stats {
+typedef struct slp_radar_client_stats {
     uint32_t connect_attempts;  ///< socket()+connect() started
     uint32_t connects;          ///< TCP connections established
     uint32_t connect_failures;  ///< connect refused/unreachable/other error
@@ -152,22 +152,22 @@ typedef struct sl_radar_client_stats {
     uint32_t messages;          ///< all decoded messages
     uint32_t tx_would_block;    ///< send() returned EAGAIN (command kept and retried)
     uint32_t tx_overflow;       ///< a command did not fit the transmit buffer (dropped)
-    uint32_t handle_calls;      ///< sl_radar_client_handle() calls (wake-ups)
+    uint32_t handle_calls;      ///< slp_radar_client_handle() calls (wake-ups)
     uint64_t bytes_rx;          ///< bytes received
     uint64_t bytes_tx;          ///< bytes sent
     int last_errno;             ///< errno of the last socket error (0 = none)
     uint32_t backoff_ms;        ///< backoff that the next failure will use
-} sl_radar_client_stats_t;
+} slp_radar_client_stats_t;
 
 /// Client instance. Caller-allocated; fields read-only to the application.
-typedef struct sl_radar_client {
-    sl_radar_client_cfg_t cfg;
+typedef struct slp_radar_client {
+    slp_radar_client_cfg_t cfg;
     sl_proto_t proto;                  ///< core decoder (its stats are readable)
-    sl_radar_client_stats_t stats;
-    sl_radar_state_t state;
+    slp_radar_client_stats_t stats;
+    slp_radar_state_t state;
     int fd;                            ///< socket, -1 when none
-    struct sockaddr_storage addrs[SL_RADAR_MAX_ADDRS];
-    socklen_t addr_lens[SL_RADAR_MAX_ADDRS];
+    struct sockaddr_storage addrs[SLP_RADAR_MAX_ADDRS];
+    socklen_t addr_lens[SLP_RADAR_MAX_ADDRS];
     unsigned n_addrs;
     unsigned next_addr;
     uint64_t deadline_us;              ///< backoff end / connect timeout (state-dependent)
@@ -182,57 +182,57 @@ typedef struct sl_radar_client {
     size_t tx_len;                     ///< bytes pending in tx
     uint8_t tx[8U * SL_PROTO_HEADER_BYTES];
     uint8_t rx[SL_RADAR_RX_CHUNK];
-} sl_radar_client_t;
+} slp_radar_client_t;
 
 /// Fill `cfg` with the defaults listed above (host NULL, port 6317, no callbacks).
-void sl_radar_client_cfg_defaults(sl_radar_client_cfg_t *cfg);
+void slp_radar_client_cfg_defaults(slp_radar_client_cfg_t *cfg);
 
 /// Initialise: copies cfg, resolves cfg->host (getaddrinfo: may block once for a name,
 /// never for a numeric address), inits the decoder. State IDLE; nothing connects yet.
 /// @return SL_OK; SL_ERR_ARG (NULL, no host, port 0, bad timeouts/backoff, NULL reasm_buf
 /// with reasm_size > 0); SL_ERR_PORT (name resolution failed).
-sl_err_t sl_radar_client_init(sl_radar_client_t *c, const sl_radar_client_cfg_t *cfg);
+sl_err_t slp_radar_client_init(slp_radar_client_t *c, const slp_radar_client_cfg_t *cfg);
 
 /// Start connecting (the first attempt happens at the next handle/poll call).
 /// @return SL_OK, SL_ERR_ARG, SL_ERR_STATE (already started).
-sl_err_t sl_radar_client_start(sl_radar_client_t *c);
+sl_err_t slp_radar_client_start(slp_radar_client_t *c);
 
 /// The socket to poll, or -1 (no connection: only timers are pending).
-int sl_radar_client_fd(const sl_radar_client_t *c);
+int slp_radar_client_fd(const slp_radar_client_t *c);
 
 /// poll() events wanted on the fd: POLLIN, plus POLLOUT while connecting or while a
 /// command is waiting to be sent. 0 when fd is -1.
-short sl_radar_client_events(const sl_radar_client_t *c);
+short slp_radar_client_events(const slp_radar_client_t *c);
 
 /// Milliseconds until the client's next deadline (rounded up), 0 if due, -1 if none.
-int sl_radar_client_timeout_ms(const sl_radar_client_t *c, uint64_t now_us);
+int slp_radar_client_timeout_ms(const slp_radar_client_t *c, uint64_t now_us);
 
 /// Do the work: I/O according to `revents` (0 = fd not ready), then the timers (connect
 /// timeout, silence, config request/timeout, backoff -> connect). Never blocks.
 /// @return SL_OK or SL_ERR_ARG. Connection problems are not errors: they are counted and
 /// reported through on_event.
-sl_err_t sl_radar_client_handle(sl_radar_client_t *c, short revents, uint64_t now_us);
+sl_err_t slp_radar_client_handle(slp_radar_client_t *c, short revents, uint64_t now_us);
 
 /// Convenience loop step: poll() on the client's fd for at most `timeout_ms` (shortened to
-/// the next deadline; -1 = until something happens), then sl_radar_client_handle() with the
+/// the next deadline; -1 = until something happens), then slp_radar_client_handle() with the
 /// configured clock. EINTR returns SL_OK early (check your stop flag).
 /// @return SL_OK, SL_ERR_ARG, SL_ERR_STATE (idle), SL_ERR_PORT (poll() failed).
-sl_err_t sl_radar_client_poll(sl_radar_client_t *c, int timeout_ms);
+sl_err_t slp_radar_client_poll(slp_radar_client_t *c, int timeout_ms);
 
 /// Stop: when streaming, send Stop FFT (22), waiting at most `linger_ms` for the socket to
-/// take it; then close. State IDLE (sl_radar_client_start() may be called again).
+/// take it; then close. State IDLE (slp_radar_client_start() may be called again).
 /// @return SL_OK, SL_ERR_ARG.
-sl_err_t sl_radar_client_stop(sl_radar_client_t *c, uint32_t linger_ms);
+sl_err_t slp_radar_client_stop(slp_radar_client_t *c, uint32_t linger_ms);
 
 /// Stop (without linger) and release nothing else: the client owns no heap memory.
-void sl_radar_client_deinit(sl_radar_client_t *c);
+void slp_radar_client_deinit(slp_radar_client_t *c);
 
 /// Short constant names for logs: "IDLE", "EOF", ...
-const char *sl_radar_state_str(sl_radar_state_t s);
-const char *sl_radar_reason_str(sl_radar_reason_t r);
+const char *slp_radar_state_str(slp_radar_state_t s);
+const char *slp_radar_reason_str(slp_radar_reason_t r);
 
 #ifdef __cplusplus
 }
 #endif
 
-#endif // SHADOWLEAN_RADAR_CLIENT_H
+#endif // SHADOWLEAN_PORT_RADAR_CLIENT_H

@@ -412,7 +412,7 @@ void test_calib_file_geom_equals_sl_make_geom()
     for (double beta : {0.0, 3.0, -5.0, 12.5}) {
         for (int c = 100; c <= 6000; c++) {
             const double theta = c / 100.0;
-            const sl_incline_geom_t a = calib_make_geom(theta, beta);
+            const sl_incline_geom_t a = slp_calib_make_geom(theta, beta);
             const sl_incline_geom_t b = sl::make_geom(theta, beta);
             n++;
             if (std::memcmp(&a, &b, sizeof a) != 0) {
@@ -420,7 +420,7 @@ void test_calib_file_geom_equals_sl_make_geom()
             }
         }
     }
-    std::printf("calib_make_geom vs sl::make_geom: %ld entries, %ld differ\n", n, diff);
+    std::printf("slp_calib_make_geom vs sl::make_geom: %ld entries, %ld differ\n", n, diff);
     CHECK(n == 4 * 5901, "entries %ld", n);
     CHECK(diff == 0, "%ld entries differ", diff);
 }

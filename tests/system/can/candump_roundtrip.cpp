@@ -160,7 +160,7 @@ int main(int argc, char **argv)
     std::vector<sl::CandumpRecord> sent;
     sl::CandumpWriter w;
     w.open(argv[1], "vcan0");
-    const sl_can_sink_t sink = w.sink();
+    const slp_can_sink_t sink = w.sink();
     std::ofstream ex(argv[2]);
     uint64_t t = 1700000000000000ULL;
     for (long i = 0; i < n; i++) {
@@ -202,7 +202,7 @@ int main(int argc, char **argv)
         ex << "\n";
     }
     sink.poll(sink.ctx, t);
-    sl_can_sink_stats_t st{};
+    slp_can_sink_stats_t st{};
     sink.get_stats(sink.ctx, &st);
     CHECK(st.sent == static_cast<uint32_t>(n) && st.dropped == 0 && st.errors == 0);
     w.close();

@@ -37,7 +37,7 @@
 #include <unistd.h>
 
 #include "can_sink.h"
-#include "can_socketcan.h"
+#include "socketcan.h"
 #include "candump_log.h"
 #include "sl_board_spec.h"
 #include "shadowlean/sl_can.h"
@@ -75,9 +75,9 @@ void on_sent(void *user, const sl_can_frame_t *f, uint64_t t_us)
     static_cast<sl::CandumpWriter *>(user)->write(*f, t_us);
 }
 
-void print_stats(const char *phase, const sl_can_socketcan_t &s)
+void print_stats(const char *phase, const slp_socketcan_t &s)
 {
-    const sl_can_socketcan_stats_t &st = s.stats;
+    const slp_socketcan_stats_t &st = s.stats;
     std::printf("[%s] sent %u retries %u (eagain %u enobufs %u) dropped: full %u stale %u down %u "
                 "bus_off %u error %u | link down %u up %u reopens %u | error frames %u bus_off %u "
                 "timeouts %u restarts %u passive %u | queued %u\n",
@@ -179,10 +179,10 @@ struct Injector {
 };
 
 // Poll until `done()` or about a second passed (softirq delivery is asynchronous).
-template <class F> bool poll_until(sl_can_socketcan_t *s, F done)
+template <class F> bool poll_until(slp_socketcan_t *s, F done)
 {
     for (int i = 0; i < 1000; i++) {
-        sl_can_socketcan_poll(s, tick(1));
+        slp_socketcan_poll(s, tick(1));
         if (done()) {
             return true;
         }
@@ -229,28 +229,28 @@ int main(int argc, char **argv)
     produced.open(out + "/produced_a.log", iface);
     sent_log.open(out + "/sent.log", iface);
 
-    sl_can_socketcan_cfg_t cfg = sl_can_socketcan_default_cfg();
+    slp_socketcan_cfg_t cfg = slp_socketcan_default_cfg();
     cfg.queue_cap = 8;
     cfg.max_age_us = 0;
     cfg.on_sent = on_sent;
     cfg.on_sent_user = &sent_log;
-    sl_can_socketcan_t s;
-    const sl_err_t oe = sl_can_socketcan_open(&s, ifn, &cfg);
+    slp_socketcan_t s;
+    const sl_err_t oe = slp_socketcan_open(&s, ifn, &cfg);
     if (oe != SL_OK) {
         std::cerr << "open " << iface << ": " << std::strerror(s.last_errno) << "\n";
         return 1;
     }
-    const sl_can_sink_t sinks[2] = {sl_can_socketcan_sink(&s), produced.sink()};
+    const slp_can_sink_t sinks[2] = {slp_socketcan_sink(&s), produced.sink()};
 
     // --- A: plain stream to both sinks
     for (long i = 0; i < n; i++) {
         const sl_can_frame_t f = gen.next(i);
-        CHECK(sl_can_sinks_send(sinks, 2, &f, tick()) == SL_OK);
+        CHECK(slp_can_sinks_send(sinks, 2, &f, tick()) == SL_OK);
         usleep(200); // let candump keep up (its receive queue is finite)
     }
-    sl_can_sinks_poll(sinks, 2, tick());
+    slp_can_sinks_poll(sinks, 2, tick());
     CHECK(s.stats.sent == static_cast<uint32_t>(n));
-    CHECK(sl_can_sinks_dropped(sinks, 2) == 0);
+    CHECK(slp_can_sinks_dropped(sinks, 2) == 0);
     produced.close();
     print_stats("A plain", s);
 
@@ -258,12 +258,12 @@ int main(int argc, char **argv)
     uint32_t sent0 = s.stats.sent;
     for (int i = 0; i < 20; i++) {
         const sl_can_frame_t f = gen.next(4);
-        CHECK(sl_can_socketcan_send(&s, &f, tick()) == SL_OK);
+        CHECK(slp_socketcan_send(&s, &f, tick()) == SL_OK);
     }
     sh("ip link set " + iface + " down");
     for (int i = 0; i < 10; i++) {
         const sl_can_frame_t f = gen.next(4);
-        CHECK(sl_can_socketcan_send(&s, &f, tick()) == SL_ERR_PORT);
+        CHECK(slp_socketcan_send(&s, &f, tick()) == SL_ERR_PORT);
     }
     CHECK(s.stats.dropped_down == 10);
     CHECK(s.stats.link_down == 1);
@@ -271,7 +271,7 @@ int main(int argc, char **argv)
     sh("ip link set " + iface + " up");
     for (int i = 0; i < 20; i++) {
         const sl_can_frame_t f = gen.next(4);
-        CHECK(sl_can_socketcan_send(&s, &f, tick()) == SL_OK);
+        CHECK(slp_socketcan_send(&s, &f, tick()) == SL_OK);
     }
     CHECK(s.stats.sent - sent0 == 40);
     CHECK(s.stats.link_up == 1 && !s.link_down);
@@ -282,12 +282,12 @@ int main(int argc, char **argv)
     sh("tc qdisc add dev " + iface + " root plug limit 160"); // 10 frames of 16 bytes
     for (int i = 0; i < 10; i++) {
         const sl_can_frame_t f = gen.next(4);
-        CHECK(sl_can_socketcan_send(&s, &f, tick()) == SL_OK); // held by the qdisc
+        CHECK(slp_socketcan_send(&s, &f, tick()) == SL_OK); // held by the qdisc
     }
     int ok = 0, busy = 0;
     for (int i = 0; i < 12; i++) {
         const sl_can_frame_t f = gen.next(4);
-        const sl_err_t e = sl_can_socketcan_send(&s, &f, tick());
+        const sl_err_t e = slp_socketcan_send(&s, &f, tick());
         ok += e == SL_OK;
         busy += e == SL_ERR_BUSY;
     }
@@ -304,34 +304,34 @@ int main(int argc, char **argv)
     sh("tc qdisc del dev " + iface + " root");
     sh("tc qdisc add dev " + iface + " root plug limit 160");
     {
-        sl_can_socketcan_cfg_t c2 = cfg;
+        slp_socketcan_cfg_t c2 = cfg;
         c2.max_age_us = 50000;
-        sl_can_socketcan_t s2;
-        CHECK(sl_can_socketcan_open(&s2, ifn, &c2) == SL_OK);
+        slp_socketcan_t s2;
+        CHECK(slp_socketcan_open(&s2, ifn, &c2) == SL_OK);
         for (int i = 0; i < 13; i++) {
             const sl_can_frame_t f = gen.next(4);
-            CHECK(sl_can_socketcan_send(&s2, &f, tick()) == SL_OK);
+            CHECK(slp_socketcan_send(&s2, &f, tick()) == SL_OK);
         }
         CHECK(s2.stats.sent == 10 && s2.q_len == 3);
         sh("tc qdisc change dev " + iface + " root plug release_indefinite");
-        sl_can_socketcan_poll(&s2, tick(100000)); // 100 ms later: too old
+        slp_socketcan_poll(&s2, tick(100000)); // 100 ms later: too old
         CHECK(s2.q_len == 0 && s2.stats.dropped_stale == 3 && s2.stats.sent == 10);
         print_stats("E stale", s2);
-        sl_can_socketcan_close(&s2);
+        slp_socketcan_close(&s2);
     }
 
     // --- D: socket send buffer full (EAGAIN), frames held by a plugged qdisc
     sh("tc qdisc del dev " + iface + " root");
     sh("tc qdisc add dev " + iface + " root plug limit 1000000");
     {
-        sl_can_socketcan_cfg_t c3 = cfg;
+        slp_socketcan_cfg_t c3 = cfg;
         c3.sndbuf_bytes = 1; // the kernel rounds up to its minimum (a few frames)
-        sl_can_socketcan_t s3;
-        CHECK(sl_can_socketcan_open(&s3, ifn, &c3) == SL_OK);
+        slp_socketcan_t s3;
+        CHECK(slp_socketcan_open(&s3, ifn, &c3) == SL_OK);
         int d_ok = 0, d_busy = 0;
         for (int i = 0; i < 40; i++) {
             const sl_can_frame_t f = gen.next(4);
-            const sl_err_t e = sl_can_socketcan_send(&s3, &f, tick());
+            const sl_err_t e = slp_socketcan_send(&s3, &f, tick());
             d_ok += e == SL_OK;
             d_busy += e == SL_ERR_BUSY;
         }
@@ -343,7 +343,7 @@ int main(int argc, char **argv)
         CHECK(poll_until(&s3, [&] { return s3.q_len == 0; }));
         CHECK(s3.stats.sent + s3.stats.dropped_full == 40);
         print_stats("D eagain", s3);
-        sl_can_socketcan_close(&s3);
+        slp_socketcan_close(&s3);
     }
     sh("tc qdisc del dev " + iface + " root");
 
@@ -357,7 +357,7 @@ int main(int argc, char **argv)
         CHECK(s.bus_off);
         for (int i = 0; i < 5; i++) {
             const sl_can_frame_t f = gen.next(4);
-            CHECK(sl_can_socketcan_send(&s, &f, tick()) == SL_ERR_BUSY);
+            CHECK(slp_socketcan_send(&s, &f, tick()) == SL_ERR_BUSY);
         }
         CHECK(s.stats.dropped_bus_off == 5);
         CHECK(inj.error_frame(CAN_ERR_RESTARTED));
@@ -365,14 +365,14 @@ int main(int argc, char **argv)
         CHECK(!s.bus_off);
         for (int i = 0; i < 5; i++) {
             const sl_can_frame_t f = gen.next(4);
-            CHECK(sl_can_socketcan_send(&s, &f, tick()) == SL_OK);
+            CHECK(slp_socketcan_send(&s, &f, tick()) == SL_OK);
         }
         // Bus-off without a restart report: the hold time ends it.
         CHECK(inj.error_frame(CAN_ERR_BUSOFF));
         CHECK(poll_until(&s, [&] { return s.stats.bus_off == 2; }));
         const sl_can_frame_t f = gen.next(4);
-        CHECK(sl_can_socketcan_send(&s, &f, tick()) == SL_ERR_BUSY);
-        CHECK(sl_can_socketcan_send(&s, &f, tick(s.cfg.bus_off_hold_us + 1)) == SL_OK);
+        CHECK(slp_socketcan_send(&s, &f, tick()) == SL_ERR_BUSY);
+        CHECK(slp_socketcan_send(&s, &f, tick(s.cfg.bus_off_hold_us + 1)) == SL_OK);
         CHECK(s.stats.bus_off_timeouts == 1);
         CHECK(inj.error_frame(CAN_ERR_CRTL, CAN_ERR_CRTL_TX_PASSIVE));
         CHECK(poll_until(&s, [&] { return s.stats.error_passive == 1; }));
@@ -387,23 +387,23 @@ int main(int argc, char **argv)
         sh("ip link del dev " + iface);
         const sl_can_frame_t f = gen.next(4);
         const uint32_t down0 = s.stats.dropped_down;
-        CHECK(sl_can_socketcan_send(&s, &f, tick()) == SL_ERR_PORT);
+        CHECK(slp_socketcan_send(&s, &f, tick()) == SL_ERR_PORT);
         CHECK(s.gone && s.fd < 0);
         sh("ip link add dev " + iface + " type vcan && ip link set up " + iface);
-        CHECK(sl_can_socketcan_send(&s, &f, tick()) == SL_ERR_PORT); // before reopen_interval
+        CHECK(slp_socketcan_send(&s, &f, tick()) == SL_ERR_PORT); // before reopen_interval
         CHECK(s.stats.dropped_down - down0 == 2);
         sent0 = s.stats.sent;
-        CHECK(sl_can_socketcan_send(&s, &f, tick(s.cfg.reopen_interval_us)) == SL_OK);
+        CHECK(slp_socketcan_send(&s, &f, tick(s.cfg.reopen_interval_us)) == SL_OK);
         CHECK(s.stats.reopens == 1 && !s.gone);
         for (int i = 0; i < 9; i++) {
             const sl_can_frame_t g = gen.next(4);
-            CHECK(sl_can_socketcan_send(&s, &g, tick()) == SL_OK);
+            CHECK(slp_socketcan_send(&s, &g, tick()) == SL_OK);
         }
         CHECK(s.stats.sent - sent0 == 10);
         print_stats("G gone/back", s);
     }
 
-    sl_can_socketcan_close(&s);
+    slp_socketcan_close(&s);
     sent_log.close();
     std::printf("vcan_sink_check: %d failures\n", failures);
     return failures == 0 ? 0 : 1;

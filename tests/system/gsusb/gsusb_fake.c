@@ -12,8 +12,8 @@ void gsusb_fake_init(gsusb_fake_t *f)
     f->dev_cfg.icount = 0;
     f->dev_cfg.sw_version = 2;
     f->dev_cfg.hw_version = 1;
-    f->bt_const.feature = SL_GSUSB_FEAT_LISTEN_ONLY | SL_GSUSB_FEAT_LOOP_BACK |
-                          SL_GSUSB_FEAT_ONE_SHOT | SL_GSUSB_FEAT_GET_STATE;
+    f->bt_const.feature = SLP_GSUSB_FEAT_LISTEN_ONLY | SLP_GSUSB_FEAT_LOOP_BACK |
+                          SLP_GSUSB_FEAT_ONE_SHOT | SLP_GSUSB_FEAT_GET_STATE;
     f->bt_const.fclk_hz = 48000000U;
     f->bt_const.tseg1_min = 1;
     f->bt_const.tseg1_max = 16;
@@ -43,16 +43,16 @@ void gsusb_fake_push_in(gsusb_fake_t *f, const uint8_t *pkt, size_t len)
 
 static unsigned fake_fmt(const gsusb_fake_t *f)
 {
-    return (f->mode_flags & SL_GSUSB_FEAT_HW_TIMESTAMP) != 0U ? SL_GSUSB_FMT_TIMESTAMP : 0U;
+    return (f->mode_flags & SLP_GSUSB_FEAT_HW_TIMESTAMP) != 0U ? SLP_GSUSB_FMT_TIMESTAMP : 0U;
 }
 
-static void push_frame(gsusb_fake_t *f, const sl_gsusb_host_frame_t *hf)
+static void push_frame(gsusb_fake_t *f, const slp_gsusb_host_frame_t *hf)
 {
-    uint8_t buf[SL_GSUSB_FRAME_MAX_BYTES];
-    sl_gsusb_host_frame_t copy = *hf;
+    uint8_t buf[SLP_GSUSB_FRAME_MAX_BYTES];
+    slp_gsusb_host_frame_t copy = *hf;
     f->clock_us += 100U;
     copy.timestamp_us = f->clock_us;
-    sl_ssize_t n = sl_gsusb_frame_encode(&copy, fake_fmt(f), buf, sizeof buf);
+    sl_ssize_t n = slp_gsusb_frame_encode(&copy, fake_fmt(f), buf, sizeof buf);
     if (n > 0) {
         gsusb_fake_push_in(f, buf, (size_t)n);
     }
@@ -61,9 +61,9 @@ static void push_frame(gsusb_fake_t *f, const sl_gsusb_host_frame_t *hf)
 void gsusb_fake_push_rx(gsusb_fake_t *f, uint32_t can_id, uint8_t dlc, const uint8_t *data,
                         uint8_t flags, uint8_t channel)
 {
-    sl_gsusb_host_frame_t hf;
+    slp_gsusb_host_frame_t hf;
     memset(&hf, 0, sizeof hf);
-    hf.echo_id = (uint32_t)SL_GSUSB_ECHO_ID_RX;
+    hf.echo_id = (uint32_t)SLP_GSUSB_ECHO_ID_RX;
     hf.can_id = can_id;
     hf.can_dlc = dlc;
     hf.channel = channel;
@@ -102,7 +102,7 @@ static void record(gsusb_fake_t *f, uint8_t rt, uint8_t breq, uint16_t wvalue, u
     }
 }
 
-static sl_gsusb_io_t fake_control_out(void *ctx, uint8_t rt, uint8_t breq, uint16_t wvalue,
+static slp_gsusb_io_t fake_control_out(void *ctx, uint8_t rt, uint8_t breq, uint16_t wvalue,
                                       uint16_t windex, const uint8_t *data, uint16_t len,
                                       uint32_t timeout_ms, size_t *transferred)
 {
@@ -110,27 +110,27 @@ static sl_gsusb_io_t fake_control_out(void *ctx, uint8_t rt, uint8_t breq, uint1
     (void)timeout_ms;
     *transferred = 0;
     if (f->gone) {
-        return SL_GSUSB_IO_NO_DEVICE;
+        return SLP_GSUSB_IO_NO_DEVICE;
     }
     record(f, rt, breq, wvalue, windex, data, len);
     if (breq < 32U && (f->refuse_mask & (1UL << breq)) != 0U) {
-        return SL_GSUSB_IO_STALL;
+        return SLP_GSUSB_IO_STALL;
     }
     if (breq < 32U && (f->timeout_mask & (1UL << breq)) != 0U) {
-        return SL_GSUSB_IO_TIMEOUT;
+        return SLP_GSUSB_IO_TIMEOUT;
     }
     switch (breq) {
-    case SL_GSUSB_BREQ_HOST_FORMAT:
+    case SLP_GSUSB_BREQ_HOST_FORMAT:
         break;
-    case SL_GSUSB_BREQ_BITTIMING:
-        if (sl_gsusb_decode_bittiming(data, len, &f->bt) != SL_OK) {
-            return SL_GSUSB_IO_STALL;
+    case SLP_GSUSB_BREQ_BITTIMING:
+        if (slp_gsusb_decode_bittiming(data, len, &f->bt) != SL_OK) {
+            return SLP_GSUSB_IO_STALL;
         }
         f->bt_set = true;
         break;
-    case SL_GSUSB_BREQ_MODE:
+    case SLP_GSUSB_BREQ_MODE:
         if (len < 8U) {
-            return SL_GSUSB_IO_STALL;
+            return SLP_GSUSB_IO_STALL;
         }
         f->started = data[0] == 1U;
         f->mode_flags = (uint32_t)data[4] | ((uint32_t)data[5] << 8) | ((uint32_t)data[6] << 16) |
@@ -140,13 +140,13 @@ static sl_gsusb_io_t fake_control_out(void *ctx, uint8_t rt, uint8_t breq, uint1
         }
         break;
     default:
-        return SL_GSUSB_IO_STALL;
+        return SLP_GSUSB_IO_STALL;
     }
     *transferred = len;
-    return SL_GSUSB_IO_OK;
+    return SLP_GSUSB_IO_OK;
 }
 
-static sl_gsusb_io_t fake_control_in(void *ctx, uint8_t rt, uint8_t breq, uint16_t wvalue,
+static slp_gsusb_io_t fake_control_in(void *ctx, uint8_t rt, uint8_t breq, uint16_t wvalue,
                                      uint16_t windex, uint8_t *data, uint16_t len,
                                      uint32_t timeout_ms, size_t *transferred)
 {
@@ -156,25 +156,25 @@ static sl_gsusb_io_t fake_control_in(void *ctx, uint8_t rt, uint8_t breq, uint16
     (void)timeout_ms;
     *transferred = 0;
     if (f->gone) {
-        return SL_GSUSB_IO_NO_DEVICE;
+        return SLP_GSUSB_IO_NO_DEVICE;
     }
     record(f, rt, breq, wvalue, windex, NULL, len);
     if (breq < 32U && (f->refuse_mask & (1UL << breq)) != 0U) {
-        return SL_GSUSB_IO_STALL;
+        return SLP_GSUSB_IO_STALL;
     }
     if (breq < 32U && (f->timeout_mask & (1UL << breq)) != 0U) {
-        return SL_GSUSB_IO_TIMEOUT;
+        return SLP_GSUSB_IO_TIMEOUT;
     }
     memset(ans, 0, sizeof ans);
     switch (breq) {
-    case SL_GSUSB_BREQ_DEVICE_CONFIG:
+    case SLP_GSUSB_BREQ_DEVICE_CONFIG:
         ans[3] = f->dev_cfg.icount;
         sl_put_le32(ans + 4, f->dev_cfg.sw_version);
         sl_put_le32(ans + 8, f->dev_cfg.hw_version);
         n = 12;
         break;
-    case SL_GSUSB_BREQ_BT_CONST: {
-        const sl_gsusb_bt_const_t *c = &f->bt_const;
+    case SLP_GSUSB_BREQ_BT_CONST: {
+        const slp_gsusb_bt_const_t *c = &f->bt_const;
         const uint32_t v[10] = {c->feature, c->fclk_hz,  c->tseg1_min, c->tseg1_max, c->tseg2_min,
                                 c->tseg2_max, c->sjw_max, c->brp_min,  c->brp_max,   c->brp_inc};
         for (size_t i = 0; i < 10; i++) {
@@ -183,9 +183,9 @@ static sl_gsusb_io_t fake_control_in(void *ctx, uint8_t rt, uint8_t breq, uint16
         n = 40;
         break;
     }
-    case SL_GSUSB_BREQ_GET_STATE:
-        if ((f->bt_const.feature & SL_GSUSB_FEAT_GET_STATE) == 0U) {
-            return SL_GSUSB_IO_STALL;
+    case SLP_GSUSB_BREQ_GET_STATE:
+        if ((f->bt_const.feature & SLP_GSUSB_FEAT_GET_STATE) == 0U) {
+            return SLP_GSUSB_IO_STALL;
         }
         sl_put_le32(ans + 0, f->can_state.state);
         sl_put_le32(ans + 4, f->can_state.rxerr);
@@ -193,7 +193,7 @@ static sl_gsusb_io_t fake_control_in(void *ctx, uint8_t rt, uint8_t breq, uint16
         n = 12;
         break;
     default:
-        return SL_GSUSB_IO_STALL;
+        return SLP_GSUSB_IO_STALL;
     }
     if (breq < 32U && (f->short_mask & (1UL << breq)) != 0U) {
         n -= 2U;
@@ -203,10 +203,10 @@ static sl_gsusb_io_t fake_control_in(void *ctx, uint8_t rt, uint8_t breq, uint16
     }
     memcpy(data, ans, n);
     *transferred = n;
-    return SL_GSUSB_IO_OK;
+    return SLP_GSUSB_IO_OK;
 }
 
-static sl_gsusb_io_t fake_bulk_out(void *ctx, const uint8_t *data, size_t len, uint32_t timeout_ms,
+static slp_gsusb_io_t fake_bulk_out(void *ctx, const uint8_t *data, size_t len, uint32_t timeout_ms,
                                    size_t *transferred)
 {
     gsusb_fake_t *f = ctx;
@@ -214,26 +214,26 @@ static sl_gsusb_io_t fake_bulk_out(void *ctx, const uint8_t *data, size_t len, u
     *transferred = 0;
     f->bulk_out_calls++;
     if (f->gone) {
-        return SL_GSUSB_IO_NO_DEVICE;
+        return SLP_GSUSB_IO_NO_DEVICE;
     }
     if (f->out_halted) {
-        return SL_GSUSB_IO_STALL;
+        return SLP_GSUSB_IO_STALL;
     }
     if (f->stall_out_at >= 0 && (size_t)f->stall_out_at == f->n_frames) {
         f->stall_out_at = -1;
         f->out_halted = true;
-        return SL_GSUSB_IO_STALL;
+        return SLP_GSUSB_IO_STALL;
     }
     if (f->out_busy) {
-        return SL_GSUSB_IO_TIMEOUT;
+        return SLP_GSUSB_IO_TIMEOUT;
     }
     if (f->out_error_count > 0) {
         f->out_error_count--;
-        return SL_GSUSB_IO_ERROR;
+        return SLP_GSUSB_IO_ERROR;
     }
-    sl_gsusb_host_frame_t hf;
-    if (sl_gsusb_frame_decode(data, len, 0U, &hf) != SL_OK || f->n_frames >= FAKE_MAX_FRAMES) {
-        return SL_GSUSB_IO_ERROR;
+    slp_gsusb_host_frame_t hf;
+    if (slp_gsusb_frame_decode(data, len, 0U, &hf) != SL_OK || f->n_frames >= FAKE_MAX_FRAMES) {
+        return SLP_GSUSB_IO_ERROR;
     }
     size_t idx = f->n_frames++;
     f->frames[idx] = hf;
@@ -241,64 +241,64 @@ static sl_gsusb_io_t fake_bulk_out(void *ctx, const uint8_t *data, size_t len, u
     *transferred = len;
     if (f->vanish_after_frames >= 0 && f->n_frames >= (size_t)f->vanish_after_frames) {
         f->gone = true; // accepted, then unplugged before the echo
-        return SL_GSUSB_IO_OK;
+        return SLP_GSUSB_IO_OK;
     }
     if (f->echo_limit < 0 || f->n_echoed < (size_t)f->echo_limit) {
         f->n_echoed++;
         push_frame(f, &hf);
     }
     if (f->inject_reply) {
-        bool eff = (hf.can_id & SL_GSUSB_CAN_EFF_FLAG) != 0U;
+        bool eff = (hf.can_id & SLP_GSUSB_CAN_EFF_FLAG) != 0U;
         uint32_t id = hf.can_id & (eff ? SL_CAN_EFF_MASK : SL_CAN_SFF_MASK);
         uint32_t reply = ((id + 1U) & (eff ? SL_CAN_EFF_MASK : SL_CAN_SFF_MASK)) |
-                         (hf.can_id & SL_GSUSB_CAN_EFF_FLAG);
+                         (hf.can_id & SLP_GSUSB_CAN_EFF_FLAG);
         gsusb_fake_push_rx(f, reply, hf.can_dlc, hf.data, 0U, hf.channel);
     }
     if (f->stall_in_after >= 0 && (size_t)f->stall_in_after == idx) {
         f->stall_in_after = -1;
         f->in_halted = true;
     }
-    return SL_GSUSB_IO_OK;
+    return SLP_GSUSB_IO_OK;
 }
 
-static sl_gsusb_io_t fake_bulk_in(void *ctx, uint8_t *buf, size_t cap, uint32_t timeout_ms,
+static slp_gsusb_io_t fake_bulk_in(void *ctx, uint8_t *buf, size_t cap, uint32_t timeout_ms,
                                   size_t *transferred)
 {
     gsusb_fake_t *f = ctx;
     (void)timeout_ms;
     *transferred = 0;
     if (f->gone) {
-        return SL_GSUSB_IO_NO_DEVICE;
+        return SLP_GSUSB_IO_NO_DEVICE;
     }
     if (f->in_halted) {
-        return SL_GSUSB_IO_STALL;
+        return SLP_GSUSB_IO_STALL;
     }
     if (f->in_error_count > 0) {
         f->in_error_count--;
-        return SL_GSUSB_IO_ERROR;
+        return SLP_GSUSB_IO_ERROR;
     }
     if (f->inq_count == 0U) {
-        return SL_GSUSB_IO_TIMEOUT;
+        return SLP_GSUSB_IO_TIMEOUT;
     }
     size_t slot = f->inq_head;
     f->inq_head = (f->inq_head + 1U) % FAKE_INQ;
     f->inq_count--;
     if (f->inq_len[slot] > cap) {
-        return SL_GSUSB_IO_OVERFLOW;
+        return SLP_GSUSB_IO_OVERFLOW;
     }
     memcpy(buf, f->inq[slot], f->inq_len[slot]);
     *transferred = f->inq_len[slot];
-    return SL_GSUSB_IO_OK;
+    return SLP_GSUSB_IO_OK;
 }
 
-static sl_gsusb_io_t fake_clear_halt(void *ctx, bool in)
+static slp_gsusb_io_t fake_clear_halt(void *ctx, bool in)
 {
     gsusb_fake_t *f = ctx;
     if (f->gone) {
-        return SL_GSUSB_IO_NO_DEVICE;
+        return SLP_GSUSB_IO_NO_DEVICE;
     }
     if (f->clear_halt_fails) {
-        return SL_GSUSB_IO_ERROR;
+        return SLP_GSUSB_IO_ERROR;
     }
     if (in) {
         f->in_halted = false;
@@ -307,10 +307,10 @@ static sl_gsusb_io_t fake_clear_halt(void *ctx, bool in)
         f->out_halted = false;
         f->clear_halts_out++;
     }
-    return SL_GSUSB_IO_OK;
+    return SLP_GSUSB_IO_OK;
 }
 
-static const sl_gsusb_transport_ops_t fake_ops = {
+static const slp_gsusb_transport_ops_t fake_ops = {
     .control_out = fake_control_out,
     .control_in = fake_control_in,
     .bulk_out = fake_bulk_out,
@@ -318,8 +318,8 @@ static const sl_gsusb_transport_ops_t fake_ops = {
     .clear_halt = fake_clear_halt,
 };
 
-sl_gsusb_transport_t gsusb_fake_transport(gsusb_fake_t *f)
+slp_gsusb_transport_t gsusb_fake_transport(gsusb_fake_t *f)
 {
-    sl_gsusb_transport_t t = {&fake_ops, f};
+    slp_gsusb_transport_t t = {&fake_ops, f};
     return t;
 }

@@ -16,7 +16,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "gsusb_proto.h"
+#include "gsusb/gsusb_proto.h"
 
 #define FAKE_MAX_REQS 64U
 #define FAKE_MAX_FRAMES 256U
@@ -34,9 +34,9 @@ typedef struct fake_req {
 
 typedef struct gsusb_fake {
     // --- device properties (gsusb_fake_init: a 48 MHz STM32F072 candleLight)
-    sl_gsusb_device_config_t dev_cfg;
-    sl_gsusb_bt_const_t bt_const;
-    sl_gsusb_can_state_t can_state;
+    slp_gsusb_device_config_t dev_cfg;
+    slp_gsusb_bt_const_t bt_const;
+    slp_gsusb_can_state_t can_state;
 
     // --- misbehaviour knobs
     uint32_t refuse_mask;       ///< bit n set: request n is stalled
@@ -58,14 +58,14 @@ typedef struct gsusb_fake {
     bool in_halted;
     bool started;
     uint32_t mode_flags;
-    sl_gsusb_bittiming_t bt;
+    slp_gsusb_bittiming_t bt;
     bool bt_set;
     uint32_t clock_us;          ///< device timestamp counter (advances 100 per frame)
 
     // --- records
     fake_req_t reqs[FAKE_MAX_REQS];
     size_t n_reqs;
-    sl_gsusb_host_frame_t frames[FAKE_MAX_FRAMES]; ///< accepted bulk OUT frames
+    slp_gsusb_host_frame_t frames[FAKE_MAX_FRAMES]; ///< accepted bulk OUT frames
     size_t frame_len[FAKE_MAX_FRAMES];
     size_t n_frames;
     size_t n_echoed;
@@ -85,7 +85,7 @@ typedef struct gsusb_fake {
 void gsusb_fake_init(gsusb_fake_t *f);
 
 /// The transport that talks to `f`.
-sl_gsusb_transport_t gsusb_fake_transport(gsusb_fake_t *f);
+slp_gsusb_transport_t gsusb_fake_transport(gsusb_fake_t *f);
 
 /// Queue a raw IN packet (at most 32 bytes).
 void gsusb_fake_push_in(gsusb_fake_t *f, const uint8_t *pkt, size_t len);

@@ -20,7 +20,7 @@
 
 #include "radar_client.h"
 #include "shadowlean/sl_proto.h"
-#include "sl_port_linux.h"
+#include "port_clock.h"
 
 #include <nlohmann/json.hpp>
 #include <pcap/pcap.h>
@@ -242,9 +242,9 @@ struct ServerProc {
         close(pfd[1]);
         out_fd = pfd[0];
         std::string line;
-        const uint64_t end = sl_port_now_us() + 20000000u;
+        const uint64_t end = slp_now_us() + 20000000u;
         while (line.find('\n') == std::string::npos) {
-            const uint64_t now = sl_port_now_us();
+            const uint64_t now = slp_now_us();
             if (now >= end) {
                 fail("server did not print its port");
                 return false;
@@ -271,9 +271,9 @@ struct ServerProc {
         if (pid <= 0) return -1;
         kill(pid, SIGTERM);
         int st = 0;
-        const uint64_t end = sl_port_now_us() + 10000000u;
+        const uint64_t end = slp_now_us() + 10000000u;
         while (waitpid(pid, &st, WNOHANG) == 0) {
-            if (sl_port_now_us() >= end) {
+            if (slp_now_us() >= end) {
                 kill(pid, SIGKILL);
                 waitpid(pid, &st, 0);
                 pid = -1;
@@ -319,22 +319,22 @@ void rx_msg(void *ctx, const sl_proto_msg_t *m, uint64_t now_us)
     }
 }
 
-void rx_event(void *ctx, sl_radar_event_t ev, sl_radar_reason_t reason, uint64_t)
+void rx_event(void *ctx, slp_radar_event_t ev, slp_radar_reason_t reason, uint64_t)
 {
     auto *rx = static_cast<Rx *>(ctx);
     static const char *names[] = {"CONNECTED", "CONFIG", "DISCONNECTED", "CONNECT_FAILED", "STOPPED"};
-    rx->events.push_back(std::string(names[ev]) + "/" + sl_radar_reason_str(reason));
+    rx->events.push_back(std::string(names[ev]) + "/" + slp_radar_reason_str(reason));
 }
 
 struct Client {
     std::vector<uint8_t> reasm = std::vector<uint8_t>(sl::kHostMaxPayloadBytes);
-    std::unique_ptr<sl_radar_client_t> c = std::make_unique<sl_radar_client_t>();
+    std::unique_ptr<slp_radar_client_t> c = std::make_unique<slp_radar_client_t>();
     Rx rx;
 
     bool init(uint16_t port, uint32_t silence_ms = 2000)
     {
-        sl_radar_client_cfg_t cfg;
-        sl_radar_client_cfg_defaults(&cfg);
+        slp_radar_client_cfg_t cfg;
+        slp_radar_client_cfg_defaults(&cfg);
         cfg.host = "127.0.0.1";
         cfg.port = port;
         cfg.silence_timeout_ms = silence_ms;
@@ -345,24 +345,24 @@ struct Client {
         cfg.on_msg = rx_msg;
         cfg.on_event = rx_event;
         cfg.ctx = &rx;
-        if (sl_radar_client_init(c.get(), &cfg) != SL_OK) {
-            fail("sl_radar_client_init");
+        if (slp_radar_client_init(c.get(), &cfg) != SL_OK) {
+            fail("slp_radar_client_init");
             return false;
         }
-        return sl_radar_client_start(c.get()) == SL_OK;
+        return slp_radar_client_start(c.get()) == SL_OK;
     }
 };
 
 // Polls the client until it holds `want` FFT messages or the deadline passes.
 bool run_until(Client &cl, size_t want, double timeout_s)
 {
-    const uint64_t end = sl_port_now_us() + static_cast<uint64_t>(timeout_s * 1e6);
+    const uint64_t end = slp_now_us() + static_cast<uint64_t>(timeout_s * 1e6);
     while (cl.rx.fft.size() < want) {
-        if (sl_port_now_us() >= end) {
+        if (slp_now_us() >= end) {
             fail("timeout: %zu of %zu FFT messages received", cl.rx.fft.size(), want);
             return false;
         }
-        if (sl_radar_client_poll(cl.c.get(), 100) == SL_ERR_PORT) {
+        if (slp_radar_client_poll(cl.c.get(), 100) == SL_ERR_PORT) {
             fail("poll failed");
             return false;
         }
@@ -370,7 +370,7 @@ bool run_until(Client &cl, size_t want, double timeout_s)
     return true;
 }
 
-void print_client_stats(const char *name, const sl_radar_client_t *c)
+void print_client_stats(const char *name, const slp_radar_client_t *c)
 {
     const auto &s = c->stats;
     const auto &p = c->proto.stats;
@@ -729,10 +729,10 @@ int test_e2e(const std::string &replay, const std::string &work, const std::vect
     if (!srv.start(server_args(replay, cap, opts))) return 1;
     Client cl;
     if (!cl.init(srv.port)) return 1;
-    const uint64_t t0 = sl_port_now_us();
+    const uint64_t t0 = slp_now_us();
     run_until(cl, s.fft_offsets.size(), 60);
-    const uint64_t t1 = sl_port_now_us();
-    sl_radar_client_stop(cl.c.get(), 500);
+    const uint64_t t1 = slp_now_us();
+    slp_radar_client_stop(cl.c.get(), 500);
     print_client_stats("client", cl.c.get());
     check_identical(s, cl.rx, "e2e");
     CHECK_EQ(cl.c->stats.connects, 1u, "connections");
@@ -778,7 +778,7 @@ int test_fault(const std::string &replay, const std::string &work, bool silent)
     Client cl;
     if (!cl.init(srv.port, silent ? 400 : 2000)) return 1;
     run_until(cl, s.fft_offsets.size(), 60);
-    sl_radar_client_stop(cl.c.get(), 500);
+    slp_radar_client_stop(cl.c.get(), 500);
     print_client_stats("client", cl.c.get());
     std::string ev;
     for (const auto &e : cl.rx.events) ev += e + " ";
@@ -819,9 +819,9 @@ size_t raw_drain(int fd, int timeout_ms, bool &eof)
 {
     size_t total = 0;
     eof = false;
-    const uint64_t end = sl_port_now_us() + static_cast<uint64_t>(timeout_ms) * 1000u;
+    const uint64_t end = slp_now_us() + static_cast<uint64_t>(timeout_ms) * 1000u;
     for (;;) {
-        const uint64_t now = sl_port_now_us();
+        const uint64_t now = slp_now_us();
         if (now >= end) return total;
         pollfd p{fd, POLLIN, 0};
         if (poll(&p, 1, static_cast<int>((end - now) / 1000 + 1)) <= 0) continue;
@@ -843,12 +843,12 @@ size_t raw_drain(int fd, int timeout_ms, bool &eof)
 // Drives several clients from one poll() loop through the fd/events/handle API.
 bool run_clients(std::vector<Client *> cls, size_t want, double timeout_s)
 {
-    const uint64_t end = sl_port_now_us() + static_cast<uint64_t>(timeout_s * 1e6);
+    const uint64_t end = slp_now_us() + static_cast<uint64_t>(timeout_s * 1e6);
     for (;;) {
         bool done = true;
         for (auto *c : cls) done = done && c->rx.fft.size() >= want;
         if (done) return true;
-        uint64_t now = sl_port_now_us();
+        uint64_t now = slp_now_us();
         if (now >= end) {
             fail("timeout waiting for %zu FFT messages per client", want);
             return false;
@@ -856,14 +856,14 @@ bool run_clients(std::vector<Client *> cls, size_t want, double timeout_s)
         std::vector<pollfd> p;
         int timeout = 100;
         for (auto *c : cls) {
-            p.push_back({sl_radar_client_fd(c->c.get()), sl_radar_client_events(c->c.get()), 0});
-            const int t = sl_radar_client_timeout_ms(c->c.get(), now);
+            p.push_back({slp_radar_client_fd(c->c.get()), slp_radar_client_events(c->c.get()), 0});
+            const int t = slp_radar_client_timeout_ms(c->c.get(), now);
             if (t >= 0 && t < timeout) timeout = t;
         }
         poll(p.data(), p.size(), timeout);
-        now = sl_port_now_us();
+        now = slp_now_us();
         for (size_t i = 0; i < cls.size(); ++i) {
-            sl_radar_client_handle(cls[i]->c.get(), p[i].fd >= 0 ? p[i].revents : 0, now);
+            slp_radar_client_handle(cls[i]->c.get(), p[i].fd >= 0 ? p[i].revents : 0, now);
         }
     }
 }
@@ -914,8 +914,8 @@ int test_clients(const std::string &replay, const std::string &work)
         if (!accepted) usleep(100000);
     }
     CHECK(accepted, "a client is accepted again once a slot is free");
-    sl_radar_client_stop(a.c.get(), 500);
-    sl_radar_client_stop(b.c.get(), 500);
+    slp_radar_client_stop(a.c.get(), 500);
+    slp_radar_client_stop(b.c.get(), 500);
     CHECK_EQ(srv.stop(), 0, "server exit status after SIGTERM");
     return g_failures ? 1 : 0;
 }
@@ -948,7 +948,7 @@ int test_fifo(const std::string &replay, const std::string &work)
     Client cl;
     if (!cl.init(srv.port)) return 1;
     run_until(cl, s.fft_offsets.size(), 60);
-    sl_radar_client_stop(cl.c.get(), 500);
+    slp_radar_client_stop(cl.c.get(), 500);
     print_client_stats("client", cl.c.get());
     check_identical(s, cl.rx, "served from a FIFO");
     int wst = 0;
@@ -975,7 +975,7 @@ int test_loop(const std::string &replay, const std::string &work)
     if (!cl.init(srv.port)) return 1;
     const size_t n = s.fft_offsets.size(), want = n * 5 / 2;
     run_until(cl, want, 60);
-    sl_radar_client_stop(cl.c.get(), 500);
+    slp_radar_client_stop(cl.c.get(), 500);
     size_t bins_bad = 0, time_bad = 0, sweep_bad = 0;
     uint64_t prev_t = 0;
     for (size_t i = 0; i < std::min(want, cl.rx.fft.size()); ++i) {
@@ -1043,15 +1043,15 @@ int test_record(const std::string &replay, const std::string &inspect, const std
 // sent once, then the config timeout), a peer whose accept queue is full (connect timeout).
 struct BackoffLog {
     std::vector<uint32_t> delays_ms; // backoff used after each failure
-    sl_radar_client_t *c = nullptr;
+    slp_radar_client_t *c = nullptr;
     std::vector<std::string> events;
 };
 
-void backoff_event(void *ctx, sl_radar_event_t ev, sl_radar_reason_t reason, uint64_t)
+void backoff_event(void *ctx, slp_radar_event_t ev, slp_radar_reason_t reason, uint64_t)
 {
     auto *b = static_cast<BackoffLog *>(ctx);
-    b->events.push_back(std::to_string(ev) + "/" + sl_radar_reason_str(reason));
-    if (ev == SL_RADAR_EV_CONNECT_FAILED || ev == SL_RADAR_EV_DISCONNECTED) {
+    b->events.push_back(std::to_string(ev) + "/" + slp_radar_reason_str(reason));
+    if (ev == SLP_RADAR_EV_CONNECT_FAILED || ev == SLP_RADAR_EV_DISCONNECTED) {
         // drop() scheduled deadline = now + previous backoff, then doubled stats.backoff_ms
         b->delays_ms.push_back(static_cast<uint32_t>((b->c->deadline_us - b->c->now_us) / 1000u));
     }
@@ -1076,10 +1076,10 @@ int loopback_socket(int backlog) // backlog < 0: bound, not listening
     return fd;
 }
 
-bool make_client(std::unique_ptr<sl_radar_client_t> &c, BackoffLog &log, uint16_t port, std::vector<uint8_t> &reasm)
+bool make_client(std::unique_ptr<slp_radar_client_t> &c, BackoffLog &log, uint16_t port, std::vector<uint8_t> &reasm)
 {
-    sl_radar_client_cfg_t cfg;
-    sl_radar_client_cfg_defaults(&cfg);
+    slp_radar_client_cfg_t cfg;
+    slp_radar_client_cfg_defaults(&cfg);
     cfg.host = "127.0.0.1";
     cfg.port = port;
     cfg.backoff_initial_ms = 10;
@@ -1092,9 +1092,9 @@ bool make_client(std::unique_ptr<sl_radar_client_t> &c, BackoffLog &log, uint16_
     cfg.reasm_size = reasm.size();
     cfg.on_event = backoff_event;
     cfg.ctx = &log;
-    c = std::make_unique<sl_radar_client_t>();
+    c = std::make_unique<slp_radar_client_t>();
     log.c = c.get();
-    return sl_radar_client_init(c.get(), &cfg) == SL_OK && sl_radar_client_start(c.get()) == SL_OK;
+    return slp_radar_client_init(c.get(), &cfg) == SL_OK && slp_radar_client_start(c.get()) == SL_OK;
 }
 
 int test_client_timeouts(const std::string &work)
@@ -1105,10 +1105,10 @@ int test_client_timeouts(const std::string &work)
     {
         const int hold = loopback_socket(-1); // keeps the port ours, refuses connections
         BackoffLog log;
-        std::unique_ptr<sl_radar_client_t> c;
+        std::unique_ptr<slp_radar_client_t> c;
         if (hold < 0 || !make_client(c, log, static_cast<uint16_t>(bound_port(hold)), reasm)) return 1;
-        const uint64_t end = sl_port_now_us() + 10000000u;
-        while (c->stats.connect_failures < 6 && sl_port_now_us() < end) sl_radar_client_poll(c.get(), 1000);
+        const uint64_t end = slp_now_us() + 10000000u;
+        while (c->stats.connect_failures < 6 && slp_now_us() < end) slp_radar_client_poll(c.get(), 1000);
         CHECK_EQ(c->stats.connect_failures, 6u, "refused: failed attempts");
         CHECK_EQ(c->stats.connect_attempts, 6u, "refused: attempts");
         CHECK_EQ(c->stats.connects, 0u, "refused: connections");
@@ -1126,17 +1126,17 @@ int test_client_timeouts(const std::string &work)
         std::printf("refused: %u attempts, %u handle calls, last errno %d (%s)\n", c->stats.connect_attempts,
                     c->stats.handle_calls, c->stats.last_errno, std::strerror(c->stats.last_errno));
         CHECK_EQ(c->stats.last_errno, ECONNREFUSED, "refused: errno");
-        sl_radar_client_deinit(c.get());
+        slp_radar_client_deinit(c.get());
         close(hold);
     }
     // 2) A mute peer: the client sends one Config Request (20), then gives up on the config.
     {
         const int lfd = loopback_socket(4);
         BackoffLog log;
-        std::unique_ptr<sl_radar_client_t> c;
+        std::unique_ptr<slp_radar_client_t> c;
         if (lfd < 0 || !make_client(c, log, static_cast<uint16_t>(bound_port(lfd)), reasm)) return 1;
-        const uint64_t end = sl_port_now_us() + 10000000u;
-        while (c->stats.config_timeouts < 1 && sl_port_now_us() < end) sl_radar_client_poll(c.get(), 1000);
+        const uint64_t end = slp_now_us() + 10000000u;
+        while (c->stats.config_timeouts < 1 && slp_now_us() < end) slp_radar_client_poll(c.get(), 1000);
         const int peer = accept4(lfd, nullptr, nullptr, SOCK_NONBLOCK);
         uint8_t buf[64];
         const ssize_t n = peer >= 0 ? recv(peer, buf, sizeof buf, 0) : -1;
@@ -1148,7 +1148,7 @@ int test_client_timeouts(const std::string &work)
               "mute peer: received one 22-byte Config Request (got %zd bytes)", n);
         CHECK(!log.delays_ms.empty() && log.delays_ms[0] == 10, "mute peer: reconnect scheduled after the initial backoff");
         if (peer >= 0) close(peer);
-        sl_radar_client_deinit(c.get());
+        slp_radar_client_deinit(c.get());
         close(lfd);
     }
     // 3) Accept queue full: the SYN is dropped, connect() never completes -> connect timeout.
@@ -1172,13 +1172,13 @@ int test_client_timeouts(const std::string &work)
             std::printf("note: accept queue never filled; connect-timeout case not exercised\n");
         } else {
             BackoffLog log;
-            std::unique_ptr<sl_radar_client_t> c;
+            std::unique_ptr<slp_radar_client_t> c;
             if (!make_client(c, log, port, reasm)) return 1;
-            const uint64_t end = sl_port_now_us() + 10000000u;
-            while (c->stats.connect_timeouts < 1 && sl_port_now_us() < end) sl_radar_client_poll(c.get(), 1000);
+            const uint64_t end = slp_now_us() + 10000000u;
+            while (c->stats.connect_timeouts < 1 && slp_now_us() < end) slp_radar_client_poll(c.get(), 1000);
             CHECK_EQ(c->stats.connect_timeouts, 1u, "full accept queue: connect timeouts");
             CHECK_EQ(c->stats.connects, 0u, "full accept queue: connections");
-            sl_radar_client_deinit(c.get());
+            slp_radar_client_deinit(c.get());
         }
         for (int fd : fill) close(fd);
         close(lfd);

@@ -1,10 +1,10 @@
 // SPDX-License-Identifier: MIT
-/// @file can_socketcan.h
+/// @file socketcan.h
 /// @brief SocketCAN raw sink: non-blocking transmit with a small bounded retry queue,
 ///        error-frame monitoring (bus-off, error passive, restarts), interface down/gone.
 ///
-/// Behaviour of `sl_can_socketcan_send()` (never blocks, never sleeps):
-/// 1. `sl_can_socketcan_poll()` first: read pending error frames, retry queued frames,
+/// Behaviour of `slp_socketcan_send()` (never blocks, never sleeps):
+/// 1. `slp_socketcan_poll()` first: read pending error frames, retry queued frames,
 ///    reopen the socket if the interface had disappeared.
 /// 2. Interface gone (ENODEV/ENXIO, or it did not exist at open): the frame is dropped
 ///    (`dropped_down`, SL_ERR_PORT); the socket is reopened every `reopen_interval_us`.
@@ -28,10 +28,10 @@
 /// kernel may have no CAN at all: open() then fails with `last_errno` EAFNOSUPPORT).
 ///
 /// Cost: send/poll are O(queue + error frames read) system calls, bounded by
-/// SL_CAN_SOCKETCAN_QUEUE_MAX + SL_CAN_SOCKETCAN_RX_BURST. RAM: ~sizeof(sl_can_socketcan_t)
-/// (about 1.7 KiB: the queue array is always SL_CAN_SOCKETCAN_QUEUE_MAX entries). Not thread-safe.
-#ifndef SHADOWLEAN_CAN_SOCKETCAN_H
-#define SHADOWLEAN_CAN_SOCKETCAN_H
+/// SLP_SOCKETCAN_QUEUE_MAX + SLP_SOCKETCAN_RX_BURST. RAM: ~sizeof(slp_socketcan_t)
+/// (about 1.7 KiB: the queue array is always SLP_SOCKETCAN_QUEUE_MAX entries). Not thread-safe.
+#ifndef SHADOWLEAN_PORT_SOCKETCAN_H
+#define SHADOWLEAN_PORT_SOCKETCAN_H
 
 #include <stdbool.h>
 #include <stdint.h>
@@ -45,13 +45,13 @@ extern "C" {
 #endif
 
 /// Largest retry queue (frames). The configured capacity may be smaller.
-#define SL_CAN_SOCKETCAN_QUEUE_MAX 64U
+#define SLP_SOCKETCAN_QUEUE_MAX 64U
 /// Error frames read per poll at most (bounds the work per call).
-#define SL_CAN_SOCKETCAN_RX_BURST 32U
+#define SLP_SOCKETCAN_RX_BURST 32U
 
-/// Configuration. Start from sl_can_socketcan_default_cfg().
-typedef struct sl_can_socketcan_cfg {
-    uint16_t queue_cap;          ///< retry queue capacity, 0..SL_CAN_SOCKETCAN_QUEUE_MAX (default 16)
+/// Configuration. Start from slp_socketcan_default_cfg().
+typedef struct slp_socketcan_cfg {
+    uint16_t queue_cap;          ///< retry queue capacity, 0..SLP_SOCKETCAN_QUEUE_MAX (default 16)
     int sndbuf_bytes;            ///< SO_SNDBUF, 0 = kernel default
     uint64_t max_age_us;         ///< queued frames older than this are dropped; 0 = no limit (default 200 ms)
     uint64_t bus_off_hold_us;    ///< drop everything this long after a bus-off report (default 1 s)
@@ -60,10 +60,10 @@ typedef struct sl_can_socketcan_cfg {
     /// with the `t_us` of the call that wrote it. May be NULL.
     void (*on_sent)(void *user, const sl_can_frame_t *f, uint64_t t_us);
     void *on_sent_user;
-} sl_can_socketcan_cfg_t;
+} slp_socketcan_cfg_t;
 
 /// Counters (totals since open; fields read-only).
-typedef struct sl_can_socketcan_stats {
+typedef struct slp_socketcan_stats {
     uint32_t sent;             ///< frames written to the socket
     uint32_t retries;          ///< writes that hit EAGAIN/ENOBUFS (frame kept for a retry)
     uint32_t eagain;           ///< ... of which EAGAIN/EWOULDBLOCK (socket buffer full)
@@ -85,15 +85,15 @@ typedef struct sl_can_socketcan_stats {
     uint32_t ctrl_overflow;    ///< controller RX/TX buffer overflow reports
     uint32_t tx_timeouts;      ///< CAN_ERR_TX_TIMEOUT reports
     uint32_t bus_errors;       ///< protocol / ack / transceiver / lost arbitration reports
-} sl_can_socketcan_stats_t;
+} slp_socketcan_stats_t;
 
 /// One SocketCAN sink. Caller-owned; fields read-only to the application.
-typedef struct sl_can_socketcan {
+typedef struct slp_socketcan {
     int fd;                    ///< -1 when closed or gone
     char ifname[16];           ///< IFNAMSIZ
-    sl_can_socketcan_cfg_t cfg;
-    sl_can_frame_t q[SL_CAN_SOCKETCAN_QUEUE_MAX];
-    uint64_t q_t_us[SL_CAN_SOCKETCAN_QUEUE_MAX]; ///< time each queued frame was handed in
+    slp_socketcan_cfg_t cfg;
+    sl_can_frame_t q[SLP_SOCKETCAN_QUEUE_MAX];
+    uint64_t q_t_us[SLP_SOCKETCAN_QUEUE_MAX]; ///< time each queued frame was handed in
     uint16_t q_head, q_len;
     bool link_down;            ///< last write said ENETDOWN
     bool gone;                 ///< no socket (interface missing); reopen pending
@@ -101,37 +101,37 @@ typedef struct sl_can_socketcan {
     uint64_t bus_off_t_us;     ///< time of the last bus-off report
     uint64_t next_reopen_t_us;
     int last_errno;            ///< errno of the last failure (0 = none)
-    sl_can_socketcan_stats_t stats;
-} sl_can_socketcan_t;
+    slp_socketcan_stats_t stats;
+} slp_socketcan_t;
 
 /// Defaults: queue 16, kernel SO_SNDBUF, max age 200 ms, bus-off hold 1 s, reopen 1 s.
-sl_can_socketcan_cfg_t sl_can_socketcan_default_cfg(void);
+slp_socketcan_cfg_t slp_socketcan_default_cfg(void);
 
 /// Open a raw CAN socket on `ifname` ("vcan0", "can0"), non-blocking, error frames on.
 /// `cfg` may be NULL (defaults). @return SL_OK when bound; SL_ERR_ARG for a bad name or
 /// config; SL_ERR_PORT when the socket or the interface is unavailable (last_errno says
 /// why). After SL_ERR_PORT the object is still valid: send() drops and counts, and it
-/// retries the open every reopen_interval_us. Always call sl_can_socketcan_close().
-sl_err_t sl_can_socketcan_open(sl_can_socketcan_t *s, const char *ifname,
-                               const sl_can_socketcan_cfg_t *cfg);
+/// retries the open every reopen_interval_us. Always call slp_socketcan_close().
+sl_err_t slp_socketcan_open(slp_socketcan_t *s, const char *ifname,
+                               const slp_socketcan_cfg_t *cfg);
 
 /// Close the socket; queued frames are discarded (not counted as drops). Idempotent.
-void sl_can_socketcan_close(sl_can_socketcan_t *s);
+void slp_socketcan_close(slp_socketcan_t *s);
 
 /// Send one frame (see the file comment). Never blocks.
-sl_err_t sl_can_socketcan_send(sl_can_socketcan_t *s, const sl_can_frame_t *f, uint64_t t_us);
+sl_err_t slp_socketcan_send(slp_socketcan_t *s, const sl_can_frame_t *f, uint64_t t_us);
 
 /// Deferred work: error frames, queue retries, reopen. Never blocks.
-void sl_can_socketcan_poll(sl_can_socketcan_t *s, uint64_t t_us);
+void slp_socketcan_poll(slp_socketcan_t *s, uint64_t t_us);
 
 /// Total frames dropped for any reason.
-uint32_t sl_can_socketcan_dropped(const sl_can_socketcan_t *s);
+uint32_t slp_socketcan_dropped(const slp_socketcan_t *s);
 
 /// This object as a generic sink (ctx = s; borrowed, must outlive the sink).
-sl_can_sink_t sl_can_socketcan_sink(sl_can_socketcan_t *s);
+slp_can_sink_t slp_socketcan_sink(slp_socketcan_t *s);
 
 #ifdef __cplusplus
 }
 #endif
 
-#endif // SHADOWLEAN_CAN_SOCKETCAN_H
+#endif // SHADOWLEAN_PORT_SOCKETCAN_H

@@ -1,10 +1,10 @@
 // SPDX-License-Identifier: MIT
-/// @file sl_port_linux.h
-/// @brief Linux port helpers shared by the port modules (clock).
+/// @file port_clock.h
+/// @brief The Linux port's clock, shared by the port modules.
 ///
 /// The core never reads a clock; the port does, here, and passes `now_us` in.
-#ifndef SHADOWLEAN_SL_PORT_LINUX_H
-#define SHADOWLEAN_SL_PORT_LINUX_H
+#ifndef SHADOWLEAN_PORT_CLOCK_H
+#define SHADOWLEAN_PORT_CLOCK_H
 
 #include <stdint.h>
 
@@ -13,10 +13,10 @@ extern "C" {
 #endif
 
 /// Microseconds of CLOCK_MONOTONIC (arbitrary origin, never jumps). Cost: one vDSO call.
-uint64_t sl_port_now_us(void);
+uint64_t slp_now_us(void);
 
 #ifdef __cplusplus
 }
 #endif
 
-#endif // SHADOWLEAN_SL_PORT_LINUX_H
+#endif // SHADOWLEAN_PORT_CLOCK_H

@@ -1,16 +1,16 @@
 // SPDX-License-Identifier: MIT
-/// @file gsusb_libusb.h
+/// @file gsusb_usb.h
 /// @brief libusb-1.0 transport for gs_usb (candleLight) adapters: finds, claims and talks to
-///        the device behind the `sl_gsusb_transport_t` seam of gsusb_proto.h.
+///        the device behind the `slp_gsusb_transport_t` seam of gsusb_proto.h.
 ///
 /// What it does:
 /// - finds the adapter by VID:PID, by bus-port ("1-1", "3-2.4": the sysfs name), or the
-///   first device with a known gs_usb id (sl_gsusb_known_ids());
+///   first device with a known gs_usb id (slp_gsusb_known_ids());
 /// - detaches the kernel driver (gs_usb) when it is bound, claims interface 0, and on close
 ///   releases it and re-attaches the kernel driver (the kernel re-probes the device);
 /// - takes the bulk endpoints from the interface descriptor (first bulk IN / OUT), falling
 ///   back to 0x81 / 0x02 (`eps_from_descriptor` false) when the descriptor lists none;
-/// - keeps SL_GSUSB_USB_IN_XFERS bulk IN transfers queued at all times (like the kernel's
+/// - keeps SLP_GSUSB_USB_IN_XFERS bulk IN transfers queued at all times (like the kernel's
 ///   RX URBs), so the device can always deliver echoes and RX frames; `bulk_in` hands out
 ///   the completed packets in order and resubmits the transfer;
 /// - sends bulk OUT asynchronously: `bulk_out` submits and returns at once (OK = handed to
@@ -21,17 +21,17 @@
 ///   `out_timeout_ms` loses it (counted in out_timeouts; the driver's echo timeout reports
 ///   it unconfirmed);
 /// - a vanished device (unplug, reset, gadget unbound): every call returns NO_DEVICE.
-///   Close it and open again (sl_gsusb_sink does that periodically).
+///   Close it and open again (slp_gsusb_sink does that periodically).
 ///
 /// Blocking: `bulk_out` and `bulk_in` with timeout 0 never block (libusb events are handled
 /// with a zero timeout); control requests and clear_halt are synchronous (bounded by their
 /// timeouts: a few ms with a healthy adapter). Not thread-safe: one thread per instance
 /// (and per libusb context: each instance has its own).
 ///
-/// Memory: sl_gsusb_usb_t is about 6 KB (transfer buffers inside); libusb allocates its
+/// Memory: slp_gsusb_usb_t is about 6 KB (transfer buffers inside); libusb allocates its
 /// transfer structs at open and frees them at close.
-#ifndef SHADOWLEAN_GSUSB_LIBUSB_H
-#define SHADOWLEAN_GSUSB_LIBUSB_H
+#ifndef SHADOWLEAN_PORT_GSUSB_USB_H
+#define SHADOWLEAN_PORT_GSUSB_USB_H
 
 #include <poll.h>
 #include <stdbool.h>
@@ -49,28 +49,28 @@ struct libusb_context;
 struct libusb_device_handle;
 struct libusb_transfer;
 
-#define SL_GSUSB_USB_IN_XFERS 8U                               ///< bulk IN transfers kept queued
-#define SL_GSUSB_USB_OUT_XFERS (SL_GSUSB_MAX_IN_FLIGHT + 4U)   ///< bulk OUT transfer slots
-#define SL_GSUSB_USB_IN_BUF 512U                               ///< one packet (high-speed max)
-#define SL_GSUSB_USB_MAX_PORTS 7U                              ///< USB hub depth limit
+#define SLP_GSUSB_USB_IN_XFERS 8U                               ///< bulk IN transfers kept queued
+#define SLP_GSUSB_USB_OUT_XFERS (SLP_GSUSB_MAX_IN_FLIGHT + 4U)   ///< bulk OUT transfer slots
+#define SLP_GSUSB_USB_IN_BUF 512U                               ///< one packet (high-speed max)
+#define SLP_GSUSB_USB_MAX_PORTS 7U                              ///< USB hub depth limit
 
-/// Which adapter. Parse one with sl_gsusb_usb_parse_selector().
-typedef struct sl_gsusb_usb_sel {
+/// Which adapter. Parse one with slp_gsusb_usb_parse_selector().
+typedef struct slp_gsusb_usb_sel {
     bool by_id;        ///< match vid:pid
     uint16_t vid, pid;
     bool by_port;      ///< match bus + port path
     uint8_t bus;
-    uint8_t ports[SL_GSUSB_USB_MAX_PORTS];
+    uint8_t ports[SLP_GSUSB_USB_MAX_PORTS];
     uint8_t n_ports;
-} sl_gsusb_usb_sel_t;
+} slp_gsusb_usb_sel_t;
 
 /// Parse "VID:PID" (hex, "1d50:606f"), "BUS-PORT[.PORT...]" (decimal, "1-1", "3-2.4"), or
 /// NULL / "" (first adapter with a known gs_usb id).
 /// @return SL_OK or SL_ERR_ARG (anything else). O(strlen).
-sl_err_t sl_gsusb_usb_parse_selector(const char *s, sl_gsusb_usb_sel_t *out);
+sl_err_t slp_gsusb_usb_parse_selector(const char *s, slp_gsusb_usb_sel_t *out);
 
 /// Counters since init. Read-only.
-typedef struct sl_gsusb_usb_stats {
+typedef struct slp_gsusb_usb_stats {
     uint32_t opens;             ///< successful opens
     uint32_t open_failures;     ///< opens that failed (see `err`)
     uint32_t kernel_detaches;   ///< kernel driver detached at open
@@ -88,31 +88,31 @@ typedef struct sl_gsusb_usb_stats {
     uint32_t clear_halts;       ///< libusb_clear_halt calls that succeeded
     uint32_t no_device;         ///< times the device was found gone
     uint32_t stuck_transfers;   ///< transfers still active when close gave up waiting (leaked)
-} sl_gsusb_usb_stats_t;
+} slp_gsusb_usb_stats_t;
 
 /// One bulk IN transfer.
-typedef struct sl_gsusb_usb_in {
-    struct sl_gsusb_usb *u;
+typedef struct slp_gsusb_usb_in {
+    struct slp_gsusb_usb *u;
     struct libusb_transfer *t;
     uint8_t state;                 ///< idle / active / done (internal)
-    uint8_t buf[SL_GSUSB_USB_IN_BUF];
-} sl_gsusb_usb_in_t;
+    uint8_t buf[SLP_GSUSB_USB_IN_BUF];
+} slp_gsusb_usb_in_t;
 
 /// One bulk OUT transfer.
-typedef struct sl_gsusb_usb_out {
-    struct sl_gsusb_usb *u;
+typedef struct slp_gsusb_usb_out {
+    struct slp_gsusb_usb *u;
     struct libusb_transfer *t;
     uint8_t state;                 ///< idle / active / stalled (internal)
     uint32_t seq;                  ///< submission order (stalled frames are resent in order)
     uint8_t len;
-    uint8_t buf[SL_GSUSB_FRAME_MAX_BYTES];
-} sl_gsusb_usb_out_t;
+    uint8_t buf[SLP_GSUSB_FRAME_MAX_BYTES];
+} slp_gsusb_usb_out_t;
 
 /// Transport instance. Caller-allocated; fields read-only to the application.
-typedef struct sl_gsusb_usb {
+typedef struct slp_gsusb_usb {
     struct libusb_context *ctx;
     struct libusb_device_handle *h;
-    sl_gsusb_usb_sel_t sel;
+    slp_gsusb_usb_sel_t sel;
     uint32_t out_timeout_ms;       ///< per bulk OUT transfer (default 1000; gsusb_sink sets
                                    ///< it to the echo timeout)
     uint16_t vid, pid;             ///< of the opened device
@@ -127,49 +127,49 @@ typedef struct sl_gsusb_usb {
     bool out_halted;
     uint32_t out_seq;
     uint32_t open_attempts;        ///< every attempt after the first uses a fresh libusb context
-    sl_gsusb_usb_in_t in[SL_GSUSB_USB_IN_XFERS];
-    uint8_t done_q[SL_GSUSB_USB_IN_XFERS]; ///< completed IN transfers, oldest first
+    slp_gsusb_usb_in_t in[SLP_GSUSB_USB_IN_XFERS];
+    uint8_t done_q[SLP_GSUSB_USB_IN_XFERS]; ///< completed IN transfers, oldest first
     uint8_t done_head, done_count;
-    sl_gsusb_usb_out_t out[SL_GSUSB_USB_OUT_XFERS];
-    sl_gsusb_usb_stats_t stats;
+    slp_gsusb_usb_out_t out[SLP_GSUSB_USB_OUT_XFERS];
+    slp_gsusb_usb_stats_t stats;
     char err[192];                 ///< why the last open failed ("" = no failure)
-} sl_gsusb_usb_t;
+} slp_gsusb_usb_t;
 
 /// Initialise: a private libusb context. @return SL_OK or SL_ERR_PORT (libusb_init failed:
 /// `err` says why). Nothing is opened yet.
-sl_err_t sl_gsusb_usb_init(sl_gsusb_usb_t *u);
+sl_err_t slp_gsusb_usb_init(slp_gsusb_usb_t *u);
 
 /// Find, open, detach the kernel driver, claim interface 0, find the endpoints, queue the
 /// IN transfers. Every call after the first re-creates the libusb context first, so the
 /// bus is rescanned even where no udev daemon delivers hotplug events. @return SL_OK; SL_ERR_PORT (no matching device, permission denied,
 /// interface busy, ...: `err` says which, with the device); SL_ERR_STATE (already open);
 /// SL_ERR_ARG. Cost: one bus scan plus a few descriptor reads.
-sl_err_t sl_gsusb_usb_open(sl_gsusb_usb_t *u, const sl_gsusb_usb_sel_t *sel);
+sl_err_t slp_gsusb_usb_open(slp_gsusb_usb_t *u, const slp_gsusb_usb_sel_t *sel);
 
 /// True while a device is open (it may have vanished since: see `gone`).
-bool sl_gsusb_usb_is_open(const sl_gsusb_usb_t *u);
+bool slp_gsusb_usb_is_open(const slp_gsusb_usb_t *u);
 
 /// Cancel the transfers (waits up to 500 ms for them), release the interface, re-attach
 /// the kernel driver if we detached it, close. Idempotent; fine on a vanished device.
-void sl_gsusb_usb_close(sl_gsusb_usb_t *u);
+void slp_gsusb_usb_close(slp_gsusb_usb_t *u);
 
 /// Close and free the libusb context. Idempotent.
-void sl_gsusb_usb_deinit(sl_gsusb_usb_t *u);
+void slp_gsusb_usb_deinit(slp_gsusb_usb_t *u);
 
-/// The transport for sl_gsusb_init() (ops + this instance; borrowed).
-sl_gsusb_transport_t sl_gsusb_usb_transport(sl_gsusb_usb_t *u);
+/// The transport for slp_gsusb_init() (ops + this instance; borrowed).
+slp_gsusb_transport_t slp_gsusb_usb_transport(slp_gsusb_usb_t *u);
 
 /// File descriptors libusb wants polled (for a caller's poll() loop): up to `cap` entries
 /// written to `fds`. When one is ready, call the driver's poll. They belong to the current
 /// libusb context: ask again after every (re)open. @return how many. O(fds).
-size_t sl_gsusb_usb_pollfds(sl_gsusb_usb_t *u, struct pollfd *fds, size_t cap);
+size_t slp_gsusb_usb_pollfds(slp_gsusb_usb_t *u, struct pollfd *fds, size_t cap);
 
 /// Print every USB device with a known gs_usb id ("1d50:606f at 1-1 (bound to gs_usb)")
 /// into `buf` (one per line). @return the number found, or -1 when libusb failed.
-int sl_gsusb_usb_list(sl_gsusb_usb_t *u, char *buf, size_t cap);
+int slp_gsusb_usb_list(slp_gsusb_usb_t *u, char *buf, size_t cap);
 
 #ifdef __cplusplus
 }
 #endif
 
-#endif // SHADOWLEAN_GSUSB_LIBUSB_H
+#endif // SHADOWLEAN_PORT_GSUSB_USB_H

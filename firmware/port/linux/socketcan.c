@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
-// SocketCAN raw sink (can_socketcan.h). Non-blocking socket + MSG_DONTWAIT everywhere.
-#include "can_socketcan.h"
+// SocketCAN raw sink (socketcan.h). Non-blocking socket + MSG_DONTWAIT everywhere.
+#include "socketcan.h"
 
 #include <errno.h>
 #include <linux/can.h>
@@ -11,9 +11,9 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
-sl_can_socketcan_cfg_t sl_can_socketcan_default_cfg(void)
+slp_socketcan_cfg_t slp_socketcan_default_cfg(void)
 {
-    sl_can_socketcan_cfg_t c;
+    slp_socketcan_cfg_t c;
     memset(&c, 0, sizeof c);
     c.queue_cap = 16U;
     c.sndbuf_bytes = 0;
@@ -24,7 +24,7 @@ sl_can_socketcan_cfg_t sl_can_socketcan_default_cfg(void)
 }
 
 /// Create, configure and bind the socket. Sets s->fd or s->last_errno.
-static sl_err_t sock_open(sl_can_socketcan_t *s)
+static sl_err_t sock_open(slp_socketcan_t *s)
 {
     const int fd = socket(PF_CAN, SOCK_RAW | SOCK_NONBLOCK | SOCK_CLOEXEC, CAN_RAW);
     if (fd < 0) {
@@ -60,17 +60,17 @@ static sl_err_t sock_open(sl_can_socketcan_t *s)
     return SL_OK;
 }
 
-sl_err_t sl_can_socketcan_open(sl_can_socketcan_t *s, const char *ifname,
-                               const sl_can_socketcan_cfg_t *cfg)
+sl_err_t slp_socketcan_open(slp_socketcan_t *s, const char *ifname,
+                               const slp_socketcan_cfg_t *cfg)
 {
     if (s == NULL || ifname == NULL) {
         return SL_ERR_ARG;
     }
     memset(s, 0, sizeof *s);
     s->fd = -1;
-    s->cfg = (cfg != NULL) ? *cfg : sl_can_socketcan_default_cfg();
+    s->cfg = (cfg != NULL) ? *cfg : slp_socketcan_default_cfg();
     const size_t n = strlen(ifname);
-    if (n == 0U || n >= sizeof s->ifname || s->cfg.queue_cap > SL_CAN_SOCKETCAN_QUEUE_MAX) {
+    if (n == 0U || n >= sizeof s->ifname || s->cfg.queue_cap > SLP_SOCKETCAN_QUEUE_MAX) {
         return SL_ERR_ARG;
     }
     memcpy(s->ifname, ifname, n + 1U);
@@ -81,13 +81,13 @@ sl_err_t sl_can_socketcan_open(sl_can_socketcan_t *s, const char *ifname,
     return e;
 }
 
-static void queue_clear(sl_can_socketcan_t *s)
+static void queue_clear(slp_socketcan_t *s)
 {
     s->q_head = 0;
     s->q_len = 0;
 }
 
-void sl_can_socketcan_close(sl_can_socketcan_t *s)
+void slp_socketcan_close(slp_socketcan_t *s)
 {
     if (s == NULL) {
         return;
@@ -100,33 +100,33 @@ void sl_can_socketcan_close(sl_can_socketcan_t *s)
 }
 
 /// Everything queued is lost (link down / gone): count it.
-static void queue_drop_all(sl_can_socketcan_t *s, uint32_t *counter)
+static void queue_drop_all(slp_socketcan_t *s, uint32_t *counter)
 {
     *counter += s->q_len;
     queue_clear(s);
 }
 
-static bool queue_push(sl_can_socketcan_t *s, const sl_can_frame_t *f, uint64_t t_us)
+static bool queue_push(slp_socketcan_t *s, const sl_can_frame_t *f, uint64_t t_us)
 {
     if (s->q_len >= s->cfg.queue_cap) {
         s->stats.dropped_full++;
         return false;
     }
-    const unsigned tail = (s->q_head + s->q_len) % SL_CAN_SOCKETCAN_QUEUE_MAX;
+    const unsigned tail = (s->q_head + s->q_len) % SLP_SOCKETCAN_QUEUE_MAX;
     s->q[tail] = *f;
     s->q_t_us[tail] = t_us;
     s->q_len++;
     return true;
 }
 
-static void queue_pop(sl_can_socketcan_t *s)
+static void queue_pop(slp_socketcan_t *s)
 {
-    s->q_head = (uint16_t)((s->q_head + 1U) % SL_CAN_SOCKETCAN_QUEUE_MAX);
+    s->q_head = (uint16_t)((s->q_head + 1U) % SLP_SOCKETCAN_QUEUE_MAX);
     s->q_len--;
 }
 
 /// The interface vanished: drop the socket; reopen later.
-static void become_gone(sl_can_socketcan_t *s, uint64_t t_us)
+static void become_gone(slp_socketcan_t *s, uint64_t t_us)
 {
     if (s->fd >= 0) {
         close(s->fd);
@@ -140,7 +140,7 @@ static void become_gone(sl_can_socketcan_t *s, uint64_t t_us)
 /// Result of one write attempt.
 typedef enum { WR_OK, WR_RETRY, WR_DOWN, WR_GONE, WR_ERROR } wres_t;
 
-static wres_t write_frame(sl_can_socketcan_t *s, const sl_can_frame_t *f, uint64_t t_us)
+static wres_t write_frame(slp_socketcan_t *s, const sl_can_frame_t *f, uint64_t t_us)
 {
     struct can_frame cf;
     memset(&cf, 0, sizeof cf);
@@ -196,9 +196,9 @@ static wres_t write_frame(sl_can_socketcan_t *s, const sl_can_frame_t *f, uint64
 }
 
 /// Read the error frames waiting on the socket (bounded).
-static void read_errors(sl_can_socketcan_t *s, uint64_t t_us)
+static void read_errors(slp_socketcan_t *s, uint64_t t_us)
 {
-    for (unsigned i = 0; i < SL_CAN_SOCKETCAN_RX_BURST && s->fd >= 0; i++) {
+    for (unsigned i = 0; i < SLP_SOCKETCAN_RX_BURST && s->fd >= 0; i++) {
         struct can_frame cf;
         const ssize_t n = recv(s->fd, &cf, sizeof cf, MSG_DONTWAIT);
         if (n < 0) {
@@ -258,7 +258,7 @@ static void read_errors(sl_can_socketcan_t *s, uint64_t t_us)
 }
 
 /// Retry the queue head-first until it is empty or the socket pushes back.
-static void flush_queue(sl_can_socketcan_t *s, uint64_t t_us)
+static void flush_queue(slp_socketcan_t *s, uint64_t t_us)
 {
     while (s->q_len > 0U && s->fd >= 0) {
         const sl_can_frame_t *f = &s->q[s->q_head];
@@ -288,7 +288,7 @@ static void flush_queue(sl_can_socketcan_t *s, uint64_t t_us)
     }
 }
 
-void sl_can_socketcan_poll(sl_can_socketcan_t *s, uint64_t t_us)
+void slp_socketcan_poll(slp_socketcan_t *s, uint64_t t_us)
 {
     if (s == NULL) {
         return;
@@ -315,12 +315,12 @@ void sl_can_socketcan_poll(sl_can_socketcan_t *s, uint64_t t_us)
     }
 }
 
-sl_err_t sl_can_socketcan_send(sl_can_socketcan_t *s, const sl_can_frame_t *f, uint64_t t_us)
+sl_err_t slp_socketcan_send(slp_socketcan_t *s, const sl_can_frame_t *f, uint64_t t_us)
 {
     if (s == NULL || f == NULL) {
         return SL_ERR_ARG;
     }
-    sl_can_socketcan_poll(s, t_us);
+    slp_socketcan_poll(s, t_us);
     if (s->fd < 0) {
         s->stats.dropped_down++;
         return SL_ERR_PORT;
@@ -351,34 +351,34 @@ sl_err_t sl_can_socketcan_send(sl_can_socketcan_t *s, const sl_can_frame_t *f, u
     return SL_ERR_PORT;
 }
 
-uint32_t sl_can_socketcan_dropped(const sl_can_socketcan_t *s)
+uint32_t slp_socketcan_dropped(const slp_socketcan_t *s)
 {
-    const sl_can_socketcan_stats_t *st = &s->stats;
+    const slp_socketcan_stats_t *st = &s->stats;
     return st->dropped_full + st->dropped_stale + st->dropped_down + st->dropped_bus_off +
            st->dropped_error;
 }
 
 static sl_err_t sink_send(void *ctx, const sl_can_frame_t *f, uint64_t t_us)
 {
-    return sl_can_socketcan_send((sl_can_socketcan_t *)ctx, f, t_us);
+    return slp_socketcan_send((slp_socketcan_t *)ctx, f, t_us);
 }
 
 static void sink_poll(void *ctx, uint64_t t_us)
 {
-    sl_can_socketcan_poll((sl_can_socketcan_t *)ctx, t_us);
+    slp_socketcan_poll((slp_socketcan_t *)ctx, t_us);
 }
 
-static void sink_stats(void *ctx, sl_can_sink_stats_t *out)
+static void sink_stats(void *ctx, slp_can_sink_stats_t *out)
 {
-    const sl_can_socketcan_t *s = (const sl_can_socketcan_t *)ctx;
+    const slp_socketcan_t *s = (const slp_socketcan_t *)ctx;
     out->sent = s->stats.sent;
-    out->dropped = sl_can_socketcan_dropped(s);
+    out->dropped = slp_socketcan_dropped(s);
     out->queued = s->q_len;
     out->errors = s->stats.error_frames;
 }
 
-sl_can_sink_t sl_can_socketcan_sink(sl_can_socketcan_t *s)
+slp_can_sink_t slp_socketcan_sink(slp_socketcan_t *s)
 {
-    sl_can_sink_t k = {"socketcan", s, sink_send, sink_poll, sink_stats};
+    slp_can_sink_t k = {"socketcan", s, sink_send, sink_poll, sink_stats};
     return k;
 }

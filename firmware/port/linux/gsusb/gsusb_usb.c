@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
-// libusb-1.0 transport for gs_usb adapters (see gsusb_libusb.h).
-#include "gsusb_libusb.h"
+// libusb-1.0 transport for gs_usb adapters (see gsusb_usb.h).
+#include "gsusb_usb.h"
 
 #include <libusb-1.0/libusb.h>
 #include <stdarg.h>
@@ -18,8 +18,8 @@ static uint64_t mono_ms(void)
     return (uint64_t)ts.tv_sec * 1000U + (uint64_t)ts.tv_nsec / 1000000U;
 }
 
-static void set_err(sl_gsusb_usb_t *u, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
-static void set_err(sl_gsusb_usb_t *u, const char *fmt, ...)
+static void set_err(slp_gsusb_usb_t *u, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+static void set_err(slp_gsusb_usb_t *u, const char *fmt, ...)
 {
     va_list ap;
     va_start(ap, fmt);
@@ -45,7 +45,7 @@ static bool parse_uint(const char **p, unsigned base, unsigned long max, unsigne
     return true;
 }
 
-sl_err_t sl_gsusb_usb_parse_selector(const char *s, sl_gsusb_usb_sel_t *out)
+sl_err_t slp_gsusb_usb_parse_selector(const char *s, slp_gsusb_usb_sel_t *out)
 {
     if (out == NULL) {
         return SL_ERR_ARG;
@@ -72,7 +72,7 @@ sl_err_t sl_gsusb_usb_parse_selector(const char *s, sl_gsusb_usb_sel_t *out)
     }
     out->bus = (uint8_t)a;
     for (;;) {
-        if (out->n_ports >= SL_GSUSB_USB_MAX_PORTS || !parse_uint(&p, 10, 255, &b) || b == 0U) {
+        if (out->n_ports >= SLP_GSUSB_USB_MAX_PORTS || !parse_uint(&p, 10, 255, &b) || b == 0U) {
             return SL_ERR_ARG;
         }
         out->ports[out->n_ports++] = (uint8_t)b;
@@ -89,7 +89,7 @@ sl_err_t sl_gsusb_usb_parse_selector(const char *s, sl_gsusb_usb_sel_t *out)
 
 static void port_name(libusb_device *dev, char *buf, size_t cap)
 {
-    uint8_t ports[SL_GSUSB_USB_MAX_PORTS];
+    uint8_t ports[SLP_GSUSB_USB_MAX_PORTS];
     int n = libusb_get_port_numbers(dev, ports, (int)sizeof ports);
     int k = snprintf(buf, cap, "%u-", (unsigned)libusb_get_bus_number(dev));
     for (int i = 0; i < n && k > 0 && (size_t)k < cap; i++) {
@@ -100,22 +100,22 @@ static void port_name(libusb_device *dev, char *buf, size_t cap)
     }
 }
 
-static bool matches(const sl_gsusb_usb_sel_t *sel, libusb_device *dev,
+static bool matches(const slp_gsusb_usb_sel_t *sel, libusb_device *dev,
                     const struct libusb_device_descriptor *dd)
 {
     if (sel->by_id) {
         return dd->idVendor == sel->vid && dd->idProduct == sel->pid;
     }
     if (sel->by_port) {
-        uint8_t ports[SL_GSUSB_USB_MAX_PORTS];
+        uint8_t ports[SLP_GSUSB_USB_MAX_PORTS];
         int n = libusb_get_port_numbers(dev, ports, (int)sizeof ports);
         return libusb_get_bus_number(dev) == sel->bus && n == (int)sel->n_ports &&
                memcmp(ports, sel->ports, sel->n_ports) == 0;
     }
-    return sl_gsusb_is_known_id(dd->idVendor, dd->idProduct);
+    return slp_gsusb_is_known_id(dd->idVendor, dd->idProduct);
 }
 
-static void sel_text(const sl_gsusb_usb_sel_t *sel, char *buf, size_t cap)
+static void sel_text(const slp_gsusb_usb_sel_t *sel, char *buf, size_t cap)
 {
     if (sel->by_id) {
         (void)snprintf(buf, cap, "%04x:%04x", (unsigned)sel->vid, (unsigned)sel->pid);
@@ -132,7 +132,7 @@ static void sel_text(const sl_gsusb_usb_sel_t *sel, char *buf, size_t cap)
 // ---------------------------------------------------------------------------------------
 // Init / open / close
 
-sl_err_t sl_gsusb_usb_init(sl_gsusb_usb_t *u)
+sl_err_t slp_gsusb_usb_init(slp_gsusb_usb_t *u)
 {
     if (u == NULL) {
         return SL_ERR_ARG;
@@ -148,27 +148,27 @@ sl_err_t sl_gsusb_usb_init(sl_gsusb_usb_t *u)
     return SL_OK;
 }
 
-bool sl_gsusb_usb_is_open(const sl_gsusb_usb_t *u)
+bool slp_gsusb_usb_is_open(const slp_gsusb_usb_t *u)
 {
     return u != NULL && u->h != NULL;
 }
 
 static void LIBUSB_CALL in_cb(struct libusb_transfer *t)
 {
-    sl_gsusb_usb_in_t *x = t->user_data;
-    sl_gsusb_usb_t *u = x->u;
+    slp_gsusb_usb_in_t *x = t->user_data;
+    slp_gsusb_usb_t *u = x->u;
     x->state = X_DONE;
-    if (u->done_count < SL_GSUSB_USB_IN_XFERS) {
+    if (u->done_count < SLP_GSUSB_USB_IN_XFERS) {
         uint8_t idx = (uint8_t)(x - u->in);
-        u->done_q[(u->done_head + u->done_count) % SL_GSUSB_USB_IN_XFERS] = idx;
+        u->done_q[(u->done_head + u->done_count) % SLP_GSUSB_USB_IN_XFERS] = idx;
         u->done_count++;
     }
 }
 
 static void LIBUSB_CALL out_cb(struct libusb_transfer *t)
 {
-    sl_gsusb_usb_out_t *x = t->user_data;
-    sl_gsusb_usb_t *u = x->u;
+    slp_gsusb_usb_out_t *x = t->user_data;
+    slp_gsusb_usb_t *u = x->u;
     switch (t->status) {
     case LIBUSB_TRANSFER_COMPLETED:
         if (t->actual_length == t->length) {
@@ -213,7 +213,7 @@ static void LIBUSB_CALL out_cb(struct libusb_transfer *t)
     }
 }
 
-static void mark_gone(sl_gsusb_usb_t *u)
+static void mark_gone(slp_gsusb_usb_t *u)
 {
     if (!u->gone) {
         u->stats.no_device++;
@@ -221,7 +221,7 @@ static void mark_gone(sl_gsusb_usb_t *u)
     u->gone = true;
 }
 
-static void submit_in(sl_gsusb_usb_t *u, sl_gsusb_usb_in_t *x)
+static void submit_in(slp_gsusb_usb_t *u, slp_gsusb_usb_in_t *x)
 {
     if (u->gone || x->t == NULL) {
         x->state = X_IDLE;
@@ -241,7 +241,7 @@ static void submit_in(sl_gsusb_usb_t *u, sl_gsusb_usb_in_t *x)
     }
 }
 
-static int submit_out(sl_gsusb_usb_t *u, sl_gsusb_usb_out_t *x)
+static int submit_out(slp_gsusb_usb_t *u, slp_gsusb_usb_out_t *x)
 {
     libusb_fill_bulk_transfer(x->t, u->h, u->ep_out, x->buf, (int)x->len, out_cb, x,
                               u->out_timeout_ms);
@@ -260,32 +260,32 @@ static int submit_out(sl_gsusb_usb_t *u, sl_gsusb_usb_out_t *x)
     return r;
 }
 
-static void handle_events_ms(sl_gsusb_usb_t *u, uint32_t ms)
+static void handle_events_ms(slp_gsusb_usb_t *u, uint32_t ms)
 {
     struct timeval tv = {(time_t)(ms / 1000U), (suseconds_t)((ms % 1000U) * 1000U)};
     (void)libusb_handle_events_timeout_completed(u->ctx, &tv, NULL);
 }
 
-static size_t active_in(const sl_gsusb_usb_t *u)
+static size_t active_in(const slp_gsusb_usb_t *u)
 {
     size_t n = 0;
-    for (size_t i = 0; i < SL_GSUSB_USB_IN_XFERS; i++) {
+    for (size_t i = 0; i < SLP_GSUSB_USB_IN_XFERS; i++) {
         n += u->in[i].state == X_ACTIVE ? 1U : 0U;
     }
     return n;
 }
 
-static size_t active_out(const sl_gsusb_usb_t *u)
+static size_t active_out(const slp_gsusb_usb_t *u)
 {
     size_t n = 0;
-    for (size_t i = 0; i < SL_GSUSB_USB_OUT_XFERS; i++) {
+    for (size_t i = 0; i < SLP_GSUSB_USB_OUT_XFERS; i++) {
         n += u->out[i].state == X_ACTIVE ? 1U : 0U;
     }
     return n;
 }
 
 // Wait (handling events) until `count(u)` is 0 or `ms` passed.
-static void wait_idle(sl_gsusb_usb_t *u, size_t (*count)(const sl_gsusb_usb_t *), uint32_t ms)
+static void wait_idle(slp_gsusb_usb_t *u, size_t (*count)(const slp_gsusb_usb_t *), uint32_t ms)
 {
     uint64_t end = mono_ms() + ms;
     while (count(u) > 0U) {
@@ -297,10 +297,10 @@ static void wait_idle(sl_gsusb_usb_t *u, size_t (*count)(const sl_gsusb_usb_t *)
     }
 }
 
-static void find_endpoints(sl_gsusb_usb_t *u, libusb_device *dev)
+static void find_endpoints(slp_gsusb_usb_t *u, libusb_device *dev)
 {
-    u->ep_in = (uint8_t)SL_GSUSB_EP_IN_DEFAULT;
-    u->ep_out = (uint8_t)SL_GSUSB_EP_OUT_DEFAULT;
+    u->ep_in = (uint8_t)SLP_GSUSB_EP_IN_DEFAULT;
+    u->ep_out = (uint8_t)SLP_GSUSB_EP_OUT_DEFAULT;
     u->mps_in = 64;
     u->eps_from_descriptor = false;
     struct libusb_config_descriptor *cfg = NULL;
@@ -311,7 +311,7 @@ static void find_endpoints(sl_gsusb_usb_t *u, libusb_device *dev)
     bool have_out = false;
     for (uint8_t i = 0; i < cfg->bNumInterfaces; i++) {
         const struct libusb_interface *itf = &cfg->interface[i];
-        if (itf->num_altsetting < 1 || itf->altsetting[0].bInterfaceNumber != SL_GSUSB_INTERFACE) {
+        if (itf->num_altsetting < 1 || itf->altsetting[0].bInterfaceNumber != SLP_GSUSB_INTERFACE) {
             continue;
         }
         const struct libusb_interface_descriptor *alt = &itf->altsetting[0];
@@ -335,18 +335,18 @@ static void find_endpoints(sl_gsusb_usb_t *u, libusb_device *dev)
     libusb_free_config_descriptor(cfg);
     u->eps_from_descriptor = have_in && have_out;
     if (!u->eps_from_descriptor) {
-        u->ep_in = (uint8_t)SL_GSUSB_EP_IN_DEFAULT;
-        u->ep_out = (uint8_t)SL_GSUSB_EP_OUT_DEFAULT;
+        u->ep_in = (uint8_t)SLP_GSUSB_EP_IN_DEFAULT;
+        u->ep_out = (uint8_t)SLP_GSUSB_EP_OUT_DEFAULT;
         u->mps_in = 64;
     }
-    if (u->mps_in < SL_GSUSB_FRAME_MAX_BYTES || u->mps_in > SL_GSUSB_USB_IN_BUF) {
+    if (u->mps_in < SLP_GSUSB_FRAME_MAX_BYTES || u->mps_in > SLP_GSUSB_USB_IN_BUF) {
         u->mps_in = 64; // nonsense descriptor: a full-speed packet holds any classic frame
     }
 }
 
-static void free_transfers(sl_gsusb_usb_t *u)
+static void free_transfers(slp_gsusb_usb_t *u)
 {
-    for (size_t i = 0; i < SL_GSUSB_USB_IN_XFERS; i++) {
+    for (size_t i = 0; i < SLP_GSUSB_USB_IN_XFERS; i++) {
         if (u->in[i].t != NULL && u->in[i].state != X_ACTIVE) {
             libusb_free_transfer(u->in[i].t);
         } else if (u->in[i].t != NULL) {
@@ -355,7 +355,7 @@ static void free_transfers(sl_gsusb_usb_t *u)
         u->in[i].t = NULL;
         u->in[i].state = X_IDLE;
     }
-    for (size_t i = 0; i < SL_GSUSB_USB_OUT_XFERS; i++) {
+    for (size_t i = 0; i < SLP_GSUSB_USB_OUT_XFERS; i++) {
         if (u->out[i].t != NULL && u->out[i].state != X_ACTIVE) {
             libusb_free_transfer(u->out[i].t);
         } else if (u->out[i].t != NULL) {
@@ -368,14 +368,14 @@ static void free_transfers(sl_gsusb_usb_t *u)
     u->done_count = 0;
 }
 
-static sl_err_t open_fail(sl_gsusb_usb_t *u)
+static sl_err_t open_fail(slp_gsusb_usb_t *u)
 {
     u->stats.open_failures++;
-    sl_gsusb_usb_close(u);
+    slp_gsusb_usb_close(u);
     return SL_ERR_PORT;
 }
 
-sl_err_t sl_gsusb_usb_open(sl_gsusb_usb_t *u, const sl_gsusb_usb_sel_t *sel)
+sl_err_t slp_gsusb_usb_open(slp_gsusb_usb_t *u, const slp_gsusb_usb_sel_t *sel)
 {
     if (u == NULL || sel == NULL) {
         return SL_ERR_ARG;
@@ -452,9 +452,9 @@ sl_err_t sl_gsusb_usb_open(sl_gsusb_usb_t *u, const sl_gsusb_usb_sel_t *sel)
     find_endpoints(u, dev);
     libusb_free_device_list(list, 1);
 
-    int r = libusb_kernel_driver_active(u->h, (int)SL_GSUSB_INTERFACE);
+    int r = libusb_kernel_driver_active(u->h, (int)SLP_GSUSB_INTERFACE);
     if (r == 1) {
-        r = libusb_detach_kernel_driver(u->h, (int)SL_GSUSB_INTERFACE);
+        r = libusb_detach_kernel_driver(u->h, (int)SLP_GSUSB_INTERFACE);
         if (r != 0) {
             set_err(u, "%04x:%04x at %s: cannot detach the kernel driver: %s", u->vid, u->pid,
                     u->where, libusb_error_name(r));
@@ -463,7 +463,7 @@ sl_err_t sl_gsusb_usb_open(sl_gsusb_usb_t *u, const sl_gsusb_usb_sel_t *sel)
         u->detached = true;
         u->stats.kernel_detaches++;
     }
-    r = libusb_claim_interface(u->h, (int)SL_GSUSB_INTERFACE);
+    r = libusb_claim_interface(u->h, (int)SLP_GSUSB_INTERFACE);
     if (r != 0) {
         set_err(u, "%04x:%04x at %s: cannot claim interface 0: %s%s", u->vid, u->pid, u->where,
                 libusb_error_name(r), r == LIBUSB_ERROR_BUSY ? " (another program has it)" : "");
@@ -471,7 +471,7 @@ sl_err_t sl_gsusb_usb_open(sl_gsusb_usb_t *u, const sl_gsusb_usb_sel_t *sel)
     }
     u->claimed = true;
 
-    for (size_t i = 0; i < SL_GSUSB_USB_IN_XFERS; i++) {
+    for (size_t i = 0; i < SLP_GSUSB_USB_IN_XFERS; i++) {
         u->in[i].u = u;
         u->in[i].state = X_IDLE;
         u->in[i].t = libusb_alloc_transfer(0);
@@ -480,7 +480,7 @@ sl_err_t sl_gsusb_usb_open(sl_gsusb_usb_t *u, const sl_gsusb_usb_sel_t *sel)
             return open_fail(u);
         }
     }
-    for (size_t i = 0; i < SL_GSUSB_USB_OUT_XFERS; i++) {
+    for (size_t i = 0; i < SLP_GSUSB_USB_OUT_XFERS; i++) {
         u->out[i].u = u;
         u->out[i].state = X_IDLE;
         u->out[i].t = libusb_alloc_transfer(0);
@@ -491,7 +491,7 @@ sl_err_t sl_gsusb_usb_open(sl_gsusb_usb_t *u, const sl_gsusb_usb_sel_t *sel)
     }
     u->done_head = 0;
     u->done_count = 0;
-    for (size_t i = 0; i < SL_GSUSB_USB_IN_XFERS; i++) {
+    for (size_t i = 0; i < SLP_GSUSB_USB_IN_XFERS; i++) {
         submit_in(u, &u->in[i]);
     }
     if (u->gone || active_in(u) == 0U) {
@@ -503,17 +503,17 @@ sl_err_t sl_gsusb_usb_open(sl_gsusb_usb_t *u, const sl_gsusb_usb_sel_t *sel)
     return SL_OK;
 }
 
-void sl_gsusb_usb_close(sl_gsusb_usb_t *u)
+void slp_gsusb_usb_close(slp_gsusb_usb_t *u)
 {
     if (u == NULL || u->h == NULL) {
         return;
     }
-    for (size_t i = 0; i < SL_GSUSB_USB_IN_XFERS; i++) {
+    for (size_t i = 0; i < SLP_GSUSB_USB_IN_XFERS; i++) {
         if (u->in[i].state == X_ACTIVE) {
             (void)libusb_cancel_transfer(u->in[i].t);
         }
     }
-    for (size_t i = 0; i < SL_GSUSB_USB_OUT_XFERS; i++) {
+    for (size_t i = 0; i < SLP_GSUSB_USB_OUT_XFERS; i++) {
         if (u->out[i].state == X_ACTIVE) {
             (void)libusb_cancel_transfer(u->out[i].t);
         }
@@ -522,11 +522,11 @@ void sl_gsusb_usb_close(sl_gsusb_usb_t *u)
     wait_idle(u, active_out, 200U);
     free_transfers(u);
     if (u->claimed) {
-        (void)libusb_release_interface(u->h, (int)SL_GSUSB_INTERFACE);
+        (void)libusb_release_interface(u->h, (int)SLP_GSUSB_INTERFACE);
         u->claimed = false;
     }
     if (u->detached) {
-        int r = libusb_attach_kernel_driver(u->h, (int)SL_GSUSB_INTERFACE);
+        int r = libusb_attach_kernel_driver(u->h, (int)SLP_GSUSB_INTERFACE);
         if (r == 0) {
             u->stats.kernel_reattaches++;
         } else {
@@ -540,12 +540,12 @@ void sl_gsusb_usb_close(sl_gsusb_usb_t *u)
     u->out_halted = false;
 }
 
-void sl_gsusb_usb_deinit(sl_gsusb_usb_t *u)
+void slp_gsusb_usb_deinit(slp_gsusb_usb_t *u)
 {
     if (u == NULL) {
         return;
     }
-    sl_gsusb_usb_close(u);
+    slp_gsusb_usb_close(u);
     if (u->ctx != NULL) {
         libusb_exit(u->ctx);
         u->ctx = NULL;
@@ -555,45 +555,45 @@ void sl_gsusb_usb_deinit(sl_gsusb_usb_t *u)
 // ---------------------------------------------------------------------------------------
 // Transport operations
 
-static sl_gsusb_io_t map_err(sl_gsusb_usb_t *u, int r)
+static slp_gsusb_io_t map_err(slp_gsusb_usb_t *u, int r)
 {
     switch (r) {
-    case LIBUSB_SUCCESS: return SL_GSUSB_IO_OK;
-    case LIBUSB_ERROR_TIMEOUT: return SL_GSUSB_IO_TIMEOUT;
-    case LIBUSB_ERROR_PIPE: return SL_GSUSB_IO_STALL;
-    case LIBUSB_ERROR_OVERFLOW: return SL_GSUSB_IO_OVERFLOW;
+    case LIBUSB_SUCCESS: return SLP_GSUSB_IO_OK;
+    case LIBUSB_ERROR_TIMEOUT: return SLP_GSUSB_IO_TIMEOUT;
+    case LIBUSB_ERROR_PIPE: return SLP_GSUSB_IO_STALL;
+    case LIBUSB_ERROR_OVERFLOW: return SLP_GSUSB_IO_OVERFLOW;
     case LIBUSB_ERROR_NO_DEVICE:
         mark_gone(u);
-        return SL_GSUSB_IO_NO_DEVICE;
-    default: return SL_GSUSB_IO_ERROR;
+        return SLP_GSUSB_IO_NO_DEVICE;
+    default: return SLP_GSUSB_IO_ERROR;
     }
 }
 
-static sl_gsusb_io_t usb_control(sl_gsusb_usb_t *u, uint8_t rt, uint8_t breq, uint16_t wvalue,
+static slp_gsusb_io_t usb_control(slp_gsusb_usb_t *u, uint8_t rt, uint8_t breq, uint16_t wvalue,
                                  uint16_t windex, uint8_t *data, uint16_t len, uint32_t timeout_ms,
                                  size_t *transferred)
 {
     *transferred = 0;
     if (u->h == NULL || u->gone) {
-        return SL_GSUSB_IO_NO_DEVICE;
+        return SLP_GSUSB_IO_NO_DEVICE;
     }
     int r = libusb_control_transfer(u->h, rt, breq, wvalue, windex, data, len,
                                     timeout_ms == 0U ? 1U : timeout_ms);
     if (r >= 0) {
         *transferred = (size_t)r;
-        return SL_GSUSB_IO_OK;
+        return SLP_GSUSB_IO_OK;
     }
     return map_err(u, r);
 }
 
-static sl_gsusb_io_t op_control_out(void *ctx, uint8_t rt, uint8_t breq, uint16_t wvalue,
+static slp_gsusb_io_t op_control_out(void *ctx, uint8_t rt, uint8_t breq, uint16_t wvalue,
                                     uint16_t windex, const uint8_t *data, uint16_t len,
                                     uint32_t timeout_ms, size_t *transferred)
 {
     uint8_t buf[64];
     if (len > sizeof buf) {
         *transferred = 0;
-        return SL_GSUSB_IO_ERROR;
+        return SLP_GSUSB_IO_ERROR;
     }
     if (len > 0U) {
         memcpy(buf, data, len);
@@ -601,35 +601,35 @@ static sl_gsusb_io_t op_control_out(void *ctx, uint8_t rt, uint8_t breq, uint16_
     return usb_control(ctx, rt, breq, wvalue, windex, buf, len, timeout_ms, transferred);
 }
 
-static sl_gsusb_io_t op_control_in(void *ctx, uint8_t rt, uint8_t breq, uint16_t wvalue,
+static slp_gsusb_io_t op_control_in(void *ctx, uint8_t rt, uint8_t breq, uint16_t wvalue,
                                    uint16_t windex, uint8_t *data, uint16_t len,
                                    uint32_t timeout_ms, size_t *transferred)
 {
     return usb_control(ctx, rt, breq, wvalue, windex, data, len, timeout_ms, transferred);
 }
 
-static sl_gsusb_io_t op_bulk_out(void *ctx, const uint8_t *data, size_t len, uint32_t timeout_ms,
+static slp_gsusb_io_t op_bulk_out(void *ctx, const uint8_t *data, size_t len, uint32_t timeout_ms,
                                  size_t *transferred)
 {
-    sl_gsusb_usb_t *u = ctx;
+    slp_gsusb_usb_t *u = ctx;
     *transferred = 0;
     if (u->h == NULL || u->gone) {
-        return SL_GSUSB_IO_NO_DEVICE;
+        return SLP_GSUSB_IO_NO_DEVICE;
     }
-    if (len > SL_GSUSB_FRAME_MAX_BYTES) {
-        return SL_GSUSB_IO_ERROR;
+    if (len > SLP_GSUSB_FRAME_MAX_BYTES) {
+        return SLP_GSUSB_IO_ERROR;
     }
     handle_events_ms(u, 0); // reap finished transfers (a stall or unplug shows up here)
     if (u->gone) {
-        return SL_GSUSB_IO_NO_DEVICE;
+        return SLP_GSUSB_IO_NO_DEVICE;
     }
     if (u->out_halted) {
-        return SL_GSUSB_IO_STALL;
+        return SLP_GSUSB_IO_STALL;
     }
     uint64_t end = mono_ms() + timeout_ms;
-    sl_gsusb_usb_out_t *x = NULL;
+    slp_gsusb_usb_out_t *x = NULL;
     for (;;) {
-        for (size_t i = 0; i < SL_GSUSB_USB_OUT_XFERS; i++) {
+        for (size_t i = 0; i < SLP_GSUSB_USB_OUT_XFERS; i++) {
             if (u->out[i].state == X_IDLE) {
                 x = &u->out[i];
                 break;
@@ -642,13 +642,13 @@ static sl_gsusb_io_t op_bulk_out(void *ctx, const uint8_t *data, size_t len, uin
         handle_events_ms(u, (uint32_t)(end - now));
     }
     if (u->gone) {
-        return SL_GSUSB_IO_NO_DEVICE;
+        return SLP_GSUSB_IO_NO_DEVICE;
     }
     if (u->out_halted) {
-        return SL_GSUSB_IO_STALL;
+        return SLP_GSUSB_IO_STALL;
     }
     if (x == NULL) {
-        return SL_GSUSB_IO_TIMEOUT; // every slot busy: the device is not taking frames
+        return SLP_GSUSB_IO_TIMEOUT; // every slot busy: the device is not taking frames
     }
     memcpy(x->buf, data, len);
     x->len = (uint8_t)len;
@@ -658,25 +658,25 @@ static sl_gsusb_io_t op_bulk_out(void *ctx, const uint8_t *data, size_t len, uin
         return map_err(u, r);
     }
     *transferred = len;
-    return SL_GSUSB_IO_OK;
+    return SLP_GSUSB_IO_OK;
 }
 
-static sl_gsusb_io_t op_bulk_in(void *ctx, uint8_t *buf, size_t cap, uint32_t timeout_ms,
+static slp_gsusb_io_t op_bulk_in(void *ctx, uint8_t *buf, size_t cap, uint32_t timeout_ms,
                                 size_t *transferred)
 {
-    sl_gsusb_usb_t *u = ctx;
+    slp_gsusb_usb_t *u = ctx;
     *transferred = 0;
     if (u->h == NULL) {
-        return SL_GSUSB_IO_NO_DEVICE;
+        return SLP_GSUSB_IO_NO_DEVICE;
     }
     uint64_t end = mono_ms() + timeout_ms;
     bool waited = false;
     for (;;) {
         while (u->done_count > 0U) {
             uint8_t idx = u->done_q[u->done_head];
-            u->done_head = (uint8_t)((u->done_head + 1U) % SL_GSUSB_USB_IN_XFERS);
+            u->done_head = (uint8_t)((u->done_head + 1U) % SLP_GSUSB_USB_IN_XFERS);
             u->done_count--;
-            sl_gsusb_usb_in_t *x = &u->in[idx];
+            slp_gsusb_usb_in_t *x = &u->in[idx];
             struct libusb_transfer *t = x->t;
             size_t got = t->actual_length > 0 ? (size_t)t->actual_length : 0U;
             x->state = X_IDLE;
@@ -690,20 +690,20 @@ static sl_gsusb_io_t op_bulk_in(void *ctx, uint8_t *buf, size_t cap, uint32_t ti
                 if (!u->in_halted) {
                     submit_in(u, x);
                 }
-                return got > cap ? SL_GSUSB_IO_OVERFLOW : SL_GSUSB_IO_OK;
+                return got > cap ? SLP_GSUSB_IO_OVERFLOW : SLP_GSUSB_IO_OK;
             }
             switch (t->status) {
             case LIBUSB_TRANSFER_STALL:
                 u->stats.in_stalls++;
                 u->in_halted = true; // resubmitted by clear_halt(IN)
-                return SL_GSUSB_IO_STALL;
+                return SLP_GSUSB_IO_STALL;
             case LIBUSB_TRANSFER_NO_DEVICE:
                 mark_gone(u);
-                return SL_GSUSB_IO_NO_DEVICE;
+                return SLP_GSUSB_IO_NO_DEVICE;
             case LIBUSB_TRANSFER_OVERFLOW:
                 u->stats.in_errors++;
                 submit_in(u, x);
-                return SL_GSUSB_IO_OVERFLOW;
+                return SLP_GSUSB_IO_OVERFLOW;
             case LIBUSB_TRANSFER_COMPLETED: // zero-length packet
                 submit_in(u, x);
                 continue;
@@ -717,42 +717,42 @@ static sl_gsusb_io_t op_bulk_in(void *ctx, uint8_t *buf, size_t cap, uint32_t ti
             default:
                 u->stats.in_errors++;
                 submit_in(u, x);
-                return SL_GSUSB_IO_ERROR;
+                return SLP_GSUSB_IO_ERROR;
             }
         }
         if (u->gone) {
-            return SL_GSUSB_IO_NO_DEVICE;
+            return SLP_GSUSB_IO_NO_DEVICE;
         }
         if (u->in_halted) {
-            return SL_GSUSB_IO_STALL;
+            return SLP_GSUSB_IO_STALL;
         }
         uint64_t now = mono_ms();
         if (waited && now >= end) {
-            return SL_GSUSB_IO_TIMEOUT;
+            return SLP_GSUSB_IO_TIMEOUT;
         }
         handle_events_ms(u, now >= end ? 0U : (uint32_t)(end - now));
         waited = true;
     }
 }
 
-static sl_gsusb_io_t op_clear_halt(void *ctx, bool in)
+static slp_gsusb_io_t op_clear_halt(void *ctx, bool in)
 {
-    sl_gsusb_usb_t *u = ctx;
+    slp_gsusb_usb_t *u = ctx;
     if (u->h == NULL || u->gone) {
-        return SL_GSUSB_IO_NO_DEVICE;
+        return SLP_GSUSB_IO_NO_DEVICE;
     }
     if (in) {
-        for (size_t i = 0; i < SL_GSUSB_USB_IN_XFERS; i++) {
+        for (size_t i = 0; i < SLP_GSUSB_USB_IN_XFERS; i++) {
             if (u->in[i].state == X_ACTIVE) {
                 (void)libusb_cancel_transfer(u->in[i].t);
             }
         }
         wait_idle(u, active_in, 200U);
         // Keep completed packets (in order); forget the stalled/cancelled empty ones.
-        uint8_t keep[SL_GSUSB_USB_IN_XFERS];
+        uint8_t keep[SLP_GSUSB_USB_IN_XFERS];
         uint8_t nkeep = 0;
         for (uint8_t k = 0; k < u->done_count; k++) {
-            uint8_t idx = u->done_q[(u->done_head + k) % SL_GSUSB_USB_IN_XFERS];
+            uint8_t idx = u->done_q[(u->done_head + k) % SLP_GSUSB_USB_IN_XFERS];
             struct libusb_transfer *t = u->in[idx].t;
             if (t->actual_length > 0 && t->status != LIBUSB_TRANSFER_STALL &&
                 t->status != LIBUSB_TRANSFER_NO_DEVICE) {
@@ -770,15 +770,15 @@ static sl_gsusb_io_t op_clear_halt(void *ctx, bool in)
         }
         u->stats.clear_halts++;
         u->in_halted = false;
-        for (size_t i = 0; i < SL_GSUSB_USB_IN_XFERS; i++) {
+        for (size_t i = 0; i < SLP_GSUSB_USB_IN_XFERS; i++) {
             if (u->in[i].state == X_IDLE) {
                 submit_in(u, &u->in[i]);
             }
         }
-        return u->gone ? SL_GSUSB_IO_NO_DEVICE : SL_GSUSB_IO_OK;
+        return u->gone ? SLP_GSUSB_IO_NO_DEVICE : SLP_GSUSB_IO_OK;
     }
     // OUT: stop what is still queued (it would hit the halt too), clear, resend in order.
-    for (size_t i = 0; i < SL_GSUSB_USB_OUT_XFERS; i++) {
+    for (size_t i = 0; i < SLP_GSUSB_USB_OUT_XFERS; i++) {
         if (u->out[i].state == X_ACTIVE) {
             (void)libusb_cancel_transfer(u->out[i].t);
         }
@@ -791,9 +791,9 @@ static sl_gsusb_io_t op_clear_halt(void *ctx, bool in)
     u->stats.clear_halts++;
     u->out_halted = false;
     for (;;) {
-        sl_gsusb_usb_out_t *first = NULL;
-        for (size_t i = 0; i < SL_GSUSB_USB_OUT_XFERS; i++) {
-            sl_gsusb_usb_out_t *x = &u->out[i];
+        slp_gsusb_usb_out_t *first = NULL;
+        for (size_t i = 0; i < SLP_GSUSB_USB_OUT_XFERS; i++) {
+            slp_gsusb_usb_out_t *x = &u->out[i];
             if (x->state == X_STALLED && (first == NULL || (int32_t)(x->seq - first->seq) < 0)) {
                 first = x;
             }
@@ -806,24 +806,24 @@ static sl_gsusb_io_t op_clear_halt(void *ctx, bool in)
             break;
         }
     }
-    for (size_t i = 0; i < SL_GSUSB_USB_OUT_XFERS; i++) {
+    for (size_t i = 0; i < SLP_GSUSB_USB_OUT_XFERS; i++) {
         if (u->out[i].state == X_STALLED) {
             u->out[i].state = X_IDLE; // could not be resent: lost (echo timeout reports it)
         }
     }
-    return u->gone ? SL_GSUSB_IO_NO_DEVICE : SL_GSUSB_IO_OK;
+    return u->gone ? SLP_GSUSB_IO_NO_DEVICE : SLP_GSUSB_IO_OK;
 }
 
 static bool op_out_stalled(void *ctx)
 {
-    sl_gsusb_usb_t *u = ctx;
+    slp_gsusb_usb_t *u = ctx;
     if (u->h != NULL && !u->gone) {
         handle_events_ms(u, 0);
     }
     return u->h != NULL && !u->gone && u->out_halted;
 }
 
-static const sl_gsusb_transport_ops_t usb_ops = {
+static const slp_gsusb_transport_ops_t usb_ops = {
     .control_out = op_control_out,
     .control_in = op_control_in,
     .bulk_out = op_bulk_out,
@@ -832,13 +832,13 @@ static const sl_gsusb_transport_ops_t usb_ops = {
     .out_stalled = op_out_stalled,
 };
 
-sl_gsusb_transport_t sl_gsusb_usb_transport(sl_gsusb_usb_t *u)
+slp_gsusb_transport_t slp_gsusb_usb_transport(slp_gsusb_usb_t *u)
 {
-    sl_gsusb_transport_t t = {&usb_ops, u};
+    slp_gsusb_transport_t t = {&usb_ops, u};
     return t;
 }
 
-size_t sl_gsusb_usb_pollfds(sl_gsusb_usb_t *u, struct pollfd *fds, size_t cap)
+size_t slp_gsusb_usb_pollfds(slp_gsusb_usb_t *u, struct pollfd *fds, size_t cap)
 {
     if (u == NULL || u->ctx == NULL || fds == NULL) {
         return 0;
@@ -858,7 +858,7 @@ size_t sl_gsusb_usb_pollfds(sl_gsusb_usb_t *u, struct pollfd *fds, size_t cap)
     return n;
 }
 
-int sl_gsusb_usb_list(sl_gsusb_usb_t *u, char *buf, size_t cap)
+int slp_gsusb_usb_list(slp_gsusb_usb_t *u, char *buf, size_t cap)
 {
     if (u == NULL || u->ctx == NULL || buf == NULL || cap == 0U) {
         return -1;
@@ -874,7 +874,7 @@ int sl_gsusb_usb_list(sl_gsusb_usb_t *u, char *buf, size_t cap)
     for (ssize_t i = 0; i < n; i++) {
         struct libusb_device_descriptor dd;
         if (libusb_get_device_descriptor(list[i], &dd) != 0 ||
-            !sl_gsusb_is_known_id(dd.idVendor, dd.idProduct)) {
+            !slp_gsusb_is_known_id(dd.idVendor, dd.idProduct)) {
             continue;
         }
         char where[32];

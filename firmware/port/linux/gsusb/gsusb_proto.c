@@ -11,7 +11,7 @@
 // ---------------------------------------------------------------------------------------
 // Identity
 
-static const sl_gsusb_usb_id_t known_ids[] = {
+static const slp_gsusb_usb_id_t known_ids[] = {
     {0x1d50, 0x606f, "candleLight_fw default / Geschwister Schneider USB2CAN"},
     {0x1209, 0x2323, "candleLight (pid.codes)"},
     {0x1cd2, 0x606f, "CES CANext FD"},
@@ -20,7 +20,7 @@ static const sl_gsusb_usb_id_t known_ids[] = {
     {0x1209, 0xca01, "CANnectivity (Zephyr)"},
 };
 
-const sl_gsusb_usb_id_t *sl_gsusb_known_ids(size_t *n)
+const slp_gsusb_usb_id_t *slp_gsusb_known_ids(size_t *n)
 {
     if (n != NULL) {
         *n = sizeof known_ids / sizeof known_ids[0];
@@ -28,7 +28,7 @@ const sl_gsusb_usb_id_t *sl_gsusb_known_ids(size_t *n)
     return known_ids;
 }
 
-bool sl_gsusb_is_known_id(uint16_t vid, uint16_t pid)
+bool slp_gsusb_is_known_id(uint16_t vid, uint16_t pid)
 {
     for (size_t i = 0; i < sizeof known_ids / sizeof known_ids[0]; i++) {
         if (known_ids[i].vid == vid && known_ids[i].pid == pid) {
@@ -38,35 +38,35 @@ bool sl_gsusb_is_known_id(uint16_t vid, uint16_t pid)
     return false;
 }
 
-const char *sl_gsusb_breq_name(uint8_t breq)
+const char *slp_gsusb_breq_name(uint8_t breq)
 {
     switch (breq) {
-    case SL_GSUSB_BREQ_HOST_FORMAT: return "HOST_FORMAT";
-    case SL_GSUSB_BREQ_BITTIMING: return "BITTIMING";
-    case SL_GSUSB_BREQ_MODE: return "MODE";
-    case SL_GSUSB_BREQ_BERR: return "BERR";
-    case SL_GSUSB_BREQ_BT_CONST: return "BT_CONST";
-    case SL_GSUSB_BREQ_DEVICE_CONFIG: return "DEVICE_CONFIG";
-    case SL_GSUSB_BREQ_TIMESTAMP: return "TIMESTAMP";
-    case SL_GSUSB_BREQ_IDENTIFY: return "IDENTIFY";
-    case SL_GSUSB_BREQ_DATA_BITTIMING: return "DATA_BITTIMING";
-    case SL_GSUSB_BREQ_BT_CONST_EXT: return "BT_CONST_EXT";
-    case SL_GSUSB_BREQ_SET_TERMINATION: return "SET_TERMINATION";
-    case SL_GSUSB_BREQ_GET_TERMINATION: return "GET_TERMINATION";
-    case SL_GSUSB_BREQ_GET_STATE: return "GET_STATE";
+    case SLP_GSUSB_BREQ_HOST_FORMAT: return "HOST_FORMAT";
+    case SLP_GSUSB_BREQ_BITTIMING: return "BITTIMING";
+    case SLP_GSUSB_BREQ_MODE: return "MODE";
+    case SLP_GSUSB_BREQ_BERR: return "BERR";
+    case SLP_GSUSB_BREQ_BT_CONST: return "BT_CONST";
+    case SLP_GSUSB_BREQ_DEVICE_CONFIG: return "DEVICE_CONFIG";
+    case SLP_GSUSB_BREQ_TIMESTAMP: return "TIMESTAMP";
+    case SLP_GSUSB_BREQ_IDENTIFY: return "IDENTIFY";
+    case SLP_GSUSB_BREQ_DATA_BITTIMING: return "DATA_BITTIMING";
+    case SLP_GSUSB_BREQ_BT_CONST_EXT: return "BT_CONST_EXT";
+    case SLP_GSUSB_BREQ_SET_TERMINATION: return "SET_TERMINATION";
+    case SLP_GSUSB_BREQ_GET_TERMINATION: return "GET_TERMINATION";
+    case SLP_GSUSB_BREQ_GET_STATE: return "GET_STATE";
     default: return "REQ?";
     }
 }
 
-const char *sl_gsusb_io_name(sl_gsusb_io_t io)
+const char *slp_gsusb_io_name(slp_gsusb_io_t io)
 {
     switch (io) {
-    case SL_GSUSB_IO_OK: return "OK";
-    case SL_GSUSB_IO_TIMEOUT: return "TIMEOUT";
-    case SL_GSUSB_IO_STALL: return "STALL";
-    case SL_GSUSB_IO_NO_DEVICE: return "NO_DEVICE";
-    case SL_GSUSB_IO_OVERFLOW: return "OVERFLOW";
-    case SL_GSUSB_IO_ERROR: return "ERROR";
+    case SLP_GSUSB_IO_OK: return "OK";
+    case SLP_GSUSB_IO_TIMEOUT: return "TIMEOUT";
+    case SLP_GSUSB_IO_STALL: return "STALL";
+    case SLP_GSUSB_IO_NO_DEVICE: return "NO_DEVICE";
+    case SLP_GSUSB_IO_OVERFLOW: return "OVERFLOW";
+    case SLP_GSUSB_IO_ERROR: return "ERROR";
     default: return "IO?";
     }
 }
@@ -74,12 +74,12 @@ const char *sl_gsusb_io_name(sl_gsusb_io_t io)
 // ---------------------------------------------------------------------------------------
 // Request payloads
 
-void sl_gsusb_encode_host_format(uint8_t out[SL_GSUSB_HOST_FORMAT_BYTES])
+void slp_gsusb_encode_host_format(uint8_t out[SLP_GSUSB_HOST_FORMAT_BYTES])
 {
-    sl_put_le32(out, (uint32_t)SL_GSUSB_HOST_FORMAT_WORD);
+    sl_put_le32(out, (uint32_t)SLP_GSUSB_HOST_FORMAT_WORD);
 }
 
-void sl_gsusb_encode_bittiming(const sl_gsusb_bittiming_t *bt, uint8_t out[SL_GSUSB_BITTIMING_BYTES])
+void slp_gsusb_encode_bittiming(const slp_gsusb_bittiming_t *bt, uint8_t out[SLP_GSUSB_BITTIMING_BYTES])
 {
     sl_put_le32(out + 0, bt->prop_seg);
     sl_put_le32(out + 4, bt->phase_seg1);
@@ -88,18 +88,18 @@ void sl_gsusb_encode_bittiming(const sl_gsusb_bittiming_t *bt, uint8_t out[SL_GS
     sl_put_le32(out + 16, bt->brp);
 }
 
-void sl_gsusb_encode_mode(uint32_t mode, uint32_t flags, uint8_t out[SL_GSUSB_MODE_BYTES])
+void slp_gsusb_encode_mode(uint32_t mode, uint32_t flags, uint8_t out[SLP_GSUSB_MODE_BYTES])
 {
     sl_put_le32(out + 0, mode);
     sl_put_le32(out + 4, flags);
 }
 
-sl_err_t sl_gsusb_decode_device_config(const uint8_t *buf, size_t len, sl_gsusb_device_config_t *out)
+sl_err_t slp_gsusb_decode_device_config(const uint8_t *buf, size_t len, slp_gsusb_device_config_t *out)
 {
     if (buf == NULL || out == NULL) {
         return SL_ERR_ARG;
     }
-    if (len < SL_GSUSB_DEVICE_CONFIG_BYTES) {
+    if (len < SLP_GSUSB_DEVICE_CONFIG_BYTES) {
         return SL_ERR_MALFORMED;
     }
     out->icount = buf[3];
@@ -108,12 +108,12 @@ sl_err_t sl_gsusb_decode_device_config(const uint8_t *buf, size_t len, sl_gsusb_
     return SL_OK;
 }
 
-sl_err_t sl_gsusb_decode_bt_const(const uint8_t *buf, size_t len, sl_gsusb_bt_const_t *out)
+sl_err_t slp_gsusb_decode_bt_const(const uint8_t *buf, size_t len, slp_gsusb_bt_const_t *out)
 {
     if (buf == NULL || out == NULL) {
         return SL_ERR_ARG;
     }
-    if (len < SL_GSUSB_BT_CONST_BYTES) {
+    if (len < SLP_GSUSB_BT_CONST_BYTES) {
         return SL_ERR_MALFORMED;
     }
     out->feature = sl_get_le32(buf + 0);
@@ -129,12 +129,12 @@ sl_err_t sl_gsusb_decode_bt_const(const uint8_t *buf, size_t len, sl_gsusb_bt_co
     return SL_OK;
 }
 
-sl_err_t sl_gsusb_decode_bittiming(const uint8_t *buf, size_t len, sl_gsusb_bittiming_t *out)
+sl_err_t slp_gsusb_decode_bittiming(const uint8_t *buf, size_t len, slp_gsusb_bittiming_t *out)
 {
     if (buf == NULL || out == NULL) {
         return SL_ERR_ARG;
     }
-    if (len < SL_GSUSB_BITTIMING_BYTES) {
+    if (len < SLP_GSUSB_BITTIMING_BYTES) {
         return SL_ERR_MALFORMED;
     }
     out->prop_seg = sl_get_le32(buf + 0);
@@ -145,12 +145,12 @@ sl_err_t sl_gsusb_decode_bittiming(const uint8_t *buf, size_t len, sl_gsusb_bitt
     return SL_OK;
 }
 
-sl_err_t sl_gsusb_decode_state(const uint8_t *buf, size_t len, sl_gsusb_can_state_t *out)
+sl_err_t slp_gsusb_decode_state(const uint8_t *buf, size_t len, slp_gsusb_can_state_t *out)
 {
     if (buf == NULL || out == NULL) {
         return SL_ERR_ARG;
     }
-    if (len < SL_GSUSB_STATE_BYTES) {
+    if (len < SLP_GSUSB_STATE_BYTES) {
         return SL_ERR_MALFORMED;
     }
     out->state = sl_get_le32(buf + 0);
@@ -159,15 +159,15 @@ sl_err_t sl_gsusb_decode_state(const uint8_t *buf, size_t len, sl_gsusb_can_stat
     return SL_OK;
 }
 
-sl_err_t sl_gsusb_bt_const_check(const sl_gsusb_bt_const_t *c)
+sl_err_t slp_gsusb_bt_const_check(const slp_gsusb_bt_const_t *c)
 {
     if (c == NULL) {
         return SL_ERR_ARG;
     }
     if (c->fclk_hz == 0U || c->brp_inc == 0U || c->brp_max == 0U || c->tseg2_max == 0U ||
         c->tseg1_max == 0U || c->tseg1_min > c->tseg1_max || c->tseg2_min > c->tseg2_max ||
-        c->brp_min > c->brp_max || c->tseg1_max > SL_GSUSB_TSEG_LIMIT ||
-        c->tseg2_max > SL_GSUSB_TSEG_LIMIT) {
+        c->brp_min > c->brp_max || c->tseg1_max > SLP_GSUSB_TSEG_LIMIT ||
+        c->tseg2_max > SLP_GSUSB_TSEG_LIMIT) {
         return SL_ERR_MALFORMED;
     }
     return SL_OK;
@@ -176,7 +176,7 @@ sl_err_t sl_gsusb_bt_const_check(const sl_gsusb_bt_const_t *c)
 // ---------------------------------------------------------------------------------------
 // Bit timing (Linux can_calc_bittiming(), drivers/net/can/dev/calc_bittiming.c, 6.1)
 
-uint16_t sl_gsusb_default_sample_point(uint32_t bitrate)
+uint16_t slp_gsusb_default_sample_point(uint32_t bitrate)
 {
     if (bitrate > 800000U) {
         return 750U;
@@ -187,7 +187,7 @@ uint16_t sl_gsusb_default_sample_point(uint32_t bitrate)
     return 875U;
 }
 
-uint32_t sl_gsusb_bittiming_rate(const sl_gsusb_bittiming_t *bt, uint32_t fclk_hz)
+uint32_t slp_gsusb_bittiming_rate(const slp_gsusb_bittiming_t *bt, uint32_t fclk_hz)
 {
     if (bt == NULL || bt->brp == 0U) {
         return 0U;
@@ -204,7 +204,7 @@ static uint64_t absdiff_u64(uint64_t a, uint64_t b)
 // For `tseg` = tseg1 + tseg2 time quanta (plus the sync quantum), split it so the sample
 // point is as close as possible to, but not above, the nominal one. Returns false when no
 // split fits the limits.
-static bool split_tseg(const sl_gsusb_bt_const_t *c, uint32_t sp_nominal, int64_t tseg,
+static bool split_tseg(const slp_gsusb_bt_const_t *c, uint32_t sp_nominal, int64_t tseg,
                        int64_t *tseg1_out, int64_t *tseg2_out, uint32_t *sp_err_out)
 {
     uint32_t best_err = UINT32_MAX;
@@ -239,17 +239,17 @@ static bool split_tseg(const sl_gsusb_bt_const_t *c, uint32_t sp_nominal, int64_
     return best_err != UINT32_MAX;
 }
 
-sl_err_t sl_gsusb_bittiming_calc(const sl_gsusb_bt_const_t *c, uint32_t bitrate,
-                                 uint16_t sample_point_permille, sl_gsusb_bt_result_t *out)
+sl_err_t slp_gsusb_bittiming_calc(const slp_gsusb_bt_const_t *c, uint32_t bitrate,
+                                 uint16_t sample_point_permille, slp_gsusb_bt_result_t *out)
 {
     if (c == NULL || out == NULL || bitrate == 0U || sample_point_permille >= 1000U) {
         return SL_ERR_ARG;
     }
     memset(out, 0, sizeof *out);
     uint32_t sp_nominal =
-        sample_point_permille != 0U ? sample_point_permille : sl_gsusb_default_sample_point(bitrate);
+        sample_point_permille != 0U ? sample_point_permille : slp_gsusb_default_sample_point(bitrate);
     out->sample_point_nominal = (uint16_t)sp_nominal;
-    if (sl_gsusb_bt_const_check(c) != SL_OK) {
+    if (slp_gsusb_bt_const_check(c) != SL_OK) {
         return SL_ERR_MALFORMED;
     }
 
@@ -309,7 +309,7 @@ sl_err_t sl_gsusb_bittiming_calc(const sl_gsusb_bt_const_t *c, uint32_t bitrate,
     out->bitrate = (uint32_t)((uint64_t)c->fclk_hz / (best_brp * tq));
     out->error_ppm = (uint32_t)((absdiff_u64(bitrate, out->bitrate) * 1000000U) / bitrate);
     out->sample_point_permille = (uint16_t)((1000U * (1U + (uint64_t)best_tseg1)) / tq);
-    if (bitrate > SL_GSUSB_MAX_BITRATE || out->error_ppm > SL_GSUSB_MAX_RATE_ERROR_PPM) {
+    if (bitrate > SLP_GSUSB_MAX_BITRATE || out->error_ppm > SLP_GSUSB_MAX_RATE_ERROR_PPM) {
         return SL_ERR_RANGE;
     }
     return SL_OK;
@@ -318,26 +318,26 @@ sl_err_t sl_gsusb_bittiming_calc(const sl_gsusb_bt_const_t *c, uint32_t bitrate,
 // ---------------------------------------------------------------------------------------
 // Bulk frames
 
-size_t sl_gsusb_frame_size(unsigned fmt)
+size_t slp_gsusb_frame_size(unsigned fmt)
 {
-    if ((fmt & SL_GSUSB_FMT_TIMESTAMP) != 0U) {
-        return SL_GSUSB_FRAME_TS_BYTES;
+    if ((fmt & SLP_GSUSB_FMT_TIMESTAMP) != 0U) {
+        return SLP_GSUSB_FRAME_TS_BYTES;
     }
-    if ((fmt & SL_GSUSB_FMT_QUIRK) != 0U) {
-        return SL_GSUSB_FRAME_QUIRK_BYTES;
+    if ((fmt & SLP_GSUSB_FMT_QUIRK) != 0U) {
+        return SLP_GSUSB_FRAME_QUIRK_BYTES;
     }
-    return SL_GSUSB_FRAME_BYTES;
+    return SLP_GSUSB_FRAME_BYTES;
 }
 
-sl_ssize_t sl_gsusb_frame_encode(const sl_gsusb_host_frame_t *hf, unsigned fmt, uint8_t *buf,
+sl_ssize_t slp_gsusb_frame_encode(const slp_gsusb_host_frame_t *hf, unsigned fmt, uint8_t *buf,
                                  size_t cap)
 {
     if (hf == NULL || buf == NULL ||
-        (fmt & (SL_GSUSB_FMT_TIMESTAMP | SL_GSUSB_FMT_QUIRK)) ==
-            (SL_GSUSB_FMT_TIMESTAMP | SL_GSUSB_FMT_QUIRK)) {
+        (fmt & (SLP_GSUSB_FMT_TIMESTAMP | SLP_GSUSB_FMT_QUIRK)) ==
+            (SLP_GSUSB_FMT_TIMESTAMP | SLP_GSUSB_FMT_QUIRK)) {
         return SL_ERR_ARG;
     }
-    size_t n = sl_gsusb_frame_size(fmt);
+    size_t n = slp_gsusb_frame_size(fmt);
     if (cap < n) {
         return SL_ERR_FULL;
     }
@@ -348,21 +348,21 @@ sl_ssize_t sl_gsusb_frame_encode(const sl_gsusb_host_frame_t *hf, unsigned fmt, 
     buf[10] = hf->flags;
     buf[11] = hf->reserved;
     memcpy(buf + 12, hf->data, 8);
-    if ((fmt & SL_GSUSB_FMT_TIMESTAMP) != 0U) {
+    if ((fmt & SLP_GSUSB_FMT_TIMESTAMP) != 0U) {
         sl_put_le32(buf + 20, hf->timestamp_us);
-    } else if ((fmt & SL_GSUSB_FMT_QUIRK) != 0U) {
+    } else if ((fmt & SLP_GSUSB_FMT_QUIRK) != 0U) {
         buf[20] = 0U;
     }
     return (sl_ssize_t)n;
 }
 
-sl_err_t sl_gsusb_frame_decode(const uint8_t *buf, size_t len, unsigned fmt, sl_gsusb_host_frame_t *out)
+sl_err_t slp_gsusb_frame_decode(const uint8_t *buf, size_t len, unsigned fmt, slp_gsusb_host_frame_t *out)
 {
     if (buf == NULL || out == NULL) {
         return SL_ERR_ARG;
     }
-    bool ts = (fmt & SL_GSUSB_FMT_TIMESTAMP) != 0U;
-    if (len < (ts ? SL_GSUSB_FRAME_TS_BYTES : SL_GSUSB_FRAME_BYTES)) {
+    bool ts = (fmt & SLP_GSUSB_FMT_TIMESTAMP) != 0U;
+    if (len < (ts ? SLP_GSUSB_FRAME_TS_BYTES : SLP_GSUSB_FRAME_BYTES)) {
         return SL_ERR_MALFORMED;
     }
     out->echo_id = sl_get_le32(buf + 0);
@@ -376,8 +376,8 @@ sl_err_t sl_gsusb_frame_decode(const uint8_t *buf, size_t len, unsigned fmt, sl_
     return SL_OK;
 }
 
-sl_err_t sl_gsusb_frame_from_can(const sl_can_frame_t *f, uint32_t echo_id, uint8_t channel,
-                                 sl_gsusb_host_frame_t *out)
+sl_err_t slp_gsusb_frame_from_can(const sl_can_frame_t *f, uint32_t echo_id, uint8_t channel,
+                                 slp_gsusb_host_frame_t *out)
 {
     if (f == NULL || out == NULL || f->dlc > 8U || (f->flags & SL_CAN_FLAG_ERR) != 0U) {
         return SL_ERR_ARG;
@@ -389,8 +389,8 @@ sl_err_t sl_gsusb_frame_from_can(const sl_can_frame_t *f, uint32_t echo_id, uint
     }
     memset(out, 0, sizeof *out);
     out->echo_id = echo_id;
-    out->can_id = f->id | (eff ? (uint32_t)SL_GSUSB_CAN_EFF_FLAG : 0U) |
-                  (rtr ? (uint32_t)SL_GSUSB_CAN_RTR_FLAG : 0U);
+    out->can_id = f->id | (eff ? (uint32_t)SLP_GSUSB_CAN_EFF_FLAG : 0U) |
+                  (rtr ? (uint32_t)SLP_GSUSB_CAN_RTR_FLAG : 0U);
     out->can_dlc = f->dlc;
     out->channel = channel;
     if (!rtr) {
@@ -399,24 +399,24 @@ sl_err_t sl_gsusb_frame_from_can(const sl_can_frame_t *f, uint32_t echo_id, uint
     return SL_OK;
 }
 
-sl_err_t sl_gsusb_frame_to_can(const sl_gsusb_host_frame_t *hf, sl_can_frame_t *out)
+sl_err_t slp_gsusb_frame_to_can(const slp_gsusb_host_frame_t *hf, sl_can_frame_t *out)
 {
     if (hf == NULL || out == NULL) {
         return SL_ERR_ARG;
     }
-    if ((hf->flags & SL_GSUSB_FRAME_FLAG_FD) != 0U || hf->can_dlc > 8U) {
+    if ((hf->flags & SLP_GSUSB_FRAME_FLAG_FD) != 0U || hf->can_dlc > 8U) {
         return SL_ERR_MALFORMED;
     }
-    bool eff = (hf->can_id & SL_GSUSB_CAN_EFF_FLAG) != 0U;
-    bool rtr = (hf->can_id & SL_GSUSB_CAN_RTR_FLAG) != 0U;
-    bool err = (hf->can_id & SL_GSUSB_CAN_ERR_FLAG) != 0U;
+    bool eff = (hf->can_id & SLP_GSUSB_CAN_EFF_FLAG) != 0U;
+    bool rtr = (hf->can_id & SLP_GSUSB_CAN_RTR_FLAG) != 0U;
+    bool err = (hf->can_id & SLP_GSUSB_CAN_ERR_FLAG) != 0U;
     if (err && rtr) {
         return SL_ERR_MALFORMED;
     }
     memset(out, 0, sizeof *out);
     out->dlc = hf->can_dlc;
     if (err) {
-        out->id = hf->can_id & (uint32_t)SL_GSUSB_CAN_ERR_MASK;
+        out->id = hf->can_id & (uint32_t)SLP_GSUSB_CAN_ERR_MASK;
         out->flags = SL_CAN_FLAG_ERR;
         memcpy(out->data, hf->data, hf->can_dlc);
         return SL_OK;
@@ -432,17 +432,17 @@ sl_err_t sl_gsusb_frame_to_can(const sl_gsusb_host_frame_t *hf, sl_can_frame_t *
 // ---------------------------------------------------------------------------------------
 // Echo ids
 
-sl_err_t sl_gsusb_echo_init(sl_gsusb_echo_t *e, uint8_t capacity)
+sl_err_t slp_gsusb_echo_init(slp_gsusb_echo_t *e, uint8_t capacity)
 {
-    if (e == NULL || capacity > SL_GSUSB_MAX_IN_FLIGHT) {
+    if (e == NULL || capacity > SLP_GSUSB_MAX_IN_FLIGHT) {
         return SL_ERR_ARG;
     }
     memset(e, 0, sizeof *e);
-    e->capacity = capacity != 0U ? capacity : (uint8_t)SL_GSUSB_DEFAULT_IN_FLIGHT;
+    e->capacity = capacity != 0U ? capacity : (uint8_t)SLP_GSUSB_DEFAULT_IN_FLIGHT;
     return SL_OK;
 }
 
-sl_ssize_t sl_gsusb_echo_alloc(sl_gsusb_echo_t *e, const sl_can_frame_t *frame, uint32_t tag,
+sl_ssize_t slp_gsusb_echo_alloc(slp_gsusb_echo_t *e, const sl_can_frame_t *frame, uint32_t tag,
                                uint64_t now_us)
 {
     if (e == NULL || frame == NULL) {
@@ -450,7 +450,7 @@ sl_ssize_t sl_gsusb_echo_alloc(sl_gsusb_echo_t *e, const sl_can_frame_t *frame, 
     }
     for (uint8_t k = 0; k < e->capacity; k++) {
         uint8_t id = (uint8_t)((e->next + k) % e->capacity);
-        sl_gsusb_echo_slot_t *s = &e->slot[id];
+        slp_gsusb_echo_slot_t *s = &e->slot[id];
         if (!s->in_use) {
             s->in_use = true;
             s->tag = tag;
@@ -469,7 +469,7 @@ sl_ssize_t sl_gsusb_echo_alloc(sl_gsusb_echo_t *e, const sl_can_frame_t *frame, 
     return SL_ERR_FULL;
 }
 
-sl_err_t sl_gsusb_echo_release(sl_gsusb_echo_t *e, uint32_t echo_id)
+sl_err_t slp_gsusb_echo_release(slp_gsusb_echo_t *e, uint32_t echo_id)
 {
     if (e == NULL || echo_id >= e->capacity || !e->slot[echo_id].in_use) {
         return SL_ERR_ARG;
@@ -482,7 +482,7 @@ sl_err_t sl_gsusb_echo_release(sl_gsusb_echo_t *e, uint32_t echo_id)
     return SL_OK;
 }
 
-const sl_gsusb_echo_slot_t *sl_gsusb_echo_peek(const sl_gsusb_echo_t *e, uint32_t echo_id)
+const slp_gsusb_echo_slot_t *slp_gsusb_echo_peek(const slp_gsusb_echo_t *e, uint32_t echo_id)
 {
     if (e == NULL || echo_id >= e->capacity || !e->slot[echo_id].in_use) {
         return NULL;
@@ -490,7 +490,7 @@ const sl_gsusb_echo_slot_t *sl_gsusb_echo_peek(const sl_gsusb_echo_t *e, uint32_
     return &e->slot[echo_id];
 }
 
-sl_err_t sl_gsusb_echo_confirm(sl_gsusb_echo_t *e, uint32_t echo_id, sl_gsusb_echo_slot_t *done)
+sl_err_t slp_gsusb_echo_confirm(slp_gsusb_echo_t *e, uint32_t echo_id, slp_gsusb_echo_slot_t *done)
 {
     if (e == NULL) {
         return SL_ERR_ARG;
@@ -508,52 +508,52 @@ sl_err_t sl_gsusb_echo_confirm(sl_gsusb_echo_t *e, uint32_t echo_id, sl_gsusb_ec
     return SL_OK;
 }
 
-size_t sl_gsusb_echo_expire(sl_gsusb_echo_t *e, uint64_t now_us, uint64_t timeout_us,
-                            sl_gsusb_echo_done_fn cb, void *ctx)
+size_t slp_gsusb_echo_expire(slp_gsusb_echo_t *e, uint64_t now_us, uint64_t timeout_us,
+                            slp_gsusb_echo_done_fn cb, void *ctx)
 {
     size_t n = 0;
     if (e == NULL) {
         return 0;
     }
     for (uint8_t id = 0; id < e->capacity; id++) {
-        sl_gsusb_echo_slot_t *s = &e->slot[id];
+        slp_gsusb_echo_slot_t *s = &e->slot[id];
         if (s->in_use && now_us >= s->sent_us && now_us - s->sent_us >= timeout_us) {
-            sl_gsusb_echo_slot_t copy = *s;
+            slp_gsusb_echo_slot_t copy = *s;
             s->in_use = false;
             e->in_flight--;
             e->stats.timeouts++;
             n++;
             if (cb != NULL) {
-                cb(ctx, id, &copy, SL_GSUSB_TX_TIMEOUT);
+                cb(ctx, id, &copy, SLP_GSUSB_TX_TIMEOUT);
             }
         }
     }
     return n;
 }
 
-size_t sl_gsusb_echo_drop_all(sl_gsusb_echo_t *e, sl_gsusb_echo_done_fn cb, void *ctx)
+size_t slp_gsusb_echo_drop_all(slp_gsusb_echo_t *e, slp_gsusb_echo_done_fn cb, void *ctx)
 {
     size_t n = 0;
     if (e == NULL) {
         return 0;
     }
     for (uint8_t id = 0; id < e->capacity; id++) {
-        sl_gsusb_echo_slot_t *s = &e->slot[id];
+        slp_gsusb_echo_slot_t *s = &e->slot[id];
         if (s->in_use) {
-            sl_gsusb_echo_slot_t copy = *s;
+            slp_gsusb_echo_slot_t copy = *s;
             s->in_use = false;
             e->in_flight--;
             e->stats.dropped++;
             n++;
             if (cb != NULL) {
-                cb(ctx, id, &copy, SL_GSUSB_TX_DROPPED);
+                cb(ctx, id, &copy, SLP_GSUSB_TX_DROPPED);
             }
         }
     }
     return n;
 }
 
-uint64_t sl_gsusb_echo_deadline(const sl_gsusb_echo_t *e, uint64_t timeout_us)
+uint64_t slp_gsusb_echo_deadline(const slp_gsusb_echo_t *e, uint64_t timeout_us)
 {
     uint64_t best = UINT64_MAX;
     if (e == NULL) {
@@ -570,7 +570,7 @@ uint64_t sl_gsusb_echo_deadline(const sl_gsusb_echo_t *e, uint64_t timeout_us)
 // ---------------------------------------------------------------------------------------
 // Driver
 
-void sl_gsusb_cfg_defaults(sl_gsusb_cfg_t *cfg)
+void slp_gsusb_cfg_defaults(slp_gsusb_cfg_t *cfg)
 {
     if (cfg == NULL) {
         return;
@@ -578,7 +578,7 @@ void sl_gsusb_cfg_defaults(sl_gsusb_cfg_t *cfg)
     memset(cfg, 0, sizeof *cfg);
     cfg->bitrate = 500000U;
     cfg->reset_first = true;
-    cfg->max_in_flight = (uint8_t)SL_GSUSB_DEFAULT_IN_FLIGHT;
+    cfg->max_in_flight = (uint8_t)SLP_GSUSB_DEFAULT_IN_FLIGHT;
     cfg->echo_timeout_ms = 1000U;
     cfg->control_timeout_ms = 1000U;
     cfg->bulk_out_timeout_ms = 100U;
@@ -586,19 +586,19 @@ void sl_gsusb_cfg_defaults(sl_gsusb_cfg_t *cfg)
     cfg->io_error_limit = 3U;
 }
 
-sl_err_t sl_gsusb_init(sl_gsusb_t *d, const sl_gsusb_cfg_t *cfg, const sl_gsusb_transport_t *tr)
+sl_err_t slp_gsusb_init(slp_gsusb_t *d, const slp_gsusb_cfg_t *cfg, const slp_gsusb_transport_t *tr)
 {
     if (d == NULL || cfg == NULL || tr == NULL || tr->ops == NULL || tr->ops->control_out == NULL ||
         tr->ops->control_in == NULL || tr->ops->bulk_out == NULL || tr->ops->bulk_in == NULL ||
-        cfg->bitrate == 0U || cfg->max_in_flight > SL_GSUSB_MAX_IN_FLIGHT ||
-        (cfg->mode_flags & ~(uint32_t)SL_GSUSB_MODE_FLAGS_ALLOWED) != 0U ||
+        cfg->bitrate == 0U || cfg->max_in_flight > SLP_GSUSB_MAX_IN_FLIGHT ||
+        (cfg->mode_flags & ~(uint32_t)SLP_GSUSB_MODE_FLAGS_ALLOWED) != 0U ||
         cfg->sample_point_permille >= 1000U) {
         return SL_ERR_ARG;
     }
     memset(d, 0, sizeof *d);
     d->cfg = *cfg;
     if (d->cfg.max_in_flight == 0U) {
-        d->cfg.max_in_flight = (uint8_t)SL_GSUSB_DEFAULT_IN_FLIGHT;
+        d->cfg.max_in_flight = (uint8_t)SLP_GSUSB_DEFAULT_IN_FLIGHT;
     }
     if (d->cfg.echo_timeout_ms == 0U) {
         d->cfg.echo_timeout_ms = 1000U;
@@ -616,12 +616,12 @@ sl_err_t sl_gsusb_init(sl_gsusb_t *d, const sl_gsusb_cfg_t *cfg, const sl_gsusb_
         d->cfg.io_error_limit = 3U;
     }
     d->tr = *tr;
-    d->state = SL_GSUSB_CLOSED;
-    (void)sl_gsusb_echo_init(&d->echo, d->cfg.max_in_flight);
+    d->state = SLP_GSUSB_CLOSED;
+    (void)slp_gsusb_echo_init(&d->echo, d->cfg.max_in_flight);
     return SL_OK;
 }
 
-void sl_gsusb_set_transport(sl_gsusb_t *d, const sl_gsusb_transport_t *tr)
+void slp_gsusb_set_transport(slp_gsusb_t *d, const slp_gsusb_transport_t *tr)
 {
     if (d != NULL && tr != NULL) {
         d->tr = *tr;
@@ -629,8 +629,8 @@ void sl_gsusb_set_transport(sl_gsusb_t *d, const sl_gsusb_transport_t *tr)
 }
 
 // printf-style into last_error; keeps the first message of a start-up.
-static void set_error(sl_gsusb_t *d, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
-static void set_error(sl_gsusb_t *d, const char *fmt, ...)
+static void set_error(slp_gsusb_t *d, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+static void set_error(slp_gsusb_t *d, const char *fmt, ...)
 {
     if (d->last_error[0] != '\0') {
         return;
@@ -641,14 +641,14 @@ static void set_error(sl_gsusb_t *d, const char *fmt, ...)
     va_end(ap);
 }
 
-static void echo_done_cb(void *ctx, uint32_t echo_id, const sl_gsusb_echo_slot_t *slot,
-                         sl_gsusb_tx_result_t result)
+static void echo_done_cb(void *ctx, uint32_t echo_id, const slp_gsusb_echo_slot_t *slot,
+                         slp_gsusb_tx_result_t result)
 {
-    sl_gsusb_t *d = ctx;
+    slp_gsusb_t *d = ctx;
     (void)echo_id;
-    if (result == SL_GSUSB_TX_TIMEOUT) {
+    if (result == SLP_GSUSB_TX_TIMEOUT) {
         d->stats.tx_unconfirmed++;
-    } else if (result == SL_GSUSB_TX_DROPPED) {
+    } else if (result == SLP_GSUSB_TX_DROPPED) {
         d->stats.tx_dropped++;
     }
     if (d->cfg.on_tx_done != NULL) {
@@ -656,101 +656,101 @@ static void echo_done_cb(void *ctx, uint32_t echo_id, const sl_gsusb_echo_slot_t
     }
 }
 
-void sl_gsusb_mark_down(sl_gsusb_t *d)
+void slp_gsusb_mark_down(slp_gsusb_t *d)
 {
     if (d == NULL) {
         return;
     }
-    if (d->state != SL_GSUSB_DOWN) {
+    if (d->state != SLP_GSUSB_DOWN) {
         d->stats.vanished++;
     }
-    d->state = SL_GSUSB_DOWN;
+    d->state = SLP_GSUSB_DOWN;
     d->io_errors_in_row = 0;
-    (void)sl_gsusb_echo_drop_all(&d->echo, echo_done_cb, d);
+    (void)slp_gsusb_echo_drop_all(&d->echo, echo_done_cb, d);
 }
 
 // Why a control request failed, for last_error.
-static const char *io_reason(sl_gsusb_io_t io)
+static const char *io_reason(slp_gsusb_io_t io)
 {
     switch (io) {
-    case SL_GSUSB_IO_STALL: return "refused by the device (control request stalled)";
-    case SL_GSUSB_IO_TIMEOUT: return "timed out";
-    case SL_GSUSB_IO_NO_DEVICE: return "failed: the device vanished";
-    case SL_GSUSB_IO_OVERFLOW: return "failed: answer overflow";
-    case SL_GSUSB_IO_OK:
-    case SL_GSUSB_IO_ERROR:
+    case SLP_GSUSB_IO_STALL: return "refused by the device (control request stalled)";
+    case SLP_GSUSB_IO_TIMEOUT: return "timed out";
+    case SLP_GSUSB_IO_NO_DEVICE: return "failed: the device vanished";
+    case SLP_GSUSB_IO_OVERFLOW: return "failed: answer overflow";
+    case SLP_GSUSB_IO_OK:
+    case SLP_GSUSB_IO_ERROR:
     default: return "failed (USB error)";
     }
 }
 
-static sl_err_t ctrl_fail(sl_gsusb_t *d, uint8_t breq, sl_gsusb_io_t io)
+static sl_err_t ctrl_fail(slp_gsusb_t *d, uint8_t breq, slp_gsusb_io_t io)
 {
-    if (io == SL_GSUSB_IO_STALL) {
+    if (io == SLP_GSUSB_IO_STALL) {
         d->stats.ctrl_stalls++;
     } else {
         d->stats.ctrl_errors++;
     }
-    set_error(d, "%s %s", sl_gsusb_breq_name(breq), io_reason(io));
-    if (io == SL_GSUSB_IO_NO_DEVICE) {
-        sl_gsusb_mark_down(d);
+    set_error(d, "%s %s", slp_gsusb_breq_name(breq), io_reason(io));
+    if (io == SLP_GSUSB_IO_NO_DEVICE) {
+        slp_gsusb_mark_down(d);
     }
     return SL_ERR_PORT;
 }
 
-static sl_err_t ctrl_out(sl_gsusb_t *d, uint8_t breq, uint16_t wvalue, uint16_t windex,
-                         const uint8_t *data, uint16_t len, sl_gsusb_io_t *io_out)
+static sl_err_t ctrl_out(slp_gsusb_t *d, uint8_t breq, uint16_t wvalue, uint16_t windex,
+                         const uint8_t *data, uint16_t len, slp_gsusb_io_t *io_out)
 {
     size_t n = 0;
-    sl_gsusb_io_t io = d->tr.ops->control_out(d->tr.ctx, (uint8_t)SL_GSUSB_RT_OUT, breq, wvalue,
+    slp_gsusb_io_t io = d->tr.ops->control_out(d->tr.ctx, (uint8_t)SLP_GSUSB_RT_OUT, breq, wvalue,
                                               windex, data, len, d->cfg.control_timeout_ms, &n);
     if (io_out != NULL) {
         *io_out = io;
     }
-    if (io == SL_GSUSB_IO_OK && n != len) {
-        io = SL_GSUSB_IO_ERROR;
+    if (io == SLP_GSUSB_IO_OK && n != len) {
+        io = SLP_GSUSB_IO_ERROR;
     }
-    return io == SL_GSUSB_IO_OK ? SL_OK : ctrl_fail(d, breq, io);
+    return io == SLP_GSUSB_IO_OK ? SL_OK : ctrl_fail(d, breq, io);
 }
 
-static sl_err_t ctrl_in(sl_gsusb_t *d, uint8_t breq, uint16_t wvalue, uint16_t windex,
+static sl_err_t ctrl_in(slp_gsusb_t *d, uint8_t breq, uint16_t wvalue, uint16_t windex,
                         uint8_t *data, uint16_t len)
 {
     size_t n = 0;
-    sl_gsusb_io_t io = d->tr.ops->control_in(d->tr.ctx, (uint8_t)SL_GSUSB_RT_IN, breq, wvalue,
+    slp_gsusb_io_t io = d->tr.ops->control_in(d->tr.ctx, (uint8_t)SLP_GSUSB_RT_IN, breq, wvalue,
                                              windex, data, len, d->cfg.control_timeout_ms, &n);
-    if (io != SL_GSUSB_IO_OK) {
+    if (io != SLP_GSUSB_IO_OK) {
         return ctrl_fail(d, breq, io);
     }
     if (n < len) {
         d->stats.ctrl_errors++;
-        set_error(d, "%s answer too short (%zu of %u bytes)", sl_gsusb_breq_name(breq), n,
+        set_error(d, "%s answer too short (%zu of %u bytes)", slp_gsusb_breq_name(breq), n,
                   (unsigned)len);
         return SL_ERR_MALFORMED;
     }
     return SL_OK;
 }
 
-static sl_err_t start_sequence(sl_gsusb_t *d)
+static sl_err_t start_sequence(slp_gsusb_t *d)
 {
-    uint8_t buf[SL_GSUSB_BT_CONST_BYTES];
+    uint8_t buf[SLP_GSUSB_BT_CONST_BYTES];
     sl_err_t rc;
     uint16_t ch = d->cfg.channel;
 
     // 1. HOST_FORMAT (per device: wValue 1, wIndex = interface number)
-    sl_gsusb_encode_host_format(buf);
-    rc = ctrl_out(d, SL_GSUSB_BREQ_HOST_FORMAT, 1U, SL_GSUSB_INTERFACE, buf,
-                  SL_GSUSB_HOST_FORMAT_BYTES, NULL);
+    slp_gsusb_encode_host_format(buf);
+    rc = ctrl_out(d, SLP_GSUSB_BREQ_HOST_FORMAT, 1U, SLP_GSUSB_INTERFACE, buf,
+                  SLP_GSUSB_HOST_FORMAT_BYTES, NULL);
     if (rc != SL_OK) {
         return rc;
     }
     // 2. DEVICE_CONFIG
     memset(buf, 0, sizeof buf);
-    rc = ctrl_in(d, SL_GSUSB_BREQ_DEVICE_CONFIG, 1U, SL_GSUSB_INTERFACE, buf,
-                 SL_GSUSB_DEVICE_CONFIG_BYTES);
+    rc = ctrl_in(d, SLP_GSUSB_BREQ_DEVICE_CONFIG, 1U, SLP_GSUSB_INTERFACE, buf,
+                 SLP_GSUSB_DEVICE_CONFIG_BYTES);
     if (rc != SL_OK) {
         return rc;
     }
-    (void)sl_gsusb_decode_device_config(buf, SL_GSUSB_DEVICE_CONFIG_BYTES, &d->dev_cfg);
+    (void)slp_gsusb_decode_device_config(buf, SLP_GSUSB_DEVICE_CONFIG_BYTES, &d->dev_cfg);
     if ((unsigned)d->cfg.channel > d->dev_cfg.icount) {
         set_error(d, "channel %u not present (the device has %u)", (unsigned)d->cfg.channel,
                   (unsigned)d->dev_cfg.icount + 1U);
@@ -758,13 +758,13 @@ static sl_err_t start_sequence(sl_gsusb_t *d)
     }
     // 3. BT_CONST (per channel: wValue = channel, wIndex 0)
     memset(buf, 0, sizeof buf);
-    rc = ctrl_in(d, SL_GSUSB_BREQ_BT_CONST, ch, 0U, buf, SL_GSUSB_BT_CONST_BYTES);
+    rc = ctrl_in(d, SLP_GSUSB_BREQ_BT_CONST, ch, 0U, buf, SLP_GSUSB_BT_CONST_BYTES);
     if (rc != SL_OK) {
         return rc;
     }
-    (void)sl_gsusb_decode_bt_const(buf, SL_GSUSB_BT_CONST_BYTES, &d->bt_const);
-    const sl_gsusb_bt_const_t *c = &d->bt_const;
-    if (sl_gsusb_bt_const_check(c) != SL_OK) {
+    (void)slp_gsusb_decode_bt_const(buf, SLP_GSUSB_BT_CONST_BYTES, &d->bt_const);
+    const slp_gsusb_bt_const_t *c = &d->bt_const;
+    if (slp_gsusb_bt_const_check(c) != SL_OK) {
         set_error(d,
                   "BT_CONST reports implausible limits (fclk %lu Hz, tseg1 %lu..%lu, tseg2 "
                   "%lu..%lu, brp %lu..%lu step %lu)",
@@ -779,13 +779,13 @@ static sl_err_t start_sequence(sl_gsusb_t *d)
                   (unsigned long)(d->cfg.mode_flags & ~c->feature), (unsigned long)c->feature);
         return SL_ERR_ARG;
     }
-    d->rx_fmt = (d->cfg.hw_timestamp && (c->feature & SL_GSUSB_FEAT_HW_TIMESTAMP) != 0U)
-                    ? SL_GSUSB_FMT_TIMESTAMP
+    d->rx_fmt = (d->cfg.hw_timestamp && (c->feature & SLP_GSUSB_FEAT_HW_TIMESTAMP) != 0U)
+                    ? SLP_GSUSB_FMT_TIMESTAMP
                     : 0U;
-    d->tx_fmt = (c->feature & SL_GSUSB_FEAT_QUIRK_LPC546XX) != 0U ? SL_GSUSB_FMT_QUIRK : 0U;
+    d->tx_fmt = (c->feature & SLP_GSUSB_FEAT_QUIRK_LPC546XX) != 0U ? SLP_GSUSB_FMT_QUIRK : 0U;
 
     // 4. bit timing from the clock and limits
-    rc = sl_gsusb_bittiming_calc(c, d->cfg.bitrate, d->cfg.sample_point_permille, &d->timing);
+    rc = slp_gsusb_bittiming_calc(c, d->cfg.bitrate, d->cfg.sample_point_permille, &d->timing);
     if (rc != SL_OK) {
         if (d->timing.tq_per_bit == 0U) {
             set_error(d,
@@ -796,9 +796,9 @@ static sl_err_t start_sequence(sl_gsusb_t *d)
                       (unsigned long)c->brp_inc, (unsigned long)c->tseg1_min,
                       (unsigned long)c->tseg1_max, (unsigned long)c->tseg2_min,
                       (unsigned long)c->tseg2_max);
-        } else if (d->cfg.bitrate > SL_GSUSB_MAX_BITRATE) {
+        } else if (d->cfg.bitrate > SLP_GSUSB_MAX_BITRATE) {
             set_error(d, "bitrate %lu bit/s is above the classic CAN maximum of %lu bit/s",
-                      (unsigned long)d->cfg.bitrate, (unsigned long)SL_GSUSB_MAX_BITRATE);
+                      (unsigned long)d->cfg.bitrate, (unsigned long)SLP_GSUSB_MAX_BITRATE);
         } else {
             set_error(d,
                       "bitrate %lu bit/s cannot be produced from the %lu Hz clock: closest is "
@@ -807,205 +807,205 @@ static sl_err_t start_sequence(sl_gsusb_t *d)
                       (unsigned long)d->timing.bitrate, (unsigned long)d->timing.bt.brp,
                       (unsigned)d->timing.tq_per_bit, (unsigned long)(d->timing.error_ppm / 10000U),
                       (unsigned long)((d->timing.error_ppm / 100U) % 100U),
-                      SL_GSUSB_MAX_RATE_ERROR_PPM / 10000U,
-                      (SL_GSUSB_MAX_RATE_ERROR_PPM / 100U) % 100U);
+                      SLP_GSUSB_MAX_RATE_ERROR_PPM / 10000U,
+                      (SLP_GSUSB_MAX_RATE_ERROR_PPM / 100U) % 100U);
         }
         return rc;
     }
 
     // 5. MODE RESET first (a channel left running), tolerated when refused
     if (d->cfg.reset_first) {
-        sl_gsusb_io_t io = SL_GSUSB_IO_OK;
-        sl_gsusb_encode_mode(SL_GSUSB_MODE_RESET, 0U, buf);
-        rc = ctrl_out(d, SL_GSUSB_BREQ_MODE, ch, 0U, buf, SL_GSUSB_MODE_BYTES, &io);
+        slp_gsusb_io_t io = SLP_GSUSB_IO_OK;
+        slp_gsusb_encode_mode(SLP_GSUSB_MODE_RESET, 0U, buf);
+        rc = ctrl_out(d, SLP_GSUSB_BREQ_MODE, ch, 0U, buf, SLP_GSUSB_MODE_BYTES, &io);
         if (rc != SL_OK) {
-            if (io != SL_GSUSB_IO_STALL) {
+            if (io != SLP_GSUSB_IO_STALL) {
                 return rc;
             }
             d->last_error[0] = '\0'; // a refused RESET of a stopped channel is harmless
         }
     }
     // 6. BITTIMING
-    sl_gsusb_encode_bittiming(&d->timing.bt, buf);
-    rc = ctrl_out(d, SL_GSUSB_BREQ_BITTIMING, ch, 0U, buf, SL_GSUSB_BITTIMING_BYTES, NULL);
+    slp_gsusb_encode_bittiming(&d->timing.bt, buf);
+    rc = ctrl_out(d, SLP_GSUSB_BREQ_BITTIMING, ch, 0U, buf, SLP_GSUSB_BITTIMING_BYTES, NULL);
     if (rc != SL_OK) {
         return rc;
     }
     // 7. MODE START
-    d->mode_flags_sent = d->cfg.mode_flags | (d->rx_fmt != 0U ? (uint32_t)SL_GSUSB_FEAT_HW_TIMESTAMP : 0U);
-    sl_gsusb_encode_mode(SL_GSUSB_MODE_START, d->mode_flags_sent, buf);
-    return ctrl_out(d, SL_GSUSB_BREQ_MODE, ch, 0U, buf, SL_GSUSB_MODE_BYTES, NULL);
+    d->mode_flags_sent = d->cfg.mode_flags | (d->rx_fmt != 0U ? (uint32_t)SLP_GSUSB_FEAT_HW_TIMESTAMP : 0U);
+    slp_gsusb_encode_mode(SLP_GSUSB_MODE_START, d->mode_flags_sent, buf);
+    return ctrl_out(d, SLP_GSUSB_BREQ_MODE, ch, 0U, buf, SLP_GSUSB_MODE_BYTES, NULL);
 }
 
-sl_err_t sl_gsusb_start(sl_gsusb_t *d, uint64_t now_us)
+sl_err_t slp_gsusb_start(slp_gsusb_t *d, uint64_t now_us)
 {
     (void)now_us;
     if (d == NULL) {
         return SL_ERR_ARG;
     }
-    if (d->state == SL_GSUSB_RUNNING) {
+    if (d->state == SLP_GSUSB_RUNNING) {
         return SL_ERR_STATE;
     }
-    (void)sl_gsusb_echo_drop_all(&d->echo, echo_done_cb, d);
+    (void)slp_gsusb_echo_drop_all(&d->echo, echo_done_cb, d);
     d->last_error[0] = '\0';
     d->io_errors_in_row = 0;
-    sl_gsusb_state_t before = d->state;
+    slp_gsusb_state_t before = d->state;
     sl_err_t rc = start_sequence(d);
     if (rc != SL_OK) {
         d->stats.start_failures++;
-        if (d->state != SL_GSUSB_DOWN) {
-            d->state = before == SL_GSUSB_DOWN ? SL_GSUSB_DOWN : SL_GSUSB_CLOSED;
+        if (d->state != SLP_GSUSB_DOWN) {
+            d->state = before == SLP_GSUSB_DOWN ? SLP_GSUSB_DOWN : SLP_GSUSB_CLOSED;
         }
         return rc;
     }
-    d->state = SL_GSUSB_RUNNING;
+    d->state = SLP_GSUSB_RUNNING;
     d->stats.starts++;
     return SL_OK;
 }
 
 // Count a transfer error; too many in a row means the device is as good as gone.
-static void io_error(sl_gsusb_t *d)
+static void io_error(slp_gsusb_t *d)
 {
     if (++d->io_errors_in_row >= d->cfg.io_error_limit) {
-        sl_gsusb_mark_down(d);
+        slp_gsusb_mark_down(d);
     }
 }
 
-static bool clear_halt(sl_gsusb_t *d, bool in)
+static bool clear_halt(slp_gsusb_t *d, bool in)
 {
     if (d->tr.ops->clear_halt == NULL) {
         d->stats.clear_halt_failures++;
         return false;
     }
-    sl_gsusb_io_t io = d->tr.ops->clear_halt(d->tr.ctx, in);
-    if (io == SL_GSUSB_IO_OK) {
+    slp_gsusb_io_t io = d->tr.ops->clear_halt(d->tr.ctx, in);
+    if (io == SLP_GSUSB_IO_OK) {
         d->stats.clear_halts++;
         return true;
     }
     d->stats.clear_halt_failures++;
-    if (io == SL_GSUSB_IO_NO_DEVICE) {
-        sl_gsusb_mark_down(d);
+    if (io == SLP_GSUSB_IO_NO_DEVICE) {
+        slp_gsusb_mark_down(d);
     }
     return false;
 }
 
-static uint64_t echo_timeout_us(const sl_gsusb_t *d)
+static uint64_t echo_timeout_us(const slp_gsusb_t *d)
 {
     return (uint64_t)d->cfg.echo_timeout_ms * 1000U;
 }
 
-sl_err_t sl_gsusb_send(sl_gsusb_t *d, const sl_can_frame_t *f, uint32_t tag, uint64_t now_us)
+sl_err_t slp_gsusb_send(slp_gsusb_t *d, const sl_can_frame_t *f, uint32_t tag, uint64_t now_us)
 {
     if (d == NULL || f == NULL) {
         return SL_ERR_ARG;
     }
-    if (d->state != SL_GSUSB_RUNNING) {
+    if (d->state != SLP_GSUSB_RUNNING) {
         return SL_ERR_STATE;
     }
-    sl_gsusb_host_frame_t hf;
-    if (sl_gsusb_frame_from_can(f, 0U, d->cfg.channel, &hf) != SL_OK) {
+    slp_gsusb_host_frame_t hf;
+    if (slp_gsusb_frame_from_can(f, 0U, d->cfg.channel, &hf) != SL_OK) {
         return SL_ERR_ARG;
     }
-    (void)sl_gsusb_echo_expire(&d->echo, now_us, echo_timeout_us(d), echo_done_cb, d);
-    sl_ssize_t id = sl_gsusb_echo_alloc(&d->echo, f, tag, now_us);
+    (void)slp_gsusb_echo_expire(&d->echo, now_us, echo_timeout_us(d), echo_done_cb, d);
+    sl_ssize_t id = slp_gsusb_echo_alloc(&d->echo, f, tag, now_us);
     if (id < 0) {
         d->stats.tx_window_full++;
         return SL_ERR_BUSY;
     }
     hf.echo_id = (uint32_t)id;
-    uint8_t buf[SL_GSUSB_FRAME_MAX_BYTES];
-    sl_ssize_t len = sl_gsusb_frame_encode(&hf, d->tx_fmt, buf, sizeof buf);
+    uint8_t buf[SLP_GSUSB_FRAME_MAX_BYTES];
+    sl_ssize_t len = slp_gsusb_frame_encode(&hf, d->tx_fmt, buf, sizeof buf);
     SL_ASSERT(len > 0);
 
     for (int attempt = 0; attempt < 2; attempt++) {
         size_t n = 0;
-        sl_gsusb_io_t io = d->tr.ops->bulk_out(d->tr.ctx, buf, (size_t)len,
+        slp_gsusb_io_t io = d->tr.ops->bulk_out(d->tr.ctx, buf, (size_t)len,
                                                d->cfg.bulk_out_timeout_ms, &n);
-        if (n == (size_t)len && (io == SL_GSUSB_IO_OK || io == SL_GSUSB_IO_TIMEOUT)) {
+        if (n == (size_t)len && (io == SLP_GSUSB_IO_OK || io == SLP_GSUSB_IO_TIMEOUT)) {
             d->stats.tx_frames++;
             d->io_errors_in_row = 0;
             return SL_OK;
         }
         switch (io) {
-        case SL_GSUSB_IO_STALL:
+        case SLP_GSUSB_IO_STALL:
             d->stats.stalls_out++;
             if (attempt == 0 && clear_halt(d, false)) {
                 d->stats.tx_retries++;
                 continue;
             }
-            (void)sl_gsusb_echo_release(&d->echo, (uint32_t)id);
+            (void)slp_gsusb_echo_release(&d->echo, (uint32_t)id);
             d->stats.tx_errors++;
             return SL_ERR_PORT;
-        case SL_GSUSB_IO_TIMEOUT:
-            (void)sl_gsusb_echo_release(&d->echo, (uint32_t)id);
+        case SLP_GSUSB_IO_TIMEOUT:
+            (void)slp_gsusb_echo_release(&d->echo, (uint32_t)id);
             d->stats.tx_timeouts++;
             return SL_ERR_BUSY;
-        case SL_GSUSB_IO_NO_DEVICE:
-            (void)sl_gsusb_echo_release(&d->echo, (uint32_t)id);
+        case SLP_GSUSB_IO_NO_DEVICE:
+            (void)slp_gsusb_echo_release(&d->echo, (uint32_t)id);
             d->stats.tx_errors++;
-            sl_gsusb_mark_down(d);
+            slp_gsusb_mark_down(d);
             return SL_ERR_PORT;
-        case SL_GSUSB_IO_OK: // short write
-        case SL_GSUSB_IO_OVERFLOW:
-        case SL_GSUSB_IO_ERROR:
+        case SLP_GSUSB_IO_OK: // short write
+        case SLP_GSUSB_IO_OVERFLOW:
+        case SLP_GSUSB_IO_ERROR:
         default:
-            (void)sl_gsusb_echo_release(&d->echo, (uint32_t)id);
+            (void)slp_gsusb_echo_release(&d->echo, (uint32_t)id);
             d->stats.tx_errors++;
             io_error(d);
             return SL_ERR_PORT;
         }
     }
     // Unreachable: the second attempt returns in every branch.
-    (void)sl_gsusb_echo_release(&d->echo, (uint32_t)id);
+    (void)slp_gsusb_echo_release(&d->echo, (uint32_t)id);
     d->stats.tx_errors++;
     return SL_ERR_PORT;
 }
 
-static void handle_error_frame(sl_gsusb_t *d, const sl_can_frame_t *f)
+static void handle_error_frame(slp_gsusb_t *d, const sl_can_frame_t *f)
 {
     d->stats.rx_error_frames++;
-    if ((f->id & SL_GSUSB_ERR_BUSOFF) != 0U) {
+    if ((f->id & SLP_GSUSB_ERR_BUSOFF) != 0U) {
         d->stats.bus_off++;
     }
-    if ((f->id & SL_GSUSB_ERR_CRTL) != 0U && f->dlc >= 2U) {
+    if ((f->id & SLP_GSUSB_ERR_CRTL) != 0U && f->dlc >= 2U) {
         uint8_t st = f->data[1];
-        if ((st & (SL_GSUSB_ERR_CRTL_RX_PASSIVE | SL_GSUSB_ERR_CRTL_TX_PASSIVE)) != 0U) {
+        if ((st & (SLP_GSUSB_ERR_CRTL_RX_PASSIVE | SLP_GSUSB_ERR_CRTL_TX_PASSIVE)) != 0U) {
             d->stats.err_passive++;
         }
-        if ((st & (SL_GSUSB_ERR_CRTL_RX_WARNING | SL_GSUSB_ERR_CRTL_TX_WARNING)) != 0U) {
+        if ((st & (SLP_GSUSB_ERR_CRTL_RX_WARNING | SLP_GSUSB_ERR_CRTL_TX_WARNING)) != 0U) {
             d->stats.err_warning++;
         }
     }
 }
 
-static void handle_packet(sl_gsusb_t *d, const uint8_t *pkt, size_t len, uint64_t now_us)
+static void handle_packet(slp_gsusb_t *d, const uint8_t *pkt, size_t len, uint64_t now_us)
 {
-    sl_gsusb_host_frame_t hf;
-    if (sl_gsusb_frame_decode(pkt, len, d->rx_fmt, &hf) != SL_OK) {
+    slp_gsusb_host_frame_t hf;
+    if (slp_gsusb_frame_decode(pkt, len, d->rx_fmt, &hf) != SL_OK) {
         d->stats.rx_malformed++;
         return;
     }
-    if (hf.echo_id != (uint32_t)SL_GSUSB_ECHO_ID_RX) {
-        const sl_gsusb_echo_slot_t *slot = sl_gsusb_echo_peek(&d->echo, hf.echo_id);
+    if (hf.echo_id != (uint32_t)SLP_GSUSB_ECHO_ID_RX) {
+        const slp_gsusb_echo_slot_t *slot = slp_gsusb_echo_peek(&d->echo, hf.echo_id);
         if (slot == NULL) {
             d->echo.stats.unknown++;
             d->stats.echo_unknown++;
             return;
         }
-        sl_gsusb_host_frame_t sent;
-        (void)sl_gsusb_frame_from_can(&slot->frame, hf.echo_id, d->cfg.channel, &sent);
-        bool rtr = (sent.can_id & SL_GSUSB_CAN_RTR_FLAG) != 0U;
+        slp_gsusb_host_frame_t sent;
+        (void)slp_gsusb_frame_from_can(&slot->frame, hf.echo_id, d->cfg.channel, &sent);
+        bool rtr = (sent.can_id & SLP_GSUSB_CAN_RTR_FLAG) != 0U;
         if (sent.can_id != hf.can_id || sent.can_dlc != hf.can_dlc ||
             (!rtr && memcmp(sent.data, hf.data, sent.can_dlc) != 0)) {
             d->stats.echo_mismatch++; // late echo of an earlier user of this id, or bogus
             return;
         }
-        sl_gsusb_echo_slot_t done;
-        (void)sl_gsusb_echo_confirm(&d->echo, hf.echo_id, &done);
+        slp_gsusb_echo_slot_t done;
+        (void)slp_gsusb_echo_confirm(&d->echo, hf.echo_id, &done);
         d->stats.tx_confirmed++;
         if (d->cfg.on_tx_done != NULL) {
             uint64_t lat = now_us >= done.sent_us ? now_us - done.sent_us : 0U;
-            d->cfg.on_tx_done(d->cfg.ctx, &done.frame, done.tag, SL_GSUSB_TX_CONFIRMED, lat);
+            d->cfg.on_tx_done(d->cfg.ctx, &done.frame, done.tag, SLP_GSUSB_TX_CONFIRMED, lat);
         }
         return;
     }
@@ -1014,15 +1014,15 @@ static void handle_packet(sl_gsusb_t *d, const uint8_t *pkt, size_t len, uint64_
         return;
     }
     sl_can_frame_t f;
-    if (sl_gsusb_frame_to_can(&hf, &f) != SL_OK) {
+    if (slp_gsusb_frame_to_can(&hf, &f) != SL_OK) {
         d->stats.rx_malformed++;
         return;
     }
-    sl_gsusb_rx_info_t info = {
+    slp_gsusb_rx_info_t info = {
         .now_us = now_us,
         .timestamp_us = hf.timestamp_us,
         .has_timestamp = d->rx_fmt != 0U,
-        .overflow = (hf.flags & SL_GSUSB_FRAME_FLAG_OVERFLOW) != 0U,
+        .overflow = (hf.flags & SLP_GSUSB_FRAME_FLAG_OVERFLOW) != 0U,
     };
     if (info.overflow) {
         d->stats.rx_overflows++;
@@ -1037,12 +1037,12 @@ static void handle_packet(sl_gsusb_t *d, const uint8_t *pkt, size_t len, uint64_
     }
 }
 
-sl_ssize_t sl_gsusb_poll(sl_gsusb_t *d, uint32_t timeout_ms, uint64_t now_us)
+sl_ssize_t slp_gsusb_poll(slp_gsusb_t *d, uint32_t timeout_ms, uint64_t now_us)
 {
     if (d == NULL) {
         return SL_ERR_ARG;
     }
-    if (d->state != SL_GSUSB_RUNNING) {
+    if (d->state != SLP_GSUSB_RUNNING) {
         return SL_ERR_STATE;
     }
     sl_ssize_t handled = 0;
@@ -1051,33 +1051,33 @@ sl_ssize_t sl_gsusb_poll(sl_gsusb_t *d, uint32_t timeout_ms, uint64_t now_us)
     if (d->tr.ops->out_stalled != NULL && d->tr.ops->out_stalled(d->tr.ctx)) {
         d->stats.stalls_out++;
         (void)clear_halt(d, false);
-        if (d->state != SL_GSUSB_RUNNING) {
+        if (d->state != SLP_GSUSB_RUNNING) {
             return SL_ERR_PORT;
         }
     }
     for (uint16_t k = 0; k < d->cfg.rx_budget; k++) {
         size_t n = 0;
-        sl_gsusb_io_t io = d->tr.ops->bulk_in(d->tr.ctx, pkt, sizeof pkt, wait, &n);
+        slp_gsusb_io_t io = d->tr.ops->bulk_in(d->tr.ctx, pkt, sizeof pkt, wait, &n);
         wait = 0;
-        if (io == SL_GSUSB_IO_OK) {
+        if (io == SLP_GSUSB_IO_OK) {
             d->io_errors_in_row = 0;
             handle_packet(d, pkt, n, now_us);
             handled++;
             continue;
         }
-        if (io == SL_GSUSB_IO_TIMEOUT) {
+        if (io == SLP_GSUSB_IO_TIMEOUT) {
             break;
         }
-        if (io == SL_GSUSB_IO_STALL) {
+        if (io == SLP_GSUSB_IO_STALL) {
             d->stats.stalls_in++;
             (void)clear_halt(d, true);
             break;
         }
-        if (io == SL_GSUSB_IO_NO_DEVICE) {
-            sl_gsusb_mark_down(d);
+        if (io == SLP_GSUSB_IO_NO_DEVICE) {
+            slp_gsusb_mark_down(d);
             break;
         }
-        if (io == SL_GSUSB_IO_OVERFLOW) {
+        if (io == SLP_GSUSB_IO_OVERFLOW) {
             d->stats.rx_malformed++;
             continue;
         }
@@ -1085,60 +1085,60 @@ sl_ssize_t sl_gsusb_poll(sl_gsusb_t *d, uint32_t timeout_ms, uint64_t now_us)
         io_error(d);
         break;
     }
-    if (d->state != SL_GSUSB_RUNNING) {
+    if (d->state != SLP_GSUSB_RUNNING) {
         return SL_ERR_PORT;
     }
-    (void)sl_gsusb_echo_expire(&d->echo, now_us, echo_timeout_us(d), echo_done_cb, d);
+    (void)slp_gsusb_echo_expire(&d->echo, now_us, echo_timeout_us(d), echo_done_cb, d);
     return handled;
 }
 
-sl_err_t sl_gsusb_get_state(sl_gsusb_t *d, sl_gsusb_can_state_t *out)
+sl_err_t slp_gsusb_get_state(slp_gsusb_t *d, slp_gsusb_can_state_t *out)
 {
     if (d == NULL || out == NULL) {
         return SL_ERR_ARG;
     }
-    if (d->state != SL_GSUSB_RUNNING || (d->bt_const.feature & SL_GSUSB_FEAT_GET_STATE) == 0U) {
+    if (d->state != SLP_GSUSB_RUNNING || (d->bt_const.feature & SLP_GSUSB_FEAT_GET_STATE) == 0U) {
         return SL_ERR_STATE;
     }
-    uint8_t buf[SL_GSUSB_STATE_BYTES];
-    sl_err_t rc = ctrl_in(d, SL_GSUSB_BREQ_GET_STATE, d->cfg.channel, 0U, buf, SL_GSUSB_STATE_BYTES);
+    uint8_t buf[SLP_GSUSB_STATE_BYTES];
+    sl_err_t rc = ctrl_in(d, SLP_GSUSB_BREQ_GET_STATE, d->cfg.channel, 0U, buf, SLP_GSUSB_STATE_BYTES);
     if (rc != SL_OK) {
         return rc;
     }
-    return sl_gsusb_decode_state(buf, sizeof buf, out);
+    return slp_gsusb_decode_state(buf, sizeof buf, out);
 }
 
-void sl_gsusb_stop(sl_gsusb_t *d)
+void slp_gsusb_stop(slp_gsusb_t *d)
 {
     if (d == NULL) {
         return;
     }
-    if (d->state == SL_GSUSB_RUNNING) {
-        uint8_t buf[SL_GSUSB_MODE_BYTES];
+    if (d->state == SLP_GSUSB_RUNNING) {
+        uint8_t buf[SLP_GSUSB_MODE_BYTES];
         size_t n = 0;
-        sl_gsusb_encode_mode(SL_GSUSB_MODE_RESET, 0U, buf);
-        sl_gsusb_io_t io = d->tr.ops->control_out(d->tr.ctx, (uint8_t)SL_GSUSB_RT_OUT,
-                                                  SL_GSUSB_BREQ_MODE, d->cfg.channel, 0U, buf,
-                                                  SL_GSUSB_MODE_BYTES, d->cfg.control_timeout_ms, &n);
-        if (io != SL_GSUSB_IO_OK) {
+        slp_gsusb_encode_mode(SLP_GSUSB_MODE_RESET, 0U, buf);
+        slp_gsusb_io_t io = d->tr.ops->control_out(d->tr.ctx, (uint8_t)SLP_GSUSB_RT_OUT,
+                                                  SLP_GSUSB_BREQ_MODE, d->cfg.channel, 0U, buf,
+                                                  SLP_GSUSB_MODE_BYTES, d->cfg.control_timeout_ms, &n);
+        if (io != SLP_GSUSB_IO_OK) {
             d->stats.ctrl_errors++;
         }
     }
-    (void)sl_gsusb_echo_drop_all(&d->echo, echo_done_cb, d);
-    d->state = SL_GSUSB_CLOSED;
+    (void)slp_gsusb_echo_drop_all(&d->echo, echo_done_cb, d);
+    d->state = SLP_GSUSB_CLOSED;
 }
 
-uint8_t sl_gsusb_in_flight(const sl_gsusb_t *d)
+uint8_t slp_gsusb_in_flight(const slp_gsusb_t *d)
 {
     return d != NULL ? d->echo.in_flight : 0U;
 }
 
-int sl_gsusb_next_timeout_ms(const sl_gsusb_t *d, uint64_t now_us)
+int slp_gsusb_next_timeout_ms(const slp_gsusb_t *d, uint64_t now_us)
 {
     if (d == NULL) {
         return -1;
     }
-    uint64_t dl = sl_gsusb_echo_deadline(&d->echo, echo_timeout_us(d));
+    uint64_t dl = slp_gsusb_echo_deadline(&d->echo, echo_timeout_us(d));
     if (dl == UINT64_MAX) {
         return -1;
     }

@@ -6,22 +6,22 @@
 #include <string.h>
 #include <time.h>
 
-#include "sl_port_linux.h"
+#include "port_clock.h"
 
-sl_gsusb_sink_cfg_t sl_gsusb_sink_default_cfg(void)
+slp_gsusb_sink_cfg_t slp_gsusb_sink_default_cfg(void)
 {
-    sl_gsusb_sink_cfg_t c;
+    slp_gsusb_sink_cfg_t c;
     memset(&c, 0, sizeof c);
-    sl_gsusb_cfg_defaults(&c.can);
+    slp_gsusb_cfg_defaults(&c.can);
     c.queue_cap = 32U;
     c.max_age_us = 200000U;
     c.reopen_interval_us = 1000000U;
     return c;
 }
 
-static void on_rx(void *ctx, const sl_can_frame_t *f, const sl_gsusb_rx_info_t *info)
+static void on_rx(void *ctx, const sl_can_frame_t *f, const slp_gsusb_rx_info_t *info)
 {
-    sl_gsusb_sink_t *s = ctx;
+    slp_gsusb_sink_t *s = ctx;
     if ((f->flags & SL_CAN_FLAG_ERR) != 0U) {
         s->stats.rx_error_frames++;
     } else {
@@ -32,14 +32,14 @@ static void on_rx(void *ctx, const sl_can_frame_t *f, const sl_gsusb_rx_info_t *
     }
 }
 
-static void on_tx_done(void *ctx, const sl_can_frame_t *f, uint32_t tag, sl_gsusb_tx_result_t r,
+static void on_tx_done(void *ctx, const sl_can_frame_t *f, uint32_t tag, slp_gsusb_tx_result_t r,
                        uint64_t latency_us)
 {
-    sl_gsusb_sink_t *s = ctx;
+    slp_gsusb_sink_t *s = ctx;
     switch (r) {
-    case SL_GSUSB_TX_CONFIRMED: s->stats.confirmed++; break;
-    case SL_GSUSB_TX_TIMEOUT: s->stats.unconfirmed++; break;
-    case SL_GSUSB_TX_DROPPED:
+    case SLP_GSUSB_TX_CONFIRMED: s->stats.confirmed++; break;
+    case SLP_GSUSB_TX_TIMEOUT: s->stats.unconfirmed++; break;
+    case SLP_GSUSB_TX_DROPPED:
     default: s->stats.dropped_in_flight++; break;
     }
     if (s->cfg.on_tx_done != NULL) {
@@ -47,14 +47,14 @@ static void on_tx_done(void *ctx, const sl_can_frame_t *f, uint32_t tag, sl_gsus
     }
 }
 
-static void drop_queue(sl_gsusb_sink_t *s, uint32_t *counter)
+static void drop_queue(slp_gsusb_sink_t *s, uint32_t *counter)
 {
     *counter += s->q_len;
     s->q_head = 0;
     s->q_len = 0;
 }
 
-static void go_down(sl_gsusb_sink_t *s, uint64_t t_us, const char *why)
+static void go_down(slp_gsusb_sink_t *s, uint64_t t_us, const char *why)
 {
     if (!s->up) {
         return;
@@ -63,33 +63,33 @@ static void go_down(sl_gsusb_sink_t *s, uint64_t t_us, const char *why)
     s->stats.down_events++;
     (void)snprintf(s->last_error, sizeof s->last_error, "%s", why);
     drop_queue(s, &s->stats.dropped_down);
-    sl_gsusb_mark_down(&s->drv); // in-flight frames -> on_tx_done(DROPPED)
-    sl_gsusb_usb_close(&s->usb);
+    slp_gsusb_mark_down(&s->drv); // in-flight frames -> on_tx_done(DROPPED)
+    slp_gsusb_usb_close(&s->usb);
     s->next_reopen_us = t_us + s->cfg.reopen_interval_us;
 }
 
 // Open the USB device and run the start-up sequence.
-static sl_err_t bring_up(sl_gsusb_sink_t *s, uint64_t t_us)
+static sl_err_t bring_up(slp_gsusb_sink_t *s, uint64_t t_us)
 {
-    if (sl_gsusb_usb_is_open(&s->usb)) {
-        sl_gsusb_usb_close(&s->usb);
+    if (slp_gsusb_usb_is_open(&s->usb)) {
+        slp_gsusb_usb_close(&s->usb);
     }
-    sl_err_t rc = sl_gsusb_usb_open(&s->usb, &s->sel);
+    sl_err_t rc = slp_gsusb_usb_open(&s->usb, &s->sel);
     if (rc != SL_OK) {
         (void)snprintf(s->last_error, sizeof s->last_error, "%s", s->usb.err);
         s->stats.open_failures++;
         s->next_reopen_us = t_us + s->cfg.reopen_interval_us;
         return rc;
     }
-    sl_gsusb_transport_t tr = sl_gsusb_usb_transport(&s->usb);
-    sl_gsusb_set_transport(&s->drv, &tr);
-    rc = sl_gsusb_start(&s->drv, t_us);
+    slp_gsusb_transport_t tr = slp_gsusb_usb_transport(&s->usb);
+    slp_gsusb_set_transport(&s->drv, &tr);
+    rc = slp_gsusb_start(&s->drv, t_us);
     if (rc != SL_OK) {
         (void)snprintf(s->last_error, sizeof s->last_error, "%04x:%04x at %s: %s",
                        (unsigned)s->usb.vid, (unsigned)s->usb.pid, s->usb.where,
                        s->drv.last_error);
         s->stats.open_failures++;
-        sl_gsusb_usb_close(&s->usb); // gives the device back to the kernel driver
+        slp_gsusb_usb_close(&s->usb); // gives the device back to the kernel driver
         s->next_reopen_us = t_us + s->cfg.reopen_interval_us;
         return rc;
     }
@@ -102,9 +102,9 @@ static sl_err_t bring_up(sl_gsusb_sink_t *s, uint64_t t_us)
     return SL_OK;
 }
 
-sl_err_t sl_gsusb_sink_open(sl_gsusb_sink_t *s, const sl_gsusb_sink_cfg_t *cfg, uint64_t t_us)
+sl_err_t slp_gsusb_sink_open(slp_gsusb_sink_t *s, const slp_gsusb_sink_cfg_t *cfg, uint64_t t_us)
 {
-    if (s == NULL || cfg == NULL || cfg->queue_cap > SL_GSUSB_SINK_QUEUE_MAX ||
+    if (s == NULL || cfg == NULL || cfg->queue_cap > SLP_GSUSB_SINK_QUEUE_MAX ||
         (cfg->selector != NULL && strlen(cfg->selector) >= sizeof s->selector)) {
         return SL_ERR_ARG;
     }
@@ -117,24 +117,24 @@ sl_err_t sl_gsusb_sink_open(sl_gsusb_sink_t *s, const sl_gsusb_sink_cfg_t *cfg, 
     if (s->cfg.reopen_interval_us == 0U) {
         s->cfg.reopen_interval_us = 1000000U;
     }
-    if (sl_gsusb_usb_parse_selector(s->selector, &s->sel) != SL_OK) {
+    if (slp_gsusb_usb_parse_selector(s->selector, &s->sel) != SL_OK) {
         (void)snprintf(s->last_error, sizeof s->last_error,
                        "bad adapter selector '%s' (want VID:PID like 1d50:606f or BUS-PORT like 1-1.4)",
                        s->selector);
         return SL_ERR_ARG;
     }
-    sl_gsusb_cfg_t dc = cfg->can;
+    slp_gsusb_cfg_t dc = cfg->can;
     dc.on_rx = on_rx;
     dc.on_tx_done = on_tx_done;
     dc.ctx = s;
     // The driver talks to the transport only after a successful USB open; until then it
     // holds an empty transport that it never calls (state CLOSED).
-    sl_gsusb_transport_t tr = sl_gsusb_usb_transport(&s->usb);
-    if (sl_gsusb_init(&s->drv, &dc, &tr) != SL_OK) {
+    slp_gsusb_transport_t tr = slp_gsusb_usb_transport(&s->usb);
+    if (slp_gsusb_init(&s->drv, &dc, &tr) != SL_OK) {
         (void)snprintf(s->last_error, sizeof s->last_error, "invalid CAN configuration");
         return SL_ERR_ARG;
     }
-    if (sl_gsusb_usb_init(&s->usb) != SL_OK) {
+    if (slp_gsusb_usb_init(&s->usb) != SL_OK) {
         (void)snprintf(s->last_error, sizeof s->last_error, "%s", s->usb.err);
         return SL_ERR_PORT;
     }
@@ -145,7 +145,7 @@ sl_err_t sl_gsusb_sink_open(sl_gsusb_sink_t *s, const sl_gsusb_sink_cfg_t *cfg, 
     return bring_up(s, t_us);
 }
 
-static void flush_queue(sl_gsusb_sink_t *s, uint64_t t_us)
+static void flush_queue(slp_gsusb_sink_t *s, uint64_t t_us)
 {
     while (s->up && s->q_len > 0U) {
         const sl_can_frame_t *f = &s->q[s->q_head];
@@ -153,7 +153,7 @@ static void flush_queue(sl_gsusb_sink_t *s, uint64_t t_us)
         if (s->cfg.max_age_us != 0U && t_us > qt && t_us - qt > s->cfg.max_age_us) {
             s->stats.dropped_stale++;
         } else {
-            sl_err_t rc = sl_gsusb_send(&s->drv, f, s->tag, t_us);
+            sl_err_t rc = slp_gsusb_send(&s->drv, f, s->tag, t_us);
             if (rc == SL_ERR_BUSY) {
                 return; // window still full: keep it
             }
@@ -162,9 +162,9 @@ static void flush_queue(sl_gsusb_sink_t *s, uint64_t t_us)
                 s->stats.submitted++;
             } else if (rc == SL_ERR_ARG) {
                 s->stats.dropped_invalid++;
-            } else if (s->drv.state == SL_GSUSB_DOWN) {
+            } else if (s->drv.state == SLP_GSUSB_DOWN) {
                 s->stats.dropped_down++;
-                s->q_head = (uint16_t)((s->q_head + 1U) % SL_GSUSB_SINK_QUEUE_MAX);
+                s->q_head = (uint16_t)((s->q_head + 1U) % SLP_GSUSB_SINK_QUEUE_MAX);
                 s->q_len--;
                 go_down(s, t_us, "adapter vanished (USB device gone)");
                 return;
@@ -172,26 +172,26 @@ static void flush_queue(sl_gsusb_sink_t *s, uint64_t t_us)
                 s->stats.dropped_error++;
             }
         }
-        s->q_head = (uint16_t)((s->q_head + 1U) % SL_GSUSB_SINK_QUEUE_MAX);
+        s->q_head = (uint16_t)((s->q_head + 1U) % SLP_GSUSB_SINK_QUEUE_MAX);
         s->q_len--;
     }
 }
 
 // Non-blocking (timeout 0) or waiting driver poll, then the queue.
-static void service(sl_gsusb_sink_t *s, uint32_t timeout_ms, uint64_t t_us)
+static void service(slp_gsusb_sink_t *s, uint32_t timeout_ms, uint64_t t_us)
 {
     if (!s->up) {
         return;
     }
-    sl_ssize_t r = sl_gsusb_poll(&s->drv, timeout_ms, t_us);
-    if (r < 0 || s->drv.state != SL_GSUSB_RUNNING) {
+    sl_ssize_t r = slp_gsusb_poll(&s->drv, timeout_ms, t_us);
+    if (r < 0 || s->drv.state != SLP_GSUSB_RUNNING) {
         go_down(s, t_us, "adapter vanished (USB device gone)");
         return;
     }
     flush_queue(s, t_us);
 }
 
-sl_err_t sl_gsusb_sink_send(sl_gsusb_sink_t *s, const sl_can_frame_t *f, uint64_t t_us)
+sl_err_t slp_gsusb_sink_send(slp_gsusb_sink_t *s, const sl_can_frame_t *f, uint64_t t_us)
 {
     if (s == NULL || f == NULL) {
         return SL_ERR_ARG;
@@ -205,7 +205,7 @@ sl_err_t sl_gsusb_sink_send(sl_gsusb_sink_t *s, const sl_can_frame_t *f, uint64_
         return SL_ERR_PORT;
     }
     if (s->q_len == 0U) {
-        sl_err_t rc = sl_gsusb_send(&s->drv, f, s->tag, t_us);
+        sl_err_t rc = slp_gsusb_send(&s->drv, f, s->tag, t_us);
         if (rc == SL_OK) {
             s->tag++;
             s->stats.submitted++;
@@ -216,7 +216,7 @@ sl_err_t sl_gsusb_sink_send(sl_gsusb_sink_t *s, const sl_can_frame_t *f, uint64_
             return SL_ERR_ARG;
         }
         if (rc != SL_ERR_BUSY) { // BUSY: window full or the adapter slow: queue it
-            if (s->drv.state != SL_GSUSB_RUNNING) {
+            if (s->drv.state != SLP_GSUSB_RUNNING) {
                 s->stats.dropped_down++;
                 go_down(s, t_us, "adapter vanished (USB device gone)");
             } else {
@@ -230,14 +230,14 @@ sl_err_t sl_gsusb_sink_send(sl_gsusb_sink_t *s, const sl_can_frame_t *f, uint64_
         s->stats.dropped_full++;
         return SL_ERR_BUSY;
     }
-    uint16_t slot = (uint16_t)((s->q_head + s->q_len) % SL_GSUSB_SINK_QUEUE_MAX);
+    uint16_t slot = (uint16_t)((s->q_head + s->q_len) % SLP_GSUSB_SINK_QUEUE_MAX);
     s->q[slot] = *f;
     s->q_t_us[slot] = t_us;
     s->q_len++;
     return SL_OK;
 }
 
-void sl_gsusb_sink_poll(sl_gsusb_sink_t *s, uint64_t t_us)
+void slp_gsusb_sink_poll(slp_gsusb_sink_t *s, uint64_t t_us)
 {
     if (s == NULL || !s->opened) {
         return;
@@ -250,23 +250,23 @@ void sl_gsusb_sink_poll(sl_gsusb_sink_t *s, uint64_t t_us)
     }
 }
 
-void sl_gsusb_sink_wait(sl_gsusb_sink_t *s, uint32_t timeout_ms)
+void slp_gsusb_sink_wait(slp_gsusb_sink_t *s, uint32_t timeout_ms)
 {
     if (s == NULL || !s->opened) {
         return;
     }
     if (s->up) {
         // Wait in the driver's first bulk IN read; expiry uses the time after the wait.
-        sl_ssize_t r = sl_gsusb_poll(&s->drv, timeout_ms, sl_port_now_us());
-        uint64_t now = sl_port_now_us();
-        if (r < 0 || s->drv.state != SL_GSUSB_RUNNING) {
+        sl_ssize_t r = slp_gsusb_poll(&s->drv, timeout_ms, slp_now_us());
+        uint64_t now = slp_now_us();
+        if (r < 0 || s->drv.state != SLP_GSUSB_RUNNING) {
             go_down(s, now, "adapter vanished (USB device gone)");
             return;
         }
         service(s, 0U, now);
         return;
     }
-    uint64_t now = sl_port_now_us();
+    uint64_t now = slp_now_us();
     if (now < s->next_reopen_us) {
         uint64_t wait_us = s->next_reopen_us - now;
         if (wait_us > (uint64_t)timeout_ms * 1000U) {
@@ -274,12 +274,12 @@ void sl_gsusb_sink_wait(sl_gsusb_sink_t *s, uint32_t timeout_ms)
         }
         struct timespec ts = {(time_t)(wait_us / 1000000U), (long)((wait_us % 1000000U) * 1000U)};
         (void)nanosleep(&ts, NULL);
-        now = sl_port_now_us();
+        now = slp_now_us();
     }
-    sl_gsusb_sink_poll(s, now);
+    slp_gsusb_sink_poll(s, now);
 }
 
-sl_err_t sl_gsusb_sink_reopen(sl_gsusb_sink_t *s, uint64_t t_us)
+sl_err_t slp_gsusb_sink_reopen(slp_gsusb_sink_t *s, uint64_t t_us)
 {
     if (s == NULL) {
         return SL_ERR_ARG;
@@ -288,7 +288,7 @@ sl_err_t sl_gsusb_sink_reopen(sl_gsusb_sink_t *s, uint64_t t_us)
         return SL_ERR_STATE;
     }
     if (s->up) {
-        sl_gsusb_stop(&s->drv);
+        slp_gsusb_stop(&s->drv);
         drop_queue(s, &s->stats.dropped_down);
         s->up = false;
     }
@@ -296,60 +296,60 @@ sl_err_t sl_gsusb_sink_reopen(sl_gsusb_sink_t *s, uint64_t t_us)
     return bring_up(s, t_us);
 }
 
-bool sl_gsusb_sink_is_up(const sl_gsusb_sink_t *s)
+bool slp_gsusb_sink_is_up(const slp_gsusb_sink_t *s)
 {
     return s != NULL && s->up;
 }
 
-uint32_t sl_gsusb_sink_pending(const sl_gsusb_sink_t *s)
+uint32_t slp_gsusb_sink_pending(const slp_gsusb_sink_t *s)
 {
-    return s == NULL ? 0U : (uint32_t)s->q_len + sl_gsusb_in_flight(&s->drv);
+    return s == NULL ? 0U : (uint32_t)s->q_len + slp_gsusb_in_flight(&s->drv);
 }
 
-const char *sl_gsusb_sink_last_error(const sl_gsusb_sink_t *s)
+const char *slp_gsusb_sink_last_error(const slp_gsusb_sink_t *s)
 {
     return s == NULL ? "" : s->last_error;
 }
 
-void sl_gsusb_sink_close(sl_gsusb_sink_t *s)
+void slp_gsusb_sink_close(slp_gsusb_sink_t *s)
 {
     if (s == NULL || !s->opened) {
         return;
     }
     if (s->up) {
-        sl_gsusb_stop(&s->drv); // MODE RESET; in flight -> dropped_in_flight
+        slp_gsusb_stop(&s->drv); // MODE RESET; in flight -> dropped_in_flight
         drop_queue(s, &s->stats.dropped_down);
         s->up = false;
     }
-    sl_gsusb_usb_deinit(&s->usb);
+    slp_gsusb_usb_deinit(&s->usb);
     s->opened = false;
 }
 
 static sl_err_t sink_send(void *ctx, const sl_can_frame_t *f, uint64_t t_us)
 {
-    return sl_gsusb_sink_send(ctx, f, t_us);
+    return slp_gsusb_sink_send(ctx, f, t_us);
 }
 
 static void sink_poll(void *ctx, uint64_t t_us)
 {
-    sl_gsusb_sink_poll(ctx, t_us);
+    slp_gsusb_sink_poll(ctx, t_us);
 }
 
-static void sink_stats(void *ctx, sl_can_sink_stats_t *out)
+static void sink_stats(void *ctx, slp_can_sink_stats_t *out)
 {
-    const sl_gsusb_sink_t *s = ctx;
-    const sl_gsusb_sink_stats_t *st = &s->stats;
-    const sl_gsusb_stats_t *d = &s->drv.stats;
+    const slp_gsusb_sink_t *s = ctx;
+    const slp_gsusb_sink_stats_t *st = &s->stats;
+    const slp_gsusb_stats_t *d = &s->drv.stats;
     out->sent = st->confirmed;
     out->dropped = st->unconfirmed + st->dropped_in_flight + st->dropped_down + st->dropped_full +
                    st->dropped_stale + st->dropped_error + st->dropped_invalid;
-    out->queued = sl_gsusb_sink_pending(s);
+    out->queued = slp_gsusb_sink_pending(s);
     out->errors = d->rx_error_frames + d->stalls_in + d->stalls_out + d->tx_errors +
                   d->rx_io_errors + d->ctrl_errors + d->ctrl_stalls + d->rx_malformed;
 }
 
-sl_can_sink_t sl_gsusb_sink_as_sink(sl_gsusb_sink_t *s)
+slp_can_sink_t slp_gsusb_sink_as_sink(slp_gsusb_sink_t *s)
 {
-    sl_can_sink_t k = {"gs_usb", s, sink_send, sink_poll, sink_stats};
+    slp_can_sink_t k = {"gs_usb", s, sink_send, sink_poll, sink_stats};
     return k;
 }
