@@ -47,7 +47,7 @@ static void rotation(sl_drift_t *d, const sl_board_t *b, const uint8_t *row)
 {
     uint32_t bits[(BINS + 31U) / 32U];
     sl_thresh_u8(row, BINS, THR, bits); // as the pipeline thresholds the row
-    sl_drift_row(d, b, d->watch_az, bits, BINS, b->bin_size_um);
+    sl_drift_row(d, b, d->watch_az, bits, NULL, BINS, b->bin_size_um);
     sl_drift_end_rotation(d);
 }
 
@@ -165,7 +165,8 @@ static void test_drift_rejects_occupied_rows_missing_ground_and_outliers(void **
     ground_row(row, 26.0, b);
     uint32_t bits[(BINS + 31U) / 32U];
     sl_thresh_u8(row, BINS, THR, bits);
-    sl_drift_row(&d, b, (uint16_t)((d.watch_az + 1U) % b->azimuths), bits, BINS, b->bin_size_um);
+    sl_drift_row(&d, b, (uint16_t)((d.watch_az + 1U) % b->azimuths), bits, NULL, BINS,
+                 b->bin_size_um);
     assert_int_equal(d.stats.samples, 1);
 }
 
