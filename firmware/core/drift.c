@@ -111,6 +111,16 @@ void sl_drift_tail(sl_drift_t *d, const sl_proto_fft_t *f, uint16_t from, uint8_
     d->tail_n = (uint8_t)n;
 }
 
+// The last two bins of a row of n bins are stable: occupied (bits) or free (free_).
+static bool settled_end(const uint32_t *bits, const uint32_t *free_, uint32_t n)
+{
+    if (free_ == NULL || n < 2U) {
+        return false;
+    }
+    const int32_t k = (int32_t)n - 1;
+    return (bit(bits, k) || bit(free_, k)) && (bit(bits, k - 1) || bit(free_, k - 1));
+}
+
 void sl_drift_row(sl_drift_t *d, const sl_board_t *board, uint16_t az, const uint32_t *bits,
                   const uint32_t *free_, uint16_t bins, uint32_t bin_um)
 {
@@ -128,9 +138,10 @@ void sl_drift_row(sl_drift_t *d, const sl_board_t *board, uint16_t az, const uin
     // The join needs the mask settled at its end: its last two bins stable (occupied or
     // free). Otherwise (the window filling, the vehicle moving, ground flickering at the
     // edge) the mask's end says nothing and a tail would put the ground start at the join.
-    const bool tail = d->tail_n > 0U && d->tail_from == mask_n && mask_n >= 2U &&
-                      free_ != NULL && (bit(bits, (int32_t)mask_n - 1) || bit(free_, (int32_t)mask_n - 1)) &&
-                      (bit(bits, (int32_t)mask_n - 2) || bit(free_, (int32_t)mask_n - 2));
+    bool tail = false;
+    if (d->tail_n > 0U && d->tail_from == mask_n) {
+        tail = settled_end(bits, free_, mask_n);
+    }
     if (tail) {
         if ((mask_n & 31U) != 0U) {
             row[mw - 1U] &= ~0U >> (32U - (mask_n & 31U)); // bits past the mask's end: 0
