@@ -49,23 +49,31 @@
 /// 2 deg: each sector is sampled every 8th rotation and needs two samples past the step
 /// (est = 0.5 then 0.75 of the step: 1.5 deg > 1 deg), so the median moves after ~2 x 8
 /// rotations, plus SL_DRIFT_PERSIST: within 32 rotations of the rows changing
-/// (tests/unit/test_drift.c). In the pipeline the rows are the consistency mask's stable
+/// (tests/core/test_drift.c). In the pipeline the rows are the consistency mask's stable
 /// rows, which show newly lit ground n rotations (the window, 16) after it appears: the
-/// fault is raised within n + 32 = 48 rotations (12 s at 4 Hz) of the step
-/// (calib_drift_theta_step_2deg_raises_theta_drift_within_48_rotations).
+/// fault is raised within n + 32 = 48 rotations (12 s at 4 Hz) of the step, in both
+/// directions (below).
 ///
+/// The join: the tail is used only when the mask's row is settled at its end (its last two
+/// bins stable-occupied or stable-free, sl_drift_row's `free_`). While the window fills,
+/// while driving, or where ground flickers at the mask's edge those bins are neither, and a
+/// tail joined there would put the ground start at the join whatever the truth; such rows
+/// are read without the tail (the one-sided reading, usually "no ground").
 /// Noise: a tail bin is one rotation's return, where the mask's bins are consistent over its
 /// window. Isolated noise bins in the shadow are not "occupied" (that needs two adjacent
 /// bins) and shift g by at most two bins (0.4 deg) when next to the run; a gap of two bins
 /// in the tail's ground (weak clutter) cuts the run short (theta_live too small). Both are
 /// single samples: each sector's estimate halves their weight at every later sample, and
 /// the median over sectors and SL_DRIFT_PERSIST rotations keep a single bad sample off the
-/// fault. A shrinking theta is therefore seen with the same latency as a growing one, minus
-/// the mask's window: the tail shows the new ground start in the rotation it appears, but
-/// the mask's part keeps the old ground's bins (between the new and the old start: the
-/// now-dark bins) as stable for up to its window, so the latency bound is the same
-/// n + 32 = 48 rotations for both directions
-/// (calib_drift_theta_step_minus_2deg_raises_theta_drift_within_48_rotations).
+/// fault (no k-of-m vote over rotations was needed: the sectors' samples are already 8
+/// rotations apart).
+/// Latency, both directions: theta growing, the newly lit bins become stable-occupied n
+/// rotations (the mask's window, 16) after the step; theta shrinking, the now-dark bins at
+/// the mask's end become stable-free (the join) n rotations after it. Then as above:
+/// within n + 32 = 48 rotations (12 s at 4 Hz) of the step either way
+/// (calib_drift_theta_step_2deg_raises_theta_drift_within_48_rotations: +2 deg;
+/// calib_drift_theta_step_minus_2deg_... and _minus_6deg_past_the_mask_...: -2 and -6 deg,
+/// measured 18 and 25 rotations on paper-sim).
 ///
 /// Units: theta and drift in 0.01 deg (Health.ThetaDrift sends 0.1 deg).
 /// Cost: per azimuth one compare in the pipeline (is this the watched azimuth?); per
