@@ -505,6 +505,9 @@ static void on_row(void *ctx, const sl_scan_row_t *row)
     p->last_row_us = p->now_us;
     p->have_row = true;
     sl_thresh_u8(row->power, p->mask_bins, p->cfg.threshold, p->bits);
+    if (row->idx == p->drift.watch_az) { // once per rotation: the bins past the mask
+        sl_drift_tail(&p->drift, row->fft, p->mask_bins, p->cfg.pow16_shift, p->cfg.threshold);
+    }
     if (p->cfg.profile) {
         sl_profile_row(&p->prof, row->idx, row->power, p->mask_bins, p->bits,
                        p->detect.win_bins[row->idx < p->detect.azimuths ? row->idx : 0U]);
@@ -643,9 +646,10 @@ static void on_rot(void *ctx, const sl_scan_rot_t *rot)
     sl_tiltobs_advance(&p->tilt, p->motion_valid, p->speed_mm_s, p->yaw_cdeg_s, p->rotation_us);
     sl_tiltobs_update(&p->tilt, p->tracker.tracks, p->detect.targets, n_targets);
     // Drift watch (sl_drift.h): one azimuth per rotation, read from the mask's stable row at
-    // the rotation's end (nothing per azimuth); p->occ is free once detection has ended.
-    if (sl_mask_stable_prefix(&p->mask, p->drift.watch_az, p->mask_words, p->occ, NULL)) {
-        sl_drift_row(&p->drift, &p->det_board, p->drift.watch_az, p->occ, p->mask_bins,
+    // the rotation's end, joined with its raw tail when the mask's end is settled (stable-free
+    // plane in p->bits); p->occ and p->bits are free once detection has ended.
+    if (sl_mask_stable_prefix(&p->mask, p->drift.watch_az, p->mask_words, p->occ, p->bits)) {
+        sl_drift_row(&p->drift, &p->det_board, p->drift.watch_az, p->occ, p->bits, p->mask_bins,
                      p->det_board.bin_size_um);
     }
     sl_drift_end_rotation(&p->drift);

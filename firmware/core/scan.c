@@ -346,7 +346,7 @@ static void store(sl_scan_t *s, const sl_proto_fft_t *f, uint16_t idx, uint8_t e
     if (s->cfg.on_row != NULL) {
         const sl_scan_row_t row = {.rotation = r->rotation, .idx = idx, .bins = (uint16_t)n,
                                    .ticks = f->azimuth_ticks, .sweep = f->sweep_counter,
-                                   .flags = flags, .t_us = t, .power = view};
+                                   .flags = flags, .t_us = t, .power = view, .fft = f};
         s->cfg.on_row(s->cfg.ctx, &row);
     }
 }

@@ -10,17 +10,25 @@
 /// gives theta_live (sin(theta_live) = H / S), compared with the board's (the loaded
 /// calibration's) theta of that azimuth.
 ///
-/// ## One sample (sl_drift_row, on the watched azimuth only)
-/// On the watched azimuth's stable-occupied row (the consistency mask's, as detection reads
-/// it, taken at the end of the rotation): the masked range, which ends at the
-/// board's shadow edge (sl_detect_bins_needed()), so the ground clutter reaches into the
-/// row's last bins only. Hence the watch is one-sided: it measures theta growing (the body
-/// sinking: a loaded vehicle, a mount tilted down; the ground start moves inwards, about 5
-/// bins per degree at theta 26 deg, 4.38 cm bins) and the nominal case (the ground starts in
-/// the last bin); a shrinking theta moves the ground start out of the row ("no ground"
-/// samples, nothing reported). Reading more bins would cost every azimuth (the mask).
+/// ## One sample (sl_drift_tail + sl_drift_row, on the watched azimuth only)
+/// The row read is two parts joined:
+/// - bins [0, bins): the watched azimuth's stable-occupied row (the consistency mask's, as
+///   detection reads it, taken at the end of the rotation), which ends at the board's shadow
+///   edge (sl_detect_bins_needed(), rounded up to whole words);
+/// - bins [bins, bins + SL_DRIFT_EXTRA_BINS): the "tail", thresholded by sl_drift_tail from
+///   the watched azimuth's raw FFT message as it passes through the pipeline (the message
+///   carries the whole range; the mask and the scan's ROI are not widened). It is that
+///   rotation's single row, not a stable one (see "Noise" below). Missing (the row lost, the
+///   message shorter than the mask): the mask's part alone, as before (one-sided).
+/// With the tail the watch is two-sided: theta growing (the body sinking: a loaded vehicle,
+/// a mount tilted down) moves the ground start inwards into the mask's part, theta
+/// shrinking (an unloaded vehicle, a mount tilted up, a calibration made loaded) moves it
+/// outwards into the tail; about 5 bins per degree at theta 26 deg, 4.38 cm bins, so the 64
+/// tail bins cover a shrink of up to ~10 deg on the paper-sim board (beyond the 8 deg
+/// outlier bound). Without a tail a shrinking theta gives "no ground" samples.
 /// - ground start g = the start of the run of bins >= threshold (gaps of one bin allowed)
-///   that reaches the row's last bin; no such run: no sample ("no ground");
+///   that reaches the row's last bin (or, with a tail, the one before: a single row may miss
+///   its last bin); no such run: no sample ("no ground");
 /// - rejected when any two adjacent bins in [near_exclusion_bins, g - 2) are >= threshold
 ///   (something stands in the shadow on this azimuth: a target, not ground) ("occupied");
 /// - theta_live - theta from the slant range of g's centre, S = (g + 1/2) x bin, to first
@@ -41,17 +49,40 @@
 /// 2 deg: each sector is sampled every 8th rotation and needs two samples past the step
 /// (est = 0.5 then 0.75 of the step: 1.5 deg > 1 deg), so the median moves after ~2 x 8
 /// rotations, plus SL_DRIFT_PERSIST: within 32 rotations of the rows changing
-/// (tests/unit/test_drift.c). In the pipeline the rows are the consistency mask's stable
+/// (tests/core/test_drift.c). In the pipeline the rows are the consistency mask's stable
 /// rows, which show newly lit ground n rotations (the window, 16) after it appears: the
-/// fault is raised within n + 32 = 48 rotations (12 s at 4 Hz) of the step
-/// (calib_drift_theta_step_2deg_raises_theta_drift_within_48_rotations).
+/// fault is raised within n + 32 = 48 rotations (12 s at 4 Hz) of the step, in both
+/// directions (below).
+///
+/// The join: the tail is used only when the mask's row is settled at its end (its last two
+/// bins stable-occupied or stable-free, sl_drift_row's `free_`). While the window fills,
+/// while driving, or where ground flickers at the mask's edge those bins are neither, and a
+/// tail joined there would put the ground start at the join whatever the truth; such rows
+/// are read without the tail (the one-sided reading, usually "no ground").
+/// Noise: a tail bin is one rotation's return, where the mask's bins are consistent over its
+/// window. Isolated noise bins in the shadow are not "occupied" (that needs two adjacent
+/// bins) and shift g by at most two bins (0.4 deg) when next to the run; a gap of two bins
+/// in the tail's ground (weak clutter) cuts the run short (theta_live too small). Both are
+/// single samples: each sector's estimate halves their weight at every later sample, and
+/// the median over sectors and SL_DRIFT_PERSIST rotations keep a single bad sample off the
+/// fault (no k-of-m vote over rotations was needed: the sectors' samples are already 8
+/// rotations apart).
+/// Latency, both directions: theta growing, the newly lit bins become stable-occupied n
+/// rotations (the mask's window, 16) after the step; theta shrinking, the now-dark bins at
+/// the mask's end become stable-free (the join) n rotations after it. Then as above:
+/// within n + 32 = 48 rotations (12 s at 4 Hz) of the step either way
+/// (calib_drift_theta_step_2deg_raises_theta_drift_within_48_rotations: +2 deg;
+/// calib_drift_theta_step_minus_2deg_... and _minus_6deg_past_the_mask_...: -2 and -6 deg,
+/// measured 18 and 25 rotations on paper-sim).
 ///
 /// Units: theta and drift in 0.01 deg (Health.ThetaDrift sends 0.1 deg).
-/// Cost: nothing per azimuth; per rotation one azimuth's stable row from the mask,
+/// Cost: per azimuth one compare in the pipeline (is this the watched azimuth?); per
+/// rotation the tail (SL_DRIFT_EXTRA_BINS compares) and one azimuth's stable row from the mask,
 /// O(bins / 32) word operations and one 64-bit division for the sample, O(sectors^2) for the
 /// median (x86-64: ~680 instructions per rotation, 1.7 per azimuth). RAM: sizeof(sl_drift_t)
-/// = 52 B. No allocation, no float.
-/// Limits: one-sided (above); needs ground returns above the threshold at the shadow's edge
+/// = 64 B (the tail: 8 B). No allocation, no float.
+/// Limits: two-sided only where the raw message carries SL_DRIFT_EXTRA_BINS bins past the
+/// mask (the CTS350-X sends its whole range); needs ground returns above the threshold at the shadow's edge
 /// and the mask's window of consistent rows (parked, or slow on open ground); walls, kerbs
 /// or parked cars at the shadow's edge are samples too (outliers beyond 8 deg are dropped,
 /// and the median over sectors ignores a minority of sectors).
@@ -62,6 +93,7 @@
 #include <stdint.h>
 
 #include "shadowlean/sl_board.h"
+#include "shadowlean/sl_proto.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -74,6 +106,7 @@ extern "C" {
 #define SL_DRIFT_MIN_SECTORS 5U      ///< sectors needed for an estimate
 #define SL_DRIFT_FAULT_CDEG 100      ///< THETA_DRIFT above 1 deg ...
 #define SL_DRIFT_PERSIST 8U          ///< ... in this many consecutive rotations
+#define SL_DRIFT_EXTRA_BINS 64U      ///< tail bins read past the mask's end (multiple of 32)
 
 typedef struct sl_drift_stats {
     uint32_t samples;     ///< samples used
@@ -91,18 +124,32 @@ typedef struct sl_drift {
     bool valid;                              ///< enough sectors
     bool fault;                              ///< THETA_DRIFT holds
     uint8_t persist;                         ///< consecutive rotations against `fault`
+    uint8_t tail_n;                          ///< tail bins held (0: none this rotation)
+    uint16_t tail_from;                      ///< the tail's first bin (the mask's bins)
+    uint32_t tail[SL_DRIFT_EXTRA_BINS / 32U]; ///< tail bits, bin tail_from + k = bit k
     sl_drift_stats_t stats;
 } sl_drift_t;
 
 /// Reset for `board` (azimuths). O(1).
 void sl_drift_init(sl_drift_t *d, const sl_board_t *board);
 
-/// The watched azimuth's occupied row: `bits` (bin k = bit k % 32 of word k / 32, as
+/// The watched azimuth's raw FFT message (sl_scan_row_t.fft; its azimuth index is the
+/// watched one, the caller checks): bins [from, from + SL_DRIFT_EXTRA_BINS) of `f->bin_data`
+/// (`f->bins` bins in wire format: 8-bit, or 16-bit little-endian reduced as the scan reduces
+/// them: min(v >> pow16_shift, 255)), thresholded (>= threshold) into the tail, which
+/// sl_drift_row joins to the mask's row when its `bins` == `from`. Bins past f->bins are not
+/// read (fewer tail bins); NULL `f`: no tail. O(SL_DRIFT_EXTRA_BINS). Cleared at the end of
+/// the rotation.
+void sl_drift_tail(sl_drift_t *d, const sl_proto_fft_t *f, uint16_t from, uint8_t pow16_shift,
+                   uint16_t threshold);
+
+/// The watched azimuth's occupied row and (nullable: no tail joined) its stable-free row
+/// `free_` (same layout; sl_mask_stable's): `bits` (bin k = bit k % 32 of word k / 32, as
 /// sl_thresh_u8 and sl_mask write it), `bins` of them (bin 0 = range 0), bin size `bin_um` (the
 /// radar's). Any other azimuth: ignored (the pipeline calls it for d->watch_az only).
 /// O(bins / 32) word operations + one 64-bit division.
 void sl_drift_row(sl_drift_t *d, const sl_board_t *board, uint16_t az, const uint32_t *bits,
-                  uint16_t bins, uint32_t bin_um);
+                  const uint32_t *free_, uint16_t bins, uint32_t bin_um);
 
 /// End of a rotation: the estimate, the fault's persistence, the next watched azimuth.
 /// O(SL_DRIFT_SECTORS^2).

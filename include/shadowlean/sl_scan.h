@@ -187,6 +187,7 @@ typedef struct sl_scan_row {
     uint8_t flags;            ///< SL_SCAN_AZ_*
     uint64_t t_us;            ///< timestamp, UNIX us
     const uint8_t *power;     ///< roi_bins uint8 power values (see "Frame-less mode")
+    const sl_proto_fft_t *fft; ///< the message the row came from (all its bins, wire format)
 } sl_scan_row_t;
 
 /// Row callback (both modes).

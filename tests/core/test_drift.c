@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
 // Unit tests of the theta drift watch (sl_drift.h) on synthetic rows of the paper-sim board:
 // ground clutter from the slant range H / sin(theta_live) outwards, in the masked range the
-// pipeline reads (135 bins: up to the board's shadow edge).
+// pipeline reads (135 bins: up to the board's shadow edge), and with the raw tail past it.
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -27,12 +27,15 @@ static const sl_board_t *board(void)
     return b;
 }
 
-// A row whose ground starts where a vehicle with theta `theta_deg` lights it.
-static void ground_row(uint8_t *row, double theta_deg, const sl_board_t *b)
+#define TAIL SL_DRIFT_EXTRA_BINS
+#define FULL (BINS + TAIL)
+
+// A row of `n` bins whose ground starts where a vehicle with theta `theta_deg` lights it.
+static void ground_row_n(uint8_t *row, double theta_deg, const sl_board_t *b, unsigned n)
 {
-    memset(row, 0, BINS);
+    memset(row, 0, n);
     const double s = b->radar_height_um / sin(theta_deg * kPi / 180.0);
-    for (unsigned k = 0; k < BINS; k++) {
+    for (unsigned k = 0; k < n; k++) {
         if ((k + 1U) * (double)b->bin_size_um > s) {
             row[k] = 60U; // this bin holds some ground
         }
@@ -42,12 +45,44 @@ static void ground_row(uint8_t *row, double theta_deg, const sl_board_t *b)
     }
 }
 
+static void ground_row(uint8_t *row, double theta_deg, const sl_board_t *b)
+{
+    ground_row_n(row, theta_deg, b, BINS);
+}
+
+// One rotation with the tail: the raw message holds FULL bins (8-bit, or 16-bit with the
+// power in the high byte), the mask the first BINS; `settled`: the mask's bins are all
+// stable (occupied or free), else none is (the window still filling).
+static void rotation_tail(sl_drift_t *d, const sl_board_t *b, const uint8_t *row, bool settled,
+                          bool wide)
+{
+    uint32_t bits[(BINS + 31U) / 32U];
+    uint32_t free_[(BINS + 31U) / 32U];
+    uint8_t raw16[2U * FULL];
+    sl_thresh_u8(row, BINS, THR, bits);
+    for (unsigned w = 0; w < (BINS + 31U) / 32U; w++) {
+        free_[w] = settled ? ~bits[w] : 0U;
+        if (!settled) {
+            bits[w] = 0U;
+        }
+    }
+    for (unsigned k = 0; k < FULL; k++) {
+        raw16[2U * k] = 0x5AU; // low byte: below the shift
+        raw16[2U * k + 1U] = row[k];
+    }
+    const sl_proto_fft_t f = {.id = wide ? 31U : 30U, .bytes_per_bin = wide ? 2U : 1U,
+                              .bins = FULL, .bin_data = wide ? raw16 : row};
+    sl_drift_tail(d, &f, BINS, 8U, THR);
+    sl_drift_row(d, b, d->watch_az, bits, free_, BINS, b->bin_size_um);
+    sl_drift_end_rotation(d);
+}
+
 // One rotation: the watched azimuth's row, then the end of the rotation.
 static void rotation(sl_drift_t *d, const sl_board_t *b, const uint8_t *row)
 {
     uint32_t bits[(BINS + 31U) / 32U];
     sl_thresh_u8(row, BINS, THR, bits); // as the pipeline thresholds the row
-    sl_drift_row(d, b, d->watch_az, bits, BINS, b->bin_size_um);
+    sl_drift_row(d, b, d->watch_az, bits, NULL, BINS, b->bin_size_um);
     sl_drift_end_rotation(d);
 }
 
@@ -152,7 +187,7 @@ static void test_drift_rejects_occupied_rows_missing_ground_and_outliers(void **
     row[90] = 50U;
     rotation(&d, b, row);
     assert_int_equal(d.stats.samples, 1);
-    // theta smaller than the board's: the ground starts beyond the row (one-sided watch)
+    // theta smaller than the board's: the ground starts beyond the row (no tail: one-sided)
     ground_row(row, 24.0, b);
     rotation(&d, b, row);
     assert_int_equal(d.stats.no_ground, 1);
@@ -165,7 +200,8 @@ static void test_drift_rejects_occupied_rows_missing_ground_and_outliers(void **
     ground_row(row, 26.0, b);
     uint32_t bits[(BINS + 31U) / 32U];
     sl_thresh_u8(row, BINS, THR, bits);
-    sl_drift_row(&d, b, (uint16_t)((d.watch_az + 1U) % b->azimuths), bits, BINS, b->bin_size_um);
+    sl_drift_row(&d, b, (uint16_t)((d.watch_az + 1U) % b->azimuths), bits, NULL, BINS,
+                 b->bin_size_um);
     assert_int_equal(d.stats.samples, 1);
 }
 
@@ -187,6 +223,99 @@ static void test_drift_median_ignores_a_minority_of_sectors(void **state)
     assert_true(abs(sl_drift_cdeg(&d)) <= 25);
 }
 
+static void test_drift_shrinking_theta_is_seen_in_the_tail_with_its_sign(void **state)
+{
+    (void)state;
+    const sl_board_t *b = board();
+    sl_drift_t d;
+    sl_drift_init(&d, b);
+    uint8_t row[FULL];
+    ground_row_n(row, 26.0, b, FULL);
+    for (int r = 0; r < 40; r++) {
+        rotation_tail(&d, b, row, true, false);
+    }
+    assert_true(d.valid);
+    assert_true(abs(sl_drift_cdeg(&d)) <= 25);
+    assert_false(d.fault);
+    // the body rises: theta 24 deg, the ground starts past the mask's 135 bins (~145)
+    ground_row_n(row, 24.0, b, FULL);
+    int raised = -1;
+    for (int r = 0; r < 64; r++) {
+        rotation_tail(&d, b, row, true, false);
+        if (d.fault && raised < 0) {
+            raised = r + 1;
+        }
+    }
+    assert_true(raised > 0 && raised <= 32);
+    assert_in_range(sl_drift_cdeg(&d), -225, -175); // the sign: theta smaller
+    assert_int_equal(d.stats.no_ground, 0);
+    // the same rows without their tail: nothing past the mask, no ground (one-sided)
+    rotation(&d, b, row);
+    assert_int_equal(d.stats.no_ground, 1);
+}
+
+static void test_drift_tail_of_16bit_rows_and_6deg_shrink(void **state)
+{
+    (void)state;
+    const sl_board_t *b = board();
+    sl_drift_t d;
+    sl_drift_init(&d, b);
+    uint8_t row[FULL];
+    ground_row_n(row, 20.0, b, FULL); // ground from ~172: only in the tail
+    for (int r = 0; r < 48; r++) {
+        rotation_tail(&d, b, row, true, true);
+    }
+    assert_true(d.fault);
+    assert_in_range(sl_drift_cdeg(&d), -640, -560);
+}
+
+static void test_drift_tail_is_not_joined_to_an_unsettled_mask(void **state)
+{
+    (void)state;
+    const sl_board_t *b = board();
+    sl_drift_t d;
+    sl_drift_init(&d, b);
+    uint8_t row[FULL];
+    // the window still filling (no stable bins): the tail alone would put the ground start
+    // at the join, whatever the truth; it is not used
+    ground_row_n(row, 26.0, b, FULL);
+    for (int r = 0; r < 40; r++) {
+        rotation_tail(&d, b, row, false, false);
+    }
+    assert_int_equal(d.stats.samples, 0);
+    assert_int_equal(d.stats.no_ground, 40);
+    assert_false(d.valid);
+    // a message that ends at the mask: no tail
+    sl_drift_init(&d, b);
+    const sl_proto_fft_t f = {.id = 30U, .bytes_per_bin = 1U, .bins = BINS, .bin_data = row};
+    sl_drift_tail(&d, &f, BINS, 8U, THR);
+    assert_int_equal(d.tail_n, 0);
+    sl_drift_tail(&d, NULL, BINS, 8U, THR);
+    assert_int_equal(d.tail_n, 0);
+}
+
+static void test_drift_tail_keeps_the_occupied_rejection(void **state)
+{
+    (void)state;
+    const sl_board_t *b = board();
+    sl_drift_t d;
+    sl_drift_init(&d, b);
+    uint8_t row[FULL];
+    ground_row_n(row, 22.0, b, FULL); // ground from ~157
+    memset(row + 70, 120, 10);        // a pole standing in the shadow
+    rotation_tail(&d, b, row, true, false);
+    assert_int_equal(d.stats.occupied, 1);
+    assert_int_equal(d.stats.samples, 0);
+    ground_row_n(row, 22.0, b, FULL);
+    row[140] = 80U; // a two-bin return past the mask, before the ground
+    row[141] = 80U;
+    rotation_tail(&d, b, row, true, false);
+    assert_int_equal(d.stats.occupied, 2);
+    ground_row_n(row, 22.0, b, FULL);
+    rotation_tail(&d, b, row, true, false);
+    assert_int_equal(d.stats.samples, 1);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -195,6 +324,10 @@ int main(void)
         cmocka_unit_test(test_drift_step_of_2deg_raises_the_fault_within_32_rotations_and_clears),
         cmocka_unit_test(test_drift_rejects_occupied_rows_missing_ground_and_outliers),
         cmocka_unit_test(test_drift_median_ignores_a_minority_of_sectors),
+        cmocka_unit_test(test_drift_shrinking_theta_is_seen_in_the_tail_with_its_sign),
+        cmocka_unit_test(test_drift_tail_of_16bit_rows_and_6deg_shrink),
+        cmocka_unit_test(test_drift_tail_is_not_joined_to_an_unsettled_mask),
+        cmocka_unit_test(test_drift_tail_keeps_the_occupied_rejection),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
