@@ -58,7 +58,7 @@ int bad_arg(const std::string &a, int i, int argc, char **argv)
 {
     static const char *const with_value[] = {"--rotations", "--range-bins", "--json-out", "--plot",
                                              "--threads", "--extract", "--positions", "--reps",
-                                             "--calib", "--frames", "--smear-decay", "--pipe-last"};
+                                             "--calib", "--frames", "--smear-decay", "--pipe-last", "--hard-set"};
     for (const char *o : with_value) {
         if (a == o && i + 1 >= argc) {
             return sl_cli_bad_value("sl-eval", o, "needs a value", usage);
@@ -174,6 +174,18 @@ int cmd_realistic(int argc, char **argv)
             o.progress = false;
         } else if (a == "--smear-decay" && i + 1 < argc) {
             o.smear_decay_db = std::atof(argv[++i]);
+        } else if (a == "--hard") {
+            o.hard = true;
+        } else if (a == "--hard-set" && i + 1 < argc) {
+            const std::string kv = argv[++i];
+            const size_t eq = kv.find('=');
+            char *end = nullptr;
+            const double v = eq == std::string::npos ? 0.0 : std::strtod(kv.c_str() + eq + 1, &end);
+            if (eq == std::string::npos || end == nullptr || *end != '\0' ||
+                !o.hard_cond.set(kv.substr(0, eq), v)) {
+                return sl_cli_bad_value("sl-eval", "--hard-set", "must be NAME=VALUE with a known name in range (see usage)", usage);
+            }
+            o.hard = true;
         } else if (a == "--speckle-per-frame") {
             o.speckle_static = 0;
         } else if (a == "--no-profile") {
