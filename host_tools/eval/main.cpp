@@ -222,6 +222,9 @@ int cmd_realistic(int argc, char **argv)
             return bad_arg(a, i, argc, argv);
         }
     }
+    if (o.hard && o.hard_cond.segment_m > 0 && o.hard_cond.segment_fill_m > o.hard_cond.segment_m) {
+        return sl_cli_bad_value("sl-eval", "--hard-set", "segment_fill_m must not exceed segment_m", usage);
+    }
     const sl::RealisticResult r = sl::run_realistic(o);
     if (!json_out.empty() && !write_text(json_out, sl::realistic_json(r))) {
         return 1;
