@@ -1263,6 +1263,77 @@ Scene realistic_scene(double dist_m, double alpha_deg, uint64_t seed, int frames
     return s;
 }
 
+bool HardCondition::set(const std::string &name, double v)
+{
+    struct F {
+        const char *name;
+        double *p;
+        double lo, hi;
+    };
+    const F fs[] = {{"fast_decay_db", &fast_decay_db, 0.1, 50},    {"slow_db", &slow_db, -100, 0},
+                    {"slow_decay_db", &slow_decay_db, 0.1, 50},    {"amp_decay_db", &amp_decay_db, 0, 10},
+                    {"front_db", &front_db, -200, 0},              {"speckle_frame_db", &speckle_frame_db, 0, 20},
+                    {"az_jitter_deg", &az_jitter_deg, 0, 5},       {"segment_m", &segment_m, 0, 1},
+                    {"segment_fill_m", &segment_fill_m, 0.001, 1}, {"segment_gap", &segment_gap, 0, 1},
+                    {"theta_tol_deg", &theta_tol_deg, 0, 5},       {"beta_tol_deg", &beta_tol_deg, 0, 5},
+                    {"height_tol_m", &height_tol_m, 0, 0.5},       {"bearing_tol_deg", &bearing_tol_deg, 0, 5},
+                    {"refl_tol_db", &refl_tol_db, 0, 20}};
+    for (const F &f : fs) {
+        if (name == f.name) {
+            if (!(v >= f.lo && v <= f.hi)) {
+                return false;
+            }
+            *f.p = v;
+            return true;
+        }
+    }
+    return false;
+}
+
+void make_hard(Scene &s, const HardCondition &h, uint64_t seed)
+{
+    s.smear_shape = 2;
+    s.smear_decay_db = h.fast_decay_db;
+    s.smear_slow_db = h.slow_db;
+    s.smear_slow_decay_db = h.slow_decay_db;
+    s.smear_amp_decay_db = h.amp_decay_db;
+    s.smear_front_db = h.front_db;
+    s.speckle_frame_db = h.speckle_frame_db;
+    s.az_jitter_deg = h.az_jitter_deg;
+    for (auto &p : s.poles) {
+        p.segment_m = h.segment_m;
+        p.segment_fill_m = h.segment_fill_m;
+        p.segment_gap = h.segment_gap;
+    }
+    auto draw = [seed](uint64_t salt, double tol) {
+        return tol * (2.0 * sim_uniform(sim_hash(seed, 0x4A2D, salt)) - 1.0);
+    };
+    // H first (theta depends on it), then the chassis scaled about the radar so that theta
+    // towards the pole (azimuth 0) is the nominal one plus its draw; beta = the emission's top
+    const double theta0 = s.board.theta_deg(0);
+    s.board.radar_height_m += draw(1, h.height_tol_m);
+    double w = 0, eh = 0;
+    s.board.edge_along(0, &w, &eh);
+    const double want = sim_d2r(theta0 + draw(2, h.theta_tol_deg));
+    const double k = (s.board.radar_height_m - eh) / std::tan(want) / w;
+    for (auto &v : s.board.polygon) {
+        v.x_m = s.board.radar_x_m + (v.x_m - s.board.radar_x_m) * k;
+        v.y_m = s.board.radar_y_m + (v.y_m - s.board.radar_y_m) * k;
+    }
+    s.elev_top_deg += draw(3, h.beta_tol_deg);
+    // the pole: bearing offset d (clockwise from azimuth 0 = world +y) about the radar, its
+    // lean turned with it (still in the radar's plane), and its reflectivity
+    const double d = draw(4, h.bearing_tol_deg), g = std::pow(10.0, 0.1 * draw(5, h.refl_tol_db));
+    for (auto &p : s.poles) {
+        const double dist = std::hypot(p.x_m - s.vehicle_x_m, p.y_m - s.vehicle_y_m);
+        p.x_m = s.vehicle_x_m + dist * std::sin(sim_d2r(d));
+        p.y_m = s.vehicle_y_m + dist * std::cos(sim_d2r(d));
+        p.lean_deg -= d;
+        p.reflectivity *= g;
+    }
+    validate_scene(s);
+}
+
 namespace {
 
 // A bin is the pole's own when >= 12 % of its power is not the tail of the bins before it
@@ -1426,6 +1497,9 @@ RealisticResult run_realistic(const RealisticOptions &o)
     }
     res.positions = o.positions;
     res.reps = o.reps;
+    res.hard = o.hard;
+    res.hard_cond = o.hard_cond;
+    const HardCondition &hc = res.hard_cond;
     const auto t0 = Clock::now();
     const BoardSpec b = load_board("paper-bench");
     const double bin = b.bin_size_m, H = b.radar_height_m;
@@ -1446,11 +1520,21 @@ RealisticResult run_realistic(const RealisticOptions &o)
     int done = 0;
     const int total = nc * 2 + 5 * o.positions * o.reps;
     for (int c = 0; c < nc; c++) {
-        const double dist = 1.75 + (2.85 - 1.75) * c / (nc - 1);
+        double dist = 1.75 + (2.85 - 1.75) * c / (nc - 1);
+        if (o.hard) {
+            // disjoint from the measurements' 2.2-2.6 m: half below, half above
+            const int nlo = (nc + 1) / 2, nhi = nc - nlo;
+            dist = c < nlo ? 1.75 + (hc.calib_gap_lo_m - 1.75) * c / std::max(1, nlo - 1)
+                           : hc.calib_gap_hi_m + (3.0 - hc.calib_gap_hi_m) * (c - nlo) / std::max(1, nhi - 1);
+        }
         for (int rep = 0; rep < 2; rep++) {
-            Scene s = realistic_scene(dist, 0.0, 5000 + static_cast<uint64_t>(c * 10 + rep), o.frames, o.range_bins);
+            const uint64_t cseed = 5000 + static_cast<uint64_t>(c * 10 + rep);
+            Scene s = realistic_scene(dist, 0.0, cseed, o.frames, o.range_bins);
             s.smear_decay_db = o.smear_decay_db;
             s.speckle_static = o.speckle_static;
+            if (o.hard) {
+                make_hard(s, hc, cseed);
+            }
             const Frames f = run_frames(s, o.threads, thr);
             done++;
             if (o.progress) {
@@ -1466,7 +1550,7 @@ RealisticResult run_realistic(const RealisticOptions &o)
                 cal_ours.emplace_back(r2o, r2o - f.gt.r2_m);
                 res.calib.emplace_back(r2o, r2o - f.gt.r2_m);
             }
-            if (rc.found && dist <= 2.30 + 1e-9) {
+            if (rc.found && dist <= (o.hard ? hc.calib_gap_lo_m : 2.30) + 1e-9) {
                 const double r2o = (rc.i2 + 1) * bin;
                 cal_paper.emplace_back(r2o, r2o - f.gt.r2_m);
             }
@@ -1567,6 +1651,9 @@ RealisticResult run_realistic(const RealisticOptions &o)
                 Scene s = realistic_scene(dist, res.angles[a], seed, o.frames, o.range_bins);
                 s.smear_decay_db = o.smear_decay_db;
                 s.speckle_static = o.speckle_static;
+                if (o.hard) {
+                    make_hard(s, hc, seed);
+                }
                 s.rotations += std::max(0, o.track_rotations);
                 std::unique_ptr<PipelineEval> pipe;
                 std::function<void(int, const uint8_t *, size_t)> on_bytes;
@@ -1581,7 +1668,11 @@ RealisticResult run_realistic(const RealisticOptions &o)
                     pipe.reset(new PipelineEval(pc));
                     on_bytes = [&pipe](int k, const uint8_t *d, size_t n) { pipe->feed(k, d, n); };
                 }
-                const Frames f = run_frames(s, o.threads, thr, on_bytes);
+                Frames f = run_frames(s, o.threads, thr, on_bytes);
+                // the processing knows the board's installation, not the perturbed true one
+                // (the truth row keeps the true alpha and bounds)
+                f.gt.theta_deg = b.theta_deg(f.gt.azimuth);
+                f.gt.beta_deg = b.beta_up_deg;
                 if (pipe && f.have) {
                     pipe->finish();
                     realistic_pipe_add(*pipe, f.gt, res.pipe_cfg.assoc_az, o.pipe_last, pipe_az, res.pipe[a]);
@@ -1639,6 +1730,86 @@ void mean_sd(const std::vector<double> &v, double *mean, double *sd)
         q += (x - *mean) * (x - *mean);
     }
     *sd = v.size() > 1 ? std::sqrt(q / static_cast<double>(v.size() - 1)) : 0.0;
+}
+
+// Per angle and processing path: mean / std of the error, median / p90 of |error|, missed and
+// ambiguous rates (of measurements; ambiguous estimates count as the bound in the errors).
+struct ErrSummary {
+    double mean = std::nan(""), std = std::nan(""), median_abs = std::nan(""), p90_abs = std::nan("");
+    size_t n = 0;
+    double missed_rate = std::nan(""), ambiguous_rate = std::nan("");
+};
+
+ErrSummary summarize(const std::vector<double> &err, int runs, int missed, int ambiguous)
+{
+    ErrSummary s;
+    mean_sd(err, &s.mean, &s.std);
+    s.n = err.size();
+    std::vector<double> e;
+    for (double x : err) {
+        e.push_back(std::fabs(x));
+    }
+    std::sort(e.begin(), e.end());
+    auto q = [&e](double t) {
+        return e.empty() ? std::nan("")
+                         : e[std::min(e.size() - 1, static_cast<size_t>(std::ceil(t * static_cast<double>(e.size())) - 1))];
+    };
+    s.median_abs = q(0.5);
+    s.p90_abs = q(0.9);
+    if (runs > 0) {
+        s.missed_rate = static_cast<double>(missed) / runs;
+        s.ambiguous_rate = static_cast<double>(ambiguous) / runs;
+    }
+    return s;
+}
+
+ErrSummary summarize(const ErrStats &e) { return summarize(e.err, e.rows, e.missed, e.ambiguous); }
+
+ErrSummary summarize(const RealisticPipe &p, int angle)
+{
+    std::vector<double> err;
+    for (double x : p.raw) {
+        err.push_back(x - angle);
+    }
+    // ambiguous: measurements whose matched targets were AMBIGUOUS in majority
+    const int matched = p.valid + p.ambiguous + p.other;
+    ErrSummary s = summarize(err, p.runs, p.runs - p.detected, 0);
+    s.ambiguous_rate = matched > 0 ? static_cast<double>(p.ambiguous) / matched : std::nan("");
+    return s;
+}
+
+std::string jsummary(const ErrSummary &s)
+{
+    std::ostringstream o;
+    o << "{\"mean\": " << jnum(s.mean) << ", \"std\": " << jnum(s.std) << ", \"median_abs\": " << jnum(s.median_abs)
+      << ", \"p90_abs\": " << jnum(s.p90_abs) << ", \"n\": " << s.n << ", \"missed_rate\": " << jnum(s.missed_rate)
+      << ", \"ambiguous_rate\": " << jnum(s.ambiguous_rate) << "}";
+    return o.str();
+}
+
+void print_summary_line(std::FILE *f, const char *what, const ErrSummary &s)
+{
+    std::fprintf(f, "       | %-17s mean %+6.2f std %5.2f | |err| median %5.2f p90 %5.2f | n %3zu | missed %3.0f %% | ambiguous %3.0f %%\n",
+                 what, s.mean, s.std, s.median_abs, s.p90_abs, s.n, 100.0 * s.missed_rate, 100.0 * s.ambiguous_rate);
+}
+
+void print_hard(std::FILE *f, const RealisticResult &r)
+{
+    if (!r.hard) {
+        return;
+    }
+    const HardCondition &h = r.hard_cond;
+    std::fprintf(f,
+                 "HARD condition (--hard): two-component smear (%.1f dB/bin + a %.1f dB/bin component at %.0f dB,\n"
+                 "both decays %.1f dB/bin slower per 20 dB of level), a one-bin front skirt at %.0f dB; per-frame\n"
+                 "speckle %.1f dB on the frozen 2 dB; azimuth jitter +-%.2f deg; segmented pole (%.0f mm\n"
+                 "reflectors every %.0f mm, %.2f between); true theta +-%.1f deg, beta +-%.1f deg, H +-%.0f mm per\n"
+                 "measurement (uniform; the processing uses the board); the pole placed by hand: bearing\n"
+                 "+-%.2f deg off the azimuth, return +-%.1f dB; calibration on vertical poles at 1.75-%.2f and\n"
+                 "%.2f-3.00 m with their own seeds (the paper's constant d from the near ones).\n\n",
+                 h.fast_decay_db, h.slow_decay_db, h.slow_db, h.amp_decay_db, h.front_db, h.speckle_frame_db, h.az_jitter_deg,
+                 h.segment_fill_m * 1e3, h.segment_m * 1e3, h.segment_gap, h.theta_tol_deg, h.beta_tol_deg,
+                 h.height_tol_m * 1e3, h.bearing_tol_deg, h.refl_tol_db, h.calib_gap_lo_m, h.calib_gap_hi_m);
 }
 
 void print_realistic_pipeline(std::FILE *f, const RealisticResult &r)
@@ -1701,6 +1872,7 @@ void print_realistic_pipeline(std::FILE *f, const RealisticResult &r)
 void print_realistic(std::FILE *f, const RealisticResult &r)
 {
     if (r.have_pipe) {
+        print_hard(f, r);
         print_realistic_pipeline(f, r);
         if (!r.bbox_table) {
             std::fprintf(f, "run time %.1f s\n", r.seconds);
@@ -1716,15 +1888,16 @@ void print_realistic(std::FILE *f, const RealisticResult &r)
                  "noise floor (log-magnitude 8-bit, ~35%% zeros), near-field leakage. Ambiguous estimates\n"
                  "(rho below the model's bound) count as the bound (beta - theta)/2, as in the paper.\n"
                  "Paper processing: n-frame consistency mask, raw bounds, r2 -= d (constant, calibrated\n"
-                 "on vertical poles at 1.75-2.30 m: d = %.3f m), beta = 0.\n"
+                 "on vertical poles at 1.75-%.2f m: d = %.3f m), beta = 0.\n"
                  "Ours: n-frame mean, threshold %d, smear deconvolved (exponential kernel calibrated on the\n"
                  "vertical poles' tails: %.2f values/bin, a = %.3f; a bin is kept when >= 12%% of its power is\n"
                  "its own; gaps <= 3 bins merged), half-bin on both bounds, r1 += R, r2 -= residual offset %.3f m (same\n"
                  "calibration set), beta = +3. (For reference, a linear d(r2_obs) fit would give d = %.3f m\n"
                  "at %.2f m .. %.3f m at %.2f m.)\n\n",
-                 r.positions, r.reps, r.frames, r.d_const_m, 40, r.tail_slope, r.kernel_a, r.d_resid_m,
+                 r.positions, r.reps, r.frames, r.hard ? r.hard_cond.calib_gap_lo_m : 2.30, r.d_const_m, 40, r.tail_slope, r.kernel_a, r.d_resid_m,
                  r.d_table.empty() ? 0.0 : r.d_table.front().d_m, r.d_table.empty() ? 0.0 : r.d_table.front().range_m,
                  r.d_table.empty() ? 0.0 : r.d_table.back().d_m, r.d_table.empty() ? 0.0 : r.d_table.back().range_m);
+    print_hard(f, r);
     std::fprintf(f, "%-6s | %-18s | %-34s | %-34s\n", "true", "paper mean / std", "ours, paper processing: mean / std",
                  "ours, improved: mean / std");
     for (int a = 0; a < 5; a++) {
@@ -1757,6 +1930,11 @@ void print_realistic(std::FILE *f, const RealisticResult &r)
                          r.paper_style[a].missed, r.paper_style[a].ambiguous, r.paper_style[a].invalid,
                          r.improved[a].missed, r.improved[a].ambiguous, r.improved[a].invalid);
         }
+        print_summary_line(f, "paper processing:", summarize(r.paper_style[a]));
+        print_summary_line(f, "research path:", summarize(r.improved[a]));
+        if (r.have_pipe) {
+            print_summary_line(f, "pipeline (raw):", summarize(r.pipe[a], r.angles[a]));
+        }
     }
     double sm = 0, ss = 0, pm = 0, ps = 0;
     for (int a = 0; a < 5; a++) {
@@ -1774,6 +1952,7 @@ std::string realistic_json(const RealisticResult &r)
 {
     std::ostringstream o;
     o << "{\n  \"schema\": \"shadowlean-eval-realistic/1\",\n  \"experiment\": \"realistic\",\n  \"extraction\": \"bbox extraction (detection pipeline not used)\",\n"
+      << "  \"condition\": \"" << (r.hard ? "hard" : "table2") << "\",\n"
       << "  \"frames\": " << r.frames << ", \"positions\": " << r.positions << ", \"reps\": " << r.reps << ",\n"
       << "  \"d_const_m\": " << jnum(r.d_const_m) << ", \"tail_slope\": " << jnum(r.tail_slope)
       << ", \"kernel_a\": " << jnum(r.kernel_a) << ", \"d_resid_m\": " << jnum(r.d_resid_m)
@@ -1785,7 +1964,9 @@ std::string realistic_json(const RealisticResult &r)
     for (int a = 0; a < 5 && r.bbox_table; a++) {
         o << "    {\"true_deg\": " << r.angles[a] << ", \"paper\": {\"mean\": " << r.paper_mean[a]
           << ", \"std\": " << r.paper_std[a] << "}, \"paper_processing\": " << jstats(r.paper_style[a])
-          << ", \"improved\": " << jstats(r.improved[a]) << "}" << (a < 4 ? "," : "") << "\n";
+          << ", \"improved\": " << jstats(r.improved[a]) << ",\n     \"summary\": {\"paper_processing\": "
+          << jsummary(summarize(r.paper_style[a])) << ", \"improved\": " << jsummary(summarize(r.improved[a])) << "}}"
+          << (a < 4 ? "," : "") << "\n";
     }
     o << "  ]";
     if (r.have_pipe) {
@@ -1803,9 +1984,22 @@ std::string realistic_json(const RealisticResult &r)
               << ", \"valid\": " << p.valid << ", \"ambiguous\": " << p.ambiguous << ", \"other\": " << p.other
               << ", \"unmatched\": " << p.unmatched << ", \"rotations_checked\": " << p.rot_checked
               << ", \"rotations_detected\": " << p.rot_detected << ", \"frames_eff\": [" << p.frames_eff_min << ", "
-              << p.frames_eff_max << "]}" << (a < 4 ? "," : "") << "\n";
+              << p.frames_eff_max << "],\n     \"summary\": " << jsummary(summarize(p, r.angles[a])) << "}"
+              << (a < 4 ? "," : "") << "\n";
         }
         o << "  ]}";
+    }
+    if (r.hard) {
+        const HardCondition &h = r.hard_cond;
+        o << ",\n  \"hard\": {\"fast_decay_db\": " << jnum(h.fast_decay_db) << ", \"slow_db\": " << jnum(h.slow_db)
+          << ", \"slow_decay_db\": " << jnum(h.slow_decay_db) << ", \"amp_decay_db\": " << jnum(h.amp_decay_db)
+          << ", \"front_db\": " << jnum(h.front_db) << ", \"speckle_frame_db\": " << jnum(h.speckle_frame_db)
+          << ", \"az_jitter_deg\": " << jnum(h.az_jitter_deg) << ", \"segment_m\": " << jnum(h.segment_m)
+          << ", \"segment_fill_m\": " << jnum(h.segment_fill_m) << ", \"segment_gap\": " << jnum(h.segment_gap)
+          << ", \"theta_tol_deg\": " << jnum(h.theta_tol_deg) << ", \"beta_tol_deg\": " << jnum(h.beta_tol_deg)
+          << ", \"height_tol_m\": " << jnum(h.height_tol_m) << ", \"bearing_tol_deg\": " << jnum(h.bearing_tol_deg)
+          << ", \"refl_tol_db\": " << jnum(h.refl_tol_db) << ", \"calib_gap_m\": [" << jnum(h.calib_gap_lo_m) << ", "
+          << jnum(h.calib_gap_hi_m) << "]}";
     }
     o << ",\n  \"seconds\": " << jnum(r.seconds) << "\n}\n";
     return o.str();

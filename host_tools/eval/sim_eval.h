@@ -290,6 +290,33 @@ std::string table1_json(const Table1Result &r);
 /// Fig. 7-8 style plot (alpha(y) curves). false + err on failure.
 bool plot_table1(const std::string &png, const Table1Result &r, std::string &err);
 
+/// The harder realistic condition (sl-eval realistic --hard, issue 11). The sensor and the
+/// installation differ from what the processing assumes; nothing here is fitted to a
+/// processing path (values: docs/EXTRACTION.md section 3 and the paper's bench).
+struct HardCondition {
+    // smear (scene smear_shape two-component)
+    double fast_decay_db = 3.3;  ///< main exponential (dB per bin), as the Table II condition
+    double slow_db = -15;        ///< slow component's level at the target (dB)
+    double slow_decay_db = 1.5;  ///< its decay (dB per bin)
+    double amp_decay_db = 0.5;   ///< both decays change by this per 20 dB of level (strong: slower)
+    double front_db = -6;        ///< one-bin front skirt
+    double speckle_frame_db = 1.0; ///< per-frame speckle on top of the frozen 2 dB
+    double az_jitter_deg = 0.1;  ///< uniform +- per azimuth and rotation
+    double segment_m = 0.06, segment_fill_m = 0.02, segment_gap = 0.1; ///< reflectors 2 cm every 6 cm
+    // the true installation, drawn per measurement (uniform +-); the processing uses the board
+    double theta_tol_deg = 0.3, beta_tol_deg = 0.2, height_tol_m = 0.01;
+    // the pole as placed by hand for each measurement (uniform +-): its bearing between two
+    // azimuths (0.45 deg = half the 0.9 deg azimuth spacing) and the reflectors' return
+    // (their orientation to the radar), in the radar plane as before
+    double bearing_tol_deg = 0.45, refl_tol_db = 3.0;
+    // ranges: measurements 2.2-2.6 m (as Table II); calibration (vertical poles, own seeds)
+    // only outside them: 1.75-2.15 m and 2.65-3.0 m
+    double calib_gap_lo_m = 2.15, calib_gap_hi_m = 2.65;
+    /// Sets one field by name (the names of sl-eval realistic --hard-set, as in the JSON's
+    /// "hard" object); false when the name is unknown or the value out of its range.
+    bool set(const std::string &name, double value);
+};
+
 struct RealisticOptions {
     int positions = 11, reps = 4, frames = 16, threads = 0;
     int calib_positions = 12;   ///< vertical poles over 1.75-3.0 m for d(r)
@@ -305,7 +332,10 @@ struct RealisticOptions {
     bool pipe_profile = true;   ///< pipeline: range-profile bounds (false: mask + d(r))
     int track_rotations = 0;    ///< pipeline: rotations simulated beyond the window's n (the
                                 ///< tracker then sees several rotations of the same pole)
+    bool hard = false;          ///< the harder condition (HardCondition; sl-eval realistic --hard)
+    HardCondition hard_cond;    ///< its parameters (defaults: the documented condition)
 };
+
 
 /// Core-pipeline results for one true angle of the realistic bench (one estimate per
 /// measurement = position x repetition).
@@ -344,6 +374,8 @@ struct RealisticResult {
     PipeCfg pipe_cfg;           ///< the pipeline's configuration (first measurement's)
     int pipe_last = 4;
     unsigned pipe_mask_frames = 0; ///< board n (paper-bench)
+    bool hard = false;          ///< the harder condition was run
+    HardCondition hard_cond;
 };
 
 RealisticResult run_realistic(const RealisticOptions &o);
@@ -353,6 +385,9 @@ std::string realistic_json(const RealisticResult &r);
 /// The realistic bench scene (paper-bench board): pole base `dist_m` ahead on azimuth 0,
 /// tilt `alpha_deg` in the radar's plane (> 0 = towards it).
 Scene realistic_scene(double dist_m, double alpha_deg, uint64_t seed, int frames, int range_bins);
+/// Applies the harder condition to a realistic_scene: sensor effects, segmented pole and the
+/// true installation perturbed (theta, beta, H drawn from `seed`).
+void make_hard(Scene &s, const HardCondition &h, uint64_t seed);
 /// The table-1 pass scene: `cond` 0 ideal, 1 real res, 2 measured emission, 3 10 cm, 4 20 cm.
 Scene table1_scene(int cond, int angle_deg, int rotations, double lateral_m, int range_bins = 0);
 

@@ -67,6 +67,7 @@ struct Simulator::PoleView {
     int pole = 0;
     RadarPose pose;
     VisibleAxis va;
+    double az_off_deg = 0; ///< azimuth jitter of this rotation's azimuth (beam points off)
 };
 
 struct Simulator::RotationGeom {
@@ -78,7 +79,8 @@ struct Simulator::RotationGeom {
 namespace {
 
 constexpr uint64_t kSaltSpeckle = 0x5BEC1EULL, kSaltPhase = 0x9A5EULL, kSaltNoise = 0x4015EULL,
-                   kSaltLeak = 0x1EA4ULL, kSaltClutter = 0xC1A77E4ULL;
+                   kSaltLeak = 0x1EA4ULL, kSaltClutter = 0xC1A77E4ULL, kSaltJitter = 0x717E5ULL,
+                   kSaltFrame = 0xF4A3EULL;
 
 void add_uniform(std::vector<double> &e, double bin, double a, double c, double E)
 {
@@ -244,7 +246,7 @@ Simulator::Simulator(const Scene &scene) : s_(scene)
     }
 
     // smear kernel: triangular, mode weight 1, front part = mode_frac of the width
-    if (s_.smear) {
+    if (s_.smear && s_.smear_shape != 2) {
         const int W = std::max(1, static_cast<int>(std::lround(s_.smear_width_bins)));
         const int F = std::min(W - 1, static_cast<int>(std::lround(W * s_.smear_mode_frac)));
         smear_front_ = F;
@@ -277,7 +279,7 @@ Simulator::Simulator(const Scene &scene) : s_(scene)
     }
 
     // static scene: the geometry never changes; compute it once
-    if (s_.speed_mps == 0.0 && s_.yaw_rate_dps == 0.0) {
+    if (s_.speed_mps == 0.0 && s_.yaw_rate_dps == 0.0 && s_.az_jitter_deg == 0.0) {
         RotationGeom rg;
         rotation_geom(0, rg);
         static_cols_.resize(static_cast<size_t>(b.azimuths));
@@ -285,7 +287,7 @@ Simulator::Simulator(const Scene &scene) : s_(scene)
             column_from(rg, i, static_cols_[static_cast<size_t>(i)]);
         }
     }
-    deterministic_ = !s_.noise && (!s_.speckle || scene_speckle_static(s_));
+    deterministic_ = !s_.noise && (!s_.speckle || (scene_speckle_static(s_) && s_.speckle_frame_db == 0.0));
     if (deterministic_) {
         out_cache_.resize(static_cast<size_t>(b.azimuths));
         SimColumn col;
@@ -434,6 +436,12 @@ void Simulator::rotation_geom(int k, RotationGeom &rg) const
             pv.pose = radar_pose_at(s_, time_of(k, j));
             pv.va = visible_axis(b, pv.pose, pg, self, occ, w, az_deg_[static_cast<size_t>(j)],
                                  cut_az_, 128);
+            if (s_.az_jitter_deg > 0) {
+                pv.az_off_deg = s_.az_jitter_deg *
+                                (2.0 * sim_uniform(sim_hash(s_.seed, kSaltJitter, static_cast<uint64_t>(k),
+                                                            static_cast<uint64_t>(j))) -
+                                 1.0);
+            }
             if (pv.va.runs == 0) {
                 continue;
             }
@@ -498,7 +506,15 @@ void Simulator::splat_pole(const PoleView &pv, int i, SimColumn *col, double *r1
     const PoleGeom &pg = poles_[static_cast<size_t>(pv.pole)];
     const RadarPose &r = pv.pose;
     const double bin = bin_m();
-    const double a_c = az_deg_[static_cast<size_t>(i)];
+    const double a_c = az_deg_[static_cast<size_t>(i)] + pv.az_off_deg;
+    const ScenePole &sp = s_.poles[static_cast<size_t>(pv.pole)];
+    auto seg = [&sp](double s) {
+        if (sp.segment_m <= 0) {
+            return 1.0;
+        }
+        const double u = s - sp.segment_m * std::floor(s / sp.segment_m);
+        return u < sp.segment_fill_m ? 1.0 : sp.segment_gap;
+    };
     const double s_foot = dot(r.o - pg.base, pg.v);
     double r1 = std::numeric_limits<double>::infinity(), r2 = 0;
     struct Smp {
@@ -538,7 +554,8 @@ void Simulator::splat_pole(const PoleView &pv, int i, SimColumn *col, double *r1
             const double rt = pg.radius * std::sqrt(1.0 + pg.tan_psi * pg.tan_psi * tl * tl);
             const double wdeg = sim_r2d(std::asin(std::min(1.0, rt / std::max(h, 1e-9))));
             const double g = elevation_gain(e) * azimuth_gain(az);
-            sm.push_back({rr, re, e, pg.reflectivity * g * 2.0 * wdeg, pg.reflectivity * g});
+            const double rf = pg.reflectivity * seg(s);
+            sm.push_back({rr, re, e, rf * g * 2.0 * wdeg, rf * g});
             r1 = std::min(r1, rr - re);
             r2 = std::max(r2, rr);
         }
@@ -758,11 +775,42 @@ void Simulator::map_column(int k, int i, const SimColumn &col, uint8_t *out) con
             if (E[static_cast<size_t>(j)] > 0) {
                 const double g = sim_normal(sim_hash(spk_seed, spk_k, static_cast<uint64_t>(i),
                                                      static_cast<uint64_t>(j)));
-                E[static_cast<size_t>(j)] *= std::pow(10.0, 0.1 * s_.speckle_db * g);
+                double db = s_.speckle_db * g;
+                if (s_.speckle_frame_db > 0) {
+                    db += s_.speckle_frame_db * sim_normal(sim_hash(spk_seed ^ kSaltFrame, static_cast<uint64_t>(k) + 1,
+                                                                    static_cast<uint64_t>(i), static_cast<uint64_t>(j)));
+                }
+                E[static_cast<size_t>(j)] *= std::pow(10.0, 0.1 * db);
             }
         }
     }
-    if (s_.smear) {
+    if (s_.smear && s_.smear_shape == 2) {
+        // two-component smear: the kernel of each source bin depends on its level
+        std::vector<double> S(static_cast<size_t>(nb), 0.0);
+        const int W = std::max(1, static_cast<int>(std::lround(s_.smear_width_bins)));
+        const double slow0 = std::pow(10.0, 0.1 * s_.smear_slow_db);
+        const double front = s_.smear_front_db <= -100 ? 0.0 : std::pow(10.0, 0.1 * s_.smear_front_db);
+        for (int j = 0; j < nb; j++) {
+            const double v = E[static_cast<size_t>(j)];
+            if (v <= 0) {
+                continue;
+            }
+            const double x = std::clamp(0.5 * std::log10(v / s_.log_ref_energy), -1.0, 1.0);
+            const double df = std::max(0.05, s_.smear_decay_db - s_.smear_amp_decay_db * x);
+            const double ds = std::max(0.05, s_.smear_slow_decay_db - s_.smear_amp_decay_db * x);
+            const double af = std::pow(10.0, -0.1 * df), as = std::pow(10.0, -0.1 * ds);
+            if (j > 0) {
+                S[static_cast<size_t>(j) - 1] += v * front;
+            }
+            double kf = 1.0, ks = slow0;
+            for (int q = 0; q < W && j + q < nb; q++) {
+                S[static_cast<size_t>(j + q)] += v * (kf + ks);
+                kf *= af;
+                ks *= as;
+            }
+        }
+        E.swap(S);
+    } else if (s_.smear) {
         std::vector<double> S(static_cast<size_t>(nb), 0.0);
         const int nk = static_cast<int>(smear_kernel_.size());
         for (int j = 0; j < nb; j++) {

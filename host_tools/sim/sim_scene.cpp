@@ -211,7 +211,7 @@ Scene build(const Parsed &p)
     {
         Sec c = sec("beam");
         c.only({"elevation", "top_deg", "bottom_deg", "measured_edge_db", "measured_peak_deg",
-                "azimuth_width_deg", "azimuth_p_in_cone", "azimuth_cutoff_deg",
+                "azimuth_width_deg", "azimuth_p_in_cone", "azimuth_cutoff_deg", "azimuth_jitter_deg",
                 "pole_step_deg", "ground_azimuth_samples", "box_step_deg"});
         s.elevation = c.choice<ElevationProfile>(
             "elevation", ElevationProfile::Ideal,
@@ -224,6 +224,7 @@ Scene build(const Parsed &p)
         s.az_width_deg = c.real("azimuth_width_deg", s.az_width_deg, 0.05, 60);
         s.az_p_in_cone = c.real("azimuth_p_in_cone", s.az_p_in_cone, 0.05, 0.999);
         s.az_cutoff_deg = c.real("azimuth_cutoff_deg", 0, 0, 90);
+        s.az_jitter_deg = c.real("azimuth_jitter_deg", 0, 0, 5);
         s.pole_step_deg = c.real("pole_step_deg", s.pole_step_deg, 0.001, 1);
         s.ground_az_samples =
             static_cast<int>(c.integer("ground_azimuth_samples", s.ground_az_samples, 1, 1001));
@@ -249,17 +250,23 @@ Scene build(const Parsed &p)
     }
     {
         Sec c = sec("effects");
-        c.only({"smear", "smear_shape", "smear_width_bins", "smear_mode_frac", "smear_decay_db", "speckle", "speckle_db",
+        c.only({"smear", "smear_shape", "smear_width_bins", "smear_mode_frac", "smear_decay_db", "smear_slow_db",
+                "smear_slow_decay_db", "smear_amp_decay_db", "smear_front_db", "speckle", "speckle_db", "speckle_frame_db",
                 "speckle_static", "speckle_seed", "noise", "noise_sigma", "leakage",
                 "leak_level", "leak_shoulder", "leak_edge_m", "leak_shoulder_end_m",
                 "leak_jitter"});
         s.smear = c.boolean("smear", false);
-        s.smear_shape = c.choice<int>("smear_shape", 0, {{"triangular", 0}, {"exponential", 1}});
+        s.smear_shape = c.choice<int>("smear_shape", 0, {{"triangular", 0}, {"exponential", 1}, {"two-component", 2}});
         s.smear_width_bins = c.real("smear_width_bins", s.smear_width_bins, 1, 500);
         s.smear_decay_db = c.real("smear_decay_db", s.smear_decay_db, 0.01, 100);
         s.smear_mode_frac = c.real("smear_mode_frac", s.smear_mode_frac, 0, 1);
+        s.smear_slow_db = c.real("smear_slow_db", s.smear_slow_db, -100, 0);
+        s.smear_slow_decay_db = c.real("smear_slow_decay_db", s.smear_slow_decay_db, 0.01, 100);
+        s.smear_amp_decay_db = c.real("smear_amp_decay_db", s.smear_amp_decay_db, 0, 10);
+        s.smear_front_db = c.real("smear_front_db", s.smear_front_db, -200, 0);
         s.speckle = c.boolean("speckle", false);
         s.speckle_db = c.real("speckle_db", s.speckle_db, 0, 20);
+        s.speckle_frame_db = c.real("speckle_frame_db", s.speckle_frame_db, 0, 20);
         if (c.has("speckle_static")) {
             const std::string v = c.str("speckle_static", "auto");
             s.speckle_static = v == "auto" ? -1 : (c.boolean("speckle_static", false) ? 1 : 0);
@@ -293,7 +300,7 @@ Scene build(const Parsed &p)
         Sec c = sec(name);
         if (kind == "pole") {
             c.only({"x_m", "y_m", "at_height_m", "length_m", "radius_m", "tilt_deg",
-                    "lean_deg", "reflectivity"});
+                    "lean_deg", "reflectivity", "segment_m", "segment_fill_m", "segment_gap"});
             ScenePole q;
             q.name = obj;
             if (!c.has("x_m") || !c.has("y_m")) {
@@ -307,6 +314,12 @@ Scene build(const Parsed &p)
             q.tilt_deg = c.real("tilt_deg", 0, 0, 60);
             q.lean_deg = c.real("lean_deg", 0, -360, 360);
             q.reflectivity = c.real("reflectivity", q.reflectivity, 0, 1e9);
+            q.segment_m = c.real("segment_m", 0, 0, 10);
+            q.segment_fill_m = c.real("segment_fill_m", q.segment_fill_m, 0.001, 10);
+            q.segment_gap = c.real("segment_gap", q.segment_gap, 0, 1);
+            if (q.segment_m > 0 && q.segment_fill_m > q.segment_m) {
+                c.fail("segment_fill_m", "must not exceed segment_m");
+            }
             s.poles.push_back(q);
         } else if (kind == "box") {
             c.only({"cx_m", "cy_m", "size_x_m", "size_y_m", "yaw_deg", "z0_m", "height_m",

@@ -32,6 +32,12 @@ struct ScenePole {
     double tilt_deg = 0;        ///< psi: angle of the axis from vertical, [0, 60]
     double lean_deg = 0;        ///< phi: direction the top leans towards, world CCW from +x
     double reflectivity = 1.0;  ///< energy per unit solid angle (deg^2) of the lit surface
+    /// Segmented pole (the paper's: corner reflectors along it): > 0 = a reflector of
+    /// `segment_fill_m` every `segment_m` along the axis from the base; between them the
+    /// surface returns `segment_gap` of its reflectivity. 0 = a uniform cylinder.
+    double segment_m = 0;
+    double segment_fill_m = 0.02;
+    double segment_gap = 0.1;
 };
 
 /// An oriented box on (or above) the ground; walls are thin boxes.
@@ -80,6 +86,9 @@ struct Scene {
     double az_width_deg = 8.0;     ///< full width of the normal cone (RadaRays beam_width)
     double az_p_in_cone = 0.8;     ///< fraction of the normal inside +-width/2 (RadaRays)
     double az_cutoff_deg = 0;      ///< hard window half-width; 0 = 2 sigma
+    double az_jitter_deg = 0;      ///< > 0: each azimuth of each rotation points off by a
+                                   ///< uniform draw in +-this (encoder/motor jitter); the
+                                   ///< reported azimuth stays nominal
     double pole_step_deg = 0.05;   ///< elevation step of the pole quadrature
     int ground_az_samples = 33;    ///< bearing samples across the beam for ground/boxes
     double box_step_deg = 0.05;    ///< elevation step of the box ray grid
@@ -95,13 +104,25 @@ struct Scene {
     double log_ref_value = 100;    ///< ... reads this value (noise-free)
     // [effects]
     bool smear = false;
-    int smear_shape = 0;           ///< 0 triangular (RadaRays), 1 exponential tail
+    int smear_shape = 0;           ///< 0 triangular (RadaRays), 1 exponential tail,
+                                   ///< 2 two-component (fast + slow exponential, decay
+                                   ///< depending on the source bin's level, front skirt)
     double smear_width_bins = 20;  ///< kernel length (RadaRays triangular: 50, MulRan 35)
     double smear_mode_frac = 0.0;  ///< fraction of the kernel in front of the target (RadaRays 0.35)
     double smear_decay_db = 3.0;   ///< exponential: power decay per bin behind the target (dB)
+    // two-component (smear_shape 2): kernel(j > 0) = 10^(-d_f j / 10) + 10^((L_s - d_s j) / 10),
+    // kernel(0) = 1 + 10^(L_s / 10), kernel(-1) = 10^(front_db / 10); d_f = smear_decay_db - a x,
+    // d_s = smear_slow_decay_db - a x, x = clamp(10 log10(E / log_ref_energy) / 20, -1, 1)
+    // (E = the source bin's energy: strong returns decay slower), a = smear_amp_decay_db
+    double smear_slow_db = -15;    ///< L_s: level of the slow component at the target (dB)
+    double smear_slow_decay_db = 1.5; ///< d_s at the reference level (dB per bin)
+    double smear_amp_decay_db = 0.5;  ///< a: decay change per 20 dB of level (dB per bin)
+    double smear_front_db = -6;    ///< one-bin front skirt (dB); <= -100: none
     bool speckle = false;
     double speckle_db = 2.0;       ///< log-normal power fluctuation per bin, 1 sigma
     int speckle_static = -1;       ///< 1: fixed over time (static scene), 0: per rotation, -1 auto
+    double speckle_frame_db = 0;   ///< > 0: a further log-normal fluctuation drawn anew every
+                                   ///< rotation (1 sigma, dB), on top of the pattern above
     uint64_t speckle_seed = 0;     ///< 0: derived from seed
     bool noise = false;
     double noise_sigma = 1.62;     ///< complex Gaussian per component: P(round|n| <= 1) = 35 %

@@ -44,5 +44,9 @@ run "$EVAL" realistic --positions 2 --reps 1 --frames 4 --calib 2 --extract both
     --quiet --json-out "$OUT/realistic.json" > /dev/null
 run $V "$S/eval.schema.json" "$OUT/realistic.json" --expect-schema shadowlean-eval-realistic/1 \
     --require rows --require pipeline.rows
+run "$EVAL" realistic --hard --positions 1 --reps 1 --frames 4 --calib 2 --range-bins 160 --extract both \
+    --threads 1 --quiet --json-out "$OUT/realistic_hard.json" > /dev/null
+run $V "$S/eval.schema.json" "$OUT/realistic_hard.json" --expect-schema shadowlean-eval-realistic/1 \
+    --require rows --require pipeline.rows --require hard
 [ $fail -eq 0 ] && echo "json_outputs: ok"
 exit $fail
