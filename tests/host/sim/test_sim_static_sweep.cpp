@@ -32,6 +32,7 @@ constexpr int kAngles[3] = {-10, 0, 10};
 constexpr int kPositions = 40;
 constexpr int kPerScene = 4; // positions per scene (x 3 angles = 12 poles)
 constexpr double kBin = 0.0438;
+constexpr double kRadius = 0.01; // m (2 cm poles)
 constexpr double kBase = 3.0; // m, base of the first position (inside the 5.29 m shadow)
 constexpr double kPi = 3.14159265358979323846;
 
@@ -40,6 +41,12 @@ struct Cell {
     int n = 0;
     int rows = 0, detected = 0;
     double dr1_mm = NAN, dr2_mm = NAN; // last target's r1 / r2 - the axis truth
+    // Edge bins on the pole's azimuth (rotation 0): the fraction of r2's bin the axis fills
+    // and its value with the bin before; the fraction of the first bin in front of the
+    // front surface (axis r1 - radius) and its value with the bin after. The data a
+    // sub-bin edge model has to explain (EXTRACTION.md).
+    double fill2 = NAN, fill1 = NAN;
+    int v2 = -1, v2_prev = -1, v1 = -1, v1_next = -1;
 };
 Cell g_cell[3][kPositions];
 
@@ -60,8 +67,8 @@ std::string scene_text(int scene)
             char buf[400];
             std::snprintf(buf, sizeof buf,
                           "[pole.p%d_%d]\nx_m = %.6f\ny_m = %.6f\nat_height_m = 0\nlength_m = 4.0\n"
-                          "radius_m = 0.01\ntilt_deg = %d\nlean_deg = %.6f\nreflectivity = 1.0\n",
-                          a, pos, x, y, std::abs(kAngles[a]), lean);
+                          "radius_m = %.3f\ntilt_deg = %d\nlean_deg = %.6f\nreflectivity = 1.0\n",
+                          a, pos, x, y, kRadius, std::abs(kAngles[a]), lean);
             t += buf;
         }
     }
@@ -93,6 +100,21 @@ int setup(void **)
         });
         pe.finish();
         const std::map<int, PipeEval> res = pe.result();
+        for (const auto &g : truth) {
+            const int a = g.first / kPerScene, pos = sc * kPerScene + g.first % kPerScene;
+            Cell &cell = g_cell[a][pos];
+            const std::vector<uint8_t> row = sim.render_bins(0, g.second.azimuth);
+            const double e2 = g.second.r2_m / kBin, e1 = (g.second.r1_m - kRadius) / kBin;
+            const size_t b2 = static_cast<size_t>(e2), b1 = static_cast<size_t>(e1);
+            if (b1 >= 1 && b2 + 1 < row.size()) {
+                cell.fill2 = e2 - static_cast<double>(b2);
+                cell.v2 = row[b2];
+                cell.v2_prev = row[b2 - 1];
+                cell.fill1 = 1.0 - (e1 - static_cast<double>(b1));
+                cell.v1 = row[b1];
+                cell.v1_next = row[b1 + 1];
+            }
+        }
         for (const auto &t : pe.targets()) {
             for (const auto &g : truth) {
                 if (std::abs(t.az - g.second.azimuth) <= 1) {
@@ -140,9 +162,10 @@ int setup(void **)
                     at);
         for (int p = 0; p < kPositions; p++) {
             const Cell &c = g_cell[a][p];
-            std::printf("  pos %2d  rows %2d det %2d  mean %+7.3f  max %6.3f  dr1 %+6.1f dr2 %+6.1f mm\n",
+            std::printf("  pos %2d  rows %2d det %2d  mean %+7.3f  max %6.3f  dr1 %+6.1f dr2 %+6.1f mm"
+                        "  | r2 fill %.3f v %3d prev %3d | r1 fill %.3f v %3d next %3d\n",
                         p, c.rows, c.detected, c.n ? c.sum / c.n : std::nan(""), c.maxabs, c.dr1_mm,
-                        c.dr2_mm);
+                        c.dr2_mm, c.fill2, c.v2, c.v2_prev, c.fill1, c.v1, c.v1_next);
         }
     }
     return 0;
