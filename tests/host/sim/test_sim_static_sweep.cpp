@@ -35,10 +35,15 @@ constexpr double kBin = 0.0438;
 constexpr double kRadius = 0.01; // m (2 cm poles)
 constexpr double kBase = 3.0; // m, base of the first position (inside the 5.29 m shadow)
 constexpr double kPi = 3.14159265358979323846;
+// The n = 16 window fills at rotation 15; the profile of a target's azimuth (assigned at
+// its first detection) replaces the mask's bounds from cfg.min_frames = 2 rows on.
+constexpr int kSteady = 17;
 
 struct Cell {
-    double maxabs = 0, sum = 0;
+    double maxabs = 0, sum = 0; // every rotation with a target
     int n = 0;
+    double steady_max = 0;      // rotations >= kSteady (the profile's bounds are in)
+    int steady_n = 0;
     int rows = 0, detected = 0;
     double dr1_mm = NAN, dr2_mm = NAN; // last target's r1 / r2 - the axis truth
     // Edge bins on the pole's azimuth (rotation 0): the fraction of r2's bin the axis fills
@@ -119,8 +124,14 @@ int setup(void **)
             for (const auto &g : truth) {
                 if (std::abs(t.az - g.second.azimuth) <= 1) {
                     const int a = g.first / kPerScene, pos = sc * kPerScene + g.first % kPerScene;
-                    g_cell[a][pos].dr1_mm = (t.r1_m - g.second.r1_m) * 1e3;
-                    g_cell[a][pos].dr2_mm = (t.r2_m - g.second.r2_m) * 1e3;
+                    Cell &cell = g_cell[a][pos];
+                    cell.dr1_mm = (t.r1_m - g.second.r1_m) * 1e3;
+                    cell.dr2_mm = (t.r2_m - g.second.r2_m) * 1e3;
+                    if (t.rotation >= kSteady) {
+                        cell.steady_n++;
+                        cell.steady_max =
+                            std::fmax(cell.steady_max, std::fabs(t.alpha_deg - g.second.alpha_deg));
+                    }
                 }
             }
         }
@@ -140,10 +151,11 @@ int setup(void **)
         }
     }
     std::printf("static sweep (paper-sim, noise-free, 40 sub-bin positions of the base)\n");
-    std::printf("%6s %8s %8s %8s %6s\n", "alpha", "mean", "min", "max|e|", "@pos");
+    std::printf("%6s %8s %8s %8s %6s %8s %6s\n", "alpha", "mean", "min", "max|e|", "@pos",
+                "steady", "@pos");
     for (int a = 0; a < 3; a++) {
-        double s = 0, mn = 1e9, mx = 0;
-        int n = 0, at = -1;
+        double s = 0, mn = 1e9, mx = 0, smx = 0;
+        int n = 0, at = -1, sat = -1;
         for (int p = 0; p < kPositions; p++) {
             const Cell &c = g_cell[a][p];
             if (c.n == 0) {
@@ -157,14 +169,19 @@ int setup(void **)
                 mx = c.maxabs;
                 at = p;
             }
+            if (c.steady_max > smx) {
+                smx = c.steady_max;
+                sat = p;
+            }
         }
-        std::printf("%+6d %+8.3f %+8.3f %8.3f %6d\n", kAngles[a], n ? s / n : std::nan(""), mn, mx,
-                    at);
+        std::printf("%+6d %+8.3f %+8.3f %8.3f %6d %8.3f %6d\n", kAngles[a], n ? s / n : std::nan(""),
+                    mn, mx, at, smx, sat);
         for (int p = 0; p < kPositions; p++) {
             const Cell &c = g_cell[a][p];
-            std::printf("  pos %2d  rows %2d det %2d  mean %+7.3f  max %6.3f  dr1 %+6.1f dr2 %+6.1f mm"
+            std::printf("  pos %2d  rows %2d det %2d  mean %+7.3f  max %6.3f  steady %6.3f  dr1 %+6.1f dr2 %+6.1f mm"
                         "  | r2 fill %.3f v %3d prev %3d | r1 fill %.3f v %3d next %3d\n",
-                        p, c.rows, c.detected, c.n ? c.sum / c.n : std::nan(""), c.maxabs, c.dr1_mm,
+                        p, c.rows, c.detected, c.n ? c.sum / c.n : std::nan(""), c.maxabs,
+                        c.steady_max, c.dr1_mm,
                         c.dr2_mm, c.fill2, c.v2, c.v2_prev, c.fill1, c.v1, c.v1_next);
         }
     }
@@ -183,6 +200,7 @@ static void test_static_sweep_every_pole_found(void **)
             assert_int_equal(c.rows, 20);
             assert_int_equal(c.detected, 20 - 15);
             assert_int_equal(c.n, c.detected);
+            assert_int_equal(c.steady_n, 20 - kSteady);
         }
     }
 }
