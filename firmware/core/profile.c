@@ -307,6 +307,29 @@ sl_profile_bounds_t sl_profile_extract(const uint16_t *sum, uint32_t n, uint32_t
     return r;
 }
 
+// round(65536 x 10^(-k/20)), k = 0..48 values (0.5 dB each), saturated at 65535.
+static const uint16_t k_fill_q16[SL_PROFILE_FILL_VALUES + 1U] = {
+    65535U, 58409U, 52057U, 46396U, 41350U, 36854U, 32846U, 29274U, 26090U, 23253U, 20724U,
+    18471U, 16462U, 14672U, 13076U, 11654U, 10387U, 9257U,  8250U,  7353U,  6554U,  5841U,
+    5206U,  4640U,  4135U,  3685U,  3285U,  2927U,  2609U,  2325U,  2072U,  1847U,  1646U,
+    1467U,  1308U,  1165U,  1039U,  926U,   825U,   735U,   655U,   584U,   521U,   464U,
+    414U,   369U,   328U,   293U,   261U};
+
+uint32_t sl_profile_fill_q16(uint32_t edge_sum, uint32_t ref_sum, uint32_t frames)
+{
+    if (frames == 0U || edge_sum >= ref_sum) {
+        return 65535U;
+    }
+    const uint32_t dv = ref_sum - edge_sum; // values x frames
+    const uint32_t k = dv / frames;
+    if (k >= SL_PROFILE_FILL_VALUES) {
+        return 0U;
+    }
+    // linear between whole values; (dv % frames) < frames <= 2^16, so no overflow
+    const uint32_t fr = ((dv % frames) << 8) / frames; // Q8
+    return ((uint32_t)k_fill_q16[k] * (256U - fr) + (uint32_t)k_fill_q16[k + 1U] * fr) >> 8;
+}
+
 static void calibrate(sl_profile_t *pr, uint32_t s)
 {
     if (pr->cal_n >= CAL_GATE_N) {
@@ -363,7 +386,13 @@ uint8_t sl_profile_refine(sl_profile_t *pr, const sl_board_t *board, uint32_t th
     const int64_t r1_term = (int64_t)t->r1_um - r1_hb_mask;
     const int64_t r2_term = (int64_t)t->r2_um - (r2_hb_mask - (int64_t)t->elong_um);
     const int64_t r1_hb = (int64_t)(((2U * i1 + 1U) * b + 1U) / 2U);
-    const int64_t r2_hb = (int64_t)(((2U * i2 + 1U) * b + 1U) / 2U);
+    int64_t r2_hb = (int64_t)(((2U * i2 + 1U) * b + 1U) / 2U);
+    if (pb.slope_src == SL_PROFILE_SLOPE_CLIFF && pb.i2 > pb.i1) {
+        // Sub-bin far edge (see sl_profile_fill_q16): the last own bin's lit fraction from
+        // its power against the own bin before it.
+        const uint32_t f = sl_profile_fill_q16(s->sum[pb.i2], s->sum[pb.i2 - 1U], s->frames);
+        r2_hb = (int64_t)(i2 * b + ((uint64_t)f * b + 32768U) / 65536U);
+    }
     t->r1_um = sl_fx_usat32(r1_hb + r1_term);
     t->r2_um = sl_fx_usat32(r2_hb + r2_term);
     t->elong_um = sl_fx_sat32(r2_hb_mask - r2_hb);

@@ -332,6 +332,78 @@ static void test_profile_refines_a_target_after_min_frames(void **state)
     assert_int_equal(pr.stats.fallback[SL_PROFILE_FEW_FRAMES], 1);
 }
 
+// Lit fraction of an edge bin from the log values (0.5 dB per value, power adds along the
+// pole): 10^(-dv/20), linear between whole values; full at or above the reference, empty
+// 48 values (24 dB) below it.
+static void test_profile_fill_from_the_log_values(void **state)
+{
+    (void)state;
+    assert_int_equal(sl_profile_fill_q16(16U * 100U, 16U * 100U, 16U), 65535);
+    assert_int_equal(sl_profile_fill_q16(16U * 101U, 16U * 100U, 16U), 65535);
+    assert_int_equal(sl_profile_fill_q16(5U, 10U, 0U), 65535);       // no frame: no claim
+    assert_int_equal(sl_profile_fill_q16(16U * 94U, 16U * 100U, 16U), 32846); // 6 values: 0.50
+    assert_int_equal(sl_profile_fill_q16(16U * 80U, 16U * 100U, 16U), 6554);  // 20: 0.10
+    // half a value (8 of 16 frames one lower): midway between 0 and 1 value
+    assert_int_equal(sl_profile_fill_q16(16U * 100U - 8U, 16U * 100U, 16U), (65535 + 58409) / 2);
+    assert_int_equal(sl_profile_fill_q16(16U * 53U, 16U * 100U, 16U), 293); // 47 values
+    assert_int_equal(sl_profile_fill_q16(16U * 52U, 16U * 100U, 16U), 0);   // 48: empty
+    assert_int_equal(sl_profile_fill_q16(0U, 16U * 100U, 16U), 0);
+    // monotonic in the difference
+    uint32_t prev = 65536U;
+    for (uint32_t e = 16U * 100U; e >= 16U * 50U; e--) {
+        const uint32_t f = sl_profile_fill_q16(e, 16U * 100U, 16U);
+        assert_true(f <= prev);
+        prev = f;
+    }
+}
+
+// A return that ends in a cliff (no smear tail): r2 is the start of its last own bin plus
+// the lit fraction of that bin from its value against the bin before it.
+static void test_profile_refines_r2_within_the_last_bin_of_a_cliff(void **state)
+{
+    (void)state;
+    assert_int_equal(sl_profile_init(&pr, 400, 0, NULL), SL_OK);
+    sl_board_t board;
+    memset(&board, 0, sizeof board);
+    board.bin_size_um = 43800;
+    uint8_t row[NB];
+    memset(row, 0, sizeof row);
+    for (int k = 10; k <= 17; k++) {
+        row[k] = (uint8_t)(110 - (k - 10)); // own bins falling 1 value per bin, 103 at 17
+    }
+    row[18] = 97; // the pole fills half of bin 18 (-3 dB = 6 values below bin 17)
+    uint32_t bits[2] = {0U, 0U};
+    for (int k = 0; k < NB; k++) {
+        if (row[k] >= 40) {
+            bits[k >> 5] |= 1U << (k & 31);
+        }
+    }
+    sl_profile_row(&pr, 7, row, NB, bits, NB);
+    sl_profile_row(&pr, 7, row, NB, bits, NB);
+    sl_target_t t;
+    memset(&t, 0, sizeof t);
+    t.az = 7;
+    t.bin_first = 10;
+    t.bin_last = 18;
+    t.r1_um = (uint32_t)((2 * 10 + 1) * 43800 / 2);
+    t.r2_um = (uint32_t)((2 * 18 + 1) * 43800 / 2);
+    assert_int_equal(sl_profile_refine(&pr, &board, 40, &t), SL_PROFILE_OK);
+    assert_int_equal(t.r1_um, (2 * 10 + 1) * 43800 / 2);
+    // 18 bins + 32846 / 65536 of a bin = 788,400 + 21,952 um
+    assert_int_equal(t.r2_um, 18 * 43800 + (32846LL * 43800 + 32768) / 65536);
+    // a full last bin: its end
+    row[18] = 103;
+    assert_int_equal(sl_profile_init(&pr, 400, 0, NULL), SL_OK);
+    sl_profile_row(&pr, 7, row, NB, bits, NB);
+    sl_profile_row(&pr, 7, row, NB, bits, NB);
+    t.r1_um = (uint32_t)((2 * 10 + 1) * 43800 / 2);
+    t.r2_um = (uint32_t)((2 * 18 + 1) * 43800 / 2);
+    t.flags = 0;
+    t.elong_um = 0;
+    assert_int_equal(sl_profile_refine(&pr, &board, 40, &t), SL_PROFILE_OK);
+    assert_int_equal(t.r2_um, 18 * 43800 + (65535LL * 43800 + 32768) / 65536);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -343,6 +415,8 @@ int main(void)
         cmocka_unit_test(test_profile_keeps_the_own_bins_of_a_return_without_smear),
         cmocka_unit_test(test_profile_slots_follow_the_targets),
         cmocka_unit_test(test_profile_refines_a_target_after_min_frames),
+        cmocka_unit_test(test_profile_fill_from_the_log_values),
+        cmocka_unit_test(test_profile_refines_r2_within_the_last_bin_of_a_cliff),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
