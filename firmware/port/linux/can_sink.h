@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: MIT
 /// @file can_sink.h
 /// @brief A CAN frame sink: a const vtable + context, so the daemon can send every frame
-///        to several outputs (SocketCAN, a candump log file, later gs_usb over libusb).
+///        to several outputs (SocketCAN, a candump log file, gs_usb over libusb), and the
+///        exit drain of all of them (can_sink.c).
 ///
 /// Contract of every sink:
 /// - `send` never blocks. It returns SL_OK when the frame was written or queued for a
