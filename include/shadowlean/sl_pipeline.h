@@ -133,7 +133,7 @@
 /// SL_CFG_MASK_BINS / 8 bytes; then detection (8,424 B), the tracker (1,864 B), the scan
 /// bookkeeping (624 B), the range profiles (sl_profile.h, 2.1 KB), the 3D tilt history
 /// (sl_tiltobs.h: 2,472 B firmware, 7.4 KB host default), the reassembly buffer
-/// (SL_PIPELINE_REASM_BYTES), a row buffer and the theta drift watch (sl_drift.h, 52 B).
+/// (SL_PIPELINE_REASM_BYTES), a row buffer and the theta drift watch (sl_drift.h, 60 B).
 ///
 /// | configuration (400 azimuths, 32 targets)              | x86-64    | Cortex-M0 |
 /// |--------------------------------------------------------|-----------|-----------|

@@ -747,6 +747,7 @@ typedef struct rowrec {
     uint64_t rot_hash[MAX_FRAMES]; // header, stats, flags
     unsigned in_buf, in_other;   // frame-less views: row buffer vs. elsewhere (the message)
     unsigned bad_view;           // a view that is neither where it should be
+    unsigned bad_fft;            // a row whose message (r->fft) is missing or not its source
     const uint8_t *row_buf;
     uint16_t roi;
 } rowrec_t;
@@ -766,6 +767,12 @@ static void on_row(void *ctx, const sl_scan_row_t *r)
     h = sl_golden_fnv1a(b, sizeof b, h);
     h = sl_golden_fnv1a(r->power, w->roi, h);
     w->row_hash[w->rows++] = h;
+    // The row's message carries at least the row's bins, and (8-bit) they are the row's.
+    if (r->fft == NULL || r->fft->bins < r->bins ||
+        ((r->flags & SL_SCAN_AZ_16BIT) == 0U &&
+         memcmp(r->fft->bin_data, r->power, r->bins) != 0)) {
+        w->bad_fft++;
+    }
     if (w->row_buf != NULL) {
         const bool in_buf = r->power == w->row_buf;
         const bool must_copy = (r->flags & (SL_SCAN_AZ_SHORT | SL_SCAN_AZ_16BIT)) != 0U;
@@ -880,6 +887,7 @@ static void test_scan_frameless_reports_the_rows_and_rotations_of_frame_mode(voi
                 assert_true(g_rows.rot_hash[k] == want.rot_hash[k]);
             }
             assert_int_equal(g_rows.bad_view, 0);
+            assert_int_equal(g_rows.bad_fft, 0);
             // 8-bit complete rows are views of the message; short and 16-bit ones are copies.
             assert_int_equal(g_rows.in_buf, width == 1 ? 60 : 120);
             assert_int_equal(c.p.stats.bytes_skipped, 0);
@@ -1030,6 +1038,7 @@ static void test_scan_frameless_bookkeeping_equals_frame_mode_with_gaps(void **s
             continue;
         }
         assert_memory_equal(&s.stats, &want_stats, sizeof want_stats);
+        assert_int_equal(g_rows.bad_fft, 0);
         assert_int_equal(g_rows.rows, want.rows);
         assert_int_equal(g_rows.rots, want.rots);
         for (size_t k = 0; k < want.rows; k++) {
