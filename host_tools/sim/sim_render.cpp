@@ -775,12 +775,13 @@ void Simulator::map_column(int k, int i, const SimColumn &col, uint8_t *out) con
             if (E[static_cast<size_t>(j)] > 0) {
                 const double g = sim_normal(sim_hash(spk_seed, spk_k, static_cast<uint64_t>(i),
                                                      static_cast<uint64_t>(j)));
-                double db = s_.speckle_db * g;
+                double x = 0.1 * s_.speckle_db * g; // (this exact expression: same bytes as before)
                 if (s_.speckle_frame_db > 0) {
-                    db += s_.speckle_frame_db * sim_normal(sim_hash(spk_seed ^ kSaltFrame, static_cast<uint64_t>(k) + 1,
-                                                                    static_cast<uint64_t>(i), static_cast<uint64_t>(j)));
+                    x += 0.1 * s_.speckle_frame_db *
+                         sim_normal(sim_hash(spk_seed ^ kSaltFrame, static_cast<uint64_t>(k) + 1,
+                                             static_cast<uint64_t>(i), static_cast<uint64_t>(j)));
                 }
-                E[static_cast<size_t>(j)] *= std::pow(10.0, 0.1 * db);
+                E[static_cast<size_t>(j)] *= std::pow(10.0, x);
             }
         }
     }
