@@ -135,10 +135,7 @@
 /// (sl_tiltobs.h: 2,472 B firmware, 7.4 KB host default), the reassembly buffer
 /// (SL_PIPELINE_REASM_BYTES), a row buffer and the theta drift watch (sl_drift.h, 60 B).
 ///
-/// | configuration (400 azimuths, 32 targets)              | x86-64    | Cortex-M0 |
-/// |--------------------------------------------------------|-----------|-----------|
-/// | firmware: SL_CFG_MASK_BINS 160, SL_CFG_MASK_FRAMES_MAX 16 | 58,312 B  | 58,168 B  |
-/// | host default: mask bins 512 (whole ROI), n <= 32          | 177,952 B |           |
+/// Measured sizes per configuration: docs/PERFORMANCE.md ("Core modules").
 ///
 /// The boards carried today need 135 (paper-sim), 119 (paper-bench) and 141 (robotcar-leaf)
 /// masked bins (sl_detect_bins_needed(), rounded up to 160).
