@@ -5,7 +5,7 @@
 /// Plain C11 with no libusb and no OS calls, so the unit tests can run it against an
 /// in-process fake device on every test target (x86-64, aarch64, big-endian s390x).
 /// The libusb-1.0 transport lives in gsusb_usb.h; the daemon-facing CAN sink in
-/// gsusb_sink.h. Facts and sources: /work/shared/design/CAN_AND_USB.md s.1.
+/// gsusb_sink.h. Facts and sources: docs/CAN_AND_USB.md s.1.
 ///
 /// Three parts:
 /// 1. **Codec** (pure functions): vendor request payloads (HOST_FORMAT, DEVICE_CONFIG,
