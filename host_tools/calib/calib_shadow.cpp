@@ -77,6 +77,65 @@ double max_in(const float *p, int k0, int k1, int *at = nullptr)
 
 } // namespace
 
+ShadowAccumulator::ShadowAccumulator(int azimuths, int bins, int az_half_window)
+    : A_(azimuths), K_(bins), w_(std::max(0, az_half_window)),
+      sum_(static_cast<size_t>(std::max(0, azimuths)) * std::max(0, bins), 0.0),
+      cnt_(static_cast<size_t>(std::max(0, azimuths)), 0),
+      wm_(sum_.size(), 0.0), wm2_(sum_.size(), 0.0), wn_(cnt_.size(), 0)
+{
+    if (azimuths <= 0 || bins <= 0) {
+        throw std::invalid_argument("ShadowAccumulator: azimuths and bins must be > 0");
+    }
+}
+
+void ShadowAccumulator::add(const cv::Mat &frame, const std::vector<uint8_t> &valid)
+{
+    if (frame.rows != A_ || frame.cols != K_ || frame.type() != CV_8U) {
+        throw std::invalid_argument("calibrate_shadow: frames differ in shape or type");
+    }
+    auto is_valid = [&](int a) {
+        return valid.empty() || (a < static_cast<int>(valid.size()) && valid[a] != 0);
+    };
+    const int A = A_, K = K_, w = w_;
+    for (int a = 0; a < A; a++) {
+        if (!is_valid(a)) {
+            continue;
+        }
+        cnt_[a]++;
+        const uint8_t *row = frame.ptr<uint8_t>(a);
+        double *sr = &sum_[static_cast<size_t>(a) * K];
+        for (int k = 0; k < K; k++) {
+            sr[k] += row[k];
+        }
+    }
+    // Band stability in time: per azimuth and bin, the window's mean of this rotation,
+    // summed and squared across rotations (estimate() takes std/mean over its band).
+    for (int a = 0; a < A; a++) {
+        int na = 0;
+        for (int j = -w; j <= w; j++) {
+            na += is_valid(((a + j) % A + A) % A) ? 1 : 0;
+        }
+        if (na == 0) {
+            continue;
+        }
+        wn_[a]++;
+        double *m = &wm_[static_cast<size_t>(a) * K], *m2 = &wm2_[static_cast<size_t>(a) * K];
+        for (int kk = 1; kk < K; kk++) {
+            double acc = 0;
+            for (int j = -w; j <= w; j++) {
+                const int aa = ((a + j) % A + A) % A;
+                if (is_valid(aa)) {
+                    acc += frame.ptr<uint8_t>(aa)[kk];
+                }
+            }
+            const double v = acc / na;
+            m[kk] += v;
+            m2[kk] += v * v;
+        }
+    }
+    frames_++;
+}
+
 ShadowCalib calibrate_shadow(const std::vector<cv::Mat> &frames,
                              const std::vector<std::vector<uint8_t>> &valid,
                              const ShadowCalibOptions &opt)
@@ -84,45 +143,39 @@ ShadowCalib calibrate_shadow(const std::vector<cv::Mat> &frames,
     if (frames.empty()) {
         throw std::invalid_argument("calibrate_shadow: no frames");
     }
-    if (!(opt.radar_height_m > 0) || !(opt.bin_size_m > 0)) {
-        throw std::invalid_argument("calibrate_shadow: radar height and bin size must be > 0");
-    }
-    const int A = frames[0].rows, K = frames[0].cols, N = static_cast<int>(frames.size());
-    for (const auto &f : frames) {
-        if (f.rows != A || f.cols != K || f.type() != CV_8U) {
-            throw std::invalid_argument("calibrate_shadow: frames differ in shape or type");
-        }
-    }
     if (!valid.empty() && valid.size() != frames.size()) {
         throw std::invalid_argument("calibrate_shadow: valid[] does not match frames");
     }
-    auto is_valid = [&](int f, int a) {
-        return valid.empty() || (a < static_cast<int>(valid[f].size()) && valid[f][a] != 0);
-    };
-    const double b = opt.bin_size_m, H = opt.radar_height_m;
-    const int w = std::max(0, opt.az_half_window), s = std::max(0, opt.range_smooth_bins);
+    ShadowAccumulator acc(frames[0].rows, frames[0].cols, opt.az_half_window);
+    static const std::vector<uint8_t> all;
+    for (size_t f = 0; f < frames.size(); f++) {
+        acc.add(frames[f], valid.empty() ? all : valid[f]);
+    }
+    return acc.estimate(opt);
+}
 
+ShadowCalib ShadowAccumulator::estimate(const ShadowCalibOptions &opt, int bins) const
+{
+    if (frames_ == 0) {
+        throw std::invalid_argument("calibrate_shadow: no frames");
+    }
+    if (!(opt.radar_height_m > 0) || !(opt.bin_size_m > 0)) {
+        throw std::invalid_argument("calibrate_shadow: radar height and bin size must be > 0");
+    }
+    if (std::max(0, opt.az_half_window) != w_) {
+        throw std::invalid_argument("calibrate_shadow: az_half_window differs from the accumulator's");
+    }
+    const int A = A_, N = frames_, KS = K_;
+    const int K = bins > 0 ? std::min(bins, K_) : K_;
+    const double b = opt.bin_size_m, H = opt.radar_height_m;
+    const int w = w_, s = std::max(0, opt.range_smooth_bins);
     ShadowCalib c;
     c.opt = opt;
     c.frames = N;
     c.azimuths = A;
     c.bins = K;
-    // Per (az, bin) sum and count over frames.
-    std::vector<double> sum(static_cast<size_t>(A) * K, 0.0);
-    std::vector<int> cnt(A, 0);
-    for (int f = 0; f < N; f++) {
-        for (int a = 0; a < A; a++) {
-            if (!is_valid(f, a)) {
-                continue;
-            }
-            cnt[a]++;
-            const uint8_t *row = frames[f].ptr<uint8_t>(a);
-            double *sr = &sum[static_cast<size_t>(a) * K];
-            for (int k = 0; k < K; k++) {
-                sr[k] += row[k];
-            }
-        }
-    }
+    const std::vector<int> &cnt = cnt_;
+    auto sum_at = [&](int a, int k) { return sum_[static_cast<size_t>(a) * KS + k]; };
     c.mean = cv::Mat(A, K, CV_32F, cv::Scalar(0));
     cv::Mat single(A, K, CV_32F, cv::Scalar(0)); // range-smoothed single-azimuth means
     cv::Mat raw(A, K, CV_32F, cv::Scalar(0));    // windowed, not range-smoothed
@@ -130,7 +183,7 @@ ShadowCalib calibrate_shadow(const std::vector<cv::Mat> &frames,
     std::vector<double> tmp(K);
     for (int a = 0; a < A; a++) {
         for (int k = 0; k < K; k++) {
-            tmp[k] = cnt[a] ? sum[static_cast<size_t>(a) * K + k] / cnt[a] : 0.0;
+            tmp[k] = cnt[a] ? sum_at(a, k) / cnt[a] : 0.0;
             c.mean.at<float>(a, k) = static_cast<float>(tmp[k]);
         }
         smooth_row(tmp.data(), single.ptr<float>(a), K, s);
@@ -140,7 +193,7 @@ ShadowCalib calibrate_shadow(const std::vector<cv::Mat> &frames,
             const int aa = ((a + j) % A + A) % A;
             n += cnt[aa];
             for (int k = 0; k < K; k++) {
-                tmp[k] += sum[static_cast<size_t>(aa) * K + k];
+                tmp[k] += sum_at(aa, k);
             }
         }
         for (int k = 0; k < K; k++) {
@@ -189,26 +242,9 @@ ShadowCalib calibrate_shadow(const std::vector<cv::Mat> &frames,
         {
             std::vector<double> cvs;
             const int kend = std::min(k, K);
+            const int nf = wn_[a];
             for (int kk = 1; kk < kend; kk++) {
-                double m = 0, m2 = 0;
-                int nf = 0;
-                for (int f = 0; f < N; f++) {
-                    double acc = 0;
-                    int na = 0;
-                    for (int j = -w; j <= w; j++) {
-                        const int aa = ((a + j) % A + A) % A;
-                        if (is_valid(f, aa)) {
-                            acc += frames[f].ptr<uint8_t>(aa)[kk];
-                            na++;
-                        }
-                    }
-                    if (na) {
-                        const double v = acc / na;
-                        m += v;
-                        m2 += v * v;
-                        nf++;
-                    }
-                }
+                double m = wm_[static_cast<size_t>(a) * KS + kk], m2 = wm2_[static_cast<size_t>(a) * KS + kk];
                 if (nf > 1 && m > 0) {
                     m /= nf;
                     const double var = std::max(0.0, m2 / nf - m * m);

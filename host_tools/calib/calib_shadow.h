@@ -107,6 +107,28 @@ struct ShadowCalib {
     int usable_count = 0;
 };
 
+/// The estimator's input, accumulated one rotation at a time (memory: four values per
+/// azimuth and bin, whatever the number of rotations): per (azimuth, bin) the sum over
+/// rotations, and for the band's stability the sum and sum of squares of the
+/// `az_half_window` window's mean of each rotation.
+class ShadowAccumulator {
+public:
+    ShadowAccumulator(int azimuths, int bins, int az_half_window);
+    /// One rotation (CV_8U, azimuths x bins); `valid[a]` (empty = all valid) excludes rows.
+    void add(const cv::Mat &frame, const std::vector<uint8_t> &valid);
+    int frames() const { return frames_; }
+    /// The estimator on what was added; `bins` > 0 uses only the first `bins` columns.
+    /// Throws std::invalid_argument like calibrate_shadow.
+    ShadowCalib estimate(const ShadowCalibOptions &opt, int bins = 0) const;
+
+private:
+    int A_, K_, w_, frames_ = 0;
+    std::vector<double> sum_;
+    std::vector<int> cnt_;
+    std::vector<double> wm_, wm2_;
+    std::vector<int> wn_;
+};
+
 /// Runs the estimator on `frames` (CV_8U, all azimuths x bins, same shape). `valid[f][a]`
 /// (optional: empty = all valid) excludes missing rows. Throws std::invalid_argument on
 /// inconsistent input (no frames, shapes differ, H or b not positive).

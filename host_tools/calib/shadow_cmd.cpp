@@ -9,6 +9,7 @@
 #include <fstream>
 #include <limits>
 #include <string>
+#include <memory>
 #include <vector>
 
 #include <sys/stat.h>
@@ -243,7 +244,21 @@ int cmd_shadow(const ShadowArgs &a)
     }
     Progress progress("sl-calib", a.quiet); // two steps: read the capture, fit the shadow
     progress.update(0, 2, "reading the capture");
-    if (!load_frames(a.input, fo, fs, err)) {
+    // Rotations are accumulated as they arrive (bounded memory whatever the capture's length).
+    std::unique_ptr<ShadowAccumulator> acc;
+    std::vector<uint8_t> valid;
+    const bool read_ok = for_each_frame(a.input, fo, fs, [&](RadarFrame &f, const FrameSet &) {
+        if (!acc) {
+            acc = std::make_unique<ShadowAccumulator>(f.power.rows, f.power.cols, a.opt.az_half_window);
+        }
+        valid.resize(f.flags.size());
+        for (size_t i = 0; i < valid.size(); i++) {
+            valid[i] = (f.flags[i] & SL_SCAN_AZ_VALID) ? 1 : 0;
+        }
+        acc->add(f.power, valid);
+        return true;
+    }, err);
+    if (!read_ok) {
         std::fprintf(stderr, "sl-calib: %s\n", err.c_str());
         return 1;
     }
@@ -259,16 +274,6 @@ int cmd_shadow(const ShadowArgs &a)
                      fs.azimuths, board.name.c_str(), board.azimuths);
         return 1;
     }
-    std::vector<cv::Mat> frames;
-    std::vector<std::vector<uint8_t>> valid;
-    for (const auto &f : fs.frames) {
-        frames.push_back(f.power);
-        std::vector<uint8_t> v(f.flags.size());
-        for (size_t i = 0; i < v.size(); i++) {
-            v[i] = (f.flags[i] & SL_SCAN_AZ_VALID) ? 1 : 0;
-        }
-        valid.push_back(v);
-    }
     ShadowCalibOptions so = a.opt;
     so.radar_height_m = a.height_m > 0 ? a.height_m : board.radar_height_m;
     so.bin_size_m = fs.bin_size_m;
@@ -276,7 +281,7 @@ int cmd_shadow(const ShadowArgs &a)
     ShadowCalib c;
     progress.update(1, 2, "fitting the shadow");
     try {
-        c = calibrate_shadow(frames, valid, so);
+        c = acc->estimate(so, fs.roi_bins);
     } catch (const std::exception &e) {
         std::fprintf(stderr, "sl-calib: %s\n", e.what());
         return 1;
@@ -304,7 +309,7 @@ int cmd_shadow(const ShadowArgs &a)
     }
     std::printf("sl-calib shadow: %s (%s), %zu rotations, %d azimuths, bin %.4f m, H %.3f m, "
                 "board %s\n",
-                a.input.c_str(), fs.kind.c_str(), fs.frames.size(), c.azimuths, so.bin_size_m,
+                a.input.c_str(), fs.kind.c_str(), static_cast<size_t>(fs.delivered), c.azimuths, so.bin_size_m,
                 so.radar_height_m, board.name.c_str());
     std::printf("  usable azimuths: %d / %d\n", c.usable_count, c.azimuths);
     std::printf("  near-field band end (median): %.2f m; band std/mean over time (median): "

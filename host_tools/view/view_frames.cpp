@@ -16,6 +16,8 @@ struct DecodeCtx {
     sl_scan_t scan{};
     const FrameOptions *opt = nullptr;
     FrameSet *out = nullptr;
+    const FrameFn *fn = nullptr;    // set: frames go to it, not into out->frames
+    int widest = 0;                 // widest row of the frames handed to fn
     bool stop = false;
     uint32_t config_bin_um = 0;
 };
@@ -46,8 +48,23 @@ void on_frame(void *vctx, const sl_scan_frame_t *f)
     }
     c->out->azimuths = az;
     c->out->encoder_size = f->encoder_size;
-    c->out->frames.push_back(std::move(fr));
-    if (c->opt->max_frames > 0 && static_cast<int>(c->out->frames.size()) >= c->opt->max_frames) {
+    c->out->delivered++;
+    if (c->fn) {
+        c->widest = std::max(c->widest, fr.widest_row);
+        c->out->roi_bins = c->opt->roi_bins;
+        if (c->opt->bin_size_m > 0) {
+            c->out->bin_size_m = c->opt->bin_size_m;
+        } else if (c->config_bin_um > 0) {
+            c->out->bin_size_m = c->config_bin_um * 1e-6;
+            c->out->bin_from_config = true;
+        }
+        if (!(*c->fn)(fr, *c->out)) {
+            c->stop = true;
+        }
+    } else {
+        c->out->frames.push_back(std::move(fr));
+    }
+    if (c->opt->max_frames > 0 && c->out->delivered >= c->opt->max_frames) {
         c->stop = true;
     }
 }
@@ -76,7 +93,8 @@ bool is_dir(const std::string &p)
     return ::stat(p.c_str(), &st) == 0 && S_ISDIR(st.st_mode);
 }
 
-bool decode(MessageReader &rd, const FrameOptions &opt, FrameSet &out, std::string &err)
+bool decode(MessageReader &rd, const FrameOptions &opt, FrameSet &out, std::string &err,
+            const FrameFn *fn = nullptr)
 {
     if (opt.roi_bins < 1 || opt.roi_bins > SL_CFG_ROI_BINS) {
         err = "roi_bins must be in 1.." + std::to_string(SL_CFG_ROI_BINS);
@@ -87,6 +105,7 @@ bool decode(MessageReader &rd, const FrameOptions &opt, FrameSet &out, std::stri
     auto spare = std::make_unique<sl_scan_frame_t>();
     ctx->opt = &opt;
     ctx->out = &out;
+    ctx->fn = fn;
     sl_scan_cfg_t sc{};
     sc.roi_bins = static_cast<uint16_t>(opt.roi_bins);
     sc.pow16_shift = 8;
@@ -130,7 +149,7 @@ bool decode(MessageReader &rd, const FrameOptions &opt, FrameSet &out, std::stri
     // Rows shorter than the ROI (contoured data, captures with fewer bins) are zero-filled
     // by sl_scan: crop every frame to the longest row actually received.
     {
-        int widest = 0;
+        int widest = ctx->widest;
         for (const auto &f : out.frames) {
             widest = std::max(widest, f.widest_row);
         }
@@ -141,7 +160,7 @@ bool decode(MessageReader &rd, const FrameOptions &opt, FrameSet &out, std::stri
             out.roi_bins = widest;
         }
     }
-    if (out.frames.empty()) {
+    if (out.delivered == 0) {
         err = "no complete rotation decoded (" + std::to_string(out.proto.fft8 + out.proto.fft16) +
               " FFT messages, " + std::to_string(out.dropped_partial) + " partial frames)";
         return false;
@@ -166,8 +185,10 @@ bool decode_frames(const std::vector<uint8_t> &bytes, const FrameOptions &opt, F
     return decode(rd, opt, out, err);
 }
 
-bool load_frames(const std::string &path, const FrameOptions &opt, FrameSet &out,
-                 std::string &err)
+namespace {
+
+bool read_path(const std::string &path, const FrameOptions &opt, FrameSet &out,
+               const FrameFn *fn, std::string &err)
 {
     out = FrameSet{};
     out.source = path;
@@ -182,7 +203,9 @@ bool load_frames(const std::string &path, const FrameOptions &opt, FrameSet &out
             return false;
         }
         out.kind = "oxford-png";
-        if (!decode_frames(bytes, opt, out, err)) {
+        MessageReader rd;
+        rd.open_memory(bytes.data(), bytes.size());
+        if (!decode(rd, opt, out, err, fn)) {
             err = path + ": " + err;
             return false;
         }
@@ -194,7 +217,8 @@ bool load_frames(const std::string &path, const FrameOptions &opt, FrameSet &out
         err = path + ": " + err;
         return false;
     }
-    const bool ok = decode(rd, opt, out, err);
+    out.kind = capture_format_name(rd.format());
+    const bool ok = decode(rd, opt, out, err, fn);
     out.kind = capture_format_name(rd.format());
     if (!ok) {
         if (err.compare(0, path.size(), path) != 0) {
@@ -203,6 +227,20 @@ bool load_frames(const std::string &path, const FrameOptions &opt, FrameSet &out
         return false;
     }
     return true;
+}
+
+} // namespace
+
+bool load_frames(const std::string &path, const FrameOptions &opt, FrameSet &out,
+                 std::string &err)
+{
+    return read_path(path, opt, out, nullptr, err);
+}
+
+bool for_each_frame(const std::string &path, const FrameOptions &opt, FrameSet &meta,
+                    const FrameFn &fn, std::string &err)
+{
+    return read_path(path, opt, meta, &fn, err);
 }
 
 } // namespace sl

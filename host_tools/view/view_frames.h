@@ -22,6 +22,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -60,6 +61,7 @@ struct FrameSet {
     bool bin_from_config = false;   ///< true: the stream's Configuration gave the bin size
     std::vector<RadarFrame> frames;
     int dropped_partial = 0;        ///< frames dropped by min_valid_fraction
+    int delivered = 0;              ///< frames kept (load_frames) or handed over (for_each_frame)
     sl_proto_stats_t proto{};
     sl_scan_stats_t scan{};
 };
@@ -68,6 +70,18 @@ struct FrameSet {
 /// false + err on I/O or format errors, or when no frame survives.
 bool load_frames(const std::string &path, const FrameOptions &opt, FrameSet &out,
                  std::string &err);
+
+/// One decoded rotation as it arrives; `meta` is the FrameSet so far (geometry, bin size once
+/// known; `frames` stays empty). Return false to stop reading.
+using FrameFn = std::function<bool(RadarFrame &frame, const FrameSet &meta)>;
+
+/// load_frames without keeping the frames: each surviving rotation goes to `fn` in stream
+/// order (memory: one frame plus the reader's window, whatever the capture's length). The
+/// frames are not cropped: they have FrameOptions::roi_bins columns; at the end
+/// `meta.roi_bins` is the crop load_frames would have applied (the widest row received) and
+/// `meta.delivered` the number of frames handed over. Same errors as load_frames.
+bool for_each_frame(const std::string &path, const FrameOptions &opt, FrameSet &meta,
+                    const FrameFn &fn, std::string &err);
 
 /// Decodes an in-memory Colossus byte stream (same rules as load_frames).
 bool decode_frames(const std::vector<uint8_t> &bytes, const FrameOptions &opt, FrameSet &out,

@@ -4,7 +4,7 @@
 # read_capture): a FIFO or stdin ("-") gives exactly what the file gives, and memory does
 # not grow with the capture's size.
 #   tools_stream.sh TOOL BINDIR SRCDIR WORKDIR
-#   TOOL = view | calib | eval | eval-memory | serve-memory
+#   TOOL = view | calib | calib-memory | eval | eval-memory | serve-memory
 set -eu
 tool=$1 B=$2 S=$3 d=$4
 rm -rf "$d"; mkdir -p "$d"; cd "$d"
@@ -42,6 +42,22 @@ eval)
   grep -q 'detected' pfile.txt; same pfile.txt pfifo.txt; same pfile.txt ppcap.txt
   ! "$B/eval/sl-eval" run missing.colossus s.gt.csv 2> err.txt
   grep -q 'missing.colossus' err.txt ;;
+calib-memory)
+  # sl-calib shadow on 4 vs 15 copies of the capture (80 / 300 rotations, 17 / 66 MB)
+  # through a pipe: peak RSS grows <= 16 MiB (it used to keep every rotation, ~200 KB
+  # each), and the calibration equals the one from the file.
+  for k in 4 15; do
+    i=0; while [ $i -lt $k ]; do cat s.colossus; i=$((i + 1)); done > big$k
+    cat big$k | /usr/bin/time -v -o time$k.txt "$B/calib/sl-calib" shadow - --board paper-sim --out-ini pipe.ini > pipe$k.txt
+    grep -q "$((k * 20)) rotations" pipe$k.txt
+  done
+  "$B/calib/sl-calib" shadow big15 --board paper-sim --out-ini file.ini > file15.txt
+  sed -i "s#big15#INPUT#g" file15.txt file.ini
+  same file.ini pipe.ini; same file15.txt pipe15.txt
+  a=$(sed -n 's/.*Maximum resident set size (kbytes): //p' time4.txt)
+  b=$(sed -n 's/.*Maximum resident set size (kbytes): //p' time15.txt)
+  echo "sl-calib shadow peak RSS: $a KiB for 80 rotations, $b KiB for 300 rotations"
+  test $((b - a)) -le 16384 ;;
 eval-memory)
   # 4 vs 15 copies of the capture (17 / 66 MB) through a pipe: peak RSS grows < 8 MiB.
   for k in 4 15; do
