@@ -172,7 +172,7 @@ static uint32_t fit_slope_q8(const uint16_t *sum, uint32_t e, uint32_t m, uint32
 // One extraction; `fit_max` (<= FIT_BINS) caps the size of the tail fit (bins ending at e).
 static sl_profile_bounds_t extract_once(const uint16_t *sum, uint32_t n, uint32_t frames,
                                         uint32_t threshold, uint32_t hint, uint32_t cal_slope_q8,
-                                        uint32_t fit_max)
+                                        uint32_t fit_max, uint32_t cliff_end)
 {
     sl_profile_bounds_t r;
     memset(&r, 0, sizeof r);
@@ -233,8 +233,12 @@ static sl_profile_bounds_t extract_once(const uint16_t *sum, uint32_t n, uint32_
     }
     r.slope_q8 = (uint16_t)s;
     // No tail at all: the return ends in a cliff (the step after its last bin above the
-    // threshold falls by more than two tail slopes), so its last bins are its own.
-    if (((int64_t)sum[last] - (int64_t)sum[last + 1U]) * 256 > 2 * (int64_t)frames * (int64_t)s) {
+    // threshold falls by more than two tail slopes), so its last bins are its own. Not at
+    // or beyond `cliff_end` (the shadow edge): a pole's own return ends inside the shadow,
+    // so a drop there ends a smear tail (where it meets the floor, or where the smear's
+    // support ends) and the walk from e decides.
+    if (last < cliff_end &&
+        ((int64_t)sum[last] - (int64_t)sum[last + 1U]) * 256 > 2 * (int64_t)frames * (int64_t)s) {
         r.i1 = (uint16_t)i1;
         r.i2 = (uint16_t)last;
         r.e = (uint16_t)e;
@@ -291,15 +295,18 @@ static sl_profile_bounds_t extract_once(const uint16_t *sum, uint32_t n, uint32_
 }
 
 sl_profile_bounds_t sl_profile_extract(const uint16_t *sum, uint32_t n, uint32_t frames,
-                                       uint32_t threshold, uint32_t hint, uint32_t cal_slope_q8)
+                                       uint32_t threshold, uint32_t hint, uint32_t cal_slope_q8,
+                                       uint32_t cliff_end)
 {
-    sl_profile_bounds_t r = extract_once(sum, n, frames, threshold, hint, cal_slope_q8, FIT_BINS);
+    sl_profile_bounds_t r =
+        extract_once(sum, n, frames, threshold, hint, cal_slope_q8, FIT_BINS, cliff_end);
     // The first fit may reach into the pole's own bins when the tail is short: refit on the
     // tail the walk found (when it has >= FIT_MIN_BINS and < FIT_BINS bins) and walk again.
     if (r.fail == (uint8_t)SL_PROFILE_OK && r.slope_src == SL_PROFILE_SLOPE_FIT &&
         (uint32_t)r.i2 + FIT_BINS > r.e && (uint32_t)r.e >= (uint32_t)r.i2 + FIT_MIN_BINS) {
         const sl_profile_bounds_t r2 =
-            extract_once(sum, n, frames, threshold, hint, cal_slope_q8, (uint32_t)r.e - r.i2);
+            extract_once(sum, n, frames, threshold, hint, cal_slope_q8, (uint32_t)r.e - r.i2,
+                         cliff_end);
         if (r2.fail == (uint8_t)SL_PROFILE_OK) {
             r = r2;
         }
@@ -367,9 +374,15 @@ uint8_t sl_profile_refine(sl_profile_t *pr, const sl_board_t *board, uint32_t th
         pr->stats.fallback[SL_PROFILE_FEW_FRAMES]++;
         return (uint8_t)SL_PROFILE_FEW_FRAMES;
     }
+    // Bins from the first that starts at or beyond the shadow edge on: no cliff there.
+    uint32_t cliff_end = UINT32_MAX;
+    if (t->shadow_slant_um != 0U && board->bin_size_um != 0U) {
+        const uint32_t eb = (t->shadow_slant_um + board->bin_size_um - 1U) / board->bin_size_um;
+        cliff_end = eb > s->bin0 ? eb - s->bin0 : 0U;
+    }
     const sl_profile_bounds_t pb =
         sl_profile_extract(s->sum, SL_CFG_PROFILE_BINS, s->frames, threshold,
-                           (uint32_t)t->bin_first - s->bin0, pr->slope_q8);
+                           (uint32_t)t->bin_first - s->bin0, pr->slope_q8, cliff_end);
     if (pb.fail != (uint8_t)SL_PROFILE_OK) {
         pr->stats.fallback[pb.fail]++;
         return pb.fail;

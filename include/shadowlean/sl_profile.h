@@ -34,7 +34,10 @@
 ///    s in 1/256 value per bin per frame; plausible in [0.5, 24] values/bin over >= 4 bins,
 ///    else the running calibration (below) is used, else NO_TAIL.
 ///    No tail: when the step after the run's last bin above F T falls by more than 2 F s
-///    (a cliff, not a smear tail), r2 is that last bin and there is no walk.
+///    (a cliff, not a smear tail), r2 is that last bin and there is no walk; but not when
+///    that bin lies at or beyond the shadow edge (`cliff_end`): a pole's own return ends
+///    inside the shadow (else it is rejected as SHADOW), so a drop there ends a smear tail
+///    (where it meets the floor, or where the smear's support ends) and the walk decides.
 /// 4. Walk back from e while the bin before decays into this one like a tail:
 ///    S[j-1] - S[j] >= F (s_loc - s_loc / 6) (a bin is the pole's own when it decays by
 ///    clearly less than the local tail slope). A shallower step is still tail when it is
@@ -226,9 +229,13 @@ void sl_profile_assign(sl_profile_t *pr, const sl_target_t *targets, uint32_t n)
 uint32_t sl_profile_fill_q16(uint32_t edge_sum, uint32_t ref_sum, uint32_t frames);
 
 /// Smear-aware bounds from a profile (pure; see "Extraction"). `hint` = the mask's first
-/// bin relative to the profile start, `cal_slope_q8` the fallback slope (0: none).
+/// bin relative to the profile start, `cal_slope_q8` the fallback slope (0: none),
+/// `cliff_end` the first bin (relative to the profile start) that lies at or beyond the
+/// shadow edge: a run whose last bin is there never ends in a cliff (step 3), UINT32_MAX
+/// for no limit.
 sl_profile_bounds_t sl_profile_extract(const uint16_t *sum, uint32_t n, uint32_t frames,
-                                       uint32_t threshold, uint32_t hint, uint32_t cal_slope_q8);
+                                       uint32_t threshold, uint32_t hint, uint32_t cal_slope_q8,
+                                       uint32_t cliff_end);
 
 /// Refine a detected target with the profile of its azimuth: r1 from the leading edge, r2
 /// from the last own bin (half-bin centres, r2 sub-bin when the return ends in a cliff (6.), the target's radius terms kept, no d(r)), alpha

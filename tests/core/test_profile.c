@@ -154,7 +154,7 @@ static void check_shape(kernel_fn kern, const double *own_db, int len, int frame
     const int a = 10;
     const int b = a + len - 1;
     synth(sum, frames, a, b, own_db, kern);
-    const sl_profile_bounds_t r = sl_profile_extract(sum, NB, (uint32_t)frames, 40U, (uint32_t)a, 0U);
+    const sl_profile_bounds_t r = sl_profile_extract(sum, NB, (uint32_t)frames, 40U, (uint32_t)a, 0U, UINT32_MAX);
     assert_int_equal(r.fail, SL_PROFILE_OK);
     assert_int_equal(r.slope_src, SL_PROFILE_SLOPE_FIT);
     assert_int_equal(r.i1, a);
@@ -208,24 +208,24 @@ static void test_profile_reports_why_it_cannot_extract(void **state)
     uint16_t sum[NB];
     memset(sum, 0, sizeof sum);
     // nothing above the threshold
-    assert_int_equal(sl_profile_extract(sum, NB, 4, 40, 10, 0).fail, SL_PROFILE_NO_RUN);
+    assert_int_equal(sl_profile_extract(sum, NB, 4, 40, 10, 0, UINT32_MAX).fail, SL_PROFILE_NO_RUN);
     // run from bin 0: no leading edge
     for (int k = 0; k < 20; k++) {
         sum[k] = (uint16_t)(4 * (100 - 3 * k));
     }
-    assert_int_equal(sl_profile_extract(sum, NB, 4, 40, 0, 0).fail, SL_PROFILE_LEAD_CUT);
+    assert_int_equal(sl_profile_extract(sum, NB, 4, 40, 0, 0, UINT32_MAX).fail, SL_PROFILE_LEAD_CUT);
     // run to the end of the profile
     for (int k = 0; k < NB; k++) {
         sum[k] = k < 5 ? 0 : 4 * 200;
     }
-    assert_int_equal(sl_profile_extract(sum, NB, 4, 40, 5, 0).fail, SL_PROFILE_TAIL_CUT);
+    assert_int_equal(sl_profile_extract(sum, NB, 4, 40, 5, 0, UINT32_MAX).fail, SL_PROFILE_TAIL_CUT);
     // flat run, no tail to fit and no calibration; with one the calibration is used
     for (int k = 0; k < NB; k++) {
         sum[k] = (k >= 5 && k < 15) ? 4 * 80 : 0;
     }
-    assert_int_equal(sl_profile_extract(sum, NB, 4, 40, 5, 0).fail, SL_PROFILE_NO_TAIL);
+    assert_int_equal(sl_profile_extract(sum, NB, 4, 40, 5, 0, UINT32_MAX).fail, SL_PROFILE_NO_TAIL);
     // with a calibrated slope it extracts; the run ends in a cliff: r2 = its last bin
-    const sl_profile_bounds_t r = sl_profile_extract(sum, NB, 4, 40, 5, 3U * 256U);
+    const sl_profile_bounds_t r = sl_profile_extract(sum, NB, 4, 40, 5, 3U * 256U, UINT32_MAX);
     assert_int_equal(r.fail, SL_PROFILE_OK);
     assert_int_equal(r.slope_src, SL_PROFILE_SLOPE_CLIFF);
     assert_int_equal(r.i1, 5);
@@ -241,11 +241,59 @@ static void test_profile_keeps_the_own_bins_of_a_return_without_smear(void **sta
     for (int k = 0; k < NB; k++) {
         sum[k] = (uint16_t)(k >= 8 && k <= 20 ? 16 * (110 - 4 * (k - 8)) : 0);
     }
-    const sl_profile_bounds_t r = sl_profile_extract(sum, NB, 16, 40, 8, 0U);
+    const sl_profile_bounds_t r = sl_profile_extract(sum, NB, 16, 40, 8, 0U, UINT32_MAX);
     assert_int_equal(r.fail, SL_PROFILE_OK);
     assert_int_equal(r.slope_src, SL_PROFILE_SLOPE_CLIFF);
     assert_int_equal(r.i1, 8);
     assert_int_equal(r.i2, 20);
+}
+
+// A two-component smear whose support ends `g_cut` bins after each source bin (a finite
+// range response; the same drop where a tail meets a floor): the run above the threshold
+// ends in a cliff far behind the pole. Read as a cliff, r2 would be the tail's last bin,
+// beyond the shadow edge (the pole then rejected as SHADOW); with the edge given, the cliff
+// is not the pole's end and the walk finds the own bins.
+static int g_cut = 25;
+static double k_two_cut(int j, double level_db)
+{
+    return j > g_cut ? 0.0 : k_two(j, level_db);
+}
+
+static void test_profile_a_cliff_beyond_the_shadow_edge_ends_a_tail(void **state)
+{
+    (void)state;
+    double uni[6];
+    for (int i = 0; i < 6; i++) {
+        uni[i] = 100.0;
+    }
+    uint16_t sum[NB];
+    const int a = 10, b = 15, edge = 24; // the shadow edge 9 bins behind the pole
+    g_cut = 25;
+    synth(sum, 16, a, b, uni, k_two_cut);
+    // the old reading, without an edge: a cliff far behind the pole
+    const sl_profile_bounds_t c = sl_profile_extract(sum, NB, 16, 40U, (uint32_t)a, 0U, UINT32_MAX);
+    assert_int_equal(c.fail, SL_PROFILE_OK);
+    assert_int_equal(c.slope_src, SL_PROFILE_SLOPE_CLIFF);
+    assert_true(c.i2 >= edge);
+    const sl_profile_bounds_t r = sl_profile_extract(sum, NB, 16, 40U, (uint32_t)a, 0U, (uint32_t)edge);
+    assert_int_equal(r.fail, SL_PROFILE_OK);
+    assert_int_equal(r.slope_src, SL_PROFILE_SLOPE_FIT);
+    assert_int_equal(r.i1, a);
+    assert_int_equal(r.i2, b);
+    // Known limit: a support that ends while the tail is still above T + T/4 bends the
+    // tail's last fitted bins (fewer sources reach them), and the walk stops there. r2 then
+    // stays beyond the edge (a missed pole, rejected as SHADOW), never inside the shadow.
+    g_cut = 20;
+    synth(sum, 16, a, b, uni, k_two_cut);
+    const sl_profile_bounds_t l = sl_profile_extract(sum, NB, 16, 40U, (uint32_t)a, 0U, (uint32_t)edge);
+    assert_true(l.fail != SL_PROFILE_OK || l.i2 == b || l.i2 >= edge);
+    // a cliff inside the shadow is still the pole's end (a return without smear)
+    for (int k = 0; k < NB; k++) {
+        sum[k] = (uint16_t)(k >= 8 && k <= 20 ? 16 * (110 - 4 * (k - 8)) : 0);
+    }
+    const sl_profile_bounds_t n = sl_profile_extract(sum, NB, 16, 40U, 8U, 0U, 21U);
+    assert_int_equal(n.slope_src, SL_PROFILE_SLOPE_CLIFF);
+    assert_int_equal(n.i2, 20);
 }
 
 // Evidence fills every slot; targets then take slots from azimuths that are no target's,
@@ -413,6 +461,7 @@ int main(void)
         cmocka_unit_test(test_profile_extracts_own_bins_under_other_smear_shapes),
         cmocka_unit_test(test_profile_reports_why_it_cannot_extract),
         cmocka_unit_test(test_profile_keeps_the_own_bins_of_a_return_without_smear),
+        cmocka_unit_test(test_profile_a_cliff_beyond_the_shadow_edge_ends_a_tail),
         cmocka_unit_test(test_profile_slots_follow_the_targets),
         cmocka_unit_test(test_profile_refines_a_target_after_min_frames),
         cmocka_unit_test(test_profile_fill_from_the_log_values),

@@ -30,7 +30,7 @@ extern "C" {
 using namespace sl;
 
 // Measurements (of 30) in which the pipeline finds the pole: see the test's comment.
-static const int kMinDetected = 10;
+static const int kMinDetected = 28;
 
 namespace {
 
