@@ -29,7 +29,9 @@ extern "C" {
 
 using namespace sl;
 
-// Measurements (of 30) in which the pipeline finds the pole: see the test's comment.
+// Measurements (of 30) in which the pipeline finds the pole: 30 measured. 16 before a drop at
+// or beyond the shadow edge stopped being read as the pole's end (sl_profile.h step 3): the
+// slow smear component's tail ends there and the pole was rejected as SHADOW.
 static const int kMinDetected = 28;
 
 namespace {
