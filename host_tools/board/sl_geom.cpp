@@ -2,6 +2,8 @@
 // sl_geom.cpp: see sl_geom.h.
 #include "sl_geom.h"
 
+#include "geom.h"
+
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -14,30 +16,6 @@ constexpr double kPi = 3.14159265358979323846;
 
 double rad(double deg) { return deg * kPi / 180.0; }
 double deg(double r) { return r * 180.0 / kPi; }
-
-int32_t q30(double v)
-{
-    // |v| <= 1 here, so llround(v * 2^30) is in [-2^30, 2^30]: fits Q2.30.
-    return static_cast<int32_t>(std::llround(v * 1073741824.0));
-}
-
-uint32_t uq28(double v)
-{
-    if (!(v > 0.0) || !std::isfinite(v)) {
-        return UINT32_MAX; // 1/cos of an angle >= 90 deg: no finite positive bound
-    }
-    const double s = v * 268435456.0;
-    if (s >= 4294967295.0) {
-        return UINT32_MAX;
-    }
-    return static_cast<uint32_t>(std::llround(s));
-}
-
-uint32_t bam(double d)
-{
-    // Modular int64 -> uint32: two's complement for negative angles; 180 deg wraps to -180.
-    return static_cast<uint32_t>(static_cast<uint64_t>(std::llround(d / 360.0 * 4294967296.0)));
-}
 
 void check_angle(double d, const char *what)
 {
@@ -97,20 +75,7 @@ sl_incline_geom_t make_geom(double theta_deg, double beta_deg)
 {
     check_angle(theta_deg, "theta");
     check_angle(beta_deg, "beta");
-    const double t = rad(theta_deg);
-    const double b = rad(beta_deg);
-    sl_incline_geom_t g{};
-    g.cos_theta_q30 = q30(std::cos(t));
-    g.sin_theta_q30 = q30(std::sin(t));
-    g.cos_beta_q30 = q30(std::cos(b));
-    g.sin_beta_q30 = q30(std::sin(b));
-    g.cos_tb_q30 = q30(std::cos(t + b));
-    g.sin_tb_q30 = q30(std::sin(t + b));
-    g.rho_amb_q28 = uq28(1.0 / std::cos((t + b) / 2.0));
-    g.rho_seam_q28 = uq28(1.0 / std::cos(t + b));
-    g.theta_bam32 = bam(theta_deg);
-    g.beta_bam32 = bam(beta_deg);
-    return g;
+    return slp_geom_make(theta_deg, beta_deg);
 }
 
 double alpha_oracle_deg(double r1, double r2, double theta_deg, double beta_deg, int *flag,

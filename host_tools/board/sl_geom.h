@@ -11,12 +11,8 @@
 
 namespace sl {
 
-/// The geometry entry of one azimuth. Every field is its exact value (computed in double
-/// from theta and beta in radians) rounded ONCE to nearest, ties away from zero (llround):
-///   cos/sin of theta, beta, theta+beta  -> Q30 (x 2^30)
-///   rho_amb = 1/cos((theta+beta)/2), rho_seam = 1/cos(theta+beta) -> UQ4.28 (x 2^28),
-///       saturated to UINT32_MAX when >= 16 or when the cosine is <= 0
-///   theta, beta -> bam32 (x 2^32/360, two's complement for negative angles)
+/// The geometry entry of one azimuth: slp_geom_make() (firmware/port/linux/geom.h, the one
+/// implementation, shared with a vehicle's calibration file) after checking the angles.
 /// Any finite angle in [-180, 180] degrees gives an entry (the core decides whether it is in
 /// its supported domain, sl_incline_geom_ok()); NaN/inf or |angle| > 180 throw
 /// std::domain_error. Pure, thread-safe.

@@ -31,7 +31,7 @@
 ///   outside [1, 60] deg are errors naming the line. The calibrated board is the nominal one
 ///   with these values; each measured azimuth gets its geometry entry, shadow radius
 ///   R = H / tan(theta) and shadow bins computed exactly as sl-tables computes a board's
-///   (slp_calib_make_geom() is the C twin of sl::make_geom, compared bit for bit by a test).
+///   (slp_geom_make(), geom.h: the same function sl::make_geom calls).
 ///
 /// Host/port only (libm, stdio, malloc); not part of the core. Reentrant (no static state).
 #ifndef SHADOWLEAN_PORT_CALIB_FILE_H
@@ -46,9 +46,6 @@
 #ifdef __cplusplus
 extern "C" {
 #endif
-
-/// The geometry entry of theta, beta (degrees): the same rounding as sl::make_geom.
-sl_incline_geom_t slp_calib_make_geom(double theta_deg, double beta_deg);
 
 /// Read `path` (blob or INI) for `nominal` and return a malloc'd blob in `*blob` (`*len`
 /// bytes; free() it). On error returns -1 with a message in `err` (file, line, key) and

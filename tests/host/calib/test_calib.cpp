@@ -21,6 +21,7 @@
 
 #include "calib_elong.h"
 #include "calib_file.h"
+#include "geom.h"
 #include "calib_shadow.h"
 #include "gen_scans.h"
 #include "sl_board_spec.h"
@@ -405,14 +406,15 @@ int check_elong_ini(char **argv)
 
 // The calibration reader (C, calib_file.c: what the daemon runs on a calibration INI) and
 // the board generator (C++, sl::make_geom: what sl-tables runs on a board file) must give
-// the same geometry entry bit for bit, or a calibrated azimuth would differ from a board's.
+// the same geometry entry bit for bit, or a calibrated azimuth would differ from a board's:
+// both call slp_geom_make (geom.h); sl::make_geom adds only the angle checks.
 void test_calib_file_geom_equals_sl_make_geom()
 {
     long n = 0, diff = 0;
     for (double beta : {0.0, 3.0, -5.0, 12.5}) {
         for (int c = 100; c <= 6000; c++) {
             const double theta = c / 100.0;
-            const sl_incline_geom_t a = slp_calib_make_geom(theta, beta);
+            const sl_incline_geom_t a = slp_geom_make(theta, beta);
             const sl_incline_geom_t b = sl::make_geom(theta, beta);
             n++;
             if (std::memcmp(&a, &b, sizeof a) != 0) {
@@ -420,7 +422,7 @@ void test_calib_file_geom_equals_sl_make_geom()
             }
         }
     }
-    std::printf("slp_calib_make_geom vs sl::make_geom: %ld entries, %ld differ\n", n, diff);
+    std::printf("slp_geom_make vs sl::make_geom: %ld entries, %ld differ\n", n, diff);
     CHECK(n == 4 * 5901, "entries %ld", n);
     CHECK(diff == 0, "%ld entries differ", diff);
 }
