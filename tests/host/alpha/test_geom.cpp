@@ -10,18 +10,11 @@
 
 #include "sl_geom.h"
 #include "shadowlean/sl_incline.h"
+#include "check.hpp"
 
 namespace {
 
-int failures = 0;
-
-#define CHECK(cond)                                                                          \
-    do {                                                                                     \
-        if (!(cond)) {                                                                       \
-            std::printf("%s:%d: CHECK failed: %s\n", __FILE__, __LINE__, #cond);             \
-            failures++;                                                                      \
-        }                                                                                    \
-    } while (0)
+using sl_test::failures;
 
 constexpr double kPi = 3.14159265358979323846;
 double rad(double d) { return d * kPi / 180.0; }

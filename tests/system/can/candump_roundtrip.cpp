@@ -18,18 +18,11 @@
 #include <string>
 
 #include "candump_log.h"
+#include "check.hpp"
 
 namespace {
 
-int failures = 0;
-
-#define CHECK(cond)                                                                          \
-    do {                                                                                     \
-        if (!(cond)) {                                                                       \
-            std::cerr << __FILE__ << ":" << __LINE__ << ": CHECK failed: " #cond "\n";       \
-            failures++;                                                                      \
-        }                                                                                    \
-    } while (0)
+using sl_test::failures;
 
 bool same(const sl_can_frame_t &a, const sl_can_frame_t &b)
 {

@@ -9,16 +9,10 @@
 
 #include "can_sink.h"
 #include "socketcan.h"
+#include "check.hpp"
 
 namespace {
-int failures = 0;
-#define CHECK(cond)                                                                          \
-    do {                                                                                     \
-        if (!(cond)) {                                                                       \
-            std::cerr << __FILE__ << ":" << __LINE__ << ": CHECK failed: " #cond "\n";       \
-            failures++;                                                                      \
-        }                                                                                    \
-    } while (0)
+using sl_test::failures;
 } // namespace
 
 int main()

@@ -41,18 +41,11 @@
 #include "candump_log.h"
 #include "sl_board_spec.h"
 #include "shadowlean/sl_can.h"
+#include "check.hpp"
 
 namespace {
 
-int failures = 0;
-
-#define CHECK(cond)                                                                          \
-    do {                                                                                     \
-        if (!(cond)) {                                                                       \
-            std::cerr << __FILE__ << ":" << __LINE__ << ": CHECK failed: " #cond "\n";       \
-            failures++;                                                                      \
-        }                                                                                    \
-    } while (0)
+using sl_test::failures;
 
 uint64_t now_us = 1000000000000ULL; // synthetic clock
 uint64_t tick(uint64_t dt = 1000)
