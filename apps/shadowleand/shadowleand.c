@@ -757,10 +757,12 @@ static void log_stats(daemon_t *d, int level, const char *what)
         const sl_can_e2e_rx_t *e2e = &g_pipe.motion_rx.e2e;
         sld_log(level, "%s: VehicleMotion E2E: %" PRIu32 " accepted, %" PRIu32 " CRC errors, %" PRIu32
                 " repeated, %" PRIu32 " bad counter, %" PRIu32 " bad DLC, %" PRIu32 " counter jumps (%" PRIu32
-                " lost), %" PRIu32 " timeouts, %" PRIu32 " other ids",
+                " lost), %" PRIu32 " timeouts, %" PRIu32 " other ids, %" PRIu32
+                " only synchronising (first after a start or a gap: value unused)",
                 what, e2e->stats.accepted, e2e->stats.crc_errors, e2e->stats.repeated, e2e->stats.bad_counter,
                 e2e->stats.bad_dlc, e2e->stats.counter_jumps, e2e->stats.lost_frames,
-                g_pipe.motion_rx.stats.timeouts, g_pipe.motion_rx.stats.other_ids);
+                g_pipe.motion_rx.stats.timeouts, g_pipe.motion_rx.stats.other_ids,
+                g_pipe.motion_rx.stats.sync_only);
     }
     if (d->exit_undrained != 0) {
         sld_log(SLD_LOG_WARN, "%s: CAN: %" PRIu32 " frames undrained at exit (dropped)", what, d->exit_undrained);

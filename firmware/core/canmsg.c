@@ -712,11 +712,21 @@ sl_err_t sl_can_motion_rx_feed(sl_can_motion_rx_t *rx, const sl_can_frame_t *f, 
     // After a reception gap the counter sequence means nothing: restart it.
     if (rx->e2e.synced && t_us > rx->last_t_us && t_us - rx->last_t_us > rx->timeout_us) {
         sl_can_e2e_rx_reset(&rx->e2e);
+        rx->have_value = false; // stale anyway (sl_can_motion_rx_get), and not renewed by a sync
         rx->stats.timeouts++;
     }
+    const bool checked = rx->e2e.synced; // the counter can be checked against a previous one
     const sl_err_t e = sl_can_e2e_check(&rx->e2e, SL_CAN_DATA_ID_VEHICLE_MOTION, f);
     if (e != SL_OK) {
         return e;
+    }
+    if (!checked) {
+        // First frame since init or a reception gap: nothing to check its counter against,
+        // so a stale or repeated frame would pass as fresh. It only synchronises the
+        // sequence; values are used from the next frame that continues it.
+        rx->last_t_us = t_us;
+        rx->stats.sync_only++;
+        return SL_OK;
     }
     (void)sl_can_decode_vehicle_motion(f, &rx->last); // cannot fail: checked above
     rx->last_t_us = t_us;

@@ -581,6 +581,11 @@ sl_err_t sl_can_decode_pole_tilt(const sl_can_frame_t *f, sl_can_pole_tilt_t *ou
 
 /// VehicleMotion receiver for the motion-aware masks: id match, E2E check (CRC errors and
 /// counter jumps counted in `e2e.stats`), latest accepted value with its time.
+/// The first frame after init or after a reception gap (no accepted frame for `timeout_us`)
+/// has no counter to be checked against: a stale or repeated frame would pass as fresh, so
+/// it only synchronises the sequence (`stats.sync_only`) and its value is not used; values
+/// are used from the next frame that continues the sequence (one frame period later, 20 ms
+/// at the DBC's cycle time). A gap also drops the last value.
 /// Fields read-only to the application.
 typedef struct sl_can_motion_rx {
     uint32_t id_dbc;             ///< expected id, board/DBC style
@@ -592,6 +597,7 @@ typedef struct sl_can_motion_rx {
     struct {
         uint32_t other_ids;      ///< frames with another id (ignored, counted)
         uint32_t timeouts;       ///< sequence resets after a reception gap
+        uint32_t sync_only;      ///< frames that only synchronised the sequence (value unused)
     } stats;
 } sl_can_motion_rx_t;
 
@@ -599,8 +605,9 @@ typedef struct sl_can_motion_rx {
 /// the gap after which the counter sequence restarts. O(1).
 void sl_can_motion_rx_init(sl_can_motion_rx_t *rx, uint32_t id_dbc, uint64_t timeout_us);
 
-/// Feed one received frame at time `t_us`. @return SL_OK (accepted), SL_ERR_ARG (another
-/// id: ignored, counted in stats.other_ids), or the sl_can_e2e_check() error. O(1).
+/// Feed one received frame at time `t_us`. @return SL_OK (accepted: its value used, or, for
+/// the first frame of a sequence, the sequence synchronised), SL_ERR_ARG (another id:
+/// ignored, counted in stats.other_ids), or the sl_can_e2e_check() error. O(1).
 sl_err_t sl_can_motion_rx_feed(sl_can_motion_rx_t *rx, const sl_can_frame_t *f, uint64_t t_us);
 
 /// The latest accepted motion if it is younger than the timeout at `now_us`. O(1).

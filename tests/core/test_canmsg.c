@@ -842,8 +842,15 @@ static void test_canmsg_motion_rx_checks_id_sequence_and_age(void **state)
         sl_can_encode_vehicle_motion(&tx, &in, &f[i]);
     }
     uint64_t t = 1000000;
+    // The first frame only synchronises the sequence: its value is not used.
+    assert_int_equal(sl_can_motion_rx_feed(&rx, &f[9], t - 20000), SL_OK);
+    assert_int_equal(rx.stats.sync_only, 1);
+    assert_false(sl_can_motion_rx_get(&rx, t - 20000, &mv));
+    // The next one continues it (a jump: 9 -> 0 over the modulo 15, frames lost): used.
     assert_int_equal(sl_can_motion_rx_feed(&rx, &f[0], t), SL_OK);
+    assert_int_equal(rx.e2e.stats.counter_jumps, 1);
     assert_true(sl_can_motion_rx_get(&rx, t + 100000, &mv));
+    assert_int_equal(mv.speed_mm_s, 0);
     assert_false(sl_can_motion_rx_get(&rx, t + 100001, &mv));
     // Another id is ignored and counted.
     sl_can_frame_t other = f[1];
@@ -862,20 +869,26 @@ static void test_canmsg_motion_rx_checks_id_sequence_and_age(void **state)
     assert_int_equal(mv.speed_mm_s, 0);
     // Frames 1 and 2 lost: a jump of 2.
     assert_int_equal(sl_can_motion_rx_feed(&rx, &f[3], t + 20000), SL_OK);
-    assert_int_equal(rx.e2e.stats.counter_jumps, 1);
-    assert_int_equal(rx.e2e.stats.lost_frames, 2);
+    assert_int_equal(rx.e2e.stats.counter_jumps, 2);
+    assert_int_equal(rx.e2e.stats.lost_frames, 5 + 2);
     assert_true(sl_can_motion_rx_get(&rx, t + 20000, &mv));
     assert_int_equal(mv.speed_mm_s, 3000);
     assert_int_equal(mv.yaw_rate_cdeg_s, -150);
     assert_true(mv.speed_valid && mv.yaw_rate_valid);
     // Repeat rejected.
     assert_int_equal(sl_can_motion_rx_feed(&rx, &f[3], t + 30000), SL_ERR_STATE);
-    // After a gap longer than the timeout, the sequence restarts: no jump counted.
-    assert_int_equal(sl_can_motion_rx_feed(&rx, &f[9], t + 500000), SL_OK);
+    // After a gap longer than the timeout, the sequence restarts: no jump counted, and the
+    // first frame after the gap (here a stale repetition of frame 3, 3.0 m/s)
+    // only synchronises: never used, whatever its counter.
+    assert_int_equal(sl_can_motion_rx_feed(&rx, &f[3], t + 500000), SL_OK);
     assert_int_equal(rx.stats.timeouts, 1);
-    assert_int_equal(rx.e2e.stats.counter_jumps, 1);
-    assert_true(sl_can_motion_rx_get(&rx, t + 500000, &mv));
-    assert_int_equal(mv.speed_mm_s, 9000);
+    assert_int_equal(rx.stats.sync_only, 2);
+    assert_int_equal(rx.e2e.stats.counter_jumps, 2);
+    assert_false(sl_can_motion_rx_get(&rx, t + 500000, &mv));
+    assert_int_equal(sl_can_motion_rx_feed(&rx, &f[4], t + 520000), SL_OK);
+    assert_true(sl_can_motion_rx_get(&rx, t + 520000, &mv));
+    assert_int_equal(mv.speed_mm_s, 4000);
+    assert_int_equal(rx.e2e.stats.counter_jumps, 2);
 }
 
 int main(void)

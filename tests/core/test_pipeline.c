@@ -1071,7 +1071,12 @@ static void test_pipeline_takes_motion_from_can_and_the_setter(void **state)
     for (int r = 0; r < g_static.rots; r++) {
         const uint64_t now = 1000000U + (uint64_t)r * 250000U;
         if (r == 2) {
-            sl_can_frame_t f = motion_frame(&vtx, 50, 0); // 5 cm/s: n_eff 4
+            // The first frame only synchronises the E2E sequence (its value is not used);
+            // the next one, a bus cycle later, continues it and is used.
+            sl_can_frame_t f = motion_frame(&vtx, 3000, 0);
+            assert_int_equal(sl_pipeline_on_can_rx(&pl, &f, now - 20000U), SL_OK);
+            assert_int_equal(pl.motion_rx.stats.sync_only, 1);
+            f = motion_frame(&vtx, 50, 0); // 5 cm/s: n_eff 4
             assert_int_equal(sl_pipeline_on_can_rx(&pl, &f, now), SL_OK);
             f.data[3] ^= 1U; // corrupted: rejected by the CRC
             assert_int_equal(sl_pipeline_on_can_rx(&pl, &f, now), SL_ERR_MALFORMED);
@@ -1102,7 +1107,7 @@ static void test_pipeline_takes_motion_from_can_and_the_setter(void **state)
     for (int k = 0; k < 10; k++) {
         assert_int_equal(rec.frames_eff[k], want[k]);
     }
-    assert_int_equal(pl.stats.motion_accepted, 2);   // CAN frames only
+    assert_int_equal(pl.stats.motion_accepted, 3);   // CAN frames only (one synchronising)
     assert_int_equal(pl.stats.motion_set_calls, 2);  // the two setter calls
     assert_int_equal(pl.stats.motion_rejected, 1);
     assert_int_equal(pl.motion_rx.stats.other_ids, 1);

@@ -35,14 +35,17 @@ def main(argv):
     db = scd.load_dbc(argv[1])
     fr = next(f for f in db.frames if f.name == "VehicleMotion")
     data_id = int(fr.attributes["SlE2EDataId"])
-    ctr, good = 0, 0
+    ctr, good, last_good = 0, 0, 0
     for line in range(1, 31):
         if line % 10 == 0:
-            print(frame(fr, data_id, "1.0", (ctr - 1) % 15))  # repetition: rejected
+            # repetition of the last good frame's counter: rejected (not ctr - 1, which after
+            # a jump is a forward step the receiver rightly accepts)
+            print(frame(fr, data_id, "1.0", last_good))
         elif line % 3 == 0:
             print(frame(fr, data_id, "1.0", ctr, bad_crc=True))  # bad CRC: rejected
         else:
             print(frame(fr, data_id, "0.05", ctr))
+            last_good = ctr
             good += 1
             ctr = (ctr + (3 if good % 4 == 0 else 1)) % 15  # a counter jump every 4 good frames
     return 0

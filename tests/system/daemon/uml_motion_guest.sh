@@ -3,8 +3,10 @@
 # uml_motion_guest.sh DAEMON CAPTURE MOTION_FRAMES OUTDIR: runs INSIDE user-mode Linux
 # (tests/support/vm/uml_run.sh, vcan0 up). shadowleand replays CAPTURE in real time with --can vcan0
 # (VehicleMotion read from vcan0) while MOTION_FRAMES (motion_fault_frames.py: good frames,
-# bad CRCs, repetitions, counter jumps) go onto vcan0 every 20 ms, from the daemon's first
-# rotation until 4 rotations used the motion input; then the sender stops (a reception
+# bad CRCs, repetitions, counter jumps) go onto vcan0 every 20 ms (canplayer), from the daemon's first
+# rotation until 4 rotations used the motion input AND the whole file (every kind of fault)
+# was sent at least once (a slow guest on a loaded host may need many rotations for one
+# pass: the stop must not depend on how fast cansend runs); then the sender stops (a reception
 # timeout: the window must fall back to the board's n), and 6 rotations later the daemon is
 # stopped with SIGINT (exit 0). Ordering by the daemon's own output files, not by timing.
 set -u
@@ -15,12 +17,24 @@ dpid=$!
 used() { _n=$(grep -c '"motion_valid":true' "$out/motion.jsonl" 2>/dev/null); echo "${_n:-0}"; }
 i=0
 while [ ! -s "$out/motion.jsonl" ] && [ $i -lt 400 ]; do sleep 0.05; i=$((i + 1)); done
+# One pass of the file as a candump log 20 ms apart, replayed by ONE canplayer process per
+# pass: a cansend process per frame is slow enough in a guest on a loaded host to leave
+# gaps beyond the receiver's 500 ms timeout, which restarts the counter sequence (a
+# repetition or a jump after a gap is not one), and the counts asserted on the host would
+# depend on the host's load.
+awk '{ printf "(%d.%06d) vcan0 %s\n", (NR * 20000) / 1000000, (NR * 20000) % 1000000, $1 }' \
+    "$motion" > "$out/motion.pass.log"
+rm -f "$out/motion.pass"
 ( while :; do
-      while read -r f; do cansend vcan0 "$f"; sleep 0.02; done < "$motion"
+      canplayer -I "$out/motion.pass.log"
+      : > "$out/motion.pass"
   done ) &
 sender=$!
 i=0
-while [ "$(used)" -lt 4 ] && [ $i -lt 600 ] && kill -0 $dpid 2>/dev/null; do sleep 0.05; i=$((i + 1)); done
+while { [ "$(used)" -lt 4 ] || [ ! -e "$out/motion.pass" ]; } && [ $i -lt 1800 ] &&
+    kill -0 $dpid 2>/dev/null; do
+    sleep 0.05; i=$((i + 1))
+done
 kill $sender; wait $sender 2>/dev/null
 echo "sender stopped after $(used) rotations with motion"
 # The fallback to static: wait (by the daemon's output, not by time) until 6 more rotations
