@@ -363,6 +363,19 @@ Outcome run_case(const std::string &board_name, const Case &k, bool realistic, i
         (void)sl_pipeline_feed(p.get(), bytes.data(), bytes.size(), now);
     }
     (void)sl_pipeline_finish(p.get(), 1000000ULL + static_cast<uint64_t>(rotations) * 250000ULL);
+    if (dump) { // why a pass has no track: detection's rejections, the tracker, the rings
+        const sl_detect_stats_t &d = p->detect.stats;
+        const sl_track_stats_t &t = p->tracker.stats;
+        const sl_tiltobs_stats_t &o = p->tilt.stats;
+        std::printf("  stats: groups %u targets %u rejected near %u shadow %u wide %u broken %u short %u "
+                    "rho %u weak %u; tracks created %u confirmed %u associated %u inconsistent %u "
+                    "dropped %u; tilt obs %u rejected %u no_target %u\n",
+                    d.groups, d.targets, d.rejected[SL_DETECT_REJ_NEAR], d.rejected[SL_DETECT_REJ_SHADOW],
+                    d.rejected[SL_DETECT_REJ_WIDE], d.rejected[SL_DETECT_REJ_BROKEN],
+                    d.rejected[SL_DETECT_REJ_SHORT], d.rejected[SL_DETECT_REJ_RHO],
+                    d.rejected[SL_DETECT_REJ_WEAK], t.created, t.confirmations, t.associated,
+                    t.inconsistent, t.dropped, o.observations, o.rejected, o.no_target);
+    }
     if (dump && ctx.fitted_ring.track_id != 0U) {
         dump_ring(ctx.fitted_ring, p->tilt.prm, k);
     }
@@ -498,8 +511,9 @@ void usage(FILE *out)
                  "  fitted curve, truth.\n"
                  "  --psi DEG, --phi DEG, --offset M (signed, left +): only the passes of the sweep\n"
                  "  with that value (repeatable; each pass keeps its seed of the whole sweep).\n"
-                 "  --dump: after each pass, the observations behind its result and the fit's interval\n"
-                 "  readings of the fold (double precision), best first.\n"
+                 "  --dump: after each pass, detection's rejections, the tracker's and the rings'\n"
+                 "  counters (why a pass has no track), the observations behind its result and the\n"
+                 "  fit's interval readings of the fold (double precision), best first.\n"
                  "  --obs-log FILE: every new fit of the pole's ring during each pass as one JSON line\n"
                  "  (the case, the observations the fit read as stored, the result).\n");
 }
