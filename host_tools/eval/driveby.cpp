@@ -498,7 +498,8 @@ void usage(FILE *out)
 {
     std::fprintf(out,
                  "usage: sl-eval driveby [--board NAME] [--quick] [--realistic] [--speeds A,B,..]\n"
-                 "                       [--check] [--plot FILE.png]\n"
+                 "                       [--check] [--plot FILE.png] [--psi DEG] [--phi DEG]\n"
+                 "                       [--offset M] [--dump] [--obs-log FILE]\n"
                  "  Simulated drive-bys, one pole per pass, through the core pipeline with the pass's\n"
                  "  speed as motion input; the last FITTED 3D tilt of each pass against the truth.\n"
                  "  Default sweep: speeds 1, 2, 3 m/s; psi 3, 5, 10, 20 deg; phi every 45 deg; offsets\n"
