@@ -374,6 +374,11 @@ static const uint16_t t2_3sigma_q8[SL_TILT_MAX_OBS - SL_TILT_MIN_OBS + 1U] = {
     2892, 2864, 2838, 2815, 2793, 2773, 2755, 2738,
 };
 
+static uint64_t max_u64(uint64_t a, uint64_t b)
+{
+    return (a > b) ? a : b;
+}
+
 #define CDEG_PER_RAD_Q16 375493621LL // 18000 / pi * 2^16
 
 // Radians (Q30, >= 0) -> 0.01 deg, rounded, saturated to `max`.
@@ -643,8 +648,7 @@ sl_err_t sl_tilt_fit(const sl_tilt_obs_t *obs, size_t n, const sl_tilt_params_t 
     // margin in score units: d chi2 = W d(r / det) / sigma_min^2 -> d r = chi2 sigma^2 det / W
     const uint64_t sig2 = (uint64_t)smin * smin; // Q32
     const int64_t per_chi2_q46 = (int64_t)((sig2 * (uint64_t)f.det_q30) / (uint64_t)W);
-    uint64_t window_q8 = (uint64_t)16 * (uint64_t)SL_TILT_AMBIGUITY_CHI2_Q8;
-    window_q8 = (margin_q8 > window_q8) ? margin_q8 : window_q8;
+    const uint64_t window_q8 = max_u64(margin_q8, (uint64_t)16 * (uint64_t)SL_TILT_AMBIGUITY_CHI2_Q8);
     alt.window_q54 = (per_chi2_q46 > 0 && window_q8 > (uint64_t)INT64_MAX / (uint64_t)per_chi2_q46)
                          ? INT64_MAX
                          : per_chi2_q46 * (int64_t)window_q8;
