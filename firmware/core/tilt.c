@@ -367,6 +367,9 @@ static uint32_t chi2_of_score_q8(const fit_ctx_t *f, int64_t r_q54)
 //     f=lambda t,v: m.betainc(v/2.,.5,0,v/(v+t*t),regularized=True)/2-(1-p)
 //     print([int(m.nint(m.findroot(lambda t: f(t,v),(1,300),solver='bisect')**2*256))
 //            for v in range(3,31)])"
+#if SL_TILT_MIN_OBS != 5U || SL_TILT_MAX_OBS != 32U
+#error "t2_3sigma_q8 covers dof 3..30: regenerate it for SL_TILT_MIN_OBS .. SL_TILT_MAX_OBS"
+#endif
 #define T2_DOF_MIN (SL_TILT_MIN_OBS - 2U)
 static const uint16_t t2_3sigma_q8[SL_TILT_MAX_OBS - SL_TILT_MIN_OBS + 1U] = {
     21757, 11220, 7764, 6157, 5253, 4682, 4291, 4008, 3794, 3627,

@@ -34,15 +34,15 @@
 /// bounds, the group's union extent and the azimuth cells add errors that are neither
 /// Gaussian nor independent from one rotation to the next, and a pass's residuals often
 /// exceed the sigmas (the fits of `sl-eval driveby`: chi2 / dof median 1.0, 90th percentile
-/// 1.9, 99th 5.6). A fixed chi-square difference
-/// of 9 then let the mirror win by chance with a margin of 10-17 and say FITTED (issue #12:
-/// psi 7-8 deg for a 20 deg pole). So the chi-square's scale is estimated from the best
-/// fit's residuals, s^2 = max(1, chi2 / dof) (dof = n - 2; the same inflation as the
-/// sigmas), and with a scale estimated from dof residuals the 3-sigma test of the difference
-/// is Student's t: margin = t^2 s^2, t^2 the square of t_dof at the normal's 3-sigma tail
-/// (0.00135): 85.0 at dof 3, 13.2 at 14, 10.7 at 30, tending to SL_TILT_AMBIGUITY_CHI2_Q8 /
-/// 256 = 9. A best fit that is INCONSISTENT is reported as such before the ambiguity (its
-/// scale estimate would call every reading ambiguous).
+/// 1.9, 99th 5.6). A fixed chi-square difference of 9 then let the mirror win by chance
+/// with a margin of 10-17 and say FITTED (issue #12: psi 7-8 deg for a 20 deg pole). So the
+/// chi-square's scale is estimated from the best fit's residuals, s^2 = max(1, chi2 / dof)
+/// (dof = n - 2; the same inflation as the sigmas), and with a scale estimated from dof
+/// residuals the 3-sigma test of the difference is Student's t: margin = t^2 s^2, t^2 the
+/// square of t_dof at the normal's 3-sigma tail (0.00135): 85.0 at dof 3, 13.2 at 14, 10.7
+/// at 30, tending to SL_TILT_AMBIGUITY_CHI2_Q8 / 256 = 9. A best fit that is INCONSISTENT is
+/// reported as such before the ambiguity (its scale estimate would call every reading
+/// ambiguous).
 ///
 /// Position. Each measurement also places the pole: with the fitted in-plane inclination
 /// alpha^ (from (1)) and the inner bound r1, the pole's horizontal distance at radar height
