@@ -361,6 +361,27 @@ static uint32_t chi2_of_score_q8(const fit_ctx_t *f, int64_t r_q54)
     return (c > UINT32_MAX) ? UINT32_MAX : (uint32_t)c;
 }
 
+// t^2 at the normal's 3-sigma point (one-sided tail 0.00135) of Student's t with dof degrees
+// of freedom, Q8, dof = SL_TILT_MIN_OBS - 2 .. SL_TILT_MAX_OBS - 2 (9 = 2304 as dof grows):
+//   python3 -c "import mpmath as m; m.mp.dps=40; p=m.ncdf(3)
+//     f=lambda t,v: m.betainc(v/2.,.5,0,v/(v+t*t),regularized=True)/2-(1-p)
+//     print([int(m.nint(m.findroot(lambda t: f(t,v),(1,300),solver='bisect')**2*256))
+//            for v in range(3,31)])"
+#if SL_TILT_MIN_OBS != 5U || SL_TILT_MAX_OBS != 32U
+#error "t2_3sigma_q8 covers dof 3..30: regenerate it for SL_TILT_MIN_OBS .. SL_TILT_MAX_OBS"
+#endif
+#define T2_DOF_MIN (SL_TILT_MIN_OBS - 2U)
+static const uint16_t t2_3sigma_q8[SL_TILT_MAX_OBS - SL_TILT_MIN_OBS + 1U] = {
+    21757, 11220, 7764, 6157, 5253, 4682, 4291, 4008, 3794, 3627,
+    3494, 3384, 3293, 3216, 3149, 3092, 3042, 2998, 2959, 2924,
+    2892, 2864, 2838, 2815, 2793, 2773, 2755, 2738,
+};
+
+static uint64_t max_u64(uint64_t a, uint64_t b)
+{
+    return (a > b) ? a : b;
+}
+
 #define CDEG_PER_RAD_Q16 375493621LL // 18000 / pi * 2^16
 
 // Radians (Q30, >= 0) -> 0.01 deg, rounded, saturated to `max`.
@@ -608,15 +629,32 @@ sl_err_t sl_tilt_fit(const sl_tilt_obs_t *obs, size_t n, const sl_tilt_params_t 
         best_r = (top.c[c].r_q54 < best_r) ? top.c[c].r_q54 : best_r;
     }
 
-    // Pass 2: the best candidate with a different answer, within a wide window of scores
-    // (chi-square up to 16 x the ambiguity margin above the best).
+    // The ambiguity margin, chi-square units (Q8). The stated sigmas are a floor, not the
+    // whole error: quantised bounds, the union extent and the azimuth cells add errors that are
+    // neither Gaussian nor independent from one rotation to the next. So the scale of the
+    // chi-square is estimated from the best fit's residuals, s^2 = max(1, chi2 / dof) (the same
+    // inflation report() applies to the sigmas), and with a scale estimated from dof residuals
+    // the 3-sigma test of the difference is Student's t with dof degrees of freedom, not the
+    // normal's 9: margin = t^2 s^2 (sl_tilt.h).
+    const uint32_t dof = (uint32_t)n - 2U;
+    uint64_t s2_q8 = (uint64_t)chi2 / dof;
+    s2_q8 = (s2_q8 < 256U) ? 256U : s2_q8;
+    uint64_t margin_q8 = ((uint64_t)t2_3sigma_q8[dof - T2_DOF_MIN] * s2_q8) >> 8;
+    margin_q8 = (margin_q8 > UINT32_MAX) ? UINT32_MAX : margin_q8;
+
+    // Pass 2: the best candidate with a different answer, within a window of scores that
+    // covers the margin (and at least 16 x the normal's 9, so chi2_other says how far the
+    // nearest other reading is).
     alt_search_t alt;
     memset(&alt, 0, sizeof alt);
     alt.best_r_q54 = best_r;
     // margin in score units: d chi2 = W d(r / det) / sigma_min^2 -> d r = chi2 sigma^2 det / W
     const uint64_t sig2 = (uint64_t)smin * smin; // Q32
     const int64_t per_chi2_q46 = (int64_t)((sig2 * (uint64_t)f.det_q30) / (uint64_t)W);
-    alt.window_q54 = per_chi2_q46 * 16 * (SL_TILT_AMBIGUITY_CHI2_Q8 / 256) * 256;
+    const uint64_t window_q8 = max_u64(margin_q8, (uint64_t)16 * (uint64_t)SL_TILT_AMBIGUITY_CHI2_Q8);
+    alt.window_q54 = (per_chi2_q46 > 0 && window_q8 > (uint64_t)INT64_MAX / (uint64_t)per_chi2_q46)
+                         ? INT64_MAX
+                         : per_chi2_q46 * (int64_t)window_q8;
     alt.tx_q24 = tx;
     alt.ty_q24 = ty;
     {
@@ -633,11 +671,13 @@ sl_err_t sl_tilt_fit(const sl_tilt_obs_t *obs, size_t n, const sl_tilt_params_t 
     report(&f, prm, choice, tx, ty, chi2, out);
     const uint32_t best_chi2_fast = chi2_of_score_q8(&f, best_r);
     const bool ambiguous = alt.found &&
-        (out->chi2_other_q8 < best_chi2_fast + (uint32_t)SL_TILT_AMBIGUITY_CHI2_Q8);
-    if (ambiguous) {
-        out->quality = (uint8_t)SL_TILT_AMBIGUOUS;
-    } else if ((uint64_t)chi2 > (uint64_t)SL_TILT_INCONSISTENT_CHI2_Q8 * (n - 2U)) {
+        ((uint64_t)out->chi2_other_q8 < (uint64_t)best_chi2_fast + margin_q8);
+    if ((uint64_t)chi2 > (uint64_t)SL_TILT_INCONSISTENT_CHI2_Q8 * dof) {
+        // Not a straight pole seen as measured (whatever reading of the fold): its scale
+        // estimate would call every reading ambiguous, and that is not what is wrong.
         out->quality = (uint8_t)SL_TILT_INCONSISTENT;
+    } else if (ambiguous) {
+        out->quality = (uint8_t)SL_TILT_AMBIGUOUS;
     } else {
         out->quality = (uint8_t)SL_TILT_FITTED;
     }

@@ -13,6 +13,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <memory>
 #include <string>
 #include <vector>
@@ -51,6 +52,14 @@ struct PlotData {
 struct RunCtx {
     sl_pipeline_t *p = nullptr;
     PlotData *plot = nullptr;
+    // --dump: every ring as of the previous rotation (what the fit read at the end of it),
+    // and the one behind the pass's reported result.
+    bool dump = false;
+    sl_tiltobs_ring_t prev[SL_CFG_TILT_TRACKS]{};
+    sl_tiltobs_ring_t fitted_ring{};
+    FILE *obs_log = nullptr; // --obs-log: every new fit of the pole's ring, one JSON line
+    const Case *kase = nullptr;
+    sl_tilt_result_t logged[SL_CFG_TILT_TRACKS]{};
     double want_y = 0; // truth base offset, vehicle frame
     Outcome last;      // last FITTED (or, failing that, last AMBIGUOUS) result
     int other_q = -1;  // last quality of the fullest ring (INSUFFICIENT_MOTION, TOO_FEW, ...)
@@ -69,10 +78,55 @@ const char *quality_name(int q)
     }
 }
 
+// --obs-log: one JSON line per new fit of a ring placed within 1 m of the pole: the case,
+// the observations the fit read (the ring as of the previous rotation) and the result.
+void log_fits(RunCtx *c)
+{
+    const sl_tiltobs_t *t = &c->p->tilt;
+    for (size_t i = 0; i < SL_CFG_TILT_TRACKS; ++i) {
+        const sl_tiltobs_ring_t &ring = t->ring[i];
+        sl_tiltobs_vehicle_t v;
+        if (ring.track_id == 0U || !sl_tiltobs_vehicle(t, &ring, &v) ||
+            std::memcmp(&ring.res, &c->logged[i], sizeof ring.res) == 0) {
+            continue;
+        }
+        c->logged[i] = ring.res;
+        if (ring.res.n_obs < SL_TILT_MIN_OBS || std::fabs(v.base_y_um * 1e-6 - c->want_y) > 1.0) {
+            continue;
+        }
+        const sl_tiltobs_ring_t &pr = c->prev[i];
+        if (pr.track_id != ring.track_id || pr.count != ring.res.n_obs) {
+            continue; // not the observations this fit read
+        }
+        std::vector<sl_tilt_obs_t> obs(pr.obs, pr.obs + pr.count);
+        if (pr.count == SL_CFG_TILT_OBS_PER_TRACK) {
+            std::rotate(obs.begin(), obs.begin() + pr.head, obs.end());
+        }
+        const Case &k = *c->kase;
+        std::fprintf(c->obs_log,
+                     "{\"v\":%.1f,\"psi\":%.1f,\"phi\":%.1f,\"off\":%.1f,\"q\":%d,"
+                     "\"psi_fit\":%.2f,\"phi_fit\":%.2f,\"chi2\":%.3f,\"other\":%.3f,\"mask\":%u,"
+                     "\"obs\":[",
+                     k.speed, k.psi, k.phi_v, k.offset, v.quality, v.psi_cdeg / 100.0,
+                     v.phi_cdeg / 100.0, ring.res.chi2_q8 / 256.0, ring.res.chi2_other_q8 / 256.0,
+                     ring.res.mirrored_mask);
+        for (size_t j = 0; j < obs.size(); ++j) {
+            const sl_tilt_obs_t &o = obs[j];
+            std::fprintf(c->obs_log, "%s[%d,%d,%u,%d,%d,%d,%d,%u,%u]", j ? "," : "", o.radar_x_um,
+                         o.radar_y_um, o.r1_um, o.cos_a_q15, o.sin_a_q15, o.tan_q12,
+                         o.tan_mirror_q12, o.sigma_q16, o.mirrorable);
+        }
+        std::fprintf(c->obs_log, "]}\n");
+    }
+}
+
 void on_rotation(void *ctx, const sl_pipeline_rotation_t *r)
 {
     auto *c = static_cast<RunCtx *>(ctx);
     const sl_tiltobs_t *t = &c->p->tilt;
+    if (c->obs_log != nullptr) {
+        log_fits(c);
+    }
     // The ring nearest to the pole's true lateral offset (one pole per pass).
     const sl_tiltobs_ring_t *best = nullptr;
     sl_tiltobs_vehicle_t bv{};
@@ -97,6 +151,9 @@ void on_rotation(void *ctx, const sl_pipeline_rotation_t *r)
         }
     }
     if (best == nullptr || be > 1.0) {
+        if (c->dump || c->obs_log != nullptr) {
+            std::copy(std::begin(t->ring), std::end(t->ring), std::begin(c->prev));
+        }
         return;
     }
     Outcome o;
@@ -114,6 +171,110 @@ void on_rotation(void *ctx, const sl_pipeline_rotation_t *r)
             c->plot->have = true;
             c->plot->ring = *best;
         }
+        if (c->dump) { // the observations the fit read: the ring as of the previous rotation
+            const auto idx = static_cast<size_t>(best - &t->ring[0]);
+            c->fitted_ring = c->prev[idx];
+            c->fitted_ring.res = best->res;
+        }
+    }
+    if (c->dump || c->obs_log != nullptr) {
+        std::copy(std::begin(t->ring), std::end(t->ring), std::begin(c->prev));
+    }
+}
+
+// --dump: the observations behind a pass's result and every interval reading of the fold,
+// solved in double (sl_tilt.h's estimator: weights (sigma_min / sigma)^2, chi-square with
+// the stated sigmas), best first; and the fixed-point fit re-run on them.
+void dump_ring(const sl_tiltobs_ring_t &r, const sl_tilt_params_t &prm, const Case &kc)
+{
+    const double ttrue = std::tan(kc.psi * M_PI / 180), ptrue = kc.phi_v * M_PI / 180;
+    const unsigned n = r.count;
+    std::vector<sl_tilt_obs_t> obs(r.obs, r.obs + n); // ring order: oldest at head when full
+    if (n == SL_CFG_TILT_OBS_PER_TRACK) {
+        std::rotate(obs.begin(), obs.begin() + r.head, obs.end());
+    }
+    sl_tilt_work_t wk;
+    sl_tilt_result_t re;
+    (void)sl_tilt_fit(obs.data(), obs.size(), &prm, &wk, &re);
+    std::printf("  dump: %u obs; reported q %d psi %.2f phi %.2f chi2 %.2f other %.2f mask %08x; "
+                "re-fit q %d psi %.2f phi %.2f chi2 %.2f other %.2f mask %08x%s\n",
+                n, r.res.quality, r.res.psi_cdeg / 100.0, r.res.phi_cdeg / 100.0,
+                r.res.chi2_q8 / 256.0, r.res.chi2_other_q8 / 256.0, r.res.mirrored_mask,
+                re.quality, re.psi_cdeg / 100.0, re.phi_cdeg / 100.0, re.chi2_q8 / 256.0,
+                re.chi2_other_q8 / 256.0, re.mirrored_mask,
+                (re.tx_q24 == r.res.tx_q24 && re.ty_q24 == r.res.ty_q24) ? " (same)" : " (DIFFERS)");
+    std::vector<double> a(n), t0(n), t1(n), sg(n);
+    std::vector<int> mir(n);
+    for (unsigned k = 0; k < n; ++k) {
+        const sl_tilt_obs_t &o = obs[k];
+        a[k] = std::atan2(o.sin_a_q15, o.cos_a_q15);
+        t0[k] = o.tan_q12 / 4096.0;
+        t1[k] = o.tan_mirror_q12 / 4096.0;
+        sg[k] = o.sigma_q16 / 65536.0;
+        mir[k] = o.mirrorable;
+        std::printf("  obs %2u: radar (%8.3f, %8.3f) m bearing %8.3f deg r1 %6.3f m alpha %7.3f "
+                    "mirror %7.3f sigma %6.3f deg m%d true %7.3f {%d,%d,%u,%d,%d,%d,%d,%u,%u},\n",
+                    k, o.radar_x_um * 1e-6, o.radar_y_um * 1e-6, a[k] * 180 / M_PI, o.r1_um * 1e-6,
+                    std::atan(t0[k]) * 180 / M_PI, std::atan(t1[k]) * 180 / M_PI,
+                    sg[k] / (1 + t0[k] * t0[k]) * 180 / M_PI, o.mirrorable,
+                    -std::atan(ttrue * std::cos(a[k] - ptrue)) * 180 / M_PI,
+                    o.radar_x_um, o.radar_y_um, o.r1_um, o.cos_a_q15, o.sin_a_q15, o.tan_q12,
+                    o.tan_mirror_q12, o.sigma_q16, o.mirrorable);
+    }
+    double w0 = 1e300;
+    for (unsigned k = 0; k < n; ++k) {
+        w0 = std::min(w0, sg[k]);
+    }
+    std::vector<unsigned> ord;
+    double mc = 0, ms = 0;
+    for (unsigned k = 0; k < n; ++k) {
+        if (mir[k] != 0) {
+            ord.push_back(k);
+            mc += std::cos(a[k]);
+            ms += std::sin(a[k]);
+        }
+    }
+    const double ref = std::atan2(ms, mc);
+    std::stable_sort(ord.begin(), ord.end(), [&](unsigned x, unsigned y) {
+        return std::remainder(a[x] - ref, 2 * M_PI) < std::remainder(a[y] - ref, 2 * M_PI);
+    });
+    struct Cand {
+        uint64_t ch;
+        double tx, ty, x2;
+    };
+    std::vector<Cand> cs;
+    const size_t m = ord.size();
+    for (size_t len = 0; len <= m; ++len) {
+        const size_t starts = (len == 0 || len == m) ? 1 : m;
+        for (size_t i = 0; i < starts; ++i) {
+            uint64_t ch = 0;
+            for (size_t j = 0; j < len; ++j) {
+                ch |= uint64_t{1} << ord[(i + j) % m];
+            }
+            double A = 0, B = 0, C = 0, U = 0, V = 0;
+            for (unsigned k = 0; k < n; ++k) {
+                const double w = (w0 / sg[k]) * (w0 / sg[k]);
+                const double cc = std::cos(a[k]), ss = std::sin(a[k]);
+                const double tt = ((ch >> k) & 1U) ? t1[k] : t0[k];
+                A += w * cc * cc; B += w * cc * ss; C += w * ss * ss; U += w * cc * tt; V += w * ss * tt;
+            }
+            const double det = A * C - B * B;
+            const double tx = -(C * U - B * V) / det, ty = -(A * V - B * U) / det;
+            double x2 = 0;
+            for (unsigned k = 0; k < n; ++k) {
+                const double tt = ((ch >> k) & 1U) ? t1[k] : t0[k];
+                const double res = (tt + tx * std::cos(a[k]) + ty * std::sin(a[k])) / sg[k];
+                x2 += res * res;
+            }
+            cs.push_back({ch, tx, ty, x2});
+        }
+    }
+    std::sort(cs.begin(), cs.end(), [](const Cand &x, const Cand &y) { return x.x2 < y.x2; });
+    for (size_t i = 0; i < cs.size() && i < 12; ++i) {
+        std::printf("  cand mask %08llx chi2 %9.2f psi %6.2f phi %7.1f\n",
+                    static_cast<unsigned long long>(cs[i].ch), cs[i].x2,
+                    std::atan(std::hypot(cs[i].tx, cs[i].ty)) * 180 / M_PI,
+                    std::atan2(cs[i].ty, cs[i].tx) * 180 / M_PI);
     }
 }
 
@@ -155,7 +316,7 @@ std::string scene_text(const std::string &board, const Case &k, bool realistic, 
 }
 
 Outcome run_case(const std::string &board_name, const Case &k, bool realistic, int seed,
-                 PlotData *plot = nullptr)
+                 PlotData *plot = nullptr, bool dump = false, FILE *obs_log = nullptr)
 {
     int rotations = 0;
     const sl::Scene scene =
@@ -170,6 +331,9 @@ Outcome run_case(const std::string &board_name, const Case &k, bool realistic, i
     ctx.p = p.get();
     ctx.want_y = k.offset;
     ctx.plot = plot;
+    ctx.dump = dump;
+    ctx.obs_log = obs_log;
+    ctx.kase = &k;
     if (plot != nullptr) {
         plot->H = b->radar_height_um * 1e-6;
     }
@@ -199,6 +363,22 @@ Outcome run_case(const std::string &board_name, const Case &k, bool realistic, i
         (void)sl_pipeline_feed(p.get(), bytes.data(), bytes.size(), now);
     }
     (void)sl_pipeline_finish(p.get(), 1000000ULL + static_cast<uint64_t>(rotations) * 250000ULL);
+    if (dump) { // why a pass has no track: detection's rejections, the tracker, the rings
+        const sl_detect_stats_t &d = p->detect.stats;
+        const sl_track_stats_t &t = p->tracker.stats;
+        const sl_tiltobs_stats_t &o = p->tilt.stats;
+        std::printf("  stats: groups %u targets %u rejected near %u shadow %u wide %u broken %u short %u "
+                    "rho %u weak %u; tracks created %u confirmed %u associated %u inconsistent %u "
+                    "dropped %u; tilt obs %u rejected %u no_target %u\n",
+                    d.groups, d.targets, d.rejected[SL_DETECT_REJ_NEAR], d.rejected[SL_DETECT_REJ_SHADOW],
+                    d.rejected[SL_DETECT_REJ_WIDE], d.rejected[SL_DETECT_REJ_BROKEN],
+                    d.rejected[SL_DETECT_REJ_SHORT], d.rejected[SL_DETECT_REJ_RHO],
+                    d.rejected[SL_DETECT_REJ_WEAK], t.created, t.confirmations, t.associated,
+                    t.inconsistent, t.dropped, o.observations, o.rejected, o.no_target);
+    }
+    if (dump && ctx.fitted_ring.track_id != 0U) {
+        dump_ring(ctx.fitted_ring, p->tilt.prm, k);
+    }
     if (ctx.last.quality >= 0) {
         return ctx.last;
     }
@@ -318,7 +498,8 @@ void usage(FILE *out)
 {
     std::fprintf(out,
                  "usage: sl-eval driveby [--board NAME] [--quick] [--realistic] [--speeds A,B,..]\n"
-                 "                       [--check] [--plot FILE.png]\n"
+                 "                       [--check] [--plot FILE.png] [--psi DEG] [--phi DEG]\n"
+                 "                       [--offset M] [--dump] [--obs-log FILE]\n"
                  "  Simulated drive-bys, one pole per pass, through the core pipeline with the pass's\n"
                  "  speed as motion input; the last FITTED 3D tilt of each pass against the truth.\n"
                  "  Default sweep: speeds 1, 2, 3 m/s; psi 3, 5, 10, 20 deg; phi every 45 deg; offsets\n"
@@ -328,7 +509,14 @@ void usage(FILE *out)
                  "  bounds (1 deg / 10 deg noise-free; 2 deg / 20 deg with --realistic).\n"
                  "  --plot FILE.png: instead of the sweep, one pass (1 m/s, a pole 3 m left of the\n"
                  "  path leaning 15 deg away from it: beyond the fold) drawn as alpha(y): measured,\n"
-                 "  fitted curve, truth.\n");
+                 "  fitted curve, truth.\n"
+                 "  --psi DEG, --phi DEG, --offset M (signed, left +): only the passes of the sweep\n"
+                 "  with that value (repeatable; each pass keeps its seed of the whole sweep).\n"
+                 "  --dump: after each pass, detection's rejections, the tracker's and the rings'\n"
+                 "  counters (why a pass has no track), the observations behind its result and the\n"
+                 "  fit's interval readings of the fold (double precision), best first.\n"
+                 "  --obs-log FILE: every new fit of the pole's ring during each pass as one JSON line\n"
+                 "  (the case, the observations the fit read as stored, the result).\n");
 }
 
 } // namespace
@@ -339,6 +527,14 @@ int cmd_driveby(int argc, char **argv)
     bool quick = false, realistic = false, check = false;
     std::string plot;
     std::vector<double> speeds = {1.0, 2.0, 3.0};
+    std::vector<double> only_psi, only_phi, only_off;
+    bool dump = false;
+    std::string obs_log_path;
+    auto num = [](const char *s, double *v) {
+        char *end = nullptr;
+        *v = std::strtod(s, &end);
+        return end != s && *end == '\0';
+    };
     for (int i = 0; i < argc; ++i) {
         const std::string a = argv[i];
         if (a == "--board" && i + 1 < argc) {
@@ -351,6 +547,16 @@ int cmd_driveby(int argc, char **argv)
             check = true;
         } else if (a == "--plot" && i + 1 < argc) {
             plot = argv[++i];
+        } else if (a == "--obs-log" && i + 1 < argc) {
+            obs_log_path = argv[++i];
+        } else if (a == "--dump") {
+            dump = true;
+        } else if ((a == "--psi" || a == "--phi" || a == "--offset") && i + 1 < argc) {
+            double v = 0;
+            if (!num(argv[++i], &v)) {
+                return sl_cli_bad_value("sl-eval", a.c_str(), "must be a number", usage);
+            }
+            (a == "--psi" ? only_psi : a == "--phi" ? only_phi : only_off).push_back(v);
         } else if (a == "--speeds" && i + 1 < argc) {
             speeds.clear();
             for (const char *s = argv[++i]; *s != '\0';) {
@@ -383,6 +589,11 @@ int cmd_driveby(int argc, char **argv)
                     quality_name(o.quality), o.psi, o.phi);
         return 0;
     }
+    FILE *obs_log = nullptr;
+    if (!obs_log_path.empty() && (obs_log = std::fopen(obs_log_path.c_str(), "w")) == nullptr) {
+        std::fprintf(stderr, "sl-eval: cannot write %s\n", obs_log_path.c_str());
+        return 1;
+    }
     std::vector<double> psis = {3.0, 5.0, 10.0, 20.0}, offsets = {2.0, 3.0, 4.0};
     double phi_step = 45.0;
     if (quick) {
@@ -408,7 +619,16 @@ int cmd_driveby(int argc, char **argv)
                 for (double off : offsets) {
                     for (int side = -1; side <= 1; side += 2) {
                         const Case k{v, psi, phi, side * off};
-                        const Outcome o = run_case(board, k, realistic, seed++);
+                        auto picked = [](const std::vector<double> &only, double x) {
+                            return only.empty() || std::any_of(only.begin(), only.end(), [x](double y) {
+                                       return std::fabs(x - y) < 1e-6;
+                                   });
+                        };
+                        const int pass_seed = seed++;
+                        if (!picked(only_psi, psi) || !picked(only_phi, phi) || !picked(only_off, k.offset)) {
+                            continue;
+                        }
+                        const Outcome o = run_case(board, k, realistic, pass_seed, nullptr, dump, obs_log);
                         ++n;
                         const double e_psi = o.psi - psi, e_phi = wrap180(o.phi - phi);
                         const double e_off = o.base_y - k.offset;
@@ -440,5 +660,8 @@ int cmd_driveby(int argc, char **argv)
     std::printf("driveby: %d passes, %d FITTED, %d AMBIGUOUS; psi >= 5: %d of %d within bounds; "
                 "max |err| of FITTED: psi %.2f deg, phi %.1f deg, offset %.2f m\n",
                 n, n_fitted, n_amb, n_ok, n_check, max_psi, max_phi, max_off);
+    if (obs_log != nullptr) {
+        std::fclose(obs_log);
+    }
     return (check && n_ok != n_check) ? 1 : 0;
 }

@@ -61,7 +61,12 @@ void usage(FILE *out)
                  "      --scene, or the options); --calibration: on the board's calibrated view (a vehicle's\n"
                  "      INI or blob).\n"
                  "  sl-eval driveby [--board NAME] [--quick] [--realistic] [--speeds A,B] [--check]\n"
+                 "                  [--plot FILE.png] [--psi DEG] [--phi DEG] [--offset M] [--dump]\n"
+                 "                  [--obs-log FILE]\n"
                  "      3D tilt (psi, phi, base offset) fitted over simulated drive-bys against the truth.\n"
+                 "      --psi/--phi/--offset (repeatable): only those passes of the sweep; --dump: per pass\n"
+                 "      the rejection counters, the observations behind the result and the fold's\n"
+                 "      interval readings; --obs-log: every fit of the pass as one JSON line.\n"
                  "Progress goes to stderr when it is a terminal; -q/--quiet silences it.\n");
 }
 

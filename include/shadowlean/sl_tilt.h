@@ -27,8 +27,22 @@
 /// SL_TILT_TOP_K of them exactly from the measurements and keeps the smallest chi-square.
 /// Over a pass the true tilt traces a sinusoid in bearing and its mirror does not, so the
 /// residuals separate them; when another candidate with a different answer (|t - t'| >
-/// max(0.035, 0.3 |t|)) fits within SL_TILT_AMBIGUITY_CHI2_Q8 / 256 of the best, the best is
-/// reported with quality SL_TILT_AMBIGUOUS: never a confident wrong direction.
+/// max(0.035, 0.3 |t|)) fits within the ambiguity margin of the best, the best is reported
+/// with quality SL_TILT_AMBIGUOUS: never a confident wrong direction.
+///
+/// The ambiguity margin. The stated sigmas are a floor, not the whole error: quantised range
+/// bounds, the group's union extent and the azimuth cells add errors that are neither
+/// Gaussian nor independent from one rotation to the next, and a pass's residuals often
+/// exceed the sigmas (the fits of `sl-eval driveby`: chi2 / dof median 1.0, 90th percentile
+/// 1.9, 99th 5.6). A fixed chi-square difference of 9 then let the mirror win by chance
+/// with a margin of 10-17 and say FITTED (issue #12: psi 7-8 deg for a 20 deg pole). So the
+/// chi-square's scale is estimated from the best fit's residuals, s^2 = max(1, chi2 / dof)
+/// (dof = n - 2; the same inflation as the sigmas), and with a scale estimated from dof
+/// residuals the 3-sigma test of the difference is Student's t: margin = t^2 s^2, t^2 the
+/// square of t_dof at the normal's 3-sigma tail (0.00135): 85.0 at dof 3, 13.2 at 14, 10.7
+/// at 30, tending to SL_TILT_AMBIGUITY_CHI2_Q8 / 256 = 9. A best fit that is INCONSISTENT is
+/// reported as such before the ambiguity (its scale estimate would call every reading
+/// ambiguous).
 ///
 /// Position. Each measurement also places the pole: with the fitted in-plane inclination
 /// alpha^ (from (1)) and the inner bound r1, the pole's horizontal distance at radar height
@@ -81,7 +95,9 @@ extern "C" {
 /// sin^2(3 deg) = 0.00274 (Q30: 2,941,974). Below it: SL_TILT_INSUFFICIENT_MOTION.
 #define SL_TILT_MIN_SPREAD_Q30 2941974
 /// Two hypotheses are told apart when their chi-square values differ by at least 9
-/// (3 sigma), Q8.
+/// (3 sigma) with known sigmas, Q8: the large-dof limit of the ambiguity margin (file
+/// comment, "The ambiguity margin"); 16 x this is the smallest window searched for
+/// `chi2_other_q8`.
 #define SL_TILT_AMBIGUITY_CHI2_Q8 (9 * 256)
 /// A fit whose chi-square per degree of freedom exceeds 25 (residuals 5x the stated
 /// sigmas) is reported as SL_TILT_INCONSISTENT (not a straight pole, a wrong association,
@@ -162,7 +178,8 @@ typedef struct sl_tilt_result {
     int32_t base_x_um;        ///< pole base on the ground, odometry frame
     int32_t base_y_um;
     uint32_t chi2_q8;         ///< chi-square of the reported fit, Q8
-    uint32_t chi2_other_q8;   ///< chi-square of the other hypothesis (== chi2_q8 if none)
+    uint32_t chi2_other_q8;   ///< chi-square of the other hypothesis (UINT32_MAX if none
+                              ///< within max(16 x 9, the ambiguity margin) of the best)
 } sl_tilt_result_t;
 
 /// Fits tilt, direction and base to `n` measurements (any order). `n` <= SL_TILT_MAX_OBS.

@@ -184,8 +184,9 @@ static void truth(const pole_t *p, double v, double w, int rotations, double *ph
 }
 
 // The fold test with the firmware's 16-observation rings: AMBIGUOUS (right answer, flagged)
-// is accepted for at most two of its four poles (the ring then holds only the half pass after
-// the pole; the value must still be within the bounds). The alpha sigmas are the model's for the
+// is accepted for at most three of its four poles (the ring then holds only the half pass
+// after the pole, 14 degrees of freedom: the mirror's chi-square must exceed the best's by
+// t^2 = 13.2, not 9, sl_tilt.h; the value must still be within the bounds). The alpha sigmas are the model's for the
 // union bounds (0.6-1.2 deg near the fold on paper-sim), no longer a fixed 0.5 deg.
 static int ambiguous_ok;
 static int ambiguous_seen;
@@ -265,7 +266,7 @@ static void test_leaning_away_beyond_the_fold(void **state)
         }
     }
     ambiguous_ok = 0;
-    assert_true(ambiguous_seen <= 2);
+    assert_true(ambiguous_seen <= 3);
 }
 
 static void test_curved_path_10_deg_per_second(void **state)
