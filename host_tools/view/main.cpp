@@ -607,7 +607,7 @@ public:
             return 1;
         }
         // --rotation K: the shot kept (K >= 0) or the oldest of the ring of the last -K.
-        Shot &s = a_.rotation >= 0 ? ring_.front() : ring_[ring_next_ % ring_.size()];
+        Shot &s = a_.rotation >= 0 ? ring_.front() : ring_[ring_next_ % ring_cap_];
         count_ = N;
         if (!prepare(meta)) {
             return report();
@@ -650,7 +650,9 @@ private:
             return false;
         }
         if (!a_.all) {
-            ring_.resize(a_.rotation >= 0 ? 1U : static_cast<size_t>(-static_cast<long long>(a_.rotation)));
+            // The ring grows to -K as rotations arrive (a K beyond the capture costs nothing).
+            ring_cap_ = a_.rotation >= 0 ? 1U : static_cast<size_t>(-static_cast<long long>(a_.rotation));
+            ring_.resize(1);
         }
         std::vector<sl::RadarFrame> held;
         held.swap(window_);
@@ -726,7 +728,11 @@ private:
         if (a_.rotation >= 0 && k > a_.rotation) {
             return true; // after the rotation drawn: only counted
         }
-        Shot &s = a_.rotation >= 0 ? ring_.front() : ring_[ring_next_++ % ring_.size()];
+        const size_t slot = a_.rotation >= 0 ? 0U : ring_next_++ % ring_cap_;
+        if (slot >= ring_.size()) {
+            ring_.emplace_back();
+        }
+        Shot &s = ring_[slot];
         s.index = k;
         core_.step(fr, s.targets);
         if (a_.rotation < 0 || k == a_.rotation) {
@@ -843,8 +849,8 @@ private:
     std::vector<sl::RadarFrame> window_;
     sl::RadarFrame first_;
     CoreRun core_;
-    std::vector<Shot> ring_;
-    size_t ring_next_ = 0;
+    std::vector<Shot> ring_;   ///< --rotation K >= 0: rotation K; K < 0: the last -K
+    size_t ring_cap_ = 1, ring_next_ = 0;
     cv::VideoWriter vw_;
     std::string video_path_, video_note_;
     int written_ = 0;
