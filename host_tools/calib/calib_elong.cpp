@@ -3,6 +3,7 @@
 #include "calib_elong.h"
 
 #include <algorithm>
+#include <climits>
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -46,9 +47,154 @@ std::vector<Run> runs_of(const uint32_t *bits, int bins, int gap)
 
 } // namespace
 
-ElongMeasurement measure_elongation(const FrameSet &fs, const ElongTruth &t,
-                                    const ElongOptions &opt)
+struct ElongStream::Pos {
+    ElongTruth t;
+    int frames = 0, mask_n = 0;
+    bool closed = false, mask_failed = false;
+    std::unique_ptr<sl_mask_t> mask;            ///< while the position's rotations arrive
+    std::vector<std::vector<uint32_t>> held;    ///< thresholded rows of its first rotations
+    std::vector<std::vector<uint8_t>> held_flags; ///< (until the mask's n is known)
+    std::vector<int> rows_az;                   ///< the azimuths searched, in search order,
+    std::vector<std::vector<uint32_t>> rows;    ///< and their stable rows (empty: none)
+};
+
+ElongStream::ElongStream(const std::vector<ElongTruth> &positions, const ElongOptions &opt) : opt_(opt)
 {
+    for (const ElongTruth &t : positions) {
+        pos_.push_back(std::make_unique<Pos>());
+        pos_.back()->t = t;
+    }
+}
+
+ElongStream::~ElongStream() = default;
+
+namespace {
+
+/// n = min(mask_frames, rotations of the position), within the mask's limits.
+int mask_n_for(int mask_frames, int frames)
+{
+    return std::clamp(std::min(mask_frames, frames), 1, SL_CFG_MASK_FRAMES_MAX);
+}
+
+void apply_rows(sl_mask_t *mask, const std::vector<uint32_t> &bits, const std::vector<uint8_t> &flags,
+                int azimuths)
+{
+    for (int az = 0; az < azimuths; az++) {
+        if (!(flags[static_cast<size_t>(az)] & SL_SCAN_AZ_VALID)) {
+            continue;
+        }
+        (void)sl_mask_update(mask, static_cast<uint16_t>(az), bits.data() + static_cast<size_t>(az) * SL_ROI_WORDS,
+                             nullptr, nullptr);
+    }
+    sl_mask_end_rotation(mask);
+}
+
+} // namespace
+
+void ElongStream::start_mask(Pos &p, int n)
+{
+    p.mask_n = n;
+    p.mask = std::make_unique<sl_mask_t>();
+    if (sl_mask_init(p.mask.get(), static_cast<uint16_t>(azimuths_), static_cast<uint16_t>(bins_),
+                     static_cast<uint8_t>(n), SL_MASK_MAX_MISSED_DEFAULT) != SL_OK) {
+        p.mask_failed = true;
+        p.mask.reset();
+    }
+    for (size_t i = 0; i < p.held.size() && p.mask; i++) {
+        apply_rows(p.mask.get(), p.held[i], p.held_flags[i], azimuths_);
+    }
+    p.held.clear();
+    p.held_flags.clear();
+}
+
+void ElongStream::close(Pos &p)
+{
+    p.closed = true;
+    if (p.frames == 0) {
+        return;
+    }
+    if (!p.mask && !p.mask_failed) {
+        start_mask(p, mask_n_for(opt_.mask_frames, p.frames));
+    }
+    if (!p.mask) {
+        return;
+    }
+    // The stable rows of the azimuths allowed by the truth (all when it has none).
+    std::vector<uint32_t> occ(SL_ROI_WORDS);
+    for (int j = 0; j < azimuths_; j++) {
+        int az = j;
+        if (p.t.az >= 0) {
+            if (j > 2 * opt_.az_search) {
+                break;
+            }
+            az = ((p.t.az - opt_.az_search + j) % azimuths_ + azimuths_) % azimuths_;
+        }
+        p.rows_az.push_back(az);
+        p.rows.emplace_back();
+        if (sl_mask_stable(p.mask.get(), static_cast<uint16_t>(az), occ.data(), nullptr)) {
+            p.rows.back() = occ;
+        }
+    }
+    p.mask.reset();
+}
+
+void ElongStream::add(const RadarFrame &f, int azimuths)
+{
+    azimuths_ = azimuths;
+    bins_ = f.power.cols;
+    const int rot = static_cast<int>(f.rotation);
+    bool thresholded = false;
+    for (auto &pp : pos_) {
+        Pos &p = *pp;
+        if (p.closed || rot < p.t.rot_first) {
+            continue;
+        }
+        if (rot > p.t.rot_last) { // rotations arrive in order: the position is complete
+            close(p);
+            continue;
+        }
+        if (!thresholded) {
+            bits_.assign(static_cast<size_t>(azimuths) * SL_ROI_WORDS, 0);
+            for (int az = 0; az < azimuths; az++) {
+                if (f.flags[static_cast<size_t>(az)] & SL_SCAN_AZ_VALID) {
+                    sl_thresh_u8(f.power.ptr<uint8_t>(az), static_cast<uint32_t>(bins_),
+                                 static_cast<uint16_t>(opt_.threshold),
+                                 bits_.data() + static_cast<size_t>(az) * SL_ROI_WORDS);
+                }
+            }
+            thresholded = true;
+        }
+        p.frames++;
+        if (p.mask) {
+            apply_rows(p.mask.get(), bits_, f.flags, azimuths);
+        } else if (!p.mask_failed) {
+            p.held.push_back(bits_);
+            p.held_flags.push_back(f.flags);
+            // Once the position has mask_frames rotations, n is known: no more holding back.
+            const int cap = mask_n_for(opt_.mask_frames, INT_MAX);
+            if (p.frames >= cap) {
+                start_mask(p, cap);
+            }
+        }
+    }
+}
+
+std::vector<ElongMeasurement> ElongStream::finish(const FrameSet &fs, const ElongOptions &opt)
+{
+    std::vector<ElongMeasurement> out;
+    for (auto &pp : pos_) {
+        Pos &p = *pp;
+        if (!p.closed) {
+            close(p);
+        }
+        out.push_back(measure(p, fs, opt));
+    }
+    return out;
+}
+
+ElongMeasurement ElongStream::measure(const Pos &p, const FrameSet &fs, const ElongOptions &opt)
+{
+    const ElongTruth &t = p.t;
     ElongMeasurement m;
     m.capture = fs.source;
     m.label = t.label;
@@ -56,38 +202,18 @@ ElongMeasurement measure_elongation(const FrameSet &fs, const ElongTruth &t,
     m.rot_last = t.rot_last;
     m.r1_true_m = t.r1_true_m;
     m.r2_true_m = t.r2_true_m;
-    const int A = fs.azimuths, bins = fs.roi_bins;
+    // The frames are not cropped: runs end at the capture's widest row, as on cropped frames.
+    const int bins = fs.roi_bins;
     const double b = fs.bin_size_m;
-    std::vector<const RadarFrame *> fr;
-    for (const auto &f : fs.frames) {
-        if (static_cast<int>(f.rotation) >= t.rot_first && static_cast<int>(f.rotation) <= t.rot_last) {
-            fr.push_back(&f);
-        }
-    }
-    if (fr.empty()) {
+    if (p.frames == 0) {
         m.why = "no decoded rotation in the truth's range";
         return m;
     }
-    m.frames_used = static_cast<int>(fr.size());
-    m.mask_n = std::clamp(std::min(opt.mask_frames, m.frames_used), 1, SL_CFG_MASK_FRAMES_MAX);
-    auto mask = std::make_unique<sl_mask_t>();
-    if (sl_mask_init(mask.get(), static_cast<uint16_t>(A), static_cast<uint16_t>(bins),
-                     static_cast<uint8_t>(m.mask_n), SL_MASK_MAX_MISSED_DEFAULT) != SL_OK) {
+    m.frames_used = p.frames;
+    m.mask_n = p.mask_n;
+    if (p.mask_failed) {
         m.why = "sl_mask_init failed";
         return m;
-    }
-    std::vector<uint32_t> bits(SL_ROI_WORDS);
-    for (const RadarFrame *f : fr) {
-        for (int az = 0; az < A; az++) {
-            if (!(f->flags[az] & SL_SCAN_AZ_VALID)) {
-                continue;
-            }
-            sl_thresh_u8(f->power.ptr<uint8_t>(az), static_cast<uint32_t>(bins),
-                         static_cast<uint16_t>(opt.threshold), bits.data());
-            (void)sl_mask_update(mask.get(), static_cast<uint16_t>(az), bits.data(), nullptr,
-                                 nullptr);
-        }
-        sl_mask_end_rotation(mask.get());
     }
     // Candidates per azimuth.
     const double k1_true = t.r1_true_m / b;
@@ -97,24 +223,16 @@ ElongMeasurement measure_elongation(const FrameSet &fs, const ElongTruth &t,
         Run r;
     };
     std::vector<Cand> cands;
-    std::vector<uint32_t> occ(SL_ROI_WORDS);
-    for (int j = 0; j < A; j++) {
-        int az = j;
-        if (t.az >= 0) {
-            if (j > 2 * opt.az_search) {
-                break;
-            }
-            az = ((t.az - opt.az_search + j) % A + A) % A;
-        }
-        if (!sl_mask_stable(mask.get(), static_cast<uint16_t>(az), occ.data(), nullptr)) {
+    for (size_t i = 0; i < p.rows.size(); i++) {
+        if (p.rows[i].empty()) {
             continue;
         }
-        for (const Run &r : runs_of(occ.data(), bins, opt.gap_bins)) {
+        for (const Run &r : runs_of(p.rows[i].data(), bins, opt.gap_bins)) {
             if (r.first < opt.near_exclusion_bins) {
                 continue;
             }
             if (std::fabs(r.first + 0.5 - k1_true) <= tol) {
-                cands.push_back({az, r});
+                cands.push_back({p.rows_az[i], r});
             }
         }
     }
@@ -152,6 +270,16 @@ ElongMeasurement measure_elongation(const FrameSet &fs, const ElongTruth &t,
     m.d_m = m.r2_m - t.r2_true_m;
     m.d_r1_m = m.r1_m - t.r1_true_m;
     return m;
+}
+
+ElongMeasurement measure_elongation(const FrameSet &fs, const ElongTruth &t,
+                                    const ElongOptions &opt)
+{
+    ElongStream st({t}, opt);
+    for (const RadarFrame &f : fs.frames) {
+        st.add(f, fs.azimuths);
+    }
+    return st.finish(fs, opt).front();
 }
 
 ElongTable fit_elongation(const std::vector<ElongMeasurement> &all, int points)

@@ -20,6 +20,8 @@
 // with (the paper's table is keyed by target distance; MATH.md s.4).
 #pragma once
 
+#include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -53,7 +55,40 @@ struct ElongMeasurement {
     double d_m = 0, d_r1_m = 0;
 };
 
-/// Measures one position in `fs` (frames whose `rotation` is in [t.rot_first, t.rot_last]).
+/// The positions of one capture measured as its rotations stream by (sl::for_each_frame),
+/// in memory that does not grow with the capture: while a position's rotations arrive it
+/// holds one consistency mask (and, until it has mask_frames rotations, so that n is known,
+/// the thresholded rows of those rotations: ~26 KB each); once they are past, only the stable
+/// rows of the azimuths it searches. Rotations must come in stream order.
+class ElongStream {
+public:
+    /// `opt`: threshold, mask_frames and az_search are used while streaming.
+    ElongStream(const std::vector<ElongTruth> &positions, const ElongOptions &opt);
+    ~ElongStream();
+    ElongStream(const ElongStream &) = delete;
+    ElongStream &operator=(const ElongStream &) = delete;
+
+    /// One decoded rotation (not cropped: for_each_frame's frames).
+    void add(const RadarFrame &f, int azimuths);
+    /// After the last rotation: one measurement per position, in the order given. `fs`: the
+    /// capture's FrameSet at the end (source, bin size, roi_bins = the crop); `opt` as
+    /// measure_elongation's (near_exclusion_bins from that bin size).
+    std::vector<ElongMeasurement> finish(const FrameSet &fs, const ElongOptions &opt);
+
+private:
+    struct Pos;
+    void start_mask(Pos &p, int n);
+    void close(Pos &p);
+    static ElongMeasurement measure(const Pos &p, const FrameSet &fs, const ElongOptions &opt);
+
+    std::vector<std::unique_ptr<Pos>> pos_;
+    ElongOptions opt_;
+    int azimuths_ = 0, bins_ = 0;
+    std::vector<uint32_t> bits_; ///< the rotation being added, thresholded (azimuths x SL_ROI_WORDS)
+};
+
+/// Measures one position in `fs` (frames whose `rotation` is in [t.rot_first, t.rot_last]);
+/// an ElongStream over the frames held in `fs`.
 ElongMeasurement measure_elongation(const FrameSet &fs, const ElongTruth &t,
                                     const ElongOptions &opt);
 

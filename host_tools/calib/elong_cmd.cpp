@@ -221,19 +221,16 @@ int cmd_elongation(const ElongArgs &a)
         fo.encoder_size = board.encoder_size;
         fo.roi_bins = std::min(board.roi_bins, SL_CFG_ROI_BINS);
         fo.bin_size_m = a.bin_size_m;
-        FrameSet fs;
-        if (!load_frames(cap, fo, fs, err)) {
-            std::fprintf(stderr, "sl-calib: %s\n", err.c_str());
-            return 1;
-        }
-        eo.near_exclusion_bins = static_cast<int>(std::ceil(board.near_exclusion_m / fs.bin_size_m - 1e-9));
+        // The positions (truth segments) first, so that the capture is read once, rotation
+        // by rotation, each position holding only its mask (ElongStream); a truth error is
+        // reported after the capture's own.
         std::vector<ElongTruth> pos;
+        std::string pos_err;
         if (paired) {
 #ifdef SL_HAVE_SIM_TRUTH
             std::vector<GtRow> rows;
-            if (!gt_read(a.truth[ci], rows, err)) {
-                std::fprintf(stderr, "sl-calib: %s\n", err.c_str());
-                return 1;
+            if (!gt_read(a.truth[ci], rows, pos_err)) {
+                rows.clear();
             }
             std::map<int, std::vector<const GtRow *>> by_pole;
             for (const auto &r : rows) {
@@ -264,19 +261,38 @@ int cmd_elongation(const ElongArgs &a)
         } else {
             auto it = list.find(basename_of(cap));
             if (it == list.end()) {
-                std::fprintf(stderr, "sl-calib: %s is not in %s\n", cap.c_str(), a.truth[0].c_str());
-                return 1;
+                pos_err = cap + " is not in " + a.truth[0];
             }
             ElongTruth t;
             t.rot_first = 0;
             t.rot_last = INT_MAX;
-            t.r1_true_m = it->second.first;
-            t.r2_true_m = it->second.second; // NaN: from theta at the measured azimuth
-            t.label = basename_of(cap);
-            pos.push_back(t);
+            if (it != list.end()) {
+                t.r1_true_m = it->second.first;
+                t.r2_true_m = it->second.second; // NaN: from theta at the measured azimuth
+                t.label = basename_of(cap);
+                pos.push_back(t);
+            }
         }
-        for (const auto &t : pos) {
-            ElongMeasurement m = measure_elongation(fs, t, eo);
+        FrameSet fs;
+        ElongStream stream(pos_err.empty() ? pos : std::vector<ElongTruth>{}, eo);
+        if (!for_each_frame(cap, fo, fs,
+                            [&](RadarFrame &f, const FrameSet &meta) {
+                                stream.add(f, meta.azimuths);
+                                return true;
+                            },
+                            err)) {
+            std::fprintf(stderr, "sl-calib: %s\n", err.c_str());
+            return 1;
+        }
+        if (!pos_err.empty()) {
+            std::fprintf(stderr, "sl-calib: %s\n", pos_err.c_str());
+            return 1;
+        }
+        eo.near_exclusion_bins = static_cast<int>(std::ceil(board.near_exclusion_m / fs.bin_size_m - 1e-9));
+        const std::vector<ElongMeasurement> found = stream.finish(fs, eo);
+        for (size_t pi = 0; pi < pos.size(); pi++) {
+            const ElongTruth &t = pos[pi];
+            ElongMeasurement m = found[pi];
             if (m.found && !std::isfinite(t.r2_true_m)) {
                 // A vertical pole at horizontal distance p: the -theta ray meets it at p / cos(theta).
                 const double th = board.theta_deg(m.az);

@@ -222,6 +222,8 @@ struct MessageReader::Impl {
     std::string path;
     const uint8_t *mem = nullptr; // open_memory: the stream and how far it has been fed
     size_t mem_size = 0, mem_off = 0;
+    const uint8_t *piece = nullptr; // the capture's current DATA piece and how far it has
+    size_t piece_size = 0, piece_off = 0; // been fed (valid until the next slp_capture_next)
 };
 
 MessageReader::MessageReader() : m_(new Impl) {}
@@ -284,10 +286,19 @@ bool MessageReader::next(uint8_t &id, std::vector<uint8_t> &msg)
         }
     }
     while (m_->q.empty() && !m_->eof && m_->c != nullptr) {
+        if (m_->piece_off < m_->piece_size) {
+            // A piece of a raw file is a 16 MiB mapped window: 1 MiB of it at a time too.
+            const size_t n = std::min<size_t>(m_->piece_size - m_->piece_off, 1u << 20);
+            m_->dec.feed(m_->piece + m_->piece_off, n);
+            m_->piece_off += n;
+            continue;
+        }
         slp_capture_piece_t pc;
         slp_capture_next(m_->c, &pc);
         if (pc.kind == SLP_CAPTURE_DATA) {
-            m_->dec.feed(pc.data, pc.size);
+            m_->piece = pc.data;
+            m_->piece_size = pc.size;
+            m_->piece_off = 0;
         } else if (pc.kind == SLP_CAPTURE_BREAK) {
             m_->dec.finish();
         } else {

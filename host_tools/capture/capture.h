@@ -175,8 +175,9 @@ private:
 /// A capture as a sequence of whole messages, pulled one at a time in bounded memory: the
 /// port's streaming reader (as read_capture: "-", FIFOs, pcap reassembly), the core decoder
 /// (1 MiB reassembly buffer, reset at every gap or new TCP session), and the messages of the
-/// piece of the stream being decoded. For tools that need messages rather than bytes
-/// (`sl-replay serve`). Each message is returned whole (22-byte header + payload, the header
+/// piece of the stream being decoded (at most 1 MiB of it: a raw file's 16 MiB mapped window
+/// is fed a megabyte at a time). For tools that need messages rather than bytes
+/// (`sl-replay serve`, sl-view, sl-calib). Each message is returned whole (22-byte header + payload, the header
 /// re-encoded, which is byte for byte the captured one: a valid header has no free field).
 class MessageReader {
 public:

@@ -33,6 +33,13 @@
 // writer cannot be opened, the same frames go to .avi with MJPG and a note says so) or, with
 // a .png output, into FILE_0000.png, FILE_0001.png, ...
 //
+// Memory does not grow with the capture: it is streamed (sl::for_each_frame, "-", pipes and
+// FIFOs too) through the core's mask and detector, and only what is drawn is kept (class
+// Viewer). --rotation reads to the end (the rotation count is drawn and printed); --all
+// draws each rotation as it comes, after a first pass over a file for that count; from a
+// pipe its pictures say "rotation K" without the count. --motion runs the pipeline over the
+// file first (a second pass): it needs a file, not a pipe (usage error).
+//
 // Exit status: 0 done, 1 error, 2 usage.
 #include <cmath>
 #include <cstdio>
@@ -41,6 +48,7 @@
 #include <memory>
 #include <filesystem>
 #include <string>
+#include <sys/stat.h>
 #include <vector>
 
 #include <opencv2/imgcodecs.hpp>
@@ -89,7 +97,8 @@ void usage(FILE *out)
         "  from sl-calib --out-ini, or a blob from sl-tables --blob)\n"
         "  --motion V[,W]: run the core pipeline with this constant motion (m/s, deg/s; as\n"
         "  shadowleand --motion) and draw the fitted 3D tilt of each pole in the top view:\n"
-        "  base, an arrow to the top of a 4 m pole, tilt and direction (CCW from forward).\n",
+        "  base, an arrow to the top of a 4 m pole, tilt and direction (CCW from forward);\n"
+        "  it reads the capture twice: a file, not stdin (-), a pipe or a FIFO.\n",
         out);
 }
 
@@ -116,7 +125,7 @@ struct TruthMark {
 /// Everything drawn on one rotation.
 struct RotationView {
     const sl::RadarFrame *frame = nullptr;
-    int index = 0, count = 0;
+    int index = 0, count = 0;               ///< count 0: not known (--all from a pipe)
     std::vector<std::vector<uint32_t>> occ; ///< stable-occupied rows (empty: no history)
     std::vector<sl_target_t> targets;
     std::vector<TruthMark> truth;
@@ -273,8 +282,13 @@ cv::Mat render(const Scene &sc, const RotationView &rv)
     {
         char b[256];
         const double t = rv.frame->t_first_us * 1e-6;
-        std::snprintf(b, sizeof b, "rotation %d of %d (frame #%u, t = %.3f s)", rv.index + 1,
-                      rv.count, rv.frame->rotation, t);
+        if (rv.count > 0) {
+            std::snprintf(b, sizeof b, "rotation %d of %d (frame #%u, t = %.3f s)", rv.index + 1,
+                          rv.count, rv.frame->rotation, t);
+        } else { // --all from a pipe: the count is not known while drawing
+            std::snprintf(b, sizeof b, "rotation %d (frame #%u, t = %.3f s)", rv.index + 1,
+                          rv.frame->rotation, t);
+        }
         sl::draw_text(img, b, cv::Point(20, 55), 0.5, cv::Scalar(200, 200, 200));
     }
     sl::PolarAxes pa;
@@ -419,6 +433,430 @@ cv::Mat render(const Scene &sc, const RotationView &rv)
     return img;
 }
 
+/// True for an input that can be read only once: "-" (stdin), a pipe, a FIFO, a socket or
+/// character device (not a regular file or an Oxford folder; a missing path is not one).
+bool is_stream(const std::string &path)
+{
+    struct stat st {};
+    return path == "-" || (::stat(path.c_str(), &st) == 0 && !S_ISREG(st.st_mode) && !S_ISDIR(st.st_mode));
+}
+
+/// The first `cols` columns of `power` (a copy), as load_frames crops a capture's frames.
+cv::Mat crop_cols(const cv::Mat &power, int cols)
+{
+    if (cols <= 0 || cols >= power.cols) {
+        return power;
+    }
+    return power(cv::Rect(0, 0, cols, power.rows)).clone();
+}
+
+/// The core's consistency mask and detector over the rotations in order.
+class CoreRun {
+public:
+    /// `frame_bins`: columns of the frames (the mask's width without a core board).
+    bool init(Scene &sc, int azimuths, int frame_bins, double bin_size_m, std::string &err)
+    {
+        A_ = azimuths;
+        threshold_ = sc.threshold;
+        // The mask spans the board's region of interest (the detector's rows); captures with
+        // shorter rows are padded with free bins.
+        bins_ = sc.core_board ? std::min<int>(sc.core_board->roi_bins, SL_CFG_ROI_BINS) : frame_bins;
+        padded_.assign(static_cast<size_t>(std::max(bins_, frame_bins)), 0);
+        bits_.assign(SL_ROI_WORDS, 0);
+        if (sl_mask_init(mask_.get(), static_cast<uint16_t>(A_), static_cast<uint16_t>(bins_),
+                         static_cast<uint8_t>(sc.mask_n), SL_MASK_MAX_MISSED_DEFAULT) != SL_OK) {
+            err = "sl_mask_init failed (azimuths " + std::to_string(A_) + ", bins " + std::to_string(bins_) +
+                  ", n " + std::to_string(sc.mask_n) + ")";
+            return false;
+        }
+        if (sc.core_board == nullptr) {
+            sc.detect_note = "detections: none drawn (board " + sc.board.name + " is not linked into the core)";
+        } else if (std::fabs(sc.core_board->bin_size_um * 1e-6 - bin_size_m) > 1e-6) {
+            sc.detect_note = "detections: none drawn (capture bin " + fmt("%.4f", bin_size_m) +
+                             " m / ROI differ from the board's tables)";
+        } else if (sl_detect_init(det_.get(), sc.core_board, nullptr) == SL_OK) {
+            have_det_ = true;
+        } else {
+            sc.detect_note = "detections: sl_detect_init rejected the board";
+        }
+        return true;
+    }
+
+    /// One rotation through the mask and the detector; its detections into `targets`.
+    void step(const sl::RadarFrame &fr, std::vector<sl_target_t> &targets)
+    {
+        for (int az = 0; az < A_; az++) {
+            if (!(fr.flags[az] & SL_SCAN_AZ_VALID)) continue;
+            const int w = std::min(bins_, fr.power.cols);
+            std::copy(fr.power.ptr<uint8_t>(az), fr.power.ptr<uint8_t>(az) + w, padded_.begin());
+            std::fill(padded_.begin() + w, padded_.end(), 0);
+            sl_thresh_u8(padded_.data(), static_cast<uint32_t>(bins_), static_cast<uint16_t>(threshold_),
+                         bits_.data());
+            (void)sl_mask_update(mask_.get(), static_cast<uint16_t>(az), bits_.data(), nullptr, nullptr);
+        }
+        sl_mask_end_rotation(mask_.get());
+        targets.clear();
+        if (have_det_) {
+            const sl_ssize_t n = sl_detect_rotation_from_mask(det_.get(), mask_.get());
+            for (sl_ssize_t i = 0; i < n; i++) targets.push_back(det_->targets[i]);
+        }
+    }
+
+    /// The stable-occupied rows after the last step (empty row: no history).
+    void occupied(std::vector<std::vector<uint32_t>> &occ) const
+    {
+        occ.assign(static_cast<size_t>(A_), {});
+        std::vector<uint32_t> row(SL_ROI_WORDS);
+        for (int az = 0; az < A_; az++) {
+            if (sl_mask_stable(mask_.get(), static_cast<uint16_t>(az), row.data(), nullptr)) {
+                occ[static_cast<size_t>(az)] = row;
+            }
+        }
+    }
+
+private:
+    std::unique_ptr<sl_mask_t> mask_ = std::make_unique<sl_mask_t>();
+    std::unique_ptr<sl_detect_t> det_ = std::make_unique<sl_detect_t>();
+    bool have_det_ = false;
+    int A_ = 0, bins_ = 0, threshold_ = 0;
+    std::vector<uint8_t> padded_;
+    std::vector<uint32_t> bits_;
+};
+
+/// A rotation kept to be drawn at the end (--rotation K): its frame and what the core saw.
+struct Shot {
+    sl::RadarFrame frame;
+    int index = 0;
+    std::vector<std::vector<uint32_t>> occ;
+    std::vector<sl_target_t> targets;
+};
+
+/// sl-view's rotations one at a time, as sl::for_each_frame hands them over. Memory does not
+/// follow the capture's length:
+///   - the first n rotations (the mask window) are held only until the mask's n is known:
+///     n rotations arrived (the board's n holds) or the capture ended first (n = its count);
+///   - --all draws each rotation as it comes (the rotation count and the crop of short rows
+///     come from a first pass over a file; from a pipe the count is not drawn and the crop is
+///     the widest row of the rotations received before the first picture);
+///   - --rotation K >= 0 keeps rotation K, --rotation -K a ring of the last K rotations, and
+///     draws at the end (the count, drawn and printed, is known only there);
+///   - the first rotation (display stretch) is kept.
+class Viewer {
+public:
+    Viewer(const Args &a, Scene &sc, const std::vector<std::vector<TruthMark>> &truth,
+           const std::vector<std::vector<slv::TiltMark>> &tilt)
+        : a_(a), sc_(sc), truth_(truth), tilt_(tilt), progress_("sl-view", a.quiet || !a.all)
+    {
+        board_n_ = a.mask_frames > 0 ? a.mask_frames : sc.board.mask_frames;
+        video_ = a.all && !ends_with(a.out, ".png");
+    }
+
+    /// --all from a file: what a first pass counted (rotations, columns after the crop).
+    void know(const sl::FrameSet &first_pass)
+    {
+        count_ = first_pass.delivered;
+        known_ = first_pass;
+    }
+
+    /// for_each_frame's callback. false stops reading (error() says why).
+    bool on_frame(sl::RadarFrame &fr, const sl::FrameSet &meta)
+    {
+        if (received_++ == 0) {
+            if (meta.azimuths != sc_.board.azimuths) {
+                return fail("capture has " + std::to_string(meta.azimuths) + " azimuths, board " +
+                            sc_.board.name + " has " + std::to_string(sc_.board.azimuths));
+            }
+            first_ = fr;
+            first_.power = fr.power.clone();
+        }
+        if (!started_) {
+            window_.push_back(std::move(fr));
+            if (count_ > 0) {
+                return start(std::min(count_, board_n_), meta);
+            }
+            if (static_cast<int>(window_.size()) >= board_n_ || a_.mask_frames > 0) {
+                return start(board_n_, meta);
+            }
+            return true;
+        }
+        return take(fr);
+    }
+
+    /// At the end of the capture (`meta`: for_each_frame's final FrameSet). Exit status.
+    int finish(const sl::FrameSet &meta)
+    {
+        const int N = meta.delivered;
+        if (!started_ && !start(std::max(1, std::min(N, board_n_)), meta)) {
+            return report();
+        }
+        if (a_.all) {
+            progress_.finish();
+            if (video_) {
+                vw_.release();
+                std::printf("sl-view: wrote %s (%d frames at %.1f fps)%s\n", video_path_.c_str(), written_,
+                            a_.fps, video_note_.c_str());
+            } else {
+                std::printf("sl-view: wrote %d PNGs %s_NNNN.png\n", written_,
+                            a_.out.substr(0, a_.out.size() - 4).c_str());
+            }
+            return 0;
+        }
+        const int k = a_.rotation < 0 ? N + a_.rotation : a_.rotation;
+        if (k < 0 || k >= N) {
+            std::fprintf(stderr, "sl-view: rotation %d out of range (0..%d)\n", a_.rotation, N - 1);
+            return 1;
+        }
+        // --rotation K: the shot kept (K >= 0) or the oldest of the ring of the last -K.
+        Shot &s = a_.rotation >= 0 ? ring_.front() : ring_[ring_next_ % ring_cap_];
+        count_ = N;
+        if (!prepare(meta)) {
+            return report();
+        }
+        s.frame.power = crop_cols(s.frame.power, drawn_.roi_bins);
+        return write_one(s);
+    }
+
+    const std::string &error() const { return err_; }
+    bool failed() const { return !err_.empty(); }
+
+private:
+    bool fail(const std::string &why)
+    {
+        err_ = why;
+        return false;
+    }
+    int report() const
+    {
+        std::fprintf(stderr, "sl-view: %s\n", err_.c_str());
+        return 1;
+    }
+
+    /// The mask's n is known: the note when the capture is shorter, the core's mask and
+    /// detector, and the rotations held back go through.
+    bool start(int mask_n, const sl::FrameSet &meta)
+    {
+        started_ = true;
+        sc_.mask_n = board_n_;
+        if (a_.mask_frames <= 0 && mask_n < board_n_) {
+            sc_.mask_note = " (board n = " + std::to_string(sc_.board.mask_frames) + "; the capture has " +
+                            std::to_string(mask_n) + " rotations)";
+            sc_.mask_n = mask_n;
+        }
+        std::string e;
+        if (!core_.init(sc_, meta.azimuths, window_.front().power.cols, meta.bin_size_m, e)) {
+            return fail(e);
+        }
+        if (a_.all && !prepare(count_ > 0 ? known_ : meta)) {
+            return false;
+        }
+        if (!a_.all) {
+            // The ring grows to -K as rotations arrive (a K beyond the capture costs nothing).
+            ring_cap_ = a_.rotation >= 0 ? 1U : static_cast<size_t>(-static_cast<long long>(a_.rotation));
+            ring_.resize(1);
+        }
+        std::vector<sl::RadarFrame> held;
+        held.swap(window_);
+        for (auto &f : held) {
+            if (!take(f)) {
+                return false;
+            }
+        }
+        return true;
+    }
+
+    /// What the pictures need of the whole capture: the shadow curves, the calibrated
+    /// shadow, the range shown, the display stretch (from the first rotation).
+    bool prepare(const sl::FrameSet &meta)
+    {
+        drawn_ = meta;
+        if (count_ <= 0) { // --all from a pipe: the widest row received so far
+            int widest = first_.widest_row;
+            for (const auto &f : window_) widest = std::max(widest, f.widest_row);
+            if (widest > 0 && widest < drawn_.roi_bins) drawn_.roi_bins = widest;
+        }
+        sc_.fs = &drawn_;
+        const int A = drawn_.azimuths;
+        sc_.board_slant_m.resize(A);
+        sc_.near_m.assign(A, sc_.board.near_exclusion_m);
+        double smax = 0;
+        sc_.theta_min = 1e9;
+        sc_.theta_max = -1e9;
+        for (int i = 0; i < A; i++) {
+            sc_.theta_min = std::min(sc_.theta_min, sc_.board.theta_deg(i));
+            sc_.theta_max = std::max(sc_.theta_max, sc_.board.theta_deg(i));
+            const double R = sc_.board.shadow_radius_m(i);
+            sc_.board_slant_m[i] = std::isfinite(R) ? std::hypot(R, sc_.board.radar_height_m) : kNaN;
+            if (std::isfinite(sc_.board_slant_m[i])) smax = std::max(smax, sc_.board_slant_m[i]);
+        }
+        if (!a_.calib.empty()) {
+            sl::ShadowCalibFile cf;
+            std::string e;
+            if (!sl::read_shadow_calib(a_.calib, cf, e)) {
+                return fail(e);
+            }
+            if (cf.azimuths != A) {
+                return fail(a_.calib + " has " + std::to_string(cf.azimuths) + " azimuths, the capture " +
+                            std::to_string(A));
+            }
+            sc_.calib_slant_m.assign(A, kNaN);
+            for (int i = 0; i < A; i++) {
+                if (std::isfinite(cf.theta_deg[i])) {
+                    sc_.calib_slant_m[i] = cf.ground_start_m[i];
+                }
+            }
+            sc_.have_calib = true;
+        }
+        sc_.roi_m = a_.roi_m > 0 ? a_.roi_m : std::max(6.0, std::ceil(1.6 * smax));
+        sc_.roi_m = std::min(sc_.roi_m, drawn_.roi_bins * drawn_.bin_size_m);
+        sc_.vmax = a_.vmax > 0 ? a_.vmax : sl::display_max(crop_cols(first_.power, drawn_.roi_bins), 0.995);
+        return true;
+    }
+
+    /// One rotation after the mask window: through the core, then drawn (--all) or kept.
+    bool take(sl::RadarFrame &fr)
+    {
+        const int k = index_++;
+        if (a_.all) {
+            Shot s;
+            s.index = k;
+            core_.step(fr, s.targets);
+            core_.occupied(s.occ);
+            s.frame = std::move(fr);
+            s.frame.power = crop_cols(s.frame.power, drawn_.roi_bins);
+            return draw_next(s);
+        }
+        if (a_.rotation >= 0 && k > a_.rotation) {
+            return true; // after the rotation drawn: only counted
+        }
+        const size_t slot = a_.rotation >= 0 ? 0U : ring_next_++ % ring_cap_;
+        if (slot >= ring_.size()) {
+            ring_.emplace_back();
+        }
+        Shot &s = ring_[slot];
+        s.index = k;
+        core_.step(fr, s.targets);
+        if (a_.rotation < 0 || k == a_.rotation) {
+            core_.occupied(s.occ);
+            s.frame = std::move(fr);
+        }
+        return true;
+    }
+
+    RotationView view_of(const Shot &s) const
+    {
+        RotationView rv;
+        rv.frame = &s.frame;
+        rv.index = s.index;
+        rv.count = std::max(0, count_);
+        rv.occ = s.occ;
+        rv.targets = s.targets;
+        if (static_cast<int>(s.frame.rotation) < static_cast<int>(truth_.size())) {
+            rv.truth = truth_[s.frame.rotation];
+        }
+        if (s.index < static_cast<int>(tilt_.size())) {
+            rv.tilt = tilt_[static_cast<size_t>(s.index)];
+        }
+        return rv;
+    }
+
+    /// --all: one more video frame or PNG.
+    bool draw_next(const Shot &s)
+    {
+        const RotationView rv = view_of(s);
+        cv::Mat img = render(sc_, rv);
+        progress_.update(static_cast<long long>(s.index + 1), static_cast<long long>(std::max(0, count_)),
+                         video_ ? "video frame" : "picture");
+        if (video_) {
+            if (!vw_.isOpened()) {
+                video_path_ = a_.out;
+                if (ends_with(a_.out, ".mp4")) {
+                    vw_.open(video_path_, cv::VideoWriter::fourcc('m', 'p', '4', 'v'), a_.fps, img.size());
+                }
+                if (!vw_.isOpened()) {
+                    const std::string base = a_.out.substr(0, a_.out.rfind('.'));
+                    video_path_ = base + ".avi";
+                    vw_.open(video_path_, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), a_.fps, img.size());
+                    if (ends_with(a_.out, ".mp4")) {
+                        video_note_ = " (mp4 writer unavailable in this OpenCV build: wrote MJPG .avi)";
+                    }
+                }
+                if (!vw_.isOpened()) {
+                    return fail("cannot open a video writer for " + a_.out);
+                }
+            }
+            vw_.write(img);
+            written_++;
+            return true;
+        }
+        char b[32];
+        std::snprintf(b, sizeof b, "_%04d.png", s.index);
+        const std::string path = a_.out.substr(0, a_.out.size() - 4) + b;
+        if (!cv::imwrite(path, img, {cv::IMWRITE_PNG_COMPRESSION, 9})) {
+            return fail("cannot write " + path);
+        }
+        written_++;
+        return true;
+    }
+
+    /// --rotation K: the picture, and one line per target with the truth of the nearest pole
+    /// (within 3 azimuths).
+    int write_one(const Shot &s)
+    {
+        const RotationView rv = view_of(s);
+        cv::Mat img = render(sc_, rv);
+        if (!cv::imwrite(a_.out, img, {cv::IMWRITE_PNG_COMPRESSION, 9})) {
+            std::fprintf(stderr, "sl-view: cannot write %s\n", a_.out.c_str());
+            return 1;
+        }
+        const int A = drawn_.azimuths;
+        std::printf("sl-view: wrote %s (rotation %d of %d = --rotation %d, %zu detections)\n", a_.out.c_str(),
+                    s.index + 1, count_, s.index, rv.targets.size());
+        for (size_t i = 0; i < rv.targets.size(); i++) {
+            const sl_target_t &t = rv.targets[i];
+            const TruthMark *best = nullptr;
+            int best_d = 4;
+            for (const auto &m : rv.truth) {
+                const int d = std::abs(((m.az - t.az) % A + A + A / 2) % A - A / 2);
+                if (d < best_d) {
+                    best_d = d;
+                    best = &m;
+                }
+            }
+            std::printf("sl-view: target %c az %u r1 %.3f r2 %.3f m alpha %s", 'A' + static_cast<int>(i % 26), t.az,
+                        t.r1_um * 1e-6, t.r2_um * 1e-6,
+                        t.incline_flag == SL_INCLINE_VALID ? fmt("%+.2f", t.alpha_cdeg / 100.0).c_str()
+                                                           : flag_name(t.incline_flag));
+            if (best) {
+                std::printf(" truth %s %+.2f", best->name.c_str(), best->alpha_deg);
+            }
+            std::printf("\n");
+        }
+        return 0;
+    }
+
+    const Args &a_;
+    Scene &sc_;
+    const std::vector<std::vector<TruthMark>> &truth_;
+    const std::vector<std::vector<slv::TiltMark>> &tilt_;
+    sl::Progress progress_;
+    int board_n_ = 16;
+    bool video_ = false;
+    int count_ = 0;            ///< rotations in the capture (0: not known yet)
+    sl::FrameSet known_;       ///< --all from a file: the first pass's FrameSet
+    sl::FrameSet drawn_;       ///< what the pictures are drawn with (Scene::fs)
+    int received_ = 0, index_ = 0;
+    bool started_ = false;
+    std::vector<sl::RadarFrame> window_;
+    sl::RadarFrame first_;
+    CoreRun core_;
+    std::vector<Shot> ring_;   ///< --rotation K >= 0: rotation K; K < 0: the last -K
+    size_t ring_cap_ = 1, ring_next_ = 0;
+    cv::VideoWriter vw_;
+    std::string video_path_, video_note_;
+    int written_ = 0;
+    std::string err_;
+};
+
 } // namespace
 
 int main(int argc, char **argv)
@@ -510,6 +948,11 @@ int main(int argc, char **argv)
     if (a.out.empty()) {
         return sl_cli_usage_error("sl-view", "missing --out FILE", usage);
     }
+    if (a.motion && is_stream(a.input)) {
+        // The pipeline pass of --motion and the pictures' pass each read the capture.
+        return sl_cli_usage_error(
+            "sl-view", "--motion reads the capture twice: give a file, not stdin, a pipe or a FIFO", usage);
+    }
     Scene sc;
     try {
         sc.board = sl::load_board(a.board);
@@ -550,73 +993,19 @@ int main(int argc, char **argv)
     fo.encoder_size = sc.board.encoder_size;
     fo.roi_bins = std::min(sc.board.roi_bins, SL_CFG_ROI_BINS);
     fo.bin_size_m = a.bin_size_m;
-    sl::FrameSet fs;
-    std::string err;
+    // An Oxford folder has no bin size of its own: the board's (or --bin-size-m).
     {
-        // An Oxford folder has no bin size of its own: the board's (or --bin-size-m).
-        sl::FrameOptions f2 = fo;
         const bool dir = [&] {
             FILE *f = std::fopen((a.input + "/.").c_str(), "r");
             if (f) std::fclose(f);
             return f != nullptr;
         }();
-        if (dir && f2.bin_size_m <= 0) {
-            f2.bin_size_m = sc.board.bin_size_m;
-        }
-        if (!sl::load_frames(a.input, f2, fs, err)) {
-            std::fprintf(stderr, "sl-view: %s\n", err.c_str());
-            return 1;
+        if (dir && fo.bin_size_m <= 0) {
+            fo.bin_size_m = sc.board.bin_size_m;
         }
     }
-    if (fs.azimuths != sc.board.azimuths) {
-        std::fprintf(stderr, "sl-view: capture has %d azimuths, board %s has %d\n", fs.azimuths,
-                     sc.board.name.c_str(), sc.board.azimuths);
-        return 1;
-    }
-    sc.fs = &fs;
-    const int A = fs.azimuths, N = static_cast<int>(fs.frames.size());
-    // Shadow curves.
-    sc.board_slant_m.resize(A);
-    sc.near_m.assign(A, sc.board.near_exclusion_m);
-    double smax = 0;
-    sc.theta_min = 1e9;
-    sc.theta_max = -1e9;
-    for (int i = 0; i < A; i++) {
-        sc.theta_min = std::min(sc.theta_min, sc.board.theta_deg(i));
-        sc.theta_max = std::max(sc.theta_max, sc.board.theta_deg(i));
-        const double R = sc.board.shadow_radius_m(i);
-        sc.board_slant_m[i] = std::isfinite(R) ? std::hypot(R, sc.board.radar_height_m) : kNaN;
-        if (std::isfinite(sc.board_slant_m[i])) smax = std::max(smax, sc.board_slant_m[i]);
-    }
-    if (!a.calib.empty()) {
-        sl::ShadowCalibFile cf;
-        if (!sl::read_shadow_calib(a.calib, cf, err)) {
-            std::fprintf(stderr, "sl-view: %s\n", err.c_str());
-            return 1;
-        }
-        if (cf.azimuths != A) {
-            std::fprintf(stderr, "sl-view: %s has %d azimuths, the capture %d\n", a.calib.c_str(),
-                         cf.azimuths, A);
-            return 1;
-        }
-        sc.calib_slant_m.assign(A, kNaN);
-        for (int i = 0; i < A; i++) {
-            if (std::isfinite(cf.theta_deg[i])) {
-                sc.calib_slant_m[i] = cf.ground_start_m[i];
-            }
-        }
-        sc.have_calib = true;
-    }
-    sc.roi_m = a.roi_m > 0 ? a.roi_m : std::max(6.0, std::ceil(1.6 * smax));
-    sc.roi_m = std::min(sc.roi_m, fs.roi_bins * fs.bin_size_m);
-    sc.vmax = a.vmax > 0 ? a.vmax : sl::display_max(fs.frames[0].power, 0.995);
+    std::string err;
     sc.threshold = a.threshold >= 0 ? a.threshold : sc.board.threshold;
-    sc.mask_n = a.mask_frames > 0 ? a.mask_frames : sc.board.mask_frames;
-    if (a.mask_frames <= 0 && N < sc.mask_n) {
-        sc.mask_note = " (board n = " + std::to_string(sc.board.mask_frames) + "; the capture has " +
-                       std::to_string(N) + " rotations)";
-        sc.mask_n = std::max(1, N);
-    }
     // Default title: the input's file name, never the path of the machine it was made on.
     sc.title = a.title.empty() ? "sl-view  " + std::filesystem::path(a.input).filename().string()
                                : a.title;
@@ -647,7 +1036,8 @@ int main(int argc, char **argv)
         return 1;
 #endif
     }
-    // --motion: the whole core pipeline with that motion, for the fitted 3D tilt.
+    // --motion: the whole core pipeline with that motion, for the fitted 3D tilt (a first
+    // pass over the file).
     std::vector<std::vector<slv::TiltMark>> tilt_by_rot;
     if (a.motion) {
         if (sc.core_board == nullptr) {
@@ -659,153 +1049,35 @@ int main(int argc, char **argv)
             return 1;
         }
     }
-    // Core mask + detection over all rotations in order.
-    auto mask = std::make_unique<sl_mask_t>();
-    // The mask spans the board's region of interest (the detector's rows); captures with
-    // shorter rows are padded with free bins.
-    const int bins = sc.core_board ? std::min<int>(sc.core_board->roi_bins, SL_CFG_ROI_BINS) : fs.roi_bins;
-    std::vector<uint8_t> padded(static_cast<size_t>(std::max(bins, fs.roi_bins)), 0);
-    if (sl_mask_init(mask.get(), static_cast<uint16_t>(A), static_cast<uint16_t>(bins),
-                     static_cast<uint8_t>(sc.mask_n), SL_MASK_MAX_MISSED_DEFAULT) != SL_OK) {
-        std::fprintf(stderr, "sl-view: sl_mask_init failed (azimuths %d, bins %d, n %d)\n", A, bins,
-                     sc.mask_n);
-        return 1;
-    }
-    auto det = std::make_unique<sl_detect_t>();
-    bool have_det = false;
-    if (sc.core_board == nullptr) {
-        sc.detect_note = "detections: none drawn (board " + sc.board.name + " is not linked into the core)";
-    } else if (std::fabs(sc.core_board->bin_size_um * 1e-6 - fs.bin_size_m) > 1e-6) {
-        sc.detect_note = "detections: none drawn (capture bin " + fmt("%.4f", fs.bin_size_m) +
-                         " m / ROI differ from the board's tables)";
-    } else if (sl_detect_init(det.get(), sc.core_board, nullptr) == SL_OK) {
-        have_det = true;
-    } else {
-        sc.detect_note = "detections: sl_detect_init rejected the board";
-    }
-    std::vector<int> todo;
-    if (a.all) {
-        for (int k = 0; k < N; k++) todo.push_back(k);
-    } else {
-        int k = a.rotation < 0 ? N + a.rotation : a.rotation;
-        if (k < 0 || k >= N) {
-            std::fprintf(stderr, "sl-view: rotation %d out of range (0..%d)\n", a.rotation, N - 1);
+    Viewer view(a, sc, truth_by_rot, tilt_by_rot);
+    if (a.all && !is_stream(a.input)) {
+        // --all from a file: a first pass counts the rotations (drawn on every picture) and
+        // finds the crop of short rows; nothing is kept.
+        sl::FrameSet first;
+        if (!sl::for_each_frame(a.input, fo, first, [](sl::RadarFrame &, const sl::FrameSet &) { return true; },
+                                err)) {
+            std::fprintf(stderr, "sl-view: %s\n", err.c_str());
             return 1;
         }
-        todo.push_back(k);
+        view.know(first);
     }
-    cv::VideoWriter vw;
-    std::string video_path, video_note;
-    const bool video = a.all && !ends_with(a.out, ".png");
-    std::vector<uint32_t> bits(SL_ROI_WORDS);
-    int written = 0;
-    size_t next = 0;
-    sl::Progress progress("sl-view", a.quiet || !a.all); // --all: minutes on a long capture
-    for (int k = 0; k < N && next < todo.size(); k++) {
-        const auto &fr = fs.frames[k];
-        for (int az = 0; az < A; az++) {
-            if (!(fr.flags[az] & SL_SCAN_AZ_VALID)) continue;
-            const int w = std::min(bins, fs.roi_bins);
-            std::copy(fr.power.ptr<uint8_t>(az), fr.power.ptr<uint8_t>(az) + w, padded.begin());
-            std::fill(padded.begin() + w, padded.end(), 0);
-            sl_thresh_u8(padded.data(), static_cast<uint32_t>(bins),
-                         static_cast<uint16_t>(sc.threshold), bits.data());
-            (void)sl_mask_update(mask.get(), static_cast<uint16_t>(az), bits.data(), nullptr, nullptr);
-        }
-        sl_mask_end_rotation(mask.get());
-        RotationView rv;
-        rv.frame = &fr;
-        rv.index = k;
-        rv.count = N;
-        if (have_det) {
-            const sl_ssize_t n = sl_detect_rotation_from_mask(det.get(), mask.get());
-            for (sl_ssize_t i = 0; i < n; i++) rv.targets.push_back(det->targets[i]);
-        }
-        if (todo[next] != k) continue;
-        next++;
-        rv.occ.resize(A);
-        for (int az = 0; az < A; az++) {
-            std::vector<uint32_t> occ(SL_ROI_WORDS);
-            if (sl_mask_stable(mask.get(), static_cast<uint16_t>(az), occ.data(), nullptr)) {
-                rv.occ[az] = occ;
-            }
-        }
-        if (static_cast<int>(fr.rotation) < static_cast<int>(truth_by_rot.size())) {
-            rv.truth = truth_by_rot[fr.rotation];
-        }
-        if (k < static_cast<int>(tilt_by_rot.size())) {
-            rv.tilt = tilt_by_rot[static_cast<size_t>(k)];
-        }
-        cv::Mat img = render(sc, rv);
-        progress.update(static_cast<long long>(next), static_cast<long long>(todo.size()),
-                        video ? "video frame" : "picture");
-        if (video) {
-            if (!vw.isOpened()) {
-                video_path = a.out;
-                if (ends_with(a.out, ".mp4")) {
-                    vw.open(video_path, cv::VideoWriter::fourcc('m', 'p', '4', 'v'), a.fps, img.size());
-                }
-                if (!vw.isOpened()) {
-                    const std::string base = a.out.substr(0, a.out.rfind('.'));
-                    video_path = base + ".avi";
-                    vw.open(video_path, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), a.fps, img.size());
-                    if (ends_with(a.out, ".mp4")) {
-                        video_note = " (mp4 writer unavailable in this OpenCV build: wrote MJPG .avi)";
-                    }
-                }
-                if (!vw.isOpened()) {
-                    std::fprintf(stderr, "sl-view: cannot open a video writer for %s\n", a.out.c_str());
-                    return 1;
-                }
-            }
-            vw.write(img);
-            written++;
-        } else {
-            std::string path = a.out;
-            if (a.all) {
-                char b[32];
-                std::snprintf(b, sizeof b, "_%04d.png", k);
-                path = a.out.substr(0, a.out.size() - 4) + b;
-            }
-            if (!cv::imwrite(path, img, {cv::IMWRITE_PNG_COMPRESSION, 9})) {
-                std::fprintf(stderr, "sl-view: cannot write %s\n", path.c_str());
-                return 1;
-            }
-            written++;
-            if (!a.all) {
-                std::printf("sl-view: wrote %s (rotation %d of %d = --rotation %d, %zu detections)\n",
-                            path.c_str(), k + 1, N, k, rv.targets.size());
-                // One line per target, with the truth of the nearest pole (within 3 azimuths).
-                for (size_t i = 0; i < rv.targets.size(); i++) {
-                    const sl_target_t &t = rv.targets[i];
-                    const TruthMark *best = nullptr;
-                    int best_d = 4;
-                    for (const auto &m : rv.truth) {
-                        const int d = std::abs(((m.az - t.az) % A + A + A / 2) % A - A / 2);
-                        if (d < best_d) {
-                            best_d = d;
-                            best = &m;
-                        }
-                    }
-                    std::printf("sl-view: target %c az %u r1 %.3f r2 %.3f m alpha %s", 'A' + static_cast<int>(i % 26),
-                                t.az, t.r1_um * 1e-6, t.r2_um * 1e-6,
-                                t.incline_flag == SL_INCLINE_VALID ? fmt("%+.2f", t.alpha_cdeg / 100.0).c_str()
-                                                                   : flag_name(t.incline_flag));
-                    if (best) {
-                        std::printf(" truth %s %+.2f", best->name.c_str(), best->alpha_deg);
-                    }
-                    std::printf("\n");
-                }
-            }
-        }
+    // The core's mask and detector over the rotations in order, each rotation drawn as it
+    // comes (--all) or the one asked for kept (--rotation).
+    sl::FrameSet fs;
+    const bool ok = sl::for_each_frame(
+        a.input, fo, fs, [&](sl::RadarFrame &fr, const sl::FrameSet &meta) { return view.on_frame(fr, meta); },
+        err);
+    if (view.failed()) {
+        std::fprintf(stderr, "sl-view: %s\n", view.error().c_str());
+        return 1;
     }
-    progress.finish();
-    if (video) {
-        vw.release();
-        std::printf("sl-view: wrote %s (%d frames at %.1f fps)%s\n", video_path.c_str(), written, a.fps,
-                    video_note.c_str());
-    } else if (a.all) {
-        std::printf("sl-view: wrote %d PNGs %s_NNNN.png\n", written, a.out.substr(0, a.out.size() - 4).c_str());
+    if (!ok) {
+        std::fprintf(stderr, "sl-view: %s\n", err.c_str());
+        return 1;
+    }
+    const int rc = view.finish(fs);
+    if (rc != 0) {
+        return rc;
     }
     if (!sc.detect_note.empty()) std::printf("sl-view: note: %s\n", sc.detect_note.c_str());
     if (!sc.mask_note.empty()) std::printf("sl-view: note: mask n = %d%s\n", sc.mask_n, sc.mask_note.c_str());

@@ -17,8 +17,10 @@
 //
 // A capture file, pipe, FIFO or "-" is streamed (capture.h read_capture: the port's reader),
 // never loaded, and reading stops once `max_frames` frames are kept.
-// Memory: one Mat per kept frame (400 x 512 B = 200 KB each; bound it with max_frames) plus
-// the reader's window; an Oxford folder's converted stream is held while it is decoded.
+// Memory: load_frames keeps one Mat per frame (400 x 512 B = 200 KB each; bound it with
+// max_frames); for_each_frame hands each frame over and keeps none (sl-view, sl-calib
+// shadow and elongation); both hold the reader's window, and an Oxford folder's converted
+// stream while it is decoded.
 #pragma once
 
 #include <cstdint>

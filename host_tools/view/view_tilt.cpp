@@ -48,10 +48,6 @@ void on_rotation(void *ctx, const sl_pipeline_rotation_t *r)
 bool tilt_marks(const std::string &path, const sl_board_t *b, double speed_mps, double yaw_dps,
                 std::vector<std::vector<TiltMark>> &out, std::string &err)
 {
-    sl::Capture cap;
-    if (!sl::load_capture(path, cap, err)) {
-        return false;
-    }
     auto p = std::make_unique<sl_pipeline_t>();
     Ctx ctx{p.get(), &out};
     sl_pipeline_cfg_t cfg;
@@ -65,13 +61,40 @@ bool tilt_marks(const std::string &path, const sl_board_t *b, double speed_mps, 
     const int32_t v = static_cast<int32_t>(std::lround(speed_mps * 1000.0));
     const int32_t w = static_cast<int32_t>(std::lround(yaw_dps * 100.0));
     // Motion refreshed before every chunk (the vehicle bus would send it at 50 Hz); the
-    // rotation period comes from the radar's timestamps.
+    // rotation period comes from the radar's timestamps. The capture is streamed and cut
+    // into 64 KiB chunks of the reassembled stream (memory: one chunk, not the capture).
     const size_t chunk = 65536;
     uint64_t now = 1000000U;
-    for (size_t o = 0; o < cap.bytes.size(); o += chunk, now += 1000U) {
+    std::vector<uint8_t> buf;
+    buf.reserve(chunk);
+    auto feed = [&] {
         sl_pipeline_set_motion(p.get(), v, true, w, true, now);
-        const size_t n = std::min(chunk, cap.bytes.size() - o);
-        (void)sl_pipeline_feed(p.get(), cap.bytes.data() + o, n, now);
+        (void)sl_pipeline_feed(p.get(), buf.data(), buf.size(), now);
+        buf.clear();
+        now += 1000U;
+    };
+    sl::Capture info;
+    uint64_t bytes = 0;
+    const bool ok = sl::read_capture(
+        path,
+        [&](const uint8_t *d, size_t n) {
+            while (n > 0) {
+                const size_t k = std::min(n, chunk - buf.size());
+                buf.insert(buf.end(), d, d + k);
+                d += k;
+                n -= k;
+                if (buf.size() == chunk) {
+                    feed();
+                }
+            }
+            return true;
+        },
+        sl::CaptureBreakFn{}, info, bytes, err);
+    if (!ok) {
+        return false;
+    }
+    if (!buf.empty()) {
+        feed();
     }
     (void)sl_pipeline_finish(p.get(), now);
     return true;

@@ -22,8 +22,9 @@ struct TiltMark {
     double psi_deg = 0, phi_deg = 0; ///< tilt; direction the top leans to, CCW from forward
 };
 
-/// Runs sl_pipeline over the capture at `path` with the motion (speed m/s, yaw rate deg/s)
-/// and returns the fitted poles of every rotation (index = rotation since the start).
+/// Runs sl_pipeline over the capture at `path` (streamed in 64 KiB chunks, read_capture)
+/// with the motion (speed m/s, yaw rate deg/s) and returns the fitted poles of every
+/// rotation (index = rotation since the start).
 /// false + err when the capture cannot be read or the pipeline rejects the board.
 bool tilt_marks(const std::string &path, const sl_board_t *b, double speed_mps, double yaw_dps,
                 std::vector<std::vector<TiltMark>> &out, std::string &err);
