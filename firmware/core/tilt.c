@@ -415,18 +415,15 @@ static int64_t var_factor_q20(const fit_ctx_t *f, sl_q30_t p1, sl_q30_t p2)
 // along p. It does not shrink with n, only with the bearing spread (M^-1 ~ 1 / spread).
 static int64_t bias_bound_q30(const fit_ctx_t *f, sl_q30_t p1, sl_q30_t p2)
 {
+    // g = adj(M) p (adj(M) is symmetric), Q30; then p' adj(M) e_k = g . e_k
+    const int64_t g1 = sl_fx_mul_q30(f->c_q30, p1) - sl_fx_mul_q30(f->b_q30, p2);
+    const int64_t g2 = sl_fx_mul_q30(f->a_q30, p2) - sl_fx_mul_q30(f->b_q30, p1);
     int64_t sum_q46 = 0;
     for (size_t k = 0; k < f->n; ++k) {
         const sl_tilt_obs_t *o = &f->obs[k];
-        const int64_t ck = o->cos_a_q15;
-        const int64_t sk = o->sin_a_q15;
-        // adj(M) e_k, Q30 (|.| <= 2)
-        const int64_t m1 = sl_fx_rshift_round64((int64_t)f->c_q30 * ck - (int64_t)f->b_q30 * sk, 15U);
-        const int64_t m2 = sl_fx_rshift_round64((int64_t)f->a_q30 * sk - (int64_t)f->b_q30 * ck, 15U);
-        int64_t q = sl_fx_rshift_round64((int64_t)p1 * m1 + (int64_t)p2 * m2, 30U); // Q30
+        int64_t q = (g1 * o->cos_a_q15 + g2 * o->sin_a_q15) >> 15; // Q30, |.| <= 2
         q = (q < 0) ? -q : q;
-        const int64_t ws_q16 = ((int64_t)f->wk->w_q16[k] * (int64_t)obs_sigma(o)) >> 16;
-        sum_q46 += ws_q16 * q;
+        sum_q46 += (((int64_t)f->wk->w_q16[k] * (int64_t)obs_sigma(o)) >> 16) * q;
     }
     const int64_t mean_q30 = div_round(sum_q46, f->w_sum_q16); // sum(w sigma |adj e|) / W
     if (mean_q30 >= 2 * f->det_q30) {
