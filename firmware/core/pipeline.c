@@ -337,7 +337,7 @@ static SL_NOINLINE void warn_view(const sl_pipeline_t *p, const sl_track_t *t, w
         v->valid = true;
         v->fitted = true;
         v->lean_cdeg = tv.lean_path_cdeg;
-        v->sigma_cdeg = tv.psi_sigma_cdeg;
+        v->sigma_cdeg = tv.lean_path_sigma_cdeg;
         v->level = lean_level(p, tv.lean_path_cdeg);
     }
 }

@@ -405,6 +405,33 @@ static int64_t var_factor_q20(const fit_ctx_t *f, sl_q30_t p1, sl_q30_t p2)
     return div_round(q_q60 >> 10, f->det_q30); // Q50 / Q30
 }
 
+// The bias bound along p (a unit vector, Q30), tan units, Q30, saturated at 2.0. The errors
+// of the measurements are not independent from one rotation to the next (quantised bounds,
+// the union extent, the azimuth cells drift slowly along a pass), so they do not average out
+// as 1 / sqrt(n): a bias beta_k with |beta_k| <= sigma_k on every measurement, shaped in
+// any way over the pass (a trend in bearing is the worst for few, close bearings), moves the
+// fit by d t = -M^-1 sum(w_k e_k beta_k) / W, at most
+//     b_p = sum(w_k sigma_k |p' M^-1 e_k|) / W
+// along p. It does not shrink with n, only with the bearing spread (M^-1 ~ 1 / spread).
+static int64_t bias_bound_q30(const fit_ctx_t *f, sl_q30_t p1, sl_q30_t p2)
+{
+    // g = adj(M) p (adj(M) is symmetric), Q30; then p' adj(M) e_k = g . e_k
+    const int64_t g1 = sl_fx_mul_q30(f->c_q30, p1) - sl_fx_mul_q30(f->b_q30, p2);
+    const int64_t g2 = sl_fx_mul_q30(f->a_q30, p2) - sl_fx_mul_q30(f->b_q30, p1);
+    int64_t sum_q46 = 0;
+    for (size_t k = 0; k < f->n; ++k) {
+        const sl_tilt_obs_t *o = &f->obs[k];
+        int64_t q = (g1 * o->cos_a_q15 + g2 * o->sin_a_q15) >> 15; // Q30, |.| <= 2
+        q = (q < 0) ? -q : q;
+        sum_q46 += (((int64_t)f->wk->w_q16[k] * (int64_t)obs_sigma(o)) >> 16) * q;
+    }
+    const int64_t mean_q30 = div_round(sum_q46, f->w_sum_q16); // sum(w sigma |adj e|) / W
+    if (mean_q30 >= 2 * f->det_q30) {
+        return 2 * P2_30;
+    }
+    return div_round(mean_q30 * P2_30, f->det_q30);
+}
+
 static void report(const fit_ctx_t *f, const sl_tilt_params_t *prm, uint64_t choice, int32_t tx32,
                    int32_t ty32, uint32_t chi2_q8, sl_tilt_result_t *out)
 {
@@ -463,12 +490,24 @@ static void report(const fit_ctx_t *f, const sl_tilt_params_t *prm, uint64_t cho
         if (var_q30 > ((uint64_t)1 << 32)) {
             var_q30 = (uint64_t)1 << 32;
         }
+        // plus the bias bound, as a systematic term (sl_tilt.h, "The stated sigmas")
+        const int64_t b_q30 = bias_bound_q30(f, dir[i][0], dir[i][1]); // <= 2^31
+        var_q30 += (uint64_t)((b_q30 * b_q30) >> 30);
+        if (var_q30 > ((uint64_t)1 << 32)) {
+            var_q30 = (uint64_t)1 << 32;
+        }
         sig_q30[i] = (int64_t)sl_fx_isqrt64(var_q30 << 30);
     }
-    // d psi = d|t| / (1 + |t|^2); d phi = d(across) / |t|.
+    // d psi = d|t| / (1 + |t|^2); d phi = d(across) / |t|: linearisations that hold only when
+    // |t| is well above its error in every direction. When it is not (|t| < 3 x the larger
+    // sigma), the direction is not determined (phi sigma saturated) and |t| may be off by the
+    // error across t as much as along it (a small fitted |t| can hide a tilt across it).
     const int64_t sec2_q24 = P2_24 + (int64_t)(((uint64_t)tn_q24 * tn_q24) >> 24);
-    out->psi_sigma_cdeg = rad_q30_to_cdeg(div_round(sig_q30[0] << 24, sec2_q24), UINT16_MAX);
-    out->phi_sigma_cdeg = (tn_q24 == 0U) ? 18000U
+    const int64_t sig_max_q30 = (sig_q30[1] > sig_q30[0]) ? sig_q30[1] : sig_q30[0];
+    const bool oriented = (int64_t)tn_q24 * 64 >= 3 * sig_max_q30; // Q24 -> Q30
+    const int64_t sig_psi_q30 = oriented ? sig_q30[0] : sig_max_q30;
+    out->psi_sigma_cdeg = rad_q30_to_cdeg(div_round(sig_psi_q30 << 24, sec2_q24), UINT16_MAX);
+    out->phi_sigma_cdeg = (!oriented || tn_q24 == 0U) ? 18000U
         : rad_q30_to_cdeg(div_round(sig_q30[1] << 24, (int64_t)tn_q24), 18000U);
 
     // Base: each measurement's point at radar height, averaged, minus H t.

@@ -277,6 +277,33 @@ void sl_tiltobs_fit_pending(sl_tiltobs_t *o)
     }
 }
 
+#define RAD_Q24_PER_CDEG 2928LL       // pi / 18000 * 2^24 (2928.2)
+#define CDEG_PER_RAD_Q16 375493621LL  // 18000 / pi * 2^16
+
+// 1-sigma of the path lean atan(t_n), t_n = the tilt vector's component on the path's normal
+// (`tn_q24`; `tp_q24` the one along the path, vehicle frame): d t_n = (t_n / |t|) d|t| +
+// t_p d phi, d|t| = (1 + |t|^2) d psi; when the direction is not determined, the tilt sigma
+// (the larger one, sl_tilt.h) in every direction. Then / (1 + t_n^2). O(1).
+static uint16_t lean_sigma_cdeg(const sl_tilt_result_t *res, int64_t tp_q24, int64_t tn_q24)
+{
+    const int64_t an = (tn_q24 < 0) ? -tn_q24 : tn_q24;
+    const int64_t ap = (tp_q24 < 0) ? -tp_q24 : tp_q24;
+    const int64_t t2_q24 = (an * an + ap * ap) >> 24;                       // |t|^2
+    const int64_t tnorm_q24 = (int64_t)sl_fx_isqrt64((uint64_t)t2_q24 << 24);
+    const int64_t along_q24 = (((int64_t)res->psi_sigma_cdeg * RAD_Q24_PER_CDEG) *
+                               (((int64_t)1 << 24) + t2_q24)) >> 24;        // sigma of |t|
+    int64_t a1 = along_q24;
+    int64_t a2 = 0;
+    if (res->phi_sigma_cdeg < 18000U && tnorm_q24 > 0) {
+        a1 = (along_q24 * an) / tnorm_q24;
+        a2 = (((int64_t)res->phi_sigma_cdeg * RAD_Q24_PER_CDEG) * ap) >> 24;
+    }
+    const int64_t sig_q24 = (int64_t)sl_fx_isqrt64((uint64_t)(a1 * a1) + (uint64_t)(a2 * a2));
+    const int64_t lean_q24 = (sig_q24 << 24) / (((int64_t)1 << 24) + ((an * an) >> 24));
+    const int64_t cdeg = (lean_q24 * CDEG_PER_RAD_Q16 + ((int64_t)1 << 39)) >> 40;
+    return (cdeg > (int64_t)UINT16_MAX) ? (uint16_t)UINT16_MAX : (uint16_t)cdeg;
+}
+
 bool sl_tiltobs_vehicle(const sl_tiltobs_t *o, const sl_tiltobs_ring_t *r,
                         sl_tiltobs_vehicle_t *out)
 {
@@ -313,5 +340,7 @@ bool sl_tiltobs_vehicle(const sl_tiltobs_t *o, const sl_tiltobs_ring_t *r,
     const int64_t towards = (by >= 0) ? -ty_v : ty_v;
     const sl_bam32_t lean = sl_incline_atan2_bam32(sat32(towards), (int32_t)0x1000000);
     out->lean_path_cdeg = sl_incline_bam32_to_cdeg(lean);
+    const int64_t tx_v = sl_fx_rshift_round64((int64_t)res->tx_q24 * c + (int64_t)res->ty_q24 * s, 30U);
+    out->lean_path_sigma_cdeg = lean_sigma_cdeg(res, tx_v, ty_v);
     return true;
 }

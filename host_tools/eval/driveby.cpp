@@ -105,10 +105,11 @@ void log_fits(RunCtx *c)
         const Case &k = *c->kase;
         std::fprintf(c->obs_log,
                      "{\"v\":%.1f,\"psi\":%.1f,\"phi\":%.1f,\"off\":%.1f,\"q\":%d,"
-                     "\"psi_fit\":%.2f,\"phi_fit\":%.2f,\"chi2\":%.3f,\"other\":%.3f,\"mask\":%u,"
-                     "\"obs\":[",
+                     "\"psi_fit\":%.2f,\"phi_fit\":%.2f,\"psi_sig\":%.2f,\"phi_sig\":%.2f,"
+                     "\"lean\":%.2f,\"lean_sig\":%.2f,\"chi2\":%.3f,\"other\":%.3f,\"mask\":%u,\"obs\":[",
                      k.speed, k.psi, k.phi_v, k.offset, v.quality, v.psi_cdeg / 100.0,
-                     v.phi_cdeg / 100.0, ring.res.chi2_q8 / 256.0, ring.res.chi2_other_q8 / 256.0,
+                     v.phi_cdeg / 100.0, v.psi_sigma_cdeg / 100.0, v.phi_sigma_cdeg / 100.0,
+                     v.lean_path_cdeg / 100.0, v.lean_path_sigma_cdeg / 100.0, ring.res.chi2_q8 / 256.0, ring.res.chi2_other_q8 / 256.0,
                      ring.res.mirrored_mask);
         for (size_t j = 0; j < obs.size(); ++j) {
             const sl_tilt_obs_t &o = obs[j];

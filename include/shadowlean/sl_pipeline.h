@@ -80,8 +80,8 @@
 /// AMBIGUOUS), the warning uses the tilt TOWARDS THE VEHICLE'S PATH instead of the in-plane
 /// alpha: lean = atan(-sign(base_y) t_y) with t the tilt vector and base_y the base's
 /// lateral offset in the vehicle frame (> 0: the top leans over the path, the sign
-/// convention of Lean), its sigma the fit's tilt sigma, its level the board's thresholds
-/// applied to it directly (DANGER at lean >= danger, CAUTION at |lean| (or lean, per
+/// convention of Lean), its sigma that of the path lean (sl_tiltobs_vehicle_t
+/// .lean_path_sigma_cdeg), its level the board's thresholds applied to it directly (DANGER at lean >= danger, CAUTION at |lean| (or lean, per
 /// cfg.track.caution_abs) >= caution; no hysteresis: the fit is already an average over the
 /// pass), Quality FILTERED. This is what resolves the fold: a pole leaning away beyond
 /// (theta - beta) / 2 reads as leaning towards on every single rotation, its fit does not.

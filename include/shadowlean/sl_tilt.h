@@ -44,6 +44,24 @@
 /// reported as such before the ambiguity (its scale estimate would call every reading
 /// ambiguous).
 ///
+/// The stated sigmas. The errors of the measurements drift slowly along a pass (a quantised
+/// bound stays in its bin over several rotations, the union extent and the azimuth cells
+/// change stepwise), so they do not average out as 1 / sqrt(n); over a few close bearings
+/// such a drift is a trend in bearing, which the fit turns into tilt across the line of sight
+/// (issue #12: fits of the first 5-14 observations of `sl-eval driveby` passes said FITTED
+/// 3-7 deg or 30-116 deg off, up to 17 of their sigmas). So each direction p's variance is
+/// the covariance of the fit (inflated by chi2 / dof > 1) PLUS the square of the worst-case
+/// effect of a bias of up to each measurement's own sigma, shaped in any way over the pass:
+///     b_p = sum(w_k sigma_k |p' M^-1 e_k|) / W     (M the weighted bearing moment matrix)
+/// which shrinks only with the bearing spread, not with n. Tilt and direction sigmas are the
+/// linearisations d psi = d|t| / (1 + |t|^2), d phi = d(across t) / |t|, valid only when |t|
+/// is well above its error in every direction: when |t| < 3 x the larger of the two sigmas
+/// the direction is not determined (`phi_sigma_cdeg` = 18000) and the tilt sigma is the
+/// larger one (a small fitted |t| can hide a tilt across it). With that, a FITTED result
+/// holds the truth within 3 of its stated sigmas (tests/core/test_tilt.c: every prefix of
+/// 400 quantised-bound drive-bys, 1 of 3,938 at 3.01 sigma; the sweep's 4,322 FITTED fits:
+/// none outside, 667 before); the price is sigmas 2-3x what a pass's final errors are.
+///
 /// Position. Each measurement also places the pole: with the fitted in-plane inclination
 /// alpha^ (from (1)) and the inner bound r1, the pole's horizontal distance at radar height
 /// is d0 = r1 (cos beta + sin beta tan alpha^) when alpha^ >= beta (r1 is the top of the
@@ -173,8 +191,9 @@ typedef struct sl_tilt_result {
     int32_t ty_q24;
     int32_t psi_cdeg;         ///< tilt from vertical, 0..9000
     int32_t phi_cdeg;         ///< direction the top leans towards, CCW from +x, 0..35999
-    uint16_t psi_sigma_cdeg;  ///< 1-sigma (covariance of the fit, inflated by chi2/dof > 1)
-    uint16_t phi_sigma_cdeg;  ///< 1-sigma, saturated at 18000 (tilt too small to orient)
+    uint16_t psi_sigma_cdeg;  ///< 1-sigma: covariance of the fit (inflated by chi2/dof > 1)
+                              ///< plus the bias bound (file comment, "The stated sigmas")
+    uint16_t phi_sigma_cdeg;  ///< 1-sigma, the same; 18000 when |t| < 3 sigma (not oriented)
     int32_t base_x_um;        ///< pole base on the ground, odometry frame
     int32_t base_y_um;
     uint32_t chi2_q8;         ///< chi-square of the reported fit, Q8

@@ -117,6 +117,10 @@ typedef struct sl_tiltobs_vehicle {
     int32_t lean_path_cdeg;   ///< tilt towards the vehicle's path: atan of the tilt
                               ///< vector's component along -sign(base_y) y (> 0: the top
                               ///< leans over the path; the sign convention of PoleLean)
+    uint16_t lean_path_sigma_cdeg; ///< 1-sigma of lean_path_cdeg: the tilt sigma along t and
+                              ///< the direction sigma across it, projected on the path's
+                              ///< normal; the tilt sigma (the larger one) when the direction
+                              ///< is not determined (phi_sigma_cdeg 18000)
 } sl_tiltobs_vehicle_t;
 
 /// Initialise for `board` (borrowed): no history, pose at the origin, heading 0.
