@@ -670,6 +670,22 @@ static size_t simulate_quantised(const scene_t *sc, const sl_board_t *b, double 
     return n;
 }
 
+// One random drive-by of the quantised tests: tilt psi_lo + psi_span x U, any direction,
+// the pole 2-4 m either side, 1-3 m/s, the pass started 2-7 m before it, and a per-pass fill
+// threshold of 0-50 % of a bin. Its observations into `o`; @return their count.
+static size_t random_quantised_pass(const sl_board_t *b, double psi_lo, double psi_span,
+                                    scene_t *sc, sl_tilt_obs_t *o)
+{
+    *sc = base_scene();
+    sc->psi = psi_lo + psi_span * urand();
+    sc->phi = 360.0 * urand();
+    sc->by = (urand() < 0.5 ? -1.0 : 1.0) * (2.0 + 2.0 * urand());
+    sc->v = 1.0 + 2.0 * urand();
+    sc->x0 = -2.0 - 5.0 * urand();
+    sc->seconds = 12.0 / sc->v;
+    return simulate_quantised(sc, b, 0.5 * urand(), o);
+}
+
 static void test_quantised_bounds_never_a_fitted_mirror(void **state)
 {
     (void)state;
@@ -688,14 +704,8 @@ static void test_quantised_bounds_never_a_fitted_mirror(void **state)
     double worst_fitted = 0;
     static sl_tilt_obs_t o[SL_TILT_MAX_OBS];
     for (int i = 0; i < 400; ++i) {
-        scene_t sc = base_scene();
-        sc.psi = 14.0 + 11.0 * urand();
-        sc.phi = 360.0 * urand();
-        sc.by = (urand() < 0.5 ? -1.0 : 1.0) * (2.0 + 2.0 * urand());
-        sc.v = 1.0 + 2.0 * urand();
-        sc.x0 = -2.0 - 5.0 * urand();
-        sc.seconds = 12.0 / sc.v;
-        const size_t n = simulate_quantised(&sc, b, 0.5 * urand(), o);
+        scene_t sc;
+        const size_t n = random_quantised_pass(b, 14.0, 11.0, &sc, o);
         // does the pole lean away beyond the fold on some rotation of the pass?
         const double tt = tan(rad(sc.psi));
         int folds = 0;
@@ -851,14 +861,8 @@ static void test_quantised_bounds_fitted_within_3_sigma(void **state)
     double worst_z = 0;
     static sl_tilt_obs_t o[SL_TILT_MAX_OBS];
     for (int i = 0; i < 400; ++i) {
-        scene_t sc = base_scene();
-        sc.psi = 1.0 + 24.0 * urand();
-        sc.phi = 360.0 * urand();
-        sc.by = (urand() < 0.5 ? -1.0 : 1.0) * (2.0 + 2.0 * urand());
-        sc.v = 1.0 + 2.0 * urand();
-        sc.x0 = -2.0 - 5.0 * urand();
-        sc.seconds = 12.0 / sc.v;
-        const size_t n = simulate_quantised(&sc, b, 0.5 * urand(), o);
+        scene_t sc;
+        const size_t n = random_quantised_pass(b, 1.0, 24.0, &sc, o);
         for (size_t m = SL_TILT_MIN_OBS; m <= n; ++m) {
             sl_tilt_result_t r;
             assert_int_equal(sl_tilt_fit(o, m, &prm, &work, &r), SL_OK);
