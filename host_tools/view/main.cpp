@@ -441,7 +441,7 @@ bool is_stream(const std::string &path)
     return path == "-" || (::stat(path.c_str(), &st) == 0 && !S_ISREG(st.st_mode) && !S_ISDIR(st.st_mode));
 }
 
-/// The first `cols` columns of `power` (a copy), as load_frames crops a capture's frames.
+/// The first `cols` columns of `power` (a copy): a capture's frames cropped to its widest row.
 cv::Mat crop_cols(const cv::Mat &power, int cols)
 {
     if (cols <= 0 || cols >= power.cols) {

@@ -231,12 +231,6 @@ bool read_path(const std::string &path, const FrameOptions &opt, FrameSet &out,
 
 } // namespace
 
-bool load_frames(const std::string &path, const FrameOptions &opt, FrameSet &out,
-                 std::string &err)
-{
-    return read_path(path, opt, out, nullptr, err);
-}
-
 bool for_each_frame(const std::string &path, const FrameOptions &opt, FrameSet &meta,
                     const FrameFn &fn, std::string &err)
 {

@@ -17,10 +17,10 @@
 //
 // A capture file, pipe, FIFO or "-" is streamed (capture.h read_capture: the port's reader),
 // never loaded, and reading stops once `max_frames` frames are kept.
-// Memory: load_frames keeps one Mat per frame (400 x 512 B = 200 KB each; bound it with
-// max_frames); for_each_frame hands each frame over and keeps none (sl-view, sl-calib
-// shadow and elongation); both hold the reader's window, and an Oxford folder's converted
-// stream while it is decoded.
+// Memory: for_each_frame hands each frame over and keeps none (sl-view, sl-calib shadow and
+// elongation); decode_frames (an in-memory stream, tests) keeps one Mat per frame (400 x
+// 512 B = 200 KB each; bound it with max_frames); both hold the reader's window, and an
+// Oxford folder's converted stream while it is decoded.
 #pragma once
 
 #include <cstdint>
@@ -63,29 +63,26 @@ struct FrameSet {
     bool bin_from_config = false;   ///< true: the stream's Configuration gave the bin size
     std::vector<RadarFrame> frames;
     int dropped_partial = 0;        ///< frames dropped by min_valid_fraction
-    int delivered = 0;              ///< frames kept (load_frames) or handed over (for_each_frame)
+    int delivered = 0;              ///< frames kept (decode_frames) or handed over (for_each_frame)
     sl_proto_stats_t proto{};
     sl_scan_stats_t scan{};
 };
-
-/// Decodes `path` (a capture file, or a folder of Oxford PNGs: DIR/radar/*.png or DIR/*.png).
-/// false + err on I/O or format errors, or when no frame survives.
-bool load_frames(const std::string &path, const FrameOptions &opt, FrameSet &out,
-                 std::string &err);
 
 /// One decoded rotation as it arrives; `meta` is the FrameSet so far (geometry, bin size once
 /// known; `frames` stays empty). Return false to stop reading.
 using FrameFn = std::function<bool(RadarFrame &frame, const FrameSet &meta)>;
 
-/// load_frames without keeping the frames: each surviving rotation goes to `fn` in stream
-/// order (memory: one frame plus the reader's window, whatever the capture's length). The
-/// frames are not cropped: they have FrameOptions::roi_bins columns; at the end
-/// `meta.roi_bins` is the crop load_frames would have applied (the widest row received) and
-/// `meta.delivered` the number of frames handed over. Same errors as load_frames.
+/// Decodes `path` (a capture file, pipe, FIFO or "-", or a folder of Oxford PNGs:
+/// DIR/radar/*.png or DIR/*.png) without keeping the frames: each surviving rotation goes to
+/// `fn` in stream order (memory: one frame plus the reader's window, whatever the capture's
+/// length). The frames are not cropped: they have FrameOptions::roi_bins columns; at the end
+/// `meta.roi_bins` is the crop to the widest row received and `meta.delivered` the number of
+/// frames handed over. false + err on I/O or format errors, or when no frame survives.
 bool for_each_frame(const std::string &path, const FrameOptions &opt, FrameSet &meta,
                     const FrameFn &fn, std::string &err);
 
-/// Decodes an in-memory Colossus byte stream (same rules as load_frames).
+/// Decodes an in-memory Colossus byte stream and keeps its frames in `out.frames`, each
+/// cropped to `out.roi_bins` (same rules and errors as for_each_frame).
 bool decode_frames(const std::vector<uint8_t> &bytes, const FrameOptions &opt, FrameSet &out,
                    std::string &err);
 
