@@ -609,6 +609,33 @@ static SL_NOINLINE uint32_t shadow_after_refine(sl_pipeline_t *p, uint32_t n)
     return k;
 }
 
+// Moving: the profile watches, next rotation, the azimuths where each track updated now is
+// expected (its static-object prediction under one rotation's displacement, +-2 azimuths:
+// the representative azimuth moves by up to half a beam's return, and the refinement sums
+// the neighbours of whichever it is). Confirmed tracks first, then the others updated now.
+static SL_NOINLINE void reserve_profiles(sl_pipeline_t *p)
+{
+    const uint32_t b = p->det_board.bin_size_um;
+    if (b == 0U || p->tracker.motion_reverse) {
+        return;
+    }
+    for (uint32_t pass = 0; pass < 2U; pass++) {
+        for (uint32_t i = 0; i < SL_CFG_MAX_TARGETS; i++) {
+            const sl_track_t *t = &p->tracker.tracks[i];
+            if (t->live == 0U || t->updated == 0U || (pass == 0U) != (t->confirmed != 0U)) {
+                continue;
+            }
+            uint16_t az = 0;
+            uint32_t r = 0;
+            sl_track_predict_static(&p->det_board, t->az, t->r1_um, p->tracker.motion_um, &az,
+                                    &r);
+            const uint32_t bin = r / b;
+            (void)sl_profile_reserve(&p->prof, az, (uint16_t)(bin > 0xFFFFU ? 0xFFFFU : bin),
+                                     2U);
+        }
+    }
+}
+
 static void on_rot(void *ctx, const sl_scan_rot_t *rot)
 {
     sl_pipeline_t *p = ctx;
@@ -643,6 +670,9 @@ static void on_rot(void *ctx, const sl_scan_rot_t *rot)
     set_track_motion(p);
     sl_track_set_reverse(&p->tracker, p->motion_valid && p->speed_mm_s < 0);
     sl_track_update(&p->tracker, p->detect.targets, n_targets, p->now_us);
+    if (p->cfg.profile && p->prof.moving != 0U) {
+        reserve_profiles(p);
+    }
     sl_tiltobs_advance(&p->tilt, p->motion_valid, p->speed_mm_s, p->yaw_cdeg_s, p->rotation_us);
     sl_tiltobs_update(&p->tilt, p->tracker.tracks, p->detect.targets, n_targets);
     // Drift watch (sl_drift.h): one azimuth per rotation, read from the mask's stable row at

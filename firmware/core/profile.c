@@ -83,8 +83,8 @@ void sl_profile_row(sl_profile_t *pr, uint16_t az, const uint8_t *power, uint32_
         slot_add(pr, s, power, n);
         return;
     }
-    if (first >= hi) {
-        return;
+    if (first >= hi || pr->moving != 0U) {
+        return; // moving: only the azimuths reserved for tracks are watched
     }
     if (pr->n_live >= SL_CFG_PROFILE_SLOTS) {
         pr->stats.claim_full++;
@@ -115,6 +115,7 @@ void sl_profile_end_rotation(sl_profile_t *pr, bool reset)
     if (reset) {
         pr->stats.resets++;
     }
+    pr->moving = reset ? 1U : 0U;
     for (uint32_t i = 0; i < SL_CFG_PROFILE_SLOTS; i++) {
         sl_profile_slot_t *s = &pr->slot[i];
         if (s->live == 0U) {
@@ -131,8 +132,12 @@ void sl_profile_end_rotation(sl_profile_t *pr, bool reset)
         }
         s->seen = 0U;
         if (reset) {
-            memset(s->sum, 0, sizeof s->sum);
+            // Moving: the sums are cleared and the slot is freed: the pole is at another
+            // azimuth next rotation (sl_profile_reserve gives the slots to where it will be).
+            s->live = 0U;
             s->frames = 0U;
+            pr->slot_of[s->az] = SL_PROFILE_NONE;
+            pr->n_live--;
         }
     }
 }
@@ -357,6 +362,54 @@ static void calibrate(sl_profile_t *pr, uint32_t s)
     pr->stats.cal_accepted++;
 }
 
+// The rows of target `t`'s azimuth (slot `si`) and of its two neighbours, when they belong
+// to its detection group and are watched, summed into pr->scratch over the bins all of them
+// cover (a neighbour whose window starts after the target's first bin - 3 would cut the
+// leading edge: left out). Adjacent azimuths (0.9 deg on the CTS350-X) lie inside one beam
+// width (1.8 deg), so they hold the same pole at the same ranges with their own speckle.
+// `*bin0` / `*n`: the summed window. @return the rows summed (0: none).
+static uint32_t combine_neighbours(sl_profile_t *pr, const sl_target_t *t, uint8_t si,
+                                   uint32_t *bin0, uint32_t *n)
+{
+    const sl_profile_slot_t *use[3];
+    uint32_t k = 0;
+    use[k++] = &pr->slot[si];
+    uint32_t lo = pr->slot[si].bin0;
+    uint32_t hi = lo + SL_CFG_PROFILE_BINS;
+    const uint32_t az_n = pr->azimuths;
+    for (uint32_t d = 0; d < 2U; d++) {
+        const uint32_t nb = d == 0U ? (t->az + az_n - 1U) % az_n : (t->az + 1U) % az_n;
+        if ((nb + az_n - t->az_first % az_n) % az_n >= t->az_count || nb == t->az) {
+            continue; // not in the group
+        }
+        const uint8_t ni = pr->slot_of[nb];
+        if (ni == SL_PROFILE_NONE || pr->slot[ni].frames == 0U ||
+            (uint32_t)pr->slot[ni].bin0 + 3U > t->bin_first) {
+            continue;
+        }
+        const sl_profile_slot_t *q = &pr->slot[ni];
+        lo = q->bin0 > lo ? q->bin0 : lo;
+        hi = (uint32_t)q->bin0 + SL_CFG_PROFILE_BINS < hi ? (uint32_t)q->bin0 + SL_CFG_PROFILE_BINS
+                                                          : hi;
+        use[k++] = q;
+    }
+    if (k < 2U) {
+        return pr->slot[si].frames;
+    }
+    uint32_t frames = 0;
+    memset(pr->scratch, 0, sizeof pr->scratch);
+    for (uint32_t i = 0; i < k; i++) {
+        const uint32_t off = lo - use[i]->bin0;
+        for (uint32_t j = 0; j < hi - lo; j++) {
+            pr->scratch[j] = (uint16_t)(pr->scratch[j] + use[i]->sum[off + j]);
+        }
+        frames += use[i]->frames;
+    }
+    *bin0 = lo;
+    *n = hi - lo;
+    return frames;
+}
+
 uint8_t sl_profile_refine(sl_profile_t *pr, const sl_board_t *board, uint32_t threshold,
                           sl_target_t *t)
 {
@@ -370,28 +423,49 @@ uint8_t sl_profile_refine(sl_profile_t *pr, const sl_board_t *board, uint32_t th
         return why;
     }
     const sl_profile_slot_t *s = &pr->slot[si];
-    if (s->frames < pr->cfg.min_frames) {
-        pr->stats.fallback[SL_PROFILE_FEW_FRAMES]++;
-        return (uint8_t)SL_PROFILE_FEW_FRAMES;
+    const uint16_t *sum = s->sum;
+    uint32_t frames = s->frames;
+    uint32_t bin0 = s->bin0;
+    uint32_t n = SL_CFG_PROFILE_BINS;
+    bool spatial = false;
+    if (frames < pr->cfg.min_frames) {
+        // Too few rotations summed (moving: cleared every rotation): this rotation's rows
+        // of the neighbouring azimuths of the group, aligned on their bins.
+        frames = combine_neighbours(pr, t, si, &bin0, &n);
+        if (frames < pr->cfg.min_frames) {
+            pr->stats.fallback[SL_PROFILE_FEW_FRAMES]++;
+            return (uint8_t)SL_PROFILE_FEW_FRAMES;
+        }
+        sum = pr->scratch;
+        spatial = true;
     }
     // Bins from the first that starts at or beyond the shadow edge on: no cliff there.
     uint32_t cliff_end = UINT32_MAX;
     if (t->shadow_slant_um != 0U && board->bin_size_um != 0U) {
         const uint32_t eb = (t->shadow_slant_um + board->bin_size_um - 1U) / board->bin_size_um;
-        cliff_end = eb > s->bin0 ? eb - s->bin0 : 0U;
+        cliff_end = eb > bin0 ? eb - bin0 : 0U;
     }
-    const sl_profile_bounds_t pb =
-        sl_profile_extract(s->sum, SL_CFG_PROFILE_BINS, s->frames, threshold,
-                           (uint32_t)t->bin_first - s->bin0, pr->slope_q8, cliff_end);
+    const sl_profile_bounds_t pb = sl_profile_extract(
+        sum, n, frames, threshold, (uint32_t)t->bin_first - bin0, pr->slope_q8, cliff_end);
     if (pb.fail != (uint8_t)SL_PROFILE_OK) {
         pr->stats.fallback[pb.fail]++;
         return pb.fail;
+    }
+    if (spatial && pb.slope_src == SL_PROFILE_SLOPE_CLIFF) {
+        // Neighbouring azimuths serve to remove a smear tail. Without one the mask's run is
+        // the return's own (its end is where the return ends), while a mean over azimuths
+        // that see an oblique pole at other ranges would end elsewhere: keep the mask's.
+        pr->stats.fallback[SL_PROFILE_NO_TAIL]++;
+        return (uint8_t)SL_PROFILE_NO_TAIL;
     }
     if (pb.slope_src == SL_PROFILE_SLOPE_FIT) {
         calibrate(pr, pb.slope_q8);
     }
     const uint64_t b = board->bin_size_um;
-    const uint64_t i1 = (uint64_t)s->bin0 + pb.i1, i2 = (uint64_t)s->bin0 + pb.i2;
+    if (spatial) {
+        pr->stats.spatial++;
+    }
+    const uint64_t i1 = (uint64_t)bin0 + pb.i1, i2 = (uint64_t)bin0 + pb.i2;
     // The detector's bounds are half-bin centres + radius terms (- d on r2): keep the
     // radius terms, replace the centres, drop d.
     const int64_t r1_hb_mask = (int64_t)((((uint64_t)2U * t->bin_first + 1U) * b + 1U) / 2U);
@@ -403,7 +477,7 @@ uint8_t sl_profile_refine(sl_profile_t *pr, const sl_board_t *board, uint32_t th
     if (pb.slope_src == SL_PROFILE_SLOPE_CLIFF && pb.i2 > pb.i1) {
         // Sub-bin far edge (see sl_profile_fill_q16): the last own bin's lit fraction from
         // its power against the own bin before it.
-        const uint32_t f = sl_profile_fill_q16(s->sum[pb.i2], s->sum[pb.i2 - 1U], s->frames);
+        const uint32_t f = sl_profile_fill_q16(sum[pb.i2], sum[pb.i2 - 1U], frames);
         r2_hb = (int64_t)(i2 * b + ((uint64_t)f * b + 32768U) / 65536U);
     }
     t->r1_um = sl_fx_usat32(r1_hb + r1_term);
@@ -471,4 +545,45 @@ void sl_profile_assign(sl_profile_t *pr, const sl_target_t *targets, uint32_t n)
         keep[pick] = 1U;
         pr->stats.assigned++;
     }
+}
+
+uint32_t sl_profile_reserve(sl_profile_t *pr, uint16_t az, uint16_t bin_first, uint32_t half)
+{
+    SL_ASSERT(pr != NULL);
+    if (az >= pr->azimuths) {
+        return 0U;
+    }
+    const uint32_t n = 2U * half + 1U < pr->azimuths ? 2U * half + 1U : pr->azimuths;
+    const uint32_t start = ((uint32_t)az + pr->azimuths - half % pr->azimuths) % pr->azimuths;
+    uint32_t got = 0;
+    for (uint32_t k = 0; k < n; k++) {
+        const uint32_t a = (start + k) % pr->azimuths;
+        if (pr->slot_of[a] != SL_PROFILE_NONE) {
+            got++; // already watched (another track's neighbour)
+            continue;
+        }
+        uint32_t pick = SL_CFG_PROFILE_SLOTS;
+        for (uint32_t i = 0; i < SL_CFG_PROFILE_SLOTS; i++) {
+            if (pr->slot[i].live == 0U) {
+                pick = i;
+                break;
+            }
+        }
+        if (pick == SL_CFG_PROFILE_SLOTS) {
+            pr->stats.reserve_full++;
+            continue;
+        }
+        sl_profile_slot_t *s = &pr->slot[pick];
+        memset(s, 0, sizeof *s);
+        s->live = 1U;
+        s->seen = 1U;
+        s->az = (uint16_t)a;
+        s->bin0 = (uint16_t)(bin_first > pr->cfg.lead_bins ? (uint32_t)bin_first - pr->cfg.lead_bins
+                                                           : 0U);
+        pr->slot_of[a] = (uint8_t)pick;
+        pr->n_live++;
+        pr->stats.reserved++;
+        got++;
+    }
+    return got;
 }

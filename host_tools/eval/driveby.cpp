@@ -306,15 +306,22 @@ std::string scene_text(const std::string &board, const Case &k, bool realistic, 
                   "tilt_deg = %.3f\nlean_deg = %.3f\nreflectivity = 1.0\n"
                   "[ground]\nreflectivity = 0.05\n"
                   "[beam]\nelevation = ideal\nazimuth_width_deg = 2\n"
-                  "[output]\namplitude = integral\nmapping = linear\nnormalize = column\n",
-                  board.c_str(), *rotations, seed, k.speed, -k.offset, k.psi, lean_world);
+                  "[output]\namplitude = integral\nmapping = %s\nnormalize = %s\n",
+                  board.c_str(), *rotations, seed, k.speed, -k.offset, k.psi, lean_world,
+                  realistic ? "log" : "linear", realistic ? "none" : "column");
     std::string s = buf;
     if (realistic) {
+        // The sensor's output (the Table II bench's effects): 8-bit log magnitude with its
+        // noise floor and near-field leakage, a smear tail, speckle drawn anew each rotation.
         s += "[effects]\nsmear = on\nsmear_shape = exponential\nsmear_width_bins = 40\n"
-             "smear_decay_db = 3.3\nspeckle = on\nspeckle_static = no\n";
+             "smear_decay_db = 3.3\nspeckle = on\nspeckle_static = no\nnoise = on\n"
+             "leakage = on\n";
     }
     return s;
 }
+
+// --no-profile: the pipeline's mask bounds with the board's d(r) (no range profiles).
+bool g_no_profile = false;
 
 Outcome run_case(const std::string &board_name, const Case &k, bool realistic, int seed,
                  PlotData *plot = nullptr, bool dump = false, FILE *obs_log = nullptr)
@@ -342,6 +349,9 @@ Outcome run_case(const std::string &board_name, const Case &k, bool realistic, i
     sl_pipeline_cfg_default(&cfg, b);
     cfg.port.ctx = &ctx;
     cfg.port.on_rotation = on_rotation;
+    // Range profiles read the sensor's log values; the noise-free passes are the paper's
+    // linear rendering (no smear): the mask's bounds (sim_eval.h, pipe_cfg_for_scene).
+    cfg.profile = realistic && !g_no_profile;
     if (sl_pipeline_init(p.get(), b, &cfg) != SL_OK) {
         throw std::runtime_error("sl_pipeline_init failed for board " + board_name);
     }
@@ -376,6 +386,15 @@ Outcome run_case(const std::string &board_name, const Case &k, bool realistic, i
                     d.rejected[SL_DETECT_REJ_SHORT], d.rejected[SL_DETECT_REJ_RHO],
                     d.rejected[SL_DETECT_REJ_WEAK], t.created, t.confirmations, t.associated,
                     t.inconsistent, t.dropped, o.observations, o.rejected, o.no_target);
+        const sl_profile_stats_t &f = p->prof.stats;
+        std::printf("  profile: refined %u (from neighbouring azimuths %u); fallback no_slot %u "
+                    "lead_cut %u no_run %u tail_cut %u no_tail %u few_frames %u; claims %u "
+                    "full %u; reserved %u full %u; tail slope %.2f values/bin\n",
+                    f.extracted, f.spatial, f.fallback[SL_PROFILE_NO_SLOT],
+                    f.fallback[SL_PROFILE_LEAD_CUT], f.fallback[SL_PROFILE_NO_RUN],
+                    f.fallback[SL_PROFILE_TAIL_CUT], f.fallback[SL_PROFILE_NO_TAIL],
+                    f.fallback[SL_PROFILE_FEW_FRAMES], f.claims, f.claim_full, f.reserved,
+                    f.reserve_full, p->prof.slope_q8 / 256.0);
     }
     if (dump && ctx.fitted_ring.track_id != 0U) {
         dump_ring(ctx.fitted_ring, p->tilt.prm, k);
@@ -498,14 +517,18 @@ bool plot_pass(const std::string &png, const PlotData &d, const Case &k, std::st
 void usage(FILE *out)
 {
     std::fprintf(out,
-                 "usage: sl-eval driveby [--board NAME] [--quick] [--realistic] [--speeds A,B,..]\n"
+                 "usage: sl-eval driveby [--board NAME] [--quick] [--realistic] [--no-profile] [--speeds A,B,..]\n"
                  "                       [--check] [--plot FILE.png] [--psi DEG] [--phi DEG]\n"
                  "                       [--offset M] [--dump] [--obs-log FILE]\n"
                  "  Simulated drive-bys, one pole per pass, through the core pipeline with the pass's\n"
                  "  speed as motion input; the last FITTED 3D tilt of each pass against the truth.\n"
                  "  Default sweep: speeds 1, 2, 3 m/s; psi 3, 5, 10, 20 deg; phi every 45 deg; offsets\n"
                  "  2, 3, 4 m on both sides (--quick: 1 and 3 m/s, psi 5 and 15, phi every 90 deg, 3 m).\n"
-                 "  --realistic: smear and speckle (the simulator's real-sensor effects).\n"
+                 "  --realistic: the sensor's output (8-bit log magnitude, noise floor, near-field\n"
+                 "  leakage) with a smear tail and speckle drawn anew each rotation (without it:\n"
+                 "  the paper's noise-free linear rendering).\n"
+                 "  --no-profile: the pipeline's mask bounds with the board's d(r) instead of the\n"
+                 "  range profiles (while moving: one rotation's rows of neighbouring azimuths).\n"
                  "  --check: exit 1 unless every pole with psi >= 5 is FITTED within the issue's\n"
                  "  bounds (1 deg / 10 deg noise-free; 2 deg / 20 deg with --realistic).\n"
                  "  --plot FILE.png: instead of the sweep, one pass (1 m/s, a pole 3 m left of the\n"
@@ -544,6 +567,8 @@ int cmd_driveby(int argc, char **argv)
             quick = true;
         } else if (a == "--realistic") {
             realistic = true;
+        } else if (a == "--no-profile") {
+            g_no_profile = true;
         } else if (a == "--check") {
             check = true;
         } else if (a == "--plot" && i + 1 < argc) {

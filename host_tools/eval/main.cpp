@@ -60,7 +60,7 @@ void usage(FILE *out)
                  "      - = stdin). --extract pipeline: the core pipeline (beam, threshold and speed from\n"
                  "      --scene, or the options); --calibration: on the board's calibrated view (a vehicle's\n"
                  "      INI or blob).\n"
-                 "  sl-eval driveby [--board NAME] [--quick] [--realistic] [--speeds A,B] [--check]\n"
+                 "  sl-eval driveby [--board NAME] [--quick] [--realistic] [--no-profile] [--speeds A,B] [--check]\n"
                  "                  [--plot FILE.png] [--psi DEG] [--phi DEG] [--offset M] [--dump]\n"
                  "                  [--obs-log FILE]\n"
                  "      3D tilt (psi, phi, base offset) fitted over simulated drive-bys against the truth.\n"

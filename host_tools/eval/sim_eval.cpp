@@ -397,6 +397,10 @@ PipeCfg pipe_cfg_for_scene(const Scene &s)
     c.board = s.board.name.empty() ? s.board_name : s.board.name;
     c.beam_deg = 2.0 * scene_az_cutoff_deg(s);
     c.threshold = s.mapping == OutputMapping::Linear ? std::max(1, s.detect_floor) : -1;
+    // The range profile's tail model reads the sensor's log magnitude (a smear tail falls by
+    // a constant number of values per bin); a linear rendering (the paper's simulation
+    // style, no smear) is read from the mask's bounds.
+    c.profile = s.mapping == OutputMapping::Log ? -1 : 0;
     c.speed_mps = s.speed_mps;
     c.rotation_hz = s.rotation_hz;
     return c;

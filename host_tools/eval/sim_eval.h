@@ -169,7 +169,8 @@ struct PipeCfg {
 /// Pipeline defaults for a simulated scene: its board, the simulated azimuth window as the
 /// beam (2 x scene_az_cutoff_deg: a touched bin reads >= detect_floor, so the return spans
 /// the whole window), threshold = detect_floor for the linear mapping (else the board's),
-/// speed = the scene's.
+/// range profiles only for the log mapping (their tail model reads log values), speed = the
+/// scene's.
 PipeCfg pipe_cfg_for_scene(const Scene &s);
 
 /// Result for one pole.

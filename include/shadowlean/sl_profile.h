@@ -23,7 +23,21 @@
 ///   an azimuth that is no target's when none is free.
 /// - sl_profile_end_rotation(): slots whose azimuth showed no bit in the window for more
 ///   than `cfg.max_idle` rotations are freed; with `reset` (the vehicle moved: the caller
-///   passes n_eff < n) every sum is cleared, so a profile never mixes positions.
+///   passes n_eff < n) every slot is cleared and freed, so a profile never mixes positions.
+///
+/// ## While moving (one rotation, neighbouring azimuths)
+/// A moving pole is at another range and azimuth every rotation, so rotations cannot be
+/// summed. Instead, after each rotation the caller reserves, for every track, the azimuths
+/// where it is expected next (sl_profile_reserve: its static-object prediction +-2); evidence
+/// claims nothing while moving. A target whose own slot holds fewer than `cfg.min_frames`
+/// rows is refined from the sum of this rotation's rows of its azimuth and its two
+/// neighbours when they belong to its detection group (adjacent azimuths, 0.9 deg apart,
+/// lie inside one beam width, 1.8 deg: the same pole at the same ranges, each with its own
+/// speckle), over the bins all of them cover: three rows, `stats.spatial`. Only to remove a
+/// smear tail: when that sum ends in a cliff (no tail) the mask's bounds are kept (an
+/// oblique pole spans other ranges on the neighbours), counted NO_TAIL. Limit: the walk
+/// (step 4) tolerates noise at the rounding level; with +-2 values of independent noise on
+/// every bin of each row it stops a few bins into the tail (`unit_profile`).
 ///
 /// ## Extraction (sl_profile_extract, pure; S = sum, F = frames, T = threshold)
 /// 1. r1: the first bin at or after `hint - 3` (the mask's first bin) with S >= F T.
@@ -75,7 +89,8 @@
 ///
 /// ## Ownership, memory, cost
 /// Caller-owned `sl_profile_t`, no allocation. RAM: SL_CFG_MAX_AZIMUTHS bytes + slots x
-/// (2 x SL_CFG_PROFILE_BINS + 10) + ~60 B (2,140 B with the defaults on x86-64).
+/// (2 x SL_CFG_PROFILE_BINS + 10) + 2 x SL_CFG_PROFILE_BINS (the neighbours' sum) + ~70 B
+/// (2,284 B with the defaults on x86-64).
 /// sl_profile_row: an unwatched azimuth costs one table read and a scan of the window's
 /// words for the first occupied bit; a watched one SL_CFG_PROFILE_BINS additions.
 /// sl_profile_extract: O(bins) with a 6- or 8-point integer fit per walked bin, 64-bit
@@ -137,7 +152,7 @@ typedef struct sl_profile_cfg {
     uint8_t min_frames;  ///< rows a profile needs before it replaces the mask's bounds
                          ///< (default 2: one row carries one rotation's speckle in full and
                          ///< is no better than the mask; while moving the sums are reset
-                         ///< every rotation, so the mask's bounds are used)
+                         ///< every rotation and the rows of neighbouring azimuths count)
 } sl_profile_cfg_t;
 
 void sl_profile_cfg_default(sl_profile_cfg_t *cfg);
@@ -175,6 +190,10 @@ typedef struct sl_profile_stats {
     uint32_t assign_full;   ///< targets left without a slot (every slot watches a target)
     uint32_t cal_accepted;  ///< self-fitted slopes taken into the calibration
     uint32_t cal_rejected;  ///< ... refused by the +-30 % gate
+    uint32_t spatial;       ///< targets refined from one rotation's rows of neighbouring
+                            ///< azimuths (too few rotations summed: moving)
+    uint32_t reserved;      ///< slots reserved where a track is expected (sl_profile_reserve)
+    uint32_t reserve_full;  ///< ... azimuths left unwatched: no free slot
 } sl_profile_stats_t;
 
 typedef struct sl_profile {
@@ -184,8 +203,12 @@ typedef struct sl_profile {
     uint16_t slope_q8;      ///< calibrated tail slope (0: none yet)
     uint16_t cal_n;         ///< fits taken into slope_q8 (saturating)
     uint16_t n_live;        ///< slots in use
+    uint8_t moving;         ///< the last sl_profile_end_rotation had `reset`: no claims on
+                            ///< evidence, only sl_profile_reserve
+    uint8_t pad_[3];
     uint8_t slot_of[SL_CFG_MAX_AZIMUTHS]; ///< slot index per azimuth, SL_PROFILE_NONE
     sl_profile_slot_t slot[SL_CFG_PROFILE_SLOTS];
+    uint16_t scratch[SL_CFG_PROFILE_BINS]; ///< neighbours' rows summed (sl_profile_refine)
     sl_profile_stats_t stats;
 } sl_profile_t;
 
@@ -209,6 +232,14 @@ void sl_profile_end_rotation(sl_profile_t *pr, bool reset);
 /// `stolen`; `assign_full` when every slot watches a target), with bin0 = bin_first -
 /// lead_bins. Its profile starts with the next row. O(targets x slots).
 void sl_profile_assign(sl_profile_t *pr, const sl_target_t *targets, uint32_t n);
+
+/// While moving (after sl_profile_end_rotation with `reset`, which frees every slot): watch
+/// the azimuths `az - half .. az + half` (circular) where a track is expected next rotation,
+/// with bin0 = `bin_first` - lead_bins, each in a free slot (`reserve_full` counts the ones
+/// left out). Evidence alone claims no slot while moving (wide returns and the ground at the
+/// shadow edge would take them all in azimuth order). @return the azimuths now watched.
+/// O(half x slots).
+uint32_t sl_profile_reserve(sl_profile_t *pr, uint16_t az, uint16_t bin_first, uint32_t half);
 
 /// Values of the sensor's log mapping that span the fill table (48 x 0.5 dB = 24 dB, a lit
 /// fraction of 0.004: below it the edge bin reads as empty).
@@ -237,7 +268,8 @@ sl_profile_bounds_t sl_profile_extract(const uint16_t *sum, uint32_t n, uint32_t
                                        uint32_t threshold, uint32_t hint, uint32_t cal_slope_q8,
                                        uint32_t cliff_end);
 
-/// Refine a detected target with the profile of its azimuth: r1 from the leading edge, r2
+/// Refine a detected target with the profile of its azimuth (while moving: this rotation's
+/// rows of it and its neighbours, see "While moving"): r1 from the leading edge, r2
 /// from the last own bin (half-bin centres, r2 sub-bin when the return ends in a cliff (6.), the target's radius terms kept, no d(r)), alpha
 /// re-estimated; flag SL_TARGET_PROFILE, `elong_um` = the smear removed (mask r2 centre -
 /// profile r2 centre). Without a usable profile the target is left as it is (counted by

@@ -1178,6 +1178,8 @@ typedef struct drive_result {
     int spurious;        // targets away from the pole
     int first_rot;       // first rotation with a detection (-1: none)
     int confirmed_frames; // PoleLean frames sent
+    int profiled;        // valid targets refined from the range profile (one rotation's
+                         // rows of neighbouring azimuths while moving)
 } drive_result_t;
 
 static drive_result_t run_drive(double v, bool motion, bool via_can, int drop_per_1000)
@@ -1211,7 +1213,7 @@ static drive_result_t run_drive(double v, bool motion, bool via_can, int drop_pe
         i = st.rot_end[r];
     }
     assert_int_equal(sl_pipeline_finish(&pl, 1000000U + (uint64_t)st.rots * 250000U), SL_OK);
-    drive_result_t res = {0, 0, 0, 0, 0, -1, 0};
+    drive_result_t res = {0, 0, 0, 0, 0, -1, 0, 0};
     double sum = 0;
     for (int k = 0; k < rec.rotations && k < MAXROT; k++) {
         for (int j = 0; j < rec.nt[k]; j++) {
@@ -1231,6 +1233,8 @@ static drive_result_t run_drive(double v, bool motion, bool via_can, int drop_pe
                 continue;
             }
             int flag;
+            const bool prof = (t->flags & SL_TARGET_PROFILE) != 0U;
+            res.profiled += prof ? 1 : 0;
             const double pred = predicted_alpha(d, alpha, t->az, &flag);
             const double got = t->alpha_cdeg / 100.0;
             if (flag == 0 && fabs(got - pred) > 0.05) {
@@ -1279,9 +1283,10 @@ static void test_pipeline_drive_by_detects_the_pole_only_with_motion_input(void 
                      without.detections, without.first_rot);
         }
         printf("drive-by %.1f m/s: %d rotations with the pole (%d valid), mean alpha error "
-               "%+.3f deg, max %.2f deg, %d PoleLean frames; without motion input: %d\n",
+               "%+.3f deg, max %.2f deg, %d PoleLean frames, %d from the profile; without "
+               "motion input: %d\n",
                v, with.detections, with.valid, with.mean_err, with.max_err,
-               with.confirmed_frames, without.detections);
+               with.confirmed_frames, with.profiled, without.detections);
     }
 }
 

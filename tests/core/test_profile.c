@@ -91,13 +91,21 @@ static void test_profile_halves_reset_and_counts_full(void **state)
     // 8 frames -> halved to 4 (sum 400) -> + 1 frame = 5 frames, sum 500: mean kept
     assert_int_equal(s->frames, 5);
     assert_int_equal(s->sum[0], 500);
+    // a reset (moving) clears the sums and frees the slot: the pole is elsewhere next time
     sl_profile_end_rotation(&pr, true);
     assert_int_equal(s->frames, 0);
-    assert_int_equal(s->sum[0], 0);
+    assert_int_equal(pr.slot_of[5], SL_PROFILE_NONE);
+    assert_int_equal(pr.n_live, 0);
+    // while moving, evidence claims no slot (only sl_profile_reserve does)
+    sl_profile_row(&pr, 5, row, 64, bits, 64);
+    assert_int_equal(pr.slot_of[5], SL_PROFILE_NONE);
+    assert_int_equal(pr.stats.claims, 1);
+    sl_profile_end_rotation(&pr, false); // stopped: evidence claims again
     // every slot in use: the next azimuth with evidence is counted, not claimed
-    for (uint16_t a = 10; a < 10 + SL_CFG_PROFILE_SLOTS; a++) {
+    for (uint16_t a = 10; a < 10 + SL_CFG_PROFILE_SLOTS + 1; a++) {
         sl_profile_row(&pr, a, row, 64, bits, 64);
     }
+    assert_int_equal(pr.stats.claims, 1 + SL_CFG_PROFILE_SLOTS);
     assert_int_equal(pr.stats.claim_full, 1);
     assert_int_equal(sl_profile_init(&pr, 0, 0, NULL), SL_ERR_ARG);
     c.max_frames = 300;
@@ -380,6 +388,79 @@ static void test_profile_refines_a_target_after_min_frames(void **state)
     assert_int_equal(pr.stats.fallback[SL_PROFILE_FEW_FRAMES], 1);
 }
 
+// Moving (the sums are cleared every rotation): the azimuths reserved where a track is
+// expected are watched, and a target is refined from ONE rotation's rows of its azimuth and
+// its two neighbours in the group (independent speckle on each), summed over the bins all
+// three cover. Each row alone is as noisy as the mask; their sum finds the own bins.
+static void test_profile_refines_from_neighbouring_azimuths_while_moving(void **state)
+{
+    (void)state;
+    assert_int_equal(sl_profile_init(&pr, 400, 0, NULL), SL_OK);
+    sl_board_t board;
+    memset(&board, 0, sizeof board);
+    board.bin_size_um = 43800;
+    uint16_t syn[NB];
+    double own[8];
+    for (int i = 0; i < 8; i++) {
+        own[i] = 70.0;
+    }
+    g_decay_db = 3.3;
+    synth(syn, 1, 20, 27, own, k_exp); // own bins 20..27, tail behind
+    sl_profile_end_rotation(&pr, true); // moving from now on
+    // reserved around azimuth 100 (+-2), bin0 = 20 - lead; 398..2 wraps
+    assert_int_equal(sl_profile_reserve(&pr, 100, 20, 2U), 5);
+    assert_int_equal(sl_profile_reserve(&pr, 0, 20, 2U), 5);
+    assert_int_equal(pr.slot_of[398] != SL_PROFILE_NONE, 1);
+    assert_int_equal(pr.slot_of[2] != SL_PROFILE_NONE, 1);
+    assert_int_equal(pr.slot_of[3], SL_PROFILE_NONE);
+    assert_int_equal(pr.stats.reserved, 10);
+    // not enough slots for a third track's five azimuths: the rest are counted
+    assert_int_equal(sl_profile_reserve(&pr, 200, 20, 2U), SL_CFG_PROFILE_SLOTS - 10);
+    assert_int_equal(pr.stats.reserve_full, 5 - (SL_CFG_PROFILE_SLOTS - 10));
+    // one row per azimuth, each with its own +-1 value of pseudo-random speckle (the tail
+    // falls 3.3 values per bin; the walk tolerates noise at the rounding level: with +-2 on
+    // every bin of each of three rows it stops four bins into the tail, still nine bins
+    // shorter than the mask)
+    uint32_t bits[2] = {0U, 0U};
+    uint32_t x = 12345U;
+    for (uint16_t az = 98; az <= 102; az++) {
+        uint8_t row[NB];
+        for (int k = 0; k < NB; k++) {
+            x = x * 1103515245U + 12345U;
+            const int v = (int)syn[k] + (int)((x >> 16) % 3U) - 1;
+            row[k] = (uint8_t)(v < 0 ? 0 : v);
+        }
+        sl_profile_row(&pr, az, row, NB, bits, NB);
+    }
+    sl_target_t t;
+    memset(&t, 0, sizeof t);
+    t.az = 100;
+    t.az_first = 99;
+    t.az_count = 3;
+    t.bin_first = 20;
+    t.bin_last = 40; // the mask's end: the smear tail
+    t.r1_um = (2 * 20 + 1) * 43800 / 2;
+    t.r2_um = (2 * 40 + 1) * 43800 / 2;
+    assert_int_equal(sl_profile_refine(&pr, &board, 40, &t), SL_PROFILE_OK);
+    assert_int_equal(pr.stats.spatial, 1);
+    assert_true((t.flags & SL_TARGET_PROFILE) != 0U);
+    assert_int_equal(t.r1_um, (2 * 20 + 1) * 43800 / 2);
+    // the own end (bin 27) within one bin from three noisy rows; the mask read 13 bins long
+    assert_true(t.r2_um >= (2 * 26 + 1) * 43800 / 2 && t.r2_um <= (2 * 28 + 1) * 43800 / 2);
+    assert_int_equal(t.elong_um, (int32_t)(t.r2_um > 0 ? (2 * 40 + 1) * 43800 / 2 - t.r2_um : 0));
+    // a group of one azimuth has no neighbours: one row is too few
+    memset(&t, 0, sizeof t);
+    t.az = 100;
+    t.az_first = 100;
+    t.az_count = 1;
+    t.bin_first = 20;
+    t.bin_last = 40;
+    assert_int_equal(sl_profile_refine(&pr, &board, 40, &t), SL_PROFILE_FEW_FRAMES);
+    // stopped: evidence claims again, reservations are not needed
+    sl_profile_end_rotation(&pr, false);
+    assert_int_equal(pr.moving, 0);
+}
+
 // Lit fraction of an edge bin from the log values (0.5 dB per value, power adds along the
 // pole): 10^(-dv/20), linear between whole values; full at or above the reference, empty
 // 48 values (24 dB) below it.
@@ -464,6 +545,7 @@ int main(void)
         cmocka_unit_test(test_profile_a_cliff_beyond_the_shadow_edge_ends_a_tail),
         cmocka_unit_test(test_profile_slots_follow_the_targets),
         cmocka_unit_test(test_profile_refines_a_target_after_min_frames),
+        cmocka_unit_test(test_profile_refines_from_neighbouring_azimuths_while_moving),
         cmocka_unit_test(test_profile_fill_from_the_log_values),
         cmocka_unit_test(test_profile_refines_r2_within_the_last_bin_of_a_cliff),
     };
