@@ -11,7 +11,8 @@
 # Tolerances: the issue's, |Tilt error| <= 1 deg, direction within 10 deg (the observations
 # are the detection group's union extent at its centre azimuth: sl_tiltobs.h); on
 # scenes/driveby_realistic.ini (the same drive-by as the sensor reports it: log magnitude,
-# noise floor, leakage, smear tail, speckle) the realistic bounds, 2 deg / 20 deg.
+# noise floor, leakage, smear tail, speckle) the realistic bounds, 2 deg / 20 deg,
+# and no LeanWarning above the true lean's level (lean_warning_sides.py).
 set -u
 SL_SIM=$1; D=$2; PY=$3; SRC=$4; OUT=$5
 rm -rf "$OUT"; mkdir -p "$OUT"
@@ -39,6 +40,10 @@ run curve 1.5,10 "$ROOT/scenes/driveby_curve.ini" || fail=1
 # neighbouring azimuths (sl_profile.h, "While moving"); measured 0.1 / 0.2 deg, 2 / 1 deg.
 PSI_TOL=2; PHI_TOL=20
 run realistic 1.0 "$ROOT/scenes/driveby_realistic.ini" || fail=1
+# ... and its LeanWarning never above the true lean's level by more than 3 sigma: the pole
+# leaning 10 deg away from the path never raises DANGER (before the range profile while
+# moving it did, on 9 frames at Lean +16.95).
+"$PY" "$SRC/lean_warning_sides.py" "$DBC" "$OUT/realistic.log" 10 -10 || fail=1
 # No motion input: no PoleTilt frame (the demo and Oxford frames stay as they were).
 "$D" --board paper-sim --input "$OUT/slow.colossus" --can-log "$OUT/still.log" -q || fail=1
 n=$(grep -c " 624#" "$OUT/still.log")
