@@ -456,6 +456,7 @@ uint8_t sl_profile_refine(sl_profile_t *pr, const sl_board_t *board, uint32_t th
         // the return's own (its end is where the return ends), while a mean over azimuths
         // that see an oblique pole at other ranges would end elsewhere: keep the mask's.
         pr->stats.fallback[SL_PROFILE_NO_TAIL]++;
+        t->flags = (uint8_t)(t->flags | SL_TARGET_NO_TAIL);
         return (uint8_t)SL_PROFILE_NO_TAIL;
     }
     if (pb.slope_src == SL_PROFILE_SLOPE_FIT) {

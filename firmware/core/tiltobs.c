@@ -237,6 +237,10 @@ void sl_tiltobs_update(sl_tiltobs_t *o, const sl_track_t *tracks, const sl_targe
             o->stats.no_target++;
             continue;
         }
+        if (o->verified_only && (g->flags & (SL_TARGET_PROFILE | SL_TARGET_NO_TAIL)) == 0U) {
+            o->stats.unverified++;
+            continue;
+        }
         sl_tiltobs_ring_t *r = ring_of(o, t->id);
         if (r == NULL) {
             r = ring_of(o, 0U);
@@ -251,6 +255,57 @@ void sl_tiltobs_update(sl_tiltobs_t *o, const sl_track_t *tracks, const sl_targe
         }
         observe(o, r, g);
     }
+}
+
+// The observation with the largest residual |tan(alpha_k) - pred_k| / sigma_k under the fit
+// `res` (pred = -(t . e_k), the reading the fit chose for mirrored ones). O(n).
+static uint32_t worst_obs(const sl_tiltobs_ring_t *r)
+{
+    uint32_t worst = 0;
+    int64_t wr = -1, ws = 1;
+    for (uint32_t k = 0; k < r->count; k++) {
+        const sl_tilt_obs_t *ob = &r->obs[k];
+        const bool mir = k < 32U && ((r->res.mirrored_mask >> k) & 1U) != 0U;
+        const int64_t tan_q24 = (int64_t)(mir ? ob->tan_mirror_q12 : ob->tan_q12) * 4096;
+        const int64_t pred_q24 = -(((int64_t)r->res.tx_q24 * ob->cos_a_q15 +
+                                    (int64_t)r->res.ty_q24 * ob->sin_a_q15) >> 15);
+        const int64_t d = tan_q24 - pred_q24;
+        const int64_t ad = d < 0 ? -d : d;          // < 2^28
+        const int64_t sg = (int64_t)ob->sigma_q16; // >= SL_TILT_SIGMA_MIN_Q16
+        if (ad * ws > wr * sg) {                    // ad / sg > wr / ws
+            worst = k;
+            wr = ad;
+            ws = sg;
+        }
+    }
+    return worst;
+}
+
+// Remove observation k (array index) keeping the others in age order; afterwards the ring
+// is in the not-full layout (oldest at 0, head = count). O(capacity).
+static void drop_obs(sl_tiltobs_ring_t *r, uint32_t k)
+{
+    const uint32_t cap = (uint32_t)SL_CFG_TILT_OBS_PER_TRACK;
+    const uint32_t n = r->count;
+    uint32_t at = k;
+    if (n == cap && r->head != 0U) {
+        // rotate left by head (oldest first): reverse [0, head), [head, cap), [0, cap)
+        const uint32_t h = r->head;
+        const uint32_t seg[3][2] = {{0U, h}, {h, cap}, {0U, cap}};
+        for (uint32_t q = 0; q < 3U; q++) {
+            for (uint32_t i = seg[q][0], j = seg[q][1] - 1U; i < j; i++, j--) {
+                const sl_tilt_obs_t tmp = r->obs[i];
+                r->obs[i] = r->obs[j];
+                r->obs[j] = tmp;
+            }
+        }
+        at = (k + cap - h) % cap;
+    }
+    for (uint32_t i = at; i + 1U < n; i++) {
+        r->obs[i] = r->obs[i + 1U];
+    }
+    r->count = (uint8_t)(n - 1U);
+    r->head = r->count;
 }
 
 void sl_tiltobs_fit_pending(sl_tiltobs_t *o)
@@ -268,6 +323,19 @@ void sl_tiltobs_fit_pending(sl_tiltobs_t *o)
             continue;
         }
         (void)sl_tilt_fit(r->obs, r->count, &o->prm, &o->work, &r->res);
+        // One gross outlier (a bound the profile could not clean) makes a whole pass
+        // INCONSISTENT: drop the observation with the largest residual in sigmas and fit
+        // again, at most one in SL_TILTOBS_OUTLIER_DIV of the observations per ring (a
+        // pole that is not straight, or a wrong association, stays INCONSISTENT).
+        if (r->res.quality == (uint8_t)SL_TILT_INCONSISTENT &&
+            r->count >= SL_TILTOBS_OUTLIER_MIN_N &&
+            (uint32_t)r->dropped + 1U <= (uint32_t)r->count / SL_TILTOBS_OUTLIER_DIV) {
+            drop_obs(r, worst_obs(r));
+            r->dropped++;
+            o->stats.outliers++;
+            (void)sl_tilt_fit(r->obs, r->count, &o->prm, &o->work, &r->res);
+            o->stats.fits++;
+        }
         r->fresh = 0U;
         o->pending--;
         r->fitted = 1U;

@@ -57,6 +57,7 @@ struct RunCtx {
     bool dump = false;
     sl_tiltobs_ring_t prev[SL_CFG_TILT_TRACKS]{};
     sl_tiltobs_ring_t fitted_ring{};
+    sl_tiltobs_ring_t other_ring{}; // --dump: the fullest ring when no fit was FITTED/AMBIGUOUS
     FILE *obs_log = nullptr; // --obs-log: every new fit of the pole's ring, one JSON line
     const Case *kase = nullptr;
     sl_tilt_result_t logged[SL_CFG_TILT_TRACKS]{};
@@ -140,6 +141,10 @@ void on_rotation(void *ctx, const sl_pipeline_rotation_t *r)
         if (ring.count >= c->other_n) {
             c->other_n = ring.count;
             c->other_q = v.quality;
+            if (c->dump) { // --dump of a pass without a FITTED or AMBIGUOUS result
+                c->other_ring = c->prev[static_cast<size_t>(&ring - &t->ring[0])];
+                c->other_ring.res = ring.res;
+            }
         }
         if (v.quality != SL_TILT_FITTED && v.quality != SL_TILT_AMBIGUOUS) {
             continue;
@@ -398,6 +403,8 @@ Outcome run_case(const std::string &board_name, const Case &k, bool realistic, i
     }
     if (dump && ctx.fitted_ring.track_id != 0U) {
         dump_ring(ctx.fitted_ring, p->tilt.prm, k);
+    } else if (dump && ctx.other_ring.track_id != 0U) {
+        dump_ring(ctx.other_ring, p->tilt.prm, k); // e.g. INCONSISTENT: what the fit read
     }
     if (ctx.last.quality >= 0) {
         return ctx.last;

@@ -189,6 +189,8 @@ typedef enum sl_detect_reject {
 #define SL_TARGET_PROFILE 0x20U        ///< bounds from the range profile (sl_profile.h)
 #define SL_TARGET_TAIL_EDGE 0x40U      ///< a run's smear tail crosses the shadow edge: the
                                        ///< caller tests the refined r2 against S (stage 1)
+#define SL_TARGET_NO_TAIL 0x80U        ///< the range profile saw the return end in a cliff (no
+                                       ///< smear tail): the mask's bounds are its own
 
 /// Detection parameters that are not (yet) board fields.
 typedef struct sl_detect_cfg {

@@ -140,6 +140,10 @@ typedef enum sl_profile_fail {
     SL_PROFILE_FAIL_COUNT = 7
 } sl_profile_fail_t;
 
+/// Accepted self-fitted tail slopes (`cal_n`) from which the stream counts as smearing: its
+/// mask bounds then carry a tail (sl_tiltobs_t.verified_only).
+#define SL_PROFILE_CAL_SMEAR_N 4U
+
 /// Where the slope of an extraction came from.
 #define SL_PROFILE_SLOPE_FIT 1U ///< self-fitted on this profile
 #define SL_PROFILE_SLOPE_CAL 2U ///< the running calibration (tail too short to fit)

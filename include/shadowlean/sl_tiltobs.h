@@ -76,9 +76,16 @@ typedef struct sl_tiltobs_ring {
     uint8_t head;           ///< next slot written
     uint8_t fresh;          ///< an observation was added since the last fit
     uint8_t fitted;         ///< `res` holds a fit of this ring's observations
-    uint8_t reserved;
+    uint8_t dropped;        ///< observations removed as outliers (sl_tiltobs_fit_pending)
     sl_tilt_obs_t obs[SL_CFG_TILT_OBS_PER_TRACK];
 } sl_tiltobs_ring_t;
+
+/// Outlier rejection (sl_tiltobs_fit_pending): a ring whose fit is INCONSISTENT and holds at
+/// least SL_TILTOBS_OUTLIER_MIN_N observations loses the one with the largest residual in
+/// sigmas and is fitted again, while the ring's drops stay within 1 / SL_TILTOBS_OUTLIER_DIV
+/// of its observations.
+#define SL_TILTOBS_OUTLIER_MIN_N 8U
+#define SL_TILTOBS_OUTLIER_DIV 8U
 
 /// Counters (cumulative; never asserted).
 typedef struct sl_tiltobs_stats {
@@ -89,6 +96,9 @@ typedef struct sl_tiltobs_stats {
     uint32_t no_ring;       ///< observations lost: every ring in use
     uint32_t fits;          ///< sl_tilt_fit calls
     uint32_t resets;        ///< histories cleared because the motion input was missing
+    uint32_t unverified;    ///< targets not stored under `verified_only`: bounds the range
+                            ///< profile did not check (SL_TARGET_PROFILE / _NO_TAIL unset)
+    uint32_t outliers;      ///< observations dropped from INCONSISTENT fits
 } sl_tiltobs_stats_t;
 
 /// The history of every tracked pole plus the odometry. Caller-owned.
@@ -100,6 +110,11 @@ typedef struct sl_tiltobs {
     bool moving;               ///< the last rotation had a motion input (poses usable)
     uint8_t rr;                ///< internal: round-robin start of the fits
     uint8_t pending;           ///< rings with an observation not fitted yet
+    bool verified_only;        ///< store only targets whose bounds the range profile checked
+                               ///< (SL_TARGET_PROFILE or _NO_TAIL): set by the pipeline once
+                               ///< the stream shows a smear tail, whose unremoved length in
+                               ///< the mask's bounds reads as a lean (a single such
+                               ///< observation makes a whole pass INCONSISTENT)
     sl_tiltobs_stats_t stats;
     sl_tilt_work_t work;       ///< fit scratch
     sl_tiltobs_ring_t ring[SL_CFG_TILT_TRACKS];
