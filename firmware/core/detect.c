@@ -6,6 +6,7 @@
 #include "shadowlean/sl_detect.h"
 
 #include "bits.h"
+#include "compiler.h"
 #include "shadowlean/sl_fx.h"
 
 #define CF_NEAR 0x01U
@@ -648,14 +649,10 @@ void sl_detect_set_tail_slope(sl_detect_t *d, uint16_t slope_q8)
 // with a known tail slope, ending within ceil((peak - T) 256 / slope) bins of the window;
 // without one, its first half stronger than its second by >= 1/2 value per bin of
 // separation (the profiles' smallest plausible slope). Then TAIL, else SHADOW. Without an
-// amplitude row the d(S) rule: SHADOW when the last bin reaches `edge`.
-#if defined(__GNUC__)
-#define DETECT_NOINLINE __attribute__((noinline)) // rare path: out of sl_detect_row's loop
-#else
-#define DETECT_NOINLINE
-#endif
-static DETECT_NOINLINE uint8_t edge_rule(const sl_detect_t *d, uint32_t s, uint32_t e,
-                                         uint32_t win, uint32_t edge)
+// amplitude row the d(S) rule: SHADOW when the last bin reaches `edge`. Not inlined: a rare
+// path, out of sl_detect_row's loop.
+static SL_NOINLINE uint8_t edge_rule(const sl_detect_t *d, uint32_t s, uint32_t e,
+                                     uint32_t win, uint32_t edge)
 {
     const uint8_t *p = d->amp;
     if (p == NULL || e > d->amp_bins || s >= win || e <= win) {

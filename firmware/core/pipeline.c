@@ -15,13 +15,7 @@
 
 #include "shadowlean/sl_pipeline.h"
 
-// Keeps a helper's locals out of its caller's frame (stack budget: the deepest chain runs
-// from sl_pipeline_feed through on_rot into detection; tests/core/build/stack_budget.py).
-#if defined(__GNUC__)
-#define SL_NOINLINE __attribute__((noinline))
-#else
-#define SL_NOINLINE
-#endif
+#include "compiler.h"
 
 #define ROTATION_US_MIN 50000U   // plausible radar rotation periods for the measured T
 #define ROTATION_US_MAX 2000000U

@@ -8,6 +8,8 @@
 #include "shadowlean/sl_fx.h"
 #include "shadowlean/sl_incline.h"
 
+#include "compiler.h"
+
 #define P2_32 ((int64_t)4294967296LL) // 2^32
 
 // cdeg -> bam32 (two's complement for negative angles), rounded to nearest.
@@ -259,7 +261,7 @@ void sl_tiltobs_update(sl_tiltobs_t *o, const sl_track_t *tracks, const sl_targe
 
 // The observation with the largest residual |tan(alpha_k) - pred_k| / sigma_k under the fit
 // `res` (pred = -(t . e_k), the reading the fit chose for mirrored ones). O(n).
-static uint32_t worst_obs(const sl_tiltobs_ring_t *r)
+static SL_NOINLINE uint32_t worst_obs(const sl_tiltobs_ring_t *r)
 {
     uint32_t worst = 0;
     int64_t wr = -1, ws = 1;
@@ -281,9 +283,19 @@ static uint32_t worst_obs(const sl_tiltobs_ring_t *r)
     return worst;
 }
 
+static void reverse_obs(sl_tilt_obs_t *a, uint32_t lo, uint32_t hi) // [lo, hi)
+{
+    for (uint32_t i = lo, j = hi; i + 1U < j; i++, j--) {
+        const sl_tilt_obs_t tmp = a[i];
+        a[i] = a[j - 1U];
+        a[j - 1U] = tmp;
+    }
+}
+
 // Remove observation k (array index) keeping the others in age order; afterwards the ring
-// is in the not-full layout (oldest at 0, head = count). O(capacity).
-static void drop_obs(sl_tiltobs_ring_t *r, uint32_t k)
+// is in the not-full layout (oldest at 0, head = count). O(capacity). Not inlined: its
+// frame stays off the fit's call chain (the Cortex-M0 stack budget).
+static SL_NOINLINE void drop_obs(sl_tiltobs_ring_t *r, uint32_t k)
 {
     const uint32_t cap = (uint32_t)SL_CFG_TILT_OBS_PER_TRACK;
     const uint32_t n = r->count;
@@ -291,14 +303,9 @@ static void drop_obs(sl_tiltobs_ring_t *r, uint32_t k)
     if (n == cap && r->head != 0U) {
         // rotate left by head (oldest first): reverse [0, head), [head, cap), [0, cap)
         const uint32_t h = r->head;
-        const uint32_t seg[3][2] = {{0U, h}, {h, cap}, {0U, cap}};
-        for (uint32_t q = 0; q < 3U; q++) {
-            for (uint32_t i = seg[q][0], j = seg[q][1] - 1U; i < j; i++, j--) {
-                const sl_tilt_obs_t tmp = r->obs[i];
-                r->obs[i] = r->obs[j];
-                r->obs[j] = tmp;
-            }
-        }
+        reverse_obs(r->obs, 0U, h);
+        reverse_obs(r->obs, h, cap);
+        reverse_obs(r->obs, 0U, cap);
         at = (k + cap - h) % cap;
     }
     for (uint32_t i = at; i + 1U < n; i++) {
