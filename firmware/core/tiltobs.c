@@ -330,24 +330,32 @@ void sl_tiltobs_fit_pending(sl_tiltobs_t *o)
             continue;
         }
         (void)sl_tilt_fit(r->obs, r->count, &o->prm, &o->work, &r->res);
+        o->stats.fits++;
+        done++;
         // One gross outlier (a bound the profile could not clean) makes a whole pass
         // INCONSISTENT: drop the observation with the largest residual in sigmas and fit
         // again, at most one in SL_TILTOBS_OUTLIER_DIV of the observations per ring (a
-        // pole that is not straight, or a wrong association, stays INCONSISTENT).
-        if (r->res.quality == (uint8_t)SL_TILT_INCONSISTENT &&
+        // pole that is not straight, or a wrong association, stays INCONSISTENT). The
+        // second fit counts against the bound: without room for it the ring stays fresh
+        // and starts the next call.
+        if (SL_CFG_TILT_FITS_PER_ROTATION >= 2 &&
+            r->res.quality == (uint8_t)SL_TILT_INCONSISTENT &&
             r->count >= SL_TILTOBS_OUTLIER_MIN_N &&
             (uint32_t)r->dropped + 1U <= (uint32_t)r->count / SL_TILTOBS_OUTLIER_DIV) {
+            if (done >= (uint32_t)SL_CFG_TILT_FITS_PER_ROTATION) {
+                o->rr = (uint8_t)idx;
+                break;
+            }
             drop_obs(r, worst_obs(r));
             r->dropped++;
             o->stats.outliers++;
             (void)sl_tilt_fit(r->obs, r->count, &o->prm, &o->work, &r->res);
             o->stats.fits++;
+            done++;
         }
         r->fresh = 0U;
         o->pending--;
         r->fitted = 1U;
-        o->stats.fits++;
-        done++;
         o->rr = (uint8_t)((idx + 1U) % (uint32_t)SL_CFG_TILT_TRACKS);
     }
 }

@@ -28,7 +28,9 @@
 ///    Tracks beyond SL_CFG_TILT_TRACKS rings get none (counted in `stats.no_ring`).
 /// 3. `sl_tiltobs_fit_pending()`: the fit (`sl_tilt_fit`) runs on rings that received an
 ///    observation since their last fit, at most SL_CFG_TILT_FITS_PER_ROTATION per call
-///    (round robin over the rings; the others keep their previous result until their turn):
+///    (round robin over the rings; the others keep their previous result until their turn;
+///    an INCONSISTENT fit may drop its worst observation and fit again, within the same
+///    bound, see "Outlier rejection" below):
 ///    never per azimuth. The pipeline calls it when control returns from the decoder (end
 ///    of sl_pipeline_feed / _on_msg / _finish), not from inside the rotation callback: the
 ///    fit's stack (~800 B on Cortex-M0) then does not add to the decoder's call chain. So a
