@@ -748,6 +748,18 @@ static void log_stats(daemon_t *d, int level, const char *what)
             g_pipe.proto.stats.resyncs, d->frames_out, d->status_frames, d->idle_status_frames,
             s->can_dropped, s->motion_accepted, s->motion_rejected,
             g_pipe.detect.stats.target_overflow);
+    const sl_profile_stats_t *ps = &g_pipe.prof.stats;
+    sld_log(SLD_LOG_INFO, "%s: range profiles: %" PRIu32 " targets refined (%" PRIu32
+            " from one rotation's neighbouring azimuths, moving); mask bounds kept: %" PRIu32
+            " no slot, %" PRIu32 " too few rows, %" PRIu32 " no tail, %" PRIu32
+            " other; tilt observations %" PRIu32 " (%" PRIu32 " unverified left out, %" PRIu32
+            " outliers dropped)",
+            what, ps->extracted, ps->spatial, ps->fallback[SL_PROFILE_NO_SLOT],
+            ps->fallback[SL_PROFILE_FEW_FRAMES], ps->fallback[SL_PROFILE_NO_TAIL],
+            ps->fallback[SL_PROFILE_LEAD_CUT] + ps->fallback[SL_PROFILE_NO_RUN] +
+                ps->fallback[SL_PROFILE_TAIL_CUT],
+            g_pipe.tilt.stats.observations, g_pipe.tilt.stats.unverified,
+            g_pipe.tilt.stats.outliers);
     const sl_drift_t *dw = &g_pipe.drift;
     sld_log(SLD_LOG_INFO, "%s: theta drift watch: %s %+.2f deg%s; samples %" PRIu32 ", no ground %" PRIu32
             ", occupied %" PRIu32 ", outliers %" PRIu32, what, dw->valid ? "estimate" : "no estimate",

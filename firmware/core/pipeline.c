@@ -607,10 +607,12 @@ static SL_NOINLINE uint32_t shadow_after_refine(sl_pipeline_t *p, uint32_t n)
 // expected (its static-object prediction under one rotation's displacement, +-2 azimuths:
 // the representative azimuth moves by up to half a beam's return, and the refinement sums
 // the neighbours of whichever it is). Confirmed tracks first, then the others updated now.
+// Reversing: the prediction is for forward motion, and moving back by d is moving forward by
+// d along the opposite axis: the bearing turned by half a turn, predicted, turned back.
 static SL_NOINLINE void reserve_profiles(sl_pipeline_t *p)
 {
     const uint32_t b = p->det_board.bin_size_um;
-    if (b == 0U || p->tracker.motion_reverse) {
+    if (b == 0U) {
         return;
     }
     for (uint32_t pass = 0; pass < 2U; pass++) {
@@ -619,10 +621,13 @@ static SL_NOINLINE void reserve_profiles(sl_pipeline_t *p)
             if (t->live == 0U || t->updated == 0U || (pass == 0U) != (t->confirmed != 0U)) {
                 continue;
             }
+            const uint32_t naz = p->det_board.azimuths;
+            const uint32_t turn = p->tracker.motion_reverse ? naz / 2U : 0U;
             uint16_t az = 0;
             uint32_t r = 0;
-            sl_track_predict_static(&p->det_board, t->az, t->r1_um, p->tracker.motion_um, &az,
-                                    &r);
+            sl_track_predict_static(&p->det_board, (uint16_t)(((uint32_t)t->az + turn) % naz),
+                                    t->r1_um, p->tracker.motion_um, &az, &r);
+            az = (uint16_t)(((uint32_t)az + naz - turn) % naz);
             const uint32_t bin = r / b;
             (void)sl_profile_reserve(&p->prof, az, (uint16_t)(bin > 0xFFFFU ? 0xFFFFU : bin),
                                      2U);

@@ -44,6 +44,13 @@ run realistic 1.0 "$ROOT/scenes/driveby_realistic.ini" || fail=1
 # leaning 10 deg away from the path never raises DANGER (before the range profile while
 # moving it did, on 9 frames at Lean +16.95).
 "$PY" "$SRC/lean_warning_sides.py" "$DBC" "$OUT/realistic.log" 10 -10 || fail=1
+# The same drive-by reversing (from 7.5 m past the poles, --motion -1.0): the profile's slots
+# follow the tracks backwards too (measured 10.1 / 10.5 deg, 1 / 2 deg).
+sed 's/^y_m = -6.0/y_m = 7.5/; s/^speed_mps = 1.0/speed_mps = -1.0/' \
+    "$ROOT/scenes/driveby_realistic.ini" > "$OUT/reverse.ini"
+grep -q '^speed_mps = -1.0' "$OUT/reverse.ini" || { echo "FAIL: scene edit"; exit 1; }
+run reverse -1.0 "$OUT/reverse.ini" || fail=1
+"$PY" "$SRC/lean_warning_sides.py" "$DBC" "$OUT/reverse.log" 10 -10 || fail=1
 # No motion input: no PoleTilt frame (the demo and Oxford frames stay as they were).
 "$D" --board paper-sim --input "$OUT/slow.colossus" --can-log "$OUT/still.log" -q || fail=1
 n=$(grep -c " 624#" "$OUT/still.log")
