@@ -35,9 +35,11 @@
 /// lie inside one beam width, 1.8 deg: the same pole at the same ranges, each with its own
 /// speckle), over the bins all of them cover: three rows, `stats.spatial`. Only to remove a
 /// smear tail: when that sum ends in a cliff (no tail) the mask's bounds are kept (an
-/// oblique pole spans other ranges on the neighbours), counted NO_TAIL. Limit: the walk
+/// oblique pole spans other ranges on the neighbours), counted NO_TAIL. Limits: the walk
 /// (step 4) tolerates noise at the rounding level; with +-2 values of independent noise on
-/// every bin of each row it stops a few bins into the tail (`unit_profile`).
+/// every bin of each row it stops a few bins into the tail (`unit_profile`). With the
+/// default 12 slots two tracks are watched in full while moving (5 azimuths each; confirmed
+/// tracks first), the others partly or not (`stats.reserve_full`).
 ///
 /// ## Extraction (sl_profile_extract, pure; S = sum, F = frames, T = threshold)
 /// 1. r1: the first bin at or after `hint - 3` (the mask's first bin) with S >= F T.
