@@ -11,7 +11,9 @@
 ///              consistency, window shortened with vehicle speed) -> sl_detect (runs in
 ///              the shadow, corrections, alpha) -> sl_profile (bounds re-extracted from
 ///              the summed 8-bit rows of the azimuths that show something in the shadow,
-///              smear tail removed; cfg.profile; a target is then rejected SHADOW when
+///              smear tail removed; while moving, one rotation's rows of the target's
+///              azimuth and its neighbours, in slots reserved after the tracker where each
+///              track is expected; cfg.profile; a target is then rejected SHADOW when
 ///              its refined r2 (else, for a target whose tail crosses the shadow edge,
 ///              SL_TARGET_TAIL_EDGE, its r2 less d(r2)) reaches the edge, so the board's
 ///              d decides nothing once a profile exists; the profiles' calibrated tail
@@ -131,8 +133,8 @@
 /// ## RAM budget (sizeof(sl_pipeline_t)); asserted below for the firmware configuration
 /// Dominated by the mask: SL_CFG_MAX_AZIMUTHS x (1 + ceil(log2 SL_CFG_MASK_FRAMES_MAX)) x
 /// SL_CFG_MASK_BINS / 8 bytes; then detection (8,424 B), the tracker (1,864 B), the scan
-/// bookkeeping (624 B), the range profiles (sl_profile.h, 2.1 KB), the 3D tilt history
-/// (sl_tiltobs.h: 2,472 B firmware, 7.4 KB host default), the reassembly buffer
+/// bookkeeping (624 B), the range profiles (sl_profile.h, 2.3 KB), the 3D tilt history
+/// (sl_tiltobs.h: 2,480 B firmware, 7.4 KB host default), the reassembly buffer
 /// (SL_PIPELINE_REASM_BYTES), a row buffer and the theta drift watch (sl_drift.h, 60 B).
 ///
 /// Measured sizes per configuration: docs/PERFORMANCE.md ("Core modules").
