@@ -606,7 +606,8 @@ static SL_NOINLINE uint32_t shadow_after_refine(sl_pipeline_t *p, uint32_t n)
 // Moving: the profile watches, next rotation, the azimuths where each track updated now is
 // expected (its static-object prediction under one rotation's displacement, +-2 azimuths:
 // the representative azimuth moves by up to half a beam's return, and the refinement sums
-// the neighbours of whichever it is). Confirmed tracks first, then the others updated now.
+// the neighbours of whichever it is). Confirmed tracks first (also when missed this
+// rotation), then the others updated now.
 // Reversing: the prediction is for forward motion, and moving back by d is moving forward by
 // d along the opposite axis: the bearing turned by half a turn, predicted, turned back.
 static SL_NOINLINE void reserve_profiles(sl_pipeline_t *p)
@@ -618,7 +619,10 @@ static SL_NOINLINE void reserve_profiles(sl_pipeline_t *p)
     for (uint32_t pass = 0; pass < 2U; pass++) {
         for (uint32_t i = 0; i < SL_CFG_MAX_TARGETS; i++) {
             const sl_track_t *t = &p->tracker.tracks[i];
-            if (t->live == 0U || t->updated == 0U || (pass == 0U) != (t->confirmed != 0U)) {
+            // a confirmed track missed this rotation is still predicted (dead reckoning:
+            // its az / r1 moved to the prediction); an unconfirmed one only when updated
+            if (t->live == 0U || (pass == 0U) != (t->confirmed != 0U) ||
+                (t->confirmed == 0U && t->updated == 0U)) {
                 continue;
             }
             const uint32_t naz = p->det_board.azimuths;
