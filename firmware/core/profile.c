@@ -65,6 +65,32 @@ static void slot_add(const sl_profile_t *pr, sl_profile_slot_t *s, const uint8_t
     s->frames++;
 }
 
+// The first free slot, SL_CFG_PROFILE_SLOTS when every one is in use.
+static uint32_t free_slot(const sl_profile_t *pr)
+{
+    for (uint32_t i = 0; i < SL_CFG_PROFILE_SLOTS; i++) {
+        if (pr->slot[i].live == 0U) {
+            return i;
+        }
+    }
+    return SL_CFG_PROFILE_SLOTS;
+}
+
+// Slot `i` starts watching azimuth `az` (no row yet), its window from `first` - lead_bins:
+// a claim on evidence, an assignment to a target or a reservation for a track. The caller
+// keeps n_live and the counters (and unlinks a slot it takes from another azimuth).
+static sl_profile_slot_t *slot_start(sl_profile_t *pr, uint32_t i, uint32_t az, uint32_t first)
+{
+    sl_profile_slot_t *s = &pr->slot[i];
+    memset(s, 0, sizeof *s);
+    s->live = 1U;
+    s->seen = 1U;
+    s->az = (uint16_t)az;
+    s->bin0 = (uint16_t)(first > pr->cfg.lead_bins ? first - pr->cfg.lead_bins : 0U);
+    pr->slot_of[az] = (uint8_t)i;
+    return s;
+}
+
 void sl_profile_row(sl_profile_t *pr, uint16_t az, const uint8_t *power, uint32_t n,
                     const uint32_t *bits, uint32_t win)
 {
@@ -86,27 +112,14 @@ void sl_profile_row(sl_profile_t *pr, uint16_t az, const uint8_t *power, uint32_
     if (first >= hi || pr->moving != 0U) {
         return; // moving: only the azimuths reserved for tracks are watched
     }
-    if (pr->n_live >= SL_CFG_PROFILE_SLOTS) {
+    const uint32_t i = pr->n_live < SL_CFG_PROFILE_SLOTS ? free_slot(pr) : SL_CFG_PROFILE_SLOTS;
+    if (i == SL_CFG_PROFILE_SLOTS) {
         pr->stats.claim_full++;
         return;
     }
-    for (uint32_t i = 0; i < SL_CFG_PROFILE_SLOTS; i++) {
-        sl_profile_slot_t *s = &pr->slot[i];
-        if (s->live != 0U) {
-            continue;
-        }
-        memset(s, 0, sizeof *s);
-        s->live = 1U;
-        s->seen = 1U;
-        s->az = az;
-        s->bin0 = (uint16_t)(first > pr->cfg.lead_bins ? first - pr->cfg.lead_bins : 0U);
-        pr->slot_of[az] = (uint8_t)i;
-        pr->n_live++;
-        pr->stats.claims++;
-        slot_add(pr, s, power, n);
-        return;
-    }
-    pr->stats.claim_full++;
+    pr->n_live++;
+    pr->stats.claims++;
+    slot_add(pr, slot_start(pr, i, az, first), power, n);
 }
 
 void sl_profile_end_rotation(sl_profile_t *pr, bool reset)
@@ -530,19 +543,14 @@ void sl_profile_assign(sl_profile_t *pr, const sl_target_t *targets, uint32_t n)
             pr->stats.assign_full++;
             continue;
         }
-        sl_profile_slot_t *s = &pr->slot[pick];
-        if (s->live != 0U) {
-            pr->slot_of[s->az] = SL_PROFILE_NONE;
+        const sl_profile_slot_t *old = &pr->slot[pick];
+        if (old->live != 0U) {
+            pr->slot_of[old->az] = SL_PROFILE_NONE;
             pr->stats.stolen++;
         } else {
             pr->n_live++;
         }
-        memset(s, 0, sizeof *s);
-        s->live = 1U;
-        s->seen = 1U;
-        s->az = t->az;
-        s->bin0 = (uint16_t)(t->bin_first > pr->cfg.lead_bins ? (uint32_t)t->bin_first - pr->cfg.lead_bins : 0U);
-        pr->slot_of[t->az] = (uint8_t)pick;
+        (void)slot_start(pr, pick, t->az, t->bin_first);
         keep[pick] = 1U;
         pr->stats.assigned++;
     }
@@ -563,25 +571,12 @@ uint32_t sl_profile_reserve(sl_profile_t *pr, uint16_t az, uint16_t bin_first, u
             got++; // already watched (another track's neighbour)
             continue;
         }
-        uint32_t pick = SL_CFG_PROFILE_SLOTS;
-        for (uint32_t i = 0; i < SL_CFG_PROFILE_SLOTS; i++) {
-            if (pr->slot[i].live == 0U) {
-                pick = i;
-                break;
-            }
-        }
+        const uint32_t pick = free_slot(pr);
         if (pick == SL_CFG_PROFILE_SLOTS) {
             pr->stats.reserve_full++;
             continue;
         }
-        sl_profile_slot_t *s = &pr->slot[pick];
-        memset(s, 0, sizeof *s);
-        s->live = 1U;
-        s->seen = 1U;
-        s->az = (uint16_t)a;
-        s->bin0 = (uint16_t)(bin_first > pr->cfg.lead_bins ? (uint32_t)bin_first - pr->cfg.lead_bins
-                                                           : 0U);
-        pr->slot_of[a] = (uint8_t)pick;
+        (void)slot_start(pr, pick, a, bin_first);
         pr->n_live++;
         pr->stats.reserved++;
         got++;
