@@ -341,6 +341,26 @@ static void test_profile_slots_follow_the_targets(void **state)
     assert_int_equal(pr.n_live, SL_CFG_PROFILE_SLOTS);
 }
 
+// A board with only the bin size the refinement needs (43.8 mm, the CTS350-X's).
+static sl_board_t bins_board(void)
+{
+    sl_board_t board;
+    memset(&board, 0, sizeof board);
+    board.bin_size_um = 43800;
+    return board;
+}
+
+// One row of a uniform pole (70 dB on bins [a, b]) with a 3.3 dB/bin exponential smear tail.
+static void flat_pole_row(uint16_t *syn, int a, int b)
+{
+    double own[NB];
+    for (int i = 0; i <= b - a; i++) {
+        own[i] = 70.0;
+    }
+    g_decay_db = 3.3;
+    synth(syn, 1, a, b, own, k_exp);
+}
+
 // A profile replaces the mask's bounds only with >= cfg.min_frames rows (a single row, e.g.
 // while moving, is no better than the mask); then r1/r2 are the profile's bin centres,
 // the smear removed, and the target is flagged.
@@ -348,16 +368,9 @@ static void test_profile_refines_a_target_after_min_frames(void **state)
 {
     (void)state;
     assert_int_equal(sl_profile_init(&pr, 400, 0, NULL), SL_OK);
-    sl_board_t board;
-    memset(&board, 0, sizeof board);
-    board.bin_size_um = 43800;
+    const sl_board_t board = bins_board();
     uint16_t syn[NB];
-    double own[6];
-    for (int i = 0; i < 6; i++) {
-        own[i] = 70.0;
-    }
-    g_decay_db = 3.3;
-    synth(syn, 1, 10, 15, own, k_exp); // own bins 10..15, tail behind
+    flat_pole_row(syn, 10, 15); // own bins 10..15, tail behind
     uint8_t row[NB];
     for (int k = 0; k < NB; k++) {
         row[k] = (uint8_t)syn[k];
@@ -396,16 +409,9 @@ static void test_profile_refines_from_neighbouring_azimuths_while_moving(void **
 {
     (void)state;
     assert_int_equal(sl_profile_init(&pr, 400, 0, NULL), SL_OK);
-    sl_board_t board;
-    memset(&board, 0, sizeof board);
-    board.bin_size_um = 43800;
+    const sl_board_t board = bins_board();
     uint16_t syn[NB];
-    double own[8];
-    for (int i = 0; i < 8; i++) {
-        own[i] = 70.0;
-    }
-    g_decay_db = 3.3;
-    synth(syn, 1, 20, 27, own, k_exp); // own bins 20..27, tail behind
+    flat_pole_row(syn, 20, 27); // own bins 20..27, tail behind
     sl_profile_end_rotation(&pr, true); // moving from now on
     // reserved around azimuth 100 (+-2), bin0 = 20 - lead; 398..2 wraps
     assert_int_equal(sl_profile_reserve(&pr, 100, 20, 2U), 5);
@@ -492,9 +498,7 @@ static void test_profile_refines_r2_within_the_last_bin_of_a_cliff(void **state)
 {
     (void)state;
     assert_int_equal(sl_profile_init(&pr, 400, 0, NULL), SL_OK);
-    sl_board_t board;
-    memset(&board, 0, sizeof board);
-    board.bin_size_um = 43800;
+    const sl_board_t board = bins_board();
     uint8_t row[NB];
     memset(row, 0, sizeof row);
     for (int k = 10; k <= 17; k++) {
