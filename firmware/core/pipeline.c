@@ -451,6 +451,9 @@ static void begin_rotation(sl_pipeline_t *p)
         p->yaw_cdeg_s = m.yaw_rate_valid ? m.yaw_rate_cdeg_s : 0;
     }
     p->detect.union_ext = p->motion_valid; // group extents for the tilt history
+    // Poles leaning across the beam (SLANT): their far end is the mask's, which on a
+    // smearing sensor holds the tail the range profiles remove (sl_detect.h, stage 4).
+    p->detect.slant = p->motion_valid && !p->cfg.profile;
     if (p->motion_valid && p->cfg.motion_adapt) {
         w = sl_pipeline_window(p->cfg.mask_frames, p->cfg.min_frames, p->speed_mm_s,
                                p->yaw_cdeg_s, p->rotation_us, p->cfg.motion_budget_um,

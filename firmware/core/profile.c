@@ -469,7 +469,7 @@ uint8_t sl_profile_refine(sl_profile_t *pr, const sl_board_t *board, uint32_t th
         // the return's own (its end is where the return ends), while a mean over azimuths
         // that see an oblique pole at other ranges would end elsewhere: keep the mask's.
         pr->stats.fallback[SL_PROFILE_NO_TAIL]++;
-        t->flags = (uint8_t)(t->flags | SL_TARGET_NO_TAIL);
+        t->flags = (uint16_t)(t->flags | SL_TARGET_NO_TAIL);
         return (uint8_t)SL_PROFILE_NO_TAIL;
     }
     if (pb.slope_src == SL_PROFILE_SLOPE_FIT) {
@@ -497,7 +497,7 @@ uint8_t sl_profile_refine(sl_profile_t *pr, const sl_board_t *board, uint32_t th
     t->r1_um = sl_fx_usat32(r1_hb + r1_term);
     t->r2_um = sl_fx_usat32(r2_hb + r2_term);
     t->elong_um = sl_fx_sat32(r2_hb_mask - r2_hb);
-    t->flags = (uint8_t)((t->flags & ~SL_TARGET_ELONG) | SL_TARGET_PROFILE);
+    t->flags = (uint16_t)((t->flags & ~SL_TARGET_ELONG) | SL_TARGET_PROFILE);
     if (board->geom != NULL) {
         const sl_incline_result_t res = sl_incline_estimate(
             t->r1_um, t->r2_um, &board->geom[t->az], board->range_sigma_um,
