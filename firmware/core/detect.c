@@ -490,19 +490,48 @@ static void slot_take(sl_detect_t *d, const sl_target_t *t)
 // path (groups wider than a pole, while moving), off finalize's stack frame.
 static SL_NOINLINE bool slender_lean(const sl_detect_t *d, const sl_detect_cand_t *c, uint32_t span,
                                      const sl_detect_azrun_t *rep, uint16_t az, uint16_t *uf_out,
-                                     uint16_t *ul_out)
+                                     uint16_t *ul_out, uint32_t *bottom)
 {
     const sl_board_t *bd = d->board;
     if (d->cfg.max_lean_tan_q16 == 0U || bd->geom == NULL || span > SL_CFG_DETECT_MAX_SPAN) {
         return false;
     }
+    // Only where a confirmed track is expected (sl_detect_hint): a SLANT group continues a
+    // pole the tracker already follows, it never starts one (weak clutter along the shadow
+    // edge must not become a track this way).
+    bool hinted = false;
+    for (uint32_t i = 0; i < span && !hinted; i++) {
+        const uint32_t a = ((uint32_t)c->az_first + i) % d->azimuths;
+        hinted = ((d->hint_bits[a >> 5] >> (a & 31U)) & 1U) != 0U;
+    }
+    if (!hinted) {
+        return false;
+    }
+    // One line crossing the azimuths: every run whole (no gap), and the runs stepping through
+    // range one way (each first and last bin at most one bin against the direction of the
+    // group's ends: a speckled edge). Weak clutter along the shadow edge is broken and
+    // wanders.
+    const sl_detect_azrun_t *r0 = &c->run[0];
+    const sl_detect_azrun_t *rn = &c->run[span - 1U];
+    const bool down = rn->first < r0->first;
     uint32_t uf = rep->first, ul = rep->last, occ = 0U;
+    const sl_detect_azrun_t *prev = NULL;
     for (uint32_t i = 0; i < span; i++) {
-        if (c->run[i].count != 0U) {
-            uf = c->run[i].first < uf ? c->run[i].first : uf;
-            ul = c->run[i].last > ul ? c->run[i].last : ul;
-            occ += c->run[i].count;
+        const sl_detect_azrun_t *r = &c->run[i];
+        if (r->count == 0U) {
+            continue;
         }
+        if ((uint32_t)r->count != (uint32_t)r->last - r->first + 1U) {
+            return false;
+        }
+        if (prev != NULL && (down ? (r->first > prev->first + 1U || r->last > prev->last + 1U)
+                                  : (r->first + 1U < prev->first || r->last + 1U < prev->last))) {
+            return false;
+        }
+        prev = r;
+        uf = r->first < uf ? r->first : uf;
+        ul = r->last > ul ? r->last : ul;
+        occ += r->count;
     }
     const uint32_t allowed = allowed_span(d, uf * bd->bin_size_um + bd->bin_size_um / 2U);
     if (occ > (ul - uf + 1U) * allowed) {
@@ -523,6 +552,16 @@ static SL_NOINLINE bool slender_lean(const sl_detect_t *d, const sl_detect_cand_
     }
     *uf_out = (uint16_t)uf;
     *ul_out = (uint16_t)ul;
+    // The representative: of the azimuths whose run ends on ul (the pole's lowest visible
+    // point, which a beam width sees on 2-3 of them), the middle one.
+    uint32_t lo = span, hi = 0U;
+    for (uint32_t i = 0; i < span; i++) {
+        if (c->run[i].count != 0U && c->run[i].last == ul) {
+            lo = i < lo ? i : lo;
+            hi = i;
+        }
+    }
+    *bottom = (lo + hi) / 2U;
     return true;
 }
 
@@ -561,7 +600,7 @@ static void finalize(sl_detect_t *d, sl_detect_cand_t *c)
         }
     }
     const sl_detect_azrun_t *rep = &c->run[best];
-    const uint16_t az = (uint16_t)(((uint32_t)c->az_first + best) % d->azimuths);
+    uint16_t az = (uint16_t)(((uint32_t)c->az_first + best) % d->azimuths);
     sl_target_t t;
     memset(&t, 0, sizeof t);
     t.az = az;
@@ -592,8 +631,12 @@ static void finalize(sl_detect_t *d, sl_detect_cand_t *c)
                                                  bd->bin_size_um / 2U);
     bool slant = false;
     if (span > allowed && d->slant && (c->flags & (CF_SPAN | CF_NEAR | CF_SHADOW)) == 0U &&
-        slender_lean(d, c, span, rep, az, &t.bin_first, &t.bin_last)) {
-        slant = true; // bounds: the union extent
+        slender_lean(d, c, span, rep, az, &t.bin_first, &t.bin_last, &best)) {
+        slant = true; // bounds: the union extent; representative: the lowest point's azimuth
+        rep = &c->run[best];
+        az = (uint16_t)(((uint32_t)c->az_first + best) % d->azimuths);
+        t.az = az;
+        t.occupied = (uint8_t)(rep->count < 0xFFU ? rep->count : 0xFFU);
         lo = hi = best; // no radius from the width of a leaning pole
     }
     sl_detect_correct(bd, &d->cfg, az, t.bin_first, t.bin_last, (uint16_t)(hi - lo + 1U), &t);

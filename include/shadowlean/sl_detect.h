@@ -83,9 +83,7 @@
 ///    (sl_target_t.evidence). Each drop is counted in `stats.target_overflow`
 ///    (CandidatesDropped on CAN). Ties keep the earlier.
 ///    **Leaning across the line of sight** (only while `slant` is set: the pipeline sets it
-///    while it has a motion input, fits the 3D tilt (sl_tiltobs.h) and takes the mask's
-///    bounds; with range profiles (a smearing sensor's log output) it stays off, see
-///    below). A pole whose top
+///    while it has a motion input and fits the 3D tilt, sl_tiltobs.h). A pole whose top
 ///    leans sideways crosses the azimuths one after the other: every azimuth sees a short
 ///    piece of it, the pieces step through range, and the group is wider than a vertical
 ///    pole can be (a 20 deg lean at 3 m: 13-14 azimuths for an allowance of 9-10). Such a
@@ -101,16 +99,15 @@
 ///      from r(uf) (theta, beta of the representative azimuth).
 ///    The target's bounds are then the union extent (bin_first = uf, bin_last = ul: the
 ///    nearest and farthest point of the pole, the ranges its in-plane inclination is
-///    estimated from; no radius from width, ext_grow 0) and it carries SL_TARGET_SLANT: one
+///    estimated from; no radius from width, ext_grow 0), its representative azimuth the
+///    middle of the ones whose run ends on ul (the pole's lowest visible point, the end a
+///    smear tail lengthens), `occupied` that run's bins, and it carries SL_TARGET_SLANT. One
 ///    rotation measures the lean towards the radar only approximately (the ends of the pole
 ///    lie off the half-plane of its bearing; second order in the sideways lean), which the
-///    3D tilt fit's stated sigmas cover (`sl-eval driveby`). Its far end is the mask's: on
-///    a smearing sensor it carries the smear tail, which the range profile (sl_profile.h)
-///    removes from other targets by reading one azimuth's rows; no one azimuth holds a
-///    leaning pole's whole return, so a smeared SLANT target would read as leaning towards
-///    the radar by up to 15 deg more than it does (`sl-eval driveby --realistic`: 25-29 deg
-///    for 13-15 deg): hence `slant` off with profiles. `cfg.max_lean_tan_q16` = 0 keeps
-///    every wider group WIDE.
+///    3D tilt fit's stated sigmas cover (`sl-eval driveby`). On a smearing sensor the range
+///    profile (sl_profile.h) refines its r2 from the rows of that azimuth and its
+///    neighbours; r1 stays the mask's. `cfg.max_lean_tan_q16` = 0 keeps every wider group
+///    WIDE.
 /// 5. **Corrections** (sl_detect_correct(), MATH.md s.4), b = bin_size_um:
 ///    - raw bounds: r1_raw = bin_first * b (near edge of the first occupied bin),
 ///      r2_raw = (bin_last + 1) * b (far edge of the last occupied bin);
@@ -344,7 +341,7 @@ typedef struct sl_detect {
                             ///< input is present, for the 3D tilt); O(span) per target
     bool slant;             ///< keep slender groups wider than a pole as SLANT targets
                             ///< (stage 4): set by the application before a rotation's rows
-                            ///< (the pipeline: with union_ext, without range profiles)
+                            ///< (the pipeline: while a motion input is present)
     sl_detect_stats_t stats;
 } sl_detect_t;
 

@@ -347,19 +347,28 @@ static void test_detect_keeps_a_pole_leaning_across_the_beam_while_moving(void *
     for (int a = 20; a < 40; a++) { // a car side at 3 m: fills its 20 azimuths
         set_run(a, 68, 75);
     }
-    // Parked (or with range profiles): both WIDE.
+    // Parked: both WIDE.
     assert_int_equal(run_rotation(), 0);
     assert_int_equal(det.stats.rejected[SL_DETECT_REJ_WIDE], 2);
-    // Moving: the leaning pole is kept as SLANT with the group's union extent as bounds; the
-    // car side is not thin (160 occupied bins > 8 bins x 10 azimuths) and stays WIDE.
+    // Moving, but no confirmed track expected there: a SLANT group never starts a track.
     det.union_ext = true;
     det.slant = true;
+    assert_int_equal(run_rotation(), 0);
+    // Where a track is expected (hinted azimuths, also on the car side): the leaning pole is
+    // kept as SLANT with the group's union extent as bounds; the car side is not thin (160
+    // occupied bins > 8 bins x 10 azimuths) and stays WIDE.
+    sl_detect_hint(&det, 106, 2);
+    sl_detect_hint(&det, 30, 2);
     assert_int_equal(run_rotation(), 1);
-    assert_int_equal(det.stats.rejected[SL_DETECT_REJ_WIDE], 3);
+    assert_int_equal(det.stats.rejected[SL_DETECT_REJ_WIDE], 5);
     const sl_target_t *t = &det.targets[0];
     assert_true((t->flags & SL_TARGET_SLANT) != 0U);
     assert_int_equal(t->az_first, 100);
     assert_int_equal(t->az_count, 13);
+    // representative: the middle of the azimuths whose run ends on the union's last bin
+    // (100-102: the pole's lowest visible point), with its run's occupied bins (85-89)
+    assert_int_equal(t->az, 101);
+    assert_int_equal(t->occupied, 5);
     assert_int_equal(t->bin_first, 73);
     assert_int_equal(t->bin_last, 89);
     assert_int_equal(t->ext_grow, 0);
@@ -374,15 +383,31 @@ static void test_detect_keeps_a_pole_leaning_across_the_beam_while_moving(void *
     cfg.max_lean_tan_q16 = (uint16_t)lround(tan(5.0 * kPi / 180.0) * 65536.0);
     assert_int_equal(sl_detect_init(&det, &board, &cfg), SL_OK);
     det.union_ext = det.slant = true;
+    sl_detect_hint(&det, 106, 2);
     assert_int_equal(run_rotation(), 0);
     cfg.max_lean_tan_q16 = (uint16_t)lround(tan(10.0 * kPi / 180.0) * 65536.0);
     assert_int_equal(sl_detect_init(&det, &board, &cfg), SL_OK);
     det.union_ext = det.slant = true;
+    sl_detect_hint(&det, 106, 2);
+    assert_int_equal(run_rotation(), 1);
+    // One line, not clutter: a run with a gap, or a run stepping back by two bins, breaks it.
+    sl_bits_put(rows[106], 78, false); // 77-81 -> 77, 79-81: bridged, broken
+    assert_int_equal(run_rotation(), 0);
+    sl_bits_put(rows[106], 78, true);
+    memset(rows[107], 0, sizeof rows[107]);
+    set_run(107, 78, 81); // after 77-81: first bin one against the direction (speckle)
+    assert_int_equal(run_rotation(), 1);
+    memset(rows[107], 0, sizeof rows[107]);
+    set_run(107, 76, 83); // last bin two against it (83 after 81): not one line
+    assert_int_equal(run_rotation(), 0);
+    memset(rows[107], 0, sizeof rows[107]);
+    set_run(107, 76, 79);
     assert_int_equal(run_rotation(), 1);
     // 0 keeps every wider group WIDE.
     cfg.max_lean_tan_q16 = 0U;
     assert_int_equal(sl_detect_init(&det, &board, &cfg), SL_OK);
     det.union_ext = det.slant = true;
+    sl_detect_hint(&det, 106, 2);
     assert_int_equal(run_rotation(), 0);
     assert_int_equal(det.stats.rejected[SL_DETECT_REJ_WIDE], 2);
 }
