@@ -87,8 +87,14 @@
 ///    leans sideways crosses the azimuths one after the other: every azimuth sees a short
 ///    piece of it, the pieces step through range, and the group is wider than a vertical
 ///    pole can be (a 20 deg lean at 3 m: 13-14 azimuths for an allowance of 9-10). Such a
-///    group is not WIDE when both hold, U = [uf, ul] being its union extent (min first / max
-///    last bin over its azimuths) and `allowed` the vertical pole's span above:
+///    group is not WIDE when all of these hold, U = [uf, ul] being its union extent (min
+///    first / max last bin over its azimuths) and `allowed` the vertical pole's span above:
+///    - a confirmed track is expected on one of its azimuths (sl_detect_hint()): a SLANT
+///      group continues a pole the tracker follows, it never starts a track;
+///    - one line: every run whole (no bridged gap), and the runs step through range one way
+///      (from the first azimuth's run towards the last's), no first or last bin more than
+///      one bin against that direction (weak clutter along the shadow edge is broken and
+///      wanders; a pole merged with it is lost too);
 ///    - thin: its occupied bins over all its azimuths are at most (ul - uf + 1) x allowed,
 ///      what a vertical pole of the same range extent leaves (a wall, a car side or a hedge
 ///      fills most of the span on every azimuth and fails);
@@ -106,8 +112,9 @@
 ///    lie off the half-plane of its bearing; second order in the sideways lean), which the
 ///    3D tilt fit's stated sigmas cover (`sl-eval driveby`). On a smearing sensor the range
 ///    profile (sl_profile.h) refines its r2 from the rows of that azimuth and its
-///    neighbours; r1 stays the mask's. `cfg.max_lean_tan_q16` = 0 keeps every wider group
-///    WIDE.
+///    neighbours; r1 stays the mask's. The pipeline sends no PoleLean for a track updated by
+///    a SLANT target (that frame is one azimuth's run). `cfg.max_lean_tan_q16` = 0 keeps
+///    every wider group WIDE.
 /// 5. **Corrections** (sl_detect_correct(), MATH.md s.4), b = bin_size_um:
 ///    - raw bounds: r1_raw = bin_first * b (near edge of the first occupied bin),
 ///      r2_raw = (bin_last + 1) * b (far edge of the last occupied bin);
