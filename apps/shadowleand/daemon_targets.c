@@ -57,12 +57,12 @@ int sld_targets_write_rotation(FILE *fp, const sl_pipeline_rotation_t *r)
                        "%s{\"slot\":%u,\"id\":%u,\"az\":%u,\"r1_um\":%" PRIu32 ",\"r2_um\":%" PRIu32
                        ",\"alpha_cdeg\":%" PRId32 ",\"sigma_cdeg\":%u,\"hits\":%u,"
                        "\"valid_hits\":%u,\"level\":%u,\"last_flag\":%u,\"updated\":%u,"
-                       "\"evidence\":%u,\"confirmed\":%u}",
+                       "\"evidence\":%u,\"confirmed\":%u,\"last_slant\":%u}",
                        first ? "" : ",", (unsigned)i, (unsigned)k->id, (unsigned)k->az, k->r1_um,
                        k->r2_um, k->alpha_cdeg, (unsigned)k->sigma_cdeg, (unsigned)k->hits,
                        (unsigned)k->valid_hits, (unsigned)k->level, (unsigned)k->last_flag,
                        (unsigned)k->updated, (unsigned)k->evidence,
-                       (unsigned)k->confirmed) < 0;
+                       (unsigned)k->confirmed, (unsigned)k->last_slant) < 0;
         first = 0;
     }
     bad |= fputs("]}\n", fp) < 0;

@@ -47,6 +47,7 @@ void sl_detect_cfg_default(sl_detect_cfg_t *cfg)
     cfg->radius_from_width = true;
     cfg->weak_margin = 6U;
     cfg->weak_contrast = 20U;
+    cfg->max_lean_tan_q16 = 37837U; // tan(30 deg) x 2^16
 }
 
 // ---- bit scanning: bits.h (shared with the range profiles)
@@ -123,8 +124,8 @@ void sl_detect_correct(const sl_board_t *board, const sl_detect_cfg_t *cfg, uint
     const uint64_t r2_hb = (((uint64_t)2U * bin_last + 1U) * b + 1U) / 2U;
     const int32_t d = sl_detect_elong_um(board, sl_fx_usat32((int64_t)r2_hb));
     t->elong_um = d;
-    t->flags = (uint8_t)(t->flags & ~(SL_TARGET_RADIUS_BOARD | SL_TARGET_RADIUS_WIDTH |
-                                      SL_TARGET_RADIUS_CLAMPED | SL_TARGET_ELONG));
+    t->flags = (uint16_t)(t->flags & ~(SL_TARGET_RADIUS_BOARD | SL_TARGET_RADIUS_WIDTH |
+                                       SL_TARGET_RADIUS_CLAMPED | SL_TARGET_ELONG));
     if (d != 0) {
         t->flags |= SL_TARGET_ELONG;
     }
@@ -482,6 +483,88 @@ static void slot_take(sl_detect_t *d, const sl_target_t *t)
     }
 }
 
+// WIDE exception for a pole leaning across the line of sight (sl_detect.h stage 4, "Leaning
+// across the line of sight"): true when the group of `span` azimuths (wider than a vertical
+// pole at its representative run `rep`) is thin and no wider than a lean of
+// cfg.max_lean_tan_q16 can make it; then its union extent in *uf, *ul. Not inlined: a rare
+// path (groups wider than a pole, while moving), off finalize's stack frame.
+static SL_NOINLINE bool slender_lean(const sl_detect_t *d, const sl_detect_cand_t *c, uint32_t span,
+                                     const sl_detect_azrun_t *rep, uint16_t az, uint16_t *uf_out,
+                                     uint16_t *ul_out, uint32_t *bottom)
+{
+    const sl_board_t *bd = d->board;
+    if (d->cfg.max_lean_tan_q16 == 0U || bd->geom == NULL || span > SL_CFG_DETECT_MAX_SPAN) {
+        return false;
+    }
+    // Only where a confirmed track is expected (sl_detect_hint): a SLANT group continues a
+    // pole the tracker already follows, it never starts one (weak clutter along the shadow
+    // edge must not become a track this way).
+    bool hinted = false;
+    for (uint32_t i = 0; i < span && !hinted; i++) {
+        const uint32_t a = ((uint32_t)c->az_first + i) % d->azimuths;
+        hinted = ((d->hint_bits[a >> 5] >> (a & 31U)) & 1U) != 0U;
+    }
+    if (!hinted) {
+        return false;
+    }
+    // One line crossing the azimuths: every run whole (no gap), and the runs stepping through
+    // range one way (each first and last bin at most one bin against the direction of the
+    // group's ends: a speckled edge). Weak clutter along the shadow edge is broken and
+    // wanders.
+    const sl_detect_azrun_t *r0 = &c->run[0];
+    const sl_detect_azrun_t *rn = &c->run[span - 1U];
+    const bool down = rn->first < r0->first;
+    uint32_t uf = rep->first, ul = rep->last, occ = 0U;
+    const sl_detect_azrun_t *prev = NULL;
+    for (uint32_t i = 0; i < span; i++) {
+        const sl_detect_azrun_t *r = &c->run[i];
+        if (r->count == 0U) {
+            continue;
+        }
+        if ((uint32_t)r->count != (uint32_t)r->last - r->first + 1U) {
+            return false;
+        }
+        if (prev != NULL && (down ? (r->first > prev->first + 1U || r->last > prev->last + 1U)
+                                  : (r->first + 1U < prev->first || r->last + 1U < prev->last))) {
+            return false;
+        }
+        prev = r;
+        uf = r->first < uf ? r->first : uf;
+        ul = r->last > ul ? r->last : ul;
+        occ += r->count;
+    }
+    const uint32_t allowed = allowed_span(d, uf * bd->bin_size_um + bd->bin_size_um / 2U);
+    if (occ > (ul - uf + 1U) * allowed) {
+        return false; // fills the span like a wall, not like one line crossing it
+    }
+    const uint64_t b = bd->bin_size_um;
+    const uint64_t r_first = (2U * (uint64_t)uf + 1U) * b / 2U;
+    const uint64_t r_last = (2U * (uint64_t)ul + 1U) * b / 2U;
+    const sl_incline_geom_t *g = &bd->geom[az];
+    const uint64_t sin_t = g->sin_theta_q30 > 0 ? (uint64_t)g->sin_theta_q30 : 0U;
+    const uint64_t sin_b = g->sin_beta_q30 > 0 ? (uint64_t)g->sin_beta_q30 : 0U;
+    // visible height (um) x tan(max lean): the sideways reach of the pole's top
+    const uint64_t height = (r_last * sin_t + r_first * sin_b) >> 30;
+    const uint64_t reach = (height * d->cfg.max_lean_tan_q16) >> 16;
+    const uint64_t w_bam = reach * BAM_PER_RAD / r_first;
+    if ((uint64_t)span > (uint64_t)allowed + (w_bam + d->step_bam - 1U) / d->step_bam) {
+        return false;
+    }
+    *uf_out = (uint16_t)uf;
+    *ul_out = (uint16_t)ul;
+    // The representative: of the azimuths whose run ends on ul (the pole's lowest visible
+    // point, which a beam width sees on 2-3 of them), the middle one.
+    uint32_t lo = span, hi = 0U;
+    for (uint32_t i = 0; i < span; i++) {
+        if (c->run[i].count != 0U && c->run[i].last == ul) {
+            lo = i < lo ? i : lo;
+            hi = i;
+        }
+    }
+    *bottom = (lo + hi) / 2U;
+    return true;
+}
+
 // sl_target_t.ext_grow of a group: its union extent (min first / max last bin over all its
 // azimuths) beyond the representative run, two saturating nibbles.
 static uint8_t union_grow(const sl_detect_cand_t *c, const sl_detect_azrun_t *rep, uint32_t span)
@@ -517,7 +600,7 @@ static void finalize(sl_detect_t *d, sl_detect_cand_t *c)
         }
     }
     const sl_detect_azrun_t *rep = &c->run[best];
-    const uint16_t az = (uint16_t)(((uint32_t)c->az_first + best) % d->azimuths);
+    uint16_t az = (uint16_t)(((uint32_t)c->az_first + best) % d->azimuths);
     sl_target_t t;
     memset(&t, 0, sizeof t);
     t.az = az;
@@ -525,7 +608,7 @@ static void finalize(sl_detect_t *d, sl_detect_cand_t *c)
     t.az_count = (uint16_t)(span > 0xFFFFU ? 0xFFFFU : span);
     t.bin_first = rep->first;
     t.bin_last = rep->last;
-    t.occupied = rep->count;
+    t.occupied = (uint8_t)(rep->count < 0xFFU ? rep->count : 0xFFU);
     // Radius width (D4 of EXTRACTION.md): the contiguous columns around the representative
     // azimuth whose run reaches into the slab [first, first + RADIUS_SLAB_BINS] at the
     // pole's inner edge, not the whole group, which a leaning pole widens in bearing along
@@ -542,19 +625,35 @@ static void finalize(sl_detect_t *d, sl_detect_cand_t *c)
            c->run[hi + 1U].first <= slab && c->run[hi + 1U].last >= rep->first) {
         hi++;
     }
-    sl_detect_correct(bd, &d->cfg, az, rep->first, rep->last, (uint16_t)(hi - lo + 1U), &t);
+    // A group wider than a vertical pole can be: a pole leaning across the line of sight
+    // (stage 4) when slender; its bounds are then the union extent.
+    const uint32_t allowed = allowed_span(d, (uint32_t)rep->first * bd->bin_size_um +
+                                                 bd->bin_size_um / 2U);
+    bool slant = false;
+    if (span > allowed && d->slant && (c->flags & (CF_SPAN | CF_NEAR | CF_SHADOW)) == 0U &&
+        slender_lean(d, c, span, rep, az, &t.bin_first, &t.bin_last, &best)) {
+        slant = true; // bounds: the union extent; representative: the lowest point's azimuth
+        rep = &c->run[best];
+        az = (uint16_t)(((uint32_t)c->az_first + best) % d->azimuths);
+        t.az = az;
+        t.occupied = (uint8_t)(rep->count < 0xFFU ? rep->count : 0xFFU);
+        lo = hi = best; // no radius from the width of a leaning pole
+    }
+    sl_detect_correct(bd, &d->cfg, az, t.bin_first, t.bin_last, (uint16_t)(hi - lo + 1U), &t);
     t.shadow_slant_um = sl_detect_shadow_slant_um(bd, az);
     if ((c->flags & CF_WRAPS) != 0U) {
         t.flags |= SL_TARGET_WRAPS;
     }
-    const uint32_t r1_hb = t.r1_raw_um + bd->bin_size_um / 2U;
+    if (slant) {
+        t.flags |= SL_TARGET_SLANT;
+    }
     int reason = -1;
     if ((c->flags & CF_NEAR) != 0U) {
         reason = SL_DETECT_REJ_NEAR;
     } else if ((c->flags & CF_SHADOW) != 0U ||
                ((c->flags & CF_TAIL) == 0U && t.r2_um >= t.shadow_slant_um)) {
         reason = SL_DETECT_REJ_SHADOW;
-    } else if ((c->flags & CF_SPAN) != 0U || span > allowed_span(d, r1_hb)) {
+    } else if ((c->flags & CF_SPAN) != 0U || (span > allowed && !slant)) {
         reason = SL_DETECT_REJ_WIDE;
     } else if ((uint32_t)rep->count < (uint32_t)rep->last - rep->first + 1U) {
         reason = SL_DETECT_REJ_BROKEN;
@@ -594,7 +693,7 @@ static void finalize(sl_detect_t *d, sl_detect_cand_t *c)
         az_runs += c->run[i].count != 0U ? 1U : 0U;
     }
     t.evidence = sl_detect_evidence(occ_total, az_runs, (uint32_t)rep->last - rep->first + 1U);
-    if (d->union_ext) {
+    if (d->union_ext && !slant) {
         t.ext_grow = union_grow(c, rep, span);
     }
     if (((d->hint_bits[az >> 5] >> (az & 31U)) & 1U) != 0U) {

@@ -381,8 +381,11 @@ static void emit_can(sl_pipeline_t *p)
             worst = t;
             wv = v;
         }
-        if (t->updated == 0U) {
-            continue; // PoleLean only for tracks seen this rotation
+        if (t->updated == 0U || t->last_slant != 0U) {
+            // PoleLean only for tracks seen this rotation, on one azimuth's run: a pole
+            // leaning across the beam (SL_TARGET_SLANT) has none (its bounds span the group's
+            // azimuths); it still updates the track, its warning and the 3D tilt (PoleTilt).
+            continue;
         }
         const uint8_t q = quality_of(t);
         const bool has_lean = q == (uint8_t)SL_CAN_QUALITY_FILTERED;
@@ -451,6 +454,9 @@ static void begin_rotation(sl_pipeline_t *p)
         p->yaw_cdeg_s = m.yaw_rate_valid ? m.yaw_rate_cdeg_s : 0;
     }
     p->detect.union_ext = p->motion_valid; // group extents for the tilt history
+    // Poles leaning across the beam (SLANT, sl_detect.h stage 4): with range profiles their
+    // far end is refined on the azimuth of their lowest point (sl_profile.h).
+    p->detect.slant = p->motion_valid;
     if (p->motion_valid && p->cfg.motion_adapt) {
         w = sl_pipeline_window(p->cfg.mask_frames, p->cfg.min_frames, p->speed_mm_s,
                                p->yaw_cdeg_s, p->rotation_us, p->cfg.motion_budget_um,

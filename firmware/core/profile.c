@@ -458,8 +458,16 @@ uint8_t sl_profile_refine(sl_profile_t *pr, const sl_board_t *board, uint32_t th
         const uint32_t eb = (t->shadow_slant_um + board->bin_size_um - 1U) / board->bin_size_um;
         cliff_end = eb > bin0 ? eb - bin0 : 0U;
     }
-    const sl_profile_bounds_t pb = sl_profile_extract(
-        sum, n, frames, threshold, (uint32_t)t->bin_first - bin0, pr->slope_q8, cliff_end);
+    // A pole leaning across the beam (SL_TARGET_SLANT): its azimuth holds the lowest visible
+    // point, its run there [bin_last - occupied + 1, bin_last] (the bounds are the group's
+    // union extent); only r2 is measured here.
+    const bool slant = (t->flags & SL_TARGET_SLANT) != 0U;
+    const uint32_t first =
+        slant && t->occupied != 0U && (uint32_t)t->bin_last + 1U >= (uint32_t)t->occupied
+            ? (uint32_t)t->bin_last + 1U - t->occupied
+            : t->bin_first;
+    const sl_profile_bounds_t pb = sl_profile_extract(sum, n, frames, threshold, first - bin0,
+                                                      pr->slope_q8, cliff_end);
     if (pb.fail != (uint8_t)SL_PROFILE_OK) {
         pr->stats.fallback[pb.fail]++;
         return pb.fail;
@@ -469,7 +477,7 @@ uint8_t sl_profile_refine(sl_profile_t *pr, const sl_board_t *board, uint32_t th
         // the return's own (its end is where the return ends), while a mean over azimuths
         // that see an oblique pole at other ranges would end elsewhere: keep the mask's.
         pr->stats.fallback[SL_PROFILE_NO_TAIL]++;
-        t->flags = (uint8_t)(t->flags | SL_TARGET_NO_TAIL);
+        t->flags = (uint16_t)(t->flags | SL_TARGET_NO_TAIL);
         return (uint8_t)SL_PROFILE_NO_TAIL;
     }
     if (pb.slope_src == SL_PROFILE_SLOPE_FIT) {
@@ -494,10 +502,12 @@ uint8_t sl_profile_refine(sl_profile_t *pr, const sl_board_t *board, uint32_t th
         const uint32_t f = sl_profile_fill_q16(sum[pb.i2], sum[pb.i2 - 1U], frames);
         r2_hb = (int64_t)(i2 * b + ((uint64_t)f * b + 32768U) / 65536U);
     }
-    t->r1_um = sl_fx_usat32(r1_hb + r1_term);
+    if (!slant) {
+        t->r1_um = sl_fx_usat32(r1_hb + r1_term);
+    }
     t->r2_um = sl_fx_usat32(r2_hb + r2_term);
     t->elong_um = sl_fx_sat32(r2_hb_mask - r2_hb);
-    t->flags = (uint8_t)((t->flags & ~SL_TARGET_ELONG) | SL_TARGET_PROFILE);
+    t->flags = (uint16_t)((t->flags & ~SL_TARGET_ELONG) | SL_TARGET_PROFILE);
     if (board->geom != NULL) {
         const sl_incline_result_t res = sl_incline_estimate(
             t->r1_um, t->r2_um, &board->geom[t->az], board->range_sigma_um,

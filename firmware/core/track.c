@@ -218,6 +218,7 @@ static void track_take(sl_tracker_t *tr, sl_track_t *t, const sl_target_t *g, ui
     t->r1_um = g->r1_um;
     t->r2_um = g->r2_um;
     t->last_flag = g->incline_flag;
+    t->last_slant = (g->flags & SL_TARGET_SLANT) != 0U ? 1U : 0U;
     if (now_us < t->last_seen_us) {
         tr->stats.time_backwards++;
     } else {

@@ -51,7 +51,9 @@
 ///    >= S(az): the base is not inside the shadow; the r2 test is left to the caller for a
 ///    group with a TAIL_EDGE run, stage 1);
 ///    WIDE (the group spans more azimuths than a pole of `cfg.max_pole_diameter_um` at r1
-///    can: allowed = floor((D / r1 [rad] + beam) / step) + 1 + `cfg.width_slack_az`);
+///    can: allowed = floor((D / r1 [rad] + beam) / step) + 1 + `cfg.width_slack_az`;
+///    but see "Leaning across the line of sight" below: with `slant` set, a slender
+///    group that a pole leaning across the beam explains is kept, flagged SLANT);
 ///    BROKEN (the representative run has a gap);
 ///    then the clutter tests (sl_detect_clutter_reason(), after the corrections and alpha):
 ///    SHORT (the representative run is one bin: a speck of gravel or a noise spike, no
@@ -80,6 +82,39 @@
 ///    confirmed track, so an established pole keeps its slot against any amount of clutter)
 ///    (sl_target_t.evidence). Each drop is counted in `stats.target_overflow`
 ///    (CandidatesDropped on CAN). Ties keep the earlier.
+///    **Leaning across the line of sight** (only while `slant` is set: the pipeline sets it
+///    while it has a motion input and fits the 3D tilt, sl_tiltobs.h). A pole whose top
+///    leans sideways crosses the azimuths one after the other: every azimuth sees a short
+///    piece of it, the pieces step through range, and the group is wider than a vertical
+///    pole can be (a 20 deg lean at 3 m: 13-14 azimuths for an allowance of 9-10). Such a
+///    group is not WIDE when all of these hold, U = [uf, ul] being its union extent (min
+///    first / max last bin over its azimuths) and `allowed` the vertical pole's span above:
+///    - a confirmed track is expected on one of its azimuths (sl_detect_hint()): a SLANT
+///      group continues a pole the tracker follows, it never starts a track;
+///    - one line: every run whole (no bridged gap), and the runs step through range one way
+///      (from the first azimuth's run towards the last's), no first or last bin more than
+///      one bin against that direction (weak clutter along the shadow edge is broken and
+///      wanders; a pole merged with it is lost too);
+///    - thin: its occupied bins over all its azimuths are at most (ul - uf + 1) x allowed,
+///      what a vertical pole of the same range extent leaves (a wall, a car side or a hedge
+///      fills most of the span on every azimuth and fails);
+///    - no wider than a lean of at most `cfg.max_lean_tan_q16` can make it: span <=
+///      allowed + ceil(w / step), w = (r(ul) sin(theta) + r(uf) max(sin(beta), 0)) x
+///      max_lean_tan / r(uf) [rad], the visible height of the pole (its lowest point on the
+///      -theta ray at r(ul), its top at most on the +beta ray) turned by the lean, seen
+///      from r(uf) (theta, beta of the representative azimuth).
+///    The target's bounds are then the union extent (bin_first = uf, bin_last = ul: the
+///    nearest and farthest point of the pole, the ranges its in-plane inclination is
+///    estimated from; no radius from width, ext_grow 0), its representative azimuth the
+///    middle of the ones whose run ends on ul (the pole's lowest visible point, the end a
+///    smear tail lengthens), `occupied` that run's bins, and it carries SL_TARGET_SLANT. One
+///    rotation measures the lean towards the radar only approximately (the ends of the pole
+///    lie off the half-plane of its bearing; second order in the sideways lean), which the
+///    3D tilt fit's stated sigmas cover (`sl-eval driveby`). On a smearing sensor the range
+///    profile (sl_profile.h) refines its r2 from the rows of that azimuth and its
+///    neighbours; r1 stays the mask's. The pipeline sends no PoleLean for a track updated by
+///    a SLANT target (that frame is one azimuth's run). `cfg.max_lean_tan_q16` = 0 keeps
+///    every wider group WIDE.
 /// 5. **Corrections** (sl_detect_correct(), MATH.md s.4), b = bin_size_um:
 ///    - raw bounds: r1_raw = bin_first * b (near edge of the first occupied bin),
 ///      r2_raw = (bin_last + 1) * b (far edge of the last occupied bin);
@@ -122,7 +157,7 @@
 /// Caller-owned `sl_detect_t`, no allocation; it borrows `board` (static const) until
 /// re-init. RAM: sizeof(sl_detect_t) = 4 x SL_CFG_MAX_AZIMUTHS (window tables) +
 /// SL_CFG_DETECT_MAX_CANDIDATES x (14 + 6 x SL_CFG_DETECT_MAX_SPAN) + SL_CFG_MAX_TARGETS x
-/// sizeof(sl_target_t) (52) + 50 bytes of azimuth hints + ~60 bytes (defaults: 8,504 bytes on x86-64).
+/// sizeof(sl_target_t) (52) + 50 bytes of azimuth hints + ~68 bytes (defaults: 8,512 bytes on x86-64).
 /// Cost: sl_detect_row O(words up to the shadow edge + runs x candidates); an azimuth
 /// with nothing occupied in its window exits after one OR per window word. Per target at
 /// sl_detect_end: one sl_incline_estimate + one isqrt. Measured instruction counts:
@@ -191,6 +226,10 @@ typedef enum sl_detect_reject {
                                        ///< caller tests the refined r2 against S (stage 1)
 #define SL_TARGET_NO_TAIL 0x80U        ///< the range profile saw the return end in a cliff (no
                                        ///< smear tail): the mask's bounds are its own
+#define SL_TARGET_SLANT 0x100U         ///< a slender group wider than a vertical pole, kept as
+                                       ///< a pole leaning across the line of sight (stage 4,
+                                       ///< "Leaning across the line of sight"): bounds are
+                                       ///< the group's union extent
 
 /// Detection parameters that are not (yet) board fields.
 typedef struct sl_detect_cfg {
@@ -207,10 +246,14 @@ typedef struct sl_detect_cfg {
                                    ///< on the sensor's 19.8-counts-per-decade scale)
     uint8_t weak_contrast;         ///< WEAK test: or this far above the local floor
                                    ///< (default 20 counts, ~10x in amplitude)
+    uint16_t max_lean_tan_q16;     ///< WIDE test while `union_ext`: tan of the largest lean
+                                   ///< across the line of sight a slender group may show
+                                   ///< (Q16; default tan 30 deg = 37,837; 0 = none)
 } sl_detect_cfg_t;
 
 /// Defaults: D_max 0.3 m, R clamp 0.15 m, beam 1.8 deg (CTS350-X), gap 2 bins, link 1 bin,
-/// slack 1 azimuth, radius from width on, weak margin 6, weak contrast 20.
+/// slack 1 azimuth, radius from width on, weak margin 6, weak contrast 20, sideways lean up
+/// to 30 deg.
 void sl_detect_cfg_default(sl_detect_cfg_t *cfg);
 
 /// One detected target (one rotation). Plain value.
@@ -220,7 +263,7 @@ typedef struct sl_target {
     uint16_t az_count;      ///< group width in azimuths
     uint16_t bin_first;     ///< first occupied bin of the representative run
     uint16_t bin_last;      ///< last occupied bin of the representative run
-    uint16_t occupied;      ///< occupied bins in the representative run
+    uint16_t flags;         ///< SL_TARGET_*
     uint32_t r1_raw_um;     ///< bin_first * b
     uint32_t r2_raw_um;     ///< (bin_last + 1) * b
     uint32_t r1_um;         ///< corrected inner bound (half-bin, radius)
@@ -232,7 +275,7 @@ typedef struct sl_target {
     uint16_t sigma_cdeg;    ///< 1-sigma of alpha, 0.01 deg (VALID)
     uint8_t incline_flag;   ///< sl_incline_flag_t
     uint8_t incline_branch; ///< sl_incline_branch_t
-    uint8_t flags;          ///< SL_TARGET_*
+    uint8_t occupied;       ///< occupied bins in the representative run (saturating)
     uint8_t ext_grow;       ///< the group's union extent (min first / max last bin over all
                             ///< its azimuths) beyond the representative run, in bins: low
                             ///< nibble before bin_first, high nibble after bin_last, each
@@ -303,6 +346,9 @@ typedef struct sl_detect {
     bool union_ext;         ///< fill sl_target_t.ext_grow (else 0): set by the application
                             ///< before a rotation's rows (the pipeline: while a motion
                             ///< input is present, for the 3D tilt); O(span) per target
+    bool slant;             ///< keep slender groups wider than a pole as SLANT targets
+                            ///< (stage 4): set by the application before a rotation's rows
+                            ///< (the pipeline: while a motion input is present)
     sl_detect_stats_t stats;
 } sl_detect_t;
 

@@ -278,8 +278,11 @@ sl_profile_bounds_t sl_profile_extract(const uint16_t *sum, uint32_t n, uint32_t
 /// rows of it and its neighbours, see "While moving"): r1 from the leading edge, r2
 /// from the last own bin (half-bin centres, r2 sub-bin when the return ends in a cliff (6.), the target's radius terms kept, no d(r)), alpha
 /// re-estimated; flag SL_TARGET_PROFILE, `elong_um` = the smear removed (mask r2 centre -
-/// profile r2 centre). Without a usable profile the target is left as it is (counted by
-/// reason). Updates the slope calibration. @return the extraction's sl_profile_fail_t.
+/// profile r2 centre). A pole leaning across the beam (SL_TARGET_SLANT, sl_detect.h stage
+/// 4): its azimuth's run is the pole's lowest piece [bin_last - occupied + 1, bin_last], the
+/// leading edge searched from there, and only r2 is replaced (r1, the union's first bin,
+/// lies on other azimuths). Without a usable profile the target is left as it is (counted
+/// by reason). Updates the slope calibration. @return the extraction's sl_profile_fail_t.
 uint8_t sl_profile_refine(sl_profile_t *pr, const sl_board_t *board, uint32_t threshold,
                           sl_target_t *t);
 

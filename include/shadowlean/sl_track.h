@@ -141,6 +141,8 @@ typedef struct sl_track {
     uint8_t updated;         ///< 1 = matched by the last sl_track_update()
     uint8_t evidence;        ///< consistent static-object updates (see "confirmation")
     uint8_t confirmed;       ///< 1 = evidence >= cfg.confirm_min
+    uint8_t last_slant;      ///< 1 = the last associated target was SL_TARGET_SLANT (a pole
+                             ///< leaning across the beam: no one azimuth holds its run)
     uint16_t pred_az;        ///< internal: predicted azimuth for this update
     uint32_t pred_r1_um;     ///< internal: predicted r1 for this update
 } sl_track_t;

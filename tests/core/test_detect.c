@@ -323,6 +323,95 @@ static void test_detect_rejects_wide_and_broken_returns(void **state)
     assert_int_equal(det.targets[0].r1_um, half_bin_um(68) + det.targets[0].radius_um);
 }
 
+// A 20 deg pole leaning across the line of sight at ~3.3 m, as sl-sim renders it for a
+// vehicle passing at 1 m/s (rotation 30 of `sl-eval driveby --psi 20 --phi 0 --offset 3`):
+// every azimuth holds a short piece, the pieces step through range over 13 azimuths where a
+// vertical pole may span 9.
+static void set_leaning_pole(int az0)
+{
+    static const uint16_t run[13][2] = {{87, 89}, {85, 89}, {83, 89}, {81, 87}, {80, 85},
+                                        {78, 82}, {77, 81}, {76, 79}, {75, 77}, {74, 76},
+                                        {74, 75}, {74, 74}, {73, 74}};
+    for (int i = 0; i < 13; i++) {
+        set_run(az0 + i, run[i][0], run[i][1]);
+    }
+}
+
+static void test_detect_keeps_a_pole_leaning_across_the_beam_while_moving(void **state)
+{
+    (void)state;
+    sl_detect_cfg_t cfg;
+    sl_detect_cfg_default(&cfg);
+    assert_int_equal(sl_detect_init(&det, &board, &cfg), SL_OK);
+    set_leaning_pole(100);
+    for (int a = 20; a < 40; a++) { // a car side at 3 m: fills its 20 azimuths
+        set_run(a, 68, 75);
+    }
+    // Parked: both WIDE.
+    assert_int_equal(run_rotation(), 0);
+    assert_int_equal(det.stats.rejected[SL_DETECT_REJ_WIDE], 2);
+    // Moving, but no confirmed track expected there: a SLANT group never starts a track.
+    det.union_ext = true;
+    det.slant = true;
+    assert_int_equal(run_rotation(), 0);
+    // Where a track is expected (hinted azimuths, also on the car side): the leaning pole is
+    // kept as SLANT with the group's union extent as bounds; the car side is not thin (160
+    // occupied bins > 8 bins x 10 azimuths) and stays WIDE.
+    sl_detect_hint(&det, 106, 2);
+    sl_detect_hint(&det, 30, 2);
+    assert_int_equal(run_rotation(), 1);
+    assert_int_equal(det.stats.rejected[SL_DETECT_REJ_WIDE], 5);
+    const sl_target_t *t = &det.targets[0];
+    assert_true((t->flags & SL_TARGET_SLANT) != 0U);
+    assert_int_equal(t->az_first, 100);
+    assert_int_equal(t->az_count, 13);
+    // representative: the middle of the azimuths whose run ends on the union's last bin
+    // (100-102: the pole's lowest visible point), with its run's occupied bins (85-89)
+    assert_int_equal(t->az, 101);
+    assert_int_equal(t->occupied, 5);
+    assert_int_equal(t->bin_first, 73);
+    assert_int_equal(t->bin_last, 89);
+    assert_int_equal(t->ext_grow, 0);
+    assert_int_equal(t->radius_um, 0); // not the lean's spread in bearing
+    assert_int_equal(t->r1_um, half_bin_um(73));
+    assert_int_equal(t->r2_um, half_bin_um(89));
+    assert_int_equal(t->incline_flag, SL_INCLINE_VALID);
+    const double a_ref = alpha_ref_deg(half_bin_um(73) * 1e-6, half_bin_um(89) * 1e-6);
+    assert_true(fabs(t->alpha_cdeg / 100.0 - a_ref) < 0.01);
+    // The lean bound: the pole's visible height (r(89) sin 26 = 1.71 m) turned by at most
+    // 5 deg reaches 3 azimuths at r(73) = 3.2 m: 9 + 3 < 13, WIDE; by 10 deg, 6: kept.
+    cfg.max_lean_tan_q16 = (uint16_t)lround(tan(5.0 * kPi / 180.0) * 65536.0);
+    assert_int_equal(sl_detect_init(&det, &board, &cfg), SL_OK);
+    det.union_ext = det.slant = true;
+    sl_detect_hint(&det, 106, 2);
+    assert_int_equal(run_rotation(), 0);
+    cfg.max_lean_tan_q16 = (uint16_t)lround(tan(10.0 * kPi / 180.0) * 65536.0);
+    assert_int_equal(sl_detect_init(&det, &board, &cfg), SL_OK);
+    det.union_ext = det.slant = true;
+    sl_detect_hint(&det, 106, 2);
+    assert_int_equal(run_rotation(), 1);
+    // One line, not clutter: a run with a gap, or a run stepping back by two bins, breaks it.
+    sl_bits_put(rows[106], 78, false); // 77-81 -> 77, 79-81: bridged, broken
+    assert_int_equal(run_rotation(), 0);
+    sl_bits_put(rows[106], 78, true);
+    memset(rows[107], 0, sizeof rows[107]);
+    set_run(107, 78, 81); // after 77-81: first bin one against the direction (speckle)
+    assert_int_equal(run_rotation(), 1);
+    memset(rows[107], 0, sizeof rows[107]);
+    set_run(107, 76, 83); // last bin two against it (83 after 81): not one line
+    assert_int_equal(run_rotation(), 0);
+    memset(rows[107], 0, sizeof rows[107]);
+    set_run(107, 76, 79);
+    assert_int_equal(run_rotation(), 1);
+    // 0 keeps every wider group WIDE.
+    cfg.max_lean_tan_q16 = 0U;
+    assert_int_equal(sl_detect_init(&det, &board, &cfg), SL_OK);
+    det.union_ext = det.slant = true;
+    sl_detect_hint(&det, 106, 2);
+    assert_int_equal(run_rotation(), 0);
+    assert_int_equal(det.stats.rejected[SL_DETECT_REJ_WIDE], 2);
+}
+
 static void test_detect_groups_across_the_azimuth_wrap(void **state)
 {
     (void)state;
@@ -838,6 +927,8 @@ int main(void)
         cmocka_unit_test_setup(test_detect_never_reports_the_near_field_band, setup),
         cmocka_unit_test_setup(test_detect_never_reports_ground_outside_the_shadow, setup),
         cmocka_unit_test_setup(test_detect_rejects_wide_and_broken_returns, setup),
+        cmocka_unit_test_setup(test_detect_keeps_a_pole_leaning_across_the_beam_while_moving,
+                               setup),
         cmocka_unit_test_setup(test_detect_groups_across_the_azimuth_wrap, setup),
         cmocka_unit_test_setup(test_detect_merges_groups_joined_by_a_later_azimuth, setup),
         cmocka_unit_test_setup(test_detect_handles_empty_saturated_and_misordered_input, setup),

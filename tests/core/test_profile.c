@@ -467,6 +467,53 @@ static void test_profile_refines_from_neighbouring_azimuths_while_moving(void **
     assert_int_equal(pr.moving, 0);
 }
 
+// A pole leaning across the beam (SL_TARGET_SLANT, sl_detect.h): its bounds are the group's
+// union extent, its azimuth the one of its lowest visible point, where the run is the pole's
+// last piece [bin_last - occupied + 1, bin_last] with the smear tail behind. Only r2 comes
+// from the profile (its own end), r1 (the pole's nearest point, on other azimuths) stays.
+static void test_profile_refines_only_the_far_end_of_a_pole_leaning_across_the_beam(void **state)
+{
+    (void)state;
+    assert_int_equal(sl_profile_init(&pr, 400, 0, NULL), SL_OK);
+    const sl_board_t board = bins_board();
+    uint16_t syn[NB];
+    flat_pole_row(syn, 20, 27); // the lowest piece: own bins 20..27, tail behind
+    sl_profile_end_rotation(&pr, true);
+    assert_int_equal(sl_profile_reserve(&pr, 100, 12, 2U), 5); // the track's r1: bin 12
+    uint32_t bits[2] = {0U, 0U};
+    uint32_t x = 777U;
+    for (uint16_t az = 98; az <= 102; az++) {
+        uint8_t row[NB];
+        for (int k = 0; k < NB; k++) {
+            x = x * 1103515245U + 12345U;
+            const int v = (int)syn[k] + (int)((x >> 16) % 3U) - 1;
+            row[k] = (uint8_t)(v < 0 ? 0 : v);
+        }
+        sl_profile_row(&pr, az, row, NB, bits, NB);
+    }
+    sl_target_t t;
+    memset(&t, 0, sizeof t);
+    t.az = 100;
+    t.az_first = 95;
+    t.az_count = 11;
+    t.bin_first = 12;
+    t.bin_last = 40;
+    t.occupied = 21; // bins 20..40 on azimuth 100: the last piece and its tail
+    t.flags = SL_TARGET_SLANT;
+    t.r1_um = (2 * 12 + 1) * 43800 / 2;
+    t.r2_um = (2 * 40 + 1) * 43800 / 2;
+    assert_int_equal(sl_profile_refine(&pr, &board, 40, &t), SL_PROFILE_OK);
+    assert_true((t.flags & (SL_TARGET_PROFILE | SL_TARGET_SLANT)) ==
+                (SL_TARGET_PROFILE | SL_TARGET_SLANT));
+    assert_int_equal(t.r1_um, (2 * 12 + 1) * 43800 / 2);
+    assert_true(t.r2_um >= (2 * 26 + 1) * 43800 / 2 && t.r2_um <= (2 * 28 + 1) * 43800 / 2);
+    // The same target read as a vertical pole from bin 12 finds no return there (NO_RUN):
+    // the hint is the last piece's first bin, not the union's.
+    t.flags = 0U;
+    t.r2_um = (2 * 40 + 1) * 43800 / 2;
+    assert_int_not_equal(sl_profile_refine(&pr, &board, 40, &t), SL_PROFILE_OK);
+}
+
 // Lit fraction of an edge bin from the log values (0.5 dB per value, power adds along the
 // pole): 10^(-dv/20), linear between whole values; full at or above the reference, empty
 // 48 values (24 dB) below it.
@@ -550,6 +597,7 @@ int main(void)
         cmocka_unit_test(test_profile_slots_follow_the_targets),
         cmocka_unit_test(test_profile_refines_a_target_after_min_frames),
         cmocka_unit_test(test_profile_refines_from_neighbouring_azimuths_while_moving),
+        cmocka_unit_test(test_profile_refines_only_the_far_end_of_a_pole_leaning_across_the_beam),
         cmocka_unit_test(test_profile_fill_from_the_log_values),
         cmocka_unit_test(test_profile_refines_r2_within_the_last_bin_of_a_cliff),
     };

@@ -3,12 +3,14 @@
 # driveby_tilt.sh SL_EVAL OUT_DIR
 # `sl-eval driveby --quick --speeds 1` (16 simulated passes at 1 m/s, one pole each, psi 5 and
 # 15 deg, directions every 90 deg, 3 m either side, noise-free) through the pipeline with the
-# pass's speed as motion input: >= 10 of 16 passes FITTED; every FITTED pass within the
+# pass's speed as motion input: >= 11 of 16 passes FITTED; every FITTED pass within the
 # issue's bounds (|psi error| <= 1.0 deg, direction within 10 deg, the base's lateral offset
 # within 0.25 m); the poles leaning away beyond the fold (psi 15 across the path, phi 90 on
 # the left, 270 on the right) FITTED or AMBIGUOUS (never a confident wrong direction) with
-# |psi error| <= 1.0 deg. The 15 deg poles leaning along the path give no track (detection:
-# README "3D tilt while driving").
+# |psi error| <= 1.0 deg. The 15 deg poles leaning along the path lean across the line of
+# sight while abeam and span more azimuths than a vertical pole: detection keeps them as
+# SLANT targets once a confirmed track expects them (sl_detect.h, "Leaning across the line
+# of sight"): 11 FITTED (10 before, when they gave no track).
 set -u
 EVAL=$1; OUT=$2
 mkdir -p "$OUT"
@@ -25,6 +27,6 @@ bad=$(awk '$5 == "|" && ($6 == "FITTED" || $6 == "AMBIGUOUS") {
         $6 != "FITTED" && $6 != "AMBIGUOUS" { print "beyond the fold, not fitted:", $0 }' \
     "$OUT/driveby.txt")
 [ -z "$bad" ] || { echo "FAIL: outside the bounds:"; echo "$bad"; exit 1; }
-[ "$fitted" -ge 10 ] || { echo "FAIL: $fitted of 16 passes FITTED, want >= 10"; exit 1; }
+[ "$fitted" -ge 11 ] || { echo "FAIL: $fitted of 16 passes FITTED, want >= 11"; exit 1; }
 awk -v o="$off" 'BEGIN { exit !(o <= 0.25) }' || { echo "FAIL: offset error $off m > 0.25 m"; exit 1; }
 echo "driveby_tilt: $fitted FITTED, max offset error $off m: OK"

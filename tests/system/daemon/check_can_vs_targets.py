@@ -16,7 +16,8 @@ documented in sl_pipeline.h. Checks:
   rotation record, in order (Status + Health without a group are idle Status frames:
   allowed with --idle-ok, rejected otherwise); every Status is followed at once by its
   Health; with --no-fault every rotation group's Health has Fault 0 (a clean stream);
-- PoleLean: one per confirmed track (live, updated, hits >= confirm_hits) in slot order:
+- PoleLean: one per confirmed track (live, updated, hits >= confirm_hits, not last updated
+  by a SLANT target) in slot order:
   TargetId = id mod 16, Azimuth = az x 360 / azimuths + yaw (+-0.1 deg), Quality
   (FILTERED when valid_hits > 0, else from the incline flag), Lean / LeanSigma (+-half an
   LSB, or clamped with Clamped = 1; 0 unless FILTERED), RangeInner / RangeOuter = r1 / r2
@@ -147,7 +148,9 @@ def main(argv):
         w = f"rotation {r['rotation']}"
         missing += r["missing"]
         confirmed = [t for t in r["tracks"] if t["hits"] >= confirm and t.get("confirmed", 1)]
-        want_pl = [t for t in confirmed if t["updated"]]
+        # (not for a track updated by a pole leaning across the beam, SL_TARGET_SLANT: no
+        # one azimuth holds its run; no PoleTilt then either)
+        want_pl = [t for t in confirmed if t["updated"] and not t.get("last_slant", 0)]
         poles = [d for d in g if d.name == "PoleLean"]
         # PoleTilt (only with a motion input): each right after its track's PoleLean.
         tilts = {}
