@@ -485,9 +485,11 @@ static void slot_take(sl_detect_t *d, const sl_target_t *t)
 
 // WIDE exception for a pole leaning across the line of sight (sl_detect.h stage 4, "Leaning
 // across the line of sight"): true when the group of `span` azimuths (wider than a vertical
-// pole at its representative run `rep`) is thin and no wider than a lean of
-// cfg.max_lean_tan_q16 can make it; then its union extent in *uf, *ul. Not inlined: a rare
-// path (groups wider than a pole, while moving), off finalize's stack frame.
+// pole at its representative run `rep`) lies where a confirmed track is expected, is one
+// line, thin and no wider than a lean of cfg.max_lean_tan_q16 can make it; then its union
+// extent in *uf_out, *ul_out and the offset of its new representative azimuth (the pole's
+// lowest point) in *bottom. Not inlined: a rare path (groups wider than a pole, while
+// moving), off finalize's stack frame.
 static SL_NOINLINE bool slender_lean(const sl_detect_t *d, const sl_detect_cand_t *c, uint32_t span,
                                      const sl_detect_azrun_t *rep, uint16_t az, uint16_t *uf_out,
                                      uint16_t *ul_out, uint32_t *bottom)

@@ -381,10 +381,14 @@ static void emit_can(sl_pipeline_t *p)
             worst = t;
             wv = v;
         }
-        if (t->updated == 0U || t->last_slant != 0U) {
-            // PoleLean only for tracks seen this rotation, on one azimuth's run: a pole
-            // leaning across the beam (SL_TARGET_SLANT) has none (its bounds span the group's
-            // azimuths); it still updates the track, its warning and the 3D tilt (PoleTilt).
+        if (t->updated == 0U) {
+            continue; // PoleLean only for tracks seen this rotation
+        }
+        if (t->last_slant != 0U) {
+            // ... on one azimuth's run: a pole leaning across the beam (SL_TARGET_SLANT) has
+            // none (its bounds span the group's azimuths). It still updates the track, its
+            // warning and the 3D tilt: its PoleTilt goes out alone.
+            emit_tilt(p, t);
             continue;
         }
         const uint8_t q = quality_of(t);

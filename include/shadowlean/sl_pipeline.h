@@ -40,10 +40,11 @@
 ///    tracks (filtered alpha, sigma, warning level: `sl_track_t`, live slots only matter).
 /// 2. `port.can_tx(ctx, f)` (optional) for: one PoleLean per *confirmed* track (live,
 ///    matched this rotation, `hits >= cfg.confirm_hits` and `confirmed` by the tracker's
-///    static-object evidence, sl_track.h; not when its update was a pole leaning across
-///    the beam, `last_slant`: sl_detect.h stage 4), in slot order, each followed by its PoleTilt
+///    static-object evidence, sl_track.h), in slot order, each followed by its PoleTilt
 ///    when the track has an observation history with a fit (only while a motion input is
-///    present: see "3D tilt while driving"); one LeanWarning
+///    present: see "3D tilt while driving"); a track whose update was a pole leaning across
+///    the beam (`last_slant`, sl_detect.h stage 4: no one azimuth holds its run) sends its
+///    PoleTilt without a PoleLean; one LeanWarning
 ///    (the most severe confirmed track: highest level, then largest |filtered alpha|;
 ///    HasTarget = 0 when there is none); one Status (link state, rotations, missing
 ///    azimuths, decoder resyncs, CAN drops; LinkState STREAMING only while usable rows

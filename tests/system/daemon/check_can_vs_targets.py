@@ -17,7 +17,7 @@ documented in sl_pipeline.h. Checks:
   allowed with --idle-ok, rejected otherwise); every Status is followed at once by its
   Health; with --no-fault every rotation group's Health has Fault 0 (a clean stream);
 - PoleLean: one per confirmed track (live, updated, hits >= confirm_hits, not last updated
-  by a SLANT target) in slot order:
+  by a SLANT target, whose PoleTilt comes alone) in slot order:
   TargetId = id mod 16, Azimuth = az x 360 / azimuths + yaw (+-0.1 deg), Quality
   (FILTERED when valid_hits > 0, else from the incline flag), Lean / LeanSigma (+-half an
   LSB, or clamped with Clamped = 1; 0 unless FILTERED), RangeInner / RangeOuter = r1 / r2
@@ -149,15 +149,20 @@ def main(argv):
         missing += r["missing"]
         confirmed = [t for t in r["tracks"] if t["hits"] >= confirm and t.get("confirmed", 1)]
         # (not for a track updated by a pole leaning across the beam, SL_TARGET_SLANT: no
-        # one azimuth holds its run; no PoleTilt then either)
+        # one azimuth holds its run; its PoleTilt comes alone)
         want_pl = [t for t in confirmed if t["updated"] and not t.get("last_slant", 0)]
+        slant_ids = {t["id"] % 16 for t in confirmed if t["updated"] and t.get("last_slant", 0)}
         poles = [d for d in g if d.name == "PoleLean"]
-        # PoleTilt (only with a motion input): each right after its track's PoleLean.
+        # PoleTilt (only with a motion input): each right after its track's PoleLean, or
+        # alone for a track updated by a SLANT target.
         tilts = {}
         for i, d in enumerate(g):
             if d.name == "PoleTilt":
-                if i == 0 or g[i - 1].name != "PoleLean" or g[i - 1].raw["TargetId"] != d.raw["TargetId"]:
+                after_lean = i > 0 and g[i - 1].name == "PoleLean" and g[i - 1].raw["TargetId"] == d.raw["TargetId"]
+                if not after_lean and d.raw["TargetId"] not in slant_ids:
                     errors.append(f"{w}: PoleTilt of target {d.raw['TargetId']} not right after its PoleLean")
+                if after_lean and d.raw["TargetId"] in slant_ids:
+                    errors.append(f"{w}: PoleLean of target {d.raw['TargetId']} updated by a SLANT target")
                 tilts[d.raw["TargetId"]] = d
                 last_tilt[d.raw["TargetId"]] = d
         g = [d for d in g if d.name != "PoleTilt"]
