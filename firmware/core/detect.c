@@ -483,6 +483,12 @@ static void slot_take(sl_detect_t *d, const sl_target_t *t)
     }
 }
 
+// Whether azimuth `a` is hinted (sl_detect_hint: a confirmed track is expected there).
+static inline bool is_hinted(const sl_detect_t *d, uint32_t a)
+{
+    return ((d->hint_bits[a >> 5] >> (a & 31U)) & 1U) != 0U;
+}
+
 // WIDE exception for a pole leaning across the line of sight (sl_detect.h stage 4, "Leaning
 // across the line of sight"): true when the group of `span` azimuths (wider than a vertical
 // pole at its representative run `rep`) lies where a confirmed track is expected, is one
@@ -504,7 +510,7 @@ static SL_NOINLINE bool slender_lean(const sl_detect_t *d, const sl_detect_cand_
     bool hinted = false;
     for (uint32_t i = 0; i < span && !hinted; i++) {
         const uint32_t a = ((uint32_t)c->az_first + i) % d->azimuths;
-        hinted = ((d->hint_bits[a >> 5] >> (a & 31U)) & 1U) != 0U;
+        hinted = is_hinted(d, a);
     }
     if (!hinted) {
         return false;
@@ -698,7 +704,7 @@ static void finalize(sl_detect_t *d, sl_detect_cand_t *c)
     if (d->union_ext && !slant) {
         t.ext_grow = union_grow(c, rep, span);
     }
-    if (((d->hint_bits[az >> 5] >> (az & 31U)) & 1U) != 0U) {
+    if (is_hinted(d, az)) {
         const uint32_t e = (uint32_t)t.evidence + SL_DETECT_EVIDENCE_TRACK;
         t.evidence = (uint16_t)(e > 0xFFFFU ? 0xFFFFU : e);
     }

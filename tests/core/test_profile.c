@@ -361,6 +361,23 @@ static void flat_pole_row(uint16_t *syn, int a, int b)
     synth(syn, 1, a, b, own, k_exp);
 }
 
+// One row per azimuth az_lo..az_hi into `pr`: the synthetic row `syn` with its own +-1 value
+// of pseudo-random speckle on every bin (LCG from `seed`), no threshold bits.
+static void speckled_rows(const uint16_t *syn, uint16_t az_lo, uint16_t az_hi, uint32_t seed)
+{
+    uint32_t bits[2] = {0U, 0U};
+    uint32_t x = seed;
+    for (uint16_t az = az_lo; az <= az_hi; az++) {
+        uint8_t row[NB];
+        for (int k = 0; k < NB; k++) {
+            x = x * 1103515245U + 12345U;
+            const int v = (int)syn[k] + (int)((x >> 16) % 3U) - 1;
+            row[k] = (uint8_t)(v < 0 ? 0 : v);
+        }
+        sl_profile_row(&pr, az, row, NB, bits, NB);
+    }
+}
+
 // A profile replaces the mask's bounds only with >= cfg.min_frames rows (a single row, e.g.
 // while moving, is no better than the mask); then r1/r2 are the profile's bin centres,
 // the smear removed, and the target is flagged.
@@ -427,17 +444,7 @@ static void test_profile_refines_from_neighbouring_azimuths_while_moving(void **
     // falls 3.3 values per bin; the walk tolerates noise at the rounding level: with +-2 on
     // every bin of each of three rows it stops four bins into the tail, still nine bins
     // shorter than the mask)
-    uint32_t bits[2] = {0U, 0U};
-    uint32_t x = 12345U;
-    for (uint16_t az = 98; az <= 102; az++) {
-        uint8_t row[NB];
-        for (int k = 0; k < NB; k++) {
-            x = x * 1103515245U + 12345U;
-            const int v = (int)syn[k] + (int)((x >> 16) % 3U) - 1;
-            row[k] = (uint8_t)(v < 0 ? 0 : v);
-        }
-        sl_profile_row(&pr, az, row, NB, bits, NB);
-    }
+    speckled_rows(syn, 98, 102, 12345U);
     sl_target_t t;
     memset(&t, 0, sizeof t);
     t.az = 100;
@@ -480,17 +487,7 @@ static void test_profile_refines_only_the_far_end_of_a_pole_leaning_across_the_b
     flat_pole_row(syn, 20, 27); // the lowest piece: own bins 20..27, tail behind
     sl_profile_end_rotation(&pr, true);
     assert_int_equal(sl_profile_reserve(&pr, 100, 12, 2U), 5); // the track's r1: bin 12
-    uint32_t bits[2] = {0U, 0U};
-    uint32_t x = 777U;
-    for (uint16_t az = 98; az <= 102; az++) {
-        uint8_t row[NB];
-        for (int k = 0; k < NB; k++) {
-            x = x * 1103515245U + 12345U;
-            const int v = (int)syn[k] + (int)((x >> 16) % 3U) - 1;
-            row[k] = (uint8_t)(v < 0 ? 0 : v);
-        }
-        sl_profile_row(&pr, az, row, NB, bits, NB);
-    }
+    speckled_rows(syn, 98, 102, 777U);
     sl_target_t t;
     memset(&t, 0, sizeof t);
     t.az = 100;
