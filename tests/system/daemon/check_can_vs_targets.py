@@ -155,6 +155,7 @@ def main(argv):
         poles = [d for d in g if d.name == "PoleLean"]
         # PoleTilt (only with a motion input): each right after its track's PoleLean, or
         # alone for a track updated by a SLANT target.
+        tilted_before = set(last_tilt)  # tracks with a fit sent earlier keep sending it
         tilts = {}
         for i, d in enumerate(g):
             if d.name == "PoleTilt":
@@ -165,6 +166,9 @@ def main(argv):
                     errors.append(f"{w}: PoleLean of target {d.raw['TargetId']} updated by a SLANT target")
                 tilts[d.raw["TargetId"]] = d
                 last_tilt[d.raw["TargetId"]] = d
+        for tid in sorted(slant_ids & tilted_before):
+            if tid not in tilts:
+                errors.append(f"{w}: no PoleTilt for target {tid}, updated by a SLANT target after a fit")
         g = [d for d in g if d.name != "PoleTilt"]
         rest = [d.name for d in g if d.name not in ("PoleLean", "PoleTilt")]
         if rest != ["LeanWarning", "Status", "Health"]:
