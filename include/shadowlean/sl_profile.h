@@ -196,6 +196,8 @@ typedef struct sl_profile_stats {
     uint32_t assign_full;   ///< targets left without a slot (every slot watches a target)
     uint32_t cal_accepted;  ///< self-fitted slopes taken into the calibration
     uint32_t cal_rejected;  ///< ... refused by the +-30 % gate
+    uint32_t lead_kept;     ///< cliff-ended targets whose leading edge kept the first
+                            ///< bin's centre (sl_profile_lead_edge: the shape fits no model)
     uint32_t spatial;       ///< targets refined from one rotation's rows of neighbouring
                             ///< azimuths (too few rotations summed: moving)
     uint32_t reserved;      ///< slots reserved where a track is expected (sl_profile_reserve)
@@ -264,6 +266,41 @@ uint32_t sl_profile_reserve(sl_profile_t *pr, uint16_t az, uint16_t bin_first, u
 /// is about constant over the two bins (not so at a range extremum of the pole, where the
 /// length per bin peaks: hence used for r2, not for r1).
 uint32_t sl_profile_fill_q16(uint32_t edge_sum, uint32_t ref_sum, uint32_t frames);
+
+/// Lit fraction of the FIRST bin of a return, Q16 (pure), from its summed value against the
+/// second bin's, over `frames` rows. Geometry, no constant of the scene: along a straight
+/// pole the range grows with the distance s from the foot of its line as r = sqrt(p^2 + s^2),
+/// so the pole's length per unit range is ~ 1 / sqrt(r - p). The lit part starts `delta_q16`
+/// (bins, Q16) past the foot: 0 when r1 IS the foot (estimator branch 2, a range minimum
+/// inside the lit segment), r1 (1 - cos(alpha - beta)) when r1 is the top end on the +beta
+/// ray (branch 1). With f the first bin's lit fraction, the bins hold 2 (sqrt(f + d) -
+/// sqrt(d)) and 2 (sqrt(1 + f + d) - sqrt(f + d)) (units of sqrt(bin)); f is found from their
+/// ratio, measured from the values' difference at 0.5 dB per value (either bin may be the
+/// brighter), by bisection to 1/1024 bin; full when the ratio reaches f = 1's. From
+/// SL_PROFILE_LEAD_END_Q16 on the length per bin is taken as constant (the ratio is f:
+/// sl_profile_fill_q16). A pole's radius rounds the foot's peak (its surface spreads the
+/// nearest point over R), so a well-filled first bin reads partly filled: r1 then errs
+/// towards the far end of its bin by up to ~R. Cost: 11 ratio evaluations (two 64-bit
+/// integer square roots each).
+uint32_t sl_profile_lead_fill_q16(uint32_t first_sum, uint32_t second_sum, uint32_t frames,
+                                  uint32_t delta_q16);
+
+/// The leading edge from the first three bins' sums `sum3` (pure): `*f_q16` = the first
+/// bin's lit fraction (sl_profile_lead_fill_q16 with `delta_q16`). Returns true when the
+/// third bin agrees with the same model: its power over the second's within 3 values
+/// (1.5 dB) of the model's (sqrt(f + d + 2) - sqrt(f + d + 1)) / (sqrt(f + d + 1) -
+/// sqrt(f + d)), or of 1 for an end. The tolerance: one value is the rounding of two 8-bit
+/// values; the rest is what the model leaves out (the pole's radius, the elevation pattern):
+/// on sim_static_sweep's noise-free returns the third bin sits up to 2.5 values off the
+/// model. A return whose shape the line's geometry does not explain gets false and the
+/// caller keeps the first bin's centre: a flat box (the foot model then predicts a third
+/// bin >= 3.8 values below the second), a bright scatterer on the pole, clipping.
+bool sl_profile_lead_edge(const uint16_t *sum3, uint32_t frames, uint32_t delta_q16,
+                          uint32_t *f_q16);
+
+/// Offset of the lit part from the foot beyond which the leading edge is taken as an end of
+/// constant length per bin (64 bins, Q16).
+#define SL_PROFILE_LEAD_END_Q16 (64UL << 16)
 
 /// Smear-aware bounds from a profile (pure; see "Extraction"). `hint` = the mask's first
 /// bin relative to the profile start, `cal_slope_q8` the fallback slope (0: none),
