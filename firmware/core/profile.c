@@ -406,14 +406,23 @@ static uint32_t lead_fill_from_q(uint64_t q, uint32_t delta_q16)
     if (delta_q16 >= SL_PROFILE_LEAD_END_Q16) {
         return q >= 65535U ? 65535U : (uint32_t)q;
     }
+    if (delta_q16 == 0U) {
+        // at the foot, closed form: q = f + sqrt(f (1 + f)) <=> f = q^2 / (1 + 2 q), full from
+        // q = 1 + sqrt(2) on (q < 2^24 here: q^2 fits)
+        if (q >= 158217U) {
+            return 65535U;
+        }
+        const uint64_t f = (q * q) / (65536U + 2U * q);
+        return f >= 65535U ? 65535U : (uint32_t)f;
+    }
     const uint64_t d = delta_q16;
     const uint64_t sd = sl_fx_isqrt64(d << 16);
     if (q >= lead_ratio_q16(65536U, d, sd)) {
         return 65535U;
     }
-    // the ratio grows with f: bisection to 1/1024 bin
+    // the ratio grows with f: bisection to 1/256 bin (0.2 mm on the CTS350-X)
     uint64_t lo = 0U, hi = 65536U;
-    for (uint32_t k = 0U; k < 10U; k++) {
+    for (uint32_t k = 0U; k < 8U; k++) {
         const uint64_t mid = (lo + hi) >> 1;
         if (lead_ratio_q16(mid, d, sd) <= q) {
             lo = mid;

@@ -282,12 +282,13 @@ uint32_t sl_profile_fill_q16(uint32_t edge_sum, uint32_t ref_sum, uint32_t frame
 /// ray (branch 1). With f the first bin's lit fraction, the bins hold 2 (sqrt(f + d) -
 /// sqrt(d)) and 2 (sqrt(1 + f + d) - sqrt(f + d)) (units of sqrt(bin)); f is found from their
 /// ratio, measured from the values' difference at 0.5 dB per value (either bin may be the
-/// brighter), by bisection to 1/1024 bin; full when the ratio reaches f = 1's. From
+/// brighter): at the foot in closed form, f = q^2 / (1 + 2 q) (q = f + sqrt(f (1 + f))), else
+/// by bisection to 1/256 bin (0.2 mm); full when the ratio reaches f = 1's. From
 /// SL_PROFILE_LEAD_END_Q16 on the length per bin is taken as constant (the ratio is f:
 /// sl_profile_fill_q16). A pole's radius rounds the foot's peak (its surface spreads the
 /// nearest point over R), so a well-filled first bin reads partly filled: r1 then errs
-/// towards the far end of its bin by up to ~R. Cost: 11 ratio evaluations (two 64-bit
-/// integer square roots each).
+/// towards the far end of its bin by up to ~R. Cost: one 64-bit division at the foot, else
+/// 9 ratio evaluations (two 64-bit integer square roots each).
 uint32_t sl_profile_lead_fill_q16(uint32_t first_sum, uint32_t second_sum, uint32_t frames,
                                   uint32_t delta_q16);
 
