@@ -12,7 +12,6 @@
 #define SLOPE_MIN_Q8 128U   // 0.5 value per bin
 #define SLOPE_MAX_Q8 6144U  // 24 values per bin
 #define LEAD_TOL_VALUES 3U  // sl_profile_lead_edge: the third bin within 3 values (1.5 dB)
-#define LEAD_MIN_OWN_Q16 4096U // ... and the second bin at least 1/16 its own (after the smear)
 #define FIT_BINS 8U
 #define FIT_MIN_BINS 4U
 #define CAL_GATE_N 4U       // fits before the +-30 % gate applies
@@ -389,22 +388,22 @@ static uint64_t lead_ratio_q16(uint64_t f, uint64_t d, uint64_t sd)
     return ((a - sd) << 16) / (c - a);
 }
 
-// P_num / P_den in Q16 from two summed values (0.5 dB per value), either may be the larger
-// (saturated at 2^32: 48 values or more above).
-static uint64_t power_ratio_q16(uint32_t num_sum, uint32_t den_sum, uint32_t frames)
-{
-    if (num_sum <= den_sum) {
-        return sl_profile_fill_q16(num_sum, den_sum, frames);
-    }
-    const uint32_t inv = sl_profile_fill_q16(den_sum, num_sum, frames);
-    return inv == 0U ? ((uint64_t)1U << 32) : ((uint64_t)1U << 32) / inv;
-}
-
-// The first bin's lit fraction from q = P1 / P2 (Q16), see sl_profile_lead_fill_q16.
-static uint32_t lead_fill_from_q(uint64_t q, uint32_t delta_q16)
+uint32_t sl_profile_lead_fill_q16(uint32_t first_sum, uint32_t second_sum, uint32_t frames,
+                                  uint32_t delta_q16)
 {
     if (delta_q16 >= SL_PROFILE_LEAD_END_Q16) {
-        return q >= 65535U ? 65535U : (uint32_t)q;
+        return sl_profile_fill_q16(first_sum, second_sum, frames);
+    }
+    // observed q = P1 / P2 in Q16; the first bin brighter: q = 1 / (P2 / P1)
+    uint64_t q;
+    if (first_sum <= second_sum) {
+        q = sl_profile_fill_q16(first_sum, second_sum, frames);
+    } else {
+        const uint32_t inv = sl_profile_fill_q16(second_sum, first_sum, frames);
+        if (inv == 0U) {
+            return 65535U;
+        }
+        q = ((uint64_t)1U << 32) / inv;
     }
     if (delta_q16 == 0U) {
         // at the foot, closed form: q = f + sqrt(f (1 + f)) <=> f = q^2 / (1 + 2 q), full from
@@ -432,15 +431,6 @@ static uint32_t lead_fill_from_q(uint64_t q, uint32_t delta_q16)
     }
     const uint64_t f = (lo + hi) >> 1;
     return f >= 65535U ? 65535U : (uint32_t)f;
-}
-
-uint32_t sl_profile_lead_fill_q16(uint32_t first_sum, uint32_t second_sum, uint32_t frames,
-                                  uint32_t delta_q16)
-{
-    if (delta_q16 >= SL_PROFILE_LEAD_END_Q16) {
-        return sl_profile_fill_q16(first_sum, second_sum, frames);
-    }
-    return lead_fill_from_q(power_ratio_q16(first_sum, second_sum, frames), delta_q16);
 }
 
 static void calibrate(sl_profile_t *pr, uint32_t s)
@@ -512,29 +502,12 @@ static uint32_t combine_neighbours(sl_profile_t *pr, const sl_target_t *t, uint8
 }
 
 bool sl_profile_lead_edge(const uint16_t *sum3, uint32_t frames, uint32_t delta_q16,
-                          uint32_t tail_q16, uint32_t *f_q16)
+                          uint32_t *f_q16)
 {
     SL_ASSERT(sum3 != NULL && f_q16 != NULL);
-    *f_q16 = 0U;
-    // observed P1 / P2 and P3 / P2; with a smear kernel of per-bin ratio a (tail_q16) the
-    // own powers are P2 - a P1 and P3 - a P2: q = (P1/P2) / den, own3 / own2 = (P3/P2 - a) / den
-    // with den = 1 - a P1/P2
-    const uint64_t q_obs = power_ratio_q16(sum3[0], sum3[1], frames);
-    const uint64_t r32 = power_ratio_q16(sum3[2], sum3[1], frames);
-    const uint64_t a = tail_q16;
-    if (q_obs >= ((uint64_t)1U << 24) || r32 <= a) {
-        return false; // the third bin holds no power of its own
-    }
-    const uint64_t aq = (a * q_obs) >> 16;
-    if (aq + LEAD_MIN_OWN_Q16 >= 65536U) {
-        return false; // nor the second
-    }
-    const uint64_t den = 65536U - aq;
-    const uint64_t q = (q_obs << 16) / den;
-    const uint64_t obs = ((r32 - a) << 16) / den;
-    const uint32_t f = lead_fill_from_q(q, delta_q16);
+    const uint32_t f = sl_profile_lead_fill_q16(sum3[0], sum3[1], frames, delta_q16);
     *f_q16 = f;
-    // P3 / P2 the model predicts (1 for an end), Q16
+    // P3 / P2 the model predicts (1 for an end), and the profile's, Q16
     uint64_t pred = 65536U;
     if (delta_q16 < SL_PROFILE_LEAD_END_Q16) {
         const uint64_t d = (uint64_t)f + delta_q16;
@@ -542,6 +515,13 @@ bool sl_profile_lead_edge(const uint16_t *sum3, uint32_t frames, uint32_t delta_
         const uint64_t s2 = sl_fx_isqrt64((d + 65536U) << 16);
         const uint64_t s3 = sl_fx_isqrt64((d + 131072U) << 16);
         pred = ((s3 - s2) << 16) / (s2 - s1);
+    }
+    uint64_t obs;
+    if (sum3[2] <= sum3[1]) {
+        obs = sl_profile_fill_q16(sum3[2], sum3[1], frames);
+    } else {
+        const uint32_t inv = sl_profile_fill_q16(sum3[1], sum3[2], frames);
+        obs = inv == 0U ? ((uint64_t)1U << 32) : ((uint64_t)1U << 32) / inv;
     }
     // within LEAD_TOL_VALUES values either way (x 10^(-k/20), the fill table's step)
     const uint64_t tol = k_fill_q16[LEAD_TOL_VALUES];
@@ -659,17 +639,14 @@ uint8_t sl_profile_refine(sl_profile_t *pr, const sl_board_t *board, uint32_t th
         sl_incline_result_t res = sl_incline_estimate(t->r1_um, t->r2_um, &board->geom[t->az],
                                                       board->range_sigma_um,
                                                       board->theta_sigma_cdeg);
-        if (!slant && !spatial && pb.i2 >= pb.i1 + 3U && res.flag == (uint8_t)SL_INCLINE_VALID) {
+        if (!slant && pb.slope_src == SL_PROFILE_SLOPE_CLIFF && pb.i2 >= pb.i1 + 3U &&
+            res.flag == (uint8_t)SL_INCLINE_VALID) {
             // Sub-bin leading edge (step 6): the first bin's lit fraction from its power
             // against the second's, with the model of the branch the bounds gave, when the
             // third bin follows the same model (else the centre is kept, `lead_kept`).
             uint32_t f = 0U;
-            const uint32_t tail = pb.slope_src == SL_PROFILE_SLOPE_CLIFF
-                                      ? 0U
-                                      : sl_profile_fill_q16(0U, pb.slope_q8, 256U);
             if (sl_profile_lead_edge(&sum[pb.i1], frames,
-                                     lead_delta_q16(&res, &board->geom[t->az], i1 * b, b), tail,
-                                     &f)) {
+                                     lead_delta_q16(&res, &board->geom[t->az], i1 * b, b), &f)) {
                 const int64_t r1_sub =
                     (int64_t)((i1 + 1U) * b - ((uint64_t)f * b + 32768U) / 65536U);
                 t->r1_um = sl_fx_usat32(r1_sub + r1_term);

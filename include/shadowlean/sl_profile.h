@@ -73,19 +73,13 @@
 ///    bin against the own bin before it) instead of the bin's centre. With a tail the last
 ///    own bin's power is mixed with the smear of the bins before it and the whole-bin
 ///    centre is kept (not done: the fill after removing the fitted tail).
-///    r1 within its bin (sl_profile_lead_edge), on every static profile whose run has three
-///    whole bins after its first (not while moving: neighbouring azimuths see an oblique
-///    pole at other ranges): along a straight pole the range grows as the square of the
-///    distance from the foot of its line, so the pole's length per unit range is
-///    ~ 1 / sqrt(r - foot); the lit part starts at the foot (estimator branch 2) or, on
-///    branch 1, r1 (1 - cos(alpha - beta)) past it (the top end on the +beta ray). The
-///    first bin's lit fraction follows from its power over the second's; with a smear tail
-///    the fitted slope's per-bin ratio a is removed first (own powers P2 - a P1, P3 - a P2;
-///    the smear is outward, so the first bin is all its own). The third bin checks the
-///    model; a shape it does not explain (a flat box, a bright scatterer, clipping) keeps
-///    the first bin's centre (`stats.lead_kept`). Measured on sim_static_sweep (noise-free,
-///    40 positions): mean |r1 - front surface| 4.5-6.8 mm (the centre: 11); the pole's
-///    radius, which rounds the foot's peak, is what the models leave out.
+///    r1 stays the first bin's centre. Not done: the leading edge's fill. Where r1 is a
+///    range minimum inside the lit segment the length per bin peaks (~1/sqrt(r - r1)), so
+///    the first bin reads BRIGHTER than the next when well filled and sl_profile_fill_q16
+///    does not apply. Measured on sim_static_sweep (noise-free, 40 positions): the
+///    1/sqrt model f = q^2 / (1 + 2q) (q = first / second bin's power) follows the truth
+///    within 0.05 bin for f < 0.4 at -10 / 0 deg but saturates near 0.6 for f -> 1, and
+///    at +10 deg (r1 cut by the beam's upper bound) neither it nor the uniform model fits.
 /// The value scale (log of power) only enters through the ratio 1/6 and T/4; nothing depends
 /// on the simulator's kernel, the board's d(r) or n.
 ///
@@ -293,10 +287,8 @@ uint32_t sl_profile_lead_fill_q16(uint32_t first_sum, uint32_t second_sum, uint3
                                   uint32_t delta_q16);
 
 /// The leading edge from the first three bins' sums `sum3` (pure): `*f_q16` = the first
-/// bin's lit fraction (the model of sl_profile_lead_fill_q16 with `delta_q16`), after
-/// removing an outward smear of per-bin power ratio `tail_q16` (Q16; 0: none) from the second
-/// and third bins (own = P2 - a P1, P3 - a P2; false when either keeps less than 1/16 of its
-/// power as its own). Returns true when the third bin agrees with the same model: its power over the second's within 3 values
+/// bin's lit fraction (sl_profile_lead_fill_q16 with `delta_q16`). Returns true when the
+/// third bin agrees with the same model: its power over the second's within 3 values
 /// (1.5 dB) of the model's (sqrt(f + d + 2) - sqrt(f + d + 1)) / (sqrt(f + d + 1) -
 /// sqrt(f + d)), or of 1 for an end. The tolerance: one value is the rounding of two 8-bit
 /// values; the rest is what the model leaves out (the pole's radius, the elevation pattern):
@@ -305,7 +297,7 @@ uint32_t sl_profile_lead_fill_q16(uint32_t first_sum, uint32_t second_sum, uint3
 /// caller keeps the first bin's centre: a flat box (the foot model then predicts a third
 /// bin >= 3.8 values below the second), a bright scatterer on the pole, clipping.
 bool sl_profile_lead_edge(const uint16_t *sum3, uint32_t frames, uint32_t delta_q16,
-                          uint32_t tail_q16, uint32_t *f_q16);
+                          uint32_t *f_q16);
 
 /// Offset of the lit part from the foot beyond which the leading edge is taken as an end of
 /// constant length per bin (64 bins, Q16).
@@ -322,10 +314,8 @@ sl_profile_bounds_t sl_profile_extract(const uint16_t *sum, uint32_t n, uint32_t
 
 /// Refine a detected target with the profile of its azimuth (while moving: this rotation's
 /// rows of it and its neighbours, see "While moving"): r1 from the leading edge, r2
-/// from the last own bin (half-bin centres; r2 within its bin when the return ends in a
-/// cliff, r1 within its bin when the leading edge fits the line's model, both step 6; the
-/// target's radius terms kept, no d(r)), alpha re-estimated (twice when r1 moved: the
-/// leading edge's model needs the branch); flag SL_TARGET_PROFILE, `elong_um` = the smear removed (mask r2 centre -
+/// from the last own bin (half-bin centres, r2 sub-bin when the return ends in a cliff (6.), the target's radius terms kept, no d(r)), alpha
+/// re-estimated; flag SL_TARGET_PROFILE, `elong_um` = the smear removed (mask r2 centre -
 /// profile r2 centre). A pole leaning across the beam (SL_TARGET_SLANT, sl_detect.h stage
 /// 4): its azimuth's run is the pole's lowest piece [bin_last - occupied + 1, bin_last], the
 /// leading edge searched from there, and only r2 is replaced (r1, the union's first bin,

@@ -634,7 +634,7 @@ static void test_profile_lead_fill_follows_the_lines_geometry(void **state)
                 fail_msg("d %.1f f %.2f: read %.4f", ds[i], f, got);
             }
             uint32_t fe = 0U;
-            assert_true(sl_profile_lead_edge(s3, 64U, dq, 0U, &fe)); // the third bin agrees
+            assert_true(sl_profile_lead_edge(s3, 64U, dq, &fe)); // the third bin agrees
             assert_int_equal(fe, sl_profile_lead_fill_q16(s3[0], s3[1], 64U, dq));
         }
     }
@@ -643,51 +643,6 @@ static void test_profile_lead_fill_follows_the_lines_geometry(void **state)
     // an end: the constant-length reading
     assert_int_equal(sl_profile_lead_fill_q16(16U * 94U, 16U * 100U, 16U, SL_PROFILE_LEAD_END_Q16),
                      sl_profile_fill_q16(16U * 94U, 16U * 100U, 16U));
-}
-
-// Under an outward smear (each bin's power spread into the bins after it with a per-bin
-// ratio a = 10^(-slope / 20), slope in values, the profile's fitted tail) the second and
-// third bins hold the first's smear too; with `tail_q16` = a the own powers are recovered
-// (P2 - a P1, P3 - a P2) and the lit fraction read as without smear. Read as if there were
-// none, the same bins give another fraction (the test would not be one otherwise). A third
-// bin that is all smear (no own power) is refused.
-static void test_profile_lead_edge_removes_an_outward_smear(void **state)
-{
-    (void)state;
-    const double slope = 6.6; // values per bin (3.3 dB)
-    const double a = pow(10.0, -slope / 20.0);
-    const uint32_t aq = sl_profile_fill_q16(0U, (uint32_t)lround(slope * 256.0), 256U);
-    assert_true(fabs(aq / 65536.0 - a) < 0.002);
-    const double ds[2] = {0.0, 0.5};
-    double raw_err = 0;
-    for (int i = 0; i < 2; i++) {
-        for (double f = 0.1; f <= 0.95; f += 0.05) {
-            double p[3], obs[3];
-            for (int k = 0; k < 3; k++) {
-                p[k] = line_bin_power(f, ds[i], k);
-                obs[k] = p[k] + (k > 0 ? a * obs[k - 1] : 0.0);
-            }
-            uint16_t s3[3];
-            for (int k = 0; k < 3; k++) {
-                s3[k] = (uint16_t)lround(64.0 * (150.0 + 20.0 * log10(obs[k] / obs[1])));
-            }
-            const uint32_t dq = (uint32_t)lround(ds[i] * 65536.0);
-            uint32_t got = 0U;
-            assert_true(sl_profile_lead_edge(s3, 64U, dq, aq, &got));
-            if (fabs(got / 65536.0 - f) > 0.01 * f + 0.004) {
-                fail_msg("d %.1f f %.2f: read %.4f under smear", ds[i], f, got / 65536.0);
-            }
-            uint32_t raw = 0U;
-            (void)sl_profile_lead_edge(s3, 64U, dq, 0U, &raw);
-            raw_err = fmax(raw_err, fabs(raw / 65536.0 - f));
-        }
-    }
-    print_message("lead edge read without removing the smear: up to %.3f bin off\n", raw_err);
-    assert_true(raw_err > 0.1);
-    // the third bin exactly the second's smear: no own power
-    const uint16_t tail3[3] = {64U * 150U, 64U * 150U, (uint16_t)(64U * 150U - lround(64.0 * slope))};
-    uint32_t f = 0U;
-    assert_false(sl_profile_lead_edge(tail3, 64U, 0U, aq, &f));
 }
 
 // A return whose first bins the line's geometry does not explain keeps the first bin's
@@ -699,13 +654,13 @@ static void test_profile_lead_edge_refuses_shapes_no_line_makes(void **state)
     (void)state;
     uint32_t f = 0U;
     const uint16_t flat[3] = {4U * 200U, 4U * 200U, 4U * 200U};
-    assert_false(sl_profile_lead_edge(flat, 4U, 0U, 0U, &f));
+    assert_false(sl_profile_lead_edge(flat, 4U, 0U, &f));
     uint16_t s3[3];
     line_sums(0.6, 0.0, 4U, s3);
     s3[2] = (uint16_t)(s3[1] + 4U * 2U); // the third bin 2 values above the second
-    assert_false(sl_profile_lead_edge(s3, 4U, 0U, 0U, &f));
+    assert_false(sl_profile_lead_edge(s3, 4U, 0U, &f));
     const uint16_t end[3] = {4U * 194U, 4U * 200U, 4U * 200U}; // first bin half lit
-    assert_true(sl_profile_lead_edge(end, 4U, SL_PROFILE_LEAD_END_Q16, 0U, &f));
+    assert_true(sl_profile_lead_edge(end, 4U, SL_PROFILE_LEAD_END_Q16, &f));
     assert_true(f > 32000U && f < 33500U);
 }
 
@@ -727,7 +682,6 @@ int main(void)
         cmocka_unit_test(test_profile_refines_r2_within_the_last_bin_of_a_cliff),
         cmocka_unit_test(test_profile_lead_fill_follows_the_lines_geometry),
         cmocka_unit_test(test_profile_lead_edge_refuses_shapes_no_line_makes),
-        cmocka_unit_test(test_profile_lead_edge_removes_an_outward_smear),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
