@@ -407,7 +407,7 @@ uint32_t sl_profile_lead_fill_q16(uint32_t first_sum, uint32_t second_sum, uint3
     }
     if (delta_q16 == 0U) {
         // at the foot, closed form: q = f + sqrt(f (1 + f)) <=> f = q^2 / (1 + 2 q), full from
-        // q = 1 + sqrt(2) on (q < 2^24 here: q^2 fits)
+        // q = 1 + sqrt(2) on (below it q^2 < 2^35)
         if (q >= 158217U) {
             return 65535U;
         }
