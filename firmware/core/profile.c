@@ -11,6 +11,7 @@
 
 #define SLOPE_MIN_Q8 128U   // 0.5 value per bin
 #define SLOPE_MAX_Q8 6144U  // 24 values per bin
+#define LEAD_TOL_VALUES 3U  // sl_profile_lead_edge: the third bin within 3 values (1.5 dB)
 #define FIT_BINS 8U
 #define FIT_MIN_BINS 4U
 #define CAL_GATE_N 4U       // fits before the +-30 % gate applies
@@ -188,6 +189,26 @@ static uint32_t fit_slope_q8(const uint16_t *sum, uint32_t e, uint32_t m, uint32
 }
 
 // One extraction; `fit_max` (<= FIT_BINS) caps the size of the tail fit (bins ending at e).
+// The step after the run's last bin above the threshold falls by more than two tail slopes
+// `s` (Q8 values per bin per frame).
+static bool is_cliff(const uint16_t *sum, uint32_t last, uint32_t frames, uint32_t s)
+{
+    return ((int64_t)sum[last] - (int64_t)sum[last + 1U]) * 256 > 2 * (int64_t)frames * (int64_t)s;
+}
+
+// A return that ends in a cliff: its last bins are its own (r2 = `last`).
+static sl_profile_bounds_t cliff(uint32_t i1, uint32_t last, uint32_t e)
+{
+    sl_profile_bounds_t r;
+    memset(&r, 0, sizeof r);
+    r.i1 = (uint16_t)i1;
+    r.i2 = (uint16_t)last;
+    r.e = (uint16_t)e;
+    r.slope_src = SL_PROFILE_SLOPE_CLIFF;
+    r.fail = (uint8_t)SL_PROFILE_OK;
+    return r;
+}
+
 static sl_profile_bounds_t extract_once(const uint16_t *sum, uint32_t n, uint32_t frames,
                                         uint32_t threshold, uint32_t hint, uint32_t cal_slope_q8,
                                         uint32_t fit_max, uint32_t cliff_end)
@@ -244,6 +265,12 @@ static sl_profile_bounds_t extract_once(const uint16_t *sum, uint32_t n, uint32_
         s = cal_slope_q8;
         r.slope_src = SL_PROFILE_SLOPE_CAL;
         if (s < SLOPE_MIN_Q8 || s > SLOPE_MAX_Q8) {
+            // No slope to compare with (a short flat return, nothing calibrated yet): still
+            // a cliff when the step after the run falls by more than two of the steepest
+            // plausible tail slopes (a drop no smear tail makes).
+            if (last < cliff_end && is_cliff(sum, last, frames, SLOPE_MAX_Q8)) {
+                return cliff(i1, last, e);
+            }
             r.fail = (uint8_t)SL_PROFILE_NO_TAIL;
             r.slope_src = 0U;
             return r;
@@ -255,13 +282,9 @@ static sl_profile_bounds_t extract_once(const uint16_t *sum, uint32_t n, uint32_
     // or beyond `cliff_end` (the shadow edge): a pole's own return ends inside the shadow,
     // so a drop there ends a smear tail (where it meets the floor, or where the smear's
     // support ends) and the walk from e decides.
-    if (last < cliff_end &&
-        ((int64_t)sum[last] - (int64_t)sum[last + 1U]) * 256 > 2 * (int64_t)frames * (int64_t)s) {
-        r.i1 = (uint16_t)i1;
-        r.i2 = (uint16_t)last;
-        r.e = (uint16_t)e;
-        r.slope_src = SL_PROFILE_SLOPE_CLIFF;
-        r.fail = (uint8_t)SL_PROFILE_OK;
+    if (last < cliff_end && is_cliff(sum, last, frames, s)) {
+        r = cliff(i1, last, e);
+        r.slope_q8 = (uint16_t)s;
         return r;
     }
     // 4. walk back over the tail: bin j is tail while S[j-1] - S[j] >= F (s_loc - s_loc / 6)
@@ -355,6 +378,61 @@ uint32_t sl_profile_fill_q16(uint32_t edge_sum, uint32_t ref_sum, uint32_t frame
     return ((uint32_t)k_fill_q16[k] * (256U - fr) + (uint32_t)k_fill_q16[k + 1U] * fr) >> 8;
 }
 
+// Power of the first bin over the second's, Q16, for a first bin lit over f (Q16) whose lit
+// part starts delta (Q16 bins) past the foot: (sqrt(f + d) - sqrt(d)) / (sqrt(1 + f + d) -
+// sqrt(f + d)).
+static uint64_t lead_ratio_q16(uint64_t f, uint64_t d, uint64_t sd)
+{
+    const uint64_t a = sl_fx_isqrt64((f + d) << 16);
+    const uint64_t c = sl_fx_isqrt64((f + d + 65536U) << 16);
+    return ((a - sd) << 16) / (c - a);
+}
+
+uint32_t sl_profile_lead_fill_q16(uint32_t first_sum, uint32_t second_sum, uint32_t frames,
+                                  uint32_t delta_q16)
+{
+    if (delta_q16 >= SL_PROFILE_LEAD_END_Q16) {
+        return sl_profile_fill_q16(first_sum, second_sum, frames);
+    }
+    // observed q = P1 / P2 in Q16; the first bin brighter: q = 1 / (P2 / P1)
+    uint64_t q;
+    if (first_sum <= second_sum) {
+        q = sl_profile_fill_q16(first_sum, second_sum, frames);
+    } else {
+        const uint32_t inv = sl_profile_fill_q16(second_sum, first_sum, frames);
+        if (inv == 0U) {
+            return 65535U;
+        }
+        q = ((uint64_t)1U << 32) / inv;
+    }
+    if (delta_q16 == 0U) {
+        // at the foot, closed form: q = f + sqrt(f (1 + f)) <=> f = q^2 / (1 + 2 q), full from
+        // q = 1 + sqrt(2) on (below it q^2 < 2^35)
+        if (q >= 158217U) {
+            return 65535U;
+        }
+        const uint64_t f = (q * q) / (65536U + 2U * q);
+        return f >= 65535U ? 65535U : (uint32_t)f;
+    }
+    const uint64_t d = delta_q16;
+    const uint64_t sd = sl_fx_isqrt64(d << 16);
+    if (q >= lead_ratio_q16(65536U, d, sd)) {
+        return 65535U;
+    }
+    // the ratio grows with f: bisection to 1/256 bin (0.2 mm on the CTS350-X)
+    uint64_t lo = 0U, hi = 65536U;
+    for (uint32_t k = 0U; k < 8U; k++) {
+        const uint64_t mid = (lo + hi) >> 1;
+        if (lead_ratio_q16(mid, d, sd) <= q) {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    const uint64_t f = (lo + hi) >> 1;
+    return f >= 65535U ? 65535U : (uint32_t)f;
+}
+
 static void calibrate(sl_profile_t *pr, uint32_t s)
 {
     if (pr->cal_n >= CAL_GATE_N) {
@@ -421,6 +499,55 @@ static uint32_t combine_neighbours(sl_profile_t *pr, const sl_target_t *t, uint8
     *bin0 = lo;
     *n = hi - lo;
     return frames;
+}
+
+bool sl_profile_lead_edge(const uint16_t *sum3, uint32_t frames, uint32_t delta_q16,
+                          uint32_t *f_q16)
+{
+    SL_ASSERT(sum3 != NULL && f_q16 != NULL);
+    const uint32_t f = sl_profile_lead_fill_q16(sum3[0], sum3[1], frames, delta_q16);
+    *f_q16 = f;
+    // P3 / P2 the model predicts (1 for an end), and the profile's, Q16
+    uint64_t pred = 65536U;
+    if (delta_q16 < SL_PROFILE_LEAD_END_Q16) {
+        const uint64_t d = (uint64_t)f + delta_q16;
+        const uint64_t s1 = sl_fx_isqrt64(d << 16);
+        const uint64_t s2 = sl_fx_isqrt64((d + 65536U) << 16);
+        const uint64_t s3 = sl_fx_isqrt64((d + 131072U) << 16);
+        pred = ((s3 - s2) << 16) / (s2 - s1);
+    }
+    uint64_t obs;
+    if (sum3[2] <= sum3[1]) {
+        obs = sl_profile_fill_q16(sum3[2], sum3[1], frames);
+    } else {
+        const uint32_t inv = sl_profile_fill_q16(sum3[1], sum3[2], frames);
+        obs = inv == 0U ? ((uint64_t)1U << 32) : ((uint64_t)1U << 32) / inv;
+    }
+    // within LEAD_TOL_VALUES values either way (x 10^(-k/20), the fill table's step)
+    const uint64_t tol = k_fill_q16[LEAD_TOL_VALUES];
+    return obs * tol <= pred * 65536U && pred * tol <= obs * 65536U;
+}
+
+// How far past the foot of the pole's line its lit part starts, in Q16 bins (the leading
+// edge's model, sl_profile_lead_fill_q16): 0 when r1 is the foot (branch 2); on branch 1 the
+// top end lies on the +beta ray, alpha - beta from the foot: r1 (1 - cos(alpha - beta)),
+// with 1 - cos x = x^2 / 2 - x^4 / 24 (x < 60 deg here: within 0.3 %).
+static uint32_t lead_delta_q16(const sl_incline_result_t *res, const sl_incline_geom_t *g,
+                               uint64_t r1_um, uint64_t bin_um)
+{
+    if (res->branch != (uint8_t)SL_INCLINE_BRANCH_1 || bin_um == 0U) {
+        return 0U;
+    }
+    const int32_t x_bam = (int32_t)(res->alpha_bam32 - g->beta_bam32);
+    const int64_t ax = x_bam < 0 ? -(int64_t)x_bam : (int64_t)x_bam;
+    if (ax >= ((int64_t)1 << 29)) { // 45 deg: far from the foot, an end
+        return SL_PROFILE_LEAD_END_Q16;
+    }
+    const int64_t x_q30 = (ax * 1686629713LL) >> 30; // bam32 -> rad (pi/2 in Q30)
+    const int64_t x2 = (x_q30 * x_q30) >> 30;
+    const int64_t one_minus_cos = x2 / 2 - ((x2 * x2) >> 30) / 24; // Q30
+    const uint64_t d = ((r1_um * (uint64_t)one_minus_cos) >> 14) / bin_um; // Q16 bins
+    return d >= SL_PROFILE_LEAD_END_Q16 ? SL_PROFILE_LEAD_END_Q16 : (uint32_t)d;
 }
 
 uint8_t sl_profile_refine(sl_profile_t *pr, const sl_board_t *board, uint32_t threshold,
@@ -509,9 +636,26 @@ uint8_t sl_profile_refine(sl_profile_t *pr, const sl_board_t *board, uint32_t th
     t->elong_um = sl_fx_sat32(r2_hb_mask - r2_hb);
     t->flags = (uint16_t)((t->flags & ~SL_TARGET_ELONG) | SL_TARGET_PROFILE);
     if (board->geom != NULL) {
-        const sl_incline_result_t res = sl_incline_estimate(
-            t->r1_um, t->r2_um, &board->geom[t->az], board->range_sigma_um,
-            board->theta_sigma_cdeg);
+        sl_incline_result_t res = sl_incline_estimate(t->r1_um, t->r2_um, &board->geom[t->az],
+                                                      board->range_sigma_um,
+                                                      board->theta_sigma_cdeg);
+        if (!slant && pb.slope_src == SL_PROFILE_SLOPE_CLIFF && pb.i2 >= pb.i1 + 3U &&
+            res.flag == (uint8_t)SL_INCLINE_VALID) {
+            // Sub-bin leading edge (step 6): the first bin's lit fraction from its power
+            // against the second's, with the model of the branch the bounds gave, when the
+            // third bin follows the same model (else the centre is kept, `lead_kept`).
+            uint32_t f = 0U;
+            if (sl_profile_lead_edge(&sum[pb.i1], frames,
+                                     lead_delta_q16(&res, &board->geom[t->az], i1 * b, b), &f)) {
+                const int64_t r1_sub =
+                    (int64_t)((i1 + 1U) * b - ((uint64_t)f * b + 32768U) / 65536U);
+                t->r1_um = sl_fx_usat32(r1_sub + r1_term);
+                res = sl_incline_estimate(t->r1_um, t->r2_um, &board->geom[t->az],
+                                          board->range_sigma_um, board->theta_sigma_cdeg);
+            } else {
+                pr->stats.lead_kept++;
+            }
+        }
         t->alpha_cdeg = res.alpha_cdeg;
         t->sigma_cdeg = res.sigma_cdeg;
         t->incline_flag = res.flag;

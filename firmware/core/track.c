@@ -68,12 +68,13 @@ static uint8_t raw_level(const sl_tracker_t *tr, int32_t a, int32_t lower)
 // `repeat`: the measurement's bounds are identical to the previous one's (a static scene
 // quantised the same way every rotation). Its error is then the same as last time, not a
 // new independent draw, so the variance is not allowed below the measurement's own.
+// `restart`: the first measurement from a range profile after the mask's (see "Filter").
 static void filter_update(const sl_tracker_t *tr, sl_track_t *t, int32_t z_cdeg,
-                          uint16_t sigma_cdeg, bool repeat)
+                          uint16_t sigma_cdeg, bool repeat, bool restart)
 {
     const uint64_t sz = sigma_cdeg > tr->cfg.min_sigma_cdeg ? sigma_cdeg : tr->cfg.min_sigma_cdeg;
     const uint64_t r = sz * sz;
-    if (t->valid_hits == 0U) {
+    if (t->valid_hits == 0U || restart) {
         t->alpha_q8 = sl_fx_sat32((int64_t)z_cdeg * 256);
         t->var_cdeg2 = sl_fx_usat32((int64_t)(r == 0U ? 1U : r));
     } else {
@@ -229,7 +230,12 @@ static void track_take(sl_tracker_t *tr, sl_track_t *t, const sl_target_t *g, ui
         t->hits++;
     }
     if (g->incline_flag == (uint8_t)SL_INCLINE_VALID) {
-        filter_update(tr, t, g->alpha_cdeg, g->sigma_cdeg, repeat);
+        const bool profiled = (g->flags & SL_TARGET_PROFILE) != 0U;
+        filter_update(tr, t, g->alpha_cdeg, g->sigma_cdeg, repeat,
+                      profiled && t->profiled == 0U);
+        if (profiled) {
+            t->profiled = 1U;
+        }
         level_update(tr, t);
     }
 }

@@ -630,6 +630,7 @@ std::vector<PipelineEval::Track> PipelineEval::tracks() const
             x.hits = t.hits;
             x.valid_hits = t.valid_hits;
             x.last_flag = t.last_flag;
+            x.confirmed = t.confirmed;
             x.alpha_deg = t.alpha_cdeg / 100.0;
             x.sigma_deg = t.sigma_cdeg / 100.0;
             x.level = t.level;

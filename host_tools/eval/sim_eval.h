@@ -214,6 +214,7 @@ public:
     /// One live tracker slot as reported after a rotation.
     struct Track {
         int rotation = 0, az = 0, id = 0, hits = 0, valid_hits = 0, last_flag = 0;
+        int confirmed = 0;    ///< the pipeline sends PoleLean for it
         double alpha_deg = 0; ///< filtered alpha (meaningful when valid_hits > 0)
         double sigma_deg = 0; ///< its filtered sigma
         int level = 0;        ///< warning level (sl_warn_level_t)

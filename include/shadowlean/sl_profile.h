@@ -73,13 +73,22 @@
 ///    bin against the own bin before it) instead of the bin's centre. With a tail the last
 ///    own bin's power is mixed with the smear of the bins before it and the whole-bin
 ///    centre is kept (not done: the fill after removing the fitted tail).
-///    r1 stays the first bin's centre. Not done: the leading edge's fill. Where r1 is a
-///    range minimum inside the lit segment the length per bin peaks (~1/sqrt(r - r1)), so
-///    the first bin reads BRIGHTER than the next when well filled and sl_profile_fill_q16
-///    does not apply. Measured on sim_static_sweep (noise-free, 40 positions): the
-///    1/sqrt model f = q^2 / (1 + 2q) (q = first / second bin's power) follows the truth
-///    within 0.05 bin for f < 0.4 at -10 / 0 deg but saturates near 0.6 for f -> 1, and
-///    at +10 deg (r1 cut by the beam's upper bound) neither it nor the uniform model fits.
+///    Sub-bin leading edge, also only on a cliff and with three whole bins after the first
+///    (sl_profile_lead_edge): along a straight pole the range grows as the square of the
+///    distance from the foot of its line, so the pole's length per unit range is
+///    ~ 1 / sqrt(r - foot); the lit part starts at the foot (estimator branch 2) or, on
+///    branch 1, r1 (1 - cos(alpha - beta)) past it (the top end on the +beta ray). The first
+///    bin's lit fraction follows from its power over the second's; the third bin checks
+///    the model, and a shape it does not explain (a flat box, a bright scatterer, clipping)
+///    keeps the first bin's centre (`stats.lead_kept`). Measured on sim_static_sweep
+///    (noise-free, 40 positions): mean |r1 - front surface| 4.5-6.8 mm (the centre: 11);
+///    the pole's radius, which rounds the foot's peak, is what the models leave out.
+///    Tried and left out: the same reading on smeared returns, with the fitted tail's
+///    per-bin ratio removed from the second and third bins first. It moved the harder
+///    bench's 0 / +5 / +10 deg means from +1.16 / +1.23 / +1.27 to +0.99 / +1.10 / +1.21 deg
+///    but made the estimate depend on n under per-frame speckle (mean shift n = 4 -> 16 of
+///    0.32 deg at -5 and 0 deg, 0.07 and 0.15 without it): a ratio of two noisy bins through
+///    a convex model is biased by their variance.
 /// The value scale (log of power) only enters through the ratio 1/6 and T/4; nothing depends
 /// on the simulator's kernel, the board's d(r) or n.
 ///
@@ -196,6 +205,8 @@ typedef struct sl_profile_stats {
     uint32_t assign_full;   ///< targets left without a slot (every slot watches a target)
     uint32_t cal_accepted;  ///< self-fitted slopes taken into the calibration
     uint32_t cal_rejected;  ///< ... refused by the +-30 % gate
+    uint32_t lead_kept;     ///< cliff-ended targets whose leading edge kept the first
+                            ///< bin's centre (sl_profile_lead_edge: the shape fits no model)
     uint32_t spatial;       ///< targets refined from one rotation's rows of neighbouring
                             ///< azimuths (too few rotations summed: moving)
     uint32_t reserved;      ///< slots reserved where a track is expected (sl_profile_reserve)
@@ -264,6 +275,42 @@ uint32_t sl_profile_reserve(sl_profile_t *pr, uint16_t az, uint16_t bin_first, u
 /// is about constant over the two bins (not so at a range extremum of the pole, where the
 /// length per bin peaks: hence used for r2, not for r1).
 uint32_t sl_profile_fill_q16(uint32_t edge_sum, uint32_t ref_sum, uint32_t frames);
+
+/// Lit fraction of the FIRST bin of a return, Q16 (pure), from its summed value against the
+/// second bin's, over `frames` rows. Geometry, no constant of the scene: along a straight
+/// pole the range grows with the distance s from the foot of its line as r = sqrt(p^2 + s^2),
+/// so the pole's length per unit range is ~ 1 / sqrt(r - p). The lit part starts `delta_q16`
+/// (bins, Q16) past the foot: 0 when r1 IS the foot (estimator branch 2, a range minimum
+/// inside the lit segment), r1 (1 - cos(alpha - beta)) when r1 is the top end on the +beta
+/// ray (branch 1). With f the first bin's lit fraction, the bins hold 2 (sqrt(f + d) -
+/// sqrt(d)) and 2 (sqrt(1 + f + d) - sqrt(f + d)) (units of sqrt(bin)); f is found from their
+/// ratio, measured from the values' difference at 0.5 dB per value (either bin may be the
+/// brighter): at the foot in closed form, f = q^2 / (1 + 2 q) (q = f + sqrt(f (1 + f))), else
+/// by bisection to 1/256 bin (0.2 mm); full when the ratio reaches f = 1's. From
+/// SL_PROFILE_LEAD_END_Q16 on the length per bin is taken as constant (the ratio is f:
+/// sl_profile_fill_q16). A pole's radius rounds the foot's peak (its surface spreads the
+/// nearest point over R), so a well-filled first bin reads partly filled: r1 then errs
+/// towards the far end of its bin by up to ~R. Cost: one 64-bit division at the foot, else
+/// 9 ratio evaluations (two 64-bit integer square roots each).
+uint32_t sl_profile_lead_fill_q16(uint32_t first_sum, uint32_t second_sum, uint32_t frames,
+                                  uint32_t delta_q16);
+
+/// The leading edge from the first three bins' sums `sum3` (pure): `*f_q16` = the first
+/// bin's lit fraction (sl_profile_lead_fill_q16 with `delta_q16`). Returns true when the
+/// third bin agrees with the same model: its power over the second's within 3 values
+/// (1.5 dB) of the model's (sqrt(f + d + 2) - sqrt(f + d + 1)) / (sqrt(f + d + 1) -
+/// sqrt(f + d)), or of 1 for an end. The tolerance: one value is the rounding of two 8-bit
+/// values; the rest is what the model leaves out (the pole's radius, the elevation pattern):
+/// on sim_static_sweep's noise-free returns the third bin sits up to 2.5 values off the
+/// model. A return whose shape the line's geometry does not explain gets false and the
+/// caller keeps the first bin's centre: a flat box (the foot model then predicts a third
+/// bin >= 3.8 values below the second), a bright scatterer on the pole, clipping.
+bool sl_profile_lead_edge(const uint16_t *sum3, uint32_t frames, uint32_t delta_q16,
+                          uint32_t *f_q16);
+
+/// Offset of the lit part from the foot beyond which the leading edge is taken as an end of
+/// constant length per bin (64 bins, Q16).
+#define SL_PROFILE_LEAD_END_Q16 (64UL << 16)
 
 /// Smear-aware bounds from a profile (pure; see "Extraction"). `hint` = the mask's first
 /// bin relative to the profile start, `cal_slope_q8` the fallback slope (0: none),

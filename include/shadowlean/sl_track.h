@@ -53,6 +53,13 @@
 ///                       the previous valid measurement's (a static scene quantised the
 ///                       same way every rotation is one measurement, not many: variance
 ///                       floor while the bins repeat, EXTRACTION.md D6)
+///     restart: the track's first measurement refined from a range profile
+///              (SL_TARGET_PROFILE, sl_profile.h) is taken as the first (alpha = z,
+///              P = sigma_z^2): the mask's bounds before it are whole bins shortened by the
+///              smear's compression, errors that repeat rotation after rotation (a bias, not
+///              noise the filter could average out), and the profile measures the same
+///              return without them. Later mask-only measurements (the profile unusable on
+///              a rotation) are fused as usual.
 ///
 /// `alpha_cdeg` and `sigma_cdeg` (= isqrt(P)) are the reported values.
 ///
@@ -144,6 +151,8 @@ typedef struct sl_track {
     uint8_t last_slant;      ///< 1 = the last associated target was SL_TARGET_SLANT (a pole
                              ///< leaning across the beam: no one azimuth holds its run)
     uint16_t pred_az;        ///< internal: predicted azimuth for this update
+    uint8_t profiled;        ///< 1 = a valid measurement came from a range profile
+                             ///< (SL_TARGET_PROFILE); the first one restarts the filter
     uint32_t pred_r1_um;     ///< internal: predicted r1 for this update
 } sl_track_t;
 

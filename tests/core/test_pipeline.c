@@ -89,18 +89,64 @@ static double theta_deg(uint32_t az)
     return B->theta_cdeg[az] / 100.0;
 }
 
-// What the pipeline should estimate from the bins the segment occupies (half-bin corrected).
-static double predicted_alpha(double d, double alpha, uint32_t az, int *flag)
+// Values (0.5 dB of power each, the sensor's log scale) a bin lit over `fill` of its length
+// reads below a full one; the fill the pipeline reads back from that drop.
+static int edge_drop(double fill)
+{
+    return fill <= 0 ? 255 : (int)lround(-20.0 * log10(fill));
+}
+static double read_fill(int drop)
+{
+    return drop >= 48 ? 0.0 : pow(10.0, -drop / 20.0);
+}
+
+// The first bin's lit fraction for a first-over-second power ratio q when the lit part
+// starts dl bins past the foot of the pole's line (sl_profile_lead_fill_q16's model).
+static double lead_fill_oracle(double q, double dl)
+{
+    double lo = 0, hi = 1;
+    for (int k = 0; k < 60; k++) {
+        const double f = 0.5 * (lo + hi);
+        const double g = (sqrt(f + dl) - sqrt(dl)) / (sqrt(f + dl + 1) - sqrt(f + dl));
+        if (g <= q) {
+            lo = f;
+        } else {
+            hi = f;
+        }
+    }
+    return 0.5 * (lo + hi);
+}
+
+// What the pipeline should estimate from the bins the segment occupies.
+static double predicted_alpha(double d, double alpha, uint32_t az, bool profiled, int *flag)
 {
     const seg_t s = pole_segment(d, alpha, theta_deg(az), B->beta_up_cdeg / 100.0,
                                  B->radar_height_um * 1e-6);
     const double b = bin_m();
-    const double r1 = (floor(s.r1 / b) + 0.5) * b, r2 = (floor(s.r2 / b) + 0.5) * b;
+    // r2: the start of the last bin + its lit fraction as the pipeline reads it back from
+    // the rendered value (sl_profile_fill_q16); r1: the first bin's centre, or its lit
+    // fraction when the rendered box's flat start fits the leading-edge model
+    // (sl_profile_lead_edge, here in double precision)
+    // (mask bounds, `profiled` false: both centres)
+    const double i1 = floor(s.r1 / b), i2 = floor(s.r2 / b);
+    double r1 = (i1 + 0.5) * b;
+    const double r2 = profiled ? i2 * b + read_fill(edge_drop(s.r2 / b - i2)) * b : (i2 + 0.5) * b;
     if (r2 <= r1) {
         *flag = 2;
         return 0;
     }
-    return alpha_from_rho(r2 / r1, theta_deg(az), B->beta_up_cdeg / 100.0, flag);
+    const double be = B->beta_up_cdeg / 100.0;
+    const double a0 = alpha_from_rho(r2 / r1, theta_deg(az), be, flag);
+    if (profiled && *flag == 0 && i2 >= i1 + 3) {
+        // the box: first, second and third bins at the same value (q = 1, P3 / P2 = 1)
+        const double dl = a0 >= be ? i1 * (1.0 - cos((a0 - be) * DEG)) : 0.0; // bins
+        const double f = lead_fill_oracle(1.0, dl);
+        const double p3 = (sqrt(f + dl + 2) - sqrt(f + dl + 1)) / (sqrt(f + dl + 1) - sqrt(f + dl));
+        if (fabs(20.0 * log10(p3)) <= 3.0) {
+            r1 = (i1 + 1.0 - f) * b;
+        }
+    }
+    return alpha_from_rho(r2 / r1, theta_deg(az), be, flag);
 }
 
 // A distance in [lo, hi] (1 mm steps) where the quantised estimate lies in [want_lo, want_hi]
@@ -111,7 +157,7 @@ static double place_pole(double alpha, uint32_t az, double lo, double hi, double
     double best = -1, best_err = 1e9;
     for (double d = lo; d <= hi; d += 0.001) {
         int flag;
-        const double e = predicted_alpha(d, alpha, az, &flag);
+        const double e = predicted_alpha(d, alpha, az, true, &flag);
         if (ambiguous) {
             if (flag == 1) {
                 return d;
@@ -170,6 +216,11 @@ static void draw_pole(uint8_t *row, uint32_t bins, double d, double alpha, uint3
             continue;
         }
         row[k] = 200;
+    }
+    if (s.base_in_shadow && last > first && last < bins && (gap <= 0 || last != first + (uint32_t)gap)) {
+        // the last bin lit over part of its length returns that part of a full bin's power
+        const int drop = edge_drop(s.r2 / bin_m() - floor(s.r2 / bin_m()));
+        row[last] = (uint8_t)(drop >= 160 ? 40 : 200 - drop);
     }
 }
 
@@ -511,7 +562,8 @@ static void check_targets(const scene_t *s, int k)
         }
         assert_true(t->bin_first >= B->near_exclusion_bins);
         int flag;
-        const double pred = predicted_alpha(p->d, p->alpha, t->az, &flag);
+        const double pred =
+            predicted_alpha(p->d, p->alpha, t->az, (t->flags & SL_TARGET_PROFILE) != 0U, &flag);
         if (p->alpha == -13) {
             assert_int_equal(flag, 1);
             assert_int_equal(t->incline_flag, SL_INCLINE_AMBIGUOUS);
@@ -1235,7 +1287,7 @@ static drive_result_t run_drive(double v, bool motion, bool via_can, int drop_pe
             int flag;
             const bool prof = (t->flags & SL_TARGET_PROFILE) != 0U;
             res.profiled += prof ? 1 : 0;
-            const double pred = predicted_alpha(d, alpha, t->az, &flag);
+            const double pred = predicted_alpha(d, alpha, t->az, prof, &flag);
             const double got = t->alpha_cdeg / 100.0;
             if (flag == 0 && fabs(got - pred) > 0.05) {
                 fail_msg("drive-by rotation %d az %u: alpha %.2f, oracle from the bins %.3f "

@@ -227,11 +227,26 @@ static void test_profile_reports_why_it_cannot_extract(void **state)
         sum[k] = k < 5 ? 0 : 4 * 200;
     }
     assert_int_equal(sl_profile_extract(sum, NB, 4, 40, 5, 0, UINT32_MAX).fail, SL_PROFILE_TAIL_CUT);
-    // flat run, no tail to fit and no calibration; with one the calibration is used
+    // flat run ending on a floor 45 values lower (a drop a steep smear tail could make): no
+    // tail to fit and no calibration; with one the calibration is used
     for (int k = 0; k < NB; k++) {
-        sum[k] = (k >= 5 && k < 15) ? 4 * 80 : 0;
+        sum[k] = (k >= 5 && k < 15) ? 4 * 80 : 4 * 35;
     }
     assert_int_equal(sl_profile_extract(sum, NB, 4, 40, 5, 0, UINT32_MAX).fail, SL_PROFILE_NO_TAIL);
+    // ... ending in a drop of 49 values, more than two of the steepest plausible tail slopes
+    // (24 values per bin): a cliff without any slope to compare with
+    for (int k = 15; k < NB; k++) {
+        sum[k] = 4 * 31;
+    }
+    const sl_profile_bounds_t c = sl_profile_extract(sum, NB, 4, 40, 5, 0, UINT32_MAX);
+    assert_int_equal(c.fail, SL_PROFILE_OK);
+    assert_int_equal(c.slope_src, SL_PROFILE_SLOPE_CLIFF);
+    assert_int_equal(c.i2, 14);
+    // ... not when that drop lies at or beyond the shadow edge (a smear tail's end)
+    assert_int_equal(sl_profile_extract(sum, NB, 4, 40, 5, 0, 14).fail, SL_PROFILE_NO_TAIL);
+    for (int k = 15; k < NB; k++) {
+        sum[k] = 0;
+    }
     // with a calibrated slope it extracts; the run ends in a cliff: r2 = its last bin
     const sl_profile_bounds_t r = sl_profile_extract(sum, NB, 4, 40, 5, 3U * 256U, UINT32_MAX);
     assert_int_equal(r.fail, SL_PROFILE_OK);
@@ -581,6 +596,74 @@ static void test_profile_refines_r2_within_the_last_bin_of_a_cliff(void **state)
     assert_int_equal(t.r2_um, 18 * 43800 + (65535LL * 43800 + 32768) / 65536);
 }
 
+// Power of a bin of a straight pole whose lit part starts `d` bins past the foot of its
+// line (length per unit range ~ 1 / sqrt(r - foot)): bin k (0 = the first, lit over f).
+static double line_bin_power(double f, double d, int k)
+{
+    const double a = k == 0 ? d : f + d + k - 1;
+    return sqrt(f + d + k) - sqrt(a);
+}
+
+// Summed values (`frames` rows, 0.5 dB per value, dithered to 1 / frames of a value) of the
+// first three bins of that pole, the second at 150.
+static void line_sums(double f, double d, uint32_t frames, uint16_t out[3])
+{
+    const double p1 = line_bin_power(f, d, 1);
+    for (int k = 0; k < 3; k++) {
+        const double v = 150.0 + 20.0 * log10(line_bin_power(f, d, k) / p1);
+        out[k] = (uint16_t)lround(v * frames);
+    }
+}
+
+// The leading edge's lit fraction against the line's geometry in double precision: at the
+// foot (d = 0: the first bin brighter than the second once f > 1/3), just past it, and
+// far from it (the length per bin nearly constant); from SL_PROFILE_LEAD_END_Q16 on the
+// constant-length reading of sl_profile_fill_q16. Error from the fill table's linear
+// interpolation between whole values: < 0.5 % of f, plus 1/1024 bin of bisection.
+static void test_profile_lead_fill_follows_the_lines_geometry(void **state)
+{
+    (void)state;
+    const double ds[4] = {0.0, 0.3, 1.5, 8.0};
+    for (int i = 0; i < 4; i++) {
+        for (double f = 0.02; f <= 1.0001; f += 0.02) {
+            uint16_t s3[3];
+            line_sums(f, ds[i], 64U, s3);
+            const uint32_t dq = (uint32_t)lround(ds[i] * 65536.0);
+            const double got = sl_profile_lead_fill_q16(s3[0], s3[1], 64U, dq) / 65536.0;
+            if (fabs(got - f) > 0.005 * f + 0.002) {
+                fail_msg("d %.1f f %.2f: read %.4f", ds[i], f, got);
+            }
+            uint32_t fe = 0U;
+            assert_true(sl_profile_lead_edge(s3, 64U, dq, &fe)); // the third bin agrees
+            assert_int_equal(fe, sl_profile_lead_fill_q16(s3[0], s3[1], 64U, dq));
+        }
+    }
+    // a first bin 3.8 dB (7.66 values) brighter: full at the foot
+    assert_int_equal(sl_profile_lead_fill_q16(64U * 158U, 64U * 150U, 64U, 0U), 65535U);
+    // an end: the constant-length reading
+    assert_int_equal(sl_profile_lead_fill_q16(16U * 94U, 16U * 100U, 16U, SL_PROFILE_LEAD_END_Q16),
+                     sl_profile_fill_q16(16U * 94U, 16U * 100U, 16U));
+}
+
+// A return whose first bins the line's geometry does not explain keeps the first bin's
+// centre: a flat box at the foot (the model would want the third bin >= 3.8 values below
+// the second), a bright scatterer in the third bin; an end (constant length per bin) is
+// flat from its second bin on and fits.
+static void test_profile_lead_edge_refuses_shapes_no_line_makes(void **state)
+{
+    (void)state;
+    uint32_t f = 0U;
+    const uint16_t flat[3] = {4U * 200U, 4U * 200U, 4U * 200U};
+    assert_false(sl_profile_lead_edge(flat, 4U, 0U, &f));
+    uint16_t s3[3];
+    line_sums(0.6, 0.0, 4U, s3);
+    s3[2] = (uint16_t)(s3[1] + 4U * 2U); // the third bin 2 values above the second
+    assert_false(sl_profile_lead_edge(s3, 4U, 0U, &f));
+    const uint16_t end[3] = {4U * 194U, 4U * 200U, 4U * 200U}; // first bin half lit
+    assert_true(sl_profile_lead_edge(end, 4U, SL_PROFILE_LEAD_END_Q16, &f));
+    assert_true(f > 32000U && f < 33500U);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -597,6 +680,8 @@ int main(void)
         cmocka_unit_test(test_profile_refines_only_the_far_end_of_a_pole_leaning_across_the_beam),
         cmocka_unit_test(test_profile_fill_from_the_log_values),
         cmocka_unit_test(test_profile_refines_r2_within_the_last_bin_of_a_cliff),
+        cmocka_unit_test(test_profile_lead_fill_follows_the_lines_geometry),
+        cmocka_unit_test(test_profile_lead_edge_refuses_shapes_no_line_makes),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

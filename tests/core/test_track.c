@@ -418,6 +418,41 @@ static void test_track_does_not_trust_repeated_identical_bounds(void **state)
     assert_true(trk.tracks[0].sigma_cdeg < 60);
 }
 
+// Mask bounds first (whole bins, the same error every static rotation), then the target's
+// range profile (sl_profile.h): the first profile measurement restarts the filter, so the
+// mask's bias does not linger in what PoleLean reports; later mask-only measurements are
+// fused as usual.
+static void test_track_restarts_on_the_first_profile_measurement(void **state)
+{
+    (void)state;
+    assert_int_equal(sl_track_init(&trk, &board, NULL), SL_OK);
+    uint64_t now = 0;
+    for (int i = 0; i < 3; i++) {
+        sl_target_t t = tgt(50, 2500000U, 1200, 60, SL_INCLINE_VALID); // mask: +12.00
+        sl_track_update(&trk, &t, 1, now);
+        now += 250000;
+    }
+    assert_int_equal(trk.tracks[0].alpha_cdeg, 1200);
+    sl_target_t p = tgt(50, 2510000U, 1040, 60, SL_INCLINE_VALID); // profile: +10.40
+    p.flags = SL_TARGET_PROFILE;
+    sl_track_update(&trk, &p, 1, now);
+    now += 250000;
+    assert_int_equal(trk.tracks[0].alpha_cdeg, 1040);
+    assert_int_equal(trk.tracks[0].sigma_cdeg, 60);
+    assert_int_equal(trk.tracks[0].valid_hits, 4);
+    assert_int_equal(trk.tracks[0].profiled, 1);
+    // a later mask-only measurement is fused, not restarted from
+    sl_target_t m = tgt(50, 2500000U, 1200, 60, SL_INCLINE_VALID);
+    sl_track_update(&trk, &m, 1, now);
+    assert_true(trk.tracks[0].alpha_cdeg > 1040 && trk.tracks[0].alpha_cdeg < 1200);
+    // and a second profile measurement does not restart either
+    const int32_t before = trk.tracks[0].alpha_cdeg;
+    p.r1_um = 2520000U;
+    p.alpha_cdeg = 900;
+    sl_track_update(&trk, &p, 1, now + 250000U);
+    assert_true(trk.tracks[0].alpha_cdeg > 900 && trk.tracks[0].alpha_cdeg < before);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -433,6 +468,7 @@ int main(void)
         cmocka_unit_test_setup(test_track_predicts_a_static_object_under_ego_motion, setup),
         cmocka_unit_test_setup(test_track_confirms_static_objects_not_scattered_clutter, setup),
         cmocka_unit_test_setup(test_track_prediction_follows_a_reversing_vehicle, setup),
+        cmocka_unit_test_setup(test_track_restarts_on_the_first_profile_measurement, setup),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

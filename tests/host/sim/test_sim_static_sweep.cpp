@@ -44,6 +44,8 @@ struct Cell {
     int n = 0;
     double steady_max = 0;      // rotations >= kSteady (the profile's bounds are in)
     int steady_n = 0;
+    double track_max = 0;       // confirmed track on the pole (what PoleLean carries)
+    int track_n = 0;
     int rows = 0, detected = 0;
     double dr1_mm = NAN, dr2_mm = NAN; // last target's r1 / r2 - the axis truth
     // Edge bins on the pole's azimuth (rotation 0): the fraction of r2's bin the axis fills
@@ -135,6 +137,20 @@ int setup(void **)
                 }
             }
         }
+        for (const auto &tk : pe.tracks()) {
+            if (tk.confirmed == 0 || tk.valid_hits <= 0) {
+                continue;
+            }
+            for (const auto &g : truth) {
+                if (std::abs(tk.az - g.second.azimuth) <= 1) {
+                    const int a = g.first / kPerScene, pos = sc * kPerScene + g.first % kPerScene;
+                    Cell &cell = g_cell[a][pos];
+                    cell.track_n++;
+                    cell.track_max =
+                        std::fmax(cell.track_max, std::fabs(tk.alpha_deg - g.second.alpha_deg));
+                }
+            }
+        }
         for (const auto &kv : res) {
             const int idx = kv.first; // pole index in scene order: a * kPerScene + k
             const int a = idx / kPerScene, pos = sc * kPerScene + idx % kPerScene;
@@ -151,11 +167,11 @@ int setup(void **)
         }
     }
     std::printf("static sweep (paper-sim, noise-free, 40 sub-bin positions of the base)\n");
-    std::printf("%6s %8s %8s %8s %6s %8s %6s\n", "alpha", "mean", "min", "max|e|", "@pos",
-                "steady", "@pos");
+    std::printf("%6s %8s %8s %8s %6s %8s %6s %8s %6s\n", "alpha", "mean", "min", "max|e|", "@pos",
+                "steady", "@pos", "track", "@pos");
     for (int a = 0; a < 3; a++) {
-        double s = 0, mn = 1e9, mx = 0, smx = 0;
-        int n = 0, at = -1, sat = -1;
+        double s = 0, mn = 1e9, mx = 0, smx = 0, tmx = 0;
+        int n = 0, at = -1, sat = -1, tat = -1;
         for (int p = 0; p < kPositions; p++) {
             const Cell &c = g_cell[a][p];
             if (c.n == 0) {
@@ -173,16 +189,21 @@ int setup(void **)
                 smx = c.steady_max;
                 sat = p;
             }
+            if (c.track_max > tmx) {
+                tmx = c.track_max;
+                tat = p;
+            }
         }
-        std::printf("%+6d %+8.3f %+8.3f %8.3f %6d %8.3f %6d\n", kAngles[a], n ? s / n : std::nan(""),
-                    mn, mx, at, smx, sat);
+        std::printf("%+6d %+8.3f %+8.3f %8.3f %6d %8.3f %6d %8.3f %6d\n", kAngles[a],
+                    n ? s / n : std::nan(""), mn, mx, at, smx, sat, tmx, tat);
         for (int p = 0; p < kPositions; p++) {
             const Cell &c = g_cell[a][p];
             std::printf("  pos %2d  rows %2d det %2d  mean %+7.3f  max %6.3f  steady %6.3f  dr1 %+6.1f dr2 %+6.1f mm"
-                        "  | r2 fill %.3f v %3d prev %3d | r1 fill %.3f v %3d next %3d\n",
+                        "  | r2 fill %.3f v %3d prev %3d | r1 fill %.3f v %3d next %3d | track %6.3f (%d)\n",
                         p, c.rows, c.detected, c.n ? c.sum / c.n : std::nan(""), c.maxabs,
                         c.steady_max, c.dr1_mm,
-                        c.dr2_mm, c.fill2, c.v2, c.v2_prev, c.fill1, c.v1, c.v1_next);
+                        c.dr2_mm, c.fill2, c.v2, c.v2_prev, c.fill1, c.v1, c.v1_next, c.track_max,
+                        c.track_n);
         }
     }
     return 0;
@@ -205,39 +226,54 @@ static void test_static_sweep_every_pole_found(void **)
     }
 }
 
-// max |alpha error| over 3 angles x 40 sub-bin positions x every rotation. The goal
-// is 1.0 deg; kMaxErr is what the core achieves today (whole-bin r1 / r2: 2.03 deg at
-// -10 deg, where r2 crosses a bin boundary), a regression guard to be lowered to 1.0 with
-// sub-bin edges.
-constexpr double kMaxErr = 2.1;
+// The goal: max |alpha error| <= 1.0 deg over 3 angles x 40 sub-bin positions, on
+// every rotation whose target is refined from its range profile (kSteady on: sub-bin r1
+// and r2, sl_profile.h step 6) and on every confirmed track (what PoleLean carries: a track
+// confirms on its third hit, rotation 17, and restarts its filter on the first profile
+// measurement, sl_track.h). The targets of the first two rotations after the window fills
+// carry the mask's whole-bin bounds (their azimuth's profile starts when the target first
+// appears): up to 2.03 deg at -10 deg, kept below kMaskMaxErr as a regression guard; they
+// never reach CAN.
+constexpr double kMaxErr = 1.0;
+constexpr double kMaskMaxErr = 2.1;
 static void test_static_sweep_max_error(void **)
 {
     for (int a = 0; a < 3; a++) {
         for (int p = 0; p < kPositions; p++) {
-            if (g_cell[a][p].maxabs > kMaxErr) {
-                std::printf("alpha %+d pos %d: max |error| %.3f > %.2f\n", kAngles[a], p,
-                            g_cell[a][p].maxabs, kMaxErr);
+            const Cell &c = g_cell[a][p];
+            if (c.steady_max > kMaxErr || c.track_max > kMaxErr || c.maxabs > kMaskMaxErr) {
+                std::printf("alpha %+d pos %d: max |error| profile %.3f track %.3f any %.3f\n",
+                            kAngles[a], p, c.steady_max, c.track_max, c.maxabs);
             }
-            assert_true(g_cell[a][p].maxabs <= kMaxErr);
+            assert_true(c.steady_max <= kMaxErr);
+            assert_true(c.track_n >= 3); // confirmed from rotation 17 on
+            assert_true(c.track_max <= kMaxErr);
+            assert_true(c.maxabs <= kMaskMaxErr);
         }
     }
 }
 
-// The far edge within its bin (sl_profile.h step 6, the noise-free returns end in a cliff):
-// mean |r2 - truth| over the 40 positions of the last rotation <= 6 mm at every angle.
-// Whole-bin centres give bin / 4 = 11 mm (uniform over the sawtooth); measured 2.3 / 1.8 /
-// 5.2 mm. Not asserted for r1 (whole-bin, mean |r1 error| 13.5 mm: the sub-bin model of
-// the leading edge is not done, see sl_profile.h).
-static void test_static_sweep_r2_within_the_bin(void **)
+// Both edges within their bin (sl_profile.h step 6, the noise-free returns end in a cliff),
+// over the 40 positions of the last rotation at every angle. Whole-bin centres give bin / 4
+// = 11 mm (uniform over the sawtooth).
+// - r2: mean |r2 - truth| <= 6 mm (measured 2.2 / 1.8 / 3.0 mm at -10 / 0 / +10 deg).
+// - r1 reads the pole's FRONT surface (the board states no radius; truth is the axis, 10 mm
+//   behind it): mean |r1 - (truth - R)| <= 8 mm (measured 4.8 / 6.8 / 4.5 mm; the first
+//   bin's centre gives 11: the leading edge's models, sl_profile_lead_fill_q16, leave out
+//   the radius, which rounds the foot's peak).
+static void test_static_sweep_edges_within_the_bin(void **)
 {
     for (int a = 0; a < 3; a++) {
-        double s = 0;
+        double s2 = 0, s1 = 0;
         for (int p = 0; p < kPositions; p++) {
             assert_false(std::isnan(g_cell[a][p].dr2_mm));
-            s += std::fabs(g_cell[a][p].dr2_mm);
+            s2 += std::fabs(g_cell[a][p].dr2_mm);
+            s1 += std::fabs(g_cell[a][p].dr1_mm + kRadius * 1e3);
         }
-        std::printf("alpha %+d: mean |r2 error| %.1f mm\n", kAngles[a], s / kPositions);
-        assert_true(s / kPositions <= 6.0);
+        std::printf("alpha %+d: mean |r2 error| %.1f mm, mean |r1 - front| %.1f mm\n", kAngles[a],
+                    s2 / kPositions, s1 / kPositions);
+        assert_true(s2 / kPositions <= 6.0);
+        assert_true(s1 / kPositions <= 8.0);
     }
 }
 
@@ -246,7 +282,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_static_sweep_every_pole_found),
         cmocka_unit_test(test_static_sweep_max_error),
-        cmocka_unit_test(test_static_sweep_r2_within_the_bin),
+        cmocka_unit_test(test_static_sweep_edges_within_the_bin),
     };
     return cmocka_run_group_tests(tests, setup, nullptr);
 }
