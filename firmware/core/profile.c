@@ -188,7 +188,6 @@ static uint32_t fit_slope_q8(const uint16_t *sum, uint32_t e, uint32_t m, uint32
     return q > 0xFFFFU ? 0xFFFFU : q;
 }
 
-// One extraction; `fit_max` (<= FIT_BINS) caps the size of the tail fit (bins ending at e).
 // The step after the run's last bin above the threshold falls by more than two tail slopes
 // `s` (Q8 values per bin per frame).
 static bool is_cliff(const uint16_t *sum, uint32_t last, uint32_t frames, uint32_t s)
@@ -209,6 +208,7 @@ static sl_profile_bounds_t cliff(uint32_t i1, uint32_t last, uint32_t e)
     return r;
 }
 
+// One extraction; `fit_max` (<= FIT_BINS) caps the size of the tail fit (bins ending at e).
 static sl_profile_bounds_t extract_once(const uint16_t *sum, uint32_t n, uint32_t frames,
                                         uint32_t threshold, uint32_t hint, uint32_t cal_slope_q8,
                                         uint32_t fit_max, uint32_t cliff_end)
