@@ -388,23 +388,24 @@ static uint64_t lead_ratio_q16(uint64_t f, uint64_t d, uint64_t sd)
     return ((a - sd) << 16) / (c - a);
 }
 
+// P_num / P_den in Q16 from two summed values (sl_profile_fill_q16's scale), either may be
+// the larger: 2^32 when the numerator is SL_PROFILE_FILL_VALUES or more values above.
+static uint64_t power_ratio_q16(uint32_t num_sum, uint32_t den_sum, uint32_t frames)
+{
+    if (num_sum <= den_sum) {
+        return sl_profile_fill_q16(num_sum, den_sum, frames);
+    }
+    const uint32_t inv = sl_profile_fill_q16(den_sum, num_sum, frames);
+    return inv == 0U ? ((uint64_t)1U << 32) : ((uint64_t)1U << 32) / inv;
+}
+
 uint32_t sl_profile_lead_fill_q16(uint32_t first_sum, uint32_t second_sum, uint32_t frames,
                                   uint32_t delta_q16)
 {
     if (delta_q16 >= SL_PROFILE_LEAD_END_Q16) {
         return sl_profile_fill_q16(first_sum, second_sum, frames);
     }
-    // observed q = P1 / P2 in Q16; the first bin brighter: q = 1 / (P2 / P1)
-    uint64_t q;
-    if (first_sum <= second_sum) {
-        q = sl_profile_fill_q16(first_sum, second_sum, frames);
-    } else {
-        const uint32_t inv = sl_profile_fill_q16(second_sum, first_sum, frames);
-        if (inv == 0U) {
-            return 65535U;
-        }
-        q = ((uint64_t)1U << 32) / inv;
-    }
+    const uint64_t q = power_ratio_q16(first_sum, second_sum, frames); // P1 / P2
     if (delta_q16 == 0U) {
         // at the foot, closed form: q = f + sqrt(f (1 + f)) <=> f = q^2 / (1 + 2 q), full from
         // q = 1 + sqrt(2) on (below it q^2 < 2^35)
@@ -516,13 +517,7 @@ bool sl_profile_lead_edge(const uint16_t *sum3, uint32_t frames, uint32_t delta_
         const uint64_t s3 = sl_fx_isqrt64((d + 131072U) << 16);
         pred = ((s3 - s2) << 16) / (s2 - s1);
     }
-    uint64_t obs;
-    if (sum3[2] <= sum3[1]) {
-        obs = sl_profile_fill_q16(sum3[2], sum3[1], frames);
-    } else {
-        const uint32_t inv = sl_profile_fill_q16(sum3[1], sum3[2], frames);
-        obs = inv == 0U ? ((uint64_t)1U << 32) : ((uint64_t)1U << 32) / inv;
-    }
+    const uint64_t obs = power_ratio_q16(sum3[2], sum3[1], frames);
     // within LEAD_TOL_VALUES values either way (x 10^(-k/20), the fill table's step)
     const uint64_t tol = k_fill_q16[LEAD_TOL_VALUES];
     return obs * tol <= pred * 65536U && pred * tol <= obs * 65536U;

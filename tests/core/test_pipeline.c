@@ -123,11 +123,11 @@ static double predicted_alpha(double d, double alpha, uint32_t az, bool profiled
     const seg_t s = pole_segment(d, alpha, theta_deg(az), B->beta_up_cdeg / 100.0,
                                  B->radar_height_um * 1e-6);
     const double b = bin_m();
-    // r2: the start of the last bin + its lit fraction as the pipeline reads it back from
-    // the rendered value (sl_profile_fill_q16); r1: the first bin's centre, or its lit
-    // fraction when the rendered box's flat start fits the leading-edge model
-    // (sl_profile_lead_edge, here in double precision)
-    // (mask bounds, `profiled` false: both centres)
+    // Refined from the profile (`profiled`): r2 = the start of the last bin + its lit fraction
+    // as the pipeline reads it back from the rendered value (sl_profile_fill_q16); r1 = the
+    // first bin's centre, or its lit fraction when the rendered box's flat start fits the
+    // leading-edge model (sl_profile_lead_edge, here in double precision). The mask's
+    // bounds (`profiled` false): both centres.
     const double i1 = floor(s.r1 / b), i2 = floor(s.r2 / b);
     double r1 = (i1 + 0.5) * b;
     const double r2 = profiled ? i2 * b + read_fill(edge_drop(s.r2 / b - i2)) * b : (i2 + 0.5) * b;

@@ -365,6 +365,23 @@ static sl_board_t bins_board(void)
     return board;
 }
 
+// A detected target on azimuth `az` (group az_first .. + az_count - 1) with the mask's
+// bounds: bins first .. last, r1 / r2 at their half-bin centres (43.8 mm bins).
+static sl_target_t mask_target(uint16_t az, uint16_t az_first, uint16_t az_count, uint16_t first,
+                               uint16_t last)
+{
+    sl_target_t t;
+    memset(&t, 0, sizeof t);
+    t.az = az;
+    t.az_first = az_first;
+    t.az_count = az_count;
+    t.bin_first = first;
+    t.bin_last = last;
+    t.r1_um = (uint32_t)((2 * first + 1) * 43800 / 2);
+    t.r2_um = (uint32_t)((2 * last + 1) * 43800 / 2);
+    return t;
+}
+
 // One row of a uniform pole (70 dB on bins [a, b]) with a 3.3 dB/bin exponential smear tail.
 static void flat_pole_row(uint16_t *syn, int a, int b)
 {
@@ -414,13 +431,7 @@ static void test_profile_refines_a_target_after_min_frames(void **state)
         }
     }
     sl_profile_row(&pr, 7, row, NB, bits, NB);
-    sl_target_t t;
-    memset(&t, 0, sizeof t);
-    t.az = 7;
-    t.bin_first = 10;
-    t.bin_last = 26; // where the tail crosses the threshold (the mask's end)
-    t.r1_um = (uint32_t)((2 * 10 + 1) * 43800 / 2);
-    t.r2_um = (uint32_t)((2 * 26 + 1) * 43800 / 2);
+    sl_target_t t = mask_target(7, 0, 0, 10, 26); // r2 where the tail crosses the threshold
     assert_int_equal(sl_profile_refine(&pr, &board, 40, &t), SL_PROFILE_FEW_FRAMES);
     assert_int_equal(t.flags & SL_TARGET_PROFILE, 0);
     sl_profile_row(&pr, 7, row, NB, bits, NB);
@@ -460,15 +471,7 @@ static void test_profile_refines_from_neighbouring_azimuths_while_moving(void **
     // every bin of each of three rows it stops four bins into the tail, still nine bins
     // shorter than the mask)
     speckled_rows(syn, 98, 102, 12345U);
-    sl_target_t t;
-    memset(&t, 0, sizeof t);
-    t.az = 100;
-    t.az_first = 99;
-    t.az_count = 3;
-    t.bin_first = 20;
-    t.bin_last = 40; // the mask's end: the smear tail
-    t.r1_um = (2 * 20 + 1) * 43800 / 2;
-    t.r2_um = (2 * 40 + 1) * 43800 / 2;
+    sl_target_t t = mask_target(100, 99, 3, 20, 40); // the mask's end: the smear tail
     assert_int_equal(sl_profile_refine(&pr, &board, 40, &t), SL_PROFILE_OK);
     assert_int_equal(pr.stats.spatial, 1);
     assert_true((t.flags & SL_TARGET_PROFILE) != 0U);
@@ -477,12 +480,7 @@ static void test_profile_refines_from_neighbouring_azimuths_while_moving(void **
     assert_true(t.r2_um >= (2 * 26 + 1) * 43800 / 2 && t.r2_um <= (2 * 28 + 1) * 43800 / 2);
     assert_int_equal(t.elong_um, (int32_t)(t.r2_um > 0 ? (2 * 40 + 1) * 43800 / 2 - t.r2_um : 0));
     // a group of one azimuth has no neighbours: one row is too few
-    memset(&t, 0, sizeof t);
-    t.az = 100;
-    t.az_first = 100;
-    t.az_count = 1;
-    t.bin_first = 20;
-    t.bin_last = 40;
+    t = mask_target(100, 100, 1, 20, 40);
     assert_int_equal(sl_profile_refine(&pr, &board, 40, &t), SL_PROFILE_FEW_FRAMES);
     // stopped: evidence claims again, reservations are not needed
     sl_profile_end_rotation(&pr, false);
@@ -503,17 +501,9 @@ static void test_profile_refines_only_the_far_end_of_a_pole_leaning_across_the_b
     sl_profile_end_rotation(&pr, true);
     assert_int_equal(sl_profile_reserve(&pr, 100, 12, 2U), 5); // the track's r1: bin 12
     speckled_rows(syn, 98, 102, 777U);
-    sl_target_t t;
-    memset(&t, 0, sizeof t);
-    t.az = 100;
-    t.az_first = 95;
-    t.az_count = 11;
-    t.bin_first = 12;
-    t.bin_last = 40;
+    sl_target_t t = mask_target(100, 95, 11, 12, 40);
     t.occupied = 21; // bins 20..40 on azimuth 100: the last piece and its tail
     t.flags = SL_TARGET_SLANT;
-    t.r1_um = (2 * 12 + 1) * 43800 / 2;
-    t.r2_um = (2 * 40 + 1) * 43800 / 2;
     assert_int_equal(sl_profile_refine(&pr, &board, 40, &t), SL_PROFILE_OK);
     assert_true((t.flags & (SL_TARGET_PROFILE | SL_TARGET_SLANT)) ==
                 (SL_TARGET_PROFILE | SL_TARGET_SLANT));
@@ -572,13 +562,7 @@ static void test_profile_refines_r2_within_the_last_bin_of_a_cliff(void **state)
     }
     sl_profile_row(&pr, 7, row, NB, bits, NB);
     sl_profile_row(&pr, 7, row, NB, bits, NB);
-    sl_target_t t;
-    memset(&t, 0, sizeof t);
-    t.az = 7;
-    t.bin_first = 10;
-    t.bin_last = 18;
-    t.r1_um = (uint32_t)((2 * 10 + 1) * 43800 / 2);
-    t.r2_um = (uint32_t)((2 * 18 + 1) * 43800 / 2);
+    sl_target_t t = mask_target(7, 0, 0, 10, 18);
     assert_int_equal(sl_profile_refine(&pr, &board, 40, &t), SL_PROFILE_OK);
     assert_int_equal(t.r1_um, (2 * 10 + 1) * 43800 / 2);
     // 18 bins + 32846 / 65536 of a bin = 788,400 + 21,952 um
