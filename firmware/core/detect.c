@@ -210,10 +210,26 @@ static bool overlaps(uint16_t lo, uint16_t hi, uint32_t f, uint32_t l, uint32_t 
     return lo <= hi && f <= (uint32_t)hi + tol && (uint32_t)lo <= l + tol;
 }
 
+// Strength class of a run's or a group's flags: weak = an amplitude row was seen and nothing
+// rose clearly above the threshold or its floor (CF_AMP without CF_STRONG); strong = CF_STRONG;
+// neither (no amplitude row, or a run at the shadow edge, which is not graded) links to both.
+static inline bool is_weak(uint8_t flags)
+{
+    return (flags & (CF_AMP | CF_STRONG)) == CF_AMP;
+}
+
+// Whether a run [f, l] on azimuth a (flags rf) continues candidate c: adjacent azimuth,
+// overlapping ranges (cfg.link_bins of slack), and the same strength class: a weak run never
+// joins a group holding a strong one and a strong run never joins a group of weak runs
+// (sl_detect.h stage 1: weak clutter can neither widen, break nor bridge a pole's group).
 static bool linkable(const sl_detect_t *d, const sl_detect_cand_t *c, uint32_t a, uint32_t f,
-                     uint32_t l)
+                     uint32_t l, uint8_t rf)
 {
     if (c->state != ST_OPEN || a == 0U) {
+        return false;
+    }
+    if ((is_weak(rf) && (c->flags & CF_STRONG) != 0U) ||
+        ((rf & CF_STRONG) != 0U && is_weak(c->flags))) {
         return false;
     }
     uint16_t lo, hi;
@@ -331,7 +347,7 @@ static void add_run(sl_detect_t *d, uint32_t a, uint32_t f, uint32_t l, uint32_t
             const uint32_t i = w * 32U + sl_bits_ctz32(bits);
             bits &= bits - 1U;
             sl_detect_cand_t *c = &d->cand[i];
-            if (!linkable(d, c, a, f, l)) {
+            if (!linkable(d, c, a, f, l, rflags)) {
                 continue;
             }
             if (dst == NULL) {
@@ -962,6 +978,8 @@ sl_ssize_t sl_detect_end(sl_detect_t *d)
         for (uint32_t j = 0; j < SL_CFG_DETECT_MAX_CANDIDATES; j++) {
             sl_detect_cand_t *c0 = &d->cand[j];
             if (j == i || c0->state == ST_FREE || c0->az_first != 0U ||
+                (is_weak(c->flags) && (c0->flags & CF_STRONG) != 0U) ||
+                ((c->flags & CF_STRONG) != 0U && is_weak(c0->flags)) ||
                 !overlaps(c->last_lo, c->last_hi, c0->run[0].first, c0->run[0].last,
                           d->cfg.link_bins)) {
                 continue;

@@ -38,7 +38,17 @@
 ///      amplitude row the d(S) rule stays.
 /// 2. **Grouping**. A run on azimuth a joins the group (candidate) that has a run on a - 1
 ///    whose extent overlaps it within `cfg.link_bins` bins; a run touching two groups merges
-///    them. Azimuth azimuths-1 links to azimuth 0 at the end of the rotation (wrap). A
+///    them. Azimuth azimuths-1 links to azimuth 0 at the end of the rotation (wrap).
+///    With amplitude rows, runs are graded (the WEAK test of stage 4): a *weak* run (no bin
+///    >= T + `cfg.weak_margin` and its peak < its floor + `cfg.weak_contrast`) never joins
+///    a group that holds a strong run, and a strong run never joins a group of weak runs
+///    only (nor do two such groups merge at the wrap). Weak clutter along the shadow edge
+///    (a band of returns just above the threshold) therefore can neither widen a pole's
+///    group (WIDE), break its runs' union, nor bridge it to the ground beyond the edge
+///    (SHADOW): it forms groups of its own, rejected WEAK. Runs without an amplitude row
+///    and runs at the shadow edge (not graded) link to either. Measured on
+///    `daemon_clutter_never_hides_a_pole` (sensor effects, 1 m/s, the pole leaning towards
+///    the path): 22 of its 27 clean rotations with clutter before, 25 now. A
 ///    group remembers, per azimuth, the union extent [first, last] and the occupied count
 ///    of its runs there, for up to SL_CFG_DETECT_MAX_SPAN azimuths (wider: rejected WIDE).
 /// 3. **Representative azimuth**: the azimuth of the group with the most occupied bins

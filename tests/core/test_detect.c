@@ -538,6 +538,80 @@ static void test_detect_rejects_returns_never_clearly_above_the_floor(void **sta
     }
 }
 
+// Grouping with amplitude rows (sl_detect.h stage 2): weak clutter beside a pole, overlapping
+// its ranges on the neighbouring azimuths, neither widens its group nor bridges it to the
+// ground beyond the shadow edge; it forms groups of its own, rejected WEAK. Without
+// amplitude rows the same bits are one group, WIDE.
+static int clutter_rotation(bool with_amp)
+{
+    sl_detect_begin(&det);
+    for (int a = 0; a < NAZ; a++) {
+        if (with_amp) {
+            sl_detect_set_amplitude(&det, amp[a], 512, 40);
+        }
+        assert_int_equal(sl_detect_row(&det, (uint16_t)a, rows[a], NW), SL_OK);
+    }
+    return (int)sl_detect_end(&det);
+}
+
+static void test_detect_weak_clutter_never_joins_a_pole(void **state)
+{
+    (void)state;
+    memset(amp, 0, sizeof amp);
+    for (int a = 92; a < 112; a++) {
+        for (uint32_t k = 60; k < 100; k++) {
+            amp[a][k] = 30; // the clutter band's floor, below the threshold
+        }
+    }
+    for (int a = 100; a < 104; a++) { // the pole: 4 azimuths, far above the floor
+        set_run(a, 69, 78);
+        for (uint32_t k = 69; k <= 78; k++) {
+            amp[a][k] = 90;
+        }
+    }
+    for (int a = 93; a < 111; a++) { // clutter on both sides, just above the threshold
+        if (a >= 100 && a < 104) {
+            continue;
+        }
+        const uint32_t f = 70U + (uint32_t)(a % 3);
+        set_run(a, f, f + 4U);
+        for (uint32_t k = f; k <= f + 4U; k++) {
+            amp[a][k] = 42;
+        }
+    }
+    // Without amplitude: one group of 17 azimuths, WIDE.
+    assert_int_equal(sl_detect_init(&det, &board, NULL), SL_OK);
+    assert_int_equal(clutter_rotation(false), 0);
+    assert_int_equal(det.stats.rejected[SL_DETECT_REJ_WIDE], 1);
+    // With amplitude: the pole alone, and the clutter on each side rejected WEAK.
+    assert_int_equal(sl_detect_init(&det, &board, NULL), SL_OK);
+    assert_int_equal(clutter_rotation(true), 1);
+    assert_int_equal(det.targets[0].az_first, 100);
+    assert_int_equal(det.targets[0].az_count, 4);
+    assert_int_equal(det.targets[0].bin_first, 69);
+    assert_int_equal(det.targets[0].bin_last, 78);
+    assert_int_equal(det.stats.rejected[SL_DETECT_REJ_WIDE], 0);
+    assert_int_equal(det.stats.rejected[SL_DETECT_REJ_WEAK], 2);
+    // Clutter reaching the shadow edge (a run into the ground beyond it on azimuth 105)
+    // next to the pole: before grading, the pole's group ran into the ground and was
+    // rejected SHADOW with it; now the ground's run takes the clutter only.
+    const uint32_t edge = det.edge_bins[105];
+    memset(rows[105], 0, sizeof rows[105]);
+    set_run(105, 72, edge + 20U);
+    for (uint32_t k = 72; k <= edge + 20U && k < 512U; k++) {
+        amp[105][k] = k < 77U ? 42 : 120;
+    }
+    assert_int_equal(sl_detect_init(&det, &board, NULL), SL_OK);
+    assert_int_equal(clutter_rotation(false), 0); // without amplitude: all SHADOW
+    assert_int_equal(det.stats.rejected[SL_DETECT_REJ_SHADOW], 1);
+    assert_int_equal(sl_detect_init(&det, &board, NULL), SL_OK);
+    assert_int_equal(clutter_rotation(true), 1);
+    assert_int_equal(det.targets[0].az_first, 100);
+    assert_int_equal(det.targets[0].az_count, 4);
+    assert_int_equal(det.stats.rejected[SL_DETECT_REJ_SHADOW], 1); // clutter + ground, right
+    assert_int_equal(det.stats.rejected[SL_DETECT_REJ_WEAK], 1);   // clutter, left
+}
+
 // Stage 1 at the shadow edge with amplitude rows (d(S) a prior, not the truth): a pole
 // inside the shadow whose smear tail crosses the edge is kept and flagged TAIL_EDGE; ground
 // beyond the edge joined to it (flat, not decaying), a brighter return beyond the edge (a
@@ -934,6 +1008,7 @@ int main(void)
         cmocka_unit_test_setup(test_detect_handles_empty_saturated_and_misordered_input, setup),
         cmocka_unit_test_setup(test_detect_rejects_clutter_before_it_takes_a_slot, setup),
         cmocka_unit_test_setup(test_detect_rejects_returns_never_clearly_above_the_floor, setup),
+        cmocka_unit_test_setup(test_detect_weak_clutter_never_joins_a_pole, setup),
         cmocka_unit_test_setup(test_detect_shadow_edge_tail_is_not_the_ground, setup),
         cmocka_unit_test_setup(test_detect_slots_go_to_the_strongest_not_the_lowest_azimuths, setup),
         cmocka_unit_test_setup(test_detect_correct_half_bin_elongation_and_radius, setup),
