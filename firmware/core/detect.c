@@ -507,8 +507,8 @@ static inline bool is_hinted(const sl_detect_t *d, uint32_t a)
 
 // WIDE exception for a pole leaning across the line of sight (sl_detect.h stage 4, "Leaning
 // across the line of sight"): true when the group of `span` azimuths (wider than a vertical
-// pole at its representative run `rep`) lies where a confirmed track is expected, is one
-// line, thin and no wider than a lean of cfg.max_lean_tan_q16 can make it; then its union
+// pole at its representative run `rep`) is one line, thin and no wider than a lean of
+// cfg.max_lean_tan_q16 can make it; then its union
 // extent in *uf_out, *ul_out and the offset of its new representative azimuth (the pole's
 // lowest point) in *bottom. Not inlined: a rare path (groups wider than a pole, while
 // moving), off finalize's stack frame.
@@ -518,17 +518,6 @@ static SL_NOINLINE bool slender_lean(const sl_detect_t *d, const sl_detect_cand_
 {
     const sl_board_t *bd = d->board;
     if (d->cfg.max_lean_tan_q16 == 0U || bd->geom == NULL || span > SL_CFG_DETECT_MAX_SPAN) {
-        return false;
-    }
-    // Only where a confirmed track is expected (sl_detect_hint): a SLANT group continues a
-    // pole the tracker already follows, it never starts one (weak clutter along the shadow
-    // edge must not become a track this way).
-    bool hinted = false;
-    for (uint32_t i = 0; i < span && !hinted; i++) {
-        const uint32_t a = ((uint32_t)c->az_first + i) % d->azimuths;
-        hinted = is_hinted(d, a);
-    }
-    if (!hinted) {
         return false;
     }
     // One line crossing the azimuths: every run whole (no gap), and the runs stepping through
@@ -611,6 +600,17 @@ static void finalize(sl_detect_t *d, sl_detect_cand_t *c)
     d->stats.groups++;
     const sl_board_t *bd = d->board;
     const uint32_t span = (uint32_t)c->az_last - c->az_first + 1U;
+    if ((c->flags & (CF_NEAR | CF_SHADOW)) == 0U && is_weak(c->flags)) {
+        // A group of weak runs only (stage 2 keeps them apart from strong ones) is clutter
+        // whatever its shape: WEAK, before the tests that need its representative run.
+        if ((c->flags & CF_SPAN) != 0U) {
+            d->stats.span_overflow++;
+        }
+        c->state = ST_FREE;
+        open_clr(d, c);
+        d->stats.rejected[SL_DETECT_REJ_WEAK]++;
+        return;
+    }
     // Representative azimuth: most occupied bins, then nearest the middle, then lowest.
     uint32_t best = 0, best_cnt = 0, best_dist = 0xFFFFFFFFU;
     for (uint32_t i = 0; i < span && i < SL_CFG_DETECT_MAX_SPAN; i++) {
@@ -663,35 +663,40 @@ static void finalize(sl_detect_t *d, sl_detect_cand_t *c)
         t.occupied = (uint8_t)(rep->count < 0xFFU ? rep->count : 0xFFU);
         lo = hi = best; // no radius from the width of a leaning pole
     }
-    sl_detect_correct(bd, &d->cfg, az, t.bin_first, t.bin_last, (uint16_t)(hi - lo + 1U), &t);
-    t.shadow_slant_um = sl_detect_shadow_slant_um(bd, az);
-    if ((c->flags & CF_WRAPS) != 0U) {
-        t.flags |= SL_TARGET_WRAPS;
-    }
-    if (slant) {
-        t.flags |= SL_TARGET_SLANT;
-    }
+    // The tests on the group's shape first; the corrections (an isqrt or two) only for a
+    // group that passes them, then SHADOW on its corrected r2.
     int reason = -1;
     if ((c->flags & CF_NEAR) != 0U) {
         reason = SL_DETECT_REJ_NEAR;
-    } else if ((c->flags & CF_SHADOW) != 0U ||
-               ((c->flags & CF_TAIL) == 0U && t.r2_um >= t.shadow_slant_um)) {
+    } else if ((c->flags & CF_SHADOW) != 0U) {
         reason = SL_DETECT_REJ_SHADOW;
     } else if ((c->flags & CF_SPAN) != 0U || (span > allowed && !slant)) {
         reason = SL_DETECT_REJ_WIDE;
     } else if ((uint32_t)rep->count < (uint32_t)rep->last - rep->first + 1U) {
         reason = SL_DETECT_REJ_BROKEN;
-    } else if ((c->flags & (CF_AMP | CF_STRONG)) == CF_AMP) {
-        reason = SL_DETECT_REJ_WEAK;
     }
     if ((c->flags & CF_SPAN) != 0U) {
         d->stats.span_overflow++;
     }
     c->state = ST_FREE;
     open_clr(d, c);
+    if (reason < 0) {
+        sl_detect_correct(bd, &d->cfg, az, t.bin_first, t.bin_last, (uint16_t)(hi - lo + 1U),
+                          &t);
+        t.shadow_slant_um = sl_detect_shadow_slant_um(bd, az);
+        if ((c->flags & CF_TAIL) == 0U && t.r2_um >= t.shadow_slant_um) {
+            reason = SL_DETECT_REJ_SHADOW;
+        }
+    }
     if (reason >= 0) {
         d->stats.rejected[reason]++;
         return;
+    }
+    if ((c->flags & CF_WRAPS) != 0U) {
+        t.flags |= SL_TARGET_WRAPS;
+    }
+    if (slant) {
+        t.flags |= SL_TARGET_SLANT;
     }
     t.flags |= (uint8_t)(c->flags & CF_TAIL); // CF_TAIL == SL_TARGET_TAIL_EDGE
     uint32_t rho_q28 = 0U;

@@ -55,7 +55,10 @@
 ///    (the strongest return: for a slender pole, the beam centre); ties go to the azimuth
 ///    nearest the middle of the group, then to the lower index. Its run gives raw
 ///    `bin_first`, `bin_last`.
-/// 4. **Rejections**, counted per reason in `stats.rejected[]`, first match wins:
+/// 4. **Rejections**, counted per reason in `stats.rejected[]`, first match wins in this
+///    order: NEAR, SHADOW (a run flagged), WEAK (a group of weak runs only, stage 2), WIDE,
+///    BROKEN, SHADOW (the corrected r2: the corrections are computed only for a group that
+///    passed the tests before), then SHORT and RHO:
 ///    NEAR (any run of the group crosses into the near-field band);
 ///    SHADOW (any run flagged SHADOW, or the corrected r2 of the representative run is
 ///    >= S(az): the base is not inside the shadow; the r2 test is left to the caller for a
@@ -77,8 +80,8 @@
 ///    true ratio from above whatever the actual smear, whereas d is a model that can
 ///    overcorrect by many bins (a smear steeper than tabulated, a board not calibrated) and
 ///    would push a pole leaning away below the fold or to r2 <= r1; sl_profile then
-///    measures its bounds); WEAK (checked before SHORT,
-///    only when amplitude rows were given: sl_detect_set_amplitude()): no run of the group
+///    measures its bounds); WEAK (only when amplitude rows were given:
+///    sl_detect_set_amplitude()): no run of the group
 ///    is clearly above its local floor, i.e. for every run its peak power is below
 ///    threshold + `cfg.weak_margin` AND below floor + `cfg.weak_contrast`, the floor being
 ///    the mean power of the gap_bins + 1 bins on each side of the run (free bins by
@@ -99,8 +102,6 @@
 ///    pole can be (a 20 deg lean at 3 m: 13-14 azimuths for an allowance of 9-10). Such a
 ///    group is not WIDE when all of these hold, U = [uf, ul] being its union extent (min
 ///    first / max last bin over its azimuths) and `allowed` the vertical pole's span above:
-///    - a confirmed track is expected on one of its azimuths (sl_detect_hint()): a SLANT
-///      group continues a pole the tracker follows, it never starts a track;
 ///    - one line: every run whole (no bridged gap), and the runs step through range one way
 ///      (from the first azimuth's run towards the last's), no first or last bin more than
 ///      one bin against that direction (weak clutter along the shadow edge is broken and
@@ -124,7 +125,12 @@
 ///    profile (sl_profile.h) refines its r2 from the rows of that azimuth and its
 ///    neighbours; r1 stays the mask's. The pipeline sends no PoleLean for a track updated by
 ///    a SLANT target (that frame is one azimuth's run). `cfg.max_lean_tan_q16` = 0 keeps
-///    every wider group WIDE.
+///    every wider group WIDE. A SLANT target may start a track: weak clutter cannot, as a
+///    group of weak runs is rejected WEAK whatever its shape, and since stage 2 grades the
+///    runs it cannot join a pole's group either (a SLANT target used to need a confirmed
+///    track expected on its azimuths; with the grading that gate is gone:
+///    `daemon_clutter_never_hides_a_pole` holds without it, and `sl-eval driveby` has 359
+///    of 432 noise-free passes within 1 deg / 10 deg instead of 272).
 /// 5. **Corrections** (sl_detect_correct(), MATH.md s.4), b = bin_size_um:
 ///    - raw bounds: r1_raw = bin_first * b (near edge of the first occupied bin),
 ///      r2_raw = (bin_last + 1) * b (far edge of the last occupied bin);

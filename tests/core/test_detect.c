@@ -350,17 +350,16 @@ static void test_detect_keeps_a_pole_leaning_across_the_beam_while_moving(void *
     // Parked: both WIDE.
     assert_int_equal(run_rotation(), 0);
     assert_int_equal(det.stats.rejected[SL_DETECT_REJ_WIDE], 2);
-    // Moving, but no confirmed track expected there: a SLANT group never starts a track.
+    // Moving (no track needed: a SLANT group may start one): the leaning pole is kept as
+    // SLANT with the group's union extent as bounds; the car side is not thin (160 occupied
+    // bins > 8 bins x 10 azimuths) and stays WIDE, with or without a track expected there.
     det.union_ext = true;
     det.slant = true;
-    assert_int_equal(run_rotation(), 0);
-    // Where a track is expected (hinted azimuths, also on the car side): the leaning pole is
-    // kept as SLANT with the group's union extent as bounds; the car side is not thin (160
-    // occupied bins > 8 bins x 10 azimuths) and stays WIDE.
-    sl_detect_hint(&det, 106, 2);
+    assert_int_equal(run_rotation(), 1);
+    assert_int_equal(det.stats.rejected[SL_DETECT_REJ_WIDE], 3);
     sl_detect_hint(&det, 30, 2);
     assert_int_equal(run_rotation(), 1);
-    assert_int_equal(det.stats.rejected[SL_DETECT_REJ_WIDE], 5);
+    assert_int_equal(det.stats.rejected[SL_DETECT_REJ_WIDE], 4);
     const sl_target_t *t = &det.targets[0];
     assert_true((t->flags & SL_TARGET_SLANT) != 0U);
     assert_int_equal(t->az_first, 100);
@@ -383,12 +382,10 @@ static void test_detect_keeps_a_pole_leaning_across_the_beam_while_moving(void *
     cfg.max_lean_tan_q16 = (uint16_t)lround(tan(5.0 * kPi / 180.0) * 65536.0);
     assert_int_equal(sl_detect_init(&det, &board, &cfg), SL_OK);
     det.union_ext = det.slant = true;
-    sl_detect_hint(&det, 106, 2);
     assert_int_equal(run_rotation(), 0);
     cfg.max_lean_tan_q16 = (uint16_t)lround(tan(10.0 * kPi / 180.0) * 65536.0);
     assert_int_equal(sl_detect_init(&det, &board, &cfg), SL_OK);
     det.union_ext = det.slant = true;
-    sl_detect_hint(&det, 106, 2);
     assert_int_equal(run_rotation(), 1);
     // One line, not clutter: a run with a gap, or a run stepping back by two bins, breaks it.
     sl_bits_put(rows[106], 78, false); // 77-81 -> 77, 79-81: bridged, broken
@@ -407,7 +404,6 @@ static void test_detect_keeps_a_pole_leaning_across_the_beam_while_moving(void *
     cfg.max_lean_tan_q16 = 0U;
     assert_int_equal(sl_detect_init(&det, &board, &cfg), SL_OK);
     det.union_ext = det.slant = true;
-    sl_detect_hint(&det, 106, 2);
     assert_int_equal(run_rotation(), 0);
     assert_int_equal(det.stats.rejected[SL_DETECT_REJ_WIDE], 2);
 }
@@ -610,6 +606,34 @@ static void test_detect_weak_clutter_never_joins_a_pole(void **state)
     assert_int_equal(det.targets[0].az_count, 4);
     assert_int_equal(det.stats.rejected[SL_DETECT_REJ_SHADOW], 1); // clutter + ground, right
     assert_int_equal(det.stats.rejected[SL_DETECT_REJ_WEAK], 1);   // clutter, left
+}
+
+// Without the gate of a confirmed track, what stops weak clutter from starting a track as a
+// pole leaning across the beam: the same one-line group of the SLANT test, but no bin
+// clearly above the threshold or its floor, is rejected WEAK; strong, it is SLANT.
+static void test_detect_a_weak_line_is_never_slant(void **state)
+{
+    (void)state;
+    sl_detect_cfg_t cfg;
+    sl_detect_cfg_default(&cfg);
+    memset(amp, 0, sizeof amp);
+    set_leaning_pole(100);
+    for (int a = 100; a < 113; a++) {
+        for (uint32_t k = 60; k < 100; k++) {
+            amp[a][k] = sl_bits_get(rows[a], k) ? 42 : 30;
+        }
+    }
+    assert_int_equal(sl_detect_init(&det, &board, &cfg), SL_OK);
+    det.union_ext = det.slant = true;
+    assert_int_equal(clutter_rotation(true), 0);
+    assert_int_equal(det.stats.rejected[SL_DETECT_REJ_WEAK], 1);
+    for (int a = 100; a < 113; a++) {
+        for (uint32_t k = 60; k < 100; k++) {
+            amp[a][k] = sl_bits_get(rows[a], k) ? 90 : 30;
+        }
+    }
+    assert_int_equal(clutter_rotation(true), 1);
+    assert_true((det.targets[0].flags & SL_TARGET_SLANT) != 0U);
 }
 
 // Stage 1 at the shadow edge with amplitude rows (d(S) a prior, not the truth): a pole
@@ -1009,6 +1033,7 @@ int main(void)
         cmocka_unit_test_setup(test_detect_rejects_clutter_before_it_takes_a_slot, setup),
         cmocka_unit_test_setup(test_detect_rejects_returns_never_clearly_above_the_floor, setup),
         cmocka_unit_test_setup(test_detect_weak_clutter_never_joins_a_pole, setup),
+        cmocka_unit_test_setup(test_detect_a_weak_line_is_never_slant, setup),
         cmocka_unit_test_setup(test_detect_shadow_edge_tail_is_not_the_ground, setup),
         cmocka_unit_test_setup(test_detect_slots_go_to_the_strongest_not_the_lowest_azimuths, setup),
         cmocka_unit_test_setup(test_detect_correct_half_bin_elongation_and_radius, setup),
