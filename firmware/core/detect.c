@@ -221,7 +221,7 @@ static inline bool is_weak(uint8_t flags)
 // Whether a run [f, l] on azimuth a (flags rf) continues candidate c: adjacent azimuth,
 // overlapping ranges (cfg.link_bins of slack), and the same strength class: a weak run never
 // joins a group holding a strong one and a strong run never joins a group of weak runs
-// (sl_detect.h stage 1: weak clutter can neither widen, break nor bridge a pole's group).
+// (sl_detect.h stage 2: weak clutter can neither widen, break nor bridge a pole's group).
 static bool linkable(const sl_detect_t *d, const sl_detect_cand_t *c, uint32_t a, uint32_t f,
                      uint32_t l, uint8_t rf)
 {
@@ -508,10 +508,9 @@ static inline bool is_hinted(const sl_detect_t *d, uint32_t a)
 // WIDE exception for a pole leaning across the line of sight (sl_detect.h stage 4, "Leaning
 // across the line of sight"): true when the group of `span` azimuths (wider than a vertical
 // pole at its representative run `rep`) is one line, thin and no wider than a lean of
-// cfg.max_lean_tan_q16 can make it; then its union
-// extent in *uf_out, *ul_out and the offset of its new representative azimuth (the pole's
-// lowest point) in *bottom. Not inlined: a rare path (groups wider than a pole, while
-// moving), off finalize's stack frame.
+// cfg.max_lean_tan_q16 can make it; then its union extent in *uf_out, *ul_out and the offset
+// of its new representative azimuth (the pole's lowest point) in *bottom. Not inlined: a
+// rare path (groups wider than a pole, while moving), off finalize's stack frame.
 static SL_NOINLINE bool slender_lean(const sl_detect_t *d, const sl_detect_cand_t *c, uint32_t span,
                                      const sl_detect_azrun_t *rep, uint16_t az, uint16_t *uf_out,
                                      uint16_t *ul_out, uint32_t *bottom)
