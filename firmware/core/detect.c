@@ -336,13 +336,15 @@ static void cand_attach(sl_detect_cand_t *c, uint32_t a, uint16_t f, uint16_t l,
     c->flags |= rflags;
 }
 
+// `row_open`: the groups open when azimuth a's row began (all of them end on a - 1). A group
+// opened by an earlier run of this row has no extent on a - 1 and cannot link: skipped.
 static void add_run(sl_detect_t *d, uint32_t a, uint32_t f, uint32_t l, uint32_t count,
-                    uint8_t rflags)
+                    uint8_t rflags, const uint32_t *row_open)
 {
     d->stats.runs++;
     sl_detect_cand_t *dst = NULL;
     for (uint32_t w = 0; w < OPEN_WORDS; w++) {
-        uint32_t bits = d->open_bits[w]; // snapshot: merges only clear bits
+        uint32_t bits = d->open_bits[w] & row_open[w]; // snapshot: merges only clear bits
         while (bits != 0U) {
             const uint32_t i = w * 32U + sl_bits_ctz32(bits);
             bits &= bits - 1U;
@@ -932,6 +934,8 @@ sl_err_t sl_detect_row(sl_detect_t *d, uint16_t az, const uint32_t *occ, uint32_
     }
     const uint32_t edge = d->edge_bins[az];
     const uint32_t gap = d->cfg.gap_bins;
+    uint32_t row_open[OPEN_WORDS];
+    memcpy(row_open, d->open_bits, sizeof row_open);
     uint32_t pos = near;
     while (pos < win) {
         const uint32_t s = sl_bits_next_set(occ, pos, win);
@@ -962,7 +966,7 @@ sl_err_t sl_detect_row(sl_detect_t *d, uint16_t az, const uint32_t *occ, uint32_
         if ((rf & CF_SHADOW) == 0U) { // a SHADOW group is rejected anyway
             rf |= run_strength(d, s, e);
         }
-        add_run(d, az, s, e - 1U, count, rf);
+        add_run(d, az, s, e - 1U, count, rf, row_open);
         pos = e;
     }
     d->amp = NULL;
