@@ -596,6 +596,16 @@ static uint8_t union_grow(const sl_detect_cand_t *c, const sl_detect_azrun_t *re
                      ((l < SL_TARGET_EXT_SAT ? l : SL_TARGET_EXT_SAT) << 4));
 }
 
+// A finalized group leaves the open set (its span overflow counted).
+static void group_release(sl_detect_t *d, sl_detect_cand_t *c)
+{
+    if ((c->flags & CF_SPAN) != 0U) {
+        d->stats.span_overflow++;
+    }
+    c->state = ST_FREE;
+    open_clr(d, c);
+}
+
 static void finalize(sl_detect_t *d, sl_detect_cand_t *c)
 {
     d->stats.groups++;
@@ -604,11 +614,7 @@ static void finalize(sl_detect_t *d, sl_detect_cand_t *c)
     if ((c->flags & (CF_NEAR | CF_SHADOW)) == 0U && is_weak(c->flags)) {
         // A group of weak runs only (stage 2 keeps them apart from strong ones) is clutter
         // whatever its shape: WEAK, before the tests that need its representative run.
-        if ((c->flags & CF_SPAN) != 0U) {
-            d->stats.span_overflow++;
-        }
-        c->state = ST_FREE;
-        open_clr(d, c);
+        group_release(d, c);
         d->stats.rejected[SL_DETECT_REJ_WEAK]++;
         return;
     }
@@ -676,11 +682,7 @@ static void finalize(sl_detect_t *d, sl_detect_cand_t *c)
     } else if ((uint32_t)rep->count < (uint32_t)rep->last - rep->first + 1U) {
         reason = SL_DETECT_REJ_BROKEN;
     }
-    if ((c->flags & CF_SPAN) != 0U) {
-        d->stats.span_overflow++;
-    }
-    c->state = ST_FREE;
-    open_clr(d, c);
+    group_release(d, c);
     if (reason < 0) {
         sl_detect_correct(bd, &d->cfg, az, t.bin_first, t.bin_last, (uint16_t)(hi - lo + 1U),
                           &t);

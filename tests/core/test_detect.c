@@ -538,13 +538,12 @@ static void test_detect_rejects_returns_never_clearly_above_the_floor(void **sta
 // its ranges on the neighbouring azimuths, neither widens its group nor bridges it to the
 // ground beyond the shadow edge; it forms groups of its own, rejected WEAK. Without
 // amplitude rows the same bits are one group, WIDE.
-static int clutter_rotation(bool with_amp)
+// run_rotation() with every row's amplitude (amp[], threshold 40).
+static int amp_rotation(void)
 {
     sl_detect_begin(&det);
     for (int a = 0; a < NAZ; a++) {
-        if (with_amp) {
-            sl_detect_set_amplitude(&det, amp[a], 512, 40);
-        }
+        sl_detect_set_amplitude(&det, amp[a], 512, 40);
         assert_int_equal(sl_detect_row(&det, (uint16_t)a, rows[a], NW), SL_OK);
     }
     return (int)sl_detect_end(&det);
@@ -577,11 +576,11 @@ static void test_detect_weak_clutter_never_joins_a_pole(void **state)
     }
     // Without amplitude: one group of 17 azimuths, WIDE.
     assert_int_equal(sl_detect_init(&det, &board, NULL), SL_OK);
-    assert_int_equal(clutter_rotation(false), 0);
+    assert_int_equal(run_rotation(), 0);
     assert_int_equal(det.stats.rejected[SL_DETECT_REJ_WIDE], 1);
     // With amplitude: the pole alone, and the clutter on each side rejected WEAK.
     assert_int_equal(sl_detect_init(&det, &board, NULL), SL_OK);
-    assert_int_equal(clutter_rotation(true), 1);
+    assert_int_equal(amp_rotation(), 1);
     assert_int_equal(det.targets[0].az_first, 100);
     assert_int_equal(det.targets[0].az_count, 4);
     assert_int_equal(det.targets[0].bin_first, 69);
@@ -598,10 +597,10 @@ static void test_detect_weak_clutter_never_joins_a_pole(void **state)
         amp[105][k] = k < 77U ? 42 : 120;
     }
     assert_int_equal(sl_detect_init(&det, &board, NULL), SL_OK);
-    assert_int_equal(clutter_rotation(false), 0); // without amplitude: all SHADOW
+    assert_int_equal(run_rotation(), 0); // without amplitude: all SHADOW
     assert_int_equal(det.stats.rejected[SL_DETECT_REJ_SHADOW], 1);
     assert_int_equal(sl_detect_init(&det, &board, NULL), SL_OK);
-    assert_int_equal(clutter_rotation(true), 1);
+    assert_int_equal(amp_rotation(), 1);
     assert_int_equal(det.targets[0].az_first, 100);
     assert_int_equal(det.targets[0].az_count, 4);
     assert_int_equal(det.stats.rejected[SL_DETECT_REJ_SHADOW], 1); // clutter + ground, right
@@ -625,14 +624,14 @@ static void test_detect_a_weak_line_is_never_slant(void **state)
     }
     assert_int_equal(sl_detect_init(&det, &board, &cfg), SL_OK);
     det.union_ext = det.slant = true;
-    assert_int_equal(clutter_rotation(true), 0);
+    assert_int_equal(amp_rotation(), 0);
     assert_int_equal(det.stats.rejected[SL_DETECT_REJ_WEAK], 1);
     for (int a = 100; a < 113; a++) {
         for (uint32_t k = 60; k < 100; k++) {
             amp[a][k] = sl_bits_get(rows[a], k) ? 90 : 30;
         }
     }
-    assert_int_equal(clutter_rotation(true), 1);
+    assert_int_equal(amp_rotation(), 1);
     assert_true((det.targets[0].flags & SL_TARGET_SLANT) != 0U);
 }
 
