@@ -81,9 +81,9 @@ int32_t sl_detect_elong_um(const sl_board_t *board, uint32_t r_um)
     return sl_fx_sat32((int64_t)dv[i] + num / (int64_t)(r[i + 1U] - r[i]));
 }
 
-uint32_t sl_detect_shadow_slant_um(const sl_board_t *board, uint16_t az)
+// S(az)^2 = shadow ground range^2 + H^2, um^2 (0 without shadow tables).
+static uint64_t shadow_slant_sq(const sl_board_t *board, uint16_t az)
 {
-    SL_ASSERT(board != NULL);
     uint64_t rs;
     if (board->shadow_um != NULL) {
         rs = board->shadow_um[az];
@@ -93,7 +93,13 @@ uint32_t sl_detect_shadow_slant_um(const sl_board_t *board, uint16_t az)
         return 0U;
     }
     const uint64_t h = board->radar_height_um;
-    return sl_fx_isqrt64(rs * rs + h * h);
+    return rs * rs + h * h;
+}
+
+uint32_t sl_detect_shadow_slant_um(const sl_board_t *board, uint16_t az)
+{
+    SL_ASSERT(board != NULL);
+    return sl_fx_isqrt64(shadow_slant_sq(board, az));
 }
 
 // r * w_bam * pi / 2^32: the half-width arc (small angle) of a bam32 angle w at range r.
@@ -218,25 +224,6 @@ static inline bool is_weak(uint8_t flags)
     return (flags & (CF_AMP | CF_STRONG)) == CF_AMP;
 }
 
-// Whether a run [f, l] on azimuth a (flags rf) continues candidate c: adjacent azimuth,
-// overlapping ranges (cfg.link_bins of slack), and the same strength class: a weak run never
-// joins a group holding a strong one and a strong run never joins a group of weak runs
-// (sl_detect.h stage 2: weak clutter can neither widen, break nor bridge a pole's group).
-static bool linkable(const sl_detect_t *d, const sl_detect_cand_t *c, uint32_t a, uint32_t f,
-                     uint32_t l, uint8_t rf)
-{
-    if (c->state != ST_OPEN || a == 0U) {
-        return false;
-    }
-    if ((is_weak(rf) && (c->flags & CF_STRONG) != 0U) ||
-        ((rf & CF_STRONG) != 0U && is_weak(c->flags))) {
-        return false;
-    }
-    uint16_t lo, hi;
-    ext_at(c, a - 1U, &lo, &hi);
-    return overlaps(lo, hi, f, l, d->cfg.link_bins);
-}
-
 // Move src's azimuth entries into dst at offset (src first azimuth - dst first azimuth).
 static void entries_merge(sl_detect_cand_t *dst, const sl_detect_cand_t *src, uint32_t offset)
 {
@@ -336,26 +323,49 @@ static void cand_attach(sl_detect_cand_t *c, uint32_t a, uint16_t f, uint16_t l,
     c->flags |= rflags;
 }
 
-// `row_open`: the groups open when azimuth a's row began (all of them end on a - 1). A group
-// opened by an earlier run of this row has no extent on a - 1 and cannot link: skipped.
-static void add_run(sl_detect_t *d, uint32_t a, uint32_t f, uint32_t l, uint32_t count,
-                    uint8_t rflags, const uint32_t *row_open)
+// The link table (sl_detect_links_t) of a row: the groups open when azimuth a's row began
+// (all end on a - 1; a group opened by an earlier run of this row has no extent on a - 1
+// and cannot link), in slot order, each with its extent on a - 1 (hi widened by
+// cfg.link_bins). A merge points the absorbed group's entries at the survivor and widens
+// both to the survivor's union extent, so a later run sees exactly what it would see
+// walking the open groups (first linkable in slot order = survivor, merged extents), at a
+// compare or two per group instead of a walk of the open set.
+// Run [f, l] on azimuth a (flags rflags) continues each group whose extent on a - 1 it
+// overlaps (cfg.link_bins of slack) and which is of the same strength class: a weak run
+// never joins a group holding a strong one and a strong run never joins a group of weak
+// runs (sl_detect.h stage 2: weak clutter can neither widen, break nor bridge a pole's
+// group). The first such group in slot order takes the run and absorbs the others; none:
+// a new group.
+static void add_run(sl_detect_t *d, sl_detect_links_t *t, uint32_t a, uint32_t f, uint32_t l,
+                    uint32_t count, uint8_t rflags)
 {
     d->stats.runs++;
     sl_detect_cand_t *dst = NULL;
-    for (uint32_t w = 0; w < OPEN_WORDS; w++) {
-        uint32_t bits = d->open_bits[w] & row_open[w]; // snapshot: merges only clear bits
-        while (bits != 0U) {
-            const uint32_t i = w * 32U + sl_bits_ctz32(bits);
-            bits &= bits - 1U;
-            sl_detect_cand_t *c = &d->cand[i];
-            if (!linkable(d, c, a, f, l, rflags)) {
-                continue;
-            }
-            if (dst == NULL) {
-                dst = c;
-            } else {
-                cand_merge(d, dst, c);
+    const uint32_t l_tol = l + d->cfg.link_bins;
+    const uint32_t n = t->n;
+    for (uint32_t k = 0; k < n; k++) {
+        if (f > t->hi_tol[k] || t->lo[k] > l_tol) {
+            continue;
+        }
+        sl_detect_cand_t *c = &d->cand[t->slot[k]];
+        if (c == dst || (is_weak(rflags) && (c->flags & CF_STRONG) != 0U) ||
+            ((rflags & CF_STRONG) != 0U && is_weak(c->flags))) {
+            continue;
+        }
+        if (dst == NULL) {
+            dst = c;
+            continue;
+        }
+        cand_merge(d, dst, c);
+        uint16_t lo, hi;
+        ext_at(dst, a - 1U, &lo, &hi);
+        const uint32_t h = (uint32_t)hi + d->cfg.link_bins;
+        const uint8_t ds = (uint8_t)(dst - d->cand), cs = (uint8_t)(c - d->cand);
+        for (uint32_t j = 0; j < n; j++) {
+            if (t->slot[j] == cs || t->slot[j] == ds) {
+                t->slot[j] = ds;
+                t->lo[j] = lo;
+                t->hi_tol[j] = (uint16_t)(h > 0xFFFFU ? 0xFFFFU : h);
             }
         }
     }
@@ -670,8 +680,9 @@ static void finalize(sl_detect_t *d, sl_detect_cand_t *c)
         t.occupied = (uint8_t)(rep->count < 0xFFU ? rep->count : 0xFFU);
         lo = hi = best; // no radius from the width of a leaning pole
     }
-    // The tests on the group's shape first; the corrections (an isqrt or two) only for a
-    // group that passes them, then SHADOW on its corrected r2.
+    // The tests on the group's shape first (SHORT among them: a single-bin run, most of the
+    // strong clutter); the corrections (an isqrt or two) only for a group that passes them,
+    // then SHADOW on its corrected r2.
     int reason = -1;
     if ((c->flags & CF_NEAR) != 0U) {
         reason = SL_DETECT_REJ_NEAR;
@@ -681,13 +692,19 @@ static void finalize(sl_detect_t *d, sl_detect_cand_t *c)
         reason = SL_DETECT_REJ_WIDE;
     } else if ((uint32_t)rep->count < (uint32_t)rep->last - rep->first + 1U) {
         reason = SL_DETECT_REJ_BROKEN;
+    } else if (t.bin_last <= t.bin_first) {
+        reason = SL_DETECT_REJ_SHORT; // as sl_detect_clutter_reason, before the corrections
     }
     group_release(d, c);
     if (reason < 0) {
         sl_detect_correct(bd, &d->cfg, az, t.bin_first, t.bin_last, (uint16_t)(hi - lo + 1U),
                           &t);
-        t.shadow_slant_um = sl_detect_shadow_slant_um(bd, az);
-        if ((c->flags & CF_TAIL) == 0U && t.r2_um >= t.shadow_slant_um) {
+        // r2 >= S = floor(sqrt(S^2)) <=> (r2 + 1)^2 > S^2: the square root (sl_target_t's
+        // shadow_slant_um) only for an accepted target, below.
+        // (S < 2^32: a saturated r2 is beyond it, and its square would wrap)
+        const uint64_t r2p = (uint64_t)t.r2_um + 1U;
+        if ((c->flags & CF_TAIL) == 0U &&
+            (t.r2_um == UINT32_MAX || r2p * r2p > shadow_slant_sq(bd, az))) {
             reason = SL_DETECT_REJ_SHADOW;
         }
     }
@@ -732,6 +749,7 @@ static void finalize(sl_detect_t *d, sl_detect_cand_t *c)
         const uint32_t e = (uint32_t)t.evidence + SL_DETECT_EVIDENCE_TRACK;
         t.evidence = (uint16_t)(e > 0xFFFFU ? 0xFFFFU : e);
     }
+    t.shadow_slant_um = sl_detect_shadow_slant_um(bd, az);
     slot_take(d, &t);
 }
 
@@ -754,15 +772,22 @@ static uint8_t run_strength(const sl_detect_t *d, uint32_t s, uint32_t e)
         }
     }
     const uint32_t side = (uint32_t)d->cfg.gap_bins + 1U;
-    uint32_t sum = 0U, cnt = 0U;
-    for (uint32_t k = s > side ? s - side : 0U; k < s; k++) {
-        sum += p[k];
-        cnt++;
+    const uint32_t b0 = s > side ? s - side : 0U;
+    const uint32_t e1 = e >= nb ? e : (e + side < nb ? e + side : nb);
+    uint32_t sum = 0U;
+    if (s - b0 == side && e1 - e == side) { // the common case: both sides whole, one loop
+        for (uint32_t k = 0; k < side; k++) {
+            sum += (uint32_t)p[b0 + k] + p[e + k];
+        }
+    } else {
+        for (uint32_t k = b0; k < s; k++) {
+            sum += p[k];
+        }
+        for (uint32_t k = e; k < e1; k++) {
+            sum += p[k];
+        }
     }
-    for (uint32_t k = e; k < e + side && k < nb; k++) {
-        sum += p[k];
-        cnt++;
-    }
+    const uint32_t cnt = (s - b0) + (e1 - e);
     const uint32_t floor_v = cnt != 0U ? sum / cnt : 0U;
     const bool strong = peak >= floor_v + d->cfg.weak_contrast;
     return (uint8_t)(CF_AMP | (strong ? CF_STRONG : 0U));
@@ -833,28 +858,46 @@ void sl_detect_set_amplitude(sl_detect_t *d, const uint8_t *power, uint16_t bins
     d->amp_threshold = threshold;
 }
 
-// Close groups that can no longer grow (no run on a - 1). Groups starting at azimuth 0
-// wait for the wrap merge at the end of the rotation.
-static void close_before(sl_detect_t *d, uint32_t a)
+// A group that can no longer grow (no run on the azimuth before the current one) leaves the
+// open set: finalized, or, when it starts at azimuth 0, kept for the wrap merge at the end
+// of the rotation.
+static void close_group(sl_detect_t *d, sl_detect_cand_t *c)
 {
+    d->n_open--;
+    open_clr(d, c);
+    if (c->az_first == 0U) {
+        c->state = ST_CLOSED;
+    } else {
+        finalize(d, c);
+    }
+}
+
+// Walk the open set before row a: close the groups with no run on a - 1 and, when the row
+// has runs (`links`), enter the others (all end on a - 1) in the row's link table with
+// their extent there (last_*), in slot order. One call site: inlined.
+static void open_walk(sl_detect_t *d, uint32_t a, bool links)
+{
+    sl_detect_links_t *t = &d->links;
+    const uint32_t tol = d->cfg.link_bins;
+    uint32_t n = 0U;
     for (uint32_t w = 0; w < OPEN_WORDS; w++) {
         uint32_t bits = d->open_bits[w];
         while (bits != 0U) {
             const uint32_t i = w * 32U + sl_bits_ctz32(bits);
             bits &= bits - 1U;
             sl_detect_cand_t *c = &d->cand[i];
-            if ((uint32_t)c->az_last + 1U >= a) {
-                continue;
-            }
-            d->n_open--;
-            open_clr(d, c);
-            if (c->az_first == 0U) {
-                c->state = ST_CLOSED;
-            } else {
-                finalize(d, c);
+            if ((uint32_t)c->az_last + 1U < a) {
+                close_group(d, c);
+            } else if (links) {
+                const uint32_t h = (uint32_t)c->last_hi + tol;
+                t->lo[n] = c->last_lo;
+                t->hi_tol[n] = (uint16_t)(h > 0xFFFFU ? 0xFFFFU : h);
+                t->slot[n] = (uint8_t)i;
+                n++;
             }
         }
     }
+    t->n = (uint8_t)n;
 }
 
 sl_err_t sl_detect_init(sl_detect_t *d, const sl_board_t *board, const sl_detect_cfg_t *cfg)
@@ -904,40 +947,16 @@ void sl_detect_begin(sl_detect_t *d)
     d->last_az = -1;
 }
 
-sl_err_t sl_detect_row(sl_detect_t *d, uint16_t az, const uint32_t *occ, uint32_t words)
+// Stages 1 and 2 of row az after open_walk: the runs in [near, win) (gaps bridged, the
+// shadow edge tested, graded), each added to the groups through the row's link table. Not
+// inlined: its locals stay off the chain that finalises the groups open_walk closes (the
+// Cortex-M stack budget, tests/core/build/stack_budget.py).
+static SL_NOINLINE void row_runs(sl_detect_t *d, uint32_t az, const uint32_t *occ,
+                                 uint32_t limit, uint32_t win)
 {
-    SL_ASSERT(d != NULL && (occ != NULL || words == 0U));
-    if (az >= d->azimuths || (int32_t)az <= d->last_az) {
-        d->stats.order_errors++;
-        d->amp = NULL;
-        return SL_ERR_RANGE;
-    }
-    d->last_az = az;
-    d->stats.rows++;
-    if (d->n_open != 0U) {
-        close_before(d, az);
-    }
-    const uint32_t limit = words * 32U < d->bins ? words * 32U : d->bins;
-    const uint32_t win = d->win_bins[az] < limit ? d->win_bins[az] : limit;
     const uint32_t near = d->near_bins;
-    if (win <= near) {
-        d->amp = NULL;
-        return SL_OK;
-    }
-    // Fast exit for the common azimuth: nothing occupied in [near, win) (the last word is
-    // not trimmed at win: a set bit beyond it only costs the exact scan below).
-    uint32_t any = occ[near >> 5] & (UINT32_MAX << (near & 31U));
-    for (uint32_t w = (near >> 5) + 1U; w <= (win - 1U) >> 5; w++) {
-        any |= occ[w];
-    }
-    if (any == 0U) {
-        d->amp = NULL;
-        return SL_OK;
-    }
     const uint32_t edge = d->edge_bins[az];
     const uint32_t gap = d->cfg.gap_bins;
-    uint32_t row_open[OPEN_WORDS];
-    memcpy(row_open, d->open_bits, sizeof row_open);
     uint32_t pos = near;
     while (pos < win) {
         const uint32_t s = sl_bits_next_set(occ, pos, win);
@@ -968,8 +987,40 @@ sl_err_t sl_detect_row(sl_detect_t *d, uint16_t az, const uint32_t *occ, uint32_
         if ((rf & CF_SHADOW) == 0U) { // a SHADOW group is rejected anyway
             rf |= run_strength(d, s, e);
         }
-        add_run(d, az, s, e - 1U, count, rf, row_open);
+        add_run(d, &d->links, az, s, e - 1U, count, rf);
         pos = e;
+    }
+}
+
+sl_err_t sl_detect_row(sl_detect_t *d, uint16_t az, const uint32_t *occ, uint32_t words)
+{
+    SL_ASSERT(d != NULL && (occ != NULL || words == 0U));
+    if (az >= d->azimuths || (int32_t)az <= d->last_az) {
+        d->stats.order_errors++;
+        d->amp = NULL;
+        return SL_ERR_RANGE;
+    }
+    d->last_az = az;
+    d->stats.rows++;
+    const uint32_t limit = words * 32U < d->bins ? words * 32U : d->bins;
+    const uint32_t win = d->win_bins[az] < limit ? d->win_bins[az] : limit;
+    const uint32_t near = d->near_bins;
+    // Fast exit for the common azimuth: nothing occupied in [near, win) (the last word is
+    // not trimmed at win: a set bit beyond it only costs the exact scan below).
+    uint32_t any = 0U;
+    if (win > near) {
+        any = occ[near >> 5] & (UINT32_MAX << (near & 31U));
+        for (uint32_t w = (near >> 5) + 1U; w <= (win - 1U) >> 5; w++) {
+            any |= occ[w];
+        }
+    }
+    if (any == 0U && d->n_open == 0U) {
+        d->amp = NULL;
+        return SL_OK;
+    }
+    open_walk(d, az, any != 0U);
+    if (any != 0U) {
+        row_runs(d, az, occ, limit, win);
     }
     d->amp = NULL;
     return SL_OK;

@@ -387,10 +387,11 @@ int main(int argc, char **argv)
         const sl_detect_stats_t *ds = &g_pl.detect.stats;
         printf("detect: runs %" PRIu32 " groups %" PRIu32 " targets %" PRIu32
                " rejected near %" PRIu32 " shadow %" PRIu32 " wide %" PRIu32 " broken %" PRIu32
-               "\n",
+               " short %" PRIu32 " rho %" PRIu32 " weak %" PRIu32 "\n",
                ds->runs, ds->groups, ds->targets, ds->rejected[SL_DETECT_REJ_NEAR],
                ds->rejected[SL_DETECT_REJ_SHADOW], ds->rejected[SL_DETECT_REJ_WIDE],
-               ds->rejected[SL_DETECT_REJ_BROKEN]);
+               ds->rejected[SL_DETECT_REJ_BROKEN], ds->rejected[SL_DETECT_REJ_SHORT],
+               ds->rejected[SL_DETECT_REJ_RHO], ds->rejected[SL_DETECT_REJ_WEAK]);
         uint32_t win_max = 0;
         for (uint32_t a = 0; a < g_pl.detect.azimuths; a++) {
             win_max = g_pl.detect.win_bins[a] > win_max ? g_pl.detect.win_bins[a] : win_max;

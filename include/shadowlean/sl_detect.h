@@ -173,9 +173,11 @@
 /// Caller-owned `sl_detect_t`, no allocation; it borrows `board` (static const) until
 /// re-init. RAM: sizeof(sl_detect_t) = 4 x SL_CFG_MAX_AZIMUTHS (window tables) +
 /// SL_CFG_DETECT_MAX_CANDIDATES x (14 + 6 x SL_CFG_DETECT_MAX_SPAN) + SL_CFG_MAX_TARGETS x
-/// sizeof(sl_target_t) (52) + 50 bytes of azimuth hints + ~68 bytes (defaults: 8,512 bytes on x86-64).
-/// Cost: sl_detect_row O(words up to the shadow edge + runs x candidates); an azimuth
-/// with nothing occupied in its window exits after one OR per window word. Per target at
+/// sizeof(sl_target_t) (52) + 50 bytes of azimuth hints + 5 x SL_CFG_DETECT_MAX_CANDIDATES + 1
+/// (the row's link table) + ~68 bytes (defaults: 8,672 bytes on x86-64).
+/// Cost: sl_detect_row O(words up to the shadow edge + runs x open groups), two compares per
+/// run and open group (the link table); an azimuth with nothing occupied in its window
+/// exits after one OR per window word (and a walk of the open groups when there are any). Per target at
 /// sl_detect_end: one sl_incline_estimate + one isqrt. Measured instruction counts:
 /// docs/PERFORMANCE.md, "Core modules".
 /// sl_detect_init: one isqrt per azimuth. Not reentrant per instance; no callbacks.
@@ -336,6 +338,16 @@ typedef struct sl_detect_cand {
     sl_detect_azrun_t run[SL_CFG_DETECT_MAX_SPAN];
 } sl_detect_cand_t;
 
+/// The groups the current row's runs may join, with their extents on the azimuth before
+/// (internal scratch of sl_detect_row, kept here rather than on its stack frame, which the
+/// finalisation of the groups it closes sits on top of).
+typedef struct sl_detect_links {
+    uint16_t lo[SL_CFG_DETECT_MAX_CANDIDATES];     ///< first bin on the azimuth before
+    uint16_t hi_tol[SL_CFG_DETECT_MAX_CANDIDATES]; ///< last bin there + cfg.link_bins
+    uint8_t slot[SL_CFG_DETECT_MAX_CANDIDATES];    ///< index in cand[]
+    uint8_t n;                                     ///< entries in use
+} sl_detect_links_t;
+
 /// The detector. Caller-owned; fields read-only to the application.
 typedef struct sl_detect {
     const sl_board_t *board;
@@ -353,6 +365,7 @@ typedef struct sl_detect {
     uint16_t n_open;        ///< groups in state "open" (skips the per-row close scan)
     uint32_t open_bits[(SL_CFG_DETECT_MAX_CANDIDATES + 31) / 32]; ///< open groups (bitmap)
     sl_detect_cand_t cand[SL_CFG_DETECT_MAX_CANDIDATES];
+    sl_detect_links_t links; ///< scratch of sl_detect_row
     sl_target_t targets[SL_CFG_MAX_TARGETS];
     uint32_t hint_bits[(SL_CFG_MAX_AZIMUTHS + 31) / 32]; ///< hinted azimuths (stage 4b)
     const uint8_t *amp;     ///< amplitude row for the next sl_detect_row (borrowed) or NULL
