@@ -290,6 +290,12 @@ static void cand_merge(sl_detect_t *d, sl_detect_cand_t *dst, sl_detect_cand_t *
         }
         dst->az_first = src->az_first;
     }
+    // Entries past dst's last azimuth (src reaches one further) start empty (the entries
+    // beyond a group's span are never initialised: sl_detect_cand_t).
+    for (uint32_t i = (uint32_t)dst->az_last - dst->az_first + 1U;
+         i <= last - dst->az_first && i < SL_CFG_DETECT_MAX_SPAN; i++) {
+        dst->run[i].count = 0U;
+    }
     entries_merge(dst, src, (uint32_t)src->az_first - dst->az_first);
     dst->flags |= src->flags;
     dst->az_last = (uint16_t)last;
@@ -311,6 +317,9 @@ static void cand_attach(sl_detect_cand_t *c, uint32_t a, uint16_t f, uint16_t l,
         c->last_lo = f;
         c->last_hi = l;
         c->az_last = (uint16_t)a;
+        if (a - c->az_first < SL_CFG_DETECT_MAX_SPAN) {
+            c->run[a - c->az_first].count = 0U; // a new azimuth: its entry starts empty
+        }
     } else {
         ext_union(&c->last_lo, &c->last_hi, f, l);
     }
@@ -330,6 +339,7 @@ static void cand_attach(sl_detect_cand_t *c, uint32_t a, uint16_t f, uint16_t l,
 // both to the survivor's union extent, so a later run sees exactly what it would see
 // walking the open groups (first linkable in slot order = survivor, merged extents), at a
 // compare or two per group instead of a walk of the open set.
+//
 // Run [f, l] on azimuth a (flags rflags) continues each group whose extent on a - 1 it
 // overlaps (cfg.link_bins of slack) and which is of the same strength class: a weak run
 // never joins a group holding a strong one and a strong run never joins a group of weak
@@ -380,8 +390,9 @@ static void add_run(sl_detect_t *d, sl_detect_links_t *t, uint32_t a, uint32_t f
             d->stats.cand_overflow++;
             return;
         }
-        memset(dst, 0, sizeof *dst);
+        // Only the header and the first entry: entries join as the group grows.
         dst->state = ST_OPEN;
+        dst->flags = 0U;
         open_set(d, dst);
         d->n_open++;
         dst->az_first = (uint16_t)a;
@@ -390,6 +401,7 @@ static void add_run(sl_detect_t *d, sl_detect_links_t *t, uint32_t a, uint32_t f
         dst->last_hi = (uint16_t)l;
         dst->prev_lo = EMPTY_LO;
         dst->prev_hi = EMPTY_HI;
+        dst->run[0].count = 0U;
     }
     cand_attach(dst, a, (uint16_t)f, (uint16_t)l, (uint16_t)(count > 0xFFFFU ? 0xFFFFU : count),
                 rflags);
@@ -1045,7 +1057,13 @@ sl_ssize_t sl_detect_end(sl_detect_t *d)
                           d->cfg.link_bins)) {
                 continue;
             }
-            entries_merge(c, c0, n - c->az_first);
+            // c ends on azimuth n - 1: the entries that take c0's start empty
+            const uint32_t span = n - c->az_first;
+            const uint32_t span0 = (uint32_t)c0->az_last - c0->az_first + 1U;
+            for (uint32_t k = span; k < span + span0 && k < SL_CFG_DETECT_MAX_SPAN; k++) {
+                c->run[k].count = 0U;
+            }
+            entries_merge(c, c0, span);
             const uint32_t last = n + c0->az_last;
             c->az_last = (uint16_t)(last > 0xFFFFU ? 0xFFFFU : last);
             c->flags |= (uint8_t)(c0->flags | CF_WRAPS);

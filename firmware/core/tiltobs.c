@@ -158,7 +158,7 @@ static bool union_bounds(const sl_board_t *b, const sl_target_t *g, uint32_t *r1
 // centre azimuth (a leaning pole spans several azimuths, each holding a part of it; the
 // representative run alone reads the lean short, and a constant bias becomes a sideways
 // tilt in the fit).
-static void observe(sl_tiltobs_t *o, sl_tiltobs_ring_t *r, const sl_target_t *g)
+static void observe(sl_tiltobs_t *o, sl_tiltobs_ring_t *r, const sl_target_t *g, bool fit)
 {
     const sl_board_t *b = o->board;
     const uint32_t naz = b->azimuths;
@@ -205,12 +205,45 @@ static void observe(sl_tiltobs_t *o, sl_tiltobs_ring_t *r, const sl_target_t *g)
     r->head = (uint8_t)((r->head + 1U) % (uint32_t)SL_CFG_TILT_OBS_PER_TRACK);
     if (r->count < (uint8_t)SL_CFG_TILT_OBS_PER_TRACK) {
         r->count++;
+    } else if (r->early > 0U) {
+        r->early--; // the oldest, an early one, was overwritten
     }
-    if (r->fresh == 0U) {
+    if (r->provisional != 0U) {
+        r->early++;
+    }
+    if (fit && r->fresh == 0U) {
         r->fresh = 1U;
         o->pending++;
     }
     o->stats.observations++;
+}
+
+// A ring for track `t` (slot i) with no ring yet: a free one; for a confirmed track, else a
+// provisional one (the fewest observations, then the lowest index), taken from its
+// unconfirmed track. NULL: none.
+static sl_tiltobs_ring_t *ring_take(sl_tiltobs_t *o, const sl_track_t *t, uint32_t i)
+{
+    sl_tiltobs_ring_t *r = ring_of(o, 0U);
+    if (r == NULL && t->confirmed != 0U) {
+        for (uint32_t k = 0; k < (uint32_t)SL_CFG_TILT_TRACKS; k++) {
+            sl_tiltobs_ring_t *q = &o->ring[k];
+            if (q->provisional != 0U && (r == NULL || q->count < r->count)) {
+                r = q;
+            }
+        }
+        if (r != NULL) {
+            free_ring(o, r);
+            o->stats.evicted++;
+        }
+    }
+    if (r != NULL) {
+        r->track_id = t->id;
+        r->slot = (uint8_t)i;
+        r->anchor_x_um = o->odom.x_um;
+        r->anchor_y_um = o->odom.y_um;
+        r->provisional = (uint8_t)(t->confirmed != 0U ? 0U : 1U);
+    }
+    return r;
 }
 
 void sl_tiltobs_update(sl_tiltobs_t *o, const sl_track_t *tracks, const sl_target_t *targets,
@@ -230,32 +263,39 @@ void sl_tiltobs_update(sl_tiltobs_t *o, const sl_track_t *tracks, const sl_targe
     }
     for (uint32_t i = 0; i < (uint32_t)SL_CFG_MAX_TARGETS; i++) {
         const sl_track_t *t = &tracks[i];
-        if (t->live == 0U || t->updated == 0U || t->confirmed == 0U) {
+        if (t->live == 0U || t->updated == 0U) {
             continue;
+        }
+        const bool confirmed = t->confirmed != 0U;
+        sl_tiltobs_ring_t *r = ring_of(o, t->id);
+        if (r != NULL && r->provisional == 0U && !confirmed) {
+            continue; // a history begun under confirmation records only while confirmed
+        }
+        if (r != NULL && r->provisional != 0U && !confirmed && t->evidence <= 1U) {
+            free_ring(o, r); // the track restarted: what the ring held may be another object
+            r = NULL;
         }
         const sl_target_t *g = target_of(t, targets, n_targets);
         if (g == NULL || g->incline_flag != (uint8_t)SL_INCLINE_VALID ||
             g->az >= o->board->azimuths) {
-            o->stats.no_target++;
+            o->stats.no_target += confirmed ? 1U : 0U;
             continue;
         }
         if (o->verified_only && (g->flags & (SL_TARGET_PROFILE | SL_TARGET_NO_TAIL)) == 0U) {
-            o->stats.unverified++;
+            o->stats.unverified += confirmed ? 1U : 0U;
             continue;
         }
-        sl_tiltobs_ring_t *r = ring_of(o, t->id);
         if (r == NULL) {
-            r = ring_of(o, 0U);
+            r = ring_take(o, t, i);
             if (r == NULL) {
-                o->stats.no_ring++;
+                o->stats.no_ring += confirmed ? 1U : 0U;
                 continue;
             }
-            r->track_id = t->id;
-            r->slot = (uint8_t)i;
-            r->anchor_x_um = o->odom.x_um;
-            r->anchor_y_um = o->odom.y_um;
         }
-        observe(o, r, g);
+        if (confirmed) {
+            r->provisional = 0U;
+        }
+        observe(o, r, g, confirmed);
     }
 }
 
@@ -332,6 +372,25 @@ void sl_tiltobs_fit_pending(sl_tiltobs_t *o)
         (void)sl_tilt_fit(r->obs, r->count, &o->prm, &o->work, &r->res);
         o->stats.fits++;
         done++;
+        // Observations from before the track's confirmation (sl_tiltobs.h, 2.) are trusted
+        // less: INCONSISTENT with them, they go and the fit is redone (within the bound, as
+        // below). They do not count as outliers.
+        if (SL_CFG_TILT_FITS_PER_ROTATION >= 2 &&
+            r->res.quality == (uint8_t)SL_TILT_INCONSISTENT && r->early > 0U &&
+            r->early < r->count) {
+            if (done >= (uint32_t)SL_CFG_TILT_FITS_PER_ROTATION) {
+                o->rr = (uint8_t)idx;
+                break;
+            }
+            o->stats.early_dropped += r->early;
+            while (r->early > 0U) {
+                drop_obs(r, r->count == (uint8_t)SL_CFG_TILT_OBS_PER_TRACK ? r->head : 0U);
+                r->early--;
+            }
+            (void)sl_tilt_fit(r->obs, r->count, &o->prm, &o->work, &r->res);
+            o->stats.fits++;
+            done++;
+        }
         // One gross outlier (a bound the profile could not clean) makes a whole pass
         // INCONSISTENT: drop the observation with the largest residual in sigmas and fit
         // again, at most one in SL_TILTOBS_OUTLIER_DIV of the observations per ring (a

@@ -335,7 +335,8 @@ typedef struct sl_detect_cand {
     uint16_t prev_lo, prev_hi; ///< extent on az_last - 1 (lo > hi: none)
     uint8_t state;      ///< 0 free, 1 open, 2 closed (waiting for the wrap merge)
     uint8_t flags;      ///< internal NEAR / SHADOW / SPAN / WRAPS bits
-    sl_detect_azrun_t run[SL_CFG_DETECT_MAX_SPAN];
+    sl_detect_azrun_t run[SL_CFG_DETECT_MAX_SPAN]; ///< azimuths az_first .. az_last (the
+                        ///< entries beyond the span hold stale data: never read)
 } sl_detect_cand_t;
 
 /// The groups the current row's runs may join, with their extents on the azimuth before

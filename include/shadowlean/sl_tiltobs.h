@@ -9,7 +9,7 @@
 ///    of the rotation (speed, yaw rate). A rotation WITHOUT a valid motion input breaks the
 ///    odometry: every history is cleared (observations on either side of the gap would be
 ///    placed in inconsistent frames), and nothing is recorded until motion returns.
-/// 2. `sl_tiltobs_update()`: for every live, confirmed track matched on this rotation whose
+/// 2. `sl_tiltobs_update()`: for every live track matched on this rotation whose
 ///    target has a VALID inclination, one observation (`sl_tilt_obs_t`, 24 bytes) is pushed
 ///    into the track's ring: the radar's position and the pole's bearing in the odometry
 ///    frame AT THE CENTRE AZIMUTH OF THE TARGET'S DETECTION GROUP (az_first + (az_count -
@@ -26,6 +26,18 @@
 ///    belongs to a track id; a ring whose track is gone (or whose slot now holds another
 ///    id) is freed. The ring keeps the newest SL_CFG_TILT_OBS_PER_TRACK observations.
 ///    Tracks beyond SL_CFG_TILT_TRACKS rings get none (counted in `stats.no_ring`).
+///    **Before confirmation** (the tracker's `confirmed`: three consistent rotations by
+///    default) a track's observations go into a PROVISIONAL ring: never fitted nor
+///    reported, so nothing reaches CAN for an unconfirmed object; restarted when the track's
+///    evidence falls back to 1 (an association inconsistent with a static object: what was
+///    held may be another object's); taken from the track by a confirmed track that finds
+///    no free ring (clutter's tentative tracks never starve a pole's history; counted in
+///    `stats.evicted`); a provisional track itself only takes a free ring. When the track
+///    confirms, the ring stops being provisional and is fitted with everything it holds:
+///    a fast pass keeps the rotations before confirmation (at 3 m/s a pole is in the
+///    shadow for about ten rotations, two of them before its track confirms). Those early
+///    observations are trusted less: a fit that comes out INCONSISTENT with them is redone
+///    without them, and they are dropped (sl_tiltobs_fit_pending; `stats.early_dropped`).
 /// 3. `sl_tiltobs_fit_pending()`: the fit (`sl_tilt_fit`) runs on rings that received an
 ///    observation since their last fit, at most SL_CFG_TILT_FITS_PER_ROTATION per call
 ///    (round robin over the rings; the others keep their previous result until their turn;
@@ -43,9 +55,8 @@
 ///
 /// Units: um, bam32 (2^32 per turn), cdeg (0.01 deg). No allocation, no float; every array
 /// is inside the struct. RAM: SL_CFG_TILT_TRACKS x (SL_CFG_TILT_OBS_PER_TRACK x 24 + 72)
-/// + 648 bytes (x86-64: firmware configuration 4 x 16: 2,472 B; host default 8 x 32: 7,368 B).
-/// Cost per rotation: O(tracks x targets) for the matching (only for updated confirmed
-/// tracks) + O(1) per observation (three table sine/cosine, two 64-bit divisions) + at most
+/// + 664 bytes (x86-64: firmware configuration 4 x 16: 2,488 B; host default 8 x 32: 7,384 B).
+/// Cost per rotation: O(tracks x targets) for the matching (only for updated tracks) + O(1) per observation (three table sine/cosine, two 64-bit divisions) + at most
 /// SL_CFG_TILT_FITS_PER_ROTATION fits (sl_tilt.h: O(n + m^2)). Not reentrant per instance.
 #ifndef SHADOWLEAN_SL_TILTOBS_H
 #define SHADOWLEAN_SL_TILTOBS_H
@@ -79,6 +90,9 @@ typedef struct sl_tiltobs_ring {
     uint8_t fresh;          ///< an observation was added since the last fit
     uint8_t fitted;         ///< `res` holds a fit of this ring's observations
     uint8_t dropped;        ///< observations removed as outliers (sl_tiltobs_fit_pending)
+    uint8_t provisional;    ///< 1: the track has not been confirmed yet (file comment, 2.)
+    uint8_t early;          ///< of the observations held, how many (the oldest) were taken
+                            ///< before the track's confirmation
     sl_tilt_obs_t obs[SL_CFG_TILT_OBS_PER_TRACK];
 } sl_tiltobs_ring_t;
 
@@ -95,7 +109,10 @@ typedef struct sl_tiltobs_stats {
     uint32_t rejected;      ///< VALID targets not stored: union extent saturated or without a
                             ///< VALID alpha, or sl_tilt_obs_make refused (|alpha| >= 80 deg ...)
     uint32_t no_target;     ///< updated confirmed tracks whose target was not found / not VALID
-    uint32_t no_ring;       ///< observations lost: every ring in use
+    uint32_t no_ring;       ///< observations of confirmed tracks lost: every ring in use
+                            ///< by confirmed tracks
+    uint32_t evicted;       ///< provisional rings taken by a confirmed track
+    uint32_t early_dropped; ///< pre-confirmation observations dropped (an INCONSISTENT fit)
     uint32_t fits;          ///< sl_tilt_fit calls
     uint32_t resets;        ///< histories cleared because the motion input was missing
     uint32_t unverified;    ///< targets not stored under `verified_only`: bounds the range

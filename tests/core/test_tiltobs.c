@@ -130,6 +130,11 @@ static bool see(const sl_board_t *b, const drive_t *d, const pole_t *p, sl_targe
 // for the k-th time with k % corrupt_every == corrupt_phase (corrupt_every 0: none).
 static int corrupt_every, corrupt_phase;
 
+// Sightings a track needs before it is confirmed (the tracker's evidence, one per sighting;
+// 0 or 1: confirmed from the first), and, with corrupt_early, the first pole's targets read
+// wrong on its first `corrupt_early` sightings (before its confirmation).
+static int confirm_at, corrupt_early;
+
 // Runs a drive-by of `n` poles (one track each, ids 1..n) for `rotations`; returns the
 // rotations on which at least one pole was seen.
 static int drive_by(const pole_t *p, int n, double v, double w, int rotations, sl_track_t *tracks)
@@ -148,8 +153,12 @@ static int drive_by(const pole_t *p, int n, double v, double w, int rotations, s
             t->updated = 0U;
             if (see(b, &d, &p[i], &g[ng])) {
                 t->live = 1U;
-                t->confirmed = 1U;
+                t->evidence = (uint8_t)(t->evidence < 5U ? t->evidence + 1U : 5U);
+                t->confirmed = (uint8_t)(t->evidence >= confirm_at ? 1U : 0U);
                 t->updated = 1U;
+                if (i == 0 && t->evidence <= corrupt_early) {
+                    g[ng].r2_um = (uint32_t)llround(g[ng].r2_um * 1.08); // as corrupt_every
+                }
                 t->id = (uint16_t)(i + 1);
                 t->az = g[ng].az;
                 t->r1_um = g[ng].r1_um;
@@ -503,6 +512,142 @@ static void test_degenerate_inputs(void **state)
     assert_int_equal(obs.stats.observations, 0U);
 }
 
+// Before its track is confirmed a pole's observations go into a provisional ring: never
+// fitted nor reported; at confirmation the ring is fitted with all of them (a fast pass
+// keeps its first rotations). Same result as a track confirmed from its first sighting.
+static void test_observations_before_confirmation_are_kept(void **state)
+{
+    (void)state;
+    sl_track_t tracks[SL_CFG_MAX_TARGETS];
+    const pole_t p = {4.0, 3.0, 10.0, 200.0};
+    confirm_at = 3;
+    // Two rotations with the pole seen: a provisional ring, no fit, nothing to report.
+    int seen = drive_by(&p, 1, 3.0, 0.0, 1, tracks);
+    for (int k = 1; seen < 2 && k < 40; ++k) {
+        seen = drive_by(&p, 1, 3.0, 0.0, k + 1, tracks);
+    }
+    assert_int_equal(seen, 2);
+    const sl_tiltobs_ring_t *r = sl_tiltobs_find(&obs, 1U);
+    assert_non_null(r);
+    assert_int_equal(r->provisional, 1U);
+    assert_int_equal(r->count, 2U);
+    assert_int_equal(r->early, 2U);
+    assert_int_equal(obs.stats.fits, 0U);
+    assert_int_equal(obs.pending, 0U);
+    sl_tiltobs_vehicle_t out;
+    assert_false(sl_tiltobs_vehicle(&obs, r, &out)); // never fitted: no PoleTilt
+    // The whole pass at 3 m/s: every sighting kept, FITTED within the bounds.
+    const int rotations = 32;
+    seen = drive_by(&p, 1, 3.0, 0.0, rotations, tracks);
+    r = sl_tiltobs_find(&obs, 1U);
+    assert_non_null(r);
+    assert_int_equal(r->provisional, 0U);
+    assert_int_equal(r->count, (unsigned)(seen < SL_CFG_TILT_OBS_PER_TRACK ? seen : SL_CFG_TILT_OBS_PER_TRACK));
+    assert_true(sl_tiltobs_vehicle(&obs, r, &out));
+    const int32_t psi_late = out.psi_cdeg;
+    check_pole(&p, 3.0, 0.0, rotations, 1, 1.0, 10.0);
+    // Confirmed from the first sighting: the same observations, the same fit.
+    confirm_at = 0;
+    drive_by(&p, 1, 3.0, 0.0, rotations, tracks);
+    assert_true(sl_tiltobs_vehicle(&obs, sl_tiltobs_find(&obs, 1U), &out));
+    assert_int_equal(out.psi_cdeg, psi_late);
+}
+
+// Early observations that disagree with the rest (the pole's first rotations read wrong)
+// make the fit INCONSISTENT: they are dropped and the fit is redone. A provisional ring
+// restarts when its track does (evidence back to 1), and a confirmed track that finds no
+// free ring takes a provisional one.
+static void test_early_observations_yield_and_restart(void **state)
+{
+    (void)state;
+    sl_track_t tracks[SL_CFG_MAX_TARGETS];
+    const pole_t p = {4.0, 3.0, 10.0, 200.0};
+    confirm_at = 3;
+    corrupt_early = 2;
+    drive_by(&p, 1, 3.0, 0.0, 32, tracks);
+    assert_int_equal(obs.stats.early_dropped, 2U);
+    const sl_tiltobs_ring_t *r = sl_tiltobs_find(&obs, 1U);
+    assert_non_null(r);
+    assert_int_equal(r->early, 0U);
+    assert_int_equal(r->dropped, 0U); // not counted as outliers
+    check_pole(&p, 3.0, 0.0, 32, 1, 1.0, 10.0);
+    corrupt_early = 0;
+
+    // Restart: a provisional ring whose track's evidence falls back to 1 is emptied.
+    sl_target_t g[1];
+    drive_t d = {0, 0, 0, 0, 0};
+    assert_int_equal(sl_tiltobs_init(&obs, board()), SL_OK);
+    memset(tracks, 0, sizeof(sl_track_t) * SL_CFG_MAX_TARGETS);
+    const pole_t q = {0.5, 2.5, 8.0, 90.0};
+    assert_true(see(board(), &d, &q, &g[0]));
+    sl_track_t *t = &tracks[0];
+    t->live = 1U;
+    t->updated = 1U;
+    t->id = 7U;
+    t->az = g[0].az;
+    t->r1_um = g[0].r1_um;
+    t->r2_um = g[0].r2_um;
+    for (uint8_t ev = 1U; ev <= 2U; ++ev) {
+        t->evidence = ev;
+        sl_tiltobs_advance(&obs, true, 0, 0, 250000U);
+        sl_tiltobs_update(&obs, tracks, g, 1U);
+    }
+    r = sl_tiltobs_find(&obs, 7U);
+    assert_non_null(r);
+    assert_int_equal(r->count, 2U);
+    t->evidence = 1U; // an inconsistent association: the tracker restarted its evidence
+    sl_tiltobs_advance(&obs, true, 0, 0, 250000U);
+    sl_tiltobs_update(&obs, tracks, g, 1U);
+    r = sl_tiltobs_find(&obs, 7U);
+    assert_non_null(r);
+    assert_int_equal(r->count, 1U);
+    assert_int_equal(r->provisional, 1U);
+
+    // Every ring held by an unconfirmed track: a confirmed one takes one of them.
+    for (uint32_t i = 1; i < (uint32_t)SL_CFG_TILT_TRACKS; ++i) {
+        tracks[i] = *t;
+        tracks[i].id = (uint16_t)(7U + i);
+    }
+    sl_target_t gg[SL_CFG_TILT_TRACKS + 1];
+    for (uint32_t i = 0; i <= (uint32_t)SL_CFG_TILT_TRACKS; ++i) {
+        gg[i] = g[0];
+    }
+    sl_tiltobs_advance(&obs, true, 0, 0, 250000U);
+    sl_tiltobs_update(&obs, tracks, gg, SL_CFG_TILT_TRACKS);
+    for (uint32_t i = 0; i < (uint32_t)SL_CFG_TILT_TRACKS; ++i) {
+        assert_non_null(sl_tiltobs_find(&obs, (uint16_t)(7U + i)));
+    }
+    tracks[SL_CFG_TILT_TRACKS] = *t;
+    tracks[SL_CFG_TILT_TRACKS].id = 99U;
+    tracks[SL_CFG_TILT_TRACKS].confirmed = 1U;
+    tracks[SL_CFG_TILT_TRACKS].evidence = 3U;
+    for (uint32_t i = 0; i < (uint32_t)SL_CFG_TILT_TRACKS; ++i) {
+        tracks[i].updated = 0U; // only the confirmed one this rotation
+    }
+    const uint32_t no_ring = obs.stats.no_ring;
+    sl_tiltobs_advance(&obs, true, 0, 0, 250000U);
+    sl_tiltobs_update(&obs, tracks, gg, SL_CFG_TILT_TRACKS + 1U);
+    r = sl_tiltobs_find(&obs, 99U);
+    assert_non_null(r);
+    assert_int_equal(r->provisional, 0U);
+    assert_int_equal(obs.stats.evicted, 1U);
+    assert_int_equal(obs.stats.no_ring, no_ring);
+    // ... while an unconfirmed track never takes a ring from another (nor is counted)
+    tracks[SL_CFG_TILT_TRACKS].updated = 0U;
+    tracks[SL_CFG_TILT_TRACKS + 1] = *t;
+    tracks[SL_CFG_TILT_TRACKS + 1].id = 100U;
+    sl_target_t g3[SL_CFG_TILT_TRACKS + 2];
+    for (uint32_t i = 0; i < (uint32_t)SL_CFG_TILT_TRACKS + 2U; ++i) {
+        g3[i] = g[0];
+    }
+    sl_tiltobs_advance(&obs, true, 0, 0, 250000U);
+    sl_tiltobs_update(&obs, tracks, g3, SL_CFG_TILT_TRACKS + 2U);
+    assert_null(sl_tiltobs_find(&obs, 100U));
+    assert_int_equal(obs.stats.evicted, 1U);
+    assert_int_equal(obs.stats.no_ring, no_ring);
+    confirm_at = 0;
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -516,6 +661,8 @@ int main(void)
         cmocka_unit_test(test_more_tracks_than_rings_are_counted),
         cmocka_unit_test(test_union_extent_is_observed),
         cmocka_unit_test(test_degenerate_inputs),
+        cmocka_unit_test(test_observations_before_confirmation_are_kept),
+        cmocka_unit_test(test_early_observations_yield_and_restart),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
