@@ -201,15 +201,11 @@ static void observe(sl_tiltobs_t *o, sl_tiltobs_ring_t *r, const sl_target_t *g,
         o->stats.rejected++;
         return;
     }
+    ob.unconfirmed = (uint8_t)(fit ? 0U : 1U);
     r->obs[r->head] = ob;
     r->head = (uint8_t)((r->head + 1U) % (uint32_t)SL_CFG_TILT_OBS_PER_TRACK);
     if (r->count < (uint8_t)SL_CFG_TILT_OBS_PER_TRACK) {
         r->count++;
-    } else if (r->early > 0U) {
-        r->early--; // the oldest, an early one, was overwritten
-    }
-    if (r->provisional != 0U) {
-        r->early++;
     }
     if (fit && r->fresh == 0U) {
         r->fresh = 1U;
@@ -355,6 +351,34 @@ static SL_NOINLINE void drop_obs(sl_tiltobs_ring_t *r, uint32_t k)
     r->head = r->count;
 }
 
+// Observations held that were recorded while the track was not confirmed. O(count).
+static uint32_t unconfirmed_held(const sl_tiltobs_ring_t *r)
+{
+    uint32_t n = 0U;
+    for (uint32_t k = 0; k < r->count; k++) {
+        n += r->obs[k].unconfirmed != 0U ? 1U : 0U;
+    }
+    return n;
+}
+
+// Drop them (the others keep their age order); returns how many. O(count^2) at most, on
+// the rare INCONSISTENT path. Not inlined (the fit's stack chain).
+static SL_NOINLINE uint32_t drop_unconfirmed(sl_tiltobs_ring_t *r)
+{
+    uint32_t n = 0U;
+    uint32_t k = 0U;
+    while (k < r->count) {
+        if (r->obs[k].unconfirmed != 0U) {
+            drop_obs(r, k); // (normalises the layout: oldest first from here on)
+            n++;
+            k = 0U;
+        } else {
+            k++;
+        }
+    }
+    return n;
+}
+
 void sl_tiltobs_fit_pending(sl_tiltobs_t *o)
 {
     SL_ASSERT(o != NULL);
@@ -372,21 +396,17 @@ void sl_tiltobs_fit_pending(sl_tiltobs_t *o)
         (void)sl_tilt_fit(r->obs, r->count, &o->prm, &o->work, &r->res);
         o->stats.fits++;
         done++;
-        // Observations from before the track's confirmation (sl_tiltobs.h, 2.) are trusted
-        // less: INCONSISTENT with them, they go and the fit is redone (within the bound, as
-        // below). They do not count as outliers.
+        // Observations recorded while the track was not confirmed (sl_tiltobs.h, 2.) are
+        // trusted less: INCONSISTENT with them, they go and the fit is redone (within the
+        // bound, as below). They do not count as outliers.
         if (SL_CFG_TILT_FITS_PER_ROTATION >= 2 &&
-            r->res.quality == (uint8_t)SL_TILT_INCONSISTENT && r->early > 0U &&
-            r->early < r->count) {
+            r->res.quality == (uint8_t)SL_TILT_INCONSISTENT && unconfirmed_held(r) != 0U &&
+            unconfirmed_held(r) < r->count) {
             if (done >= (uint32_t)SL_CFG_TILT_FITS_PER_ROTATION) {
                 o->rr = (uint8_t)idx;
                 break;
             }
-            o->stats.early_dropped += r->early;
-            while (r->early > 0U) {
-                drop_obs(r, r->count == (uint8_t)SL_CFG_TILT_OBS_PER_TRACK ? r->head : 0U);
-                r->early--;
-            }
+            o->stats.unconfirmed_dropped += drop_unconfirmed(r);
             (void)sl_tilt_fit(r->obs, r->count, &o->prm, &o->work, &r->res);
             o->stats.fits++;
             done++;

@@ -146,7 +146,9 @@ typedef struct sl_tilt_obs {
                             ///< (== tan_q12 when not mirrorable)
     uint16_t sigma_q16;     ///< 1-sigma of tan(alpha), >= SL_TILT_SIGMA_MIN_Q16
     uint8_t mirrorable;     ///< 1: measured on branch 2 (the fold applies)
-    uint8_t reserved;       ///< 0
+    uint8_t unconfirmed;    ///< 1: recorded while its track was not confirmed (set by
+                            ///< sl_tiltobs.h, 0 from sl_tilt_obs_make; sl_tilt_fit does
+                            ///< not read it)
 } sl_tilt_obs_t;
 
 /// Smallest sigma of tan(alpha) a measurement is credited with: 0.001 (0.06 deg), so one

@@ -35,9 +35,13 @@
 ///    `stats.evicted`); a provisional track itself only takes a free ring. When the track
 ///    confirms, the ring stops being provisional and is fitted with everything it holds:
 ///    a fast pass keeps the rotations before confirmation (at 3 m/s a pole is in the
-///    shadow for about ten rotations, two of them before its track confirms). Those early
-///    observations are trusted less: a fit that comes out INCONSISTENT with them is redone
-///    without them, and they are dropped (sl_tiltobs_fit_pending; `stats.early_dropped`).
+///    shadow for about ten rotations, two of them before its track confirms). Those
+///    observations carry `sl_tilt_obs_t.unconfirmed` and are trusted less: a fit that comes
+///    out INCONSISTENT with them is redone without them, and they are dropped
+///    (sl_tiltobs_fit_pending; `stats.unconfirmed_dropped`). A track that loses its
+///    confirmation later (its evidence restarts) records nothing until it is confirmed
+///    again (recording on through such gaps moved the curved-path test's inside pole from
+///    -1.00 to -1.10 deg, outside the 1 deg bound, for 7 more passes of 432 in the sweep).
 /// 3. `sl_tiltobs_fit_pending()`: the fit (`sl_tilt_fit`) runs on rings that received an
 ///    observation since their last fit, at most SL_CFG_TILT_FITS_PER_ROTATION per call
 ///    (round robin over the rings; the others keep their previous result until their turn;
@@ -91,8 +95,6 @@ typedef struct sl_tiltobs_ring {
     uint8_t fitted;         ///< `res` holds a fit of this ring's observations
     uint8_t dropped;        ///< observations removed as outliers (sl_tiltobs_fit_pending)
     uint8_t provisional;    ///< 1: the track has not been confirmed yet (file comment, 2.)
-    uint8_t early;          ///< of the observations held, how many (the oldest) were taken
-                            ///< before the track's confirmation
     sl_tilt_obs_t obs[SL_CFG_TILT_OBS_PER_TRACK];
 } sl_tiltobs_ring_t;
 
@@ -112,7 +114,8 @@ typedef struct sl_tiltobs_stats {
     uint32_t no_ring;       ///< observations of confirmed tracks lost: every ring in use
                             ///< by confirmed tracks
     uint32_t evicted;       ///< provisional rings taken by a confirmed track
-    uint32_t early_dropped; ///< pre-confirmation observations dropped (an INCONSISTENT fit)
+    uint32_t unconfirmed_dropped; ///< observations recorded while the track was not
+                                  ///< confirmed, dropped (an INCONSISTENT fit)
     uint32_t fits;          ///< sl_tilt_fit calls
     uint32_t resets;        ///< histories cleared because the motion input was missing
     uint32_t unverified;    ///< targets not stored under `verified_only`: bounds the range

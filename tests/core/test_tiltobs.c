@@ -131,9 +131,21 @@ static bool see(const sl_board_t *b, const drive_t *d, const pole_t *p, sl_targe
 static int corrupt_every, corrupt_phase;
 
 // Sightings a track needs before it is confirmed (the tracker's evidence, one per sighting;
-// 0 or 1: confirmed from the first), and, with corrupt_early, the first pole's targets read
-// wrong on its first `corrupt_early` sightings (before its confirmation).
-static int confirm_at, corrupt_early;
+// 0 or 1: confirmed from the first); reset_at > 0: on its reset_at-th sighting the track's
+// evidence restarts at 1 (an association inconsistent with a static object), so it is
+// unconfirmed again for confirm_at - 1 sightings; corrupt_unconfirmed: the first pole's
+// targets read wrong (r2 8 % long) whenever its track is not confirmed.
+static int confirm_at, reset_at, corrupt_unconfirmed;
+
+// Observations held that were recorded while the track was not confirmed.
+static unsigned held_unconfirmed(const sl_tiltobs_ring_t *r)
+{
+    unsigned n = 0;
+    for (unsigned k = 0; k < r->count; ++k) {
+        n += r->obs[k].unconfirmed != 0U;
+    }
+    return n;
+}
 
 // Runs a drive-by of `n` poles (one track each, ids 1..n) for `rotations`; returns the
 // rotations on which at least one pole was seen.
@@ -144,6 +156,7 @@ static int drive_by(const pole_t *p, int n, double v, double w, int rotations, s
     memset(tracks, 0, sizeof(sl_track_t) * SL_CFG_MAX_TARGETS);
     drive_t d = {v, w, 0, 0, 0};
     int seen = 0;
+    int sightings[8] = {0};
     for (int k = 0; k < rotations; ++k) {
         sl_tiltobs_advance(&obs, true, (int32_t)llround(v * 1000), (int32_t)llround(w * 100), 250000U);
         sl_target_t g[8];
@@ -153,10 +166,14 @@ static int drive_by(const pole_t *p, int n, double v, double w, int rotations, s
             t->updated = 0U;
             if (see(b, &d, &p[i], &g[ng])) {
                 t->live = 1U;
+                sightings[i < 8 ? i : 7]++;
                 t->evidence = (uint8_t)(t->evidence < 5U ? t->evidence + 1U : 5U);
+                if (reset_at > 0 && sightings[i < 8 ? i : 7] == reset_at) {
+                    t->evidence = 1U;
+                }
                 t->confirmed = (uint8_t)(t->evidence >= confirm_at ? 1U : 0U);
                 t->updated = 1U;
-                if (i == 0 && t->evidence <= corrupt_early) {
+                if (i == 0 && corrupt_unconfirmed && t->confirmed == 0U) {
                     g[ng].r2_um = (uint32_t)llround(g[ng].r2_um * 1.08); // as corrupt_every
                 }
                 t->id = (uint16_t)(i + 1);
@@ -531,7 +548,7 @@ static void test_observations_before_confirmation_are_kept(void **state)
     assert_non_null(r);
     assert_int_equal(r->provisional, 1U);
     assert_int_equal(r->count, 2U);
-    assert_int_equal(r->early, 2U);
+    assert_int_equal(held_unconfirmed(r), 2U);
     assert_int_equal(obs.stats.fits, 0U);
     assert_int_equal(obs.pending, 0U);
     sl_tiltobs_vehicle_t out;
@@ -553,25 +570,38 @@ static void test_observations_before_confirmation_are_kept(void **state)
     assert_int_equal(out.psi_cdeg, psi_late);
 }
 
-// Early observations that disagree with the rest (the pole's first rotations read wrong)
-// make the fit INCONSISTENT: they are dropped and the fit is redone. A provisional ring
-// restarts when its track does (evidence back to 1), and a confirmed track that finds no
-// free ring takes a provisional one.
+// Observations from before the track's confirmation that disagree with the rest (the
+// pole's first rotations read wrong) make the fit INCONSISTENT: they are dropped and the fit
+// is redone. A track that loses its confirmation later records nothing until confirmed
+// again. A provisional ring restarts when its track does (evidence back to 1), and a
+// confirmed track that finds no free ring takes a provisional one.
 static void test_early_observations_yield_and_restart(void **state)
 {
     (void)state;
     sl_track_t tracks[SL_CFG_MAX_TARGETS];
     const pole_t p = {4.0, 3.0, 10.0, 200.0};
     confirm_at = 3;
-    corrupt_early = 2;
+    corrupt_unconfirmed = 1;
     drive_by(&p, 1, 3.0, 0.0, 32, tracks);
-    assert_int_equal(obs.stats.early_dropped, 2U);
+    assert_int_equal(obs.stats.unconfirmed_dropped, 2U);
     const sl_tiltobs_ring_t *r = sl_tiltobs_find(&obs, 1U);
     assert_non_null(r);
-    assert_int_equal(r->early, 0U);
+    assert_int_equal(held_unconfirmed(r), 0U);
     assert_int_equal(r->dropped, 0U); // not counted as outliers
     check_pole(&p, 3.0, 0.0, 32, 1, 1.0, 10.0);
-    corrupt_early = 0;
+    // Confirmation lost on the 5th sighting (unconfirmed on the 5th and 6th): a history begun
+    // under confirmation records nothing until the track is confirmed again.
+    corrupt_unconfirmed = 1; // (those two read wrong, the first two too)
+    reset_at = 5;
+    const int seen = drive_by(&p, 1, 3.0, 0.0, 32, tracks);
+    r = sl_tiltobs_find(&obs, 1U);
+    assert_non_null(r);
+    assert_int_equal(obs.stats.unconfirmed_dropped, 2U);
+    assert_int_equal(r->count, (unsigned)seen - 4U);
+    assert_int_equal(held_unconfirmed(r), 0U);
+    check_pole(&p, 3.0, 0.0, 32, 1, 1.0, 10.0);
+    corrupt_unconfirmed = 0;
+    reset_at = 0;
 
     // Restart: a provisional ring whose track's evidence falls back to 1 is emptied.
     sl_target_t g[1];
