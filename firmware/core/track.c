@@ -185,10 +185,28 @@ static void predict(const sl_tracker_t *tr, sl_track_t *t)
     t->pred_az = (uint16_t)((paz + n - half) % n);
 }
 
+// Azimuths from `a` to the target's detection group (0 inside it): a pole leaning across
+// the line of sight spans 10-15 azimuths, and which of them is its representative (the
+// lowest visible point, SLANT) moves as the vehicle passes, while a static object's
+// predicted bearing stays inside the group. Without a group (az_count 0): to its azimuth.
+static uint32_t az_dist_group(uint32_t a, const sl_target_t *g, uint32_t n)
+{
+    if (g->az_count <= 1U) {
+        return az_dist(a, g->az, n);
+    }
+    const uint32_t off = (a + n - (g->az_first % n)) % n; // clockwise from the group's first
+    if (off < g->az_count) {
+        return 0U;
+    }
+    const uint32_t to_first = n - off;                  // back to az_first
+    const uint32_t to_last = off - (g->az_count - 1U); // on past the last
+    return to_first < to_last ? to_first : to_last;
+}
+
 // Evidence after an association (consistent or not with the static prediction).
 static void evidence_update(sl_tracker_t *tr, sl_track_t *t, const sl_target_t *g, uint32_t yaw_az)
 {
-    const uint32_t da = az_dist(t->pred_az, g->az, tr->board->azimuths);
+    const uint32_t da = az_dist_group(t->pred_az, g, tr->board->azimuths);
     const uint32_t dr = t->pred_r1_um > g->r1_um ? t->pred_r1_um - g->r1_um
                                                  : g->r1_um - t->pred_r1_um;
     const uint8_t cap = (uint8_t)(tr->cfg.confirm_min > 253U ? 255U : tr->cfg.confirm_min + 2U);

@@ -29,7 +29,10 @@
 /// sin/cos, error < 0.2 %; yaw is not predicted, only tolerated). The gates above are
 /// centred on this prediction instead of the last position. A track then accumulates
 /// `evidence`: +1 for an association whose residual from the prediction is within
-/// `cfg.consist_az` azimuths (+ the yaw per rotation) and `cfg.consist_range_um`, capped at
+/// `cfg.consist_az` azimuths (+ the yaw per rotation; measured to the target's detection
+/// group, az_first .. az_first + az_count - 1, 0 when the prediction falls inside it: the
+/// representative azimuth of a pole leaning across the line of sight moves within its
+/// 10-15 azimuths as the vehicle passes) and `cfg.consist_range_um`, capped at
 /// `cfg.confirm_min + 2`; an association outside that tolerance resets it to 1 (the track
 /// jumped: what it followed does not move like a static object); a rotation without an
 /// association takes 1 off and moves the track's az / r1 to the prediction (dead reckoning,

@@ -348,6 +348,54 @@ static void test_track_confirms_static_objects_not_scattered_clutter(void **stat
     assert_int_equal(trk.stats.confirmations, 0);
 }
 
+// A pole leaning across the line of sight is a group of 12 azimuths whose representative
+// (its lowest visible point, SLANT) moves 4-10 azimuths off the static prediction from one
+// rotation to the next; the prediction stays inside the group: consistent, the track
+// confirms. A group whose extent ends 4 azimuths short of the prediction is not.
+static void test_track_checks_consistency_against_the_group_extent(void **state)
+{
+    (void)state;
+    assert_int_equal(sl_track_init(&trk, &board, NULL), SL_OK);
+    sl_track_set_motion(&trk, 250000U, 0U);
+    uint16_t az = 60;
+    uint32_t r = 4000000U;
+    uint64_t now = 1000000;
+    const int16_t jump[6] = {0, 5, 0, 6, 1, 6}; // what sl-eval driveby --psi 20 shows
+    for (int k = 0; k < 6; k++) {
+        sl_target_t t = tgt((uint16_t)((az + 400 + jump[k]) % 400), r, 500, 80, SL_INCLINE_VALID);
+        t.az_first = (uint16_t)((az + 400 - 2) % 400); // the prediction 2 azimuths inside
+        t.az_count = 12U;
+        t.flags = SL_TARGET_SLANT;
+        sl_track_update(&trk, &t, 1, now);
+        assert_int_equal(trk.tracks[0].confirmed, k >= 2 ? 1 : 0);
+        // the tracker carries the representative's azimuth; the test predicts from the truth
+        sl_track_predict_static(&board, az, r, 250000U, &az, &r);
+        now += 250000;
+    }
+    assert_int_equal(trk.stats.inconsistent, 0);
+    assert_int_equal(trk.stats.created, 1);
+    // The group's far edge 4 azimuths short of the prediction: inconsistent every time.
+    assert_int_equal(sl_track_init(&trk, &board, NULL), SL_OK);
+    sl_track_set_motion(&trk, 250000U, 0U);
+    az = 60;
+    r = 4000000U;
+    for (int k = 0; k < 6; k++) {
+        uint16_t paz;
+        uint32_t pr;
+        sl_track_predict_static(&board, az, r, 250000U, &paz, &pr);
+        sl_target_t t = tgt(az, r, 500, 80, SL_INCLINE_VALID);
+        t.az_first = (uint16_t)((az + 400 - 11) % 400);
+        t.az_count = 12U; // [az - 11, az]
+        sl_track_update(&trk, &t, 1, now);
+        // next rotation: the representative at the group's end, the prediction 4 beyond it
+        az = (uint16_t)((paz + 400 - 4) % 400);
+        r = pr;
+        now += 250000;
+    }
+    assert_int_equal(trk.stats.confirmations, 0);
+    assert_true(trk.stats.inconsistent >= 4U);
+}
+
 // Reversing: a static pole ahead-right (bearing 45 deg, 3.5 m) seen while the vehicle backs
 // away at 1 m/s confirms only when the tracker knows the direction (sl_track_set_reverse).
 static void test_track_prediction_follows_a_reversing_vehicle(void **state)
@@ -469,6 +517,7 @@ int main(void)
         cmocka_unit_test_setup(test_track_confirms_static_objects_not_scattered_clutter, setup),
         cmocka_unit_test_setup(test_track_prediction_follows_a_reversing_vehicle, setup),
         cmocka_unit_test_setup(test_track_restarts_on_the_first_profile_measurement, setup),
+        cmocka_unit_test_setup(test_track_checks_consistency_against_the_group_extent, setup),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
