@@ -225,9 +225,15 @@ static inline bool is_weak(uint8_t flags)
 }
 
 // Move src's azimuth entries into dst at offset (src first azimuth - dst first azimuth).
-static void entries_merge(sl_detect_cand_t *dst, const sl_detect_cand_t *src, uint32_t offset)
+// dst_span: dst's entries in use (0 .. dst_span - 1); those src reaches beyond them start
+// empty (entries beyond a group's span are never initialised: sl_detect_cand_t).
+static void entries_merge(sl_detect_cand_t *dst, const sl_detect_cand_t *src, uint32_t offset,
+                          uint32_t dst_span)
 {
     const uint32_t span = (uint32_t)src->az_last - src->az_first + 1U;
+    for (uint32_t k = dst_span; k < offset + span && k < SL_CFG_DETECT_MAX_SPAN; k++) {
+        dst->run[k].count = 0U;
+    }
     for (uint32_t i = 0; i < span && i < SL_CFG_DETECT_MAX_SPAN; i++) {
         const sl_detect_azrun_t *e = &src->run[i];
         if (e->count == 0U) {
@@ -261,8 +267,11 @@ static void open_clr(sl_detect_t *d, const sl_detect_cand_t *c)
     d->open_bits[i >> 5] &= ~((uint32_t)1U << (i & 31U));
 }
 
-// Merge src into dst; both are open and touch azimuth a - 1 or a.
-static void cand_merge(sl_detect_t *d, sl_detect_cand_t *dst, sl_detect_cand_t *src)
+// Merge src into dst; both are open and touch azimuth a - 1 or a. Not inlined: a rare path,
+// out of the run loop (inlined it cost that loop 14 instructions per azimuth on the clutter
+// capture).
+static SL_NOINLINE void cand_merge(sl_detect_t *d, sl_detect_cand_t *dst,
+                                   sl_detect_cand_t *src)
 {
     const uint32_t last = dst->az_last > src->az_last ? dst->az_last : src->az_last;
     uint16_t llo = EMPTY_LO, lhi = EMPTY_HI, plo = EMPTY_LO, phi = EMPTY_HI, lo, hi;
@@ -290,13 +299,8 @@ static void cand_merge(sl_detect_t *d, sl_detect_cand_t *dst, sl_detect_cand_t *
         }
         dst->az_first = src->az_first;
     }
-    // Entries past dst's last azimuth (src reaches one further) start empty (the entries
-    // beyond a group's span are never initialised: sl_detect_cand_t).
-    for (uint32_t i = (uint32_t)dst->az_last - dst->az_first + 1U;
-         i <= last - dst->az_first && i < SL_CFG_DETECT_MAX_SPAN; i++) {
-        dst->run[i].count = 0U;
-    }
-    entries_merge(dst, src, (uint32_t)src->az_first - dst->az_first);
+    entries_merge(dst, src, (uint32_t)src->az_first - dst->az_first,
+                  (uint32_t)dst->az_last - dst->az_first + 1U);
     dst->flags |= src->flags;
     dst->az_last = (uint16_t)last;
     dst->last_lo = llo;
@@ -1057,13 +1061,8 @@ sl_ssize_t sl_detect_end(sl_detect_t *d)
                           d->cfg.link_bins)) {
                 continue;
             }
-            // c ends on azimuth n - 1: the entries that take c0's start empty
-            const uint32_t span = n - c->az_first;
-            const uint32_t span0 = (uint32_t)c0->az_last - c0->az_first + 1U;
-            for (uint32_t k = span; k < span + span0 && k < SL_CFG_DETECT_MAX_SPAN; k++) {
-                c->run[k].count = 0U;
-            }
-            entries_merge(c, c0, span);
+            const uint32_t span = n - c->az_first; // c ends on azimuth n - 1
+            entries_merge(c, c0, span, span);
             const uint32_t last = n + c0->az_last;
             c->az_last = (uint16_t)(last > 0xFFFFU ? 0xFFFFU : last);
             c->flags |= (uint8_t)(c0->flags | CF_WRAPS);

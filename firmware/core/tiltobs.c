@@ -399,9 +399,9 @@ void sl_tiltobs_fit_pending(sl_tiltobs_t *o)
         // Observations recorded while the track was not confirmed (sl_tiltobs.h, 2.) are
         // trusted less: INCONSISTENT with them, they go and the fit is redone (within the
         // bound, as below). They do not count as outliers.
-        if (SL_CFG_TILT_FITS_PER_ROTATION >= 2 &&
-            r->res.quality == (uint8_t)SL_TILT_INCONSISTENT && unconfirmed_held(r) != 0U &&
-            unconfirmed_held(r) < r->count) {
+        const uint32_t unconf = r->res.quality == (uint8_t)SL_TILT_INCONSISTENT
+                                    ? unconfirmed_held(r) : 0U;
+        if (SL_CFG_TILT_FITS_PER_ROTATION >= 2 && unconf != 0U && unconf < r->count) {
             if (done >= (uint32_t)SL_CFG_TILT_FITS_PER_ROTATION) {
                 o->rr = (uint8_t)idx;
                 break;
