@@ -147,6 +147,15 @@ static int apply(sld_opts_t *o, const char *section, const char *key, const char
         const int l = sld_log_parse_level(val);
         if (l < 0) BAD("expected error, warning, info, debug or 0..3");
         o->verbosity = l;
+    } else if (IS("daemon", "tail_slope")) {
+        // sl_profile_cfg_t.prior_slope_q8: 0 (none) or 0.5 .. 24 values per bin
+        char *end = NULL;
+        errno = 0;
+        const double v = strtod(val, &end);
+        if (errno != 0 || end == val || *end != '\0' || !(v <= 0.0 ? v >= 0.0 : (v >= 0.5 && v <= 24.0))) {
+            BAD("expected 0 (none) or 0.5 .. 24 values per bin");
+        }
+        o->tail_slope_q8 = (uint16_t)lround(v * 256.0);
     } else if (IS("daemon", "stats_every")) {
         if (parse_seconds_ms(val, &o->stats_every_ms) != 0) BAD("expected seconds >= 0");
     } else if (IS("daemon", "status_period_ms")) {
@@ -352,6 +361,7 @@ static const cli_opt_t k_cli[] = {
     {"--stderr", "daemon", "syslog", 0, "false"},
     {"--verbosity", "daemon", "verbosity", 1, NULL},
     {"--stats-every", "daemon", "stats_every", 1, NULL},
+    {"--tail-slope", "daemon", "tail_slope", 1, NULL},
     {"--status-period-ms", "daemon", "status_period_ms", 1, NULL},
     {"--duration", "daemon", "duration", 1, NULL},
     {"--exit-idle", "daemon", "exit_idle", 1, NULL},
@@ -416,6 +426,9 @@ void sld_opts_usage(void *fpv)
         "  --syslog | --stderr      [daemon] syslog           log destination (default stderr)\n"
         "  -v | -q | --verbosity L  [daemon] verbosity        error, warning, info (default), debug\n"
         "  --stats-every S          [daemon] stats_every      log counters every S seconds (0 = at exit only)\n"
+        "  --tail-slope V           [daemon] tail_slope       the radar's smear tail, values per bin, as an earlier\n"
+        "                                                     run logged it (\"tail slope\" in the stats): used until\n"
+        "                                                     the stream's own fit replaces it (0 = none, default)\n"
         "  --status-period-ms N     [daemon] status_period_ms Status frame period without data (1000)\n"
         "  --duration S             [daemon] duration         stop after S seconds (0 = never)\n"
         "  --exit-idle S            [daemon] exit_idle        radar: stop after S s without FFT data (once data came)\n"
@@ -592,6 +605,9 @@ void sld_opts_print(const sld_opts_t *o, void *fpv)
             (double)o->stats_every_ms / 1000.0, (unsigned)o->status_period_ms);
     fprintf(fp, "duration = %.3f\nexit_idle = %.3f\n", (double)o->duration_ms / 1000.0,
             (double)o->exit_idle_ms / 1000.0);
+    if (o->tail_slope_q8 != 0U) {
+        fprintf(fp, "tail_slope = %.4f\n", (double)o->tail_slope_q8 / 256.0);
+    }
     fprintf(fp, "\n[input]\n");
     if (o->radar_host[0] != '\0') {
         const bool v6 = strchr(o->radar_host, ':') != NULL;

@@ -79,6 +79,9 @@ typedef struct sld_opts {
     uint32_t status_period_ms;         ///< --status-period-ms (1000)         [daemon] status_period_ms
     uint32_t duration_ms;              ///< --duration S (0 = run until stopped) [daemon] duration
     uint32_t exit_idle_ms;             ///< --exit-idle S (0 = never)          [daemon] exit_idle
+    uint16_t tail_slope_q8;            ///< --tail-slope V: the sensor's smear tail, values per
+                                       ///< bin x 256, saved from an earlier run (0 = none)
+                                       ///< [daemon] tail_slope
 } sld_opts_t;
 
 /// Defaults: verbosity info, port 6317, timeouts as listed, everything else empty/off.

@@ -760,6 +760,12 @@ static void log_stats(daemon_t *d, int level, const char *what)
                 ps->fallback[SL_PROFILE_TAIL_CUT],
             g_pipe.tilt.stats.observations, g_pipe.tilt.stats.unverified,
             g_pipe.tilt.stats.outliers);
+    if (g_pipe.prof.slope_q8 != 0U) { // what --tail-slope takes on the next start
+        sld_log(SLD_LOG_INFO, "%s: tail slope %.4f values/bin (%s; %" PRIu32 " fits taken, %" PRIu32
+                " refused)", what, g_pipe.prof.slope_q8 / 256.0,
+                g_pipe.prof.cal_n != 0U ? "self-fitted" : "--tail-slope, no fit yet",
+                g_pipe.prof.stats.cal_accepted, g_pipe.prof.stats.cal_rejected);
+    }
     const sl_drift_t *dw = &g_pipe.drift;
     sld_log(SLD_LOG_INFO, "%s: theta drift watch: %s %+.2f deg%s; samples %" PRIu32 ", no ground %" PRIu32
             ", occupied %" PRIu32 ", outliers %" PRIu32, what, dw->valid ? "estimate" : "no estimate",
@@ -1005,6 +1011,7 @@ int main(int argc, char **argv)
     d->pcfg.port.can_tx = port_can_tx;
     d->pcfg.port.on_rotation = port_on_rotation;
     d->pcfg.port.ctx = d;
+    d->pcfg.profile_cfg.prior_slope_q8 = d->o.tail_slope_q8; // --tail-slope (0: none)
     if (sl_pipeline_init(&g_pipe, d->board, &d->pcfg) != SL_OK) {
         sld_log(SLD_LOG_ERR, "pipeline for board %s: %s", d->board->name,
                 g_pipe.last_err_msg != NULL ? g_pipe.last_err_msg : "init failed");

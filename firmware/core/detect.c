@@ -192,8 +192,8 @@ static void entry_add(sl_detect_azrun_t *e, uint16_t f, uint16_t l, uint16_t cou
         e->first = f < e->first ? f : e->first;
         e->last = l > e->last ? l : e->last;
     }
-    const uint32_t c = (uint32_t)e->count + count;
-    e->count = (uint16_t)(c > 0xFFFFU ? 0xFFFFU : c);
+    const uint32_t n = (uint32_t)e->count + count;
+    e->count = (uint16_t)(n > 0xFFFFU ? 0xFFFFU : n);
 }
 
 // Extent of c on azimuth x (x in {az_last - 1, az_last}), or empty.
@@ -240,6 +240,9 @@ static void entries_merge(sl_detect_cand_t *dst, const sl_detect_cand_t *src, ui
             continue;
         }
         if (offset + i < SL_CFG_DETECT_MAX_SPAN) {
+            // the peaks (read only while d->peaks, when every entry of the rotation has one)
+            const uint8_t pk = src->peak[i], pd = dst->peak[offset + i];
+            dst->peak[offset + i] = dst->run[offset + i].count == 0U || pk > pd ? pk : pd;
             entry_add(&dst->run[offset + i], e->first, e->last, e->count);
         } else {
             dst->flags |= CF_SPAN;
@@ -289,6 +292,7 @@ static SL_NOINLINE void cand_merge(sl_detect_t *d, sl_detect_cand_t *dst,
         for (uint32_t i = SL_CFG_DETECT_MAX_SPAN; i-- > 0U;) {
             if (i >= sh) {
                 dst->run[i] = dst->run[i - sh];
+                dst->peak[i] = dst->peak[i - sh];
             } else {
                 dst->run[i].count = 0U;
             }
@@ -350,8 +354,8 @@ static void cand_attach(sl_detect_cand_t *c, uint32_t a, uint16_t f, uint16_t l,
 // runs (sl_detect.h stage 2: weak clutter can neither widen, break nor bridge a pole's
 // group). The first such group in slot order takes the run and absorbs the others; none:
 // a new group.
-static void add_run(sl_detect_t *d, sl_detect_links_t *t, uint32_t a, uint32_t f, uint32_t l,
-                    uint32_t count, uint8_t rflags)
+static sl_detect_cand_t *add_run(sl_detect_t *d, sl_detect_links_t *t, uint32_t a, uint32_t f,
+                                 uint32_t l, uint32_t count, uint8_t rflags)
 {
     d->stats.runs++;
     sl_detect_cand_t *dst = NULL;
@@ -392,7 +396,7 @@ static void add_run(sl_detect_t *d, sl_detect_links_t *t, uint32_t a, uint32_t f
         }
         if (dst == NULL) {
             d->stats.cand_overflow++;
-            return;
+            return NULL;
         }
         // Only the header and the first entry: entries join as the group grows.
         dst->state = ST_OPEN;
@@ -409,6 +413,7 @@ static void add_run(sl_detect_t *d, sl_detect_links_t *t, uint32_t a, uint32_t f
     }
     cand_attach(dst, a, (uint16_t)f, (uint16_t)l, (uint16_t)(count > 0xFFFFU ? 0xFFFFU : count),
                 rflags);
+    return dst;
 }
 
 // Width test: most azimuths a pole of diameter D at range r1 can cover.
@@ -533,6 +538,20 @@ static inline bool is_hinted(const sl_detect_t *d, uint32_t a)
     return ((d->hint_bits[a >> 5] >> (a & 31U)) & 1U) != 0U;
 }
 
+// Last bin of an entry's own return (sl_detect.h stage 4): its last bin less the smear tail
+// its peak leaves, floor((peak - T) / slope) bins with the stream's self-calibrated slope,
+// at least its first bin; without a measured peak or a slope, its last bin.
+static uint32_t own_last(const sl_detect_t *d, const sl_detect_cand_t *c, uint32_t i)
+{
+    const sl_detect_azrun_t *r = &c->run[i];
+    const uint32_t t = d->amp_threshold, peak = c->peak[i];
+    if (!d->peaks || peak <= t) {
+        return r->last;
+    }
+    const uint32_t tail = (peak - t) * 256U / d->tail_slope_q8;
+    return (uint32_t)r->last >= (uint32_t)r->first + tail ? (uint32_t)r->last - tail : r->first;
+}
+
 // WIDE exception for a pole leaning across the line of sight (sl_detect.h stage 4, "Leaning
 // across the line of sight"): true when the group of `span` azimuths (wider than a vertical
 // pole at its representative run `rep`) is one line, thin and no wider than a lean of
@@ -554,8 +573,8 @@ static SL_NOINLINE bool slender_lean(const sl_detect_t *d, const sl_detect_cand_
     const sl_detect_azrun_t *r0 = &c->run[0];
     const sl_detect_azrun_t *rn = &c->run[span - 1U];
     const bool down = rn->first < r0->first;
-    uint32_t uf = rep->first, ul = rep->last, occ = 0U;
-    const sl_detect_azrun_t *prev = NULL;
+    uint32_t uf = rep->first, ul = rep->last, occ = 0U, pf = 0U, pl = 0U, own_max = 0U;
+    bool first_run = true;
     for (uint32_t i = 0; i < span; i++) {
         const sl_detect_azrun_t *r = &c->run[i];
         if (r->count == 0U) {
@@ -564,17 +583,21 @@ static SL_NOINLINE bool slender_lean(const sl_detect_t *d, const sl_detect_cand_
         if ((uint32_t)r->count != (uint32_t)r->last - r->first + 1U) {
             return false;
         }
-        if (prev != NULL && (down ? (r->first > prev->first + 1U || r->last > prev->last + 1U)
-                                  : (r->first + 1U < prev->first || r->last + 1U < prev->last))) {
+        const uint32_t own = own_last(d, c, i);
+        if (!first_run && (down ? (r->first > pf + 1U || own > pl + 1U)
+                                : (r->first + 1U < pf || own + 1U < pl))) {
             return false;
         }
-        prev = r;
+        first_run = false;
+        pf = r->first;
+        pl = own;
         uf = r->first < uf ? r->first : uf;
         ul = r->last > ul ? r->last : ul;
-        occ += r->count;
+        own_max = own > own_max ? own : own_max;
+        occ += own - r->first + 1U;
     }
     const uint32_t allowed = allowed_span(d, uf * bd->bin_size_um + bd->bin_size_um / 2U);
-    if (occ > (ul - uf + 1U) * allowed) {
+    if (occ > (own_max - uf + 1U) * allowed) {
         return false; // fills the span like a wall, not like one line crossing it
     }
     const uint64_t b = bd->bin_size_um;
@@ -596,7 +619,7 @@ static SL_NOINLINE bool slender_lean(const sl_detect_t *d, const sl_detect_cand_
     // point, which a beam width sees on 2-3 of them), the middle one.
     uint32_t lo = span, hi = 0U;
     for (uint32_t i = 0; i < span; i++) {
-        if (c->run[i].count != 0U && c->run[i].last == ul) {
+        if (c->run[i].count != 0U && own_last(d, c, i) == own_max) {
             lo = i < lo ? i : lo;
             hi = i;
         }
@@ -809,6 +832,28 @@ static uint8_t run_strength(const sl_detect_t *d, uint32_t s, uint32_t e)
     return (uint8_t)(CF_AMP | (strong ? CF_STRONG : 0U));
 }
 
+// While d->peaks (sl_detect_begin: moving with a known tail slope): the highest amplitude
+// value of run [s, e) of `count` occupied bins into its entry of group g on azimuth a (the
+// entry's own when the run is all it holds: its count is the run's; else the larger).
+// 0 without an amplitude row. Not inlined: off sl_detect_row's loop when not moving.
+static SL_NOINLINE void note_peak(const sl_detect_t *d, sl_detect_cand_t *g, uint32_t a,
+                                  uint32_t s, uint32_t e, uint32_t count)
+{
+    const uint32_t idx = a - g->az_first;
+    if (idx >= SL_CFG_DETECT_MAX_SPAN) {
+        return;
+    }
+    const uint8_t *p = d->amp;
+    const uint32_t n = p == NULL ? s : (e < d->amp_bins ? e : d->amp_bins);
+    uint32_t peak = 0U;
+    for (uint32_t k = s; k < n; k++) {
+        peak = p[k] > peak ? p[k] : peak;
+    }
+    g->peak[idx] = (uint32_t)g->run[idx].count == count || peak > g->peak[idx]
+                       ? (uint8_t)peak
+                       : g->peak[idx];
+}
+
 void sl_detect_set_tail_slope(sl_detect_t *d, uint16_t slope_q8)
 {
     SL_ASSERT(d != NULL);
@@ -961,6 +1006,7 @@ void sl_detect_begin(sl_detect_t *d)
     d->n_targets = 0U;
     d->n_open = 0U;
     d->last_az = -1;
+    d->peaks = d->slant && d->tail_slope_q8 != 0U; // fixed for the rotation (stage 4)
 }
 
 // Stages 1 and 2 of row az after open_walk: the runs in [near, win) (gaps bridged, the
@@ -1003,7 +1049,10 @@ static SL_NOINLINE void row_runs(sl_detect_t *d, uint32_t az, const uint32_t *oc
         if ((rf & CF_SHADOW) == 0U) { // a SHADOW group is rejected anyway
             rf |= run_strength(d, s, e);
         }
-        add_run(d, &d->links, az, s, e - 1U, count, rf);
+        sl_detect_cand_t *g = add_run(d, &d->links, az, s, e - 1U, count, rf);
+        if (d->peaks && g != NULL && (rf & CF_SHADOW) == 0U) {
+            note_peak(d, g, az, s, e, count); // (a SHADOW group's entries are never read)
+        }
         pos = e;
     }
 }

@@ -690,7 +690,8 @@ static void on_rot(void *ctx, const sl_scan_rot_t *rot)
     // Once the stream shows a smear tail (self-fitted on profiles), a target the profile
     // could not check (no slot, too few rows) carries the tail in its bounds: not a 3D-tilt
     // observation.
-    p->tilt.verified_only = p->cfg.profile && p->prof.cal_n >= SL_PROFILE_CAL_SMEAR_N;
+    p->tilt.verified_only = p->cfg.profile && (p->prof.cal_n >= SL_PROFILE_CAL_SMEAR_N ||
+                                               p->cfg.profile_cfg.prior_slope_q8 != 0U);
     sl_tiltobs_update(&p->tilt, p->tracker.tracks, p->detect.targets, n_targets);
     // Drift watch (sl_drift.h): one azimuth per rotation, read from the mask's stable row at
     // the rotation's end, joined with its raw tail when the mask's end is settled (stable-free
@@ -744,9 +745,12 @@ static void use_bin_size(sl_pipeline_t *p, uint32_t um)
         p->det_board.shadow_bins = keep_shadow;
         (void)sl_detect_init(&p->detect, &p->det_board, &p->cfg.detect);
         p->stats.bin_size_unserved++;
-        return;
+    } else {
+        p->stats.bin_size_changes++;
     }
-    p->stats.bin_size_changes++;
+    if (p->cfg.profile) {
+        sl_detect_set_tail_slope(&p->detect, p->prof.slope_q8); // re-init cleared it
+    }
 }
 
 // A Configuration message (its parsed form stays out of on_msg's frame, which the FFT
@@ -873,6 +877,9 @@ sl_err_t sl_pipeline_init(sl_pipeline_t *p, const sl_board_t *board,
     if (e == SL_OK && c->profile) {
         e = sl_profile_init(&p->prof, board->azimuths, board->near_exclusion_bins,
                             &c->profile_cfg);
+    }
+    if (e == SL_OK && c->profile) {
+        sl_detect_set_tail_slope(&p->detect, p->prof.slope_q8); // a saved prior, or 0
     }
     if (e == SL_OK) {
         e = sl_track_init(&p->tracker, board, &c->track);

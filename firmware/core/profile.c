@@ -24,6 +24,7 @@ void sl_profile_cfg_default(sl_profile_cfg_t *cfg)
     cfg->lead_bins = 6U;
     cfg->max_idle = 4U;
     cfg->min_frames = 2U;
+    cfg->prior_slope_q8 = 0U;
 }
 
 sl_err_t sl_profile_init(sl_profile_t *pr, uint16_t azimuths, uint16_t near_bins,
@@ -38,7 +39,9 @@ sl_err_t sl_profile_init(sl_profile_t *pr, uint16_t azimuths, uint16_t near_bins
     } else {
         sl_profile_cfg_default(&c);
     }
-    if (c.max_frames < 2U || c.max_frames > 257U) {
+    if (c.max_frames < 2U || c.max_frames > 257U ||
+        (c.prior_slope_q8 != 0U &&
+         (c.prior_slope_q8 < SLOPE_MIN_Q8 || c.prior_slope_q8 > SLOPE_MAX_Q8))) {
         return SL_ERR_ARG;
     }
     memset(pr, 0, sizeof *pr);
@@ -46,6 +49,7 @@ sl_err_t sl_profile_init(sl_profile_t *pr, uint16_t azimuths, uint16_t near_bins
     pr->azimuths = azimuths;
     pr->near_bins = near_bins;
     memset(pr->slot_of, SL_PROFILE_NONE, sizeof pr->slot_of);
+    pr->slope_q8 = c.prior_slope_q8; // cal_n 0: the first self-fit replaces it
     return SL_OK;
 }
 

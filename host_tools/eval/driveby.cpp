@@ -38,6 +38,7 @@ struct Outcome {
     bool fitted = false, ambiguous = false;
     double psi = 0, phi = 0, base_y = 0;
     int quality = -1, n_obs = 0, rotation = -1;
+    uint16_t slope_q8 = 0, cal_n = 0; // the profile's tail calibration at the end of the pass
 };
 
 // One pass's material for the plot: the fitted ring's observations and fit at the end of the
@@ -327,6 +328,10 @@ std::string scene_text(const std::string &board, const Case &k, bool realistic, 
 
 // --no-profile: the pipeline's mask bounds with the board's d(r) (no range profiles).
 bool g_no_profile = false;
+// The tail slope every --realistic pass starts from (sl_profile_cfg_t.prior_slope_q8): what
+// the calibration pass self-fitted, as a vehicle that has driven before has it saved; 0 with
+// --cold.
+uint16_t g_prior_slope_q8 = 0;
 
 Outcome run_case(const std::string &board_name, const Case &k, bool realistic, int seed,
                  PlotData *plot = nullptr, bool dump = false, FILE *obs_log = nullptr)
@@ -357,6 +362,7 @@ Outcome run_case(const std::string &board_name, const Case &k, bool realistic, i
     // Range profiles read the sensor's log values; the noise-free passes are the paper's
     // linear rendering (no smear): the mask's bounds (sim_eval.h, pipe_cfg_for_scene).
     cfg.profile = realistic && !g_no_profile;
+    cfg.profile_cfg.prior_slope_q8 = g_prior_slope_q8;
     if (sl_pipeline_init(p.get(), b, &cfg) != SL_OK) {
         throw std::runtime_error("sl_pipeline_init failed for board " + board_name);
     }
@@ -407,9 +413,14 @@ Outcome run_case(const std::string &board_name, const Case &k, bool realistic, i
         dump_ring(ctx.other_ring, p->tilt.prm, k); // e.g. INCONSISTENT: what the fit read
     }
     if (ctx.last.quality >= 0) {
-        return ctx.last;
+        Outcome o = ctx.last;
+        o.slope_q8 = p->prof.slope_q8;
+        o.cal_n = p->prof.cal_n;
+        return o;
     }
     Outcome o;
+    o.slope_q8 = p->prof.slope_q8;
+    o.cal_n = p->prof.cal_n;
     o.quality = ctx.other_q; // no FITTED / AMBIGUOUS result: why not
     o.n_obs = ctx.other_n;
     o.base_y = k.offset;     // not measured: no offset error counted
@@ -524,7 +535,7 @@ bool plot_pass(const std::string &png, const PlotData &d, const Case &k, std::st
 void usage(FILE *out)
 {
     std::fprintf(out,
-                 "usage: sl-eval driveby [--board NAME] [--quick] [--realistic] [--no-profile] [--speeds A,B,..]\n"
+                 "usage: sl-eval driveby [--board NAME] [--quick] [--realistic] [--no-profile] [--cold] [--speeds A,B,..]\n"
                  "                       [--check] [--plot FILE.png] [--psi DEG] [--phi DEG]\n"
                  "                       [--offset M] [--dump] [--obs-log FILE]\n"
                  "  Simulated drive-bys, one pole per pass, through the core pipeline with the pass's\n"
@@ -536,6 +547,10 @@ void usage(FILE *out)
                  "  the paper's noise-free linear rendering).\n"
                  "  --no-profile: the pipeline's mask bounds with the board's d(r) instead of the\n"
                  "  range profiles (while moving: one rotation's rows of neighbouring azimuths).\n"
+                 "  With --realistic, a calibration pass (an upright pole, its own seed) runs first\n"
+                 "  and the tail slope its stream self-fitted is every pass's starting value, as a\n"
+                 "  vehicle that has driven before has it saved (shadowleand --tail-slope);\n"
+                 "  --cold: every pass starts with nothing calibrated.\n"
                  "  --check: exit 1 unless every pole with psi >= 5 is FITTED within the issue's\n"
                  "  bounds (1 deg / 10 deg noise-free; 2 deg / 20 deg with --realistic).\n"
                  "  --plot FILE.png: instead of the sweep, one pass (1 m/s, a pole 3 m left of the\n"
@@ -555,7 +570,7 @@ void usage(FILE *out)
 int cmd_driveby(int argc, char **argv)
 {
     std::string board = "paper-sim";
-    bool quick = false, realistic = false, check = false;
+    bool quick = false, realistic = false, check = false, cold = false;
     std::string plot;
     std::vector<double> speeds = {1.0, 2.0, 3.0};
     std::vector<double> only_psi, only_phi, only_off;
@@ -576,6 +591,8 @@ int cmd_driveby(int argc, char **argv)
             realistic = true;
         } else if (a == "--no-profile") {
             g_no_profile = true;
+        } else if (a == "--cold") {
+            cold = true;
         } else if (a == "--check") {
             check = true;
         } else if (a == "--plot" && i + 1 < argc) {
@@ -603,6 +620,20 @@ int cmd_driveby(int argc, char **argv)
             }
         } else {
             return sl_cli_unknown("sl-eval", argv[i], usage);
+        }
+    }
+    if (realistic && !g_no_profile && !cold) {
+        // Calibration pass: an upright pole 2.5 m right of the path at 1 m/s, with a seed
+        // no pass of the sweep uses; what its stream self-fitted is every pass's prior.
+        const Case cal{1.0, 0.0, 0.0, -2.5};
+        const Outcome c = run_case(board, cal, realistic, 100000);
+        g_prior_slope_q8 = c.cal_n != 0U ? c.slope_q8 : 0U;
+        std::printf("tail slope prior: %.2f values/bin, self-fitted %u times on a calibration pass "
+                    "(an upright pole 2.5 m right of the path, its own seed; --cold: none)\n",
+                    g_prior_slope_q8 / 256.0, static_cast<unsigned>(c.cal_n));
+        if (g_prior_slope_q8 == 0U) {
+            std::fprintf(stderr, "sl-eval: driveby: the calibration pass fitted no tail slope\n");
+            return 1;
         }
     }
     if (!plot.empty()) {

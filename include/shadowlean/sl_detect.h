@@ -102,13 +102,26 @@
 ///    pole can be (a 20 deg lean at 3 m: 13-14 azimuths for an allowance of 9-10). Such a
 ///    group is not WIDE when all of these hold, U = [uf, ul] being its union extent (min
 ///    first / max last bin over its azimuths) and `allowed` the vertical pole's span above:
+///    - own extents: on a smearing sensor every azimuth's run is its piece of the pole plus
+///      a smear tail as long as its level allows, so in bits a slanted pole fills its range
+///      extent like a wall and the tails' ends (shorter on the beam's weaker edge azimuths)
+///      step against the line. Once the stream's tail slope is known
+///      (sl_detect_set_tail_slope, self-calibrated by the range profiles or a saved prior;
+///      both fixed for a rotation at sl_detect_begin) and amplitude rows come with the runs,
+///      each azimuth's entry keeps the highest value of its runs (sl_detect_cand_t.peak)
+///      and its own extent ends
+///      floor((peak - T) / slope) bins before its last bin (at least its first bin): the
+///      longest tail its peak can leave, so the own extent is never longer than the truth.
+///      The tests below use own extents (own last bins; u_own = the largest); without a
+///      slope or a peak an entry's own extent is its run;
 ///    - one line: every run whole (no bridged gap), and the runs step through range one way
-///      (from the first azimuth's run towards the last's), no first or last bin more than
-///      one bin against that direction (weak clutter along the shadow edge is broken and
-///      wanders; a pole merged with it is lost too);
-///    - thin: its occupied bins over all its azimuths are at most (ul - uf + 1) x allowed,
+///      (from the first azimuth's run towards the last's), no first or own last bin more
+///      than one bin against that direction (weak clutter along the shadow edge is broken
+///      and wanders; a pole merged with it is lost too);
+///    - thin: its own bins over all its azimuths are at most (u_own - uf + 1) x allowed,
 ///      what a vertical pole of the same range extent leaves (a wall, a car side or a hedge
-///      fills most of the span on every azimuth and fails);
+///      fills most of the span on every azimuth and fails, smeared or not: its own runs
+///      stay the whole wall's height);
 ///    - no wider than a lean of at most `cfg.max_lean_tan_q16` can make it: span <=
 ///      allowed + ceil(w / step), w = (r(ul) sin(theta) + r(uf) max(sin(beta), 0)) x
 ///      max_lean_tan / r(uf) [rad], the visible height of the pole (its lowest point on the
@@ -117,8 +130,9 @@
 ///    The target's bounds are then the union extent (bin_first = uf, bin_last = ul: the
 ///    nearest and farthest point of the pole, the ranges its in-plane inclination is
 ///    estimated from; no radius from width, ext_grow 0), its representative azimuth the
-///    middle of the ones whose run ends on ul (the pole's lowest visible point, the end a
-///    smear tail lengthens), `occupied` that run's bins, and it carries SL_TARGET_SLANT. One
+///    middle of the ones whose own extent ends on u_own (the pole's lowest visible point,
+///    the end a smear tail lengthens), `occupied` that run's bins, and it carries
+///    SL_TARGET_SLANT. One
 ///    rotation measures the lean towards the radar only approximately (the ends of the pole
 ///    lie off the half-plane of its bearing; second order in the sideways lean), which the
 ///    3D tilt fit's stated sigmas cover (`sl-eval driveby`). On a smearing sensor the range
@@ -172,11 +186,12 @@
 /// ## Ownership, memory, cost
 /// Caller-owned `sl_detect_t`, no allocation; it borrows `board` (static const) until
 /// re-init. RAM: sizeof(sl_detect_t) = 4 x SL_CFG_MAX_AZIMUTHS (window tables) +
-/// SL_CFG_DETECT_MAX_CANDIDATES x (14 + 6 x SL_CFG_DETECT_MAX_SPAN) + SL_CFG_MAX_TARGETS x
+/// SL_CFG_DETECT_MAX_CANDIDATES x (14 + 7 x SL_CFG_DETECT_MAX_SPAN) + SL_CFG_MAX_TARGETS x
 /// sizeof(sl_target_t) (52) + 50 bytes of azimuth hints + 5 x SL_CFG_DETECT_MAX_CANDIDATES + 1
-/// (the row's link table) + ~68 bytes (defaults: 8,672 bytes on x86-64).
+/// (the row's link table) + ~68 bytes (defaults: 9,448 bytes on x86-64).
 /// Cost: sl_detect_row O(words up to the shadow edge + runs x open groups), two compares per
-/// run and open group (the link table); an azimuth with nothing occupied in its window
+/// run and open group (the link table), plus a scan of each run's bins for its peak while
+/// `peaks` (moving with a known tail slope, stage 4); an azimuth with nothing occupied in its window
 /// exits after one OR per window word (and a walk of the open groups when there are any). Per target at
 /// sl_detect_end: one sl_incline_estimate + one isqrt. Measured instruction counts:
 /// docs/PERFORMANCE.md, "Core modules".
@@ -337,6 +352,9 @@ typedef struct sl_detect_cand {
     uint8_t flags;      ///< internal NEAR / SHADOW / SPAN / WRAPS bits
     sl_detect_azrun_t run[SL_CFG_DETECT_MAX_SPAN]; ///< azimuths az_first .. az_last (the
                         ///< entries beyond the span hold stale data: never read)
+    uint8_t peak[SL_CFG_DETECT_MAX_SPAN]; ///< per entry of run[]: the highest amplitude
+                        ///< value of its runs (0: no amplitude row), measured and read only
+                        ///< while sl_detect_t.peaks (stage 4's own extents); stale otherwise
 } sl_detect_cand_t;
 
 /// The groups the current row's runs may join, with their extents on the azimuth before
@@ -379,6 +397,8 @@ typedef struct sl_detect {
     bool slant;             ///< keep slender groups wider than a pole as SLANT targets
                             ///< (stage 4): set by the application before a rotation's rows
                             ///< (the pipeline: while a motion input is present)
+    bool peaks;             ///< this rotation measures the runs' peaks (stage 4, own
+                            ///< extents): slant and a tail slope at sl_detect_begin
     sl_detect_stats_t stats;
 } sl_detect_t;
 

@@ -95,7 +95,10 @@
 /// ## Online calibration (D3)
 /// `slope_q8`: exponential mean (weight 1/8) of the self-fitted slopes of accepted
 /// extractions, each gated to +-30 % of the current value once 4 fits are in
-/// (`stats.cal_rejected` counts the others). It is the fallback for short tails only.
+/// (`stats.cal_rejected` counts the others). It is the fallback for short tails only, and
+/// detection's tail bound (sl_detect_set_tail_slope: the shadow edge, the own extent of a
+/// pole leaning across the beam). It starts at `cfg.prior_slope_q8` when the application
+/// saved one (a fresh start otherwise waits for the first upright target's self-fit).
 /// Not done: residual r1/r2 offsets from upright poles (EXTRACTION.md D3): see the report.
 ///
 /// ## Ownership, memory, cost
@@ -152,7 +155,8 @@ typedef enum sl_profile_fail {
 } sl_profile_fail_t;
 
 /// Accepted self-fitted tail slopes (`cal_n`) from which the stream counts as smearing: its
-/// mask bounds then carry a tail (sl_tiltobs_t.verified_only).
+/// mask bounds then carry a tail (sl_tiltobs_t.verified_only; from the start with a
+/// cfg.prior_slope_q8).
 #define SL_PROFILE_CAL_SMEAR_N 4U
 
 /// Where the slope of an extraction came from.
@@ -168,6 +172,15 @@ typedef struct sl_profile_cfg {
                          ///< (default 2: one row carries one rotation's speckle in full and
                          ///< is no better than the mask; while moving the sums are reset
                          ///< every rotation and the rows of neighbouring azimuths count)
+    uint16_t prior_slope_q8; ///< tail slope to start from, 1/256 value per bin (default 0:
+                             ///< none): this sensor's calibrated slope_q8 saved from an
+                             ///< earlier run by the application. Used until the first
+                             ///< self-fit replaces it (cal_n stays 0 until then: no gate
+                             ///< against it). A prior says the sensor smears: the pipeline
+                             ///< keeps only profile-checked bounds in the tilt history from
+                             ///< the start (sl_tiltobs_t.verified_only), as after
+                             ///< SL_PROFILE_CAL_SMEAR_N fits. 0 or 128..6144 (0.5..24 values
+                             ///< per bin).
 } sl_profile_cfg_t;
 
 void sl_profile_cfg_default(sl_profile_cfg_t *cfg);
@@ -230,7 +243,8 @@ typedef struct sl_profile {
 } sl_profile_t;
 
 /// Initialise (no slot in use). `cfg` NULL = defaults. @return SL_ERR_ARG for NULL `pr`,
-/// azimuths 0 or > SL_CFG_MAX_AZIMUTHS, max_frames outside 2..257.
+/// azimuths 0 or > SL_CFG_MAX_AZIMUTHS, max_frames outside 2..257, a prior_slope_q8 other
+/// than 0 outside 128..6144.
 sl_err_t sl_profile_init(sl_profile_t *pr, uint16_t azimuths, uint16_t near_bins,
                          const sl_profile_cfg_t *cfg);
 

@@ -635,6 +635,67 @@ static void test_detect_a_weak_line_is_never_slant(void **state)
     assert_true((det.targets[0].flags & SL_TARGET_SLANT) != 0U);
 }
 
+// The same pole on a smearing sensor (sl-eval driveby --realistic): every azimuth's piece
+// (level L) is followed by a tail falling 3 values per bin to the threshold 40, (L - 40) / 3
+// bins, and the beam's edge azimuths are weaker, so shorter. In bits the runs are ~20 bins
+// over nearly the same ranges, the group fills its extent like a wall and the tails' ends
+// step against the line: WIDE. With the stream's tail slope known (3 values per bin), each
+// entry's own extent is its last bin less the tail its peak leaves: one line, thin, SLANT,
+// its representative the pole's lowest point. A smeared car side stays WIDE: its own runs
+// fill its extent whatever the slope.
+static void smear_piece(int a, uint32_t first, uint32_t own_last, int level)
+{
+    const uint32_t tail = (uint32_t)(level - 40) / 3U;
+    set_run(a, first, own_last + tail);
+    for (uint32_t k = first; k <= own_last; k++) {
+        amp[a][k] = (uint8_t)level;
+    }
+    for (uint32_t j = 1; j <= tail; j++) {
+        amp[a][own_last + j] = (uint8_t)(level - 3 * (int)j);
+    }
+}
+
+static void test_detect_a_smeared_pole_leaning_across_the_beam_with_the_tail_slope(void **state)
+{
+    (void)state;
+    static const uint16_t run[13][2] = {{87, 89}, {85, 89}, {83, 89}, {81, 87}, {80, 85},
+                                        {78, 82}, {77, 81}, {76, 79}, {75, 77}, {74, 76},
+                                        {74, 75}, {74, 74}, {73, 74}};
+    static const int level[13] = {79, 91, 100, 100, 100, 100, 100, 100, 100, 100, 100, 91, 79};
+    sl_detect_cfg_t cfg;
+    sl_detect_cfg_default(&cfg);
+    memset(rows, 0, sizeof rows);
+    memset(amp, 0, sizeof amp);
+    for (int i = 0; i < 13; i++) {
+        smear_piece(100 + i, run[i][0], run[i][1], level[i]);
+    }
+    for (int a = 20; a < 40; a++) { // a car side at 3 m, smeared the same way
+        smear_piece(a, 68, 75, 100);
+    }
+    assert_int_equal(sl_detect_init(&det, &board, &cfg), SL_OK);
+    det.union_ext = det.slant = true;
+    assert_int_equal(amp_rotation(), 0); // no slope yet: both WIDE
+    assert_int_equal(det.stats.rejected[SL_DETECT_REJ_WIDE], 2);
+    sl_detect_set_tail_slope(&det, 3U * 256U);
+    assert_int_equal(amp_rotation(), 1);
+    assert_int_equal(det.stats.rejected[SL_DETECT_REJ_WIDE], 3);
+    const sl_target_t *t = &det.targets[0];
+    assert_true((t->flags & SL_TARGET_SLANT) != 0U);
+    assert_int_equal(t->az_first, 100);
+    assert_int_equal(t->az_count, 13);
+    assert_int_equal(t->az, 101); // own extents ending on 89: azimuths 100-102
+    assert_int_equal(t->bin_first, 73);
+    assert_int_equal(t->bin_last, 89 + 20); // the union's far end, tail included (the
+                                            // range profile or d(r) corrects it)
+    // A slope twice too steep leaves half of every tail in the own extents: WIDE again.
+    sl_detect_set_tail_slope(&det, 6U * 256U);
+    assert_int_equal(amp_rotation(), 0);
+    // Not while parked, whatever the slope.
+    sl_detect_set_tail_slope(&det, 3U * 256U);
+    det.slant = false;
+    assert_int_equal(amp_rotation(), 0);
+}
+
 // Stage 1 at the shadow edge with amplitude rows (d(S) a prior, not the truth): a pole
 // inside the shadow whose smear tail crosses the edge is kept and flagged TAIL_EDGE; ground
 // beyond the edge joined to it (flat, not decaying), a brighter return beyond the edge (a
@@ -1033,6 +1094,8 @@ int main(void)
         cmocka_unit_test_setup(test_detect_rejects_returns_never_clearly_above_the_floor, setup),
         cmocka_unit_test_setup(test_detect_weak_clutter_never_joins_a_pole, setup),
         cmocka_unit_test_setup(test_detect_a_weak_line_is_never_slant, setup),
+        cmocka_unit_test_setup(test_detect_a_smeared_pole_leaning_across_the_beam_with_the_tail_slope,
+                               setup),
         cmocka_unit_test_setup(test_detect_shadow_edge_tail_is_not_the_ground, setup),
         cmocka_unit_test_setup(test_detect_slots_go_to_the_strongest_not_the_lowest_azimuths, setup),
         cmocka_unit_test_setup(test_detect_correct_half_bin_elongation_and_radius, setup),

@@ -444,6 +444,54 @@ static void test_profile_refines_a_target_after_min_frames(void **state)
     assert_int_equal(pr.stats.fallback[SL_PROFILE_FEW_FRAMES], 1);
 }
 
+// A tail slope saved from an earlier run (cfg.prior_slope_q8) is the calibration until the
+// stream's first self-fit, which replaces it outright (no +-30 % gate against a prior that
+// may be another sensor's): afterwards the same slope as a fresh start's. Implausible
+// priors are refused at init.
+static sl_profile_t pr_fresh;
+static void test_profile_starts_from_a_saved_tail_slope(void **state)
+{
+    (void)state;
+    sl_profile_cfg_t c;
+    sl_profile_cfg_default(&c);
+    assert_int_equal(c.prior_slope_q8, 0);
+    c.prior_slope_q8 = 127U; // below 0.5 value per bin
+    assert_int_equal(sl_profile_init(&pr, 400, 0, &c), SL_ERR_ARG);
+    c.prior_slope_q8 = 6145U; // above 24
+    assert_int_equal(sl_profile_init(&pr, 400, 0, &c), SL_ERR_ARG);
+    c.prior_slope_q8 = 6000U; // a steep prior, far from what the stream shows
+    assert_int_equal(sl_profile_init(&pr, 400, 0, &c), SL_OK);
+    assert_int_equal(pr.slope_q8, 6000);
+    assert_int_equal(pr.cal_n, 0);
+    assert_int_equal(sl_profile_init(&pr_fresh, 400, 0, NULL), SL_OK);
+    assert_int_equal(pr_fresh.slope_q8, 0);
+    const sl_board_t board = bins_board();
+    uint16_t syn[NB];
+    flat_pole_row(syn, 10, 15);
+    uint8_t row[NB];
+    uint32_t bits[2] = {0U, 0U};
+    for (int k = 0; k < NB; k++) {
+        row[k] = (uint8_t)syn[k];
+        if (row[k] >= 40) {
+            bits[k >> 5] |= 1U << (k & 31);
+        }
+    }
+    for (int i = 0; i < 2; i++) {
+        sl_profile_row(&pr, 7, row, NB, bits, NB);
+        sl_profile_row(&pr_fresh, 7, row, NB, bits, NB);
+    }
+    sl_target_t t = mask_target(7, 0, 0, 10, 26);
+    sl_target_t t2 = t;
+    assert_int_equal(sl_profile_refine(&pr, &board, 40, &t), SL_PROFILE_OK);
+    assert_int_equal(sl_profile_refine(&pr_fresh, &board, 40, &t2), SL_PROFILE_OK);
+    assert_int_equal(pr_fresh.cal_n, 1);
+    assert_int_equal(pr.cal_n, 1);
+    assert_int_equal(pr.stats.cal_rejected, 0);
+    assert_true(pr_fresh.slope_q8 > 128U && pr_fresh.slope_q8 < 6000U);
+    assert_int_equal(pr.slope_q8, pr_fresh.slope_q8);
+    assert_int_equal(t.r2_um, t2.r2_um);
+}
+
 // Moving (the sums are cleared every rotation): the azimuths reserved where a track is
 // expected are watched, and a target is refined from ONE rotation's rows of its azimuth and
 // its two neighbours in the group (independent speckle on each), summed over the bins all
@@ -660,6 +708,7 @@ int main(void)
         cmocka_unit_test(test_profile_a_cliff_beyond_the_shadow_edge_ends_a_tail),
         cmocka_unit_test(test_profile_slots_follow_the_targets),
         cmocka_unit_test(test_profile_refines_a_target_after_min_frames),
+        cmocka_unit_test(test_profile_starts_from_a_saved_tail_slope),
         cmocka_unit_test(test_profile_refines_from_neighbouring_azimuths_while_moving),
         cmocka_unit_test(test_profile_refines_only_the_far_end_of_a_pole_leaning_across_the_beam),
         cmocka_unit_test(test_profile_fill_from_the_log_values),

@@ -22,7 +22,8 @@ fail=0
 PSI_TOL=1; PHI_TOL=10
 run() { # name speed scene [--ambiguous-ok]
     "$SL_SIM" "$3" -o "$OUT/$1.colossus" --quiet || return 1
-    "$D" --board paper-sim --input "$OUT/$1.colossus" --motion "$2" --can-log "$OUT/$1.log" -q || return 1
+    "$D" --board paper-sim --input "$OUT/$1.colossus" --motion "$2" --can-log "$OUT/$1.log" -q \
+        ${EXTRA:-} || return 1
     echo "== $1 (--motion $2)"
     "$PY" "$SRC/tilt_vs_truth.py" "$DBC" "$OUT/$1.log" "$OUT/$1.gt.csv" --psi-tol $PSI_TOL \
         --phi-tol $PHI_TOL ${4:-} || return 1
@@ -44,6 +45,14 @@ run realistic 1.0 "$ROOT/scenes/driveby_realistic.ini" || fail=1
 # leaning 10 deg away from the path never raises DANGER (before the range profile while
 # moving it did, on 9 frames at Lean +16.95).
 "$PY" "$SRC/lean_warning_sides.py" "$DBC" "$OUT/realistic.log" 10 -10 || fail=1
+# The tail slope as calibration data: the exit log states the slope this stream self-fitted;
+# a second start from it (--tail-slope) gives the same bounds' quality from the first rotation.
+"$D" --board paper-sim --input "$OUT/realistic.colossus" --motion 1.0 2> "$OUT/realistic.err" || fail=1
+slope=$(sed -n 's/.*tail slope \([0-9.]*\) values\/bin (self-fitted.*/\1/p' "$OUT/realistic.err" | tail -1)
+echo "== self-fitted tail slope: ${slope:-none}"
+[ -n "$slope" ] || { cat "$OUT/realistic.err"; echo "FAIL: no tail slope in the exit log"; fail=1; }
+EXTRA="--tail-slope ${slope:-3}" run prior 1.0 "$ROOT/scenes/driveby_realistic.ini" || fail=1
+"$PY" "$SRC/lean_warning_sides.py" "$DBC" "$OUT/prior.log" 10 -10 || fail=1
 # The same drive-by reversing (from 7.5 m past the poles, --motion -1.0): the profile's slots
 # follow the tracks backwards too (measured 10.1 / 10.5 deg, 1 / 2 deg).
 sed 's/^y_m = -6.0/y_m = 7.5/; s/^speed_mps = 1.0/speed_mps = -1.0/' \

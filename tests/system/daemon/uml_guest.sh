@@ -6,8 +6,12 @@
 #          possible; --motion-can none);
 #   run 2: shadowleand --input SHORT_CAPTURE --realtime --can vcan0 --can-log daemon_rt.log
 #          while VehicleMotion frames (MOTION_FRAMES: one cansend argument per line, E2E
-#          counters 0..14) go onto vcan0 every 50 ms; VehicleMotion is read from vcan0 (the
-#          default: the --can interface).
+#          counters 0..14) go onto vcan0 every 50 ms, replayed by ONE canplayer process per
+#          pass (a cansend process per frame is slow enough in a guest on a loaded host to
+#          leave gaps beyond the receiver's 500 ms timeout: every frame then only
+#          resynchronises); VehicleMotion is read from vcan0 (the default: the --can
+#          interface). The daemon is stopped (SIGINT, exit 0) once 2 rotations used the motion
+#          input, by its own --targets-out, not by time (or at the capture's end).
 # Marker frames 7FF#... (SYNC / MID / END) delimit the runs in candump's recording without
 # timing assumptions (the same trick as tests/system/can/uml_sink_guest.sh).
 set -u
@@ -22,12 +26,24 @@ rc=$?
 echo "run 1 (fast): exit $rc"; cat "$out/daemon_fast.err"
 [ $rc -eq 0 ] || exit 1
 candump_mark 4D4944 || exit 1                                 # "MID"
+awk '{ printf "(%d.%06d) vcan0 %s\n", (NR * 50000) / 1000000, (NR * 50000) % 1000000, $1 }' \
+    "$motion" > "$out/motion.pass.log"
+rm -f "$out/motion.pass"
 ( while :; do
-      while read -r f; do cansend vcan0 "$f"; sleep 0.05; done < "$motion"
+      canplayer -I "$out/motion.pass.log"
+      : > "$out/motion.pass"
   done ) &
 sender=$!
 "$daemon" --board paper-sim --input "$short" --realtime --can vcan0 --can-log "$out/daemon_rt.log" \
-    --targets-out "$out/targets_rt.jsonl" 2> "$out/daemon_rt.err"
+    --targets-out "$out/targets_rt.jsonl" 2> "$out/daemon_rt.err" &
+dpid=$!
+used() { _n=$(grep -c '"motion_valid":true' "$out/targets_rt.jsonl" 2>/dev/null); echo "${_n:-0}"; }
+i=0
+while [ "$(used)" -lt 2 ] && [ $i -lt 2400 ] && kill -0 $dpid 2>/dev/null; do
+    sleep 0.05; i=$((i + 1))
+done
+kill -INT $dpid 2>/dev/null
+wait $dpid
 rc=$?
 kill $sender; wait $sender 2>/dev/null
 echo "run 2 (realtime, VehicleMotion on vcan0): exit $rc"; cat "$out/daemon_rt.err"

@@ -11,7 +11,7 @@ uml_run=$1; daemon=$2; sim=$3; py=$4; src=$(cd "$5" && pwd); out=$6
 rm -rf "$out"; mkdir -p "$out"; out=$(cd "$out" && pwd)
 dbc="$src/../../../boards/paper-sim/shadowlean.dbc"
 "$sim" "$src/scenes/static_four_poles.ini" -o "$out/scene.colossus" --quiet || exit 1
-"$sim" "$src/scenes/static_four_poles.ini" --rotations 8 -o "$out/short.colossus" --quiet || exit 1
+"$sim" "$src/scenes/static_four_poles.ini" --rotations 40 -o "$out/short.colossus" --quiet || exit 1
 "$py" "$src/motion_frames.py" "$dbc" 0.10 0 > "$out/motion.txt" || exit 1
 SL_UML_TIMEOUT=${SL_UML_TIMEOUT:-150} sh "$uml_run" "$out/vm" sh "$src/uml_guest.sh" "$daemon" \
     "$out/scene.colossus" "$out/short.colossus" "$out/motion.txt" "$out"
