@@ -817,6 +817,19 @@ static void log_stats(daemon_t *d, int level, const char *what)
                 what, d->sc.ifname, c->retries, c->enobufs, c->bus_off, c->link_down, c->dropped_full,
                 c->dropped_stale, c->dropped_down, c->dropped_bus_off, c->dropped_error);
     }
+    if (d->gs_on) {
+        const slp_gsusb_sink_stats_t *g = &d->gs.stats;
+        const bool lost = g->unconfirmed + g->dropped_in_flight + g->dropped_down + g->dropped_full +
+                              g->dropped_stale + g->dropped_error + g->dropped_invalid != 0U;
+        sld_log(level + (lost || g->down_events != 0U ? 0 : 1),
+                "%s: gs_usb: %" PRIu32 " submitted, %" PRIu32 " confirmed, %" PRIu32
+                " unconfirmed; dropped in-flight/down/full/stale/error/invalid %" PRIu32 "/%" PRIu32
+                "/%" PRIu32 "/%" PRIu32 "/%" PRIu32 "/%" PRIu32 "; %" PRIu32 " down events, %" PRIu32
+                " reopens",
+                what, g->submitted, g->confirmed, g->unconfirmed, g->dropped_in_flight, g->dropped_down,
+                g->dropped_full, g->dropped_stale, g->dropped_error, g->dropped_invalid, g->down_events,
+                g->reopens);
+    }
     if (d->is_radar) {
         const slp_radar_client_stats_t *r = &d->radar.stats;
         sld_log(level,

@@ -24,7 +24,8 @@ documented in sl_pipeline.h. Checks:
   (+-half an LSB, 0.01 m: the encoder rounds the um values once, to 0.02 m);
 - LeanWarning: the most severe confirmed track (level, then valid, then |alpha|), or
   HasTarget = 0; Level, TargetId, Azimuth, Lean, Range, LeanSigma, Quality as above;
-- Status: Rotations = records so far, AzimuthsMissing = sum of `missing`, CanDropped 0,
+- Status: Rotations = records so far, AzimuthsMissing = sum of `missing`, CanDropped 0
+  (--dropped-ok: any value, never decreasing: frames an output lost and counted),
   LinkState in --link (comma list; default STREAMING = 3).
 Prints a summary; exit 0 when everything matches.
 """
@@ -66,9 +67,12 @@ def main(argv):
     ap.add_argument("--min-poles", type=int, default=0, help="most PoleLean frames in a rotation >= N")
     ap.add_argument("--idle-ok", action="store_true", help="idle Status + Health pairs may appear")
     ap.add_argument("--no-fault", action="store_true", help="every Health frame has Fault = 0")
+    ap.add_argument("--dropped-ok", action="store_true",
+                    help="Status CanDropped may count lost frames (never decreasing)")
     a = ap.parse_args(argv[1:])
     opts = {"--link": a.link, "--rotations": a.rotations, "--min-poles": a.min_poles}
-    flags = {f for f, on in (("--idle-ok", a.idle_ok), ("--no-fault", a.no_fault)) if on}
+    flags = {f for f, on in (("--idle-ok", a.idle_ok), ("--no-fault", a.no_fault),
+                             ("--dropped-ok", a.dropped_ok)) if on}
     dbc, log, jsonl = a.dbc, a.log, a.jsonl
     db = scd.load_dbc(dbc)
     frames = scd.read_candump(log)
@@ -144,6 +148,7 @@ def main(argv):
     n_poles = 0
     max_poles = 0
     last_tilt = {}
+    last_dropped = 0
     for k, (g, r) in enumerate(zip(groups, rots)):
         w = f"rotation {r['rotation']}"
         missing += r["missing"]
@@ -247,7 +252,11 @@ def main(argv):
             errors.append(f"{w}: Status Rotations {st.raw['Rotations']}, want {k + 1}")
         if st.raw["AzimuthsMissing"] != missing:
             errors.append(f"{w}: Status AzimuthsMissing {st.raw['AzimuthsMissing']}, want {missing}")
-        if st.raw["CanDropped"] != 0:
+        if "--dropped-ok" in flags:
+            if st.raw["CanDropped"] < last_dropped:
+                errors.append(f"{w}: Status CanDropped {st.raw['CanDropped']} after {last_dropped}")
+            last_dropped = st.raw["CanDropped"]
+        elif st.raw["CanDropped"] != 0:
             errors.append(f"{w}: Status CanDropped {st.raw['CanDropped']}")
         if st.raw["LinkState"] not in [int(x) for x in opts["--link"].split(",")]:
             errors.append(f"{w}: Status LinkState {st.raw['LinkState']}, want {opts['--link']}")

@@ -6,7 +6,10 @@
 # the kernel package is downloaded once for both tests). On the host afterwards: the frames
 # the device received over USB equal the daemon's --can-log field by field, every one was
 # confirmed (echo), they decode with the DBC and match the targets, and the kernel driver
-# got the device back at exit. Exit 77 when qemu-system-x86_64 is missing.
+# got the device back at exit. When the guest stalled long enough on a loaded host to lose
+# frames (transfer and echo timeouts of 1 s), every loss must be counted by reason, the
+# device's frames an in-order subsequence of the log, the adapter never down: no timing
+# assumption. Exit 77 when qemu-system-x86_64 is missing.
 set -eu
 SRC=$1; CACHE=$2; OUT=$3; DAEMON=$4; SIM=$5; PY=$6
 GS="$SRC/tests/system/gsusb"
@@ -19,7 +22,7 @@ sh "$SRC/tests/support/vm/qemu_run.sh" "$SRC" "$CACHE" "$OUT" "$SRC/tests/system
 [ $rc -eq 0 ] || exit $rc
 [ "$(cat "$OUT/rc_daemon" 2>/dev/null)" = 0 ] || { echo "FAIL: shadowleand exit $(cat "$OUT/rc_daemon" 2>/dev/null)"; exit 1; }
 "$PY" - "$OUT" "$SRC/tests/system/daemon" <<'PY'
-import os, sys
+import os, re, sys
 sys.path.insert(0, sys.argv[2] + "/../../../scripts")
 import sl_can_decode as scd
 out = sys.argv[1]
@@ -29,13 +32,46 @@ key = lambda f: (f[2], f[3], f[4])
 errs = []
 if not mine:
     errs.append("the daemon logged no frame")
-if [key(f) for f in dev] != [key(f) for f in mine]:
-    errs.append(f"device received {len(dev)} frames, daemon logged {len(mine)}; first difference at "
-                f"{next((i for i, (a, b) in enumerate(zip(dev, mine)) if key(a) != key(b)), min(len(dev), len(mine)))}")
 txt = open(os.path.join(out, "daemon.out")).read()
 sink = [l for l in txt.splitlines() if "exit: sink gs_usb:" in l]
-if not sink or f"{len(mine)} sent, 0 dropped" not in sink[0]:
-    errs.append(f"gs_usb sink: {sink[0] if sink else 'no stats line'} (want {len(mine)} sent = confirmed, 0 dropped)")
+m = re.search(r"(\d+) sent, (\d+) dropped, (\d+) queued", sink[0]) if sink else None
+if m is None:
+    errs.append("gs_usb sink: no stats line")
+    sent = dropped = queued = -1
+else:
+    sent, dropped, queued = (int(x) for x in m.groups())
+if dropped == 0:
+    # The common case: every frame logged was confirmed by the device, in order.
+    if [key(f) for f in dev] != [key(f) for f in mine]:
+        errs.append(f"device received {len(dev)} frames, daemon logged {len(mine)}; first difference at "
+                    f"{next((i for i, (a, b) in enumerate(zip(dev, mine)) if key(a) != key(b)), min(len(dev), len(mine)))}")
+    if sent != len(mine) or queued != 0:
+        errs.append(f"gs_usb sink: {sink[0]} (want {len(mine)} sent = confirmed, 0 dropped)")
+else:
+    # A TCG guest on a loaded host can stall the device's USB side for longer than the
+    # transfer and echo timeouts (1 s): then frames are lost, and the test checks, without
+    # any timing assumption, that each loss is counted by reason and nothing else went
+    # wrong: the device got an in-order subsequence of what was logged, every logged frame
+    # is accounted for, the adapter never went down, no frame was invalid.
+    g = [l for l in txt.splitlines() if "exit: gs_usb:" in l]
+    b = re.search(r"(\d+) submitted, (\d+) confirmed, (\d+) unconfirmed; dropped "
+                  r"in-flight/down/full/stale/error/invalid (\d+)/(\d+)/(\d+)/(\d+)/(\d+)/(\d+); "
+                  r"(\d+) down events", g[0]) if g else None
+    if b is None:
+        errs.append("frames lost but no gs_usb breakdown line")
+    else:
+        sub, conf, unconf, infl, down, full, stale, err, inval, downev = (int(x) for x in b.groups())
+        it = iter(key(f) for f in mine)
+        if not all(k in it for k in (key(f) for f in dev)):
+            errs.append("the device received frames not in the daemon's log order")
+        if sub + down + full + stale + err + inval + queued != len(mine):
+            errs.append(f"accounting: {sub} submitted + drops {down + full + stale + err + inval} != {len(mine)} logged")
+        if not (conf <= len(dev) <= sub) or conf != sent:
+            errs.append(f"{len(dev)} received, {conf} confirmed, {sub} submitted: inconsistent")
+        if down or inval or downev:
+            errs.append(f"adapter down {down}/{downev} times or {inval} invalid frames")
+        print(f"gs_usb: {dropped} frames lost under load, counted: {g[0].split('gs_usb: ', 1)[1]}")
+        open(os.path.join(out, "lost"), "w").write(f"{dropped}\n")
 if open(os.path.join(out, "can0_back")).read().strip() != "1":
     errs.append("the kernel gs_usb driver did not get the device back (no can0 after exit)")
 print(f"gs_usb: the fake candleLight received {len(dev)} frames over USB, the daemon logged {len(mine)}")
@@ -43,5 +79,9 @@ for e in errs:
     print("FAIL:", e)
 sys.exit(1 if errs else 0)
 PY
+# After counted losses the Status frames say so (CanDropped), and a stalled guest may have
+# delayed a rotation past the idle Status period.
+lossy=""
+[ -f "$OUT/lost" ] && lossy="--dropped-ok --idle-ok"
 "$PY" "$SRC/tests/system/daemon/check_can_vs_targets.py" "$SRC/boards/paper-sim/shadowlean.dbc" \
-    "$OUT/daemon.log" "$OUT/targets.jsonl" --rotations 24 --min-poles 4
+    "$OUT/daemon.log" "$OUT/targets.jsonl" --rotations 24 --min-poles 4 $lossy
