@@ -233,8 +233,24 @@ def ctl_log(text):
         state["ctl"].write(text + "\n")
 
 
-while True:
-    buf = os.read(ep0, 12 * 4)
+# ep0 calls fail with EIDRM when the host cancels a setup request (a new one arrived, or the
+# UDC was unbound and bound again: scenario "vanish") and ESHUTDOWN while the function is
+# disabled: the request is gone, so read the next event (FunctionFS, f_fs.c). Any other
+# error ends the fake device, as before.
+EP0_RETRY = (errno.EIDRM, errno.ESHUTDOWN, errno.EINTR, errno.EAGAIN)
+
+
+def ep0_events():
+    while True:
+        try:
+            yield os.read(ep0, 12 * 4)
+        except OSError as e:
+            if e.errno not in EP0_RETRY:
+                raise
+            log("ep0 read: %s (request cancelled), reading the next event" % e.strerror)
+
+
+for buf in ep0_events():
     for off in range(0, len(buf), 12):
         rt, req, wval, widx, wlen, etype = struct.unpack_from("<BBHHHB", buf, off)
         if etype != 4:
@@ -258,7 +274,13 @@ while True:
                 except OSError:
                     pass
                 continue
-            os.write(ep0, data[:wlen])
+            try:
+                os.write(ep0, data[:wlen])
+            except OSError as e:
+                if e.errno not in EP0_RETRY:
+                    raise
+                log("ep0 data stage: %s (request cancelled)" % e.strerror)
+                continue
             ctl_log("%s IN wValue=%d wIndex=%d len=%d" % (name, wval, widx, wlen))
         else:
             if refused or req not in (0, 1, 2, 7):
@@ -268,7 +290,13 @@ while True:
                 except OSError:
                     pass
                 continue
-            data = os.read(ep0, wlen) if wlen else os.read(ep0, 0)
+            try:
+                data = os.read(ep0, wlen) if wlen else os.read(ep0, 0)
+            except OSError as e:
+                if e.errno not in EP0_RETRY:
+                    raise
+                log("ep0 data stage: %s (request cancelled)" % e.strerror)
+                continue
             extra = ""
             if req == 0 and len(data) >= 4:
                 extra = "byte_order=0x%08x" % struct.unpack("<I", data[:4])[0]
