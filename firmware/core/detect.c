@@ -832,6 +832,16 @@ static uint8_t run_strength(const sl_detect_t *d, uint32_t s, uint32_t e)
     return (uint8_t)(CF_AMP | (strong ? CF_STRONG : 0U));
 }
 
+// Highest value of amplitude row p over bins [s, e) (0 when empty).
+static uint32_t row_peak(const uint8_t *p, uint32_t s, uint32_t e)
+{
+    uint32_t peak = 0U;
+    for (uint32_t k = s; k < e; k++) {
+        peak = p[k] > peak ? p[k] : peak;
+    }
+    return peak;
+}
+
 // While d->peaks (sl_detect_begin: moving with a known tail slope): the highest amplitude
 // value of run [s, e) of `count` occupied bins into its entry of group g on azimuth a (the
 // entry's own when the run is all it holds: its count is the run's; else the larger).
@@ -843,12 +853,8 @@ static SL_NOINLINE void note_peak(const sl_detect_t *d, sl_detect_cand_t *g, uin
     if (idx >= SL_CFG_DETECT_MAX_SPAN) {
         return;
     }
-    const uint8_t *p = d->amp;
-    const uint32_t n = p == NULL ? s : (e < d->amp_bins ? e : d->amp_bins);
-    uint32_t peak = 0U;
-    for (uint32_t k = s; k < n; k++) {
-        peak = p[k] > peak ? p[k] : peak;
-    }
+    const uint32_t peak =
+        d->amp == NULL ? 0U : row_peak(d->amp, s, e < d->amp_bins ? e : d->amp_bins);
     g->peak[idx] = (uint32_t)g->run[idx].count == count || peak > g->peak[idx]
                        ? (uint8_t)peak
                        : g->peak[idx];
@@ -876,10 +882,7 @@ static SL_NOINLINE uint8_t edge_rule(const sl_detect_t *d, uint32_t s, uint32_t 
         return e - 1U >= edge ? (uint8_t)CF_SHADOW : 0U;
     }
     // (called for runs reaching the d(S) edge only: a shorter one keeps the r2 - d test)
-    uint32_t peak_in = 0U;
-    for (uint32_t k = s; k < win; k++) {
-        peak_in = p[k] > peak_in ? p[k] : peak_in;
-    }
+    const uint32_t peak_in = row_peak(p, s, win);
     const uint32_t o = e - win; // bins beyond the window
     if (d->tail_slope_q8 != 0U) {
         const uint32_t t = d->amp_threshold;

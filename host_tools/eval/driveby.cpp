@@ -412,18 +412,14 @@ Outcome run_case(const std::string &board_name, const Case &k, bool realistic, i
     } else if (dump && ctx.other_ring.track_id != 0U) {
         dump_ring(ctx.other_ring, p->tilt.prm, k); // e.g. INCONSISTENT: what the fit read
     }
-    if (ctx.last.quality >= 0) {
-        Outcome o = ctx.last;
-        o.slope_q8 = p->prof.slope_q8;
-        o.cal_n = p->prof.cal_n;
-        return o;
+    Outcome o = ctx.last;
+    if (o.quality < 0) {
+        o.quality = ctx.other_q; // no FITTED / AMBIGUOUS result: why not
+        o.n_obs = ctx.other_n;
+        o.base_y = k.offset;     // not measured: no offset error counted
     }
-    Outcome o;
     o.slope_q8 = p->prof.slope_q8;
     o.cal_n = p->prof.cal_n;
-    o.quality = ctx.other_q; // no FITTED / AMBIGUOUS result: why not
-    o.n_obs = ctx.other_n;
-    o.base_y = k.offset;     // not measured: no offset error counted
     return o;
 }
 

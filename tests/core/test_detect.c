@@ -327,13 +327,15 @@ static void test_detect_rejects_wide_and_broken_returns(void **state)
 // vehicle passing at 1 m/s (rotation 30 of `sl-eval driveby --psi 20 --phi 0 --offset 3`):
 // every azimuth holds a short piece, the pieces step through range over 13 azimuths where a
 // vertical pole may span 9.
+static const uint16_t k_leaning_pole[13][2] = {{87, 89}, {85, 89}, {83, 89}, {81, 87},
+                                                {80, 85}, {78, 82}, {77, 81}, {76, 79},
+                                                {75, 77}, {74, 76}, {74, 75}, {74, 74},
+                                                {73, 74}};
+
 static void set_leaning_pole(int az0)
 {
-    static const uint16_t run[13][2] = {{87, 89}, {85, 89}, {83, 89}, {81, 87}, {80, 85},
-                                        {78, 82}, {77, 81}, {76, 79}, {75, 77}, {74, 76},
-                                        {74, 75}, {74, 74}, {73, 74}};
     for (int i = 0; i < 13; i++) {
-        set_run(az0 + i, run[i][0], run[i][1]);
+        set_run(az0 + i, k_leaning_pole[i][0], k_leaning_pole[i][1]);
     }
 }
 
@@ -635,7 +637,7 @@ static void test_detect_a_weak_line_is_never_slant(void **state)
     assert_true((det.targets[0].flags & SL_TARGET_SLANT) != 0U);
 }
 
-// The same pole on a smearing sensor (sl-eval driveby --realistic): every azimuth's piece
+// The same pole (k_leaning_pole) on a smearing sensor (sl-eval driveby --realistic): every azimuth's piece
 // (level L) is followed by a tail falling 3 values per bin to the threshold 40, (L - 40) / 3
 // bins, and the beam's edge azimuths are weaker, so shorter. In bits the runs are ~20 bins
 // over nearly the same ranges, the group fills its extent like a wall and the tails' ends
@@ -658,16 +660,13 @@ static void smear_piece(int a, uint32_t first, uint32_t own_last, int level)
 static void test_detect_a_smeared_pole_leaning_across_the_beam_with_the_tail_slope(void **state)
 {
     (void)state;
-    static const uint16_t run[13][2] = {{87, 89}, {85, 89}, {83, 89}, {81, 87}, {80, 85},
-                                        {78, 82}, {77, 81}, {76, 79}, {75, 77}, {74, 76},
-                                        {74, 75}, {74, 74}, {73, 74}};
     static const int level[13] = {79, 91, 100, 100, 100, 100, 100, 100, 100, 100, 100, 91, 79};
     sl_detect_cfg_t cfg;
     sl_detect_cfg_default(&cfg);
     memset(rows, 0, sizeof rows);
     memset(amp, 0, sizeof amp);
     for (int i = 0; i < 13; i++) {
-        smear_piece(100 + i, run[i][0], run[i][1], level[i]);
+        smear_piece(100 + i, k_leaning_pole[i][0], k_leaning_pole[i][1], level[i]);
     }
     for (int a = 20; a < 40; a++) { // a car side at 3 m, smeared the same way
         smear_piece(a, 68, 75, 100);
