@@ -249,7 +249,10 @@ static void track_take(sl_tracker_t *tr, sl_track_t *t, const sl_target_t *g, ui
     }
     if (g->incline_flag == (uint8_t)SL_INCLINE_VALID) {
         const bool profiled = (g->flags & SL_TARGET_PROFILE) != 0U;
-        filter_update(tr, t, g->alpha_cdeg, g->sigma_cdeg, repeat,
+        // A coarse bound's error repeats like a repeated bin's (sl_profile.h, "Uncertainty
+        // of the bounds"): the variance floor applies to it too.
+        const bool floor = repeat || (g->flags & SL_TARGET_COARSE) != 0U;
+        filter_update(tr, t, g->alpha_cdeg, g->sigma_cdeg, floor,
                       profiled && t->profiled == 0U);
         if (profiled) {
             t->profiled = 1U;

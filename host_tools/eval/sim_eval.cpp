@@ -1447,6 +1447,9 @@ void realistic_pipe_add(const PipelineEval &pe, const GtRow &gt, int assoc_az, i
             out.valid++;
             sum += t.alpha_deg;
             cnt++;
+            if (t.sigma_deg > 0) {
+                out.raw_z.push_back((t.alpha_deg - gt.alpha_deg) / t.sigma_deg);
+            }
         } else if (t.flag == SL_INCLINE_AMBIGUOUS) {
             out.ambiguous++;
             sum += bound;
@@ -1817,6 +1820,33 @@ void print_hard(std::FILE *f, const RealisticResult &r)
                  h.height_tol_m * 1e3, h.bearing_tol_deg, h.refl_tol_db, h.calib_gap_lo_m, h.calib_gap_hi_m);
 }
 
+// Share of errors (in units of their stated sigma) within 1 / 2 / 3 sigma (%), and the largest.
+struct SigmaCover {
+    double within[3] = {std::nan(""), std::nan(""), std::nan("")};
+    double max = std::nan("");
+};
+
+SigmaCover sigma_cover(const std::vector<double> &z)
+{
+    SigmaCover c;
+    if (z.empty()) {
+        return c;
+    }
+    c.max = 0;
+    int n[3] = {0, 0, 0};
+    for (double x : z) {
+        const double a = std::fabs(x);
+        c.max = std::max(c.max, a);
+        for (int k = 0; k < 3; k++) {
+            n[k] += a <= k + 1 ? 1 : 0;
+        }
+    }
+    for (int k = 0; k < 3; k++) {
+        c.within[k] = 100.0 * n[k] / static_cast<double>(z.size());
+    }
+    return c;
+}
+
 void print_realistic_pipeline(std::FILE *f, const RealisticResult &r)
 {
     const PipeCfg &c = r.pipe_cfg;
@@ -1869,6 +1899,23 @@ void print_realistic_pipeline(std::FILE *f, const RealisticResult &r)
                      q(0.5), q(0.9), p.runs - p.detected, p.runs,
                      p.runs > 0 ? 100.0 * (p.runs - p.detected) / p.runs : 0.0, p.ambiguous, matched,
                      matched > 0 ? 100.0 * p.ambiguous / matched : 0.0);
+    }
+    // Is the stated sigma honest? |error| in units of the sigma each value carried: a normal
+    // error is within 1 / 2 / 3 sigma 68 / 95 / 99.7 % of the time.
+    std::fprintf(f, "core pipeline sigma: |error| / stated sigma, %% within 1 / 2 / 3 sigma and the largest; targets\n"
+                    "(VALID, each rotation) and the tracker's filtered alpha (what PoleLean carries)\n");
+    for (int a = 0; a < 5; a++) {
+        const RealisticPipe &p = r.pipe[a];
+        std::vector<double> fz;
+        for (size_t i = 0; i < p.filt.size(); i++) {
+            if (p.filt_sigma[i] > 0) {
+                fz.push_back((p.filt[i] - p.filt_truth[i]) / p.filt_sigma[i]);
+            }
+        }
+        const SigmaCover tc = sigma_cover(p.raw_z), fc = sigma_cover(fz);
+        std::fprintf(f, "%+4d   | targets %3.0f / %3.0f / %3.0f %%, max %5.1f (n %zu) | tracker %3.0f / %3.0f / %3.0f %%, max %5.1f (n %zu)\n",
+                     r.angles[a], tc.within[0], tc.within[1], tc.within[2], tc.max, p.raw_z.size(), fc.within[0],
+                     fc.within[1], fc.within[2], fc.max, fz.size());
     }
 }
 

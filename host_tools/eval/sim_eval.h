@@ -348,6 +348,7 @@ struct RealisticPipe {
     std::vector<double> filt_sigma; ///< ... its filtered sigma (deg), parallel to `filt`
     std::vector<int> filt_level;    ///< ... its warning level (sl_warn_level_t), parallel
     std::vector<double> filt_truth; ///< ... the measurement's true alpha, parallel
+    std::vector<double> raw_z;  ///< per VALID matched target: (alpha - truth) / its sigma
     int runs = 0;               ///< measurements
     int detected = 0;           ///< ... with >= 1 target at the pole's azimuth in the last rotations
     int rot_checked = 0, rot_detected = 0; ///< last rotations checked / with a matched target

@@ -263,6 +263,11 @@ typedef enum sl_detect_reject {
                                        ///< a pole leaning across the line of sight (stage 4,
                                        ///< "Leaning across the line of sight"): bounds are
                                        ///< the group's union extent
+#define SL_TARGET_COARSE 0x200U        ///< a bound known to two bins only (sl_profile.h,
+                                       ///< "Uncertainty of the bounds": the end of a walk
+                                       ///< over a smear tail, or one rotation's edge): sigma
+                                       ///< includes it, and its error repeats from rotation
+                                       ///< to rotation (the tracker does not average it out)
 
 /// Detection parameters that are not (yet) board fields.
 typedef struct sl_detect_cfg {

@@ -92,6 +92,27 @@
 /// The value scale (log of power) only enters through the ratio 1/6 and T/4; nothing depends
 /// on the simulator's kernel, the board's d(r) or n.
 ///
+/// ## Uncertainty of the bounds (sigma of alpha)
+/// The board's `range_sigma_um` is a bound's quantisation (b / sqrt(12) for a bin of b) and
+/// holds for an edge the profile resolves: a cliff, a leading edge summed over rotations.
+/// Two edges are known to two bins only, sigma b / sqrt(3) (uniform over two bins; the
+/// larger of the two is used):
+/// - r2 at the end of a walk over a smear tail: the walk takes a bin as tail while its own
+///   power adds less than about one sixth of the local slope to the tail's (7 % of the
+///   tail's power at 3.3 values per bin), and a pole's last, partly lit bins return less
+///   than that under the accumulated smear of its bright bins. The pole ends in the last own
+///   bin or in the next; which one, no rule without a model of the smear can say. The error
+///   is one-sided and repeats on every rotation (measured short by 15-105 mm on the
+///   simulated benches, by up to 60 mm while driving).
+/// - r1 and r2 from one rotation's rows of neighbouring azimuths (moving): the edge bins
+///   carry one rotation's speckle, so a partly lit edge bin is above the threshold on one
+///   rotation and below it on the next, and the pole is anywhere within the azimuth's beam.
+/// The two sigmas combine as sigma_rho^2 = (s2^2 + rho^2 s1^2) / r1^2 into the one sigma
+/// sl_incline_estimate() takes (sl_profile_bounds_sigma_um), and such a target is flagged
+/// SL_TARGET_COARSE: its error repeats from rotation to rotation, so the tracker does not
+/// let its fused variance fall below the measurement's (sl_track.h, "Filter"). Alpha is
+/// unchanged; only its sigma (PoleLean's LeanSigma) and the tracker's weights change.
+///
 /// ## Online calibration (D3)
 /// `slope_q8`: exponential mean (weight 1/8) of the self-fitted slopes of accepted
 /// extractions, each gated to +-30 % of the current value once 4 fits are in
@@ -325,6 +346,15 @@ bool sl_profile_lead_edge(const uint16_t *sum3, uint32_t frames, uint32_t delta_
 /// Offset of the lit part from the foot beyond which the leading edge is taken as an end of
 /// constant length per bin (64 bins, Q16).
 #define SL_PROFILE_LEAD_END_Q16 (64UL << 16)
+
+/// Sigma of a bound known to two bins of `bin_um`: bin_um / sqrt(3), rounded (pure).
+uint32_t sl_profile_coarse_sigma_um(uint32_t bin_um);
+
+/// The one range sigma that gives sl_incline_estimate() the same sigma of rho as
+/// independent bounds with sigmas `s1_um` (r1) and `s2_um` (r2): sqrt(w s2^2 + (1 - w)
+/// s1^2) with w = r1^2 / (r1^2 + r2^2) (ranges taken in whole mm; pure, one isqrt).
+uint32_t sl_profile_bounds_sigma_um(uint32_t r1_um, uint32_t r2_um, uint32_t s1_um,
+                                    uint32_t s2_um);
 
 /// Smear-aware bounds from a profile (pure; see "Extraction"). `hint` = the mask's first
 /// bin relative to the profile start, `cal_slope_q8` the fallback slope (0: none),

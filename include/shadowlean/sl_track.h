@@ -55,7 +55,10 @@
 ///              repeat:  P = max(P, sigma_z^2) when the target's corrected r1 and r2 equal
 ///                       the previous valid measurement's (a static scene quantised the
 ///                       same way every rotation is one measurement, not many: variance
-///                       floor while the bins repeat, EXTRACTION.md D6)
+///                       floor while the bins repeat, EXTRACTION.md D6); the same
+///                       floor for a target flagged SL_TARGET_COARSE (a bound known to
+///                       two bins, whose error repeats on every rotation: sl_profile.h,
+///                       "Uncertainty of the bounds")
 ///     restart: the track's first measurement refined from a range profile
 ///              (SL_TARGET_PROFILE, sl_profile.h) is taken as the first (alpha = z,
 ///              P = sigma_z^2): the mask's bounds before it are whole bins shortened by the

@@ -631,6 +631,12 @@ static void test_pipeline_detects_poles_at_minus10_0_plus10_deg_after_n_rotation
             assert_true(rec.tg[k][i].az != 110 && rec.tg[k][i].az != 300);
         }
     }
+    // Noise-free returns end in cliffs: no bound is coarse, sigma is the board's.
+    for (int k = 0; k < 24; k++) {
+        for (int i = 0; i < rec.nt[k]; i++) {
+            assert_int_equal(rec.tg[k][i].flags & SL_TARGET_COARSE, 0);
+        }
+    }
     assert_true(pl.detect.stats.rejected[SL_DETECT_REJ_SHADOW] > 0);
     assert_int_equal(pl.proto.stats.resyncs, 0);
     assert_int_equal(pl.stats.azimuths, 24 * 400);
@@ -1423,6 +1429,20 @@ static void test_pipeline_smear_tail_across_the_shadow_edge(void **state)
             assert_true((t->flags & SL_TARGET_PROFILE) != 0U);
             assert_int_equal(t->r2_um, (uint32_t)(((2ULL * (g_edge_bin - 4U) + 1U) * B->bin_size_um + 1U) / 2U));
             assert_true(t->r2_um < t->shadow_slant_um);
+            // r2 ends a walk over the smear tail: known to two bins (sl_profile.h,
+            // "Uncertainty of the bounds"); r1, summed over rotations, to the board's sigma.
+            assert_true((t->flags & SL_TARGET_COARSE) != 0U);
+            const uint32_t s2 = sl_profile_coarse_sigma_um(B->bin_size_um);
+            assert_true(s2 > B->range_sigma_um);
+            const uint32_t sr = sl_profile_bounds_sigma_um(t->r1_um, t->r2_um, B->range_sigma_um, s2);
+            const sl_incline_result_t two = sl_incline_estimate(
+                t->r1_um, t->r2_um, &B->geom[t->az], sr, B->theta_sigma_cdeg);
+            const sl_incline_result_t one = sl_incline_estimate(
+                t->r1_um, t->r2_um, &B->geom[t->az], B->range_sigma_um, B->theta_sigma_cdeg);
+            assert_int_equal(t->incline_flag, SL_INCLINE_VALID);
+            assert_int_equal(t->alpha_cdeg, one.alpha_cdeg); // the value is not changed
+            assert_int_equal(t->sigma_cdeg, two.sigma_cdeg);
+            assert_true(two.sigma_cdeg > one.sigma_cdeg + one.sigma_cdeg / 2U);
         }
     }
     // The pole beyond the edge: rejected SHADOW every rotation from the first.

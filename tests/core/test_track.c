@@ -464,6 +464,17 @@ static void test_track_does_not_trust_repeated_identical_bounds(void **state)
         now += 250000;
     }
     assert_true(trk.tracks[0].sigma_cdeg < 60);
+    // Moving bounds flagged coarse (a walk's end under a smear tail, one rotation's edges:
+    // sl_profile.h, "Uncertainty of the bounds"): their error repeats, so the same floor.
+    assert_int_equal(sl_track_init(&trk, &board, NULL), SL_OK);
+    for (int i = 0; i < 20; i++) {
+        sl_target_t t = tgt(50, 2500000U + (uint32_t)(i % 2) * 1000U, 300, 120, SL_INCLINE_VALID);
+        t.flags = SL_TARGET_PROFILE | SL_TARGET_COARSE;
+        sl_track_update(&trk, &t, 1, now);
+        now += 250000;
+    }
+    assert_int_equal(trk.tracks[0].alpha_cdeg, 300);
+    assert_true(trk.tracks[0].sigma_cdeg >= 120);
 }
 
 // Mask bounds first (whole bins, the same error every static rotation), then the target's
