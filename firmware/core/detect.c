@@ -171,6 +171,16 @@ void sl_detect_correct(const sl_board_t *board, const sl_detect_cfg_t *cfg, uint
     t->r2_um = sl_fx_usat32(r2);
 }
 
+uint32_t sl_detect_r1_sigma_um(const sl_target_t *t, uint32_t base_um)
+{
+    SL_ASSERT(t != NULL);
+    if ((t->flags & SL_TARGET_RADIUS_WIDTH) == 0U || t->radius_um == 0U) {
+        return base_um;
+    }
+    const uint64_t r = t->radius_um;
+    return sl_fx_isqrt64((uint64_t)base_um * base_um + (r * r + 1U) / 3U);
+}
+
 // ---- groups
 
 static void ext_union(uint16_t *lo, uint16_t *hi, uint16_t f, uint16_t l)
@@ -760,8 +770,15 @@ static void finalize(sl_detect_t *d, sl_detect_cand_t *c)
     t.flags |= (uint8_t)(c->flags & CF_TAIL); // CF_TAIL == SL_TARGET_TAIL_EDGE
     uint32_t rho_q28 = 0U;
     if (bd->geom != NULL) {
-        const sl_incline_result_t res = sl_incline_estimate(
-            t.r1_um, t.r2_um, &bd->geom[az], bd->range_sigma_um, bd->theta_sigma_cdeg);
+        // Sigma of the bounds: r1 with a radius from width is uncertain by the radius.
+        const uint32_t s1 = sl_detect_r1_sigma_um(&t, bd->range_sigma_um);
+        uint32_t sigma_r = bd->range_sigma_um;
+        if (s1 != sigma_r) {
+            sigma_r = sl_incline_bounds_sigma_um(t.r1_um, t.r2_um, s1, bd->range_sigma_um);
+            t.flags |= SL_TARGET_COARSE;
+        }
+        const sl_incline_result_t res = sl_incline_estimate(t.r1_um, t.r2_um, &bd->geom[az],
+                                                            sigma_r, bd->theta_sigma_cdeg);
         t.alpha_cdeg = res.alpha_cdeg;
         t.sigma_cdeg = res.sigma_cdeg;
         t.incline_flag = res.flag;

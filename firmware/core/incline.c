@@ -242,3 +242,15 @@ sl_incline_result_t sl_incline_estimate(uint32_t r1_um, uint32_t r2_um,
     res.flag = (uint8_t)SL_INCLINE_VALID;
     return res;
 }
+
+uint32_t sl_incline_bounds_sigma_um(uint32_t r1_um, uint32_t r2_um, uint32_t s1_um,
+                                    uint32_t s2_um)
+{
+    // sigma_rho^2 = (s2^2 + rho^2 s1^2) / r1^2 = s_eff^2 (1 + rho^2) / r1^2 with
+    // s_eff^2 = w s2^2 + (1 - w) s1^2, w = r1^2 / (r1^2 + r2^2) (Q16, ranges in mm).
+    const uint64_t a = (uint64_t)(r1_um / 1000U) * (r1_um / 1000U);
+    const uint64_t c = (uint64_t)(r2_um / 1000U) * (r2_um / 1000U);
+    const uint64_t w = a + c == 0U ? 32768U : (a << 16) / (a + c);
+    const uint64_t v = w * ((uint64_t)s2_um * s2_um) + (65536U - w) * ((uint64_t)s1_um * s1_um);
+    return sl_fx_isqrt64(sl_fx_urshift_round64(v, 16U));
+}

@@ -464,18 +464,6 @@ uint32_t sl_profile_coarse_sigma_um(uint32_t bin_um)
     return (uint32_t)(((uint64_t)bin_um * 37837U + 32768U) >> 16);
 }
 
-uint32_t sl_profile_bounds_sigma_um(uint32_t r1_um, uint32_t r2_um, uint32_t s1_um,
-                                    uint32_t s2_um)
-{
-    // sigma_rho^2 = (s2^2 + rho^2 s1^2) / r1^2 = s_eff^2 (1 + rho^2) / r1^2 with
-    // s_eff^2 = w s2^2 + (1 - w) s1^2, w = r1^2 / (r1^2 + r2^2) (Q16, ranges in mm).
-    const uint64_t a = (uint64_t)(r1_um / 1000U) * (r1_um / 1000U);
-    const uint64_t c = (uint64_t)(r2_um / 1000U) * (r2_um / 1000U);
-    const uint64_t w = a + c == 0U ? 32768U : (a << 16) / (a + c);
-    const uint64_t v = w * ((uint64_t)s2_um * s2_um) + (65536U - w) * ((uint64_t)s1_um * s1_um);
-    return sl_fx_isqrt64(sl_fx_urshift_round64(v, 16U));
-}
-
 // The rows of target `t`'s azimuth (slot `si`) and of its two neighbours, when they belong
 // to its detection group and are watched, summed into pr->scratch over the bins all of them
 // cover (a neighbour whose window starts after the target's first bin - 3 would cut the
@@ -654,7 +642,7 @@ uint8_t sl_profile_refine(sl_profile_t *pr, const sl_board_t *board, uint32_t th
     t->flags = (uint16_t)((t->flags & ~(SL_TARGET_ELONG | SL_TARGET_COARSE)) | SL_TARGET_PROFILE);
     // Uncertainty of the bounds: a walk's end under a smear tail, and one rotation's edges
     // (neighbouring rows, moving), are known to two bins; a cliff or summed rotations'
-    // leading edge to the board's range sigma.
+    // leading edge to the board's range sigma; r1's radius from width adds its own size.
     uint32_t s1 = board->range_sigma_um, s2 = s1;
     const uint32_t coarse = sl_profile_coarse_sigma_um(board->bin_size_um);
     if (pb.slope_src != SL_PROFILE_SLOPE_CLIFF && s2 < coarse) {
@@ -663,9 +651,10 @@ uint8_t sl_profile_refine(sl_profile_t *pr, const sl_board_t *board, uint32_t th
     if (spatial && s1 < coarse) {
         s1 = coarse;
     }
+    s1 = sl_detect_r1_sigma_um(t, s1); // the radius from width (sl_detect.h stage 6)
     uint32_t sigma_r = s1;
     if (s1 != s2) {
-        sigma_r = sl_profile_bounds_sigma_um(t->r1_um, t->r2_um, s1, s2);
+        sigma_r = sl_incline_bounds_sigma_um(t->r1_um, t->r2_um, s1, s2);
     }
     if (s1 != board->range_sigma_um || s2 != board->range_sigma_um) {
         t->flags = (uint16_t)(t->flags | SL_TARGET_COARSE);

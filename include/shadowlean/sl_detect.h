@@ -172,9 +172,12 @@
 ///      R - sqrt(max(0, R^2 - L^2)) behind the front, so r2 += sqrt(max(0, R^2 - L^2)).
 ///      A wide beam (L >= R, the paper's simulation) leaves r2 alone; a narrow one shifts
 ///      both bounds by ~R (rho unchanged to first order).
-/// 6. **Alpha**: sl_incline_estimate(r1, r2, &board->geom[az], board->range_sigma_um,
-///    board->theta_sigma_cdeg); its flag is stored in the target (targets are reported
-///    whatever the flag; consumers use `incline_flag`).
+/// 6. **Alpha**: sl_incline_estimate(r1, r2, &board->geom[az], sigma_r,
+///    board->theta_sigma_cdeg), sigma_r = board->range_sigma_um for both bounds, except
+///    r1's with a radius from width (sl_detect_r1_sigma_um; the bounds' sigmas combined by
+///    sl_incline_bounds_sigma_um, the target flagged SL_TARGET_COARSE: the same width, so
+///    the same error, every rotation); its flag is stored in the target (targets are
+///    reported whatever the flag; consumers use `incline_flag`).
 ///
 /// ## Calling sequence (one rotation)
 ///     sl_detect_begin(&d);
@@ -263,11 +266,12 @@ typedef enum sl_detect_reject {
                                        ///< a pole leaning across the line of sight (stage 4,
                                        ///< "Leaning across the line of sight"): bounds are
                                        ///< the group's union extent
-#define SL_TARGET_COARSE 0x200U        ///< a bound known to two bins only (sl_profile.h,
+#define SL_TARGET_COARSE 0x200U        ///< a bound the extraction cannot resolve (sl_profile.h,
                                        ///< "Uncertainty of the bounds": the end of a walk
-                                       ///< over a smear tail, or one rotation's edge): sigma
-                                       ///< includes it, and its error repeats from rotation
-                                       ///< to rotation (the tracker does not average it out)
+                                       ///< over a smear tail, one rotation's edge, r1 with a
+                                       ///< radius from width): sigma includes it, and its
+                                       ///< error repeats from rotation to rotation (the
+                                       ///< tracker does not average it out)
 
 /// Detection parameters that are not (yet) board fields.
 typedef struct sl_detect_cfg {
@@ -482,6 +486,14 @@ uint16_t sl_detect_evidence(uint32_t occupied_total, uint32_t az_with_run, uint3
 void sl_detect_correct(const sl_board_t *board, const sl_detect_cfg_t *cfg, uint16_t az,
                        uint16_t bin_first, uint16_t bin_last, uint16_t az_count,
                        sl_target_t *t);
+
+/// Sigma of r1 (um) from `base_um`, the sigma of the edge itself: with a radius estimated
+/// from the azimuthal width (SL_TARGET_RADIUS_WIDTH, radius_um > 0), sqrt(base^2 + R^2 / 3).
+/// The column at the inner edge holds the diameter and whatever of the beam's skirt the
+/// return's strength lifts above the threshold, which the beam width at that level (not a
+/// board field) would separate: the correction r1 += R is uncertain by its own size
+/// (uniform within +-R). Pure; one isqrt.
+uint32_t sl_detect_r1_sigma_um(const sl_target_t *t, uint32_t base_um);
 
 /// The board's elongation d(r) in micrometres (piecewise linear over elong_range_um ->
 /// elong_d_um, constant beyond the ends, 0 with no table; truncated toward zero, <= 1 um).

@@ -169,6 +169,14 @@ sl_incline_result_t sl_incline_estimate(uint32_t r1_um, uint32_t r2_um,
                                         const sl_incline_geom_t *geom, uint32_t sigma_r_um,
                                         uint16_t sigma_theta_cdeg);
 
+/// The one range sigma that gives sl_incline_estimate() the same sigma of rho as
+/// independent bounds with sigmas `s1_um` (r1) and `s2_um` (r2): sigma_rho^2 = (s2^2 +
+/// rho^2 s1^2) / r1^2 = s^2 (1 + rho^2) / r1^2, so s = sqrt(w s2^2 + (1 - w) s1^2) with
+/// w = r1^2 / (r1^2 + r2^2) (Q16, ranges taken in whole mm; floor of the square root; the
+/// same sigma back when s1 == s2). Pure, one 64-bit division and one isqrt.
+uint32_t sl_incline_bounds_sigma_um(uint32_t r1_um, uint32_t r2_um, uint32_t s1_um,
+                                    uint32_t s2_um);
+
 /// True when `geom` is inside the supported domain (see SL_INCLINE_THETA_MIN_CDEG): the
 /// same test sl_incline_estimate() applies. Checks theta_bam32 and beta_bam32 and that
 /// 2^28 < rho_amb_q28 <= rho_seam_q28 < UINT32_MAX. NULL -> false. O(1).

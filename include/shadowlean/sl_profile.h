@@ -107,8 +107,10 @@
 /// - r1 and r2 from one rotation's rows of neighbouring azimuths (moving): the edge bins
 ///   carry one rotation's speckle, so a partly lit edge bin is above the threshold on one
 ///   rotation and below it on the next, and the pole is anywhere within the azimuth's beam.
+/// r1's sigma also holds a radius from width (sl_detect_r1_sigma_um: the correction is
+/// uncertain by its own size).
 /// The two sigmas combine as sigma_rho^2 = (s2^2 + rho^2 s1^2) / r1^2 into the one sigma
-/// sl_incline_estimate() takes (sl_profile_bounds_sigma_um), and such a target is flagged
+/// sl_incline_estimate() takes (sl_incline_bounds_sigma_um), and such a target is flagged
 /// SL_TARGET_COARSE: its error repeats from rotation to rotation, so the tracker does not
 /// let its fused variance fall below the measurement's (sl_track.h, "Filter"). Alpha is
 /// unchanged; only its sigma (PoleLean's LeanSigma) and the tracker's weights change.
@@ -349,12 +351,6 @@ bool sl_profile_lead_edge(const uint16_t *sum3, uint32_t frames, uint32_t delta_
 
 /// Sigma of a bound known to two bins of `bin_um`: bin_um / sqrt(3), rounded (pure).
 uint32_t sl_profile_coarse_sigma_um(uint32_t bin_um);
-
-/// The one range sigma that gives sl_incline_estimate() the same sigma of rho as
-/// independent bounds with sigmas `s1_um` (r1) and `s2_um` (r2): sqrt(w s2^2 + (1 - w)
-/// s1^2) with w = r1^2 / (r1^2 + r2^2) (ranges taken in whole mm; pure, one isqrt).
-uint32_t sl_profile_bounds_sigma_um(uint32_t r1_um, uint32_t r2_um, uint32_t s1_um,
-                                    uint32_t s2_um);
 
 /// Smear-aware bounds from a profile (pure; see "Extraction"). `hint` = the mask's first
 /// bin relative to the profile start, `cal_slope_q8` the fallback slope (0: none),

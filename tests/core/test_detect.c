@@ -202,6 +202,7 @@ static void test_detect_estimates_a_leaning_away_pole_on_branch_two(void **state
     assert_int_equal(tg->incline_branch, SL_INCLINE_BRANCH_2);
     assert_int_equal(tg->radius_um, 0); // 2 azimuths: nothing beyond the beam
     assert_true((tg->flags & SL_TARGET_RADIUS_WIDTH) != 0U);
+    assert_int_equal(tg->flags & SL_TARGET_COARSE, 0); // no radius: the board's sigma
     assert_true(fabs(tg->alpha_cdeg / 100.0 - alpha_ref_deg(tg->r1_um, tg->r2_um)) < 0.02);
     assert_true(fabs(tg->alpha_cdeg / 100.0 + 5.0) < 1.5);
 }
@@ -321,6 +322,27 @@ static void test_detect_rejects_wide_and_broken_returns(void **state)
     const double rexp = r1 * tan(4.5 / 2.0 * kPi / 180.0) * 1e6;
     assert_true(fabs((double)det.targets[0].radius_um - rexp) < rexp * 0.002 + 2.0);
     assert_int_equal(det.targets[0].r1_um, half_bin_um(68) + det.targets[0].radius_um);
+    // The radius from width is uncertain by its own size (stage 6): r1's sigma is
+    // sqrt(s^2 + R^2 / 3), combined with r2's, and the target is flagged coarse.
+    const sl_target_t *t = &det.targets[0];
+    const uint32_t s1 = sl_detect_r1_sigma_um(t, board.range_sigma_um);
+    const double s1exp = sqrt((double)board.range_sigma_um * board.range_sigma_um +
+                              (double)t->radius_um * t->radius_um / 3.0);
+    assert_true(fabs(s1 - s1exp) <= 1.0);
+    assert_true((t->flags & SL_TARGET_COARSE) != 0U);
+    const sl_incline_result_t res = sl_incline_estimate(
+        t->r1_um, t->r2_um, &board.geom[t->az],
+        sl_incline_bounds_sigma_um(t->r1_um, t->r2_um, s1, board.range_sigma_um),
+        board.theta_sigma_cdeg);
+    assert_int_equal(t->incline_flag, res.flag);
+    assert_int_equal(t->sigma_cdeg, res.sigma_cdeg);
+    // without a radius (or with the board's): the edge's own sigma
+    sl_target_t u = *t;
+    u.radius_um = 0U;
+    assert_int_equal(sl_detect_r1_sigma_um(&u, 12640U), 12640U);
+    u.radius_um = 30000U;
+    u.flags = SL_TARGET_RADIUS_BOARD;
+    assert_int_equal(sl_detect_r1_sigma_um(&u, 12640U), 12640U);
 }
 
 // A 20 deg pole leaning across the line of sight at ~3.3 m, as sl-sim renders it for a

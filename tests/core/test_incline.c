@@ -555,9 +555,36 @@ static void test_incline_sigma_saturates_and_scales(void **state)
     assert_true(abs((int)b.sigma_cdeg - 4 * (int)a.sigma_cdeg) <= 2);
 }
 
+// sl_incline_bounds_sigma_um: the one range sigma that gives the same sigma of rho as
+// independent bounds with sigmas s1 (r1) and s2 (r2), against double precision:
+// sigma_rho^2 = (s2^2 + rho^2 s1^2) / r1^2 = s^2 (1 + rho^2) / r1^2.
+static void test_incline_bounds_sigma_combines_the_two_bounds(void **state)
+{
+    (void)state;
+    // equal sigmas: that sigma, exactly
+    assert_int_equal(sl_incline_bounds_sigma_um(3000000U, 3600000U, 12640U, 12640U), 12640U);
+    assert_int_equal(sl_incline_bounds_sigma_um(0U, 0U, 12640U, 25288U), // isqrt: floor
+                     (uint32_t)floor(sqrt((12640.0 * 12640.0 + 25288.0 * 25288.0) / 2.0)));
+    const uint32_t r1s[] = {1500000U, 3000000U, 2400000U, 9000000U, 40000000U};
+    const uint32_t r2s[] = {1550000U, 3600000U, 5100000U, 30000000U, 41000000U};
+    const uint32_t ss[][2] = {{12640U, 25288U}, {25288U, 12640U}, {12640U, 12640U},
+                              {1U, 577347U}, {60000U, 300U}};
+    for (size_t i = 0; i < sizeof r1s / sizeof r1s[0]; i++) {
+        for (size_t j = 0; j < sizeof ss / sizeof ss[0]; j++) {
+            const double r1 = r1s[i], r2 = r2s[i], s1 = ss[j][0], s2 = ss[j][1];
+            const double rho = r2 / r1;
+            const double want = sqrt((s2 * s2 + rho * rho * s1 * s1) / (1.0 + rho * rho));
+            const double got = sl_incline_bounds_sigma_um(r1s[i], r2s[i], ss[j][0], ss[j][1]);
+            // whole-mm ranges and the Q16 weight: within 0.01 % and 1 um
+            assert_true(fabs(got - want) <= 1.0 + 1e-4 * want);
+        }
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_incline_bounds_sigma_combines_the_two_bounds),
         cmocka_unit_test(test_incline_atan_table_matches_libm_at_every_node),
         cmocka_unit_test(test_incline_atan2_is_accurate_in_all_octants),
         cmocka_unit_test(test_incline_bam32_to_cdeg_rounds_half_up),

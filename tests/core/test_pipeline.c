@@ -1434,7 +1434,7 @@ static void test_pipeline_smear_tail_across_the_shadow_edge(void **state)
             assert_true((t->flags & SL_TARGET_COARSE) != 0U);
             const uint32_t s2 = sl_profile_coarse_sigma_um(B->bin_size_um);
             assert_true(s2 > B->range_sigma_um);
-            const uint32_t sr = sl_profile_bounds_sigma_um(t->r1_um, t->r2_um, B->range_sigma_um, s2);
+            const uint32_t sr = sl_incline_bounds_sigma_um(t->r1_um, t->r2_um, B->range_sigma_um, s2);
             const sl_incline_result_t two = sl_incline_estimate(
                 t->r1_um, t->r2_um, &B->geom[t->az], sr, B->theta_sigma_cdeg);
             const sl_incline_result_t one = sl_incline_estimate(

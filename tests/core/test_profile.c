@@ -632,33 +632,13 @@ static void test_profile_refines_r2_within_the_last_bin_of_a_cliff(void **state)
     assert_int_equal(t.r2_um, 18 * 43800 + (65535LL * 43800 + 32768) / 65536);
 }
 
-// Uncertainty of the bounds: two bins' sigma b / sqrt(3), and the one range sigma that gives
-// the same sigma of rho as independent bounds with sigmas s1 (r1) and s2 (r2), against
-// double precision: sigma_rho^2 = (s2^2 + rho^2 s1^2) / r1^2 = s^2 (1 + rho^2) / r1^2.
-static void test_profile_bounds_sigma_combines_the_two_bounds(void **state)
+// A bound known to two bins (sl_profile.h, "Uncertainty of the bounds"): b / sqrt(3).
+static void test_profile_coarse_sigma_is_two_bins(void **state)
 {
     (void)state;
     assert_int_equal(sl_profile_coarse_sigma_um(43800U), 25288U); // 25,287.5
     assert_int_equal(sl_profile_coarse_sigma_um(0U), 0U);
     assert_int_equal(sl_profile_coarse_sigma_um(1000000U), 577347U); // 577,350.3 (Q16 1/sqrt 3)
-    // equal sigmas: that sigma, exactly
-    assert_int_equal(sl_profile_bounds_sigma_um(3000000U, 3600000U, 12640U, 12640U), 12640U);
-    assert_int_equal(sl_profile_bounds_sigma_um(0U, 0U, 12640U, 25288U), // isqrt: floor
-                     (uint32_t)floor(sqrt((12640.0 * 12640.0 + 25288.0 * 25288.0) / 2.0)));
-    const uint32_t r1s[] = {1500000U, 3000000U, 2400000U, 9000000U, 40000000U};
-    const uint32_t r2s[] = {1550000U, 3600000U, 5100000U, 30000000U, 41000000U};
-    const uint32_t ss[][2] = {{12640U, 25288U}, {25288U, 12640U}, {12640U, 12640U},
-                              {1U, 577347U}, {60000U, 300U}};
-    for (size_t i = 0; i < sizeof r1s / sizeof r1s[0]; i++) {
-        for (size_t j = 0; j < sizeof ss / sizeof ss[0]; j++) {
-            const double r1 = r1s[i], r2 = r2s[i], s1 = ss[j][0], s2 = ss[j][1];
-            const double rho = r2 / r1;
-            const double want = sqrt((s2 * s2 + rho * rho * s1 * s1) / (1.0 + rho * rho));
-            const double got = sl_profile_bounds_sigma_um(r1s[i], r2s[i], ss[j][0], ss[j][1]);
-            // whole-mm ranges and the Q16 weight: within 0.01 % and 1 um
-            assert_true(fabs(got - want) <= 1.0 + 1e-4 * want);
-        }
-    }
 }
 
 // Power of a bin of a straight pole whose lit part starts `d` bins past the foot of its
@@ -746,7 +726,7 @@ int main(void)
         cmocka_unit_test(test_profile_refines_only_the_far_end_of_a_pole_leaning_across_the_beam),
         cmocka_unit_test(test_profile_fill_from_the_log_values),
         cmocka_unit_test(test_profile_refines_r2_within_the_last_bin_of_a_cliff),
-        cmocka_unit_test(test_profile_bounds_sigma_combines_the_two_bounds),
+        cmocka_unit_test(test_profile_coarse_sigma_is_two_bins),
         cmocka_unit_test(test_profile_lead_fill_follows_the_lines_geometry),
         cmocka_unit_test(test_profile_lead_edge_refuses_shapes_no_line_makes),
     };

@@ -46,7 +46,7 @@ run realistic 1.0 "$ROOT/scenes/driveby_realistic.ini" || fail=1
 # moving it did, on 9 frames at Lean +16.95). Every PoleLean frame's in-plane Lean within
 # 4 LeanSigma of the simulator's alpha at its azimuth (lean_sigma_vs_truth.py; before the
 # bounds' own uncertainty, sl_profile.h "Uncertainty of the bounds", up to 9.6 sigmas
-# forwards and 14 reversing; measured now 2.5 and 3.8, 2 of 49 reversing frames beyond 3).
+# forwards and 14 reversing; measured now 2.5 and 3.2, 1 of 49 reversing frames beyond 3).
 "$PY" "$SRC/lean_warning_sides.py" "$DBC" "$OUT/realistic.log" 10 -10 || fail=1
 "$PY" "$SRC/lean_sigma_vs_truth.py" "$DBC" "$OUT/realistic.log" "$OUT/realistic.gt.csv" --max-sigmas 4 || fail=1
 # The tail slope as calibration data: the exit log states the slope this stream self-fitted;
