@@ -65,12 +65,13 @@ static uint8_t raw_level(const sl_tracker_t *tr, int32_t a, int32_t lower)
     return (uint8_t)SL_WARN_NONE;
 }
 
-// `repeat`: the measurement's bounds are identical to the previous one's (a static scene
-// quantised the same way every rotation). Its error is then the same as last time, not a
-// new independent draw, so the variance is not allowed below the measurement's own.
+// `correlated`: the measurement's error is the same as last time, not a new independent
+// draw, so the variance is not allowed below the measurement's own: its bounds are
+// identical to the previous one's (a static scene quantised the same way every rotation),
+// or a bound is coarse (SL_TARGET_COARSE: sl_profile.h, "Uncertainty of the bounds").
 // `restart`: the first measurement from a range profile after the mask's (see "Filter").
 static void filter_update(const sl_tracker_t *tr, sl_track_t *t, int32_t z_cdeg,
-                          uint16_t sigma_cdeg, bool repeat, bool restart)
+                          uint16_t sigma_cdeg, bool correlated, bool restart)
 {
     const uint64_t sz = sigma_cdeg > tr->cfg.min_sigma_cdeg ? sigma_cdeg : tr->cfg.min_sigma_cdeg;
     const uint64_t r = sz * sz;
@@ -83,7 +84,7 @@ static void filter_update(const sl_tracker_t *tr, sl_track_t *t, int32_t z_cdeg,
         const int64_t e = (int64_t)z_cdeg * 256 - t->alpha_q8;
         t->alpha_q8 = sl_fx_sat32(t->alpha_q8 + sl_fx_rshift_round64((int64_t)k * e, 16U));
         uint64_t pn = sl_fx_urshift_round64((65536U - k) * p, 16U);
-        if (repeat && pn < r) {
+        if (correlated && pn < r) {
             pn = r;
         }
         t->var_cdeg2 = sl_fx_usat32((int64_t)(pn == 0U ? 1U : pn));
@@ -249,10 +250,8 @@ static void track_take(sl_tracker_t *tr, sl_track_t *t, const sl_target_t *g, ui
     }
     if (g->incline_flag == (uint8_t)SL_INCLINE_VALID) {
         const bool profiled = (g->flags & SL_TARGET_PROFILE) != 0U;
-        // A coarse bound's error repeats like a repeated bin's (sl_profile.h, "Uncertainty
-        // of the bounds"): the variance floor applies to it too.
-        const bool floor = repeat || (g->flags & SL_TARGET_COARSE) != 0U;
-        filter_update(tr, t, g->alpha_cdeg, g->sigma_cdeg, floor,
+        const bool correlated = repeat || (g->flags & SL_TARGET_COARSE) != 0U;
+        filter_update(tr, t, g->alpha_cdeg, g->sigma_cdeg, correlated,
                       profiled && t->profiled == 0U);
         if (profiled) {
             t->profiled = 1U;
