@@ -38,6 +38,8 @@
 #include <netinet/in.h>
 #include <netinet/tcp.h>
 #include <poll.h>
+#include <sys/ioctl.h>
+#include <linux/sockios.h>
 #include <sys/socket.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -394,6 +396,7 @@ struct Client {
     size_t q_bytes = 0; // bytes queued and not yet sent
     bool streaming = false, stalled = false, close_when_drained = false, dead = false;
     bool rst_on_close = false;
+    uint64_t rst_deadline_us = 0; // --rst-after: RST at the latest then, acknowledged or not
     uint64_t next_byte_us = 0; // --trickle-bps: when the next byte may go
     const char *why = "";
     Player *pl = nullptr;            // the messages this connection plays (nullptr: none)
@@ -624,6 +627,35 @@ uint64_t produce(Client &c, uint64_t now)
     return wake;
 }
 
+// --rst-after: a RST makes the sending kernel discard what it has not yet sent, so a
+// receiver slower than the sender (a loaded machine) would lose the messages before the cut
+// one, which the next connection does not resend. The RST therefore waits until the peer's
+// kernel has acknowledged every byte (SIOCOUTQ 0): what the radar sent before the reset is
+// readable by the client, as the fault means. A peer that never reads gets its RST after
+// RST_WAIT_US all the same.
+constexpr uint64_t RST_POLL_US = 5000;
+constexpr uint64_t RST_WAIT_US = 10000000;
+
+bool peer_has_all(Client &c)
+{
+    const uint64_t now = slp_now_us();
+    if (c.rst_deadline_us == 0) {
+        c.rst_deadline_us = now + RST_WAIT_US;
+    }
+    int unacked = 0;
+    if (ioctl(c.fd, SIOCOUTQ, &unacked) != 0) {
+        return true; // not a TCP socket we can ask: reset now
+    }
+    if (unacked > 0 && now < c.rst_deadline_us) {
+        return false;
+    }
+    if (unacked > 0) {
+        std::fprintf(stderr, "sl-replay: client %" PRIu64 " did not read its last %d bytes in %u s: reset anyway\n",
+                     c.serial, unacked, static_cast<unsigned>(RST_WAIT_US / 1000000u));
+    }
+    return true;
+}
+
 void flush(Client &c)
 {
     const uint32_t bps = c.srv->o.trickle_bps;
@@ -659,6 +691,9 @@ void flush(Client &c)
         }
     }
     if (!c.dead && c.q.empty() && c.close_when_drained) {
+        if (c.rst_on_close && !peer_has_all(c)) {
+            return; // the main loop looks again in RST_POLL_US
+        }
         ++c.srv->closed_by_fault;
         if (c.rst_on_close) {
             const linger lg{1, 0}; // close() sends a RST
@@ -875,6 +910,9 @@ int serve(const ServeOptions &o)
             flush(*c);
             if (o.trickle_bps > 0 && !c->q.empty()) {
                 wake = std::min(wake, c->next_byte_us);
+            }
+            if (!c->dead && c->rst_on_close && c->close_when_drained && c->q.empty()) {
+                wake = std::min(wake, now + RST_POLL_US); // waiting for the peer's acknowledgement
             }
         }
         // Forget closed clients.
