@@ -281,6 +281,7 @@ static sl_profile_bounds_t extract_once(const uint16_t *sum, uint32_t n, uint32_
         }
     }
     r.slope_q8 = (uint16_t)s;
+    r.end_drop = is_cliff(sum, last, frames, s) ? 1U : 0U;
     // No tail at all: the return ends in a cliff (the step after its last bin above the
     // threshold falls by more than two tail slopes), so its last bins are its own. Not at
     // or beyond `cliff_end` (the shadow edge): a pole's own return ends inside the shadow,
@@ -462,6 +463,48 @@ uint32_t sl_profile_coarse_sigma_um(uint32_t bin_um)
 {
     // b / sqrt(3): 37,837 / 65,536 = 0.577346 (1 / sqrt(3) = 0.577350)
     return (uint32_t)(((uint64_t)bin_um * 37837U + 32768U) >> 16);
+}
+
+// Bins of the monotone stretch at `k`: steps of at least one value per bin (per frame), up
+// from `k` towards `lim` (> k) or down towards `lim` (< k), read as rising towards `k`.
+// Used for the ramps of sl_profile.h, "Uncertainty of the bounds".
+static uint32_t ramp_bins(const uint16_t *sum, uint32_t k, uint32_t lim, uint32_t frames)
+{
+    uint32_t n = 0U;
+    if (lim > k) {
+        while (k + n < lim && (uint32_t)sum[k + n + 1U] >= (uint32_t)sum[k + n] + frames) {
+            n++;
+        }
+    } else {
+        while (k - n > lim && (uint32_t)sum[k - n - 1U] >= (uint32_t)sum[k - n] + frames) {
+            n++;
+        }
+    }
+    return n;
+}
+
+// Bins (>= 3, else 0) of the falling ramp that ends in r2 and may be a smear tail: into a
+// cliff, or at the end of a walk over a tail that ends in a drop (a kernel of finite
+// support) when the ramp falls faster in its half nearer r2 (by half a value per bin): a
+// tail flattening towards the pole, which a pole's own return does not do (its power per
+// bin falls fastest right after its brightest point).
+static uint32_t tail_ramp(const uint16_t *sum, const sl_profile_bounds_t *pb, uint32_t frames)
+{
+    const uint32_t n = ramp_bins(sum, pb->i2, pb->i1, frames);
+    if (n < 3U) {
+        return 0U;
+    }
+    if (pb->slope_src == (uint8_t)SL_PROFILE_SLOPE_CLIFF) {
+        return n;
+    }
+    if (pb->end_drop == 0U) {
+        return 0U;
+    }
+    // rates x h (n - h), 32 bits: sums < 2^16, n < 64, frames <= 257
+    const uint32_t h = n / 2U, k = pb->i2, m = k - h;
+    const uint32_t near = (uint32_t)(sum[m] - sum[k]) * (n - h);
+    const uint32_t far = (uint32_t)(sum[k - n] - sum[m]) * h;
+    return 2U * near >= 2U * far + frames * h * (n - h) ? n : 0U;
 }
 
 // The rows of target `t`'s azimuth (slot `si`) and of its two neighbours, when they belong
@@ -677,6 +720,37 @@ uint8_t sl_profile_refine(sl_profile_t *pr, const sl_board_t *board, uint32_t th
                                           board->theta_sigma_cdeg);
             } else {
                 pr->stats.lead_kept++;
+            }
+        }
+        // Ramps (sl_profile.h, "Uncertainty of the bounds"): a smear kernel with a front
+        // part or a finite support, which no tail fit sees, would leave the edges anywhere
+        // along them. The alpha stays; its sigma holds the alpha at the ramps' other ends
+        // (uniform between: the difference / sqrt(3)), or at the fold when the bounds there
+        // give no valid estimate. A slanted pole's r1 is not read here: no ramp at r1.
+        if (res.flag == (uint8_t)SL_INCLINE_VALID) {
+            const uint32_t up = !slant && res.branch == (uint8_t)SL_INCLINE_BRANCH_1
+                                    ? ramp_bins(sum, pb.i1, pb.e, frames)
+                                    : 0U;
+            // A front ramp is a smear of its own: the target's cliff may then end its kernel.
+            const uint32_t down =
+                pr->slope_q8 != 0U || up >= 3U ? tail_ramp(sum, &pb, frames) : 0U;
+            const uint64_t lo1 = (uint64_t)t->r1_um + (up >= 3U ? up * b : 0U);
+            const uint64_t dn2 = (uint64_t)down * b;
+            if (lo1 != t->r1_um || dn2 != 0U) {
+                const sl_incline_result_t far = sl_incline_estimate(
+                    sl_fx_usat32((int64_t)lo1), dn2 < t->r2_um ? t->r2_um - (uint32_t)dn2 : 0U,
+                    &board->geom[t->az], sigma_r, board->theta_sigma_cdeg);
+                const int32_t fold = (sl_incline_bam32_to_cdeg(board->geom[t->az].beta_bam32) -
+                                      sl_incline_bam32_to_cdeg(board->geom[t->az].theta_bam32)) /
+                                     2;
+                const int64_t d = (int64_t)res.alpha_cdeg -
+                                  (far.flag == (uint8_t)SL_INCLINE_VALID ? far.alpha_cdeg : fold);
+                const uint64_t v = (uint64_t)res.sigma_cdeg * res.sigma_cdeg +
+                                   (uint64_t)(d * d + 1) / 3U;
+                const uint32_t sg = sl_fx_isqrt64(v);
+                res.sigma_cdeg = (uint16_t)(sg > UINT16_MAX ? UINT16_MAX : sg);
+                t->flags = (uint16_t)(t->flags | SL_TARGET_COARSE);
+                pr->stats.ramps++;
             }
         }
         t->alpha_cdeg = res.alpha_cdeg;

@@ -109,6 +109,32 @@
 ///   rotation and below it on the next, and the pole is anywhere within the azimuth's beam.
 /// r1's sigma also holds a radius from width (sl_detect_r1_sigma_um: the correction is
 /// uncertain by its own size).
+/// Ramps. The exponential tail the walk removes is one smear shape. A kernel with a front
+/// part (RadaRays' triangular kernel starts 35 % of its width before the target) makes the
+/// leading edge a ramp, and a kernel of finite support (linear in power) ends its tail in
+/// a cliff after a slow decline, which step 3 reads as a return without smear, or which
+/// the walk (when the drop is beyond the shadow edge) leaves where the tail flattens. One
+/// profile cannot tell such a tail from the pole's own bins, so the alpha stays and its
+/// sigma holds the alpha at the ramps' other ends (the edge uniform along the ramp: the
+/// difference / sqrt(3), added in quadrature; the fold when the bounds there give no valid
+/// estimate). A ramp counts from 3 bins (two are the coarse sigma's already), in steps of
+/// at least one value per bin:
+/// - r1, on branch 1 (leaning towards the radar: r1 is the top end, nearest the foot of
+///   the perpendicular, where a pole's own return is strongest and falls from): the bins
+///   over which the profile keeps rising after r1. (On branch 2 a rise to the foot is the
+///   pole's own.)
+/// - r2, in a stream known to smear (`slope_q8` != 0: a tail slope self-fitted or given)
+///   or on a target with a ramp at r1: the bins over which the profile falls into a cliff
+///   read as r2; or into the end of a walk over a tail that ends in a drop (`end_drop`:
+///   finite support), when the ramp falls faster in its half nearer r2 (by half a value
+///   per bin: a tail flattening towards the pole; a pole's own power falls fastest right
+///   after its brightest point). A stream without smear (the noise-free demo) keeps the
+///   board's sigma on its cliffs.
+/// Counted in `stats.ramps`, flagged SL_TARGET_COARSE. On the paper's bench with a 20-bin
+/// triangular kernel, poles of -10 to +10 deg read +22 to +34 deg at a sigma below 1 deg
+/// (DANGER on CAN); their sigma is now 4-13 deg and no level is raised. Exponential and
+/// two-component tails that fade into the floor have no such ramp (Table II and the harder
+/// bench unchanged).
 /// The two sigmas combine as sigma_rho^2 = (s2^2 + rho^2 s1^2) / r1^2 into the one sigma
 /// sl_incline_estimate() takes (sl_incline_bounds_sigma_um), and such a target is flagged
 /// SL_TARGET_COARSE: its error repeats from rotation to rotation, so the tracker does not
@@ -227,6 +253,8 @@ typedef struct sl_profile_bounds {
     uint16_t slope_q8;  ///< tail slope used, 1/256 value per bin (per frame)
     uint8_t slope_src;  ///< SL_PROFILE_SLOPE_*
     uint8_t fail;       ///< sl_profile_fail_t (SL_PROFILE_OK: the fields above are valid)
+    uint8_t end_drop;   ///< 1: the step after the run's last bin falls by more than two
+                        ///< slopes (a cliff, or a smear tail whose kernel ends there)
 } sl_profile_bounds_t;
 
 typedef struct sl_profile_stats {
@@ -241,6 +269,7 @@ typedef struct sl_profile_stats {
     uint32_t assign_full;   ///< targets left without a slot (every slot watches a target)
     uint32_t cal_accepted;  ///< self-fitted slopes taken into the calibration
     uint32_t cal_rejected;  ///< ... refused by the +-30 % gate
+    uint32_t ramps;         ///< targets whose sigma holds a ramp ("Uncertainty of the bounds")
     uint32_t lead_kept;     ///< cliff-ended targets whose leading edge kept the first
                             ///< bin's centre (sl_profile_lead_edge: the shape fits no model)
     uint32_t spatial;       ///< targets refined from one rotation's rows of neighbouring

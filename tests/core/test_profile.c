@@ -709,6 +709,198 @@ static void test_profile_lead_edge_refuses_shapes_no_line_makes(void **state)
     assert_true(f > 32000U && f < 33500U);
 }
 
+// ---- Ramps (sl_profile.h, "Uncertainty of the bounds") ---------------------------------
+
+static sl_incline_geom_t ramp_geom[400];
+
+// paper-bench's geometry (theta 26 deg, beta +3 deg) on every azimuth, rounded like
+// sl::make_geom; range sigma b / sqrt(12).
+static sl_board_t geom_board(void)
+{
+    const double pi = 3.14159265358979323846;
+    const double t = 26.0 * pi / 180.0, b = 3.0 * pi / 180.0;
+    sl_incline_geom_t g;
+    g.cos_theta_q30 = (int32_t)llround(cos(t) * 1073741824.0);
+    g.sin_theta_q30 = (int32_t)llround(sin(t) * 1073741824.0);
+    g.cos_beta_q30 = (int32_t)llround(cos(b) * 1073741824.0);
+    g.sin_beta_q30 = (int32_t)llround(sin(b) * 1073741824.0);
+    g.cos_tb_q30 = (int32_t)llround(cos(t + b) * 1073741824.0);
+    g.sin_tb_q30 = (int32_t)llround(sin(t + b) * 1073741824.0);
+    g.rho_amb_q28 = (uint32_t)llround(268435456.0 / cos((t + b) / 2.0));
+    g.rho_seam_q28 = (uint32_t)llround(268435456.0 / cos(t + b));
+    g.theta_bam32 = (uint32_t)llround(26.0 / 360.0 * 4294967296.0);
+    g.beta_bam32 = (uint32_t)llround(3.0 / 360.0 * 4294967296.0);
+    for (int i = 0; i < 400; i++) {
+        ramp_geom[i] = g;
+    }
+    sl_board_t board = bins_board();
+    board.range_sigma_um = 12644; // 43.8 mm / sqrt(12)
+    board.geom = ramp_geom;
+    return board;
+}
+
+static int g_front = 0, g_back = 18;
+// RadaRays' smear kernel: linear in power, `g_front` bins before the target rising to 1,
+// falling to 0 over `g_back` bins after it (finite support).
+static double k_tri(int j, double level_db)
+{
+    (void)level_db;
+    if (j < 0) {
+        return j < -g_front ? 0.0 : (double)(j + g_front + 1) / (g_front + 1);
+    }
+    return j >= g_back ? 0.0 : 1.0 - (double)j / g_back;
+}
+
+#define RN 128 // a ramp row's bins (the pole at 2.2 m, beyond the profile's 64)
+
+// One row: a pole's own 100 dB on bins [a, b], smeared by `kern` (front part included).
+static void ramp_row(uint8_t *row, uint32_t *bits, int a, int b, kernel_fn kern)
+{
+    double p[RN];
+    for (int k = 0; k < RN; k++) {
+        p[k] = 10.0; // 10 dB floor
+    }
+    const int front = kern == k_tri ? g_front : 0;
+    for (int k = a; k <= b; k++) {
+        for (int j = -front; k + j < RN; j++) {
+            p[k + j] += 1e10 * kern(j, 100.0);
+        }
+    }
+    memset(bits, 0, RN / 8);
+    for (int k = 0; k < RN; k++) {
+        const double v = floor(10.0 * log10(p[k]) + 0.5);
+        row[k] = (uint8_t)(v < 0 ? 0 : (v > 255 ? 255 : v));
+        if (row[k] >= 40U) {
+            bits[k >> 5] |= 1U << (k & 31);
+        }
+    }
+}
+
+// Refines the pole of `row` (az 7, two rows) in a stream that smears (prior slope) or not;
+// `edge`: the shadow edge's bin (0: none). Returns the target; *ramps: stats.ramps.
+static sl_target_t ramp_refine(const uint8_t *row, const uint32_t *bits, uint16_t prior_q8,
+                               uint32_t edge, uint32_t *ramps)
+{
+    sl_profile_cfg_t c;
+    sl_profile_cfg_default(&c);
+    c.prior_slope_q8 = prior_q8;
+    assert_int_equal(sl_profile_init(&pr, 400, 0, &c), SL_OK);
+    sl_profile_row(&pr, 7, row, RN, bits, RN);
+    sl_profile_row(&pr, 7, row, RN, bits, RN);
+    uint16_t first = 0, last = 0;
+    for (uint16_t k = 1; k < RN; k++) {
+        if (row[k] >= 40U && first == 0U) {
+            first = k;
+        }
+        if (row[k] >= 40U) {
+            last = k;
+        }
+    }
+    sl_target_t t = mask_target(7, 6, 3, first, last);
+    t.shadow_slant_um = edge * 43800U;
+    const sl_board_t board = geom_board();
+    assert_int_equal(sl_profile_refine(&pr, &board, 40, &t), SL_PROFILE_OK);
+    *ramps = pr.stats.ramps;
+    return t;
+}
+
+// alpha of the pole's true bounds: bins [a, b] whole.
+static int32_t true_alpha(int a, int b)
+{
+    const sl_board_t board = geom_board();
+    const sl_incline_result_t r = sl_incline_estimate((uint32_t)a * 43800U,
+                                                      (uint32_t)(b + 1) * 43800U, &ramp_geom[7],
+                                                      board.range_sigma_um, 0U);
+    assert_int_equal(r.flag, SL_INCLINE_VALID);
+    return r.alpha_cdeg;
+}
+
+// A smear kernel of finite support (linear in power, RadaRays' shape) ends the tail in a
+// cliff after a slow decline, and with a front part the leading edge is a ramp: the profile
+// reads both as the pole's own bins, so the alpha is far off (a pole of +5 deg at 2.2 m
+// reads +20 to +30). The alpha stays (no model of that kernel here); its sigma covers the
+// ramps, so the truth is within 3 sigma and no warning level is raised (sigma > 3 deg).
+// An exponential tail, a stream not known to smear (the cliff is the pole's own end) and
+// a pole leaning away (its rise to the foot is its own) keep their sigma.
+static void test_profile_ramps_widen_the_sigma_not_the_alpha(void **state)
+{
+    (void)state;
+    uint8_t row[RN];
+    uint32_t bits[RN / 32], ramps = 0;
+    const int32_t truth = true_alpha(50, 57); // +4.48 deg
+    // 1. an 18-bin kernel without a front part: the tail falls slowly, then ends in a cliff
+    g_front = 0;
+    g_back = 18;
+    ramp_row(row, bits, 50, 57, k_tri);
+    const sl_target_t t1 = ramp_refine(row, bits, 845U, 0U, &ramps); // known to smear
+    assert_int_equal(ramps, 1);
+    assert_true(t1.alpha_cdeg > truth + 1500); // +25.35 deg: the tail read as own bins ...
+    assert_true(t1.sigma_cdeg > 300);          // ... with the cliff's ramp in its sigma
+    assert_true(t1.alpha_cdeg - truth <= 3 * (int32_t)t1.sigma_cdeg);
+    assert_true((t1.flags & SL_TARGET_COARSE) != 0U);
+    // not known to smear: the smear piling up over its own bins rises for 3 bins after r1,
+    // a ramp, so the cliff counts too (the same figures)
+    const sl_target_t plain = ramp_refine(row, bits, 0U, 0U, &ramps);
+    assert_int_equal(ramps, 1);
+    assert_int_equal(plain.alpha_cdeg, t1.alpha_cdeg);
+    assert_int_equal(plain.sigma_cdeg, t1.sigma_cdeg);
+    // 2. the same tail ending beyond the shadow edge: the walk over it stops where it
+    //    flattens towards the pole, and the ramp before it falls faster near r2
+    const sl_target_t t2 = ramp_refine(row, bits, 845U, 70U, &ramps);
+    assert_int_equal(ramps, 1);
+    assert_true(t2.sigma_cdeg > 300);
+    assert_true(t2.alpha_cdeg - truth <= 3 * (int32_t)t2.sigma_cdeg);
+    // 3. a front part of 6 bins in a stream not known to smear: on branch 1 the leading
+    //    edge rises for 6 bins, and the cliff 12 bins after the pole's end is a ramp too
+    g_front = 6;
+    g_back = 12;
+    ramp_row(row, bits, 50, 57, k_tri);
+    const sl_target_t t3 = ramp_refine(row, bits, 0U, 0U, &ramps);
+    assert_int_equal(ramps, 1);
+    assert_int_equal(t3.incline_branch, SL_INCLINE_BRANCH_1);
+    assert_true(t3.sigma_cdeg > 300);
+    assert_true(t3.alpha_cdeg - truth <= 3 * (int32_t)t3.sigma_cdeg);
+    // 4. an exponential tail (3.3 dB/bin) of the same pole: no ramp
+    g_decay_db = 3.3;
+    ramp_row(row, bits, 50, 57, k_exp);
+    (void)ramp_refine(row, bits, 845U, 0U, &ramps);
+    assert_int_equal(ramps, 0);
+    // 5. a pole leaning away (own power rising by 8 dB a bin to its foot, an exponential
+    //    tail): its rise is its own (branch 2), no ramp
+    uint16_t sum[NB];
+    double foot[6];
+    for (int i = 0; i < 6; i++) {
+        foot[i] = 60.0 + 8.0 * i;
+    }
+    synth(sum, 1, 10, 15, foot, k_exp);
+    memset(row, 0, sizeof row);
+    memset(bits, 0, sizeof bits);
+    for (int k = 0; k < NB; k++) {
+        row[k + 40] = (uint8_t)sum[k];
+    }
+    for (int k = 0; k < RN; k++) {
+        if (row[k] >= 40U) {
+            bits[k >> 5] |= 1U << (k & 31);
+        }
+    }
+    const sl_target_t t5 = ramp_refine(row, bits, 845U, 0U, &ramps);
+    assert_int_equal(ramps, 0);
+    assert_int_equal(t5.incline_branch, SL_INCLINE_BRANCH_2);
+    // 6. no smear (the noise-free demo): own bins falling one value a bin into a cliff keep
+    //    the board's sigma; the same bins in a stream known to smear are a ramp
+    memset(row, 0, sizeof row);
+    memset(bits, 0, sizeof bits);
+    for (int k = 50; k <= 57; k++) {
+        row[k] = (uint8_t)(110 - (k - 50));
+        bits[k >> 5] |= 1U << (k & 31);
+    }
+    const sl_target_t t6 = ramp_refine(row, bits, 0U, 0U, &ramps);
+    assert_int_equal(ramps, 0);
+    assert_int_equal(t6.flags & SL_TARGET_COARSE, 0);
+    (void)ramp_refine(row, bits, 845U, 0U, &ramps);
+    assert_int_equal(ramps, 1);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -729,6 +921,7 @@ int main(void)
         cmocka_unit_test(test_profile_coarse_sigma_is_two_bins),
         cmocka_unit_test(test_profile_lead_fill_follows_the_lines_geometry),
         cmocka_unit_test(test_profile_lead_edge_refuses_shapes_no_line_makes),
+        cmocka_unit_test(test_profile_ramps_widen_the_sigma_not_the_alpha),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
