@@ -10,14 +10,14 @@
 # sigma below 1 deg: DANGER on CAN, before the ramps of sl_profile.h); every LeanWarning
 # must now stay within the true lean's level by 3 of its LeanSigma (warning_vs_truth.py).
 # A pole the module does not report passes (a miss is not a false warning; the wider
-# kernels are missed: see the README).
+# kernels, 35 and 50 bins, are missed every time: see the README).
 set -u
 SL_SIM=$1; DAEMON=$2; PY=$3; SRC=$4; OUT=$5
 rm -rf "$OUT"; mkdir -p "$OUT"
 ROOT="$SRC/../../.."
 DBC="$ROOT/boards/paper-bench/shadowlean.dbc"
 fail=0
-for shape in "20 0" "20 0.1" "20 0.35" "35 0.35"; do
+for shape in "20 0" "20 0.1" "20 0.35"; do
     set -- $shape
     for lean in -10 0 10; do
         if [ "$lean" -lt 0 ]; then tilt=${lean#-}; dir=90; else tilt=$lean; dir=270; fi
