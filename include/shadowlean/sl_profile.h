@@ -132,9 +132,9 @@
 ///   board's sigma on its cliffs.
 /// Counted in `stats.ramps`, flagged SL_TARGET_COARSE. On the paper's bench with a 20-bin
 /// triangular kernel, poles of -10 to +10 deg read +22 to +34 deg at a sigma below 1 deg
-/// (DANGER on CAN); their sigma is now 4-13 deg and no level is raised. Exponential and
-/// two-component tails that fade into the floor have no such ramp (Table II and the harder
-/// bench unchanged).
+/// (DANGER on CAN); their sigma is now 4-15 deg and no level is raised. Exponential and
+/// two-component tails that fade into the floor have no such ramp (the reduced Table II
+/// and harder-bench runs are unchanged).
 /// The two sigmas combine as sigma_rho^2 = (s2^2 + rho^2 s1^2) / r1^2 into the one sigma
 /// sl_incline_estimate() takes (sl_incline_bounds_sigma_um), and such a target is flagged
 /// SL_TARGET_COARSE: its error repeats from rotation to rotation, so the tracker does not
