@@ -20,14 +20,7 @@ import sys
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "..", "..", "scripts"))
 import sl_can_decode as scd  # noqa: E402
-
-LEVELS = {"NONE": 0, "CAUTION": 1, "DANGER": 2}
-
-
-def true_level(lean, caution=5.0, danger=10.0):
-    if lean >= danger:
-        return 2
-    return 1 if abs(lean) >= caution else 0
+from warning_vs_truth import LEVELS, allowed_level, warning_frames  # noqa: E402
 
 
 def main(argv):
@@ -40,15 +33,9 @@ def main(argv):
     seen = {"right": 0, "left": 0}
     bad = 0
     worst, worst_sig = 0.0, 0.0
-    for f in scd.read_candump(args[1]):
-        d = scd.decode(db, f.can_id, f.is_eff, f.data)
-        if d is None or d.name != "LeanWarning":
-            continue
-        if not d.crc_ok:
-            print("bad CRC:", f)
+    for f, d in warning_frames(db, args[1]):
+        if d is None:
             bad += 1
-            continue
-        if int(d.raw["HasTarget"]) == 0:
             continue
         side = "right" if d.phys["Azimuth"] < 180.0 else "left"
         seen[side] += 1
@@ -57,8 +44,7 @@ def main(argv):
         err = abs(lean - truth[side])
         worst = max(worst, err)
         worst_sig = max(worst_sig, err / sig if sig > 0 else 0.0)
-        allowed = max(true_level(truth[side] - 3.0 * sig), true_level(truth[side] + 3.0 * sig))
-        if level > allowed:
+        if level > allowed_level(truth[side], sig):
             bad += 1
             print("FAIL %s pole (true lean %+.1f): Level=%s Lean=%+.2f LeanSigma=%.1f at t=%.3f"
                   % (side, truth[side], d.named["Level"], lean, sig, f.t))

@@ -22,6 +22,36 @@ import sl_can_decode as scd  # noqa: E402
 LEVELS = {"NONE": 0, "CAUTION": 1, "DANGER": 2}
 
 
+def level_of(lean, caution=5.0, danger=10.0):
+    """The board's rule: DANGER for a lean towards of `danger` deg or more, CAUTION at
+    |lean| >= `caution`."""
+    if lean >= danger:
+        return 2
+    return 1 if abs(lean) >= caution else 0
+
+
+def allowed_level(truth, sigma, caution=5.0, danger=10.0):
+    """The highest level of a lean within 3 sigma of `truth`, either way."""
+    return max(level_of(truth - 3.0 * sigma, caution, danger),
+               level_of(truth + 3.0 * sigma, caution, danger))
+
+
+def warning_frames(db, log):
+    """(frame, decoded) for every LeanWarning frame of candump `log` with a target; a frame
+    with a bad CRC is printed and yielded as (frame, None)."""
+    for f in scd.read_candump(log):
+        d = scd.decode(db, f.can_id, f.is_eff, f.data)
+        if d is None or d.name != "LeanWarning":
+            continue
+        if not d.crc_ok:
+            print("bad CRC:", f)
+            yield f, None
+            continue
+        if int(d.raw["HasTarget"]) == 0:
+            continue
+        yield f, d
+
+
 def main(argv):
     if len(argv) not in (4, 6):
         print(__doc__)
@@ -29,31 +59,18 @@ def main(argv):
     db = scd.load_dbc(argv[1])
     truth = float(argv[3])
     caution, danger = (float(argv[4]), float(argv[5])) if len(argv) == 6 else (5.0, 10.0)
-
-    def level_of(lean):
-        if lean >= danger:
-            return 2
-        return 1 if abs(lean) >= caution else 0
-
     frames = bad = top = 0
     worst_sig = 0.0
-    for f in scd.read_candump(argv[2]):
-        d = scd.decode(db, f.can_id, f.is_eff, f.data)
-        if d is None or d.name != "LeanWarning":
-            continue
-        if not d.crc_ok:
-            print("bad CRC:", f)
+    for f, d in warning_frames(db, argv[2]):
+        if d is None:
             bad += 1
-            continue
-        if int(d.raw["HasTarget"]) == 0:
             continue
         frames += 1
         lean, sig = d.phys["Lean"], d.phys["LeanSigma"]
         level = LEVELS[d.named["Level"]]
         top = max(top, level)
         worst_sig = max(worst_sig, abs(lean - truth) / sig if sig > 0 else float("inf"))
-        allowed = max(level_of(truth - 3.0 * sig), level_of(truth + 3.0 * sig))
-        if level > allowed:
+        if level > allowed_level(truth, sig, caution, danger):
             bad += 1
             print("FAIL (true lean %+.1f): Level=%s Lean=%+.2f LeanSigma=%.2f at t=%.3f"
                   % (truth, d.named["Level"], lean, sig, f.t))
