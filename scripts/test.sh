@@ -10,16 +10,20 @@
 # Exit status: non-zero when any step fails. Set SL_TEST_ONLY="host aarch64" to run a subset.
 set -eu
 cd "$(dirname "$0")/.."
+T0=$(date +%s)
 sh scripts/deps.sh build test
+echo "=== [deps] $(($(date +%s) - T0)) s"
 STEPS=${SL_TEST_ONLY:-"host host-asan aarch64 s390x cortex-m0 cortex-m4f firmware"}
 JOBS=${SL_JOBS:-2}
 failed=""
 CTLOG=$(mktemp)
 trap 'rm -f "$CTLOG"' EXIT
-run() { # name, command...
+run() { # name, command...: each step's wall time, so a slow step shows in the CI log
     name=$1; shift
     echo "=== [$name] $*"
+    t=$(date +%s)
     if ! "$@"; then failed="$failed $name"; echo "=== [$name] FAILED"; fi
+    echo "=== [$name] $(($(date +%s) - t)) s (suite $(($(date +%s) - T0)) s)"
 }
 run_ctest() { # ctest args...: keeps ctest's summary lines for the closing total
     set +e
