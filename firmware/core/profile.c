@@ -287,7 +287,7 @@ static sl_profile_bounds_t extract_once(const uint16_t *sum, uint32_t n, uint32_
     // or beyond `cliff_end` (the shadow edge): a pole's own return ends inside the shadow,
     // so a drop there ends a smear tail (where it meets the floor, or where the smear's
     // support ends) and the walk from e decides.
-    if (last < cliff_end && is_cliff(sum, last, frames, s)) {
+    if (last < cliff_end && r.end_drop != 0U) {
         r = cliff(i1, last, e);
         r.slope_q8 = (uint16_t)s;
         return r;
