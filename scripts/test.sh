@@ -23,7 +23,8 @@ run() { # name, command...: each step's wall time, so a slow step shows in the C
     echo "=== [$name] $*"
     t=$(date +%s)
     if ! "$@"; then failed="$failed $name"; echo "=== [$name] FAILED"; fi
-    echo "=== [$name] $(($(date +%s) - t)) s (suite $(($(date +%s) - T0)) s)"
+    now=$(date +%s)
+    echo "=== [$name] $((now - t)) s (suite $((now - T0)) s)"
 }
 run_ctest() { # ctest args...: keeps ctest's summary lines for the closing total
     set +e
