@@ -328,6 +328,8 @@ std::string scene_text(const std::string &board, const Case &k, bool realistic, 
 
 // --no-profile: the pipeline's mask bounds with the board's d(r) (no range profiles).
 bool g_no_profile = false;
+// --power-scale (with --realistic): the sensor's value scale (sl::scene_to_power_scale).
+bool g_power_scale = false;
 // The tail slope every --realistic pass starts from (sl_profile_cfg_t.prior_slope_q8): what
 // the calibration pass self-fitted, as a vehicle that has driven before has it saved; 0 with
 // --cold.
@@ -337,8 +339,11 @@ Outcome run_case(const std::string &board_name, const Case &k, bool realistic, i
                  PlotData *plot = nullptr, bool dump = false, FILE *obs_log = nullptr)
 {
     int rotations = 0;
-    const sl::Scene scene =
+    sl::Scene scene =
         sl::parse_scene_string(scene_text(board_name, k, realistic, seed, &rotations), "driveby");
+    if (realistic && g_power_scale) {
+        sl::scene_to_power_scale(scene);
+    }
     sl::Simulator sim(scene);
     const sl_board_t *b = sl_board_find(board_name.c_str());
     if (b == nullptr) {
@@ -531,7 +536,8 @@ bool plot_pass(const std::string &png, const PlotData &d, const Case &k, std::st
 void usage(FILE *out)
 {
     std::fprintf(out,
-                 "usage: sl-eval driveby [--board NAME] [--quick] [--realistic] [--no-profile] [--cold] [--speeds A,B,..]\n"
+                 "usage: sl-eval driveby [--board NAME] [--quick] [--realistic] [--power-scale] [--no-profile] [--cold]\n"
+                 "                       [--speeds A,B,..]\n"
                  "                       [--check] [--plot FILE.png] [--psi DEG] [--phi DEG]\n"
                  "                       [--offset M] [--dump] [--obs-log FILE]\n"
                  "  Simulated drive-bys, one pole per pass, through the core pipeline with the pass's\n"
@@ -547,6 +553,8 @@ void usage(FILE *out)
                  "  and the tail slope its stream self-fitted is every pass's starting value, as a\n"
                  "  vehicle that has driven before has it saved (shadowleand --tail-slope);\n"
                  "  --cold: every pass starts with nothing calibrated.\n"
+                 "  --power-scale (with --realistic): the CTS350-X's value scale (0.5 dB per value,\n"
+                 "  exponential noise), the effects' values per bin kept (sl::scene_to_power_scale).\n"
                  "  --check: exit 1 unless every pole with psi >= 5 is FITTED within the issue's\n"
                  "  bounds (1 deg / 10 deg noise-free; 2 deg / 20 deg with --realistic).\n"
                  "  --plot FILE.png: instead of the sweep, one pass (1 m/s, a pole 3 m left of the\n"
@@ -589,6 +597,8 @@ int cmd_driveby(int argc, char **argv)
             g_no_profile = true;
         } else if (a == "--cold") {
             cold = true;
+        } else if (a == "--power-scale") {
+            g_power_scale = true;
         } else if (a == "--check") {
             check = true;
         } else if (a == "--plot" && i + 1 < argc) {

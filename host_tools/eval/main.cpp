@@ -32,7 +32,7 @@ void usage(FILE *out)
                  "  sl-eval realistic [--quick] [--json] [--json-out FILE] [--positions N] [--reps N] [--frames N]\n"
                  "                   [--calib N] [--range-bins N] [--threads N] [--extract bbox|pipeline|both]\n"
                  "                   [--pipe-last N] [--smear-decay DB] [--speckle-per-frame] [--no-profile]\n"
-                 "                   [--hard] [--hard-set NAME=VALUE]...\n"
+                 "                   [--hard] [--hard-set NAME=VALUE]... [--power-scale]\n"
                  "      Smear, speckle, noise floor, leakage, measured emission, n-frame\n"
                  "      segmentation, poles at 2.2-2.6 m: beside the paper's Table II.\n"
                  "      --extract pipeline|both: also the core pipeline (board paper-bench, speed 0, the\n"
@@ -41,6 +41,9 @@ void usage(FILE *out)
                  "      speckle drawn anew every frame (default frozen); --no-profile: the pipeline's mask\n"
                  "      bounds with the board's d(r) instead of the range-profile bounds; --frames N is\n"
                  "      also the pipeline's window n.\n"
+                 "      --power-scale: rendered on the CTS350-X's value scale (0.5 dB per value, the noise\n"
+                 "      exponential in power; output.log_quantity = power) with the effects' dB halved, so\n"
+                 "      their values per bin are the same (also sl-eval driveby --realistic --power-scale).\n"
                  "      --hard: the harder condition (issue 11): two-component smear (fast_decay_db 3.3 dB/bin\n"
                  "      plus a slow_decay_db 1.5 dB/bin component at slow_db -15 dB; both amp_decay_db 0.5 dB/bin\n"
                  "      slower per 20 dB of level), a one-bin front skirt at front_db -6 dB; speckle_frame_db 1 dB\n"
@@ -60,7 +63,8 @@ void usage(FILE *out)
                  "      - = stdin). --extract pipeline: the core pipeline (beam, threshold and speed from\n"
                  "      --scene, or the options); --calibration: on the board's calibrated view (a vehicle's\n"
                  "      INI or blob).\n"
-                 "  sl-eval driveby [--board NAME] [--quick] [--realistic] [--no-profile] [--speeds A,B] [--check]\n"
+                 "  sl-eval driveby [--board NAME] [--quick] [--realistic] [--power-scale] [--no-profile]\n"
+                 "                  [--speeds A,B] [--check]\n"
                  "                  [--plot FILE.png] [--psi DEG] [--phi DEG] [--offset M] [--dump]\n"
                  "                  [--obs-log FILE] [--cold]\n"
                  "      3D tilt (psi, phi, base offset) fitted over simulated drive-bys against the truth.\n"
@@ -206,6 +210,8 @@ int cmd_realistic(int argc, char **argv)
             o.hard = true;
         } else if (a == "--speckle-per-frame") {
             o.speckle_static = 0;
+        } else if (a == "--power-scale") {
+            o.power_scale = true;
         } else if (a == "--no-profile") {
             o.pipe_profile = false;
         } else if (a == "--pipe-last" && i + 1 < argc) {

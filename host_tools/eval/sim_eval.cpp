@@ -545,6 +545,14 @@ std::map<int, PipeEval> PipelineEval::result() const
             }
         }
         if (best < 0) {
+            if (std::getenv("SL_EVAL_PIPE_DEBUG") != nullptr) {
+                std::fprintf(stderr, "rot %d az %d: no target within %d az (%zu in the rotation)\n",
+                             g.rotation, g.azimuth, m_->cfg.assoc_az, it->second.size());
+                for (const auto &t : it->second) {
+                    std::fprintf(stderr, "  az %u bins %u-%u alpha %.2f flag %d tflags 0x%02x\n", t.az,
+                                 t.bin_first, t.bin_last, t.alpha_cdeg / 100.0, t.incline_flag, t.flags);
+                }
+            }
             continue;
         }
         used[g.rotation][static_cast<size_t>(best)] = true;
@@ -570,7 +578,7 @@ std::map<int, PipeEval> PipelineEval::result() const
             const sl_profile_slot_t &sl = p.prof.slot[si];
             if (sl.live == 0U || sl.frames == 0U) continue;
             std::fprintf(stderr, "slot az %u bin0 %u frames %u:", sl.az, sl.bin0, sl.frames);
-            for (uint32_t k = 0; k < 40; k++) std::fprintf(stderr, " %.1f", sl.sum[k] / (double)sl.frames);
+            for (uint32_t k = 0; k < SL_CFG_PROFILE_BINS; k++) std::fprintf(stderr, " %.1f", sl.sum[k] / (double)sl.frames);
             std::fprintf(stderr, "\n");
         }
         const sl_profile_stats_t &ps = p.prof.stats;
@@ -1507,7 +1515,13 @@ RealisticResult run_realistic(const RealisticOptions &o)
     res.reps = o.reps;
     res.hard = o.hard;
     res.hard_cond = o.hard_cond;
-    const HardCondition &hc = res.hard_cond;
+    res.power_scale = o.power_scale;
+    // On the power scale the per-placement return spread keeps its values too (the
+    // acceptance spread was set in values): half the dB (scene_to_power_scale)
+    HardCondition hc = res.hard_cond;
+    if (o.power_scale) {
+        hc.refl_tol_db *= 0.5;
+    }
     const auto t0 = Clock::now();
     const BoardSpec b = load_board("paper-bench");
     const double bin = b.bin_size_m, H = b.radar_height_m;
@@ -1542,6 +1556,9 @@ RealisticResult run_realistic(const RealisticOptions &o)
             s.speckle_static = o.speckle_static;
             if (o.hard) {
                 make_hard(s, hc, cseed);
+            }
+            if (o.power_scale) {
+                scene_to_power_scale(s);
             }
             const Frames f = run_frames(s, o.threads, thr);
             done++;
@@ -1661,6 +1678,9 @@ RealisticResult run_realistic(const RealisticOptions &o)
                 s.speckle_static = o.speckle_static;
                 if (o.hard) {
                     make_hard(s, hc, seed);
+                }
+                if (o.power_scale) {
+                    scene_to_power_scale(s);
                 }
                 s.rotations += std::max(0, o.track_rotations);
                 std::unique_ptr<PipelineEval> pipe;
@@ -1860,6 +1880,10 @@ void print_realistic_pipeline(std::FILE *f, const RealisticResult &r)
                  kPipelineLabel, c.board.c_str(), r.pipe_mask_frames, c.beam_deg,
                  c.threshold >= 0 ? std::to_string(c.threshold).c_str() : "board's", r.positions, r.reps, r.frames,
                  r.pipe_last, c.assoc_az);
+    if (r.power_scale) {
+        std::fprintf(f, "Rendered on the sensor's value scale (--power-scale: 0.5 dB per value, exponential noise;\n"
+                        "the effects' dB halved so their values per bin are the same).\n\n");
+    }
     std::fprintf(f, "%-6s | %-18s | %-33s | %-33s | %-8s | %s\n", "true", "paper mean / std",
                  "core pipeline raw: mean / std", "core pipeline filtered: mean / std", "detected",
                  "rotations with target / checked; targets valid/amb/other; unmatched; n_eff");

@@ -336,6 +336,8 @@ struct RealisticOptions {
                                 ///< tracker then sees several rotations of the same pole)
     bool hard = false;          ///< the harder condition (HardCondition; sl-eval realistic --hard)
     HardCondition hard_cond;    ///< its parameters (defaults: the documented condition)
+    bool power_scale = false;   ///< the sensor's value scale (scene_to_power_scale; sl-eval
+                                ///< realistic --power-scale)
 };
 
 
@@ -379,6 +381,7 @@ struct RealisticResult {
     unsigned pipe_mask_frames = 0; ///< board n (paper-bench)
     bool hard = false;          ///< the harder condition was run
     HardCondition hard_cond;
+    bool power_scale = false;   ///< rendered on the sensor's value scale (--power-scale)
 };
 
 RealisticResult run_realistic(const RealisticOptions &o);

@@ -266,7 +266,11 @@ Simulator::Simulator(const Scene &scene) : s_(scene)
     // pure-noise magnitude: N = round(|n|), n complex Gaussian, sigma per component
     if (s_.noise) {
         const double sg = std::max(1e-9, s_.noise_sigma);
-        auto F = [&](double x) { return x <= 0 ? 0.0 : 1.0 - std::exp(-x * x / (2 * sg * sg)); };
+        // |n| is Rayleigh, |n|^2 exponential (mean 2 sg^2)
+        auto F = [&](double x) {
+            return x <= 0 ? 0.0
+                          : 1.0 - std::exp(-(s_.log_power ? x : x * x) / (2 * sg * sg));
+        };
         for (int m = 0;; m++) {
             noise_cdf_.push_back(F(m + 0.5));
             const double v = m <= 1 ? 0.0 : std::round(s_.log_db_per_decade * std::log10(m));
@@ -845,7 +849,9 @@ void Simulator::map_column(int k, int i, const SimColumn &col, uint8_t *out) con
     }
     // log-magnitude mapping with leakage and noise
     const double c = s_.log_db_per_decade;
-    const double n_ref = std::pow(10.0, s_.log_ref_value / c);
+    // N = round(|a|) (magnitude) or round(|a|^2) (power): |a| at the reference energy
+    const double n_ref = s_.log_power ? std::pow(10.0, s_.log_ref_value / (2 * c))
+                                      : std::pow(10.0, s_.log_ref_value / c);
     for (int j = 0; j < nb; j++) {
         const double r = (j + 0.5) * bin;
         double aL = 0;
@@ -863,7 +869,8 @@ void Simulator::map_column(int k, int i, const SimColumn &col, uint8_t *out) con
             if (L > 0) {
                 const double jit = sim_normal(sim_hash(s_.seed, kSaltLeak, static_cast<uint64_t>(i),
                                                        static_cast<uint64_t>(j)));
-                aL = std::max(0.0, std::pow(10.0, L / c) * (1.0 + s_.leak_jitter * jit));
+                aL = std::max(0.0, std::pow(10.0, L / (s_.log_power ? 2 * c : c)) *
+                                       (1.0 + s_.leak_jitter * jit));
             }
         }
         const double Ej = E[static_cast<size_t>(j)];
@@ -901,7 +908,7 @@ void Simulator::map_column(int k, int i, const SimColumn &col, uint8_t *out) con
             re += s_.noise_sigma * sim_normal(hn);
             im += s_.noise_sigma * sim_normal(sim_hash(hn, 1));
         }
-        const long nq = std::lround(std::hypot(re, im));
+        const long nq = std::lround(s_.log_power ? re * re + im * im : std::hypot(re, im));
         const double v = nq <= 1 ? 0.0 : std::round(c * std::log10(static_cast<double>(nq)));
         out[j] = static_cast<uint8_t>(std::min(255.0, v));
     }

@@ -233,7 +233,8 @@ Scene build(const Parsed &p)
     {
         Sec c = sec("output");
         c.only({"amplitude", "mapping", "normalize", "peak_counts", "linear_scale",
-                "detect_floor", "log_db_per_decade", "log_ref_energy", "log_ref_value"});
+                "detect_floor", "log_db_per_decade", "log_quantity", "log_ref_energy",
+                "log_ref_value"});
         s.amplitude = c.choice<AmplitudeModel>(
             "amplitude", s.amplitude,
             {{"integral", AmplitudeModel::Integral}, {"peak", AmplitudeModel::Peak}});
@@ -245,6 +246,8 @@ Scene build(const Parsed &p)
         s.linear_scale = c.real("linear_scale", s.linear_scale, 0, 1e12);
         s.detect_floor = static_cast<int>(c.integer("detect_floor", s.detect_floor, 0, 255));
         s.log_db_per_decade = c.real("log_db_per_decade", s.log_db_per_decade, 1, 100);
+        s.log_power = c.choice<bool>("log_quantity", s.log_power,
+                                     {{"magnitude", false}, {"power", true}});
         s.log_ref_energy = c.real("log_ref_energy", s.log_ref_energy, 1e-12, 1e12);
         s.log_ref_value = c.real("log_ref_value", s.log_ref_value, 1, 255);
     }
@@ -273,7 +276,7 @@ Scene build(const Parsed &p)
         }
         s.speckle_seed = static_cast<uint64_t>(c.integer("speckle_seed", 0, 0, (1LL << 62)));
         s.noise = c.boolean("noise", false);
-        s.noise_sigma = c.real("noise_sigma", s.noise_sigma, 0, 1e6);
+        s.noise_sigma = c.real("noise_sigma", s.log_power ? 1.32 : s.noise_sigma, 0, 1e6);
         s.leakage = c.boolean("leakage", false);
         s.leak_level = c.real("leak_level", s.leak_level, 0, 255);
         s.leak_shoulder = c.real("leak_shoulder", s.leak_shoulder, 0, 255);
@@ -360,6 +363,26 @@ Scene build(const Parsed &p)
 }
 
 } // namespace
+
+void scene_to_power_scale(Scene &s)
+{
+    if (s.log_power) {
+        return;
+    }
+    s.log_power = true;
+    if (s.noise_sigma == 1.62) {
+        s.noise_sigma = 1.32;
+    }
+    s.smear_decay_db *= 0.5;
+    s.smear_slow_db *= 0.5;
+    s.smear_slow_decay_db *= 0.5;
+    s.smear_amp_decay_db *= 0.5;
+    if (s.smear_front_db > -100) {
+        s.smear_front_db *= 0.5;
+    }
+    s.speckle_db *= 0.5;
+    s.speckle_frame_db *= 0.5;
+}
 
 void validate_scene(Scene &s)
 {

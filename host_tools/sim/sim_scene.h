@@ -99,7 +99,10 @@ struct Scene {
     double peak_counts = 250;      ///< Column: the column's maximum energy maps to this
     double linear_scale = 100;     ///< None + Linear: counts per unit energy
     int detect_floor = 1;          ///< Linear: a bin touched by an object reads >= this
-    double log_db_per_decade = 19.8; ///< Log: value = round(c log10(N)), N integer magnitude
+    double log_db_per_decade = 19.8; ///< Log: value = round(c log10(N)), N an integer ...
+    bool log_power = false;        ///< ... power |a|^2 (true: the CTS350-X, 0.5 dB per value,
+                                   ///< exponential noise) or magnitude |a| (false: 1 dB per
+                                   ///< value, Rayleigh noise; the round-1 model, the default)
     double log_ref_energy = 1.0;   ///< Log: this energy (deg^2) ...
     double log_ref_value = 100;    ///< ... reads this value (noise-free)
     // [effects]
@@ -125,7 +128,9 @@ struct Scene {
                                    ///< rotation (1 sigma, dB), on top of the pattern above
     uint64_t speckle_seed = 0;     ///< 0: derived from seed
     bool noise = false;
-    double noise_sigma = 1.62;     ///< complex Gaussian per component: P(round|n| <= 1) = 35 %
+    double noise_sigma = 1.62;     ///< complex Gaussian per component: 35 % of the noise reads
+                                   ///< 0 (P(round N <= 1)); default 1.62 for magnitude, 1.32 for
+                                   ///< power (log_quantity)
     bool leakage = false;
     double leak_level = 38;        ///< output value of the bright band (0 .. leak_edge_m)
     double leak_shoulder = 19;     ///< value of the shoulder
@@ -156,6 +161,16 @@ Scene parse_scene_string(const std::string &text, const std::string &name = "<st
 /// Loads the board (if `s.board` is empty or its name differs), applies the overrides and
 /// checks every field's range and the combinations. Throws SceneError.
 void validate_scene(Scene &s);
+
+/// The CTS350-X's value scale on a log-mapped scene (output.log_quantity = power: 0.5 dB per
+/// value, exponential noise) with the effects' VALUES kept: every dB level and slope of the
+/// smear, the speckle and the return spread is halved, so a smear tail, speckle and
+/// per-placement spread read the same values per bin as on the magnitude scale (their
+/// calibrations, e.g. the paper's d at threshold 40, were made in values); the geometry's
+/// energy ratios (partly lit bins, the elevation pattern, range) read twice the values and
+/// the noise has the real sensor's statistics. noise_sigma 1.62 (the magnitude default)
+/// becomes 1.32 (35 % zeros either way). No-op on a scene already on the power scale.
+void scene_to_power_scale(Scene &s);
 
 /// The scene's range resolution and bins (board values or the overrides).
 double scene_bin_size_m(const Scene &s);
