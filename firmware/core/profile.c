@@ -7,6 +7,7 @@
 #include "shadowlean/sl_profile.h"
 
 #include "bits.h"
+#include "compiler.h"
 #include "shadowlean/sl_thresh.h"
 
 #define SLOPE_MIN_Q8 128U   // 0.5 value per bin
@@ -16,6 +17,7 @@
 #define FIT_MIN_BINS 4U
 #define CAL_GATE_N 4U       // fits before the +-30 % gate applies
 #define LOCAL_BINS 6U       // bins of the local tail fit during the walk
+#define SL_PROFILE_EDGE_RETRIES 8U // walks again after a stop beyond the shadow edge (step 4')
 
 void sl_profile_cfg_default(sl_profile_cfg_t *cfg)
 {
@@ -194,28 +196,34 @@ static uint32_t fit_slope_q8(const uint16_t *sum, uint32_t e, uint32_t m, uint32
 
 // The step after the run's last bin above the threshold falls by more than two tail slopes
 // `s` (Q8 values per bin per frame).
+// 32 bits (no 64-bit multiply helper on the deepest stack chain): the drop x 256 < 2^24, and
+// with s clamped to 2^20 (far above any plausible slope) 2 frames s < 2^31 for frames <= 1023.
 static bool is_cliff(const uint16_t *sum, uint32_t last, uint32_t frames, uint32_t s)
 {
-    return ((int64_t)sum[last] - (int64_t)sum[last + 1U]) * 256 > 2 * (int64_t)frames * (int64_t)s;
+    if (sum[last] <= sum[last + 1U]) {
+        return false;
+    }
+    const uint32_t drop = ((uint32_t)sum[last] - (uint32_t)sum[last + 1U]) * 256U;
+    const uint32_t sc = s > (1UL << 20) ? (uint32_t)(1UL << 20) : s;
+    return drop > 2U * frames * sc;
 }
 
 // A return that ends in a cliff: its last bins are its own (r2 = `last`).
 static sl_profile_bounds_t cliff(uint32_t i1, uint32_t last, uint32_t e)
 {
-    sl_profile_bounds_t r;
-    memset(&r, 0, sizeof r);
-    r.i1 = (uint16_t)i1;
-    r.i2 = (uint16_t)last;
-    r.e = (uint16_t)e;
-    r.slope_src = SL_PROFILE_SLOPE_CLIFF;
-    r.fail = (uint8_t)SL_PROFILE_OK;
+    // every member set (no memset: this sits on the deepest stack chain, sl_pipeline_feed)
+    const sl_profile_bounds_t r = {(uint16_t)i1, (uint16_t)last, (uint16_t)e, 0U,
+                                   (uint8_t)SL_PROFILE_SLOPE_CLIFF, (uint8_t)SL_PROFILE_OK, 0U, 0U};
     return r;
 }
 
 // One extraction; `fit_max` (<= FIT_BINS) caps the size of the tail fit (bins ending at e).
+// `e_cap` caps the tail's end e (the walk's start; UINT32_MAX: none); `tol` (Q8 values x
+// frames) is the noise of one step of the sums beyond rounding (0: a static scene's sums).
 static sl_profile_bounds_t extract_once(const uint16_t *sum, uint32_t n, uint32_t frames,
                                         uint32_t threshold, uint32_t hint, uint32_t cal_slope_q8,
-                                        uint32_t fit_max, uint32_t cliff_end)
+                                        uint32_t fit_max, uint32_t cliff_end, uint32_t e_cap,
+                                        uint32_t tol)
 {
     sl_profile_bounds_t r;
     memset(&r, 0, sizeof r);
@@ -260,6 +268,9 @@ static sl_profile_bounds_t extract_once(const uint16_t *sum, uint32_t n, uint32_
         r.fail = (uint8_t)SL_PROFILE_TAIL_CUT;
         return r;
     }
+    if (e > e_cap) {
+        e = e_cap > i1 ? e_cap : i1;
+    }
     // 3. tail slope: self fit, else the calibration
     uint32_t m = e - i1 + 1U;
     m = m > fit_max ? fit_max : m;
@@ -281,7 +292,9 @@ static sl_profile_bounds_t extract_once(const uint16_t *sum, uint32_t n, uint32_
         }
     }
     r.slope_q8 = (uint16_t)s;
-    r.end_drop = is_cliff(sum, last, frames, s) ? 1U : 0U;
+    // a drop beyond two slopes and the step's noise (one rotation's rows near the noise floor
+    // can fall by three slopes in one step)
+    r.end_drop = is_cliff(sum, last, frames, s + tol / (2U * frames)) ? 1U : 0U;
     // No tail at all: the return ends in a cliff (the step after its last bin above the
     // threshold falls by more than two tail slopes), so its last bins are its own. Not at
     // or beyond `cliff_end` (the shadow edge): a pole's own return ends inside the shadow,
@@ -298,7 +311,8 @@ static sl_profile_bounds_t extract_once(const uint16_t *sum, uint32_t n, uint32_
     j = e;
     while (j > i1) {
         const int64_t dlt = (int64_t)sum[j - 1U] - (int64_t)sum[j]; // x F, values
-        const int64_t lim = (int64_t)frames * ((int64_t)s_loc - (int64_t)(s_loc / 6U)); // Q8
+        const int64_t lim =
+            (int64_t)frames * ((int64_t)s_loc - (int64_t)(s_loc / 6U)) - (int64_t)tol; // Q8
         if (dlt * 256 < lim) {
             // Rounding: 8-bit values of a static scene are not dithered, so a tail step can
             // read up to one value short of the slope; it is still tail when it is short by
@@ -306,9 +320,9 @@ static sl_profile_bounds_t extract_once(const uint16_t *sum, uint32_t n, uint32_
             // least two slopes less one value (the rounding bound of a two-step difference).
             const int64_t f256 = (int64_t)frames * 256;
             const bool pair_after =
-                j + 1U <= e && dlt * 256 > (int64_t)frames * (int64_t)s_loc - f256 &&
+                j + 1U <= e && dlt * 256 > (int64_t)frames * (int64_t)s_loc - f256 - (int64_t)tol &&
                 ((int64_t)sum[j - 1U] - (int64_t)sum[j + 1U]) * 256 >=
-                    2 * (int64_t)frames * (int64_t)s_loc - f256;
+                    2 * (int64_t)frames * (int64_t)s_loc - f256 - (int64_t)tol;
             // A knee between two smear components, while the slope still comes from the
             // first fit (which may straddle it): one shallow step is passed when the step
             // before it and both together fall like the tail; two shallow steps in a row are
@@ -340,23 +354,83 @@ static sl_profile_bounds_t extract_once(const uint16_t *sum, uint32_t n, uint32_
     return r;
 }
 
-sl_profile_bounds_t sl_profile_extract(const uint16_t *sum, uint32_t n, uint32_t frames,
-                                       uint32_t threshold, uint32_t hint, uint32_t cal_slope_q8,
-                                       uint32_t cliff_end)
+// One extraction with the tail's end capped at `e_cap`, and the refit of step 4.
+static sl_profile_bounds_t extract_capped(const uint16_t *sum, uint32_t n, uint32_t frames,
+                                          uint32_t threshold, uint32_t hint, uint32_t cal_slope_q8,
+                                          uint32_t cliff_end, uint32_t e_cap, uint32_t tol)
 {
-    sl_profile_bounds_t r =
-        extract_once(sum, n, frames, threshold, hint, cal_slope_q8, FIT_BINS, cliff_end);
+    sl_profile_bounds_t r = extract_once(sum, n, frames, threshold, hint, cal_slope_q8, FIT_BINS,
+                                         cliff_end, e_cap, tol);
     // The first fit may reach into the pole's own bins when the tail is short: refit on the
     // tail the walk found (when it has >= FIT_MIN_BINS and < FIT_BINS bins) and walk again.
     if (r.fail == (uint8_t)SL_PROFILE_OK && r.slope_src == SL_PROFILE_SLOPE_FIT &&
         (uint32_t)r.i2 + FIT_BINS > r.e && (uint32_t)r.e >= (uint32_t)r.i2 + FIT_MIN_BINS) {
-        const sl_profile_bounds_t r2 =
-            extract_once(sum, n, frames, threshold, hint, cal_slope_q8, (uint32_t)r.e - r.i2,
-                         cliff_end);
+        const sl_profile_bounds_t r2 = extract_once(sum, n, frames, threshold, hint, cal_slope_q8,
+                                                    (uint32_t)r.e - r.i2, cliff_end, e_cap, tol);
         if (r2.fail == (uint8_t)SL_PROFILE_OK) {
             r = r2;
         }
     }
+    return r;
+}
+
+sl_profile_bounds_t sl_profile_extract(const uint16_t *sum, uint32_t n, uint32_t frames,
+                                       uint32_t threshold, uint32_t hint, uint32_t cal_slope_q8,
+                                       uint32_t cliff_end)
+{
+    return sl_profile_extract_noisy(sum, n, frames, threshold, hint, cal_slope_q8, cliff_end, 0U);
+}
+
+sl_profile_bounds_t sl_profile_extract_noisy(const uint16_t *sum, uint32_t n, uint32_t frames,
+                                             uint32_t threshold, uint32_t hint,
+                                             uint32_t cal_slope_q8, uint32_t cliff_end,
+                                             uint32_t tol_q8)
+{
+    // A walk that stops at or beyond the shadow edge stopped on the smear, not on the pole
+    // (a pole's own return ends inside the shadow): typically where a kernel of finite
+    // support ends while its tail is still strong, the tail's last bins bend down (fewer
+    // sources reach them), the first fit over them is too steep and the regular tail before
+    // them reads as the pole's own. The bins from the stop on are tail: walk again from the
+    // bin before it, with a fit that ends there (step 4'), but only where the tail there
+    // falls like a smear tail: within a factor 1/2 .. 3/2 of the stream's calibrated slope
+    // (of the first walk's fit before any calibration; the bend makes that one steeper). A
+    // pole whose own bins reach beyond the edge falls there as it does (slowly), not as the
+    // smear, and stays beyond (SHADOW). Each retry moves the start back by at least one
+    // bin; at most SL_PROFILE_EDGE_RETRIES.
+    // (One call of extract_capped, inlined, and one bounds struct in this frame: a rejected
+    // retry is recomputed from the accepted cap; this sits on the deepest stack chain.)
+    uint32_t cap = UINT32_MAX;     // the accepted cap
+    uint32_t try_cap = UINT32_MAX; // the cap of this pass
+    uint32_t prev_i2 = 0U, k = 0U, ref = 0U;
+    bool redo = false;
+    sl_profile_bounds_t r;
+    for (;;) {
+        r = extract_capped(sum, n, frames, threshold, hint, cal_slope_q8, cliff_end, try_cap,
+                           tol_q8);
+        if (redo) {
+            break;
+        }
+        if (k > 0U && (r.fail != (uint8_t)SL_PROFILE_OK || (uint32_t)r.i2 >= prev_i2 ||
+                       (uint32_t)r.slope_q8 * 2U < ref || (uint32_t)r.slope_q8 * 2U > ref * 3U)) {
+            k--;
+            try_cap = cap;
+            redo = true;
+            continue;
+        }
+        cap = try_cap;
+        if (k == SL_PROFILE_EDGE_RETRIES || r.fail != (uint8_t)SL_PROFILE_OK ||
+            r.slope_src == SL_PROFILE_SLOPE_CLIFF || (uint32_t)r.i2 < cliff_end ||
+            (uint32_t)r.i2 < (uint32_t)r.i1 + FIT_MIN_BINS + 1U) {
+            break;
+        }
+        if (k == 0U) {
+            ref = cal_slope_q8 != 0U ? cal_slope_q8 : r.slope_q8;
+        }
+        prev_i2 = r.i2;
+        try_cap = prev_i2 - 1U;
+        k++;
+    }
+    r.retried = (uint8_t)k;
     return r;
 }
 
@@ -483,6 +557,20 @@ static uint32_t ramp_bins(const uint16_t *sum, uint32_t k, uint32_t lim, uint32_
     return n;
 }
 
+// Bins (>= 3, else 0) over which the profile does not rise into r2 from the bins before
+// it, back towards i1: after a restarted walk (step 4') r2 ends a tail whose first stop lay
+// beyond the shadow edge, and where the restarted walk stops is known only up to where the
+// tail could still go on (a kernel linear in power falls by less than a value per bin near
+// the pole, flat after rounding).
+static uint32_t fall_bins(const uint16_t *sum, uint32_t k, uint32_t lim)
+{
+    uint32_t n = 0U;
+    while (k - n > lim && sum[k - n - 1U] >= sum[k - n]) {
+        n++;
+    }
+    return n >= 3U ? n : 0U;
+}
+
 // Bins (>= 3, else 0) of the falling ramp that ends in r2 and may be a smear tail: into a
 // cliff, or at the end of a walk over a tail that ends in a drop (a kernel of finite
 // support) when the ramp falls faster in its half nearer r2 (by half a value per bin): a
@@ -514,7 +602,7 @@ static uint32_t tail_ramp(const uint16_t *sum, const sl_profile_bounds_t *pb, ui
 // width (1.8 deg), so they hold the same pole at the same ranges with their own speckle.
 // `*bin0` / `*n`: the summed window. @return the rows summed (0: none).
 static uint32_t combine_neighbours(sl_profile_t *pr, const sl_target_t *t, uint8_t si,
-                                   uint32_t *bin0, uint32_t *n)
+                                   uint32_t thr, uint32_t *bin0, uint32_t *n, uint32_t *tol_q8)
 {
     const sl_profile_slot_t *use[3];
     uint32_t k = 0;
@@ -549,6 +637,42 @@ static uint32_t combine_neighbours(sl_profile_t *pr, const sl_target_t *t, uint8
             pr->scratch[j] = (uint16_t)(pr->scratch[j] + use[i]->sum[off + j]);
         }
         frames += use[i]->frames;
+    }
+    // The noise of one step of the sum (Q8 values): the rows hold the same pole at the same
+    // ranges, so their steps differ by their noise only (a row's beam gain is an offset, the
+    // shape is common). Over the bins the sum holds above the threshold: the mean range of
+    // the rows' steps, sigma = range / 1.128 (two rows) or / 1.693 (three); the sum's step
+    // sigma is sqrt(k) times that; two of them, less the one value of rounding the walk
+    // allows already. Noise-free rows (neighbours at other gains) agree: 0.
+    // Only behind the sum's brightest bin (the tail: the pole's own bins lie at other ranges
+    // on the neighbours of an oblique pole) and where every row is above the threshold.
+    uint32_t top = 0U;
+    for (uint32_t j = 1; j < hi - lo; j++) {
+        top = pr->scratch[j] > pr->scratch[top] ? j : top;
+    }
+    uint32_t acc = 0U, cnt = 0U;
+    for (uint32_t j = top + 1U; j < hi - lo; j++) {
+        int32_t mn = INT32_MAX, mx = INT32_MIN;
+        bool all = true;
+        for (uint32_t i = 0; i < k; i++) {
+            const uint32_t off = lo - use[i]->bin0;
+            const uint32_t a = use[i]->sum[off + j - 1U], b = use[i]->sum[off + j];
+            all = all && b >= use[i]->frames * thr;
+            const int32_t d = (int32_t)a - (int32_t)b;
+            mn = d < mn ? d : mn;
+            mx = d > mx ? d : mx;
+        }
+        if (!all) {
+            break; // the tail's end on one row
+        }
+        acc += (uint32_t)(mx - mn);
+        cnt++;
+    }
+    *tol_q8 = 0U;
+    if (cnt != 0U) {
+        const uint32_t f = k == 2U ? 642U : 524U; // 2 sqrt(k) / E[range of k normals] x 256
+        const uint32_t w = (acc * f) / cnt;
+        *tol_q8 = w > frames * 256U ? w - frames * 256U : 0U;
     }
     *bin0 = lo;
     *n = hi - lo;
@@ -598,6 +722,42 @@ static uint32_t lead_delta_q16(const sl_incline_result_t *res, const sl_incline_
     return d >= SL_PROFILE_LEAD_END_Q16 ? SL_PROFILE_LEAD_END_Q16 : (uint32_t)d;
 }
 
+// A target the profile could not check, in a stream known to smear (SL_PROFILE_CAL_SMEAR_N
+// self-fits, or a prior): its r2 is the mask's, the threshold crossing of a tail shortened by
+// the board's d(r), a prior and not a measurement (a board without d keeps the whole tail).
+// r2 is then known only to lie between r1 and that end: its sigma the extent / sqrt(12), at
+// least the elongation applied and a bin, so alpha's sigma holds what the unremoved or
+// overcorrected tail can do, the target is COARSE (its error
+// repeats) and no warning level is raised on it (sl_track.h: levels rise only at a filtered
+// sigma <= max_sigma). Alpha is unchanged.
+static SL_NOINLINE void widen_unverified(const sl_profile_t *pr, const sl_board_t *board,
+                                         sl_target_t *t)
+{
+    if ((pr->cal_n < SL_PROFILE_CAL_SMEAR_N && pr->cfg.prior_slope_q8 == 0U) ||
+        board->geom == NULL || t->incline_flag != (uint8_t)SL_INCLINE_VALID) {
+        return;
+    }
+    // r2 anywhere between r1 and the mask's end (uniform: the extent / sqrt(12)), at least
+    // the correction d applied and a bin
+    uint32_t s2 = t->r2_um > t->r1_um
+                      ? (uint32_t)(((uint64_t)(t->r2_um - t->r1_um) * 37837U) >> 17)
+                      : 0U;
+    if (t->elong_um > 0 && (uint32_t)t->elong_um > s2) {
+        s2 = (uint32_t)t->elong_um;
+    }
+    if (s2 < board->bin_size_um) {
+        s2 = board->bin_size_um;
+    }
+    const uint32_t s1 = sl_detect_r1_sigma_um(t, board->range_sigma_um);
+    const uint32_t sigma_r = sl_incline_bounds_sigma_um(t->r1_um, t->r2_um, s1, s2);
+    const sl_incline_result_t res = sl_incline_estimate(t->r1_um, t->r2_um, &board->geom[t->az],
+                                                        sigma_r, board->theta_sigma_cdeg);
+    if (res.flag == (uint8_t)SL_INCLINE_VALID && res.sigma_cdeg > t->sigma_cdeg) {
+        t->sigma_cdeg = res.sigma_cdeg;
+    }
+    t->flags = (uint16_t)(t->flags | SL_TARGET_COARSE);
+}
+
 uint8_t sl_profile_refine(sl_profile_t *pr, const sl_board_t *board, uint32_t threshold,
                           sl_target_t *t)
 {
@@ -608,6 +768,7 @@ uint8_t sl_profile_refine(sl_profile_t *pr, const sl_board_t *board, uint32_t th
                                 ? (uint8_t)SL_PROFILE_LEAD_CUT
                                 : (uint8_t)SL_PROFILE_NO_SLOT;
         pr->stats.fallback[why]++;
+        widen_unverified(pr, board, t);
         return why;
     }
     const sl_profile_slot_t *s = &pr->slot[si];
@@ -615,13 +776,15 @@ uint8_t sl_profile_refine(sl_profile_t *pr, const sl_board_t *board, uint32_t th
     uint32_t frames = s->frames;
     uint32_t bin0 = s->bin0;
     uint32_t n = SL_CFG_PROFILE_BINS;
+    uint32_t tol = 0U;
     bool spatial = false;
     if (frames < pr->cfg.min_frames) {
         // Too few rotations summed (moving: cleared every rotation): this rotation's rows
         // of the neighbouring azimuths of the group, aligned on their bins.
-        frames = combine_neighbours(pr, t, si, &bin0, &n);
+        frames = combine_neighbours(pr, t, si, threshold, &bin0, &n, &tol);
         if (frames < pr->cfg.min_frames) {
             pr->stats.fallback[SL_PROFILE_FEW_FRAMES]++;
+            widen_unverified(pr, board, t);
             return (uint8_t)SL_PROFILE_FEW_FRAMES;
         }
         sum = pr->scratch;
@@ -641,10 +804,11 @@ uint8_t sl_profile_refine(sl_profile_t *pr, const sl_board_t *board, uint32_t th
         slant && t->occupied != 0U && (uint32_t)t->bin_last + 1U >= (uint32_t)t->occupied
             ? (uint32_t)t->bin_last + 1U - t->occupied
             : t->bin_first;
-    const sl_profile_bounds_t pb = sl_profile_extract(sum, n, frames, threshold, first - bin0,
-                                                      pr->slope_q8, cliff_end);
+    const sl_profile_bounds_t pb = sl_profile_extract_noisy(sum, n, frames, threshold, first - bin0,
+                                                            pr->slope_q8, cliff_end, tol);
     if (pb.fail != (uint8_t)SL_PROFILE_OK) {
         pr->stats.fallback[pb.fail]++;
+        widen_unverified(pr, board, t);
         return pb.fail;
     }
     if (spatial && pb.slope_src == SL_PROFILE_SLOPE_CLIFF) {
@@ -653,6 +817,7 @@ uint8_t sl_profile_refine(sl_profile_t *pr, const sl_board_t *board, uint32_t th
         // that see an oblique pole at other ranges would end elsewhere: keep the mask's.
         pr->stats.fallback[SL_PROFILE_NO_TAIL]++;
         t->flags = (uint16_t)(t->flags | SL_TARGET_NO_TAIL);
+        widen_unverified(pr, board, t);
         return (uint8_t)SL_PROFILE_NO_TAIL;
     }
     if (pb.slope_src == SL_PROFILE_SLOPE_FIT) {
@@ -732,8 +897,9 @@ uint8_t sl_profile_refine(sl_profile_t *pr, const sl_board_t *board, uint32_t th
                                     ? ramp_bins(sum, pb.i1, pb.e, frames)
                                     : 0U;
             // A front ramp is a smear of its own: the target's cliff may then end its kernel.
-            const uint32_t down =
-                pr->slope_q8 != 0U || up >= 3U ? tail_ramp(sum, &pb, frames) : 0U;
+            const uint32_t down = pb.retried != 0U ? fall_bins(sum, pb.i2, pb.i1)
+                                  : pr->slope_q8 != 0U || up >= 3U ? tail_ramp(sum, &pb, frames)
+                                                                   : 0U;
             const uint64_t lo1 = (uint64_t)t->r1_um + (up >= 3U ? up * b : 0U);
             const uint64_t dn2 = (uint64_t)down * b;
             if (lo1 != t->r1_um || dn2 != 0U) {

@@ -67,6 +67,21 @@
 ///    The bin where the walk stops is the last own bin: r2. When the first fit window
 ///    reached into the pole's own bins (a short tail), the fit is repeated on the tail the
 ///    walk found (>= 4 bins) and the walk done again.
+///    Noisy rows (one rotation's rows of neighbouring azimuths, moving): every step test and
+///    the cliff test of step 3 are widened by two sigmas of one step of the sum, less the
+///    value of rounding already allowed, measured from how much the rows' steps disagree
+///    behind the sum's brightest bin (the rows hold the same tail; a row's beam gain is an
+///    offset): sl_profile_extract_noisy. On the sensor's value scale (0.5 dB per value) a
+///    tail at the threshold is only ~20 dB above an exponential noise floor and its steps
+///    scatter by a value or two; summed rotations of a static scene are not widened.
+/// 4'. A walk that stops at or beyond the shadow edge stopped on the smear, not on the pole
+///    (a pole's own return ends inside the shadow): typically where a kernel of finite
+///    support ends while its tail is still strong, the tail's last bins bend down and the
+///    first fit over them is too steep. The walk restarts from the bin before the stop with a
+///    fit ending there, when that fit falls like a smear tail (1/2 .. 3/2 of the calibrated
+///    slope, or of the first walk's fit before any calibration): a pole whose own bins reach
+///    beyond the edge falls there slowly, stays beyond and is rejected (SHADOW). At most 8
+///    restarts, counted in `retried`.
 /// 5. Result in bins (relative to bin0): i1, i2, the slope used and where it came from.
 /// 6. Sub-bin far edge, only when the return ends in a cliff (no smear tail to separate):
 ///    r2 = the start of the last own bin + its lit fraction (sl_profile_fill_q16 of that
@@ -109,6 +124,13 @@
 ///   rotation and below it on the next, and the pole is anywhere within the azimuth's beam.
 /// r1's sigma also holds a radius from width (sl_detect_r1_sigma_um: the correction is
 /// uncertain by its own size).
+/// Unverified bounds. In a stream known to smear (SL_PROFILE_CAL_SMEAR_N self-fits or a
+/// prior), a target the profile could not check (no slot, too few rows, a cliff in one
+/// rotation's rows, any other fallback) keeps the mask's r2, the threshold crossing of a
+/// tail shortened by the board's d(r): a prior, not a measurement. Its r2 is then known only
+/// to lie between r1 and that end (sigma: the extent / sqrt(12), at least d and a bin), it is
+/// flagged COARSE, and no warning level rises on it
+/// (sl_track.h: levels rise only at a filtered sigma <= max_sigma). Alpha is unchanged.
 /// Ramps. The exponential tail the walk removes is one smear shape. A kernel with a front
 /// part (RadaRays' triangular kernel starts 35 % of its width before the target) makes the
 /// leading edge a ramp, and a kernel of finite support (linear in power) ends its tail in
@@ -255,6 +277,7 @@ typedef struct sl_profile_bounds {
     uint8_t fail;       ///< sl_profile_fail_t (SL_PROFILE_OK: the fields above are valid)
     uint8_t end_drop;   ///< 1: the step after the run's last bin falls by more than two
                         ///< slopes (a cliff, or a smear tail whose kernel ends there)
+    uint8_t retried;    ///< walks restarted after a stop at or beyond the shadow edge (4')
 } sl_profile_bounds_t;
 
 typedef struct sl_profile_stats {
@@ -389,6 +412,15 @@ uint32_t sl_profile_coarse_sigma_um(uint32_t bin_um);
 sl_profile_bounds_t sl_profile_extract(const uint16_t *sum, uint32_t n, uint32_t frames,
                                        uint32_t threshold, uint32_t hint, uint32_t cal_slope_q8,
                                        uint32_t cliff_end);
+
+/// sl_profile_extract on sums whose steps are noisy beyond rounding: `tol_q8` (1/256 value x
+/// frames) widens every step test of the walk and the cliff test (two sigmas of one step of
+/// the sums, less a value; sl_profile_refine measures it while moving from the disagreement
+/// of the neighbouring rows' steps). 0: sl_profile_extract.
+sl_profile_bounds_t sl_profile_extract_noisy(const uint16_t *sum, uint32_t n, uint32_t frames,
+                                             uint32_t threshold, uint32_t hint,
+                                             uint32_t cal_slope_q8, uint32_t cliff_end,
+                                             uint32_t tol_q8);
 
 /// Refine a detected target with the profile of its azimuth (while moving: this rotation's
 /// rows of it and its neighbours, see "While moving"): r1 from the leading edge, r2

@@ -303,13 +303,29 @@ static void test_profile_a_cliff_beyond_the_shadow_edge_ends_a_tail(void **state
     assert_int_equal(r.slope_src, SL_PROFILE_SLOPE_FIT);
     assert_int_equal(r.i1, a);
     assert_int_equal(r.i2, b);
-    // Known limit: a support that ends while the tail is still above T + T/4 bends the
-    // tail's last fitted bins (fewer sources reach them), and the walk stops there. r2 then
-    // stays beyond the edge (a missed pole, rejected as SHADOW), never inside the shadow.
+    // A support that ends while the tail is still above T + T/4 bends the tail's last fitted
+    // bins (fewer sources reach them), and the first walk stops there, beyond the edge. The
+    // walk restarts before the stop when the tail there falls like a smear tail (within 1/2
+    // .. 3/2 of the calibrated slope, or of the first walk's fit with nothing calibrated)
+    // and finds the own bins (step 4').
     g_cut = 20;
     synth(sum, 16, a, b, uni, k_two_cut);
     const sl_profile_bounds_t l = sl_profile_extract(sum, NB, 16, 40U, (uint32_t)a, 0U, (uint32_t)edge);
-    assert_true(l.fail != SL_PROFILE_OK || l.i2 == b || l.i2 >= edge);
+    assert_int_equal(l.fail, SL_PROFILE_OK);
+    assert_true(l.i2 >= b && l.i2 <= b + 1);
+    assert_true(l.retried >= 1U);
+    const sl_profile_bounds_t lc =
+        sl_profile_extract(sum, NB, 16, 40U, (uint32_t)a, r.slope_q8, (uint32_t)edge);
+    assert_int_equal(lc.fail, SL_PROFILE_OK);
+    assert_true(lc.i2 >= b && lc.i2 <= b + 1);
+    // ... not with a calibration the tail before the stop does not follow: r2 then stays
+    // beyond the edge (a missed pole, rejected as SHADOW), never inside the shadow
+    const sl_profile_bounds_t lw =
+        sl_profile_extract(sum, NB, 16, 40U, (uint32_t)a, 3U * r.slope_q8, (uint32_t)edge);
+    assert_true(lw.fail != SL_PROFILE_OK || lw.i2 >= edge);
+    // ... nor without an edge (no stop is beyond it)
+    const sl_profile_bounds_t ln = sl_profile_extract(sum, NB, 16, 40U, (uint32_t)a, 0U, UINT32_MAX);
+    assert_int_equal(ln.retried, 0);
     // a cliff inside the shadow is still the pole's end (a return without smear)
     for (int k = 0; k < NB; k++) {
         sum[k] = (uint16_t)(k >= 8 && k <= 20 ? 16 * (110 - 4 * (k - 8)) : 0);
@@ -804,6 +820,40 @@ static sl_target_t ramp_refine(const uint8_t *row, const uint32_t *bits, uint16_
     return t;
 }
 
+// A target the profile could not check (no slot), in a stream known to smear (a prior
+// slope): its mask r2 carries a tail the board's d(r) only guessed, so its sigma holds that
+// correction (at least a bin) and it is COARSE; the alpha stays. In a stream not known to
+// smear it keeps the board's sigma.
+static void test_profile_unverified_bounds_in_a_smearing_stream_are_coarse(void **state)
+{
+    (void)state;
+    const sl_board_t board = geom_board();
+    for (int known = 0; known < 2; known++) {
+        sl_profile_cfg_t c;
+        sl_profile_cfg_default(&c);
+        c.prior_slope_q8 = known != 0 ? 845U : 0U;
+        assert_int_equal(sl_profile_init(&pr, 400, 0, &c), SL_OK);
+        sl_target_t t = mask_target(7, 6, 3, 50, 66);
+        t.elong_um = 400000; // d(r2) = 0.4 m subtracted from the run's end
+        t.r2_um -= 400000U;
+        const sl_incline_result_t e = sl_incline_estimate(t.r1_um, t.r2_um, &ramp_geom[7],
+                                                          board.range_sigma_um, 0U);
+        assert_int_equal(e.flag, SL_INCLINE_VALID);
+        t.alpha_cdeg = e.alpha_cdeg;
+        t.sigma_cdeg = e.sigma_cdeg;
+        t.incline_flag = e.flag;
+        assert_int_equal(sl_profile_refine(&pr, &board, 40, &t), SL_PROFILE_NO_SLOT);
+        assert_int_equal(t.alpha_cdeg, e.alpha_cdeg);
+        if (known != 0) {
+            assert_true((t.flags & SL_TARGET_COARSE) != 0U);
+            assert_true(t.sigma_cdeg > 300U); // no level is raised on it (max_sigma 3 deg)
+        } else {
+            assert_int_equal(t.flags & SL_TARGET_COARSE, 0);
+            assert_int_equal(t.sigma_cdeg, e.sigma_cdeg);
+        }
+    }
+}
+
 // alpha of the pole's true bounds: bins [a, b] whole.
 static int32_t true_alpha(int a, int b)
 {
@@ -911,6 +961,7 @@ int main(void)
         cmocka_unit_test(test_profile_reports_why_it_cannot_extract),
         cmocka_unit_test(test_profile_keeps_the_own_bins_of_a_return_without_smear),
         cmocka_unit_test(test_profile_a_cliff_beyond_the_shadow_edge_ends_a_tail),
+        cmocka_unit_test(test_profile_unverified_bounds_in_a_smearing_stream_are_coarse),
         cmocka_unit_test(test_profile_slots_follow_the_targets),
         cmocka_unit_test(test_profile_refines_a_target_after_min_frames),
         cmocka_unit_test(test_profile_starts_from_a_saved_tail_slope),
