@@ -402,33 +402,34 @@ sl_profile_bounds_t sl_profile_extract_noisy(const uint16_t *sum, uint32_t n, ui
     uint32_t cap = UINT32_MAX;     // the accepted cap
     uint32_t try_cap = UINT32_MAX; // the cap of this pass
     uint32_t prev_i2 = 0U, k = 0U, ref = 0U;
-    bool redo = false;
+    bool redo = false, done = false;
     sl_profile_bounds_t r;
-    for (;;) {
+    while (!done) {
         r = extract_capped(sum, n, frames, threshold, hint, cal_slope_q8, cliff_end, try_cap,
                            tol_q8);
         if (redo) {
-            break;
-        }
-        if (k > 0U && (r.fail != (uint8_t)SL_PROFILE_OK || (uint32_t)r.i2 >= prev_i2 ||
-                       (uint32_t)r.slope_q8 * 2U < ref || (uint32_t)r.slope_q8 * 2U > ref * 3U)) {
+            done = true; // the accepted pass again
+        } else if (k > 0U && (r.fail != (uint8_t)SL_PROFILE_OK || (uint32_t)r.i2 >= prev_i2 ||
+                              (uint32_t)r.slope_q8 * 2U < ref ||
+                              (uint32_t)r.slope_q8 * 2U > ref * 3U)) {
             k--;
             try_cap = cap;
             redo = true;
-            continue;
+        } else {
+            cap = try_cap;
+            if (k == SL_PROFILE_EDGE_RETRIES || r.fail != (uint8_t)SL_PROFILE_OK ||
+                r.slope_src == SL_PROFILE_SLOPE_CLIFF || (uint32_t)r.i2 < cliff_end ||
+                (uint32_t)r.i2 < (uint32_t)r.i1 + FIT_MIN_BINS + 1U) {
+                done = true;
+            } else {
+                if (k == 0U) {
+                    ref = cal_slope_q8 != 0U ? cal_slope_q8 : r.slope_q8;
+                }
+                prev_i2 = r.i2;
+                try_cap = prev_i2 - 1U;
+                k++;
+            }
         }
-        cap = try_cap;
-        if (k == SL_PROFILE_EDGE_RETRIES || r.fail != (uint8_t)SL_PROFILE_OK ||
-            r.slope_src == SL_PROFILE_SLOPE_CLIFF || (uint32_t)r.i2 < cliff_end ||
-            (uint32_t)r.i2 < (uint32_t)r.i1 + FIT_MIN_BINS + 1U) {
-            break;
-        }
-        if (k == 0U) {
-            ref = cal_slope_q8 != 0U ? cal_slope_q8 : r.slope_q8;
-        }
-        prev_i2 = r.i2;
-        try_cap = prev_i2 - 1U;
-        k++;
     }
     r.retried = (uint8_t)k;
     return r;
@@ -652,15 +653,15 @@ static uint32_t combine_neighbours(sl_profile_t *pr, const sl_target_t *t, uint8
     }
     uint32_t acc = 0U, cnt = 0U;
     for (uint32_t j = top + 1U; j < hi - lo; j++) {
-        int32_t mn = INT32_MAX, mx = INT32_MIN;
+        int32_t mn = 0, mx = 0;
         bool all = true;
         for (uint32_t i = 0; i < k; i++) {
             const uint32_t off = lo - use[i]->bin0;
             const uint32_t a = use[i]->sum[off + j - 1U], b = use[i]->sum[off + j];
             all = all && b >= use[i]->frames * thr;
             const int32_t d = (int32_t)a - (int32_t)b;
-            mn = d < mn ? d : mn;
-            mx = d > mx ? d : mx;
+            mn = (i == 0U || d < mn) ? d : mn;
+            mx = (i == 0U || d > mx) ? d : mx;
         }
         if (!all) {
             break; // the tail's end on one row
@@ -670,8 +671,8 @@ static uint32_t combine_neighbours(sl_profile_t *pr, const sl_target_t *t, uint8
     }
     *tol_q8 = 0U;
     if (cnt != 0U) {
-        const uint32_t f = k == 2U ? 642U : 524U; // 2 sqrt(k) / E[range of k normals] x 256
-        const uint32_t w = (acc * f) / cnt;
+        uint32_t w = acc * ((k == 2U) ? 642U : 524U); // 2 sqrt(k) / E[range of k normals] x 256
+        w /= cnt;
         *tol_q8 = w > frames * 256U ? w - frames * 256U : 0U;
     }
     *bin0 = lo;
@@ -727,9 +728,9 @@ static uint32_t lead_delta_q16(const sl_incline_result_t *res, const sl_incline_
 // the board's d(r), a prior and not a measurement (a board without d keeps the whole tail).
 // r2 is then known only to lie between r1 and that end: its sigma the extent / sqrt(12), at
 // least the elongation applied and a bin, so alpha's sigma holds what the unremoved or
-// overcorrected tail can do, the target is COARSE (its error
-// repeats) and no warning level is raised on it (sl_track.h: levels rise only at a filtered
-// sigma <= max_sigma). Alpha is unchanged.
+// overcorrected tail can do, the target is COARSE (its error repeats) and no warning level
+// is raised on it (sl_track.h: levels rise only at a filtered sigma <= max_sigma). Alpha is
+// unchanged.
 static SL_NOINLINE void widen_unverified(const sl_profile_t *pr, const sl_board_t *board,
                                          sl_target_t *t)
 {
