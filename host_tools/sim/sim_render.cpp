@@ -263,7 +263,8 @@ Simulator::Simulator(const Scene &scene) : s_(scene)
         }
     }
 
-    // pure-noise magnitude: N = round(|n|), n complex Gaussian, sigma per component
+    // pure noise: N = round(|n|) (magnitude) or round(|n|^2) (power, output.log_quantity), n
+    // complex Gaussian, sigma per component
     if (s_.noise) {
         const double sg = std::max(1e-9, s_.noise_sigma);
         // |n| is Rayleigh, |n|^2 exponential (mean 2 sg^2)

@@ -28,7 +28,8 @@
 //   scene), then the range smear kernel on energy (RadaRays' triangular kernel with mode
 //   weight 1, or an exponential tail in dB per bin), near-field leakage (fixed pattern),
 //   complex Gaussian noise, and the sensor's log-magnitude 8-bit mapping
-//   value = round(c log10 N) with N an integer magnitude (Oxford: 0, 6, 9, 12, 14, 15, 17,
+//   value = round(c log10 N) with N an integer magnitude, or with output.log_quantity = power
+//   an integer power (the CTS350-X: 0.5 dB per value, exponential noise) (Oxford: 0, 6, 9, 12, 14, 15, 17,
 //   18 ...; 35 % zeros with the default noise sigma).
 // Randomness is counter-based (seed, rotation, azimuth, bin): rotations can be rendered in
 // any order or in parallel and give identical bytes.
