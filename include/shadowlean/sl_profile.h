@@ -36,8 +36,10 @@
 /// speckle), over the bins all of them cover: three rows, `stats.spatial`. Only to remove a
 /// smear tail: when that sum ends in a cliff (no tail) the mask's bounds are kept (an
 /// oblique pole spans other ranges on the neighbours), counted NO_TAIL. Limits: the walk
-/// (step 4) tolerates noise at the rounding level; with +-2 values of independent noise on
-/// every bin of each row it stops a few bins into the tail (`unit_profile`). With the
+/// (step 4) tolerates noise at the rounding level plus the step noise measured from the
+/// rows' disagreement; with +-2 values of independent noise on every bin of each row and no
+/// such measure (sl_profile_extract) it stops a few bins into the tail (`unit_profile`), and
+/// a noise the rows share (the same scatterers in overlapping beams) is not measured. With the
 /// default 12 slots two tracks are watched in full while moving (5 azimuths each; confirmed
 /// tracks first), the others partly or not (`stats.reserve_full`).
 ///
