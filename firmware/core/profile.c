@@ -540,8 +540,9 @@ uint32_t sl_profile_coarse_sigma_um(uint32_t bin_um)
     return (uint32_t)(((uint64_t)bin_um * 37837U + 32768U) >> 16);
 }
 
-// Bins of the monotone stretch at `k`: steps of at least one value per bin (per frame), up
-// from `k` towards `lim` (> k) or down towards `lim` (< k), read as rising towards `k`.
+// Bins of the monotone stretch at `k`: steps of at least `frames` (one value per bin per
+// frame of the sums; 0: any step that does not fall), up from `k` towards `lim` (> k) or
+// down towards `lim` (< k), read as rising towards `k`.
 // Used for the ramps of sl_profile.h, "Uncertainty of the bounds".
 static uint32_t ramp_bins(const uint16_t *sum, uint32_t k, uint32_t lim, uint32_t frames)
 {
@@ -556,20 +557,6 @@ static uint32_t ramp_bins(const uint16_t *sum, uint32_t k, uint32_t lim, uint32_
         }
     }
     return n;
-}
-
-// Bins (>= 3, else 0) over which the profile does not rise into r2 from the bins before
-// it, back towards i1: after a restarted walk (step 4') r2 ends a tail whose first stop lay
-// beyond the shadow edge, and where the restarted walk stops is known only up to where the
-// tail could still go on (a kernel linear in power falls by less than a value per bin near
-// the pole, flat after rounding).
-static uint32_t fall_bins(const uint16_t *sum, uint32_t k, uint32_t lim)
-{
-    uint32_t n = 0U;
-    while (k - n > lim && sum[k - n - 1U] >= sum[k - n]) {
-        n++;
-    }
-    return n >= 3U ? n : 0U;
 }
 
 // Bins (>= 3, else 0) of the falling ramp that ends in r2 and may be a smear tail: into a
@@ -898,9 +885,18 @@ uint8_t sl_profile_refine(sl_profile_t *pr, const sl_board_t *board, uint32_t th
                                     ? ramp_bins(sum, pb.i1, pb.e, frames)
                                     : 0U;
             // A front ramp is a smear of its own: the target's cliff may then end its kernel.
-            const uint32_t down = pb.retried != 0U ? fall_bins(sum, pb.i2, pb.i1)
-                                  : pr->slope_q8 != 0U || up >= 3U ? tail_ramp(sum, &pb, frames)
-                                                                   : 0U;
+            // After a restarted walk (step 4') r2 ends a tail whose first stop lay beyond the
+            // shadow edge, and where the restarted walk stops is known only up to where the
+            // tail could still go on: the bins over which the profile does not rise into r2
+            // (ramp_bins with no minimum step; a kernel linear in power falls by less than a
+            // value per bin near the pole, flat after rounding), from 3 on.
+            uint32_t down = 0U;
+            if (pb.retried != 0U) {
+                down = ramp_bins(sum, pb.i2, pb.i1, 0U);
+                down = down >= 3U ? down : 0U;
+            } else if (pr->slope_q8 != 0U || up >= 3U) {
+                down = tail_ramp(sum, &pb, frames);
+            }
             const uint64_t lo1 = (uint64_t)t->r1_um + (up >= 3U ? up * b : 0U);
             const uint64_t dn2 = (uint64_t)down * b;
             if (lo1 != t->r1_um || dn2 != 0U) {
