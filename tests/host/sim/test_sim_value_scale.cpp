@@ -16,7 +16,6 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
-#include <filesystem>
 #include <setjmp.h>
 #include <string>
 #include <vector>
@@ -27,6 +26,7 @@ extern "C" {
 #include <cmocka.h>
 }
 
+#include "oxford.h"
 #include "sim_render.h"
 #include "sim_scene.h"
 
@@ -43,11 +43,10 @@ struct Hist {
 Hist oxford_far_range()
 {
     Hist h;
-    std::vector<std::string> files;
-    for (const auto &e : std::filesystem::directory_iterator(std::string(g_dir) + "/radar")) {
-        if (e.path().extension() == ".png") {
-            files.push_back(e.path().string());
-        }
+    std::string err;
+    const std::vector<std::string> files = sl::oxford_list_pngs(g_dir, err);
+    if (files.empty()) {
+        std::fprintf(stderr, "%s\n", err.c_str());
     }
     assert_true(files.size() >= 10U);
     double n = 0;
