@@ -276,7 +276,7 @@ Scene build(const Parsed &p)
         }
         s.speckle_seed = static_cast<uint64_t>(c.integer("speckle_seed", 0, 0, (1LL << 62)));
         s.noise = c.boolean("noise", false);
-        s.noise_sigma = c.real("noise_sigma", s.log_power ? 1.32 : s.noise_sigma, 0, 1e6);
+        s.noise_sigma = c.real("noise_sigma", s.log_power ? kNoiseSigmaPower : s.noise_sigma, 0, 1e6);
         s.leakage = c.boolean("leakage", false);
         s.leak_level = c.real("leak_level", s.leak_level, 0, 255);
         s.leak_shoulder = c.real("leak_shoulder", s.leak_shoulder, 0, 255);
@@ -370,8 +370,8 @@ void scene_to_power_scale(Scene &s)
         return;
     }
     s.log_power = true;
-    if (s.noise_sigma == 1.62) {
-        s.noise_sigma = 1.32;
+    if (s.noise_sigma == Scene().noise_sigma) {
+        s.noise_sigma = kNoiseSigmaPower; // the default's 35 % zeros on the power scale
     }
     s.smear_decay_db *= 0.5;
     s.smear_slow_db *= 0.5;

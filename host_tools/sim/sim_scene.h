@@ -55,6 +55,10 @@ enum class AmplitudeModel { Integral, Peak };
 enum class OutputMapping { Linear, Log };
 enum class Normalize { Column, None };
 
+/// noise_sigma giving the same 35 % of zeros as the magnitude default (1.62) when N is a
+/// power (output.log_quantity = power): 1 - exp(-1.5 / 2 s^2) = 0.35.
+constexpr double kNoiseSigmaPower = 1.32;
+
 struct Scene {
     std::string source;         ///< file it came from ("" when built in code)
     // [scene]
