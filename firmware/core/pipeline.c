@@ -687,11 +687,12 @@ static void on_rot(void *ctx, const sl_scan_rot_t *rot)
         reserve_profiles(p);
     }
     sl_tiltobs_advance(&p->tilt, p->motion_valid, p->speed_mm_s, p->yaw_cdeg_s, p->rotation_us);
-    // Once the stream shows a smear tail (self-fitted on profiles), a target the profile
-    // could not check (no slot, too few rows) carries the tail in its bounds: not a 3D-tilt
-    // observation.
-    p->tilt.verified_only = p->cfg.profile && (p->prof.cal_n >= SL_PROFILE_CAL_SMEAR_N ||
-                                               p->cfg.profile_cfg.prior_slope_q8 != 0U);
+    // Unless the stream is known not to smear (returns seen to end in cliffs, no tail
+    // self-fitted), a target the profile could not check (no slot, too few rows) may carry
+    // a tail in its bounds: not a 3D-tilt observation. From the start of the stream: its
+    // first rotations (the first hits of every track while moving) come before any
+    // evidence either way.
+    p->tilt.verified_only = p->cfg.profile && !sl_profile_clean(&p->prof);
     sl_tiltobs_update(&p->tilt, p->tracker.tracks, p->detect.targets, n_targets);
     // Drift watch (sl_drift.h): one azimuth per rotation, read from the mask's stable row at
     // the rotation's end, joined with its raw tail when the mask's end is settled (stable-free

@@ -17,6 +17,7 @@
 #define FIT_MIN_BINS 4U
 #define CAL_GATE_N 4U       // fits before the +-30 % gate applies
 #define LOCAL_BINS 6U       // bins of the local tail fit during the walk
+#define SPAN_BINS 3U        // steps of the walk's span test (a shallow step among tail steps)
 #define SL_PROFILE_EDGE_RETRIES 8U // walks again after a stop beyond the shadow edge (step 4')
 
 void sl_profile_cfg_default(sl_profile_cfg_t *cfg)
@@ -228,7 +229,7 @@ static sl_profile_bounds_t extract_once(const uint16_t *sum, uint32_t n, uint32_
     sl_profile_bounds_t r;
     memset(&r, 0, sizeof r);
     SL_ASSERT(sum != NULL);
-    if (frames == 0U || n < 2U) {
+    if (frames == 0U || frames > SL_PROFILE_MAX_FRAMES || n < 2U) {
         r.fail = (uint8_t)SL_PROFILE_NO_SLOT;
         return r;
     }
@@ -300,40 +301,58 @@ static sl_profile_bounds_t extract_once(const uint16_t *sum, uint32_t n, uint32_
     // or beyond `cliff_end` (the shadow edge): a pole's own return ends inside the shadow,
     // so a drop there ends a smear tail (where it meets the floor, or where the smear's
     // support ends) and the walk from e decides.
-    if (last < cliff_end && r.end_drop != 0U) {
+    // Nor after a tail: a run whose last FIT_BINS bins fall like the stream's calibrated
+    // slope (within the calibration's +-30 % gate) is a smear tail, whatever ends it (one
+    // rotation's rows near the floor can drop by three slopes in one step).
+    const bool tail_before = r.slope_src == SL_PROFILE_SLOPE_FIT && m == FIT_BINS &&
+                             s * 10U >= cal_slope_q8 * 7U && s * 10U <= cal_slope_q8 * 13U;
+    if (last < cliff_end && r.end_drop != 0U && !tail_before) {
         r = cliff(i1, last, e);
         r.slope_q8 = (uint16_t)s;
         return r;
     }
     // 4. walk back over the tail: bin j is tail while S[j-1] - S[j] >= F (s_loc - s_loc / 6)
     //    (the bin before decays into it like the tail: it holds little power of its own).
+    //    32-bit: frames <= SL_PROFILE_MAX_FRAMES and s_loc <= SLOPE_MAX_Q8 give frames x s_loc
+    //    < 2^23, tol is clamped to 2^24 (beyond it every step passes anyway: 2^16 values x
+    //    frames), sums < 2^16: every term below is within +-2^26.
     uint32_t s_loc = s; // Q8 per frame
+    const int32_t tl = tol > (1UL << 24) ? (int32_t)(1L << 24) : (int32_t)tol;
+    const int32_t f256 = (int32_t)frames * 256;
     j = e;
     while (j > i1) {
-        const int64_t dlt = (int64_t)sum[j - 1U] - (int64_t)sum[j]; // x F, values
-        const int64_t lim =
-            (int64_t)frames * ((int64_t)s_loc - (int64_t)(s_loc / 6U)) - (int64_t)tol; // Q8
+        const int32_t dlt = (int32_t)sum[j - 1U] - (int32_t)sum[j]; // x F, values
+        const int32_t fs = (int32_t)frames * (int32_t)s_loc;      // Q8
+        const int32_t lim = (int32_t)frames * (int32_t)(s_loc - s_loc / 6U) - tl; // Q8
         if (dlt * 256 < lim) {
             // Rounding: 8-bit values of a static scene are not dithered, so a tail step can
             // read up to one value short of the slope; it is still tail when it is short by
             // less than one value and it and the step after it (already walked) fall by at
             // least two slopes less one value (the rounding bound of a two-step difference).
-            const int64_t f256 = (int64_t)frames * 256;
             const bool pair_after =
-                j + 1U <= e && dlt * 256 > (int64_t)frames * (int64_t)s_loc - f256 - (int64_t)tol &&
-                ((int64_t)sum[j - 1U] - (int64_t)sum[j + 1U]) * 256 >=
-                    2 * (int64_t)frames * (int64_t)s_loc - f256 - (int64_t)tol;
+                j + 1U <= e && dlt * 256 > fs - f256 - tl &&
+                ((int32_t)sum[j - 1U] - (int32_t)sum[j + 1U]) * 256 >= 2 * fs - f256 - tl;
             // A knee between two smear components, while the slope still comes from the
             // first fit (which may straddle it): one shallow step is passed when the step
-            // before it and both together fall like the tail; two shallow steps in a row are
-            // the pole's own bins.
+            // before it and both together fall like the tail.
             bool knee = false;
             if (!pair_after && j >= i1 + 2U && j + LOCAL_BINS - 1U > e) {
-                const int64_t d1 = (int64_t)sum[j - 2U] - (int64_t)sum[j - 1U];
-                const int64_t d2 = (int64_t)sum[j - 2U] - (int64_t)sum[j];
+                const int32_t d1 = (int32_t)sum[j - 2U] - (int32_t)sum[j - 1U];
+                const int32_t d2 = (int32_t)sum[j - 2U] - (int32_t)sum[j];
                 knee = d1 * 256 >= lim && d2 * 256 >= 2 * lim;
             }
-            if (!pair_after && !knee) {
+            // Noise on one bin: a shallow step passes when the fall over the (up to)
+            // SPAN_BINS steps that end in it is that of as many tail steps, less a value.
+            // That fall is a difference of two bins, as noisy as one step and SPAN_BINS
+            // times its signal: one bin read high or low no longer ends the walk, while the
+            // pole's own bins before the step (flat, or the leading edge) fall by far less.
+            bool span = false;
+            if (!pair_after && !knee && j >= i1 + 2U) {
+                const uint32_t kk = j - i1 < SPAN_BINS ? j - i1 : SPAN_BINS;
+                const int32_t dk = (int32_t)sum[j - kk] - (int32_t)sum[j];
+                span = dk * 256 >= (int32_t)kk * (lim + tl) - f256 - tl;
+            }
+            if (!pair_after && !knee && !span) {
                 break;
             }
         }
@@ -534,6 +553,13 @@ static void calibrate(sl_profile_t *pr, uint32_t s)
     pr->stats.cal_accepted++;
 }
 
+bool sl_profile_clean(const sl_profile_t *pr)
+{
+    SL_ASSERT(pr != NULL);
+    return pr->clean_n >= SL_PROFILE_CAL_SMEAR_N && pr->cal_n < SL_PROFILE_CAL_SMEAR_N &&
+           pr->cfg.prior_slope_q8 == 0U;
+}
+
 uint32_t sl_profile_coarse_sigma_um(uint32_t bin_um)
 {
     // b / sqrt(3): 37,837 / 65,536 = 0.577346 (1 / sqrt(3) = 0.577350)
@@ -710,19 +736,36 @@ static uint32_t lead_delta_q16(const sl_incline_result_t *res, const sl_incline_
     return d >= SL_PROFILE_LEAD_END_Q16 ? SL_PROFILE_LEAD_END_Q16 : (uint32_t)d;
 }
 
-// A target the profile could not check, in a stream known to smear (SL_PROFILE_CAL_SMEAR_N
-// self-fits, or a prior): its r2 is the mask's, the threshold crossing of a tail shortened by
+// The sigma of `res` when the truth lies anywhere between it and `far` (the bounds at the
+// other end of an interval; the fold when they give no valid estimate), uniform: its own
+// sigma and the difference / sqrt(3) (the RMS about one end), saturated.
+static uint16_t end_sigma(const sl_incline_result_t *res, const sl_incline_result_t *far,
+                          const sl_incline_geom_t *g)
+{
+    const int32_t fold =
+        (sl_incline_bam32_to_cdeg(g->beta_bam32) - sl_incline_bam32_to_cdeg(g->theta_bam32)) / 2;
+    const int64_t d = (int64_t)res->alpha_cdeg -
+                      (far->flag == (uint8_t)SL_INCLINE_VALID ? far->alpha_cdeg : fold);
+    const uint32_t sg = sl_fx_isqrt64((uint64_t)res->sigma_cdeg * res->sigma_cdeg +
+                                      (uint64_t)(d * d + 1) / 3U);
+    return (uint16_t)(sg > UINT16_MAX ? UINT16_MAX : sg);
+}
+
+// A target the profile could not check, in a stream not known to be clean (known to smear:
+// SL_PROFILE_CAL_SMEAR_N self-fits, or a prior; or nothing known yet: fewer than
+// SL_PROFILE_CAL_SMEAR_N returns seen to end in a cliff): its r2 is the mask's, the threshold crossing of a tail shortened by
 // the board's d(r), a prior and not a measurement (a board without d keeps the whole tail).
 // r2 is then known only to lie between r1 and that end: its sigma the extent / sqrt(12), at
 // least the elongation applied and a bin, so alpha's sigma holds what the unremoved or
 // overcorrected tail can do, the target is COARSE (its error repeats) and no warning level
 // is raised on it (sl_track.h: levels rise only at a filtered sigma <= max_sigma). Alpha is
 // unchanged.
+// Cold start: the first rotations of every stream (moving: the first hits of every track,
+// before a slot is reserved for it) come before any evidence either way.
 static SL_NOINLINE void widen_unverified(const sl_profile_t *pr, const sl_board_t *board,
                                          sl_target_t *t)
 {
-    if ((pr->cal_n < SL_PROFILE_CAL_SMEAR_N && pr->cfg.prior_slope_q8 == 0U) ||
-        board->geom == NULL || t->incline_flag != (uint8_t)SL_INCLINE_VALID) {
+    if (sl_profile_clean(pr) || board->geom == NULL || t->incline_flag != (uint8_t)SL_INCLINE_VALID) {
         return;
     }
     // r2 anywhere between r1 and the mask's end (uniform: the extent / sqrt(12)), at least
@@ -738,10 +781,23 @@ static SL_NOINLINE void widen_unverified(const sl_profile_t *pr, const sl_board_
     }
     const uint32_t s1 = sl_detect_r1_sigma_um(t, board->range_sigma_um);
     const uint32_t sigma_r = sl_incline_bounds_sigma_um(t->r1_um, t->r2_um, s1, s2);
-    const sl_incline_result_t res = sl_incline_estimate(t->r1_um, t->r2_um, &board->geom[t->az],
-                                                        sigma_r, board->theta_sigma_cdeg);
-    if (res.flag == (uint8_t)SL_INCLINE_VALID && res.sigma_cdeg > t->sigma_cdeg) {
-        t->sigma_cdeg = res.sigma_cdeg;
+    const sl_incline_geom_t *g = &board->geom[t->az];
+    sl_incline_result_t res =
+        sl_incline_estimate(t->r1_um, t->r2_um, g, sigma_r, board->theta_sigma_cdeg);
+    if (res.flag == (uint8_t)SL_INCLINE_VALID) {
+        // Where alpha is flat in r2 (rho large on branch 1) the linearised sigma says
+        // nothing of the interval: the alpha at its other end (r2 one bin past r1, or the
+        // fold when that gives no valid estimate) bounds it, uniform between (the
+        // difference / sqrt(3) about this end, as the ramps of sl_profile_refine).
+        const uint32_t lo2 = t->r1_um + board->bin_size_um;
+        if (lo2 < t->r2_um) {
+            const sl_incline_result_t far =
+                sl_incline_estimate(t->r1_um, lo2, g, sigma_r, board->theta_sigma_cdeg);
+            res.sigma_cdeg = end_sigma(&res, &far, g);
+        }
+        if (res.sigma_cdeg > t->sigma_cdeg) {
+            t->sigma_cdeg = res.sigma_cdeg;
+        }
     }
     t->flags = (uint16_t)(t->flags | SL_TARGET_COARSE);
 }
@@ -798,6 +854,9 @@ uint8_t sl_profile_refine(sl_profile_t *pr, const sl_board_t *board, uint32_t th
         pr->stats.fallback[pb.fail]++;
         widen_unverified(pr, board, t);
         return pb.fail;
+    }
+    if (pb.slope_src == SL_PROFILE_SLOPE_CLIFF && pr->clean_n < UINT8_MAX) {
+        pr->clean_n++;
     }
     if (spatial && pb.slope_src == SL_PROFILE_SLOPE_CLIFF) {
         // Neighbouring azimuths serve to remove a smear tail. Without one the mask's run is
@@ -903,15 +962,7 @@ uint8_t sl_profile_refine(sl_profile_t *pr, const sl_board_t *board, uint32_t th
                 const sl_incline_result_t far = sl_incline_estimate(
                     sl_fx_usat32((int64_t)lo1), dn2 < t->r2_um ? t->r2_um - (uint32_t)dn2 : 0U,
                     &board->geom[t->az], sigma_r, board->theta_sigma_cdeg);
-                const int32_t fold = (sl_incline_bam32_to_cdeg(board->geom[t->az].beta_bam32) -
-                                      sl_incline_bam32_to_cdeg(board->geom[t->az].theta_bam32)) /
-                                     2;
-                const int64_t d = (int64_t)res.alpha_cdeg -
-                                  (far.flag == (uint8_t)SL_INCLINE_VALID ? far.alpha_cdeg : fold);
-                const uint64_t v = (uint64_t)res.sigma_cdeg * res.sigma_cdeg +
-                                   (uint64_t)(d * d + 1) / 3U;
-                const uint32_t sg = sl_fx_isqrt64(v);
-                res.sigma_cdeg = (uint16_t)(sg > UINT16_MAX ? UINT16_MAX : sg);
+                res.sigma_cdeg = end_sigma(&res, &far, &board->geom[t->az]);
                 t->flags = (uint16_t)(t->flags | SL_TARGET_COARSE);
                 pr->stats.ramps++;
             }

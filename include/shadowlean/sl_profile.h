@@ -56,6 +56,10 @@
 ///    that bin lies at or beyond the shadow edge (`cliff_end`): a pole's own return ends
 ///    inside the shadow (else it is rejected as SHADOW), so a drop there ends a smear tail
 ///    (where it meets the floor, or where the smear's support ends) and the walk decides.
+///    Nor after a tail: when the self fit ran over all 8 bins and its slope is within the
+///    calibration's +-30 % gate of the calibrated slope, the run falls like this stream's
+///    smear tail, and a drop at its end (one rotation's rows near the floor can fall by three
+///    slopes in one step) is where that tail meets the floor: the walk decides.
 /// 4. Walk back from e while the bin before decays into this one like a tail:
 ///    S[j-1] - S[j] >= F (s_loc - s_loc / 6) (a bin is the pole's own when it decays by
 ///    clearly less than the local tail slope). A shallower step is still tail when it is
@@ -63,8 +67,11 @@
 ///    fall by at least 2 s_loc - 1 value (8-bit values of a static scene are not dithered:
 ///    that is the rounding bound), or, while s_loc is still the first fit, when the step
 ///    before it and both together fall like the tail (a knee between two smear
-///    components); two shallow steps in
-///    a row stop the walk. s_loc is the slope fitted on the 6 tail bins nearest to the walk
+///    components), or when the fall over the (up to) 3 steps that end in it is that of as
+///    many tail steps, less one value (a difference of two bins: as noisy as one step, three
+///    times its signal; one bin read high or low by speckle the rows share no longer ends
+///    the walk, while own bins before the step, flat or the leading edge, fall by far
+///    less). s_loc is the slope fitted on the 6 tail bins nearest to the walk
 ///    (j .. j + 5) once there are 6, so a tail that steepens towards the pole is followed.
 ///    The bin where the walk stops is the last own bin: r2. When the first fit window
 ///    reached into the pole's own bins (a short tail), the fit is repeated on the tail the
@@ -126,13 +133,17 @@
 ///   rotation and below it on the next, and the pole is anywhere within the azimuth's beam.
 /// r1's sigma also holds a radius from width (sl_detect_r1_sigma_um: the correction is
 /// uncertain by its own size).
-/// Unverified bounds. In a stream known to smear (SL_PROFILE_CAL_SMEAR_N self-fits or a
-/// prior), a target the profile could not check (no slot, too few rows, a cliff in one
-/// rotation's rows, any other fallback) keeps the mask's r2, the threshold crossing of a
+/// Unverified bounds. In a stream not known to be clean (SL_PROFILE_CAL_SMEAR_N self-fits or
+/// a prior: it smears; before SL_PROFILE_CAL_SMEAR_N returns were seen to end in a cliff
+/// with fewer self-fits: nothing known yet, as at the start of every stream;
+/// sl_profile_clean), a target the profile could not check (no slot, too few rows, a cliff
+/// in one rotation's rows, any other fallback) keeps the mask's r2, the threshold crossing of a
 /// tail shortened by the board's d(r): a prior, not a measurement. Its r2 is then known only
 /// to lie between r1 and that end (sigma: the extent / sqrt(12), at least d and a bin), it is
 /// flagged COARSE, and no warning level rises on it
-/// (sl_track.h: levels rise only at a filtered sigma <= max_sigma). Alpha is unchanged.
+/// (sl_track.h: levels rise only at a filtered sigma <= max_sigma). Alpha is unchanged; its
+/// sigma also holds the alpha at the interval's other end (r2 one bin past r1, or the fold),
+/// uniform between: where alpha is flat in r2 the linearised sigma says nothing of it.
 /// Ramps. The exponential tail the walk removes is one smear shape. A kernel with a front
 /// part (RadaRays' triangular kernel starts 35 % of its width before the target) makes the
 /// leading edge a ramp, and a kernel of finite support (linear in power) ends its tail in
@@ -229,7 +240,8 @@ typedef enum sl_profile_fail {
 
 /// Accepted self-fitted tail slopes (`cal_n`) from which the stream counts as smearing: its
 /// mask bounds then carry a tail (sl_tiltobs_t.verified_only; from the start with a
-/// cfg.prior_slope_q8).
+/// cfg.prior_slope_q8). Returns seen to end in a cliff (`clean_n`) from which, with fewer
+/// fits, it counts as clean (sl_profile_clean).
 #define SL_PROFILE_CAL_SMEAR_N 4U
 
 /// Where the slope of an extraction came from.
@@ -312,7 +324,10 @@ typedef struct sl_profile {
     uint16_t n_live;        ///< slots in use
     uint8_t moving;         ///< the last sl_profile_end_rotation had `reset`: no claims on
                             ///< evidence, only sl_profile_reserve
-    uint8_t pad_[3];
+    uint8_t clean_n;        ///< returns seen to end in a cliff (saturating at 255): with
+                            ///< SL_PROFILE_CAL_SMEAR_N of them and fewer self-fits, a stream
+                            ///< known not to smear ("Unverified bounds")
+    uint8_t pad_[2];
     uint8_t slot_of[SL_CFG_MAX_AZIMUTHS]; ///< slot index per azimuth, SL_PROFILE_NONE
     sl_profile_slot_t slot[SL_CFG_PROFILE_SLOTS];
     uint16_t scratch[SL_CFG_PROFILE_BINS]; ///< neighbours' rows summed (sl_profile_refine)
@@ -403,8 +418,18 @@ bool sl_profile_lead_edge(const uint16_t *sum3, uint32_t frames, uint32_t delta_
 /// constant length per bin (64 bins, Q16).
 #define SL_PROFILE_LEAD_END_Q16 (64UL << 16)
 
+/// Whether the stream is known not to smear: SL_PROFILE_CAL_SMEAR_N returns seen to end in a
+/// cliff (`clean_n`), fewer accepted self-fits and no prior. False at the start of every
+/// stream (nothing known yet) and in a smearing one: bounds the profile did not check are
+/// then unverified (sl_profile.h, "Unverified bounds"; sl_tiltobs_t.verified_only). Pure.
+bool sl_profile_clean(const sl_profile_t *pr);
+
 /// Sigma of a bound known to two bins of `bin_um`: bin_um / sqrt(3), rounded (pure).
 uint32_t sl_profile_coarse_sigma_um(uint32_t bin_um);
+
+/// Most rows a profile sum may hold for sl_profile_extract (a slot's max_frames <= 257, three
+/// neighbours' rows: <= 771): more is SL_PROFILE_NO_SLOT (the arithmetic is 32-bit).
+#define SL_PROFILE_MAX_FRAMES 1023U
 
 /// Smear-aware bounds from a profile (pure; see "Extraction"). `hint` = the mask's first
 /// bin relative to the profile start, `cal_slope_q8` the fallback slope (0: none),

@@ -69,8 +69,9 @@ run reverse -1.0 "$OUT/reverse.ini" || fail=1
 # The realistic drive-by on the sensor's value scale (output.log_quantity = power: 0.5 dB per
 # value, exponential noise; the effects' dB halved so their values per bin stay): no
 # LeanWarning above the true lean's level (before session 14: DANGER on 8 frames for the pole
-# leaning away, Lean +19 at LeanSigma 0.6). Its PoleLean sigmas and 3D fits are not yet
-# within the bounds on this scale (README, "The sensor's value scale").
+# leaning away, Lean +19 at LeanSigma 0.6) and every PoleLean frame within 4 of its LeanSigma
+# of the truth (before session 15: 16 of 46 beyond, up to 25 LeanSigma). Its 3D fits are not
+# yet within the bounds on this scale (README, "The sensor's value scale").
 sed 's/^normalize = none/normalize = none\nlog_quantity = power/; s/^smear_decay_db = 3.3/smear_decay_db = 1.65\nspeckle_db = 1.0/' \
     "$ROOT/scenes/driveby_realistic.ini" > "$OUT/power.ini"
 grep -q '^log_quantity = power' "$OUT/power.ini" && grep -q '^speckle_db = 1.0' "$OUT/power.ini" ||
@@ -79,6 +80,7 @@ grep -q '^log_quantity = power' "$OUT/power.ini" && grep -q '^speckle_db = 1.0' 
 "$D" --board paper-sim --input "$OUT/power.colossus" --motion 1.0 --can-log "$OUT/power.log" -q || fail=1
 echo "== power (the sensor's value scale, --motion 1.0)"
 "$PY" "$SRC/lean_warning_sides.py" "$DBC" "$OUT/power.log" 10 -10 || fail=1
+"$PY" "$SRC/lean_sigma_vs_truth.py" "$DBC" "$OUT/power.log" "$OUT/power.gt.csv" --max-sigmas 4 || fail=1
 # No motion input: no PoleTilt frame (the demo and Oxford frames stay as they were).
 "$D" --board paper-sim --input "$OUT/slow.colossus" --can-log "$OUT/still.log" -q || fail=1
 n=$(grep -c " 624#" "$OUT/still.log")
