@@ -261,10 +261,10 @@ typedef struct sl_profile_cfg {
                              ///< none): this sensor's calibrated slope_q8 saved from an
                              ///< earlier run by the application. Used until the first
                              ///< self-fit replaces it (cal_n stays 0 until then: no gate
-                             ///< against it). A prior says the sensor smears: the pipeline
-                             ///< keeps only profile-checked bounds in the tilt history from
-                             ///< the start (sl_tiltobs_t.verified_only), as after
-                             ///< SL_PROFILE_CAL_SMEAR_N fits. 0 or 128..6144 (0.5..24 values
+                             ///< against it). A prior says the sensor smears: the stream is
+                             ///< never taken as clean (sl_profile_clean), so unchecked bounds
+                             ///< stay unverified and out of the tilt history
+                             ///< (sl_tiltobs_t.verified_only). 0 or 128..6144 (0.5..24 values
                              ///< per bin).
 } sl_profile_cfg_t;
 

@@ -133,10 +133,13 @@ typedef struct sl_tiltobs {
     uint8_t rr;                ///< internal: round-robin start of the fits
     uint8_t pending;           ///< rings with an observation not fitted yet
     bool verified_only;        ///< store only targets whose bounds the range profile checked
-                               ///< (SL_TARGET_PROFILE or _NO_TAIL): set by the pipeline once
-                               ///< the stream shows a smear tail, whose unremoved length in
-                               ///< the mask's bounds reads as a lean (a single such
-                               ///< observation makes a whole pass INCONSISTENT)
+                               ///< (SL_TARGET_PROFILE or _NO_TAIL): set by the pipeline unless
+                               ///< the stream is known not to smear (sl_profile_clean), i.e.
+                               ///< also from the start of a stream, before any evidence: an
+                               ///< unremoved tail in the mask's bounds reads as a lean (a single
+                               ///< such observation makes a whole pass INCONSISTENT: the first
+                               ///< hit of a track on the sensor-scale drive-by, 12 deg off at
+                               ///< a stated 0.4 deg, before the stream had shown its tail)
     sl_tiltobs_stats_t stats;
     sl_tilt_work_t work;       ///< fit scratch
     sl_tiltobs_ring_t ring[SL_CFG_TILT_TRACKS];
