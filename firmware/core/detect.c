@@ -590,12 +590,22 @@ static SL_NOINLINE bool slender_lean(const sl_detect_t *d, const sl_detect_cand_
         if (r->count == 0U) {
             continue;
         }
-        if ((uint32_t)r->count != (uint32_t)r->last - r->first + 1U) {
+        // Whole, but for gaps the smear tail can hold: bins missed near the threshold
+        // behind the own extent (no more than the tail's bins). A weak run leaves no tail
+        // and must be whole.
+        const uint32_t own = own_last(d, c, i);
+        if ((uint32_t)r->count + ((uint32_t)r->last - own) < (uint32_t)r->last - r->first + 1U) {
             return false;
         }
-        const uint32_t own = own_last(d, c, i);
-        if (!first_run && (down ? (r->first > pf + 1U || own > pl + 1U)
-                                : (r->first + 1U < pf || own + 1U < pl))) {
+        // An own last bin estimated from the peak and the tail's end (own < last) is as
+        // noisy as that end: two bins against the direction (one for a first bin, or a run
+        // without a tail: weak clutter's runs have none).
+        uint32_t ot = 1U;
+        if (own < (uint32_t)r->last) {
+            ot = 2U;
+        }
+        if (!first_run && (down ? (r->first > pf + 1U || own > pl + ot)
+                                : (r->first + 1U < pf || own + ot < pl))) {
             return false;
         }
         first_run = false;

@@ -114,10 +114,14 @@
 ///      longest tail its peak can leave, so the own extent is never longer than the truth.
 ///      The tests below use own extents (own last bins; u_own = the largest); without a
 ///      slope or a peak an entry's own extent is its run;
-///    - one line: every run whole (no bridged gap), and the runs step through range one way
-///      (from the first azimuth's run towards the last's), no first or own last bin more
-///      than one bin against that direction (weak clutter along the shadow edge is broken
-///      and wanders; a pole merged with it is lost too);
+///    - one line: every run whole (no bridged gap) but for as many missed bins as its tail
+///      has (last - own last: a smear tail near the threshold dips below it on a noisy
+///      sensor; a run records how many bins it missed, not where), and the runs step through
+///      range one way (from the first azimuth's run towards the last's), no first bin more
+///      than one bin against that direction, no own last bin more than one (a run without a
+///      tail) or two (an own extent estimated from the peak and a noisy tail's end) (weak
+///      clutter along the shadow edge is broken and wanders, and leaves no tail; a pole
+///      merged with it is lost too);
 ///    - thin: its own bins over all its azimuths are at most (u_own - uf + 1) x allowed,
 ///      what a vertical pole of the same range extent leaves (a wall, a car side or a hedge
 ///      fills most of the span on every azimuth and fails, smeared or not: its own runs
