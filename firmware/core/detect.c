@@ -749,7 +749,10 @@ static void finalize(sl_detect_t *d, sl_detect_cand_t *c)
         reason = SL_DETECT_REJ_SHADOW;
     } else if ((c->flags & CF_SPAN) != 0U || (span > allowed && !slant)) {
         reason = SL_DETECT_REJ_WIDE;
-    } else if ((uint32_t)rep->count < (uint32_t)rep->last - rep->first + 1U) {
+    } else if ((uint32_t)rep->count + ((uint32_t)rep->last - own_last(d, c, best)) <
+               (uint32_t)rep->last - rep->first + 1U) {
+        // a gap, but for the bins a smear tail can miss near the threshold (as stage 4's
+        // one line: no more than its tail's bins; a run without a tail must be whole)
         reason = SL_DETECT_REJ_BROKEN;
     } else if (t.bin_last <= t.bin_first) {
         reason = SL_DETECT_REJ_SHORT; // as sl_detect_clutter_reason, before the corrections

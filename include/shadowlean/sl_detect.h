@@ -67,7 +67,9 @@
 ///    can: allowed = floor((D / r1 [rad] + beam) / step) + 1 + `cfg.width_slack_az`;
 ///    but see "Leaning across the line of sight" below: with `slant` set, a slender
 ///    group that a pole leaning across the beam explains is kept, flagged SLANT);
-///    BROKEN (the representative run has a gap);
+///    BROKEN (the representative run has a gap; while the runs' peaks are measured, i.e.
+///    moving with the stream's tail slope known (stage 4), not for as many missed bins as
+///    the tail its peak leaves: a smear tail dips below the threshold on a noisy sensor);
 ///    then the clutter tests (sl_detect_clutter_reason(), after the corrections and alpha):
 ///    SHORT (the representative run is one bin: a speck of gravel or a noise spike, no
 ///    extent to measure); RHO (the incline flag is OUT_OF_DOMAIN, or INVALID / AMBIGUOUS

@@ -766,6 +766,52 @@ static void test_detect_a_noisy_tail_keeps_a_slanted_pole_one_line(void **state)
     assert_int_equal(det.stats.rejected[SL_DETECT_REJ_WIDE], 1);
 }
 
+// BROKEN on a noisy sensor: a vertical pole's run (own bins 70..73 at 100, a tail falling 3
+// values per bin to the threshold: 20 bins) whose tail dips below the threshold at bin 85 is
+// a pole while moving once the stream's tail slope is known (the runs' peaks are measured
+// then, stage 4: the gap is within the tail's bins); without the slope, parked, or for a
+// weak run (a 1-bin tail) with a 2-bin gap, BROKEN.
+static int gapped_run(int level)
+{
+    memset(rows, 0, sizeof rows);
+    memset(amp, 0, sizeof amp);
+    for (int a = 200; a < 203; a++) {
+        smear_piece(a, 70U, 73U, a == 201 ? level : level - 10);
+        sl_bits_put(rows[a], 85, false);
+        amp[a][85] = 39;
+    }
+    return amp_rotation();
+}
+
+static void test_detect_a_gap_in_a_smear_tail_is_not_a_broken_run(void **state)
+{
+    (void)state;
+    assert_int_equal(sl_detect_init(&det, &board, NULL), SL_OK);
+    assert_int_equal(gapped_run(100), 0); // no slope yet: BROKEN
+    assert_int_equal(det.stats.rejected[SL_DETECT_REJ_BROKEN], 1);
+    sl_detect_set_tail_slope(&det, 3U * 256U);
+    assert_int_equal(gapped_run(100), 0); // parked: no peaks measured, BROKEN
+    assert_int_equal(det.stats.rejected[SL_DETECT_REJ_BROKEN], 2);
+    det.slant = true; // moving (the pipeline sets it with a motion input)
+    assert_int_equal(gapped_run(100), 1);
+    assert_int_equal(det.stats.rejected[SL_DETECT_REJ_BROKEN], 2);
+    assert_int_equal(det.targets[0].bin_first, 70);
+    // weak: peak 44, a 1-bin tail: 2 bins missing are not the tail's
+    memset(rows, 0, sizeof rows);
+    memset(amp, 0, sizeof amp);
+    for (int a = 200; a < 203; a++) {
+        set_run(a, 70, 78);
+        sl_bits_put(rows[a], 75, false);
+        sl_bits_put(rows[a], 76, false);
+        for (uint32_t k = 70; k <= 78; k++) {
+            amp[a][k] = k == 75 || k == 76 ? 39 : 44;
+        }
+    }
+    assert_int_equal(amp_rotation(), 0);
+    assert_int_equal(det.stats.rejected[SL_DETECT_REJ_BROKEN] +
+                         det.stats.rejected[SL_DETECT_REJ_WEAK], 3);
+}
+
 // Stage 1 at the shadow edge with amplitude rows (d(S) a prior, not the truth): a pole
 // inside the shadow whose smear tail crosses the edge is kept and flagged TAIL_EDGE; ground
 // beyond the edge joined to it (flat, not decaying), a brighter return beyond the edge (a
@@ -1165,6 +1211,7 @@ int main(void)
         cmocka_unit_test_setup(test_detect_weak_clutter_never_joins_a_pole, setup),
         cmocka_unit_test_setup(test_detect_a_weak_line_is_never_slant, setup),
         cmocka_unit_test_setup(test_detect_a_noisy_tail_keeps_a_slanted_pole_one_line, setup),
+        cmocka_unit_test_setup(test_detect_a_gap_in_a_smear_tail_is_not_a_broken_run, setup),
         cmocka_unit_test_setup(test_detect_a_smeared_pole_leaning_across_the_beam_with_the_tail_slope,
                                setup),
         cmocka_unit_test_setup(test_detect_shadow_edge_tail_is_not_the_ground, setup),
