@@ -753,8 +753,9 @@ static uint16_t end_sigma(const sl_incline_result_t *res, const sl_incline_resul
 
 // A target the profile could not check, in a stream not known to be clean (known to smear:
 // SL_PROFILE_CAL_SMEAR_N self-fits, or a prior; or nothing known yet: fewer than
-// SL_PROFILE_CAL_SMEAR_N returns seen to end in a cliff): its r2 is the mask's, the threshold crossing of a tail shortened by
-// the board's d(r), a prior and not a measurement (a board without d keeps the whole tail).
+// SL_PROFILE_CAL_SMEAR_N returns seen to end in a cliff): its r2 is the mask's, the
+// threshold crossing of a tail shortened by the board's d(r), a prior and not a measurement
+// (a board without d keeps the whole tail).
 // r2 is then known only to lie between r1 and that end: its sigma the extent / sqrt(12), at
 // least the elongation applied and a bin, so alpha's sigma holds what the unremoved or
 // overcorrected tail can do, the target is COARSE (its error repeats) and no warning level
@@ -765,7 +766,8 @@ static uint16_t end_sigma(const sl_incline_result_t *res, const sl_incline_resul
 static SL_NOINLINE void widen_unverified(const sl_profile_t *pr, const sl_board_t *board,
                                          sl_target_t *t)
 {
-    if (sl_profile_clean(pr) || board->geom == NULL || t->incline_flag != (uint8_t)SL_INCLINE_VALID) {
+    if (sl_profile_clean(pr) || board->geom == NULL ||
+        t->incline_flag != (uint8_t)SL_INCLINE_VALID) {
         return;
     }
     // r2 anywhere between r1 and the mask's end (uniform: the extent / sqrt(12)), at least
