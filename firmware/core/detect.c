@@ -562,6 +562,17 @@ static uint32_t own_last(const sl_detect_t *d, const sl_detect_cand_t *c, uint32
     return (uint32_t)r->last >= (uint32_t)r->first + tail ? (uint32_t)r->last - tail : r->first;
 }
 
+// Whether entry `i`'s smear tail (own_last) is at least `missing` bins long: its run may
+// miss that many near the threshold. Without the division: floor((peak - T) 256 / slope)
+// >= m <=> (peak - T) 256 >= m slope (own_last's tail is also capped at last - first, which
+// a run missing bins always exceeds).
+static bool tail_holds(const sl_detect_t *d, const sl_detect_cand_t *c, uint32_t i,
+                       uint32_t missing)
+{
+    const uint32_t t = d->amp_threshold, peak = c->peak[i];
+    return d->peaks && peak > t && (peak - t) * 256U >= missing * (uint32_t)d->tail_slope_q8;
+}
+
 // WIDE exception for a pole leaning across the line of sight (sl_detect.h stage 4, "Leaning
 // across the line of sight"): true when the group of `span` azimuths (wider than a vertical
 // pole at its representative run `rep`) is one line, thin and no wider than a lean of
@@ -749,8 +760,8 @@ static void finalize(sl_detect_t *d, sl_detect_cand_t *c)
         reason = SL_DETECT_REJ_SHADOW;
     } else if ((c->flags & CF_SPAN) != 0U || (span > allowed && !slant)) {
         reason = SL_DETECT_REJ_WIDE;
-    } else if ((uint32_t)rep->count + ((uint32_t)rep->last - own_last(d, c, best)) <
-               (uint32_t)rep->last - rep->first + 1U) {
+    } else if ((uint32_t)rep->count < (uint32_t)rep->last - rep->first + 1U &&
+               !tail_holds(d, c, best, (uint32_t)rep->last - rep->first + 1U - rep->count)) {
         // a gap, but for the bins a smear tail can miss near the threshold (as stage 4's
         // one line: no more than its tail's bins; a run without a tail must be whole)
         reason = SL_DETECT_REJ_BROKEN;
