@@ -686,7 +686,11 @@ static void on_rot(void *ctx, const sl_scan_rot_t *rot)
     if (p->cfg.profile && p->prof.moving != 0U) {
         reserve_profiles(p);
     }
-    sl_tiltobs_advance(&p->tilt, p->motion_valid, p->speed_mm_s, p->yaw_cdeg_s, p->rotation_us);
+    // A stream whose returns are cut off (sl_profile.h, "Cut-off returns") has no range bound
+    // the 3D fit could take, and what the histories hold from before that was known is
+    // suspect: cleared, as without motion.
+    sl_tiltobs_advance(&p->tilt, p->motion_valid && !(p->cfg.profile && sl_profile_cut(&p->prof)),
+                       p->speed_mm_s, p->yaw_cdeg_s, p->rotation_us);
     // Unless the stream is known not to smear (returns seen to end in cliffs, no tail
     // self-fitted), a target the profile could not check (no slot, too few rows) may carry
     // a tail in its bounds: not a 3D-tilt observation. From the start of the stream: its

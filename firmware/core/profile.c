@@ -557,7 +557,13 @@ bool sl_profile_clean(const sl_profile_t *pr)
 {
     SL_ASSERT(pr != NULL);
     return pr->clean_n >= SL_PROFILE_CAL_SMEAR_N && pr->cal_n < SL_PROFILE_CAL_SMEAR_N &&
-           pr->cfg.prior_slope_q8 == 0U;
+           pr->cut_n < SL_PROFILE_CAL_SMEAR_N && pr->cfg.prior_slope_q8 == 0U;
+}
+
+bool sl_profile_cut(const sl_profile_t *pr)
+{
+    SL_ASSERT(pr != NULL);
+    return pr->cut_n >= SL_PROFILE_CAL_SMEAR_N;
 }
 
 uint32_t sl_profile_coarse_sigma_um(uint32_t bin_um)
@@ -585,11 +591,24 @@ static uint32_t ramp_bins(const uint16_t *sum, uint32_t k, uint32_t lim, uint32_
     return n;
 }
 
+// Whether the falling ramp of `n` (>= 3) bins that ends in bin `k` falls faster in its half
+// nearer `k` (by half a value per bin): a tail flattening towards the pole, the end of a
+// kernel of finite support (the log of a power that reaches zero falls ever faster), which a
+// pole's own return does not do (its power per bin falls fastest right after its brightest
+// point).
+static SL_NOINLINE bool falls_faster_near(const uint16_t *sum, uint32_t k, uint32_t n,
+                                          uint32_t frames)
+{
+    // rates x h (n - h), 32 bits: sums < 2^16, n < 64, frames <= 257
+    const uint32_t h = n / 2U, m = k - h;
+    const uint32_t near = (uint32_t)(sum[m] - sum[k]) * (n - h);
+    const uint32_t far = (uint32_t)(sum[k - n] - sum[m]) * h;
+    return 2U * near >= 2U * far + frames * h * (n - h);
+}
+
 // Bins (>= 3, else 0) of the falling ramp that ends in r2 and may be a smear tail: into a
 // cliff, or at the end of a walk over a tail that ends in a drop (a kernel of finite
-// support) when the ramp falls faster in its half nearer r2 (by half a value per bin): a
-// tail flattening towards the pole, which a pole's own return does not do (its power per
-// bin falls fastest right after its brightest point).
+// support) when it falls faster near r2 (falls_faster_near).
 static uint32_t tail_ramp(const uint16_t *sum, const sl_profile_bounds_t *pb, uint32_t frames)
 {
     const uint32_t n = ramp_bins(sum, pb->i2, pb->i1, frames);
@@ -599,14 +618,7 @@ static uint32_t tail_ramp(const uint16_t *sum, const sl_profile_bounds_t *pb, ui
     if (pb->slope_src == (uint8_t)SL_PROFILE_SLOPE_CLIFF) {
         return n;
     }
-    if (pb->end_drop == 0U) {
-        return 0U;
-    }
-    // rates x h (n - h), 32 bits: sums < 2^16, n < 64, frames <= 257
-    const uint32_t h = n / 2U, k = pb->i2, m = k - h;
-    const uint32_t near = (uint32_t)(sum[m] - sum[k]) * (n - h);
-    const uint32_t far = (uint32_t)(sum[k - n] - sum[m]) * h;
-    return 2U * near >= 2U * far + frames * h * (n - h) ? n : 0U;
+    return pb->end_drop != 0U && falls_faster_near(sum, pb->i2, n, frames) ? n : 0U;
 }
 
 // The rows of target `t`'s azimuth (slot `si`) and of its two neighbours, when they belong
@@ -764,9 +776,9 @@ static uint16_t end_sigma(const sl_incline_result_t *res, const sl_incline_resul
 // Cold start: the first rotations of every stream (moving: the first hits of every track,
 // before a slot is reserved for it) come before any evidence either way.
 static SL_NOINLINE void widen_unverified(const sl_profile_t *pr, const sl_board_t *board,
-                                         sl_target_t *t)
+                                         sl_target_t *t, bool cut)
 {
-    if (sl_profile_clean(pr) || board->geom == NULL ||
+    if ((sl_profile_clean(pr) && !cut) || board->geom == NULL ||
         t->incline_flag != (uint8_t)SL_INCLINE_VALID) {
         return;
     }
@@ -814,7 +826,7 @@ uint8_t sl_profile_refine(sl_profile_t *pr, const sl_board_t *board, uint32_t th
                                 ? (uint8_t)SL_PROFILE_LEAD_CUT
                                 : (uint8_t)SL_PROFILE_NO_SLOT;
         pr->stats.fallback[why]++;
-        widen_unverified(pr, board, t);
+        widen_unverified(pr, board, t, false);
         return why;
     }
     const sl_profile_slot_t *s = &pr->slot[si];
@@ -830,7 +842,7 @@ uint8_t sl_profile_refine(sl_profile_t *pr, const sl_board_t *board, uint32_t th
         frames = combine_neighbours(pr, t, si, threshold, &bin0, &n, &tol);
         if (frames < pr->cfg.min_frames) {
             pr->stats.fallback[SL_PROFILE_FEW_FRAMES]++;
-            widen_unverified(pr, board, t);
+            widen_unverified(pr, board, t, false);
             return (uint8_t)SL_PROFILE_FEW_FRAMES;
         }
         sum = pr->scratch;
@@ -854,11 +866,36 @@ uint8_t sl_profile_refine(sl_profile_t *pr, const sl_board_t *board, uint32_t th
                                                             pr->slope_q8, cliff_end, tol);
     if (pb.fail != (uint8_t)SL_PROFILE_OK) {
         pr->stats.fallback[pb.fail]++;
-        widen_unverified(pr, board, t);
+        widen_unverified(pr, board, t, false);
         return pb.fail;
     }
-    if (pb.slope_src == SL_PROFILE_SLOPE_CLIFF && pr->clean_n < UINT8_MAX) {
-        pr->clean_n++;
+    bool cut = false;
+    if (pb.slope_src == SL_PROFILE_SLOPE_CLIFF) {
+        // A return whose bins before its last (a partly lit bin) fall faster and faster into
+        // the cliff is cut off, not ended: by the support of a smear kernel (the log of a
+        // power that reaches zero), or by the beam's edge (a slanted pole leaving the
+        // azimuth). Evidence on the stream ("Cut-off returns"): a kernel of finite support
+        // cuts every return so, the beam only some. (A walk's tail is no such evidence: a
+        // short tail after flatter own bins falls faster near its end too.)
+        const uint32_t k = pb.i2 - 1U;
+        const uint32_t nr = pb.i2 > pb.i1 + 3U ? ramp_bins(sum, k, pb.i1, frames) : 0U;
+        cut = nr >= 3U && falls_faster_near(sum, k, nr, frames);
+        if (cut) {
+            pr->cut_n = pr->cut_n < UINT8_MAX ? (uint8_t)(pr->cut_n + 1U) : pr->cut_n;
+            pr->stats.cut_ends++;
+        } else {
+            pr->clean_n = pr->clean_n < UINT8_MAX ? (uint8_t)(pr->clean_n + 1U) : pr->clean_n;
+            pr->cut_n = pr->cut_n > 0U ? (uint8_t)(pr->cut_n - 1U) : 0U;
+        }
+    }
+    if (cut || sl_profile_cut(pr)) {
+        // This return cut off, or a stream whose returns are (a smear no tail model here
+        // describes: what a walk would take for a tail may be the kernel's own shape): the
+        // mask's bounds, unverified whatever the stream.
+        pr->stats.fallback[SL_PROFILE_NO_TAIL]++;
+        t->flags = (uint16_t)(t->flags | SL_TARGET_NO_TAIL | SL_TARGET_CUT);
+        widen_unverified(pr, board, t, true);
+        return (uint8_t)SL_PROFILE_NO_TAIL;
     }
     if (spatial && pb.slope_src == SL_PROFILE_SLOPE_CLIFF) {
         // Neighbouring azimuths serve to remove a smear tail. Without one the mask's run is
@@ -866,7 +903,7 @@ uint8_t sl_profile_refine(sl_profile_t *pr, const sl_board_t *board, uint32_t th
         // that see an oblique pole at other ranges would end elsewhere: keep the mask's.
         pr->stats.fallback[SL_PROFILE_NO_TAIL]++;
         t->flags = (uint16_t)(t->flags | SL_TARGET_NO_TAIL);
-        widen_unverified(pr, board, t);
+        widen_unverified(pr, board, t, false);
         return (uint8_t)SL_PROFILE_NO_TAIL;
     }
     if (pb.slope_src == SL_PROFILE_SLOPE_FIT) {

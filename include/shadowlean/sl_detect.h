@@ -278,6 +278,11 @@ typedef enum sl_detect_reject {
                                        ///< radius from width): sigma includes it, and its
                                        ///< error repeats from rotation to rotation (the
                                        ///< tracker does not average it out)
+#define SL_TARGET_CUT 0x400U           ///< the range profile saw the return cut off (falling
+                                       ///< ever faster into a cliff: a smear kernel's support
+                                       ///< or the beam's edge), or the stream's returns so
+                                       ///< (sl_profile.h, "Cut-off returns"): the mask's
+                                       ///< bounds, unverified (COARSE), no tilt observation
 
 /// Detection parameters that are not (yet) board fields.
 typedef struct sl_detect_cfg {

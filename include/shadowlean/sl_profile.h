@@ -134,10 +134,11 @@
 /// r1's sigma also holds a radius from width (sl_detect_r1_sigma_um: the correction is
 /// uncertain by its own size).
 /// Unverified bounds. In a stream not known to be clean (SL_PROFILE_CAL_SMEAR_N self-fits or
-/// a prior: it smears; before SL_PROFILE_CAL_SMEAR_N returns were seen to end in a cliff
-/// with fewer self-fits: nothing known yet, as at the start of every stream;
-/// sl_profile_clean), a target the profile could not check (no slot, too few rows, a cliff
-/// in one rotation's rows, any other fallback) keeps the mask's r2, the threshold crossing of a
+/// a prior: it smears; a stream of cut-off returns, below; before SL_PROFILE_CAL_SMEAR_N
+/// returns were seen to end in a cliff that does not cut them off, with fewer self-fits:
+/// nothing known yet, as at the start of every stream; sl_profile_clean), a target the
+/// profile could not check (no slot, too few rows, a cliff in one rotation's rows, any other
+/// fallback) keeps the mask's r2, the threshold crossing of a
 /// tail shortened by the board's d(r): a prior, not a measurement. Its r2 is then known only
 /// to lie between r1 and that end (sigma: the extent / sqrt(12), at least d and a bin), it is
 /// flagged COARSE, and no warning level rises on it
@@ -170,6 +171,30 @@
 /// (DANGER on CAN); their sigma is now 4-15 deg and no level is raised. Exponential and
 /// two-component tails that fade into the floor have no such ramp (the reduced Table II
 /// and harder-bench runs are unchanged).
+/// Cut-off returns. The log of a power that reaches zero falls ever faster: a kernel of
+/// finite support (RadaRays' is linear in power) ends every return in a cliff after bins
+/// that fall faster and faster, and so does a slanted pole's run where it leaves the beam.
+/// A cliff is such a cut when the bins before its last (a partly lit bin) fall for 3 or more
+/// steps of at least a value per bin and faster, by half a value per bin, in the half nearer
+/// the cliff (a pole's own return, brightest at its foot or top, falls fastest right after
+/// it: the noise-free demo's and sim_static_sweep's never so). The target keeps the mask's
+/// bounds, unverified whatever the stream (NO_TAIL | CUT, COARSE; `stats.cut_ends`).
+/// `cut_n` counts cut-off cliffs less the others (0..255); from SL_PROFILE_CAL_SMEAR_N on
+/// (sl_profile_cut) the stream's returns are cut off: its smear is no tail the walk can
+/// remove (what it would take for a tail may be the kernel's own shape), so every target
+/// of the profile keeps the mask's bounds, unverified; the stream is not clean; and the
+/// pipeline clears the 3D-tilt histories (no range bound of such a stream is an
+/// observation, and what they hold from before it was known is suspect). A walk's tail is
+/// no such evidence (a short tail after flatter own bins falls faster near its end too),
+/// and a cut-off cliff alone does not make a stream so (the beam cuts some returns of a
+/// slanted pole; the 3D fit's union extent does not depend on one azimuth's cut).
+/// Measured on `driveby_realistic.ini` with 20- and 35-bin triangular kernels on both value
+/// scales (`daemon_triangular_smear_never_a_false_warning`): 8-10 LeanWarning frames above
+/// the true level before (DANGER for the pole leaning away, through a 3D fit of the kernel
+/// ends), none after; exponential streams, the demo and the Oxford scans show no cut.
+/// Not caught: the first rotations of such a stream, before SL_PROFILE_CAL_SMEAR_N net
+/// cut-off cliffs (walks that took the kernel's steepening end for a tail: 0-3 PoleLean
+/// frames of a pass beyond 4 LeanSigma, no level raised).
 /// The two sigmas combine as sigma_rho^2 = (s2^2 + rho^2 s1^2) / r1^2 into the one sigma
 /// sl_incline_estimate() takes (sl_incline_bounds_sigma_um), and such a target is flagged
 /// SL_TARGET_COARSE: its error repeats from rotation to rotation, so the tracker does not
@@ -313,6 +338,8 @@ typedef struct sl_profile_stats {
                             ///< azimuths (too few rotations summed: moving)
     uint32_t reserved;      ///< slots reserved where a track is expected (sl_profile_reserve)
     uint32_t reserve_full;  ///< ... azimuths left unwatched: no free slot
+    uint32_t cut_ends;      ///< cliffs the return falls ever faster into (cut off by a
+                            ///< kernel's support or the beam, not ended: "Unverified bounds")
 } sl_profile_stats_t;
 
 typedef struct sl_profile {
@@ -324,10 +351,14 @@ typedef struct sl_profile {
     uint16_t n_live;        ///< slots in use
     uint8_t moving;         ///< the last sl_profile_end_rotation had `reset`: no claims on
                             ///< evidence, only sl_profile_reserve
-    uint8_t clean_n;        ///< returns seen to end in a cliff (saturating at 255): with
+    uint8_t clean_n;        ///< returns seen to end in a cliff that does not cut them off
+                            ///< ("Cut-off returns"; saturating at 255): with
                             ///< SL_PROFILE_CAL_SMEAR_N of them and fewer self-fits, a stream
                             ///< known not to smear ("Unverified bounds")
-    uint8_t pad_[2];
+    uint8_t cut_n;          ///< cut-off returns less returns ending otherwise in a cliff
+                            ///< (0..255): from SL_PROFILE_CAL_SMEAR_N on, a stream whose
+                            ///< smear no tail model describes ("Cut-off returns")
+    uint8_t pad_[1];
     uint8_t slot_of[SL_CFG_MAX_AZIMUTHS]; ///< slot index per azimuth, SL_PROFILE_NONE
     sl_profile_slot_t slot[SL_CFG_PROFILE_SLOTS];
     uint16_t scratch[SL_CFG_PROFILE_BINS]; ///< neighbours' rows summed (sl_profile_refine)
@@ -419,10 +450,15 @@ bool sl_profile_lead_edge(const uint16_t *sum3, uint32_t frames, uint32_t delta_
 #define SL_PROFILE_LEAD_END_Q16 (64UL << 16)
 
 /// Whether the stream is known not to smear: SL_PROFILE_CAL_SMEAR_N returns seen to end in a
-/// cliff (`clean_n`), fewer accepted self-fits and no prior. False at the start of every
+/// cliff that does not cut them off (`clean_n`), fewer accepted self-fits, no prior and not
+/// a stream of cut-off returns (sl_profile_cut). False at the start of every
 /// stream (nothing known yet) and in a smearing one: bounds the profile did not check are
 /// then unverified (sl_profile.h, "Unverified bounds"; sl_tiltobs_t.verified_only). Pure.
 bool sl_profile_clean(const sl_profile_t *pr);
+
+/// Whether the stream's returns are cut off ("Cut-off returns"): `cut_n` >=
+/// SL_PROFILE_CAL_SMEAR_N, i.e. that many more cut-off cliffs than others seen. Pure.
+bool sl_profile_cut(const sl_profile_t *pr);
 
 /// Sigma of a bound known to two bins of `bin_um`: bin_um / sqrt(3), rounded (pure).
 uint32_t sl_profile_coarse_sigma_um(uint32_t bin_um);

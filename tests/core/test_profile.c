@@ -876,13 +876,23 @@ static void ramp_row(uint8_t *row, uint32_t *bits, int a, int b, kernel_fn kern)
 
 // Refines the pole of `row` (az 7, two rows) in a stream that smears (prior slope) or not;
 // `edge`: the shadow edge's bin (0: none). Returns the target; *ramps: stats.ramps.
-static sl_target_t ramp_refine(const uint8_t *row, const uint32_t *bits, uint16_t prior_q8,
-                               uint32_t edge, uint32_t *ramps)
+static sl_target_t ramp_refine_as(const uint8_t *row, const uint32_t *bits, uint16_t prior_q8,
+                                  uint32_t edge, uint32_t *ramps, uint8_t expect, bool fresh)
 {
+    // fresh: a new stream; else the same stream's next return (its evidence kept, the
+    // slots emptied so the rows do not mix)
+    const sl_profile_t keep = pr;
     sl_profile_cfg_t c;
     sl_profile_cfg_default(&c);
     c.prior_slope_q8 = prior_q8;
     assert_int_equal(sl_profile_init(&pr, 400, 0, &c), SL_OK);
+    if (!fresh) {
+        pr.slope_q8 = keep.slope_q8;
+        pr.cal_n = keep.cal_n;
+        pr.clean_n = keep.clean_n;
+        pr.cut_n = keep.cut_n;
+        pr.stats = keep.stats;
+    }
     sl_profile_row(&pr, 7, row, RN, bits, RN);
     sl_profile_row(&pr, 7, row, RN, bits, RN);
     uint16_t first = 0, last = 0;
@@ -897,9 +907,22 @@ static sl_target_t ramp_refine(const uint8_t *row, const uint32_t *bits, uint16_
     sl_target_t t = mask_target(7, 6, 3, first, last);
     t.shadow_slant_um = edge * 43800U;
     const sl_board_t board = geom_board();
-    assert_int_equal(sl_profile_refine(&pr, &board, 40, &t), SL_PROFILE_OK);
+    // the detector's estimate from the mask's bounds (what a fallback keeps)
+    const sl_incline_result_t e =
+        sl_incline_estimate(t.r1_um, t.r2_um, &ramp_geom[7], board.range_sigma_um, 0U);
+    t.alpha_cdeg = e.alpha_cdeg;
+    t.sigma_cdeg = e.sigma_cdeg;
+    t.incline_flag = e.flag;
+    t.incline_branch = e.branch;
+    assert_int_equal(sl_profile_refine(&pr, &board, 40, &t), expect);
     *ramps = pr.stats.ramps;
     return t;
+}
+
+static sl_target_t ramp_refine(const uint8_t *row, const uint32_t *bits, uint16_t prior_q8,
+                               uint32_t edge, uint32_t *ramps)
+{
+    return ramp_refine_as(row, bits, prior_q8, edge, ramps, SL_PROFILE_OK, true);
 }
 
 // A target the profile could not check (no slot), in a stream known to smear (a prior
@@ -986,22 +1009,24 @@ static void test_profile_ramps_widen_the_sigma_not_the_alpha(void **state)
     uint8_t row[RN];
     uint32_t bits[RN / 32], ramps = 0;
     const int32_t truth = true_alpha(50, 57); // +4.48 deg
-    // 1. an 18-bin kernel without a front part: the tail falls slowly, then ends in a cliff
+    // 1. an 18-bin kernel without a front part: the tail falls slowly, then faster and
+    //    faster into a cliff: a return cut off ("Cut-off returns"), whether the stream is
+    //    known to smear or not: the mask's bounds, unverified (the tail read as own bins,
+    //    +25 deg, with the interval r1 .. the cliff in its sigma)
     g_front = 0;
     g_back = 18;
     ramp_row(row, bits, 50, 57, k_tri);
-    const sl_target_t t1 = ramp_refine(row, bits, 845U, 0U, &ramps); // known to smear
-    assert_int_equal(ramps, 1);
-    assert_true(t1.alpha_cdeg > truth + 1500); // +25.35 deg: the tail read as own bins ...
-    assert_true(t1.sigma_cdeg > 300);          // ... with the cliff's ramp in its sigma
-    assert_true(t1.alpha_cdeg - truth <= 3 * (int32_t)t1.sigma_cdeg);
-    assert_true((t1.flags & SL_TARGET_COARSE) != 0U);
-    // not known to smear: the smear piling up over its own bins rises for 3 bins after r1,
-    // a ramp, so the cliff counts too (the same figures)
-    const sl_target_t plain = ramp_refine(row, bits, 0U, 0U, &ramps);
-    assert_int_equal(ramps, 1);
-    assert_int_equal(plain.alpha_cdeg, t1.alpha_cdeg);
-    assert_int_equal(plain.sigma_cdeg, t1.sigma_cdeg);
+    for (int known = 0; known < 2; known++) {
+        const sl_target_t t1 =
+            ramp_refine_as(row, bits, known ? 845U : 0U, 0U, &ramps, SL_PROFILE_NO_TAIL, true);
+        assert_int_equal(ramps, 0);
+        assert_int_equal(pr.stats.cut_ends, 1);
+        assert_true((t1.flags & (SL_TARGET_CUT | SL_TARGET_COARSE | SL_TARGET_NO_TAIL)) ==
+                    (SL_TARGET_CUT | SL_TARGET_COARSE | SL_TARGET_NO_TAIL));
+        assert_true(t1.alpha_cdeg > truth + 1500);
+        assert_true(t1.sigma_cdeg > 300);
+        assert_true(t1.alpha_cdeg - truth <= 3 * (int32_t)t1.sigma_cdeg);
+    }
     // 2. the same tail ending beyond the shadow edge: the walk over it stops where it
     //    flattens towards the pole, and the ramp before it falls faster near r2
     const sl_target_t t2 = ramp_refine(row, bits, 845U, 70U, &ramps);
@@ -1009,12 +1034,12 @@ static void test_profile_ramps_widen_the_sigma_not_the_alpha(void **state)
     assert_true(t2.sigma_cdeg > 300);
     assert_true(t2.alpha_cdeg - truth <= 3 * (int32_t)t2.sigma_cdeg);
     // 3. a front part of 6 bins in a stream not known to smear: on branch 1 the leading
-    //    edge rises for 6 bins, and the cliff 12 bins after the pole's end is a ramp too
+    //    edge rises for 6 bins (a ramp), and the cliff 12 bins after the pole's end is cut
     g_front = 6;
     g_back = 12;
     ramp_row(row, bits, 50, 57, k_tri);
-    const sl_target_t t3 = ramp_refine(row, bits, 0U, 0U, &ramps);
-    assert_int_equal(ramps, 1);
+    const sl_target_t t3 = ramp_refine_as(row, bits, 0U, 0U, &ramps, SL_PROFILE_NO_TAIL, true);
+    assert_true((t3.flags & SL_TARGET_CUT) != 0U);
     assert_int_equal(t3.incline_branch, SL_INCLINE_BRANCH_1);
     assert_true(t3.sigma_cdeg > 300);
     assert_true(t3.alpha_cdeg - truth <= 3 * (int32_t)t3.sigma_cdeg);
@@ -1054,9 +1079,80 @@ static void test_profile_ramps_widen_the_sigma_not_the_alpha(void **state)
     }
     const sl_target_t t6 = ramp_refine(row, bits, 0U, 0U, &ramps);
     assert_int_equal(ramps, 0);
-    assert_int_equal(t6.flags & SL_TARGET_COARSE, 0);
+    assert_int_equal(t6.flags & (SL_TARGET_COARSE | SL_TARGET_CUT), 0);
+    assert_int_equal(pr.stats.cut_ends, 0);
     (void)ramp_refine(row, bits, 845U, 0U, &ramps);
     assert_int_equal(ramps, 1);
+}
+
+// A stream whose returns end cut off (a kernel of finite support) is one no tail model here
+// describes: after SL_PROFILE_CAL_SMEAR_N more cut-off returns than returns ending otherwise
+// in a cliff (own bins falling evenly, as the noise-free demo's), what a walk would take for
+// a tail may be the kernel's own shape, so even a return with an exponential-looking tail
+// keeps the mask's bounds, unverified, and the stream is not clean whatever it showed.
+// A cut-off return alone is unverified too (a slanted pole leaving the beam), without
+// making the stream so.
+static void test_profile_a_stream_of_cut_off_returns_is_unverified(void **state)
+{
+    (void)state;
+    uint8_t row[RN], own[RN], tail[RN];
+    uint32_t bits[RN / 32], own_bits[RN / 32], tail_bits[RN / 32], ramps = 0;
+    g_front = 0;
+    g_back = 18;
+    ramp_row(row, bits, 50, 57, k_tri);
+    g_decay_db = 3.3;
+    ramp_row(tail, tail_bits, 50, 57, k_exp);
+    memset(own, 0, sizeof own);
+    memset(own_bits, 0, sizeof own_bits);
+    for (int k = 50; k <= 57; k++) {
+        own[k] = (uint8_t)(110 - (k - 50));
+        own_bits[k >> 5] |= 1U << (k & 31);
+    }
+    // a fresh stream: the exponential tail is walked (profile bounds)
+    sl_target_t t = ramp_refine_as(tail, tail_bits, 0U, 0U, &ramps, SL_PROFILE_OK, true);
+    assert_true((t.flags & SL_TARGET_PROFILE) != 0U);
+    pr.cal_n = 0U; // (its tail self-fitted: not counted below, where only cliffs matter)
+    // one cut-off return: unverified; the walk is still trusted
+    t = ramp_refine_as(row, bits, 0U, 0U, &ramps, SL_PROFILE_NO_TAIL, false);
+    assert_true((t.flags & (SL_TARGET_CUT | SL_TARGET_COARSE)) ==
+                (SL_TARGET_CUT | SL_TARGET_COARSE));
+    assert_false(sl_profile_cut(&pr));
+    t = ramp_refine_as(tail, tail_bits, 0U, 0U, &ramps, SL_PROFILE_OK, false);
+    assert_true((t.flags & SL_TARGET_PROFILE) != 0U);
+    pr.cal_n = 0U;
+    // three more: a stream of them
+    for (int i = 1; i < (int)SL_PROFILE_CAL_SMEAR_N; i++) {
+        t = ramp_refine_as(row, bits, 0U, 0U, &ramps, SL_PROFILE_NO_TAIL, false);
+        assert_true((t.flags & SL_TARGET_CUT) != 0U);
+    }
+    assert_true(sl_profile_cut(&pr));
+    assert_int_equal(pr.stats.cut_ends, SL_PROFILE_CAL_SMEAR_N);
+    t = ramp_refine_as(tail, tail_bits, 0U, 0U, &ramps, SL_PROFILE_NO_TAIL, false);
+    assert_true((t.flags & (SL_TARGET_CUT | SL_TARGET_COARSE)) ==
+                (SL_TARGET_CUT | SL_TARGET_COARSE));
+    assert_int_equal(t.flags & SL_TARGET_PROFILE, 0);
+    assert_true(t.sigma_cdeg > 300U); // no level is raised on it
+    // a return ending evenly in a cliff (its own end, not cut) counts one back: the walk is
+    // trusted again
+    // (its fall into the cliff is a ramp in its sigma: the stream has shown a tail slope)
+    t = ramp_refine_as(own, own_bits, 0U, 0U, &ramps, SL_PROFILE_OK, false);
+    assert_int_equal(t.flags & SL_TARGET_CUT, 0);
+    assert_false(sl_profile_cut(&pr));
+    t = ramp_refine_as(tail, tail_bits, 0U, 0U, &ramps, SL_PROFILE_OK, false);
+    assert_true((t.flags & SL_TARGET_PROFILE) != 0U);
+    pr.cal_n = 0U;
+    // clean after SL_PROFILE_CAL_SMEAR_N such returns (no self-fit counted) ...
+    for (int i = 1; i < (int)SL_PROFILE_CAL_SMEAR_N; i++) {
+        assert_false(sl_profile_clean(&pr));
+        (void)ramp_refine_as(own, own_bits, 0U, 0U, &ramps, SL_PROFILE_OK, false);
+    }
+    assert_true(sl_profile_clean(&pr));
+    // ... until the cut-off ones outnumber them again by SL_PROFILE_CAL_SMEAR_N
+    for (int i = 0; i < (int)SL_PROFILE_CAL_SMEAR_N; i++) {
+        assert_true(sl_profile_clean(&pr));
+        (void)ramp_refine_as(row, bits, 0U, 0U, &ramps, SL_PROFILE_NO_TAIL, false);
+    }
+    assert_false(sl_profile_clean(&pr));
 }
 
 int main(void)
@@ -1083,6 +1179,7 @@ int main(void)
         cmocka_unit_test(test_profile_lead_fill_follows_the_lines_geometry),
         cmocka_unit_test(test_profile_lead_edge_refuses_shapes_no_line_makes),
         cmocka_unit_test(test_profile_ramps_widen_the_sigma_not_the_alpha),
+        cmocka_unit_test(test_profile_a_stream_of_cut_off_returns_is_unverified),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
