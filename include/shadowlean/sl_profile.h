@@ -194,7 +194,9 @@
 /// ends), none after; exponential streams, the demo and the Oxford scans show no cut.
 /// Not caught: the first rotations of such a stream, before SL_PROFILE_CAL_SMEAR_N net
 /// cut-off cliffs (walks that took the kernel's steepening end for a tail: 0-3 PoleLean
-/// frames of a pass beyond 4 LeanSigma, no level raised).
+/// frames of a pass beyond 4 LeanSigma, no level raised). And a slanted pole approaching in
+/// a noise-free stream is cut by the beam on several rotations in a row, which the count
+/// cannot tell from a kernel (the stream counts as cut for a few rotations).
 /// The two sigmas combine as sigma_rho^2 = (s2^2 + rho^2 s1^2) / r1^2 into the one sigma
 /// sl_incline_estimate() takes (sl_incline_bounds_sigma_um), and such a target is flagged
 /// SL_TARGET_COARSE: its error repeats from rotation to rotation, so the tracker does not
