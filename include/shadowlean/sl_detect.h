@@ -282,7 +282,8 @@ typedef enum sl_detect_reject {
                                        ///< ever faster into a cliff: a smear kernel's support
                                        ///< or the beam's edge), or the stream's returns so
                                        ///< (sl_profile.h, "Cut-off returns"): the mask's
-                                       ///< bounds, unverified (COARSE), no tilt observation
+                                       ///< bounds, unverified (COARSE); in a stream of them
+                                       ///< the 3D-tilt histories are cleared
 
 /// Detection parameters that are not (yet) board fields.
 typedef struct sl_detect_cfg {

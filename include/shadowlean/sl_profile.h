@@ -177,7 +177,7 @@
 /// A cliff is such a cut when the bins before its last (a partly lit bin) fall for 3 or more
 /// steps of at least a value per bin and faster, by half a value per bin, in the half nearer
 /// the cliff (a pole's own return, brightest at its foot or top, falls fastest right after
-/// it: the noise-free demo's and sim_static_sweep's never so). The target keeps the mask's
+/// it: the noise-free demo's and bench_eight_poles' never so). The target keeps the mask's
 /// bounds, unverified whatever the stream (NO_TAIL | CUT, COARSE; `stats.cut_ends`).
 /// `cut_n` counts cut-off cliffs less the others (0..255); from SL_PROFILE_CAL_SMEAR_N on
 /// (sl_profile_cut) the stream's returns are cut off: its smear is no tail the walk can
@@ -341,7 +341,7 @@ typedef struct sl_profile_stats {
     uint32_t reserved;      ///< slots reserved where a track is expected (sl_profile_reserve)
     uint32_t reserve_full;  ///< ... azimuths left unwatched: no free slot
     uint32_t cut_ends;      ///< cliffs the return falls ever faster into (cut off by a
-                            ///< kernel's support or the beam, not ended: "Unverified bounds")
+                            ///< kernel's support or the beam, not ended: "Cut-off returns")
 } sl_profile_stats_t;
 
 typedef struct sl_profile {
