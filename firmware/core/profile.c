@@ -888,22 +888,20 @@ uint8_t sl_profile_refine(sl_profile_t *pr, const sl_board_t *board, uint32_t th
             pr->cut_n = pr->cut_n > 0U ? (uint8_t)(pr->cut_n - 1U) : 0U;
         }
     }
-    if (cut || sl_profile_cut(pr)) {
-        // This return cut off, or a stream whose returns are (a smear no tail model here
-        // describes: what a walk would take for a tail may be the kernel's own shape): the
-        // mask's bounds, unverified whatever the stream.
-        pr->stats.fallback[SL_PROFILE_NO_TAIL]++;
-        t->flags = (uint16_t)(t->flags | SL_TARGET_NO_TAIL | SL_TARGET_CUT);
-        widen_unverified(pr, board, t, true);
-        return (uint8_t)SL_PROFILE_NO_TAIL;
-    }
-    if (spatial && pb.slope_src == SL_PROFILE_SLOPE_CLIFF) {
-        // Neighbouring azimuths serve to remove a smear tail. Without one the mask's run is
-        // the return's own (its end is where the return ends), while a mean over azimuths
-        // that see an oblique pole at other ranges would end elsewhere: keep the mask's.
+    // The mask's bounds: for a return cut off, or in a stream whose returns are (a smear no
+    // tail model here describes: what a walk would take for a tail may be the kernel's own
+    // shape), unverified whatever the stream; while moving, for a cliff (neighbouring
+    // azimuths serve to remove a smear tail; without one the mask's run is the return's own,
+    // while a mean over azimuths that see an oblique pole at other ranges would end
+    // elsewhere), unverified unless the stream is known clean.
+    cut = cut || sl_profile_cut(pr);
+    if (cut || (spatial && pb.slope_src == SL_PROFILE_SLOPE_CLIFF)) {
         pr->stats.fallback[SL_PROFILE_NO_TAIL]++;
         t->flags = (uint16_t)(t->flags | SL_TARGET_NO_TAIL);
-        widen_unverified(pr, board, t, false);
+        if (cut) {
+            t->flags = (uint16_t)(t->flags | SL_TARGET_CUT);
+        }
+        widen_unverified(pr, board, t, cut);
         return (uint8_t)SL_PROFILE_NO_TAIL;
     }
     if (pb.slope_src == SL_PROFILE_SLOPE_FIT) {
