@@ -65,8 +65,12 @@ for shape in "20 0" "20 0.35" "35 0.1"; do
             --can-log "$OUT/$name.log" 2> "$OUT/$name.err" ||
             { cat "$OUT/$name.err"; echo "FAIL: $name: daemon"; exit 1; }
         printf '%s: ' "$name"
-        "$PY" "$SRC/lean_warning_sides.py" "$DBC_SIM" "$OUT/$name.log" 10 -10 | tail -1
-        "$PY" "$SRC/lean_warning_sides.py" "$DBC_SIM" "$OUT/$name.log" 10 -10 > /dev/null || fail=1
+        if "$PY" "$SRC/lean_warning_sides.py" "$DBC_SIM" "$OUT/$name.log" 10 -10 > "$OUT/$name.sides"
+        then
+            tail -1 "$OUT/$name.sides"
+        else
+            fail=1; cat "$OUT/$name.sides"
+        fi
     done
 done
 [ $fail -eq 0 ] && echo "smear_shapes: OK" || echo "smear_shapes: FAILED"
