@@ -607,8 +607,11 @@ static SL_NOINLINE bool falls_faster_near(const uint16_t *sum, uint32_t k, uint3
 }
 
 // Bins (>= 3, else 0) of the falling ramp that ends in r2 and may be a smear tail: into a
-// cliff, or at the end of a walk over a tail that ends in a drop (a kernel of finite
-// support) when it falls faster near r2 (falls_faster_near).
+// cliff, the steps of at least a value per bin; at the end of a walk, when those steps fall
+// faster near r2 (falls_faster_near: a kernel of finite support, whether its end is a drop
+// or lies under a weaker, longer component the walk removed), every bin over which the
+// profile does not rise into r2 (near the pole such a kernel falls by less than a value
+// per bin: flat after rounding).
 static uint32_t tail_ramp(const uint16_t *sum, const sl_profile_bounds_t *pb, uint32_t frames)
 {
     const uint32_t n = ramp_bins(sum, pb->i2, pb->i1, frames);
@@ -618,7 +621,7 @@ static uint32_t tail_ramp(const uint16_t *sum, const sl_profile_bounds_t *pb, ui
     if (pb->slope_src == (uint8_t)SL_PROFILE_SLOPE_CLIFF) {
         return n;
     }
-    return pb->end_drop != 0U && falls_faster_near(sum, pb->i2, n, frames) ? n : 0U;
+    return falls_faster_near(sum, pb->i2, n, frames) ? ramp_bins(sum, pb->i2, pb->i1, 0U) : 0U;
 }
 
 // The rows of target `t`'s azimuth (slot `si`) and of its two neighbours, when they belong
@@ -882,6 +885,12 @@ uint8_t sl_profile_refine(sl_profile_t *pr, const sl_board_t *board, uint32_t th
         cut = nr >= 3U && falls_faster_near(sum, k, nr, frames);
         if (cut) {
             pr->cut_n = pr->cut_n < UINT8_MAX ? (uint8_t)(pr->cut_n + 1U) : pr->cut_n;
+            // Until the stream is known clean, a cut-off cliff takes back a clean one: it
+            // becomes clean on SL_PROFILE_CAL_SMEAR_N more clean cliffs than cut ones
+            // (once clean, only a net run of cut ones, cut_n, undoes it).
+            if (pr->clean_n < SL_PROFILE_CAL_SMEAR_N && pr->clean_n > 0U) {
+                pr->clean_n--;
+            }
             pr->stats.cut_ends++;
         } else {
             pr->clean_n = pr->clean_n < UINT8_MAX ? (uint8_t)(pr->clean_n + 1U) : pr->clean_n;

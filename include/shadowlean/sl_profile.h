@@ -161,11 +161,16 @@
 ///   pole's own.)
 /// - r2, in a stream known to smear (`slope_q8` != 0: a tail slope self-fitted or given)
 ///   or on a target with a ramp at r1: the bins over which the profile falls into a cliff
-///   read as r2; or into the end of a walk over a tail that ends in a drop (`end_drop`:
-///   finite support), when the ramp falls faster in its half nearer r2 (by half a value
-///   per bin: a tail flattening towards the pole; a pole's own power falls fastest right
-///   after its brightest point). A stream without smear (the noise-free demo) keeps the
-///   board's sigma on its cliffs.
+///   read as r2; or into the end of a walk, when that ramp falls faster in its half nearer
+///   r2 (by half a value per bin: a tail flattening towards the pole; a pole's own power
+///   falls fastest right after its brightest point), and then over every bin where the
+///   profile does not rise into r2 (a kernel linear in power falls by less than a value
+///   per bin near the pole: flat after rounding). Whether or not a drop ends the run: a
+///   weaker, longer smear component (or a weaker part of the pole) can carry the run past
+///   the kernel's end, and the walk then removes only that (session 17; before, a walk's
+///   ramp needed a drop, and 1-3 PoleLean frames per triangular drive-by were 5-30
+///   LeanSigma off). A stream without smear (the noise-free demo) keeps the board's sigma
+///   on its cliffs.
 /// Counted in `stats.ramps`, flagged SL_TARGET_COARSE. On the paper's bench with a 20-bin
 /// triangular kernel, poles of -10 to +10 deg read +22 to +34 deg at a sigma below 1 deg
 /// (DANGER on CAN); their sigma is now 4-15 deg and no level is raised. Exponential and
@@ -179,6 +184,11 @@
 /// the cliff (a pole's own return, brightest at its foot or top, falls fastest right after
 /// it: the noise-free demo's and bench_eight_poles' never so). The target keeps the mask's
 /// bounds, unverified whatever the stream (NO_TAIL | CUT, COARSE; `stats.cut_ends`).
+/// Until the stream is known clean, a cut-off cliff also takes back one clean one (`clean_n`):
+/// a stream becomes clean on SL_PROFILE_CAL_SMEAR_N more clean cliffs than cut-off ones (a
+/// kernel's end under noise passes the cut test only now and then; with 4 clean cliffs among
+/// cut-off ones a triangular stream counted as clean and its next cliffs, the mask's bounds,
+/// went out as verified: Lean +27 at 0.6 for +9). Once clean, only `cut_n` undoes it.
 /// `cut_n` counts cut-off cliffs less the others (0..255); from SL_PROFILE_CAL_SMEAR_N on
 /// (sl_profile_cut) the stream's returns are cut off: its smear is no tail the walk can
 /// remove (what it would take for a tail may be the kernel's own shape), so every target
@@ -192,9 +202,13 @@
 /// scales (`daemon_triangular_smear_never_a_false_warning`): 8-10 LeanWarning frames above
 /// the true level before (DANGER for the pole leaning away, through a 3D fit of the kernel
 /// ends), none after; exponential streams, the demo and the Oxford scans show no cut.
-/// Not caught: the first rotations of such a stream, before SL_PROFILE_CAL_SMEAR_N net
-/// cut-off cliffs (walks that took the kernel's steepening end for a tail: 0-3 PoleLean
-/// frames of a pass beyond 4 LeanSigma, no level raised). And a slanted pole approaching in
+/// The first rotations of such a stream, before SL_PROFILE_CAL_SMEAR_N net cut-off cliffs,
+/// sent 0-3 PoleLean frames per pass beyond 4 LeanSigma (a cliff in a stream counted clean,
+/// and walks that stopped in the kernel's flattening end); since session 17 (above, and
+/// "Ramps") 14 of the 15 measured variants send none, and a 35-bin kernel without a front
+/// part one (a walk that removed nothing: its tail fit straddled a 20-value drop into a
+/// weak part of the return, whose first steps fall by less than a value). And a slanted
+/// pole approaching in
 /// a noise-free stream is cut by the beam on several rotations in a row, which the count
 /// cannot tell from a kernel (the stream counts as cut for a few rotations).
 /// The two sigmas combine as sigma_rho^2 = (s2^2 + rho^2 s1^2) / r1^2 into the one sigma
@@ -353,7 +367,8 @@ typedef struct sl_profile {
     uint16_t n_live;        ///< slots in use
     uint8_t moving;         ///< the last sl_profile_end_rotation had `reset`: no claims on
                             ///< evidence, only sl_profile_reserve
-    uint8_t clean_n;        ///< returns seen to end in a cliff that does not cut them off
+    uint8_t clean_n;        ///< returns seen to end in a cliff that does not cut them off,
+                            ///< less cut-off ones until there are SL_PROFILE_CAL_SMEAR_N
                             ///< ("Cut-off returns"; saturating at 255): with
                             ///< SL_PROFILE_CAL_SMEAR_N of them and fewer self-fits, a stream
                             ///< known not to smear ("Unverified bounds")
@@ -451,8 +466,9 @@ bool sl_profile_lead_edge(const uint16_t *sum3, uint32_t frames, uint32_t delta_
 /// constant length per bin (64 bins, Q16).
 #define SL_PROFILE_LEAD_END_Q16 (64UL << 16)
 
-/// Whether the stream is known not to smear: SL_PROFILE_CAL_SMEAR_N returns seen to end in a
-/// cliff that does not cut them off (`clean_n`), fewer accepted self-fits, no prior and not
+/// Whether the stream is known not to smear: SL_PROFILE_CAL_SMEAR_N more returns seen to end
+/// in a cliff that does not cut them off than cut-off ones (`clean_n`), fewer accepted
+/// self-fits, no prior and not
 /// a stream of cut-off returns (sl_profile_cut). False at the start of every
 /// stream (nothing known yet) and in a smearing one: bounds the profile did not check are
 /// then unverified (sl_profile.h, "Unverified bounds"; sl_tiltobs_t.verified_only). Pure.

@@ -849,6 +849,13 @@ static double k_tri(int j, double level_db)
     return j >= g_back ? 0.0 : 1.0 - (double)j / g_back;
 }
 
+// k_tri with a weaker exponential skirt (-25 dB, 1.5 dB per bin) that outlasts it: the run
+// fades into the floor instead of ending in the kernel's cliff.
+static double k_tri_skirt(int j, double level_db)
+{
+    return k_tri(j, level_db) + (j < 0 ? 0.0 : pow(10.0, -2.5 - 0.15 * j));
+}
+
 #define RN 128 // a ramp row's bins (the pole at 2.2 m, beyond the profile's 64)
 
 // One row: a pole's own 100 dB on bins [a, b], smeared by `kern` (front part included).
@@ -1083,6 +1090,19 @@ static void test_profile_ramps_widen_the_sigma_not_the_alpha(void **state)
     assert_int_equal(pr.stats.cut_ends, 0);
     (void)ramp_refine(row, bits, 845U, 0U, &ramps);
     assert_int_equal(ramps, 1);
+    // 7. the kernel's end hidden under a weaker, longer exponential skirt: the run fades
+    //    into the floor (no drop, no cliff), the walk removes the skirt and stops where the
+    //    kernel flattens towards the pole (+20 deg or more); the bins before r2 fall faster
+    //    near it, a ramp in the sigma (it took a drop at the run's end)
+    g_front = 0;
+    g_back = 18;
+    ramp_row(row, bits, 50, 57, k_tri_skirt);
+    const sl_target_t t7 = ramp_refine(row, bits, 845U, 0U, &ramps);
+    assert_int_equal(ramps, 1);
+    assert_int_equal(t7.flags & SL_TARGET_NO_TAIL, 0);
+    assert_true(t7.alpha_cdeg > truth + 1000);
+    assert_true(t7.sigma_cdeg > 300);
+    assert_true(t7.alpha_cdeg - truth <= 3 * (int32_t)t7.sigma_cdeg);
 }
 
 // A stream whose returns end cut off (a kernel of finite support) is one no tail model here
@@ -1153,6 +1173,26 @@ static void test_profile_a_stream_of_cut_off_returns_is_unverified(void **state)
         (void)ramp_refine_as(row, bits, 0U, 0U, &ramps, SL_PROFILE_NO_TAIL, false);
     }
     assert_false(sl_profile_clean(&pr));
+    // A fresh stream whose cliffs are now cut off, now not (a kernel's end under noise, or
+    // a slanted pole leaving the beam): clean only once the clean ones lead by
+    // SL_PROFILE_CAL_SMEAR_N (4 clean ones among them used to be enough)
+    (void)ramp_refine_as(own, own_bits, 0U, 0U, &ramps, SL_PROFILE_OK, true);
+    const int seq[] = {0, 1, 0, 0, 1, 0}; // 1: cut off
+    for (size_t i = 0; i < sizeof seq / sizeof seq[0]; i++) {
+        assert_false(sl_profile_clean(&pr));
+        if (seq[i] != 0) {
+            (void)ramp_refine_as(row, bits, 0U, 0U, &ramps, SL_PROFILE_NO_TAIL, false);
+        } else {
+            (void)ramp_refine_as(own, own_bits, 0U, 0U, &ramps, SL_PROFILE_OK, false);
+        }
+    }
+    assert_int_equal(pr.clean_n, 3); // 5 clean, 2 cut off
+    assert_false(sl_profile_cut(&pr));
+    (void)ramp_refine_as(own, own_bits, 0U, 0U, &ramps, SL_PROFILE_OK, false);
+    assert_true(sl_profile_clean(&pr));
+    // once clean, one cut-off cliff does not undo it (only a net run of them, above)
+    (void)ramp_refine_as(row, bits, 0U, 0U, &ramps, SL_PROFILE_NO_TAIL, false);
+    assert_true(sl_profile_clean(&pr));
 }
 
 int main(void)

@@ -39,7 +39,11 @@ done
 # read as the pole's end gave Lean +12 to +35 deg at a LeanSigma of 0.5 and, through the 3D
 # fit, DANGER for the pole leaning away (8-10 LeanWarning frames above the true level, before
 # "Cut-off returns" of sl_profile.h). Every LeanWarning must stay within the true lean's
-# level by 3 of its LeanSigma, and both poles must be reported (lean_warning_sides.py).
+# level by 3 of its LeanSigma, and both poles must be reported (lean_warning_sides.py); and
+# every PoleLean frame within 4 of its LeanSigma of the truth (lean_sigma_vs_truth.py; a
+# saturated LeanSigma, "I cannot tell", passes): the first rotations, before the stream was
+# known to cut its returns off, sent 1-3 frames per pass 5-30 LeanSigma off (session 17:
+# a cut-off cliff takes a clean one back; a walk's end that falls faster near r2 is a ramp).
 DBC_SIM="$ROOT/boards/paper-sim/shadowlean.dbc"
 for shape in "20 0" "20 0.35" "35 0.1"; do
     set -- $shape
@@ -70,6 +74,13 @@ for shape in "20 0" "20 0.35" "35 0.1"; do
             tail -1 "$OUT/$name.sides"
         else
             fail=1; cat "$OUT/$name.sides"
+        fi
+        if "$PY" "$SRC/lean_sigma_vs_truth.py" "$DBC_SIM" "$OUT/$name.log" "$OUT/$name.gt.csv" \
+            --max-sigmas 4 --saturated-ok > "$OUT/$name.sigmas"
+        then
+            printf '    %s\n' "$(tail -1 "$OUT/$name.sigmas")"
+        else
+            fail=1; cat "$OUT/$name.sigmas"
         fi
     done
 done
