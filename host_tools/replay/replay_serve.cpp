@@ -38,6 +38,8 @@
 #include <netinet/in.h>
 #include <netinet/tcp.h>
 #include <poll.h>
+#include <csignal>
+#include <ctime>
 #include <sys/ioctl.h>
 #include <linux/sockios.h>
 #include <sys/socket.h>
@@ -898,6 +900,16 @@ int serve(const ServeOptions &o)
     const uint64_t t_end = o.timeout_s > 0 ? t_start + static_cast<uint64_t>(o.timeout_s * 1e6) : UINT64_MAX;
     const char *exit_why = "signal";
     std::vector<pollfd> pfds;
+    // SIGINT / SIGTERM are blocked except inside ppoll(): a signal that arrives between the
+    // g_stop test and the wait is delivered when the wait starts (EINTR) instead of being
+    // lost until the next wake-up (none without clients or --timeout: the server hung).
+    sigset_t stop_sigs, wait_mask;
+    sigemptyset(&stop_sigs);
+    sigaddset(&stop_sigs, SIGINT);
+    sigaddset(&stop_sigs, SIGTERM);
+    sigprocmask(SIG_BLOCK, &stop_sigs, &wait_mask);
+    sigdelset(&wait_mask, SIGINT);
+    sigdelset(&wait_mask, SIGTERM);
     while (!g_stop) {
         uint64_t now = slp_now_us();
         if (now >= t_end) {
@@ -937,7 +949,10 @@ int serve(const ServeOptions &o)
             now = slp_now_us();
             timeout = wake <= now ? 0 : static_cast<int>(std::min<uint64_t>((wake - now + 999) / 1000, 60000));
         }
-        const int rc = poll(pfds.data(), pfds.size(), timeout);
+        timespec ts{};
+        ts.tv_sec = timeout / 1000;
+        ts.tv_nsec = static_cast<long>(timeout % 1000) * 1000000L;
+        const int rc = ppoll(pfds.data(), pfds.size(), timeout < 0 ? nullptr : &ts, &wait_mask);
         if (rc < 0) {
             if (errno == EINTR) {
                 continue;
@@ -967,6 +982,7 @@ int serve(const ServeOptions &o)
             accept_all(s, lfd, slp_now_us());
         }
     }
+    sigprocmask(SIG_UNBLOCK, &stop_sigs, nullptr);
     for (auto &c : s.clients) {
         kill_client(*c, "closed at exit");
     }
