@@ -891,6 +891,7 @@ sl_err_t sl_pipeline_init(sl_pipeline_t *p, const sl_board_t *board,
     }
     if (e == SL_OK) {
         e = sl_tiltobs_init(&p->tilt, &p->det_board); // bin size as detection uses it
+        p->tilt.max_tan_q16 = c->detect.max_lean_tan_q16;
     }
     sl_drift_init(&p->drift, board);
     sl_can_ids_t ids;

@@ -1009,7 +1009,7 @@ uint8_t sl_profile_refine(sl_profile_t *pr, const sl_board_t *board, uint32_t th
                     sl_fx_usat32((int64_t)lo1), dn2 < t->r2_um ? t->r2_um - (uint32_t)dn2 : 0U,
                     &board->geom[t->az], sigma_r, board->theta_sigma_cdeg);
                 res.sigma_cdeg = end_sigma(&res, &far, &board->geom[t->az]);
-                t->flags = (uint16_t)(t->flags | SL_TARGET_COARSE);
+                t->flags = (uint16_t)(t->flags | SL_TARGET_COARSE | SL_TARGET_RAMP);
                 pr->stats.ramps++;
             }
         }

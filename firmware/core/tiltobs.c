@@ -201,7 +201,8 @@ static void observe(sl_tiltobs_t *o, sl_tiltobs_ring_t *r, const sl_target_t *g,
         o->stats.rejected++;
         return;
     }
-    ob.unconfirmed = (uint8_t)(fit ? 0U : 1U);
+    ob.mark = (uint8_t)((fit ? 0U : SL_TILT_OBS_UNCONFIRMED) |
+                        ((g->flags & SL_TARGET_RAMP) != 0U ? SL_TILT_OBS_RAMP : 0U));
     r->obs[r->head] = ob;
     r->head = (uint8_t)((r->head + 1U) % (uint32_t)SL_CFG_TILT_OBS_PER_TRACK);
     if (r->count < (uint8_t)SL_CFG_TILT_OBS_PER_TRACK) {
@@ -351,12 +352,12 @@ static SL_NOINLINE void drop_obs(sl_tiltobs_ring_t *r, uint32_t k)
     r->head = r->count;
 }
 
-// Observations held that were recorded while the track was not confirmed. O(count).
-static uint32_t unconfirmed_held(const sl_tiltobs_ring_t *r)
+// Observations held with `bit` of their mark (SL_TILT_OBS_*). O(count).
+static uint32_t marked(const sl_tiltobs_ring_t *r, uint32_t bit)
 {
     uint32_t n = 0U;
     for (uint32_t k = 0; k < r->count; k++) {
-        n += r->obs[k].unconfirmed != 0U ? 1U : 0U;
+        n += ((uint32_t)r->obs[k].mark & bit) != 0U ? 1U : 0U;
     }
     return n;
 }
@@ -368,7 +369,7 @@ static SL_NOINLINE uint32_t drop_unconfirmed(sl_tiltobs_ring_t *r)
     uint32_t n = 0U;
     uint32_t k = 0U;
     while (k < r->count) {
-        if (r->obs[k].unconfirmed != 0U) {
+        if ((r->obs[k].mark & SL_TILT_OBS_UNCONFIRMED) != 0U) {
             drop_obs(r, k); // (normalises the layout: oldest first from here on)
             n++;
             k = 0U;
@@ -400,7 +401,7 @@ void sl_tiltobs_fit_pending(sl_tiltobs_t *o)
         // trusted less: INCONSISTENT with them, they go and the fit is redone (within the
         // bound, as below). They do not count as outliers.
         const uint32_t unconf = r->res.quality == (uint8_t)SL_TILT_INCONSISTENT
-                                    ? unconfirmed_held(r) : 0U;
+                                    ? marked(r, SL_TILT_OBS_UNCONFIRMED) : 0U;
         if (SL_CFG_TILT_FITS_PER_ROTATION >= 2 && unconf != 0U && unconf < r->count) {
             if (done >= (uint32_t)SL_CFG_TILT_FITS_PER_ROTATION) {
                 o->rr = (uint8_t)idx;
@@ -431,6 +432,27 @@ void sl_tiltobs_fit_pending(sl_tiltobs_t *o)
             (void)sl_tilt_fit(r->obs, r->count, &o->prm, &o->work, &r->res);
             o->stats.fits++;
             done++;
+        }
+        // A result stands on SL_TILT_MIN_OBS observations without a ramp at a bound
+        // (sl_tiltobs.h, 3.): with fewer it is TOO_FEW, as sl_tilt_fit's.
+        if ((r->res.quality == (uint8_t)SL_TILT_FITTED ||
+             r->res.quality == (uint8_t)SL_TILT_AMBIGUOUS) &&
+            (uint32_t)r->count - marked(r, SL_TILT_OBS_RAMP) < SL_TILT_MIN_OBS) {
+            const uint8_t n_obs = r->res.n_obs; // as sl_tilt_fit's TOO_FEW: no values
+            memset(&r->res, 0, sizeof r->res);
+            r->res.n_obs = n_obs;
+            r->res.quality = (uint8_t)SL_TILT_TOO_FEW;
+        }
+        // Nor a tilt beyond the largest a pole may have (max_tan_q16): INCONSISTENT.
+        if ((r->res.quality == (uint8_t)SL_TILT_FITTED ||
+             r->res.quality == (uint8_t)SL_TILT_AMBIGUOUS) &&
+            o->max_tan_q16 != 0U) {
+            const int64_t tx = r->res.tx_q24, ty = r->res.ty_q24;
+            const int64_t lim = (int64_t)o->max_tan_q16 << 8; // Q24
+            if (tx * tx + ty * ty > lim * lim) {
+                r->res.quality = (uint8_t)SL_TILT_INCONSISTENT;
+                o->stats.too_steep++;
+            }
         }
         r->fresh = 0U;
         o->pending--;

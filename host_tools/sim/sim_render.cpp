@@ -245,14 +245,24 @@ Simulator::Simulator(const Scene &scene) : s_(scene)
         }
     }
 
-    // smear kernel: triangular, mode weight 1, front part = mode_frac of the width
+    // smear kernel: mode weight 1 at offset 0, front part = mode_frac of the width
     if (s_.smear && s_.smear_shape != 2) {
         const int W = std::max(1, static_cast<int>(std::lround(s_.smear_width_bins)));
         const int F = std::min(W - 1, static_cast<int>(std::lround(W * s_.smear_mode_frac)));
         smear_front_ = F;
         for (int j = -F; j < W - F; j++) {
             double k = 0;
-            if (j <= 0) {
+            if (s_.smear_shape == 3) {
+                // Gaussian over the window: sigma = W / 6 (the window holds +-3 sigma of a
+                // centred kernel), truncated where the window ends
+                const double sg = W / 6.0;
+                k = std::exp(-0.5 * (j / sg) * (j / sg));
+            } else if (s_.smear_shape == 4) {
+                // Maxwell-Boltzmann density x^2 exp(-x^2 / (2 a^2)), x = j + F from the
+                // window's start, its mode (a sqrt 2) at the target: a = max(F, 1) / sqrt 2
+                const double x = j + F + 0.0, m = std::max(F, 1);
+                k = (x / m) * (x / m) * std::exp(1.0 - (x / m) * (x / m));
+            } else if (j <= 0) {
                 k = (j + F + 1.0) / (F + 1.0);
             } else if (s_.smear_shape == 0) {
                 k = 1.0 - static_cast<double>(j) / (W - F);

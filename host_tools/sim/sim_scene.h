@@ -113,7 +113,9 @@ struct Scene {
     bool smear = false;
     int smear_shape = 0;           ///< 0 triangular (RadaRays), 1 exponential tail,
                                    ///< 2 two-component (fast + slow exponential, decay
-                                   ///< depending on the source bin's level, front skirt)
+                                   ///< depending on the source bin's level, front skirt),
+                                   ///< 3 Gaussian, 4 Maxwell-Boltzmann (RadaRays' other
+                                   ///< two kernel families, mode weight 1 at mode_frac)
     double smear_width_bins = 20;  ///< kernel length (RadaRays triangular: 50, MulRan 35)
     double smear_mode_frac = 0.0;  ///< fraction of the kernel in front of the target (RadaRays 0.35)
     double smear_decay_db = 3.0;   ///< exponential: power decay per bin behind the target (dB)

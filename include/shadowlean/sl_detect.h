@@ -284,6 +284,12 @@ typedef enum sl_detect_reject {
                                        ///< (sl_profile.h, "Cut-off returns"): the mask's
                                        ///< bounds, unverified (COARSE); in a stream of them
                                        ///< the 3D-tilt histories are cleared
+#define SL_TARGET_RAMP 0x800U          ///< the range profile found a ramp at a bound
+                                       ///< (sl_profile.h, "Ramps": a smear kernel's front
+                                       ///< part or flattening end the profile cannot tell
+                                       ///< from the pole): the bound is anywhere along it,
+                                       ///< sigma holds it; a 3D-tilt observation that does
+                                       ///< not count towards a fit's minimum (sl_tiltobs.h)
 
 /// Detection parameters that are not (yet) board fields.
 typedef struct sl_detect_cfg {

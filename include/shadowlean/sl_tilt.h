@@ -146,10 +146,16 @@ typedef struct sl_tilt_obs {
                             ///< (== tan_q12 when not mirrorable)
     uint16_t sigma_q16;     ///< 1-sigma of tan(alpha), >= SL_TILT_SIGMA_MIN_Q16
     uint8_t mirrorable;     ///< 1: measured on branch 2 (the fold applies)
-    uint8_t unconfirmed;    ///< 1: recorded while its track was not confirmed (set by
-                            ///< sl_tiltobs.h, 0 from sl_tilt_obs_make; sl_tilt_fit does
-                            ///< not read it)
+    uint8_t mark;           ///< SL_TILT_OBS_* bits (set by sl_tiltobs.h, 0 from
+                            ///< sl_tilt_obs_make; sl_tilt_fit does not read them)
 } sl_tilt_obs_t;
+
+/// `sl_tilt_obs_t.mark`: recorded while its track was not confirmed (sl_tiltobs.h, 2.).
+#define SL_TILT_OBS_UNCONFIRMED 0x01U
+/// `sl_tilt_obs_t.mark`: its target had a ramp at a bound (SL_TARGET_RAMP): the bound lies
+/// anywhere along it; in the fit, but not among the SL_TILT_MIN_OBS a result needs
+/// (sl_tiltobs.h).
+#define SL_TILT_OBS_RAMP 0x02U
 
 /// Smallest sigma of tan(alpha) a measurement is credited with: 0.001 (0.06 deg), so one
 /// measurement can never dominate a fit through an optimistic sigma (Q16: 66).

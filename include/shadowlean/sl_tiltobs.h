@@ -36,8 +36,8 @@
 ///    confirms, the ring stops being provisional and is fitted with everything it holds:
 ///    a fast pass keeps the rotations before confirmation (at 3 m/s a pole is in the
 ///    shadow for about ten rotations, two of them before its track confirms). Those
-///    observations carry `sl_tilt_obs_t.unconfirmed` and are trusted less: a fit that comes
-///    out INCONSISTENT with them is redone without them, and they are dropped
+///    observations carry SL_TILT_OBS_UNCONFIRMED (`sl_tilt_obs_t.mark`) and are trusted
+///    less: a fit that comes out INCONSISTENT with them is redone without them, and they are dropped
 ///    (sl_tiltobs_fit_pending; `stats.unconfirmed_dropped`). A track that loses its
 ///    confirmation later (its evidence restarts) records nothing until it is confirmed
 ///    again (recording on through such gaps moved the curved-path test's inside pole from
@@ -51,6 +51,19 @@
 ///    of sl_pipeline_feed / _on_msg / _finish), not from inside the rotation callback: the
 ///    fit's stack (~800 B on Cortex-M0) then does not add to the decoder's call chain. So a
 ///    rotation's PoleTilt carries the fit of the observations up to the previous rotation.
+///    A FITTED or AMBIGUOUS result needs SL_TILT_MIN_OBS observations without a ramp at a
+///    bound (SL_TILT_OBS_RAMP, from SL_TARGET_RAMP: the bound lies anywhere along the
+///    ramp), else it is TOO_FEW. Observations with ramps stay in the fit (one rotation's
+///    rows of a pole leaning towards the path often rise after r1: excluding them cost 6 of
+///    the 96 realistic drive-by passes), but a kernel the profile cannot read, whose every
+///    bound is a ramp, no longer makes a FITTED tilt of the few that are not (RadaRays'
+///    Maxwell-Boltzmann kernel with a 10-bin front part: 19-25 deg at TiltSigma 0.8-6 for
+///    poles of 10, and DANGER for the one leaning away). And a FITTED or AMBIGUOUS result
+///    whose tilt exceeds `max_tan_q16` (the largest lean the detector keeps a pole for,
+///    30 deg) is INCONSISTENT (`stats.too_steep`): no pole leans so far, and a kernel of
+///    finite support whose ends the profile reads as the pole's puts r1 and r2 up to a
+///    metre apart (a 50-bin Gaussian kernel: a fit of 45 deg or more at TiltSigma 0.4,
+///    DANGER for a pole leaning 10 deg away).
 ///
 /// Outputs per ring: `res` (the last fit, odometry frame relative to the anchor) and, via
 /// `sl_tiltobs_vehicle()`, the tilt in the vehicle frame at the current pose (what the
@@ -59,7 +72,7 @@
 ///
 /// Units: um, bam32 (2^32 per turn), cdeg (0.01 deg). No allocation, no float; every array
 /// is inside the struct. RAM: SL_CFG_TILT_TRACKS x (SL_CFG_TILT_OBS_PER_TRACK x 24 + 72)
-/// + 664 bytes (x86-64: firmware configuration 4 x 16: 2,488 B; host default 8 x 32: 7,384 B).
+/// + 672 bytes (x86-64: firmware configuration 4 x 16: 2,496 B; host default 8 x 32: 7,392 B).
 /// Cost per rotation: O(tracks x targets) for the matching (only for updated tracks) + O(1) per observation (three table sine/cosine, two 64-bit divisions) + at most
 /// SL_CFG_TILT_FITS_PER_ROTATION fits (sl_tilt.h: O(n + m^2)). Not reentrant per instance.
 #ifndef SHADOWLEAN_SL_TILTOBS_H
@@ -121,6 +134,7 @@ typedef struct sl_tiltobs_stats {
     uint32_t unverified;    ///< targets not stored under `verified_only`: bounds the range
                             ///< profile did not check (SL_TARGET_PROFILE / _NO_TAIL unset)
     uint32_t outliers;      ///< observations dropped from INCONSISTENT fits
+    uint32_t too_steep;     ///< fits beyond `max_tan_q16`, reported INCONSISTENT
 } sl_tiltobs_stats_t;
 
 /// The history of every tracked pole plus the odometry. Caller-owned.
@@ -132,6 +146,13 @@ typedef struct sl_tiltobs {
     bool moving;               ///< the last rotation had a motion input (poses usable)
     uint8_t rr;                ///< internal: round-robin start of the fits
     uint8_t pending;           ///< rings with an observation not fitted yet
+    uint16_t max_tan_q16;      ///< tan of the largest tilt a pole may have, Q16 (0: no bound;
+                               ///< the pipeline sets the detector's cfg.max_lean_tan_q16,
+                               ///< 30 deg): a fit beyond it is INCONSISTENT (a smear kernel
+                               ///< the profile cannot read puts r1 and r2 a metre apart:
+                               ///< a 50-bin Gaussian kernel made a FITTED tilt of 45 deg or
+                               ///< more at a TiltSigma of 0.4, DANGER for a pole leaning 10
+                               ///< away; sl_tiltobs.h, 3.)
     bool verified_only;        ///< store only targets whose bounds the range profile checked
                                ///< (SL_TARGET_PROFILE or _NO_TAIL): set by the pipeline unless
                                ///< the stream is known not to smear (sl_profile_clean), i.e.

@@ -142,7 +142,7 @@ static unsigned held_unconfirmed(const sl_tiltobs_ring_t *r)
 {
     unsigned n = 0;
     for (unsigned k = 0; k < r->count; ++k) {
-        n += r->obs[k].unconfirmed != 0U;
+        n += (r->obs[k].mark & SL_TILT_OBS_UNCONFIRMED) != 0U;
     }
     return n;
 }
@@ -485,6 +485,93 @@ static void test_union_extent_is_observed(void **state)
                      atan2(sin(want), cos(want))) <= 0.002);
 }
 
+// A ramp at a bound (SL_TARGET_RAMP) is stored, marked SL_TILT_OBS_RAMP.
+static void test_ramps_are_observed_marked(void **state)
+{
+    (void)state;
+    const sl_board_t *b = board();
+    const int64_t bin = b->bin_size_um;
+    for (int ramp = 0; ramp < 2; ++ramp) {
+        assert_int_equal(sl_tiltobs_init(&obs, b), SL_OK);
+        obs.verified_only = true;
+        sl_tiltobs_advance(&obs, true, 1000, 0, 250000U);
+        sl_track_t tracks[SL_CFG_MAX_TARGETS];
+        memset(tracks, 0, sizeof tracks);
+        sl_target_t g;
+        memset(&g, 0, sizeof g);
+        g.az = 100;
+        g.bin_first = 70U;
+        g.bin_last = 79U;
+        g.r1_um = (uint32_t)(70 * bin + bin / 2);
+        g.r2_um = (uint32_t)(80 * bin);
+        g.r2_raw_um = g.r2_um;
+        g.incline_flag = SL_INCLINE_VALID;
+        g.flags = (uint16_t)(SL_TARGET_PROFILE | (ramp ? SL_TARGET_RAMP : 0U));
+        tracks[0] = (sl_track_t){.live = 1, .updated = 1, .confirmed = 1, .id = 3, .az = g.az,
+                                 .r1_um = g.r1_um, .r2_um = g.r2_um};
+        sl_tiltobs_update(&obs, tracks, &g, 1U);
+        assert_int_equal(obs.stats.observations, 1U);
+        const sl_tiltobs_ring_t *r = sl_tiltobs_find(&obs, 3U);
+        assert_non_null(r);
+        assert_int_equal(r->obs[0].mark, ramp ? SL_TILT_OBS_RAMP : 0U);
+    }
+}
+
+// A fit beyond the largest tilt a pole may have (max_tan_q16, the detector's largest lean in
+// the pipeline) is INCONSISTENT, with its values; within it, FITTED as without a bound.
+static void test_fits_beyond_the_largest_tilt_are_inconsistent(void **state)
+{
+    (void)state;
+    sl_track_t tracks[SL_CFG_MAX_TARGETS];
+    const pole_t p = {3.0, 3.0, 12.0, 0.0};
+    drive_by(&p, 1, 1.0, 0.0, 16, tracks);
+    sl_tiltobs_ring_t *r = (sl_tiltobs_ring_t *)sl_tiltobs_find(&obs, 1U);
+    assert_non_null(r);
+    assert_int_equal(r->res.quality, SL_TILT_FITTED);
+    const sl_tilt_result_t fitted = r->res;
+    const uint16_t bounds[] = {11556U /* tan 10 deg */, 37837U /* tan 30 deg */};
+    for (int i = 0; i < 2; ++i) {
+        obs.max_tan_q16 = bounds[i];
+        r->fresh = 1U;
+        obs.pending++;
+        sl_tiltobs_fit_pending(&obs);
+        assert_int_equal(r->res.quality, i == 0 ? SL_TILT_INCONSISTENT : SL_TILT_FITTED);
+        assert_int_equal(r->res.psi_cdeg, fitted.psi_cdeg);
+    }
+    assert_int_equal(obs.stats.too_steep, 1U);
+}
+
+// Observations with a ramp at a bound stay in the fit but do not make its minimum: a pass
+// whose observations are all but four ramps is TOO_FEW; the same pass unmarked is FITTED,
+// and with four of the ramps unmarked again (SL_TILT_MIN_OBS clean ones) FITTED again, with
+// the same values (the ramps are in the fit either way).
+static void test_ramps_do_not_make_a_fit(void **state)
+{
+    (void)state;
+    sl_track_t tracks[SL_CFG_MAX_TARGETS];
+    const pole_t p = {3.0, 3.0, 8.0, 0.0};
+    drive_by(&p, 1, 1.0, 0.0, 16, tracks);
+    sl_tiltobs_ring_t *r = (sl_tiltobs_ring_t *)sl_tiltobs_find(&obs, 1U);
+    assert_non_null(r);
+    assert_true(r->count >= 10U);
+    assert_int_equal(r->res.quality, SL_TILT_FITTED);
+    const sl_tilt_result_t fitted = r->res;
+    for (uint32_t keep = SL_TILT_MIN_OBS - 1U; keep <= SL_TILT_MIN_OBS; keep++) {
+        for (uint32_t k = 0; k < r->count; k++) {
+            r->obs[k].mark = (uint8_t)(k < keep ? 0U : SL_TILT_OBS_RAMP);
+        }
+        r->fresh = 1U;
+        obs.pending++;
+        sl_tiltobs_fit_pending(&obs);
+        if (keep < SL_TILT_MIN_OBS) {
+            assert_int_equal(r->res.quality, SL_TILT_TOO_FEW);
+        } else {
+            assert_int_equal(r->res.quality, SL_TILT_FITTED);
+            assert_int_equal(r->res.psi_cdeg, fitted.psi_cdeg);
+        }
+    }
+}
+
 static void test_degenerate_inputs(void **state)
 {
     (void)state;
@@ -690,6 +777,9 @@ int main(void)
         cmocka_unit_test(test_lost_motion_and_lost_tracks_clear_history),
         cmocka_unit_test(test_more_tracks_than_rings_are_counted),
         cmocka_unit_test(test_union_extent_is_observed),
+        cmocka_unit_test(test_ramps_are_observed_marked),
+        cmocka_unit_test(test_fits_beyond_the_largest_tilt_are_inconsistent),
+        cmocka_unit_test(test_ramps_do_not_make_a_fit),
         cmocka_unit_test(test_degenerate_inputs),
         cmocka_unit_test(test_observations_before_confirmation_are_kept),
         cmocka_unit_test(test_early_observations_yield_and_restart),

@@ -30,14 +30,16 @@ out=$(check "$OUT/mask.txt" | wc -l)
 # Poles leaning 15 deg, most of them across the line of sight: detection keeps a smeared
 # slanted group as SLANT from its runs' own extents once the tail slope is known (sl_detect.h
 # stage 4), which the calibration pass of sl-eval (an upright pole, its own seed) provides as
-# a saved prior would. 3 of 16 within before the own extents; 12 now (6 with --cold). Every
-# FITTED pass within the bounds, at least 12 FITTED.
+# a saved prior would. 3 of 16 within before the own extents; 12 after them (6 with --cold);
+# 10 since a fit needs five observations without a ramp at a bound (round 2, session 17:
+# two 3 m/s passes of exactly five, one of them a ramp, are TOO_FEW; sl_tiltobs.h, 3.).
+# Every FITTED pass within the bounds, at least 10 FITTED.
 "$EVAL" driveby --realistic --quick --psi 15 > "$OUT/slant.txt" 2>&1 || { cat "$OUT/slant.txt"; exit 1; }
 cat "$OUT/slant.txt"
 grep -q '^tail slope prior: ' "$OUT/slant.txt" || { echo "FAIL: no calibration pass"; exit 1; }
 bad=$(check "$OUT/slant.txt" | awk '$6 == "FITTED"')
 [ -z "$bad" ] || { echo "FAIL: FITTED outside the bounds:"; echo "$bad"; exit 1; }
 fitted=$(awk '$5 == "|" && $6 == "FITTED"' "$OUT/slant.txt" | wc -l)
-[ "$fitted" -ge 12 ] || { echo "FAIL: $fitted of 16 psi-15 passes FITTED, want >= 12"; exit 1; }
+[ "$fitted" -ge 10 ] || { echo "FAIL: $fitted of 16 psi-15 passes FITTED, want >= 10"; exit 1; }
 echo "driveby_tilt_realistic: 16 of 16 passes within 2 deg / 20 deg / 0.25 m (mask bounds: 0 of 16);" \
      "psi 15: $fitted of 16 FITTED, all within: OK"

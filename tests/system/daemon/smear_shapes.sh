@@ -44,45 +44,62 @@ done
 # saturated LeanSigma, "I cannot tell", passes): the first rotations, before the stream was
 # known to cut its returns off, sent 1-3 frames per pass 5-30 LeanSigma off (session 17:
 # a cut-off cliff takes a clean one back; a walk's end that falls faster near r2 is a ramp).
+# RadaRays' other two kernel families (sl-sim `smear_shape = gaussian | maxwell`), 50 bins:
+# the profile cannot read them either (the leans are unknown: LeanSigma saturated), and no
+# LeanWarning may rise above the true level. Before session 17 the 3D fit took their mask
+# bounds and ramps at the board's range sigma: FITTED tilts of 19 to 45+ deg at TiltSigma
+# 0.4-6, and DANGER for the pole leaning away (4, 2 and 12 frames; a fit now needs five
+# observations without a ramp, and no tilt beyond the detector's 30 deg: sl_tiltobs.h, 3.).
+# Their PoleLean frames are not checked here (a 10-bin front part of the
+# Maxwell kernel still leaves a few walks several LeanSigma off; README), and the 25-bin front
+# parts leave the pole right of the path unreported (missed, not false: --one-side-ok).
 DBC_SIM="$ROOT/boards/paper-sim/shadowlean.dbc"
+drive() { # KERNEL WIDTH FRONT SCALE CHECK_SIGMAS [--one-side-ok]
+    name="drive_$1_w$2_f$3_$4"
+    [ "$1" = triangular ] && name="drive_w$2_f$3_$4"
+    if [ "$4" = power ]; then
+        pw='s/^normalize = none/normalize = none\nlog_quantity = power/;'
+        pw="$pw"' s/^smear_decay_db = 3.3/smear_decay_db = 1.65\nspeckle_db = 1.0/'
+    else
+        pw='s/^$//'
+    fi
+    sed -e "s/^smear_shape = exponential/smear_shape = $1\nsmear_mode_frac = $3/" \
+        -e "s/^smear_width_bins = 40/smear_width_bins = $2/" -e "$pw" \
+        "$ROOT/scenes/driveby_realistic.ini" > "$OUT/$name.ini"
+    grep -q "^smear_shape = $1$" "$OUT/$name.ini" &&
+        grep -q "^smear_width_bins = $2$" "$OUT/$name.ini" ||
+        { echo "FAIL: $name: scene not rewritten"; exit 1; }
+    if [ "$4" = power ] && ! grep -q "^log_quantity = power" "$OUT/$name.ini"; then
+        echo "FAIL: $name: scale"; exit 1
+    fi
+    "$SL_SIM" "$OUT/$name.ini" -o "$OUT/$name.colossus" --quiet || exit 1
+    "$DAEMON" --board paper-sim --input "$OUT/$name.colossus" --motion 1.0 \
+        --can-log "$OUT/$name.log" 2> "$OUT/$name.err" ||
+        { cat "$OUT/$name.err"; echo "FAIL: $name: daemon"; exit 1; }
+    printf '%s: ' "$name"
+    if "$PY" "$SRC/lean_warning_sides.py" "$DBC_SIM" "$OUT/$name.log" 10 -10 ${6:-} > "$OUT/$name.sides"
+    then
+        tail -1 "$OUT/$name.sides"
+    else
+        fail=1; cat "$OUT/$name.sides"
+    fi
+    [ "$5" = yes ] || return 0
+    if "$PY" "$SRC/lean_sigma_vs_truth.py" "$DBC_SIM" "$OUT/$name.log" "$OUT/$name.gt.csv" \
+        --max-sigmas 4 --saturated-ok > "$OUT/$name.sigmas"
+    then
+        printf '    %s\n' "$(tail -1 "$OUT/$name.sigmas")"
+    else
+        fail=1; cat "$OUT/$name.sigmas"
+    fi
+}
 for shape in "20 0" "20 0.35" "35 0.1"; do
     set -- $shape
     for scale in magnitude power; do
-        name="drive_w$1_f$2_$scale"
-        if [ $scale = power ]; then
-            pw='s/^normalize = none/normalize = none\nlog_quantity = power/;'
-            pw="$pw"' s/^smear_decay_db = 3.3/smear_decay_db = 1.65\nspeckle_db = 1.0/'
-        else
-            pw='s/^$//'
-        fi
-        sed -e "s/^smear_shape = exponential/smear_shape = triangular\nsmear_mode_frac = $2/" \
-            -e "s/^smear_width_bins = 40/smear_width_bins = $1/" -e "$pw" \
-            "$ROOT/scenes/driveby_realistic.ini" > "$OUT/$name.ini"
-        grep -q "^smear_shape = triangular" "$OUT/$name.ini" &&
-            grep -q "^smear_width_bins = $1$" "$OUT/$name.ini" ||
-            { echo "FAIL: $name: scene not rewritten"; exit 1; }
-        if [ $scale = power ] && ! grep -q "^log_quantity = power" "$OUT/$name.ini"; then
-            echo "FAIL: $name: scale"; exit 1
-        fi
-        "$SL_SIM" "$OUT/$name.ini" -o "$OUT/$name.colossus" --quiet || exit 1
-        "$DAEMON" --board paper-sim --input "$OUT/$name.colossus" --motion 1.0 \
-            --can-log "$OUT/$name.log" 2> "$OUT/$name.err" ||
-            { cat "$OUT/$name.err"; echo "FAIL: $name: daemon"; exit 1; }
-        printf '%s: ' "$name"
-        if "$PY" "$SRC/lean_warning_sides.py" "$DBC_SIM" "$OUT/$name.log" 10 -10 > "$OUT/$name.sides"
-        then
-            tail -1 "$OUT/$name.sides"
-        else
-            fail=1; cat "$OUT/$name.sides"
-        fi
-        if "$PY" "$SRC/lean_sigma_vs_truth.py" "$DBC_SIM" "$OUT/$name.log" "$OUT/$name.gt.csv" \
-            --max-sigmas 4 --saturated-ok > "$OUT/$name.sigmas"
-        then
-            printf '    %s\n' "$(tail -1 "$OUT/$name.sigmas")"
-        else
-            fail=1; cat "$OUT/$name.sigmas"
-        fi
+        drive triangular "$1" "$2" $scale yes
     done
 done
+drive gaussian 50 0.5 magnitude no --one-side-ok
+drive maxwell 50 0.4 magnitude no --one-side-ok
+drive maxwell 50 0.2 power no
 [ $fail -eq 0 ] && echo "smear_shapes: OK" || echo "smear_shapes: FAILED"
 exit $fail
