@@ -433,23 +433,20 @@ void sl_tiltobs_fit_pending(sl_tiltobs_t *o)
             o->stats.fits++;
             done++;
         }
-        // A result stands on SL_TILT_MIN_OBS observations without a ramp at a bound
-        // (sl_tiltobs.h, 3.): with fewer it is TOO_FEW, as sl_tilt_fit's.
-        if ((r->res.quality == (uint8_t)SL_TILT_FITTED ||
-             r->res.quality == (uint8_t)SL_TILT_AMBIGUOUS) &&
-            (uint32_t)r->count - marked(r, SL_TILT_OBS_RAMP) < SL_TILT_MIN_OBS) {
-            const uint8_t n_obs = r->res.n_obs; // as sl_tilt_fit's TOO_FEW: no values
-            memset(&r->res, 0, sizeof r->res);
-            r->res.n_obs = n_obs;
-            r->res.quality = (uint8_t)SL_TILT_TOO_FEW;
-        }
-        // Nor a tilt beyond the largest a pole may have (max_tan_q16): INCONSISTENT.
-        if ((r->res.quality == (uint8_t)SL_TILT_FITTED ||
-             r->res.quality == (uint8_t)SL_TILT_AMBIGUOUS) &&
-            o->max_tan_q16 != 0U) {
+        // A result (FITTED or AMBIGUOUS) stands on SL_TILT_MIN_OBS observations without a
+        // ramp at a bound, else it is TOO_FEW, as sl_tilt_fit's (no values); nor is it a
+        // tilt beyond the largest a pole may have (max_tan_q16), else INCONSISTENT
+        // (sl_tiltobs.h, 3.).
+        if (r->res.quality == (uint8_t)SL_TILT_FITTED ||
+            r->res.quality == (uint8_t)SL_TILT_AMBIGUOUS) {
             const int64_t tx = r->res.tx_q24, ty = r->res.ty_q24;
             const int64_t lim = (int64_t)o->max_tan_q16 << 8; // Q24
-            if (tx * tx + ty * ty > lim * lim) {
+            if ((uint32_t)r->count - marked(r, SL_TILT_OBS_RAMP) < SL_TILT_MIN_OBS) {
+                const uint8_t n_obs = r->res.n_obs;
+                memset(&r->res, 0, sizeof r->res);
+                r->res.n_obs = n_obs;
+                r->res.quality = (uint8_t)SL_TILT_TOO_FEW;
+            } else if (o->max_tan_q16 != 0U && tx * tx + ty * ty > lim * lim) {
                 r->res.quality = (uint8_t)SL_TILT_INCONSISTENT;
                 o->stats.too_steep++;
             }

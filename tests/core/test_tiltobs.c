@@ -517,24 +517,38 @@ static void test_ramps_are_observed_marked(void **state)
     }
 }
 
+// A 1 m/s drive-by of one pole of `psi` deg (3 m out, leaning along +x) over 16 rotations,
+// FITTED; its ring.
+static sl_tiltobs_ring_t *fitted_ring(double psi)
+{
+    sl_track_t tracks[SL_CFG_MAX_TARGETS];
+    const pole_t p = {3.0, 3.0, psi, 0.0};
+    drive_by(&p, 1, 1.0, 0.0, 16, tracks);
+    sl_tiltobs_ring_t *r = (sl_tiltobs_ring_t *)sl_tiltobs_find(&obs, 1U);
+    assert_non_null(r);
+    assert_int_equal(r->res.quality, SL_TILT_FITTED);
+    return r;
+}
+
+// Fits ring `r` again (as after a new observation).
+static void refit(sl_tiltobs_ring_t *r)
+{
+    r->fresh = 1U;
+    obs.pending++;
+    sl_tiltobs_fit_pending(&obs);
+}
+
 // A fit beyond the largest tilt a pole may have (max_tan_q16, the detector's largest lean in
 // the pipeline) is INCONSISTENT, with its values; within it, FITTED as without a bound.
 static void test_fits_beyond_the_largest_tilt_are_inconsistent(void **state)
 {
     (void)state;
-    sl_track_t tracks[SL_CFG_MAX_TARGETS];
-    const pole_t p = {3.0, 3.0, 12.0, 0.0};
-    drive_by(&p, 1, 1.0, 0.0, 16, tracks);
-    sl_tiltobs_ring_t *r = (sl_tiltobs_ring_t *)sl_tiltobs_find(&obs, 1U);
-    assert_non_null(r);
-    assert_int_equal(r->res.quality, SL_TILT_FITTED);
+    sl_tiltobs_ring_t *r = fitted_ring(12.0);
     const sl_tilt_result_t fitted = r->res;
     const uint16_t bounds[] = {11556U /* tan 10 deg */, 37837U /* tan 30 deg */};
     for (int i = 0; i < 2; ++i) {
         obs.max_tan_q16 = bounds[i];
-        r->fresh = 1U;
-        obs.pending++;
-        sl_tiltobs_fit_pending(&obs);
+        refit(r);
         assert_int_equal(r->res.quality, i == 0 ? SL_TILT_INCONSISTENT : SL_TILT_FITTED);
         assert_int_equal(r->res.psi_cdeg, fitted.psi_cdeg);
     }
@@ -542,27 +556,20 @@ static void test_fits_beyond_the_largest_tilt_are_inconsistent(void **state)
 }
 
 // Observations with a ramp at a bound stay in the fit but do not make its minimum: a pass
-// whose observations are all but four ramps is TOO_FEW; the same pass unmarked is FITTED,
-// and with four of the ramps unmarked again (SL_TILT_MIN_OBS clean ones) FITTED again, with
-// the same values (the ramps are in the fit either way).
+// whose observations are all ramps but SL_TILT_MIN_OBS - 1 is TOO_FEW; with one more without
+// a ramp (SL_TILT_MIN_OBS) FITTED, with the values of the unmarked pass (the ramps are in
+// the fit either way).
 static void test_ramps_do_not_make_a_fit(void **state)
 {
     (void)state;
-    sl_track_t tracks[SL_CFG_MAX_TARGETS];
-    const pole_t p = {3.0, 3.0, 8.0, 0.0};
-    drive_by(&p, 1, 1.0, 0.0, 16, tracks);
-    sl_tiltobs_ring_t *r = (sl_tiltobs_ring_t *)sl_tiltobs_find(&obs, 1U);
-    assert_non_null(r);
+    sl_tiltobs_ring_t *r = fitted_ring(8.0);
     assert_true(r->count >= 10U);
-    assert_int_equal(r->res.quality, SL_TILT_FITTED);
     const sl_tilt_result_t fitted = r->res;
     for (uint32_t keep = SL_TILT_MIN_OBS - 1U; keep <= SL_TILT_MIN_OBS; keep++) {
         for (uint32_t k = 0; k < r->count; k++) {
             r->obs[k].mark = (uint8_t)(k < keep ? 0U : SL_TILT_OBS_RAMP);
         }
-        r->fresh = 1U;
-        obs.pending++;
-        sl_tiltobs_fit_pending(&obs);
+        refit(r);
         if (keep < SL_TILT_MIN_OBS) {
             assert_int_equal(r->res.quality, SL_TILT_TOO_FEW);
         } else {
