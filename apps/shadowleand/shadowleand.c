@@ -750,13 +750,15 @@ static void log_stats(daemon_t *d, int level, const char *what)
             g_pipe.detect.stats.target_overflow);
     const sl_profile_stats_t *ps = &g_pipe.prof.stats;
     sld_log(SLD_LOG_INFO, "%s: range profiles: %" PRIu32 " targets refined (%" PRIu32
-            " from one rotation's neighbouring azimuths, moving; %" PRIu32
+            " from one rotation's neighbouring azimuths, moving, %" PRIu32
+            " neighbours left out as ending elsewhere; %" PRIu32
             " with a ramp in their sigma); mask bounds kept: %" PRIu32
             " no slot, %" PRIu32 " too few rows, %" PRIu32 " no tail (%" PRIu32
             " cut off), %" PRIu32
             " other; tilt observations %" PRIu32 " (%" PRIu32 " unverified left out, %" PRIu32
             " outliers dropped)",
-            what, ps->extracted, ps->spatial, ps->ramps, ps->fallback[SL_PROFILE_NO_SLOT],
+            what, ps->extracted, ps->spatial, ps->misaligned, ps->ramps,
+            ps->fallback[SL_PROFILE_NO_SLOT],
             ps->fallback[SL_PROFILE_FEW_FRAMES], ps->fallback[SL_PROFILE_NO_TAIL], ps->cut_ends,
             ps->fallback[SL_PROFILE_LEAD_CUT] + ps->fallback[SL_PROFILE_NO_RUN] +
                 ps->fallback[SL_PROFILE_TAIL_CUT],

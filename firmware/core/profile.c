@@ -18,6 +18,7 @@
 #define CAL_GATE_N 4U       // fits before the +-30 % gate applies
 #define LOCAL_BINS 6U       // bins of the local tail fit during the walk
 #define SPAN_BINS 3U        // steps of the walk's span test (a shallow step among tail steps)
+#define ALIGN_BINS 2U       // neighbouring rows whose returns end this far apart are summed
 #define SL_PROFILE_EDGE_RETRIES 8U // walks again after a stop beyond the shadow edge (step 4')
 
 void sl_profile_cfg_default(sl_profile_cfg_t *cfg)
@@ -317,6 +318,18 @@ static sl_profile_bounds_t extract_once(const uint16_t *sum, uint32_t n, uint32_
     //    < 2^23, tol is clamped to 2^24 (beyond it every step passes anyway: 2^16 values x
     //    frames), sums < 2^16: every term below is within +-2^26.
     uint32_t s_loc = s; // Q8 per frame
+    if (r.slope_src == SL_PROFILE_SLOPE_FIT && m >= FIT_MIN_BINS + 2U) {
+        // A tail that steepens towards the pole (convex in the log: a power law, or a fast
+        // component under a slow one): the fit over m bins straddles the bend and is steeper
+        // than the tail where the walk starts, whose shallower steps would then read as the
+        // pole's own. Start from the slope of the FIT_MIN_BINS bins ending at e when the
+        // whole fit is steeper by a quarter and a value per bin; the local fit takes over
+        // as the walk goes.
+        const uint32_t sf = fit_slope_q8(sum, e, FIT_MIN_BINS, frames);
+        if (sf >= SLOPE_MIN_Q8 && 4U * s >= 5U * sf && s >= sf + 256U) {
+            s_loc = sf;
+        }
+    }
     const int32_t tl = tol > (1UL << 24) ? (int32_t)(1L << 24) : (int32_t)tol;
     const int32_t f256 = (int32_t)frames * 256;
     j = e;
@@ -624,11 +637,49 @@ static uint32_t tail_ramp(const uint16_t *sum, const sl_profile_bounds_t *pb, ui
     return falls_faster_near(sum, pb->i2, n, frames) ? ramp_bins(sum, pb->i2, pb->i1, 0U) : 0U;
 }
 
+// Where a row's return ends, for comparing neighbouring rows (combine_neighbours): the last
+// bin (absolute) of the first run at or after bin `first` (bins >= frames x thr, gaps <= 2
+// bridged) that is within thr / 4 values per frame of the run's highest bin. A row's beam
+// gain is an offset and the smear the same kernel, so rows that hold the pole at the same
+// ranges end there within a bin or two (speckle moves the highest bin); a row that holds an
+// oblique pole's other ranges ends elsewhere.
+static uint32_t row_end(const sl_profile_slot_t *q, uint32_t first, uint32_t thr)
+{
+    const uint32_t f = q->frames;
+    uint32_t j = first > q->bin0 ? first - q->bin0 : 0U;
+    while (j < SL_CFG_PROFILE_BINS && q->sum[j] < f * thr) {
+        j++;
+    }
+    if (j >= SL_CFG_PROFILE_BINS) {
+        return UINT32_MAX / 2U; // no return: ends nowhere near a return
+    }
+    uint32_t mx = 0U, last = j;
+    for (; j < SL_CFG_PROFILE_BINS; j++) {
+        if (q->sum[j] >= f * thr) {
+            last = j;
+            mx = q->sum[j] > mx ? q->sum[j] : mx;
+        } else if (j > last + 2U) {
+            break;
+        }
+    }
+    uint32_t e = last;
+    while (e > 0U && (uint32_t)q->sum[e] + f * (thr / 4U) < mx) {
+        e--;
+    }
+    return q->bin0 + e;
+}
+
 // The rows of target `t`'s azimuth (slot `si`) and of its two neighbours, when they belong
 // to its detection group and are watched, summed into pr->scratch over the bins all of them
 // cover (a neighbour whose window starts after the target's first bin - 3 would cut the
 // leading edge: left out). Adjacent azimuths (0.9 deg on the CTS350-X) lie inside one beam
-// width (1.8 deg), so they hold the same pole at the same ranges with their own speckle.
+// width (1.8 deg), so they hold the same pole at the same ranges with their own speckle;
+// except a pole oblique to the beam (leaning partly across the line of sight), whose end
+// is 5-7 bins apart on neighbouring azimuths: a neighbour whose return ends more than
+// ALIGN_BINS from the target's (row_end) is left out (`stats.misaligned`). Summed, its tail
+// lay over the target's own bins and read as the target's tail (under a tail that
+// steepens near the pole the walk took 8 and 13 own bins of a pole leaning towards the
+// path for smear), and its disagreement widened every step test of the walk.
 // `*bin0` / `*n`: the summed window. @return the rows summed (0: none).
 static uint32_t combine_neighbours(sl_profile_t *pr, const sl_target_t *t, uint8_t si,
                                    uint32_t thr, uint32_t *bin0, uint32_t *n, uint32_t *tol_q8)
@@ -639,6 +690,7 @@ static uint32_t combine_neighbours(sl_profile_t *pr, const sl_target_t *t, uint8
     uint32_t lo = pr->slot[si].bin0;
     uint32_t hi = lo + SL_CFG_PROFILE_BINS;
     const uint32_t az_n = pr->azimuths;
+    const uint32_t end0 = row_end(&pr->slot[si], t->bin_first, thr);
     for (uint32_t d = 0; d < 2U; d++) {
         const uint32_t nb = d == 0U ? (t->az + az_n - 1U) % az_n : (t->az + 1U) % az_n;
         if ((nb + az_n - t->az_first % az_n) % az_n >= t->az_count || nb == t->az) {
@@ -650,6 +702,11 @@ static uint32_t combine_neighbours(sl_profile_t *pr, const sl_target_t *t, uint8
             continue;
         }
         const sl_profile_slot_t *q = &pr->slot[ni];
+        const uint32_t end = row_end(q, t->bin_first, thr);
+        if (end + ALIGN_BINS < end0 || end > end0 + ALIGN_BINS) {
+            pr->stats.misaligned++; // its return ends elsewhere: not the same ranges
+            continue;
+        }
         lo = q->bin0 > lo ? q->bin0 : lo;
         hi = (uint32_t)q->bin0 + SL_CFG_PROFILE_BINS < hi ? (uint32_t)q->bin0 + SL_CFG_PROFILE_BINS
                                                           : hi;

@@ -264,6 +264,10 @@ Simulator::Simulator(const Scene &scene) : s_(scene)
                 k = (x / m) * (x / m) * std::exp(1.0 - (x / m) * (x / m));
             } else if (j <= 0) {
                 k = (j + F + 1.0) / (F + 1.0);
+            } else if (s_.smear_shape == 5) {
+                // power law: (1 + j)^-p, the first bin down by decay_db (p = decay_db / 3.01):
+                // steep next to the target, ever slower behind it (no single exponential)
+                k = std::pow(1.0 + j, -s_.smear_decay_db / (10.0 * std::log10(2.0)));
             } else if (s_.smear_shape == 0) {
                 k = 1.0 - static_cast<double>(j) / (W - F);
             } else {

@@ -260,7 +260,7 @@ Scene build(const Parsed &p)
                 "leak_jitter"});
         s.smear = c.boolean("smear", false);
         s.smear_shape = c.choice<int>("smear_shape", 0, {{"triangular", 0}, {"exponential", 1}, {"two-component", 2},
-                                                              {"gaussian", 3}, {"maxwell", 4}});
+                                                              {"gaussian", 3}, {"maxwell", 4}, {"powerlaw", 5}});
         s.smear_width_bins = c.real("smear_width_bins", s.smear_width_bins, 1, 500);
         s.smear_decay_db = c.real("smear_decay_db", s.smear_decay_db, 0.01, 100);
         s.smear_mode_frac = c.real("smear_mode_frac", s.smear_mode_frac, 0, 1);

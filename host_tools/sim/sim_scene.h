@@ -115,10 +115,13 @@ struct Scene {
                                    ///< 2 two-component (fast + slow exponential, decay
                                    ///< depending on the source bin's level, front skirt),
                                    ///< 3 Gaussian, 4 Maxwell-Boltzmann (RadaRays' other
-                                   ///< two kernel families, mode weight 1 at mode_frac)
+                                   ///< two kernel families, mode weight 1 at mode_frac),
+                                   ///< 5 power law (1 + j)^-p behind the target, p such
+                                   ///< that the first bin falls by smear_decay_db
     double smear_width_bins = 20;  ///< kernel length (RadaRays triangular: 50, MulRan 35)
     double smear_mode_frac = 0.0;  ///< fraction of the kernel in front of the target (RadaRays 0.35)
-    double smear_decay_db = 3.0;   ///< exponential: power decay per bin behind the target (dB)
+    double smear_decay_db = 3.0;   ///< exponential: power decay per bin behind the target (dB);
+                                   ///< power law: the decay of the first bin (dB)
     // two-component (smear_shape 2): kernel(j > 0) = 10^(-d_f j / 10) + 10^((L_s - d_s j) / 10),
     // kernel(0) = 1 + 10^(L_s / 10), kernel(-1) = 10^(front_db / 10); d_f = smear_decay_db - a x,
     // d_s = smear_slow_decay_db - a x, x = clamp(10 log10(E / log_ref_energy) / 20, -1, 1)

@@ -33,7 +33,11 @@
 /// rows is refined from the sum of this rotation's rows of its azimuth and its two
 /// neighbours when they belong to its detection group (adjacent azimuths, 0.9 deg apart,
 /// lie inside one beam width, 1.8 deg: the same pole at the same ranges, each with its own
-/// speckle), over the bins all of them cover: three rows, `stats.spatial`. Only to remove a
+/// speckle), over the bins all of them cover: three rows, `stats.spatial`. Not a neighbour
+/// whose return ends more than 2 bins from the target's (a row's end: its last bin within
+/// T/4 values of its own highest): an oblique pole ends 5-7 bins apart on neighbouring
+/// azimuths, and its tail laid over the target's own bins reads as the target's tail
+/// (`stats.misaligned`; session 18). Only to remove a
 /// smear tail: when that sum ends in a cliff (no tail) the mask's bounds are kept (an
 /// oblique pole spans other ranges on the neighbours), counted NO_TAIL. Limits: the walk
 /// (step 4) tolerates noise at the rounding level plus the step noise measured from the
@@ -73,6 +77,11 @@
 ///    the walk, while own bins before the step, flat or the leading edge, fall by far
 ///    less). s_loc is the slope fitted on the 6 tail bins nearest to the walk
 ///    (j .. j + 5) once there are 6, so a tail that steepens towards the pole is followed.
+///    The walk starts from the slope of the 4 bins ending at e when the whole first fit is
+///    steeper than it by a quarter and a value per bin: such a tail (convex in the log: a
+///    power law, or a fast component under a slow one) bends within the fit window, and
+///    against the fit's slope its shallower far steps read as the pole's own (r2 5-9 bins
+///    long, `test_profile_a_tail_that_steepens_towards_the_pole`; session 18).
 ///    The bin where the walk stops is the last own bin: r2. When the first fit window
 ///    reached into the pole's own bins (a short tail), the fit is repeated on the tail the
 ///    walk found (>= 4 bins) and the walk done again.
@@ -352,6 +361,8 @@ typedef struct sl_profile_stats {
                             ///< bin's centre (sl_profile_lead_edge: the shape fits no model)
     uint32_t spatial;       ///< targets refined from one rotation's rows of neighbouring
                             ///< azimuths (too few rotations summed: moving)
+    uint32_t misaligned;    ///< ... neighbouring rows left out of such a sum: their return
+                            ///< ends more than 2 bins from the target's (an oblique pole)
     uint32_t reserved;      ///< slots reserved where a track is expected (sl_profile_reserve)
     uint32_t reserve_full;  ///< ... azimuths left unwatched: no free slot
     uint32_t cut_ends;      ///< cliffs the return falls ever faster into (cut off by a

@@ -136,6 +136,14 @@ static double k_level(int j, double level_db)
     return pow(10.0, -d * j / 10.0);
 }
 
+// A power law (1 + j)^-p, the first bin down by g_decay_db: steep next to the pole, ever
+// slower behind it (convex in the log: no single exponential; sl-sim `smear_shape = powerlaw`).
+static double k_pow(int j, double level_db)
+{
+    (void)level_db;
+    return j <= 0 ? (j == 0 ? 1.0 : 0.0) : pow(1.0 + j, -g_decay_db / (10.0 * log10(2.0)));
+}
+
 static void synth(uint16_t *sum, int frames, int a, int b, const double *own_db, kernel_fn kern)
 {
     double p[NB];
@@ -208,6 +216,31 @@ static void test_profile_extracts_own_bins_under_other_smear_shapes(void **state
     check_shape(k_two, foot, 5, 16);
     check_shape(k_level, uni, 12, 16);
     check_shape(k_level, foot, 5, 16);
+}
+
+// A tail that steepens towards the pole (a power law: 12-20 dB down in its first bin, then
+// ever slower). The first fit over 8 bins straddles the bend, steeper than the tail where
+// the walk starts, and its shallow far steps read as the pole's own: r2 was 5-9 bins long
+// (uniform poles) or 8 (a foot) with this kernel (sl_profile.h step 4, "A tail that
+// steepens"). Poles 80 and 100 dB strong (the tail needs 4 bins above T + T/4 for a fit).
+static void test_profile_a_tail_that_steepens_towards_the_pole(void **state)
+{
+    (void)state;
+    const double cases[4][2] = {{12.0, 80.0}, {16.0, 80.0}, {16.0, 100.0}, {20.0, 100.0}};
+    for (int c = 0; c < 4; c++) {
+        double uni[12], foot[5];
+        for (int i = 0; i < 12; i++) {
+            uni[i] = cases[c][1];
+        }
+        for (int i = 0; i < 5; i++) {
+            foot[i] = cases[c][1] - 10.0 + 8.0 * i;
+        }
+        g_decay_db = cases[c][0];
+        for (int f = 1; f <= 16; f *= 4) {
+            check_shape(k_pow, uni, 12, f);
+            check_shape(k_pow, foot, 5, f);
+        }
+    }
 }
 
 static void test_profile_reports_why_it_cannot_extract(void **state)
@@ -634,6 +667,39 @@ static void test_profile_refines_from_neighbouring_azimuths_while_moving(void **
     // stopped: evidence claims again, reservations are not needed
     sl_profile_end_rotation(&pr, false);
     assert_int_equal(pr.moving, 0);
+}
+
+// A pole oblique to the beam holds other ranges on a neighbouring azimuth: there its return
+// ends 6 bins earlier. Summed, that row's tail (steep near its end, a power law) lay over
+// the target's own bins and read as the target's tail, and the rows' disagreement widened
+// every step of the walk: r2 came out at the pole's first bin, 10 bins short. Such a
+// neighbour is left out (its return ends more than 2 bins from the target's); the other is
+// summed.
+static void test_profile_a_neighbour_ending_elsewhere_is_not_summed(void **state)
+{
+    (void)state;
+    assert_int_equal(sl_profile_init(&pr, 400, 0, NULL), SL_OK);
+    const sl_board_t board = bins_board();
+    double own[NB];
+    for (int i = 0; i < NB; i++) {
+        own[i] = 80.0;
+    }
+    uint16_t same[NB], early[NB];
+    g_decay_db = 16.0;
+    synth(same, 1, 20, 30, own, k_pow);  // the target's azimuth and one neighbour
+    synth(early, 1, 20, 24, own, k_pow); // the other neighbour: the pole ends 6 bins sooner
+    for (int pass = 0; pass < 2; pass++) {
+        sl_profile_end_rotation(&pr, true); // moving: one rotation's rows
+        assert_int_equal(sl_profile_reserve(&pr, 100, 20, 2U), 5);
+        speckled_rows(same, 99, 100, 777U);
+        speckled_rows(pass == 0 ? early : same, 101, 101, 4242U);
+        sl_target_t t = mask_target(100, 99, 3, 20, 45);
+        const uint32_t left_out = pr.stats.misaligned;
+        assert_int_equal(sl_profile_refine(&pr, &board, 40, &t), SL_PROFILE_OK);
+        // the own end (bin 30) within one bin
+        assert_true(t.r2_um >= (2 * 29 + 1) * 43800 / 2 && t.r2_um <= (2 * 31 + 1) * 43800 / 2);
+        assert_int_equal(pr.stats.misaligned - left_out, pass == 0 ? 1U : 0U);
+    }
 }
 
 // A pole leaning across the beam (SL_TARGET_SLANT, sl_detect.h): its bounds are the group's
@@ -1202,6 +1268,7 @@ int main(void)
         cmocka_unit_test(test_profile_halves_reset_and_counts_full),
         cmocka_unit_test(test_profile_extracts_own_bins_under_exponential_smear),
         cmocka_unit_test(test_profile_extracts_own_bins_under_other_smear_shapes),
+        cmocka_unit_test(test_profile_a_tail_that_steepens_towards_the_pole),
         cmocka_unit_test(test_profile_reports_why_it_cannot_extract),
         cmocka_unit_test(test_profile_keeps_the_own_bins_of_a_return_without_smear),
         cmocka_unit_test(test_profile_a_cliff_beyond_the_shadow_edge_ends_a_tail),
@@ -1212,6 +1279,7 @@ int main(void)
         cmocka_unit_test(test_profile_refines_a_target_after_min_frames),
         cmocka_unit_test(test_profile_starts_from_a_saved_tail_slope),
         cmocka_unit_test(test_profile_refines_from_neighbouring_azimuths_while_moving),
+        cmocka_unit_test(test_profile_a_neighbour_ending_elsewhere_is_not_summed),
         cmocka_unit_test(test_profile_refines_only_the_far_end_of_a_pole_leaning_across_the_beam),
         cmocka_unit_test(test_profile_fill_from_the_log_values),
         cmocka_unit_test(test_profile_refines_r2_within_the_last_bin_of_a_cliff),
