@@ -318,13 +318,14 @@ static sl_profile_bounds_t extract_once(const uint16_t *sum, uint32_t n, uint32_
     //    < 2^23, tol is clamped to 2^24 (beyond it every step passes anyway: 2^16 values x
     //    frames), sums < 2^16: every term below is within +-2^26.
     uint32_t s_loc = s; // Q8 per frame
-    if (r.slope_src == SL_PROFILE_SLOPE_FIT && m >= FIT_MIN_BINS + 2U) {
+    if (r.slope_src == SL_PROFILE_SLOPE_FIT && m > FIT_MIN_BINS) {
         // A tail that steepens towards the pole (convex in the log: a power law, or a fast
         // component under a slow one): the fit over m bins straddles the bend and is steeper
         // than the tail where the walk starts, whose shallower steps would then read as the
         // pole's own. Start from the slope of the FIT_MIN_BINS bins ending at e when the
-        // whole fit is steeper by a quarter and a value per bin; the local fit takes over
-        // as the walk goes.
+        // whole fit (also the refit on a short tail, whose first bin may be the pole's
+        // partly lit last one) is steeper by a quarter and a value per bin; the local fit
+        // takes over as the walk goes.
         const uint32_t sf = fit_slope_q8(sum, e, FIT_MIN_BINS, frames);
         if (sf >= SLOPE_MIN_Q8 && 4U * s >= 5U * sf && s >= sf + 256U) {
             s_loc = sf;
@@ -876,6 +877,15 @@ static SL_NOINLINE void widen_unverified(const sl_profile_t *pr, const sl_board_
     t->flags = (uint16_t)(t->flags | SL_TARGET_COARSE);
 }
 
+// The target keeps the mask's bounds for reason `why` (counted), unverified unless the
+// stream is known clean (widen_unverified). @return why.
+static uint8_t keep_mask(sl_profile_t *pr, const sl_board_t *board, sl_target_t *t, uint8_t why)
+{
+    pr->stats.fallback[why]++;
+    widen_unverified(pr, board, t, false);
+    return why;
+}
+
 uint8_t sl_profile_refine(sl_profile_t *pr, const sl_board_t *board, uint32_t threshold,
                           sl_target_t *t)
 {
@@ -885,9 +895,7 @@ uint8_t sl_profile_refine(sl_profile_t *pr, const sl_board_t *board, uint32_t th
         const uint8_t why = (si != SL_PROFILE_NONE && pr->slot[si].frames != 0U)
                                 ? (uint8_t)SL_PROFILE_LEAD_CUT
                                 : (uint8_t)SL_PROFILE_NO_SLOT;
-        pr->stats.fallback[why]++;
-        widen_unverified(pr, board, t, false);
-        return why;
+        return keep_mask(pr, board, t, why);
     }
     const sl_profile_slot_t *s = &pr->slot[si];
     const uint16_t *sum = s->sum;
@@ -896,17 +904,21 @@ uint8_t sl_profile_refine(sl_profile_t *pr, const sl_board_t *board, uint32_t th
     uint32_t n = SL_CFG_PROFILE_BINS;
     uint32_t tol = 0U;
     bool spatial = false;
+    bool single = false;
     if (frames < pr->cfg.min_frames) {
         // Too few rotations summed (moving: cleared every rotation): this rotation's rows
         // of the neighbouring azimuths of the group, aligned on their bins.
         frames = combine_neighbours(pr, t, si, threshold, &bin0, &n, &tol);
-        if (frames < pr->cfg.min_frames) {
-            pr->stats.fallback[SL_PROFILE_FEW_FRAMES]++;
-            widen_unverified(pr, board, t, false);
-            return (uint8_t)SL_PROFILE_FEW_FRAMES;
-        }
-        sum = pr->scratch;
         spatial = true;
+        if (frames < pr->cfg.min_frames) {
+            // One row (no neighbour in the group, or none ending where it ends): too few to
+            // walk a tail over or calibrate on, but a return that ends in a cliff no smear
+            // tail makes is the stream's evidence all the same, as summed rows' cliffs are
+            // (below: NO_TAIL or CUT, the mask's bounds); anything else is FEW_FRAMES.
+            single = true;
+        } else {
+            sum = pr->scratch;
+        }
     }
     // Bins from the first that starts at or beyond the shadow edge on: no cliff there.
     uint32_t cliff_end = UINT32_MAX;
@@ -924,10 +936,12 @@ uint8_t sl_profile_refine(sl_profile_t *pr, const sl_board_t *board, uint32_t th
             : t->bin_first;
     const sl_profile_bounds_t pb = sl_profile_extract_noisy(sum, n, frames, threshold, first - bin0,
                                                             pr->slope_q8, cliff_end, tol);
+    if (single && (pb.fail != (uint8_t)SL_PROFILE_OK || pb.slope_src != SL_PROFILE_SLOPE_CLIFF ||
+                   !is_cliff(sum, pb.i2, frames, SLOPE_MAX_Q8))) {
+        return keep_mask(pr, board, t, (uint8_t)SL_PROFILE_FEW_FRAMES);
+    }
     if (pb.fail != (uint8_t)SL_PROFILE_OK) {
-        pr->stats.fallback[pb.fail]++;
-        widen_unverified(pr, board, t, false);
-        return pb.fail;
+        return keep_mask(pr, board, t, pb.fail);
     }
     bool cut = false;
     if (pb.slope_src == SL_PROFILE_SLOPE_CLIFF) {
@@ -940,6 +954,11 @@ uint8_t sl_profile_refine(sl_profile_t *pr, const sl_board_t *board, uint32_t th
         const uint32_t k = pb.i2 - 1U;
         const uint32_t nr = pb.i2 > pb.i1 + 3U ? ramp_bins(sum, k, pb.i1, frames) : 0U;
         cut = nr >= 3U && falls_faster_near(sum, k, nr, frames);
+        if (cut && single) {
+            // One row cut off is mostly the beam's edge on an oblique pole (whose neighbours
+            // end elsewhere): no evidence on the stream's smear, and FEW_FRAMES as before.
+            return keep_mask(pr, board, t, (uint8_t)SL_PROFILE_FEW_FRAMES);
+        }
         if (cut) {
             pr->cut_n = pr->cut_n < UINT8_MAX ? (uint8_t)(pr->cut_n + 1U) : pr->cut_n;
             // Until the stream is known clean, a cut-off cliff takes back a clean one: it

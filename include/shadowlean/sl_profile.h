@@ -37,7 +37,13 @@
 /// whose return ends more than 2 bins from the target's (a row's end: its last bin within
 /// T/4 values of its own highest): an oblique pole ends 5-7 bins apart on neighbouring
 /// azimuths, and its tail laid over the target's own bins reads as the target's tail
-/// (`stats.misaligned`; session 18). Only to remove a
+/// (`stats.misaligned`; session 18). One row left (no neighbour in the group, or none
+/// ending where it ends) is too few to walk a tail over or calibrate on (FEW_FRAMES),
+/// except a return that ends in a cliff no smear tail makes (the step after it falls by
+/// more than two of the steepest plausible slopes) and is not cut off: NO_TAIL with the
+/// mask's bounds, and evidence that the stream is clean (`clean_n`), as summed rows'
+/// cliffs are. One row cut off (mostly the beam's edge on an oblique pole) is no evidence
+/// either way: FEW_FRAMES. Only to remove a
 /// smear tail: when that sum ends in a cliff (no tail) the mask's bounds are kept (an
 /// oblique pole spans other ranges on the neighbours), counted NO_TAIL. Limits: the walk
 /// (step 4) tolerates noise at the rounding level plus the step noise measured from the
@@ -77,11 +83,12 @@
 ///    the walk, while own bins before the step, flat or the leading edge, fall by far
 ///    less). s_loc is the slope fitted on the 6 tail bins nearest to the walk
 ///    (j .. j + 5) once there are 6, so a tail that steepens towards the pole is followed.
-///    The walk starts from the slope of the 4 bins ending at e when the whole first fit is
-///    steeper than it by a quarter and a value per bin: such a tail (convex in the log: a
-///    power law, or a fast component under a slow one) bends within the fit window, and
-///    against the fit's slope its shallower far steps read as the pole's own (r2 5-9 bins
-///    long, `test_profile_a_tail_that_steepens_towards_the_pole`; session 18).
+///    The walk starts from the slope of the 4 bins ending at e when the whole fit (the
+///    first, or the refit below, over 5 or more bins) is steeper than it by a quarter and a
+///    value per bin: such a tail (convex in the log: a power law, or a fast component
+///    under a slow one) bends within the fit window, and against the fit's slope its
+///    shallower far steps read as the pole's own (r2 4-9 bins long,
+///    `test_profile_a_tail_that_steepens_towards_the_pole`; session 18).
 ///    The bin where the walk stops is the last own bin: r2. When the first fit window
 ///    reached into the pole's own bins (a short tail), the fit is repeated on the tail the
 ///    walk found (>= 4 bins) and the walk done again.
@@ -238,7 +245,7 @@
 /// ## Ownership, memory, cost
 /// Caller-owned `sl_profile_t`, no allocation. RAM: SL_CFG_MAX_AZIMUTHS bytes + slots x
 /// (2 x SL_CFG_PROFILE_BINS + 10) + 2 x SL_CFG_PROFILE_BINS (the neighbours' sum) + ~70 B
-/// (2,284 B with the defaults on x86-64).
+/// (2,304 B with the defaults on x86-64).
 /// sl_profile_row: an unwatched azimuth costs one table read and a scan of the window's
 /// words for the first occupied bit; a watched one SL_CFG_PROFILE_BINS additions.
 /// sl_profile_extract: O(bins) with a 6- or 8-point integer fit per walked bin, 64-bit

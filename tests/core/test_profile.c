@@ -138,6 +138,13 @@ static double k_level(int j, double level_db)
 
 // A power law (1 + j)^-p, the first bin down by g_decay_db: steep next to the pole, ever
 // slower behind it (convex in the log: no single exponential; sl-sim `smear_shape = powerlaw`).
+// No smear: the return ends in a cliff.
+static double k_none(int j, double level_db)
+{
+    (void)level_db;
+    return j == 0 ? 1.0 : 0.0;
+}
+
 static double k_pow(int j, double level_db)
 {
     (void)level_db;
@@ -241,6 +248,19 @@ static void test_profile_a_tail_that_steepens_towards_the_pole(void **state)
             check_shape(k_pow, foot, 5, f);
         }
     }
+    // Recorded: the paper's bench (24 rotations summed, speckle, noise) with a 20 dB power
+    // law, a pole leaning +10 deg whose last 60 % lie in bin 17 here (its own bins 6-17 read
+    // 101-107 per rotation). The first walk found bin 16; the refit on its 5-bin tail (bins
+    // 17-21) straddled the bend again and its walk stopped at e (bin 21): r2 4 bins long,
+    // +15.9 deg at a sigma of 1.0. Now bin 16 (the partly lit bin taken for tail) or 17.
+    static const uint16_t rec[40] = {
+        470,  466,  468,  463,  424,  425,  2568, 2568, 2520, 2520, 2496, 2568, 2520, 2472,
+        2448, 2424, 2424, 2208, 1776, 1536, 1392, 1272, 1176, 1104, 1032, 960,  912,  857,
+        813,  769,  726,  692,  658,  659,  717,  676,  732,  663,  694,  645};
+    const sl_profile_bounds_t r = sl_profile_extract(rec, 40U, 24U, 40U, 6U, 0U, UINT32_MAX);
+    assert_int_equal(r.fail, SL_PROFILE_OK);
+    assert_int_equal(r.i1, 6);
+    assert_true(r.i2 >= 16 && r.i2 <= 17);
 }
 
 static void test_profile_reports_why_it_cannot_extract(void **state)
@@ -700,6 +720,33 @@ static void test_profile_a_neighbour_ending_elsewhere_is_not_summed(void **state
         assert_true(t.r2_um >= (2 * 29 + 1) * 43800 / 2 && t.r2_um <= (2 * 31 + 1) * 43800 / 2);
         assert_int_equal(pr.stats.misaligned - left_out, pass == 0 ? 1U : 0U);
     }
+    // Noise-free rows of an oblique pole (no smear: cliffs) end 5 bins apart on both
+    // neighbours: one row is left, too few to walk a tail over, but its cliff is the
+    // stream's evidence that it does not smear (NO_TAIL, the mask's bounds; clean_n), as
+    // summed rows' cliffs are. A curved noise-free drive-by lost every 3D-tilt observation
+    // when such targets were FEW_FRAMES (never a cliff seen: the stream never clean).
+    uint16_t c0[NB], c1[NB];
+    synth(c0, 1, 20, 30, own, k_none);
+    synth(c1, 1, 20, 25, own, k_none);
+    sl_profile_end_rotation(&pr, true);
+    assert_int_equal(sl_profile_reserve(&pr, 100, 20, 2U), 5);
+    speckled_rows(c1, 99, 99, 99U);
+    speckled_rows(c0, 100, 100, 98U);
+    speckled_rows(c1, 101, 101, 97U);
+    const uint8_t clean = pr.clean_n;
+    sl_target_t t = mask_target(100, 99, 3, 20, 30);
+    assert_int_equal(sl_profile_refine(&pr, &board, 40, &t), SL_PROFILE_NO_TAIL);
+    assert_int_equal(pr.clean_n, clean + 1U);
+    assert_int_equal(t.r2_um, (2 * 30 + 1) * 43800 / 2);
+    // ... while one row of a smeared return stays FEW_FRAMES (its tail is not walked)
+    g_decay_db = 3.3;
+    synth(c0, 1, 20, 30, own, k_exp);
+    sl_profile_end_rotation(&pr, true);
+    assert_int_equal(sl_profile_reserve(&pr, 100, 20, 2U), 5);
+    speckled_rows(c0, 100, 100, 96U);
+    t = mask_target(100, 100, 1, 20, 45);
+    assert_int_equal(sl_profile_refine(&pr, &board, 40, &t), SL_PROFILE_FEW_FRAMES);
+    assert_int_equal(pr.clean_n, clean + 1U);
 }
 
 // A pole leaning across the beam (SL_TARGET_SLANT, sl_detect.h): its bounds are the group's
