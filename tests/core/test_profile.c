@@ -136,8 +136,6 @@ static double k_level(int j, double level_db)
     return pow(10.0, -d * j / 10.0);
 }
 
-// A power law (1 + j)^-p, the first bin down by g_decay_db: steep next to the pole, ever
-// slower behind it (convex in the log: no single exponential; sl-sim `smear_shape = powerlaw`).
 // No smear: the return ends in a cliff.
 static double k_none(int j, double level_db)
 {
@@ -145,6 +143,8 @@ static double k_none(int j, double level_db)
     return j == 0 ? 1.0 : 0.0;
 }
 
+// A power law (1 + j)^-p, the first bin down by g_decay_db: steep next to the pole, ever
+// slower behind it (convex in the log: no single exponential; sl-sim `smear_shape = powerlaw`).
 static double k_pow(int j, double level_db)
 {
     (void)level_db;
@@ -228,8 +228,8 @@ static void test_profile_extracts_own_bins_under_other_smear_shapes(void **state
 // A tail that steepens towards the pole (a power law: 12-20 dB down in its first bin, then
 // ever slower). The first fit over 8 bins straddles the bend, steeper than the tail where
 // the walk starts, and its shallow far steps read as the pole's own: r2 was 5-9 bins long
-// (uniform poles) or 8 (a foot) with this kernel (sl_profile.h step 4, "A tail that
-// steepens"). Poles 80 and 100 dB strong (the tail needs 4 bins above T + T/4 for a fit).
+// (uniform poles) or 8 (a foot) with this kernel (sl_profile.h step 4). Poles 80 and 100 dB
+// strong (the tail needs 4 bins above T + T/4 for a fit).
 static void test_profile_a_tail_that_steepens_towards_the_pole(void **state)
 {
     (void)state;
