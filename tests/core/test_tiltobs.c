@@ -438,6 +438,22 @@ static void test_more_tracks_than_rings_are_counted(void **state)
     if (n > SL_CFG_TILT_TRACKS) assert_true(obs.stats.no_ring > 0U);
 }
 
+// Target `g` as the one detection of confirmed track 3 (its bounds): one observation,
+// stored in track 3's ring, which is returned.
+static const sl_tiltobs_ring_t *observe_one(const sl_target_t *g)
+{
+    sl_track_t tracks[SL_CFG_MAX_TARGETS];
+    memset(tracks, 0, sizeof tracks);
+    tracks[0] = (sl_track_t){.live = 1, .updated = 1, .confirmed = 1, .id = 3, .az = g->az,
+                             .r1_um = g->r1_um, .r2_um = g->r2_um};
+    const uint32_t before = obs.stats.observations;
+    sl_tiltobs_update(&obs, tracks, g, 1U);
+    assert_int_equal(obs.stats.observations, before + 1U);
+    const sl_tiltobs_ring_t *r = sl_tiltobs_find(&obs, 3U);
+    assert_non_null(r);
+    return r;
+}
+
 // The observation is the group's union extent (ext_grow) with the representative's
 // corrections, at the group's centre azimuth; a width-estimated radius is taken out of both
 // bounds, the elongation re-evaluated at the union's far end.
@@ -448,8 +464,6 @@ static void test_union_extent_is_observed(void **state)
     const int64_t bin = b->bin_size_um;
     assert_int_equal(sl_tiltobs_init(&obs, b), SL_OK);
     sl_tiltobs_advance(&obs, true, 1000, 0, 250000U);
-    sl_track_t tracks[SL_CFG_MAX_TARGETS];
-    memset(tracks, 0, sizeof tracks);
     const uint16_t first = 70U, last = 79U; // representative run, bins
     const int64_t hb1 = ((2 * first + 1) * bin + 1) / 2, hb2 = ((2 * last + 1) * bin + 1) / 2;
     sl_target_t g;
@@ -464,12 +478,7 @@ static void test_union_extent_is_observed(void **state)
     g.r2_um = (uint32_t)(hb2 - g.elong_um + 25000);
     g.ext_grow = (uint8_t)(2U | (3U << 4));
     g.incline_flag = SL_INCLINE_VALID;
-    tracks[0] = (sl_track_t){.live = 1, .updated = 1, .confirmed = 1, .id = 3, .az = g.az,
-                             .r1_um = g.r1_um, .r2_um = g.r2_um};
-    sl_tiltobs_update(&obs, tracks, &g, 1U);
-    assert_int_equal(obs.stats.observations, 1U);
-    const sl_tiltobs_ring_t *r = sl_tiltobs_find(&obs, 3U);
-    assert_non_null(r);
+    const sl_tiltobs_ring_t *r = observe_one(&g);
     const int64_t u1 = hb1 - 2 * bin;
     const int64_t u2 = hb2 + 3 * bin - sl_detect_elong_um(b, (uint32_t)(hb2 + 3 * bin));
     assert_int_equal(r->obs[0].r1_um, (uint32_t)u1);
@@ -495,8 +504,6 @@ static void test_ramps_are_observed_marked(void **state)
         assert_int_equal(sl_tiltobs_init(&obs, b), SL_OK);
         obs.verified_only = true;
         sl_tiltobs_advance(&obs, true, 1000, 0, 250000U);
-        sl_track_t tracks[SL_CFG_MAX_TARGETS];
-        memset(tracks, 0, sizeof tracks);
         sl_target_t g;
         memset(&g, 0, sizeof g);
         g.az = 100;
@@ -507,12 +514,7 @@ static void test_ramps_are_observed_marked(void **state)
         g.r2_raw_um = g.r2_um;
         g.incline_flag = SL_INCLINE_VALID;
         g.flags = (uint16_t)(SL_TARGET_PROFILE | (ramp ? SL_TARGET_RAMP : 0U));
-        tracks[0] = (sl_track_t){.live = 1, .updated = 1, .confirmed = 1, .id = 3, .az = g.az,
-                                 .r1_um = g.r1_um, .r2_um = g.r2_um};
-        sl_tiltobs_update(&obs, tracks, &g, 1U);
-        assert_int_equal(obs.stats.observations, 1U);
-        const sl_tiltobs_ring_t *r = sl_tiltobs_find(&obs, 3U);
-        assert_non_null(r);
+        const sl_tiltobs_ring_t *r = observe_one(&g);
         assert_int_equal(r->obs[0].mark, ramp ? SL_TILT_OBS_RAMP : 0U);
     }
 }

@@ -34,6 +34,17 @@ for shape in "20 0" "20 0.1" "20 0.35"; do
         "$PY" "$SRC/warning_vs_truth.py" "$DBC" "$OUT/$name.log" "$lean" || fail=1
     done
 done
+# check_sigmas DBC: every PoleLean frame of run $name within 4 LeanSigma of the truth (a
+# saturated LeanSigma, "I cannot tell", passes); sets fail=1 otherwise.
+check_sigmas() {
+    if "$PY" "$SRC/lean_sigma_vs_truth.py" "$1" "$OUT/$name.log" "$OUT/$name.gt.csv" \
+        --max-sigmas 4 --saturated-ok > "$OUT/$name.sigmas"
+    then
+        printf '    %s\n' "$(tail -1 "$OUT/$name.sigmas")"
+    else
+        fail=1; cat "$OUT/$name.sigmas"
+    fi
+}
 # The paper's bench with a tail that steepens towards the pole (sl-sim `smear_shape =
 # powerlaw`: (1 + j)^-p, its first bin 20 dB down, then ever slower; 200 bins). Before
 # session 18 every PoleLean frame of the three poles was 5.9-13.7 LeanSigma off and the
@@ -54,13 +65,7 @@ for lean in -10 0 10; do
         2> "$OUT/$name.err" || { cat "$OUT/$name.err"; echo "FAIL: $name: daemon"; exit 1; }
     printf '%s: ' "$name"
     "$PY" "$SRC/warning_vs_truth.py" "$DBC" "$OUT/$name.log" "$lean" || fail=1
-    if "$PY" "$SRC/lean_sigma_vs_truth.py" "$DBC" "$OUT/$name.log" "$OUT/$name.gt.csv" \
-        --max-sigmas 4 --saturated-ok > "$OUT/$name.sigmas"
-    then
-        printf '    %s\n' "$(tail -1 "$OUT/$name.sigmas")"
-    else
-        fail=1; cat "$OUT/$name.sigmas"
-    fi
+    check_sigmas "$DBC"
 done
 # While driving (scenes/driveby_realistic.ini, --motion 1.0: two poles leaning 10 deg towards
 # and away from the path), on both value scales: a target is one rotation's rows, whose cliff
@@ -120,13 +125,7 @@ drive() { # KERNEL WIDTH FRONT SCALE CHECK_SIGMAS [--one-side-ok]; $decay: smear
         fail=1; cat "$OUT/$name.sides"
     fi
     [ "$5" = yes ] || return 0
-    if "$PY" "$SRC/lean_sigma_vs_truth.py" "$DBC_SIM" "$OUT/$name.log" "$OUT/$name.gt.csv" \
-        --max-sigmas 4 --saturated-ok > "$OUT/$name.sigmas"
-    then
-        printf '    %s\n' "$(tail -1 "$OUT/$name.sigmas")"
-    else
-        fail=1; cat "$OUT/$name.sigmas"
-    fi
+    check_sigmas "$DBC_SIM"
 }
 decay=
 for shape in "20 0" "20 0.35" "35 0.1"; do
