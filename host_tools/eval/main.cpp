@@ -68,6 +68,7 @@ void usage(FILE *out)
                  "                  [--plot FILE.png] [--psi DEG] [--phi DEG] [--offset M] [--dump]\n"
                  "                  [--obs-log FILE] [--cold]\n"
                  "      3D tilt (psi, phi, base offset) fitted over simulated drive-bys against the truth.\n"
+                 "      Noise-free passes render no smear: the board's elongation table d(r) is not applied.\n"
                  "      --realistic: the tail slope self-fitted on a calibration pass first (--cold: none).\n"
                  "      --psi/--phi/--offset (repeatable): only those passes of the sweep; --dump: per pass\n"
                  "      the rejection counters, the observations behind the result and the fold's\n"
