@@ -12,6 +12,7 @@
 
 #include "daemon_log.h"
 #include "shadowlean/sl_board.h"
+#include "shadowlean/sl_profile.h"
 #include "shadowlean/sl_can.h"
 #include "shadowlean/sl_version.h"
 
@@ -156,6 +157,13 @@ static int apply(sld_opts_t *o, const char *section, const char *key, const char
             BAD("expected 0 (none) or 0.5 .. 24 values per bin");
         }
         o->tail_slope_q8 = (uint16_t)lround(v * 256.0);
+    } else if (IS("daemon", "front_bins")) {
+        // sl_profile_cfg_t.prior_front_bins: 0 (none) or 2 .. SL_PROFILE_LEAD_HIST - 1 bins
+        uint32_t v = 0;
+        if (parse_u32(val, &v) != 0 || v == 1U || v >= SL_PROFILE_LEAD_HIST) {
+            BAD("expected 0 (none) or 2 .. 7 bins");
+        }
+        o->front_bins = (uint8_t)v;
     } else if (IS("daemon", "stats_every")) {
         if (parse_seconds_ms(val, &o->stats_every_ms) != 0) BAD("expected seconds >= 0");
     } else if (IS("daemon", "status_period_ms")) {
@@ -362,6 +370,7 @@ static const cli_opt_t k_cli[] = {
     {"--verbosity", "daemon", "verbosity", 1, NULL},
     {"--stats-every", "daemon", "stats_every", 1, NULL},
     {"--tail-slope", "daemon", "tail_slope", 1, NULL},
+    {"--front-bins", "daemon", "front_bins", 1, NULL},
     {"--status-period-ms", "daemon", "status_period_ms", 1, NULL},
     {"--duration", "daemon", "duration", 1, NULL},
     {"--exit-idle", "daemon", "exit_idle", 1, NULL},
@@ -391,7 +400,7 @@ static const cli_opt_t k_cli[] = {
 void sld_opts_usage(void *fpv)
 {
     FILE *fp = fpv;
-    fprintf(fp,
+    fputs(
         "usage: shadowleand --board NAME (--radar HOST:PORT | --input CAPTURE) [options]\n"
         "Reads a Navtech radar stream (TCP) or a capture file, detects leaning poles in the\n"
         "vehicle's radar shadow and sends PoleLean / LeanWarning / Status frames on CAN.\n"
@@ -421,7 +430,9 @@ void sld_opts_usage(void *fpv)
         "  --bitrate B              [can] bitrate             gs_usb bit rate (default: the board's)\n"
         "  --gs-usb-max-age-ms N    [can] gs_usb_max_age_ms   drop a gs_usb frame queued longer (200; 0 = never)\n"
         "  --motion-can IFACE|none  [can] motion_interface    read VehicleMotion here (default: the --can interface)\n"
-        "  --targets-out FILE       [output] targets          JSON lines, one per rotation: targets and tracks\n"
+        "  --targets-out FILE       [output] targets          JSON lines, one per rotation: targets and tracks\n",
+        fp);
+    fputs(
         "  --user NAME              [daemon] user             drop root privileges after opening everything\n"
         "  --syslog | --stderr      [daemon] syslog           log destination (default stderr)\n"
         "  -v | -q | --verbosity L  [daemon] verbosity        error, warning, info (default), debug\n"
@@ -429,13 +440,17 @@ void sld_opts_usage(void *fpv)
         "  --tail-slope V           [daemon] tail_slope       the radar's smear tail, values per bin, as an earlier\n"
         "                                                     run logged it (\"tail slope\" in the stats): used until\n"
         "                                                     the stream's own fit replaces it (0 = none, default)\n"
+        "  --front-bins N           [daemon] front_bins       the radar's smear front part, bins, as an earlier run\n"
+        "                                                     logged it (\"smear front part\"): used until the stream\n"
+        "                                                     has learned its own (0 = none, default; 2..7)\n"
         "  --status-period-ms N     [daemon] status_period_ms Status frame period without data (1000)\n"
         "  --duration S             [daemon] duration         stop after S seconds (0 = never)\n"
         "  --exit-idle S            [daemon] exit_idle        radar: stop after S s without FFT data (once data came)\n"
         "  --list-boards                                      print the boards linked in\n"
         "  --print-config                                     print the effective settings as a config file, exit\n"
         "  -h | --help, --version\n"
-        "Signals: SIGINT/SIGTERM stop cleanly (Stop FFT, last rotation flushed, sinks drained).\n");
+        "Signals: SIGINT/SIGTERM stop cleanly (Stop FFT, last rotation flushed, sinks drained).\n",
+        fp);
 }
 
 static const cli_opt_t *find_cli(const char *name, size_t len)
@@ -607,6 +622,9 @@ void sld_opts_print(const sld_opts_t *o, void *fpv)
             (double)o->exit_idle_ms / 1000.0);
     if (o->tail_slope_q8 != 0U) {
         fprintf(fp, "tail_slope = %.4f\n", (double)o->tail_slope_q8 / 256.0);
+    }
+    if (o->front_bins != 0U) {
+        fprintf(fp, "front_bins = %u\n", (unsigned)o->front_bins);
     }
     fprintf(fp, "\n[input]\n");
     if (o->radar_host[0] != '\0') {

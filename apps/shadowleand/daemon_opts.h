@@ -82,6 +82,9 @@ typedef struct sld_opts {
     uint16_t tail_slope_q8;            ///< --tail-slope V: the sensor's smear tail, values per
                                        ///< bin x 256, saved from an earlier run (0 = none)
                                        ///< [daemon] tail_slope
+    uint8_t front_bins;                ///< --front-bins N: the sensor's smear front part, bins,
+                                       ///< saved from an earlier run (0 = none; 2..7)
+                                       ///< [daemon] front_bins
 } sld_opts_t;
 
 /// Defaults: verbosity info, port 6317, timeouts as listed, everything else empty/off.

@@ -770,6 +770,15 @@ static void log_stats(daemon_t *d, int level, const char *what)
                 g_pipe.prof.cal_n != 0U ? "self-fitted" : "--tail-slope, no fit yet",
                 g_pipe.prof.stats.cal_accepted, g_pipe.prof.stats.cal_rejected);
     }
+    const uint8_t *ln = g_pipe.prof.lead_n;
+    if (g_pipe.prof.front_bins != 0U || g_pipe.prof.stats.front_skipped != 0U ||
+        ln[0] + ln[1] + ln[2] + ln[3] + ln[4] + ln[5] + ln[6] + ln[7] != 0) {
+        // what --front-bins takes on the next start
+        sld_log(SLD_LOG_INFO, "%s: smear front part %u bins; rises of leaning-away returns "
+                "(bins 0..7+, recent): %u %u %u %u %u %u %u %u; r1 moved past it on %" PRIu32
+                " targets", what, (unsigned)g_pipe.prof.front_bins, ln[0], ln[1], ln[2], ln[3],
+                ln[4], ln[5], ln[6], ln[7], g_pipe.prof.stats.front_skipped);
+    }
     const sl_drift_t *dw = &g_pipe.drift;
     sld_log(SLD_LOG_INFO, "%s: theta drift watch: %s %+.2f deg%s; samples %" PRIu32 ", no ground %" PRIu32
             ", occupied %" PRIu32 ", outliers %" PRIu32, what, dw->valid ? "estimate" : "no estimate",
@@ -1029,6 +1038,7 @@ int main(int argc, char **argv)
     d->pcfg.port.on_rotation = port_on_rotation;
     d->pcfg.port.ctx = d;
     d->pcfg.profile_cfg.prior_slope_q8 = d->o.tail_slope_q8; // --tail-slope (0: none)
+    d->pcfg.profile_cfg.prior_front_bins = d->o.front_bins;  // --front-bins (0: none)
     if (sl_pipeline_init(&g_pipe, d->board, &d->pcfg) != SL_OK) {
         sld_log(SLD_LOG_ERR, "pipeline for board %s: %s", d->board->name,
                 g_pipe.last_err_msg != NULL ? g_pipe.last_err_msg : "init failed");

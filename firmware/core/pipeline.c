@@ -689,8 +689,12 @@ static void on_rot(void *ctx, const sl_scan_rot_t *rot)
     // A stream whose returns are cut off (sl_profile.h, "Cut-off returns") has no range bound
     // the 3D fit could take, and what the histories hold from before that was known is
     // suspect: cleared, as without motion.
-    sl_tiltobs_advance(&p->tilt, p->motion_valid && !(p->cfg.profile && sl_profile_cut(&p->prof)),
-                       p->speed_mm_s, p->yaw_cdeg_s, p->rotation_us);
+    // So is what they hold from before the stream's front part became known (its r1s early
+    // by up to the front's length; sl_profile.h, "Front part").
+    const bool suspect = p->cfg.profile && (sl_profile_cut(&p->prof) || p->prof.front_news != 0U);
+    p->prof.front_news = 0U;
+    sl_tiltobs_advance(&p->tilt, p->motion_valid && !suspect, p->speed_mm_s, p->yaw_cdeg_s,
+                       p->rotation_us);
     // Unless the stream is known not to smear (returns seen to end in cliffs, no tail
     // self-fitted), a target the profile could not check (no slot, too few rows) may carry
     // a tail in its bounds: not a 3D-tilt observation. From the start of the stream: its

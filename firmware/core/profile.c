@@ -29,6 +29,7 @@ void sl_profile_cfg_default(sl_profile_cfg_t *cfg)
     cfg->max_idle = 4U;
     cfg->min_frames = 2U;
     cfg->prior_slope_q8 = 0U;
+    cfg->prior_front_bins = 0U;
 }
 
 sl_err_t sl_profile_init(sl_profile_t *pr, uint16_t azimuths, uint16_t near_bins,
@@ -45,7 +46,8 @@ sl_err_t sl_profile_init(sl_profile_t *pr, uint16_t azimuths, uint16_t near_bins
     }
     if (c.max_frames < 2U || c.max_frames > 257U ||
         (c.prior_slope_q8 != 0U &&
-         (c.prior_slope_q8 < SLOPE_MIN_Q8 || c.prior_slope_q8 > SLOPE_MAX_Q8))) {
+         (c.prior_slope_q8 < SLOPE_MIN_Q8 || c.prior_slope_q8 > SLOPE_MAX_Q8)) ||
+        c.prior_front_bins == 1U || c.prior_front_bins >= SL_PROFILE_LEAD_HIST) {
         return SL_ERR_ARG;
     }
     memset(pr, 0, sizeof *pr);
@@ -54,6 +56,7 @@ sl_err_t sl_profile_init(sl_profile_t *pr, uint16_t azimuths, uint16_t near_bins
     pr->near_bins = near_bins;
     memset(pr->slot_of, SL_PROFILE_NONE, sizeof pr->slot_of);
     pr->slope_q8 = c.prior_slope_q8; // cal_n 0: the first self-fit replaces it
+    pr->front_bins = c.prior_front_bins; // until SL_PROFILE_LEAD_MIN rises of its own
     return SL_OK;
 }
 
@@ -620,6 +623,99 @@ static SL_NOINLINE bool falls_faster_near(const uint16_t *sum, uint32_t k, uint3
     return 2U * near >= 2U * far + frames * h * (n - h);
 }
 
+// One branch-2 return's rise into the stream's front part ("Front part" in sl_profile.h):
+// counted, the counts halved at SL_PROFILE_LEAD_KEEP, and the front re-read: known when half
+// of them rise by 3 bins or more, as the smallest rise held by an eighth of them (at least
+// 2); lost when half rise by a bin at most. `front_news` when it becomes known.
+static void learn_front(sl_profile_t *pr, uint32_t rise)
+{
+    pr->lead_n[rise < SL_PROFILE_LEAD_HIST ? rise : SL_PROFILE_LEAD_HIST - 1U]++;
+    uint32_t total = 0U;
+    for (uint32_t k = 0; k < SL_PROFILE_LEAD_HIST; k++) {
+        total += pr->lead_n[k];
+    }
+    if (total >= SL_PROFILE_LEAD_KEEP) {
+        total = 0U;
+        for (uint32_t k = 0; k < SL_PROFILE_LEAD_HIST; k++) {
+            pr->lead_n[k] = (uint8_t)(pr->lead_n[k] >> 1);
+            total += pr->lead_n[k];
+        }
+    }
+    if (total < SL_PROFILE_LEAD_MIN) {
+        return;
+    }
+    // The smallest rise held by an eighth of them (q8) and by half (q2).
+    uint32_t cum = 0U;
+    uint32_t q8 = SL_PROFILE_LEAD_HIST, q2 = SL_PROFILE_LEAD_HIST;
+    for (uint32_t k = 0; k < SL_PROFILE_LEAD_HIST; k++) {
+        cum += pr->lead_n[k];
+        q8 = (q8 == SL_PROFILE_LEAD_HIST && 8U * cum >= total) ? k : q8;
+        q2 = (q2 == SL_PROFILE_LEAD_HIST && 2U * cum >= total) ? k : q2;
+    }
+    if (pr->front_bins == 0U) {
+        if (q2 >= 3U && q8 >= 2U) {
+            pr->front_bins = (uint8_t)q8;
+            pr->front_news = 1U;
+        }
+    } else {
+        // Once known, until most returns rise by a bin at most (hysteresis: a front of 2 bins
+        // shows its median at 2-3).
+        pr->front_bins = (uint8_t)(q2 <= 1U ? 0U : (q8 >= 2U ? q8 : 2U));
+    }
+}
+
+// The rise of slot `si`'s own row ("Front part"): ramp_bins from its first bin at or above
+// the threshold at or after absolute bin `a1` - 3 (within FIT_BINS + 3 bins), over at most
+// FIT_BINS bins; `*strong`: the brightest of those bins is T/2 above the threshold.
+static SL_NOINLINE uint32_t own_rise(const sl_profile_t *pr, uint32_t si, uint32_t a1,
+                                     uint32_t threshold, bool *strong)
+{
+    const sl_profile_slot_t *o = &pr->slot[si];
+    const uint32_t thr = (uint32_t)o->frames * threshold;
+    uint32_t j = a1 > (uint32_t)o->bin0 + 3U ? a1 - o->bin0 - 3U : 0U;
+    const uint32_t end = j + FIT_BINS + 3U;
+    while (j < end && j + 1U < SL_CFG_PROFILE_BINS && o->sum[j] < thr) {
+        j++;
+    }
+    *strong = false;
+    if (j >= end || j + 1U >= SL_CFG_PROFILE_BINS || o->sum[j] < thr) {
+        return 0U;
+    }
+    const uint32_t lim = j + FIT_BINS < SL_CFG_PROFILE_BINS ? j + FIT_BINS : SL_CFG_PROFILE_BINS - 1U;
+    uint32_t top = 0U;
+    for (uint32_t k = j; k <= lim; k++) {
+        top = o->sum[k] > top ? o->sum[k] : top;
+    }
+    *strong = top >= (uint32_t)o->frames * (threshold + threshold / 2U);
+    return ramp_bins(o->sum, j, lim, o->frames);
+}
+
+// Bins of a walked return's rise (`pb`, starting at absolute bin `a1`) that its r1 moves
+// past ("Front part"): min(its rise, the stream's front), r1 staying before r2. The rise is
+// the longer of its own azimuth's row's (one rotation's rows of an oblique pole may start
+// elsewhere) and the rows' sum's (less noise to break a rise's shallow steps). A leaning-
+// away return (`branch2`) strong enough to show a front counts its rise, once per slot.
+static SL_NOINLINE uint32_t front_skip(sl_profile_t *pr, uint32_t si, const uint16_t *sum,
+                                       uint32_t n, uint32_t frames, uint32_t threshold,
+                                       const sl_profile_bounds_t *pb, uint32_t a1, bool branch2)
+{
+    bool strong = false;
+    const uint32_t own = own_rise(pr, si, a1, threshold, &strong);
+    const uint32_t in_sum =
+        ramp_bins(sum, pb->i1, pb->i1 + FIT_BINS < n ? pb->i1 + FIT_BINS : n - 1U, frames);
+    const uint32_t rise = own > in_sum ? own : in_sum;
+    sl_profile_slot_t *o = &pr->slot[si];
+    if (o->lead_seen == 0U && strong && branch2) {
+        o->lead_seen = 1U;
+        learn_front(pr, rise);
+    }
+    uint32_t skip = rise < pr->front_bins ? rise : pr->front_bins;
+    if (pb->i1 + skip >= pb->i2) {
+        skip = pb->i2 > pb->i1 ? pb->i2 - pb->i1 - 1U : 0U;
+    }
+    return skip;
+}
+
 // Bins (>= 3, else 0) of the falling ramp that ends in r2 and may be a smear tail: into a
 // cliff, the steps of at least a value per bin; at the end of a walk, when those steps fall
 // faster near r2 (falls_faster_near: a kernel of finite support, whether its end is a drop
@@ -1039,6 +1135,30 @@ uint8_t sl_profile_refine(sl_profile_t *pr, const sl_board_t *board, uint32_t th
     if (board->geom != NULL) {
         sl_incline_result_t res = sl_incline_estimate(t->r1_um, t->r2_um, &board->geom[t->az],
                                                       sigma_r, board->theta_sigma_cdeg);
+        uint32_t lead = pb.i1;
+        uint64_t front_um = 0U; // half the front part r1 moved past: the rest is its sigma
+        if (!slant && pb.slope_src != SL_PROFILE_SLOPE_CLIFF) {
+            // Front part (sl_profile.h): a branch-2 return's rise is the stream's front;
+            // every walked target's r1 moves past it.
+            const uint32_t skip =
+                front_skip(pr, si, sum, n, frames, threshold, &pb, (uint32_t)i1,
+                           res.flag == (uint8_t)SL_INCLINE_VALID &&
+                               res.branch == (uint8_t)SL_INCLINE_BRANCH_2);
+            if (skip != 0U) {
+                // Where the pole starts within the rise, no rule here can say (a long own
+                // return's smear and a partly lit bin rise too): r1 at the middle of the
+                // front's bins, its sigma over all of them (the ramps below).
+                lead += skip;
+                front_um = (uint64_t)skip * b / 2U;
+                t->r1_um = sl_fx_usat32((int64_t)t->r1_um + (int64_t)front_um);
+                if (s1 != s2) {
+                    sigma_r = sl_incline_bounds_sigma_um(t->r1_um, t->r2_um, s1, s2);
+                }
+                res = sl_incline_estimate(t->r1_um, t->r2_um, &board->geom[t->az], sigma_r,
+                                          board->theta_sigma_cdeg);
+                pr->stats.front_skipped++;
+            }
+        }
         if (!slant && pb.slope_src == SL_PROFILE_SLOPE_CLIFF && pb.i2 >= pb.i1 + 3U &&
             res.flag == (uint8_t)SL_INCLINE_VALID) {
             // Sub-bin leading edge (step 6): the first bin's lit fraction from its power
@@ -1063,7 +1183,7 @@ uint8_t sl_profile_refine(sl_profile_t *pr, const sl_board_t *board, uint32_t th
         // give no valid estimate. A slanted pole's r1 is not read here: no ramp at r1.
         if (res.flag == (uint8_t)SL_INCLINE_VALID) {
             const uint32_t up = !slant && res.branch == (uint8_t)SL_INCLINE_BRANCH_1
-                                    ? ramp_bins(sum, pb.i1, pb.e, frames)
+                                    ? ramp_bins(sum, lead, pb.e, frames)
                                     : 0U;
             // A front ramp is a smear of its own: the target's cliff may then end its kernel.
             // After a restarted walk (step 4') r2 ends a tail whose first stop lay beyond the
@@ -1078,15 +1198,18 @@ uint8_t sl_profile_refine(sl_profile_t *pr, const sl_board_t *board, uint32_t th
             } else if (pr->slope_q8 != 0U || up >= 3U) {
                 down = tail_ramp(sum, &pb, frames);
             }
-            const uint64_t lo1 = (uint64_t)t->r1_um + (up >= 3U ? up * b : 0U);
+            const uint64_t lo1 = (uint64_t)t->r1_um + (up >= 3U ? up * b : 0U) + front_um;
             const uint64_t dn2 = (uint64_t)down * b;
             if (lo1 != t->r1_um || dn2 != 0U) {
                 const sl_incline_result_t far = sl_incline_estimate(
                     sl_fx_usat32((int64_t)lo1), dn2 < t->r2_um ? t->r2_um - (uint32_t)dn2 : 0U,
                     &board->geom[t->az], sigma_r, board->theta_sigma_cdeg);
                 res.sigma_cdeg = end_sigma(&res, &far, &board->geom[t->az]);
-                t->flags = (uint16_t)(t->flags | SL_TARGET_COARSE | SL_TARGET_RAMP);
-                pr->stats.ramps++;
+                t->flags = (uint16_t)(t->flags | SL_TARGET_COARSE);
+                if (up >= 3U || dn2 != 0U) {
+                    t->flags = (uint16_t)(t->flags | SL_TARGET_RAMP);
+                    pr->stats.ramps++;
+                }
             }
         }
         t->alpha_cdeg = res.alpha_cdeg;
@@ -1163,7 +1286,9 @@ uint32_t sl_profile_reserve(sl_profile_t *pr, uint16_t az, uint16_t bin_first, u
             pr->stats.reserve_full++;
             continue;
         }
-        (void)slot_start(pr, pick, a, bin_first);
+        // The track's r1 is the pole's; its return starts the stream's front part earlier.
+        (void)slot_start(pr, pick, a,
+                         bin_first > pr->front_bins ? (uint32_t)bin_first - pr->front_bins : 0U);
         pr->n_live++;
         pr->stats.reserved++;
         got++;

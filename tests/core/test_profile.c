@@ -8,6 +8,7 @@
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
+#include <stdlib.h>
 #include <string.h>
 #include <cmocka.h>
 #include <math.h>
@@ -1308,6 +1309,135 @@ static void test_profile_a_stream_of_cut_off_returns_is_unverified(void **state)
     assert_true(sl_profile_clean(&pr));
 }
 
+// ---- Front part (sl_profile.h, "Front part") -----------------------------------------
+
+// One rotation's rows of azimuths az_lo..az_hi (RN bins): a pole's own power on bins [a, b]
+// (100 dB at its first bin, falling 1 dB per bin: a leaning-away pole is brightest at its
+// foot) smeared by an exponential tail of 3.3 dB per bin and, with `front` > 0, a front part
+// linear in power over `front` bins before it; a 10 dB floor; +-1 value of pseudo-random
+// speckle per bin and row (LCG from `seed`), fed to `pr` when `feed`. Returns the threshold
+// crossings of the noise-free row in *first / *last.
+static void front_rows(uint16_t az_lo, uint16_t az_hi, int a, int b, int front, uint32_t seed,
+                       bool feed, uint16_t *first, uint16_t *last)
+{
+    double p[RN];
+    for (int k = 0; k < RN; k++) {
+        p[k] = 10.0;
+    }
+    for (int k = a; k <= b; k++) {
+        const double pk = pow(10.0, (100.0 - (k - a)) / 10.0);
+        for (int j = -front; k + j < RN; j++) {
+            if (k + j >= 0) {
+                p[k + j] += pk * (j < 0 ? (double)(j + front + 1) / (front + 1)
+                                        : pow(10.0, -3.3 * j / 10.0));
+            }
+        }
+    }
+    uint8_t syn[RN];
+    *first = 0;
+    *last = 0;
+    for (int k = 0; k < RN; k++) {
+        const double v = floor(10.0 * log10(p[k]) + 0.5);
+        syn[k] = (uint8_t)(v < 0 ? 0 : (v > 255 ? 255 : v));
+        if (syn[k] >= 40U) {
+            *first = *first == 0U ? (uint16_t)k : *first;
+            *last = (uint16_t)k;
+        }
+    }
+    uint32_t bits[RN / 32] = {0U};
+    uint32_t x = seed;
+    for (uint16_t az = az_lo; feed && az <= az_hi; az++) {
+        uint8_t row[RN];
+        for (int k = 0; k < RN; k++) {
+            x = x * 1103515245U + 12345U;
+            const int v = (int)syn[k] + (int)((x >> 16) % 3U) - 1;
+            row[k] = (uint8_t)(v < 0 ? 0 : v);
+        }
+        sl_profile_row(&pr, az, row, RN, bits, RN);
+    }
+}
+
+// Drives a stream past the pole of bins [a, b] for `rotations` rotations (moving: one
+// rotation's rows of azimuths 99..101 each time, slots reserved where the last refinement put
+// r1, as the tracker's prediction would) and returns the last refined target.
+static sl_target_t front_drive(int a, int b, int front, int rotations)
+{
+    const sl_board_t board = geom_board();
+    sl_target_t t;
+    uint16_t expect = 0;
+    for (int r = 0; r < rotations; r++) {
+        uint16_t first = 0, last = 0;
+        front_rows(99, 101, a, b, front, 0U, false, &first, &last); // the mask's bounds
+        sl_profile_end_rotation(&pr, true);
+        (void)sl_profile_reserve(&pr, 100, expect != 0U ? expect : first, 2U);
+        front_rows(99, 101, a, b, front, 1000U + 77U * (uint32_t)r, true, &first, &last);
+        t = mask_target(100, 99, 3, first, last);
+        assert_int_equal(sl_profile_refine(&pr, &board, 40, &t), SL_PROFILE_OK);
+        expect = (uint16_t)(t.r1_um / 43800U);
+    }
+    return t;
+}
+
+// A smear kernel with a front part (a linear rise over 4 bins before the target, then an
+// exponential tail) puts r1 4 bins early on every return: a pole leaning away read +2 deg
+// for -5 at a sigma of 0.6 deg, and the 3D fit of a drive-by turned the bias into FITTED
+// tilts 3-9 TiltSigma off. Learned on the stream from leaning-away returns (branch 2, where
+// a pole's own return cannot rise: r1 is the foot of the perpendicular): from the 8th such
+// return the front is known, every walked r1 moves to the middle of its rise, and its sigma
+// holds the rise's ends: the truth within 3 sigma. Without a front, or from leaning-towards
+// returns (whose own power rises with the elevation beam), nothing is learned and r1 stays.
+static void test_profile_a_front_part_is_learned_on_leaning_away_returns(void **state)
+{
+    (void)state;
+    sl_profile_cfg_t c;
+    sl_profile_cfg_default(&c);
+    assert_int_equal(c.prior_front_bins, 0);
+    c.prior_front_bins = 1U; // a rise of one bin is a partly lit bin, no front
+    assert_int_equal(sl_profile_init(&pr, 400, 0, &c), SL_ERR_ARG);
+    c.prior_front_bins = (uint8_t)SL_PROFILE_LEAD_HIST;
+    assert_int_equal(sl_profile_init(&pr, 400, 0, &c), SL_ERR_ARG);
+    // a pole leaning away at 4.4 m, own bins 100..104: rho 1.05, branch 2 (-8.3 deg)
+    const int32_t truth = true_alpha(100, 104);
+    assert_true(truth < -700 && truth > -900);
+    assert_int_equal(sl_profile_init(&pr, 400, 0, NULL), SL_OK);
+    sl_target_t t = front_drive(100, 104, 4, 7);
+    assert_int_equal(pr.front_bins, 0); // 7 returns: not known yet
+    assert_int_equal(pr.front_news, 0);
+    assert_int_equal(t.r1_um, (2 * 96 + 1) * 43800 / 2); // the front's first bin
+    assert_true(t.incline_branch == SL_INCLINE_BRANCH_2);
+    assert_true(abs(t.alpha_cdeg - truth) > 3 * (int32_t)t.sigma_cdeg); // before: untrue
+    t = front_drive(100, 104, 4, 5);
+    assert_true(pr.front_bins >= 3U && pr.front_bins <= 5U);
+    assert_int_equal(pr.front_news, 1); // the pipeline clears the 3D-tilt histories
+    assert_true(pr.stats.front_skipped >= 1U);
+    // r1 in the middle of the rise, within 2 bins of the pole's first bin
+    assert_true(t.r1_um > 98U * 43800U && t.r1_um <= 101U * 43800U);
+    assert_true((t.flags & SL_TARGET_COARSE) != 0U);
+    assert_true(abs(t.alpha_cdeg - truth) <= 3 * (int32_t)t.sigma_cdeg);
+    // a slot reserved for the track starts the front earlier than its r1 would have it
+    sl_profile_end_rotation(&pr, true);
+    assert_int_equal(sl_profile_reserve(&pr, 100, 100, 0U), 1);
+    assert_int_equal(pr.slot[pr.slot_of[100]].bin0, 100 - pr.front_bins - c.lead_bins);
+    // the same stream without a front part: nothing learned, r1 at the first bin
+    assert_int_equal(sl_profile_init(&pr, 400, 0, NULL), SL_OK);
+    t = front_drive(100, 104, 0, 12);
+    assert_int_equal(pr.front_bins, 0);
+    assert_int_equal(pr.stats.front_skipped, 0);
+    assert_int_equal(t.r1_um, (2 * 100 + 1) * 43800 / 2);
+    // a pole leaning towards (own bins 60..69 at 2.6 m: rho 1.17, branch 1) with the front
+    // part: its rise is no evidence
+    assert_int_equal(sl_profile_init(&pr, 400, 0, NULL), SL_OK);
+    t = front_drive(60, 69, 4, 12);
+    assert_true(t.incline_branch == SL_INCLINE_BRANCH_1);
+    assert_int_equal(pr.front_bins, 0);
+    // a front saved from an earlier run applies from the first return
+    c.prior_front_bins = 4U;
+    assert_int_equal(sl_profile_init(&pr, 400, 0, &c), SL_OK);
+    t = front_drive(100, 104, 4, 1);
+    assert_true(t.r1_um > 98U * 43800U && t.r1_um <= 101U * 43800U);
+    assert_true(abs(t.alpha_cdeg - truth) <= 3 * (int32_t)t.sigma_cdeg);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -1335,6 +1465,7 @@ int main(void)
         cmocka_unit_test(test_profile_lead_edge_refuses_shapes_no_line_makes),
         cmocka_unit_test(test_profile_ramps_widen_the_sigma_not_the_alpha),
         cmocka_unit_test(test_profile_a_stream_of_cut_off_returns_is_unverified),
+        cmocka_unit_test(test_profile_a_front_part_is_learned_on_leaning_away_returns),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -21,7 +21,7 @@ has "$OUT/example.ini" "stats_every = 60.000"
 
 # 2. command line over config file
 "$D" --config "$CONF" --board paper-sim --input /some/capture.pcap --can vcan1 -v --stats-every 0.5 \
-    --gs-usb 1-1.4 --bitrate 250000 --targets-out t.jsonl --tail-slope 3.27 --print-config > "$OUT/over.ini" \
+    --gs-usb 1-1.4 --bitrate 250000 --targets-out t.jsonl --tail-slope 3.27 --front-bins 4 --print-config > "$OUT/over.ini" \
     || fail "override rejected"
 has "$OUT/over.ini" "board = paper-sim"
 has "$OUT/over.ini" "capture = /some/capture.pcap"
@@ -34,6 +34,7 @@ has "$OUT/over.ini" "gs_usb = 1-1.4"
 has "$OUT/over.ini" "bitrate = 250000"
 has "$OUT/over.ini" "targets = t.jsonl"
 has "$OUT/over.ini" "tail_slope = 3.2695"            # 837 / 256: what the core keeps
+has "$OUT/over.ini" "front_bins = 4"
 
 # 3. --print-config reads back to the same settings
 grep -v '^;' "$OUT/over.ini" > "$OUT/rt1.ini"
@@ -71,6 +72,8 @@ rejects "two motion inputs" "exclusive" --board paper-sim --input x --motion 1.0
 rejects "a bad motion" "SPEED_M_S" --board paper-sim --input x --motion fast
 rejects "an implausible tail slope" "0.5 .. 24 values per bin" --board paper-sim --input x --tail-slope 30
 rejects "a tail slope that is not a number" "daemon.tail_slope" --board paper-sim --input x --tail-slope steep
+rejects "a front part of one bin" "2 .. 7 bins" --board paper-sim --input x --front-bins 1
+rejects "a front part too long" "daemon.front_bins" --board paper-sim --input x --front-bins 8
 "$D" --board paper-sim --input x --can can0 --motion 2.5,-3 --print-config > "$OUT/motion.ini" || fail "--motion"
 has "$OUT/motion.ini" "motion = 2.500,-3.00"
 hasnt "$OUT/motion.ini" "motion_interface"

@@ -124,8 +124,20 @@ drive() { # KERNEL WIDTH FRONT SCALE CHECK_SIGMAS [--one-side-ok]; $decay: smear
     else
         fail=1; cat "$OUT/$name.sides"
     fi
+    check_tilt_sigmas
     [ "$5" = yes ] || return 0
     check_sigmas "$DBC_SIM"
+}
+# check_tilt_sigmas: every FITTED PoleTilt frame of run $name within 3 of its own sigmas
+# (tilt_vs_truth.py --max-sigmas; no FITTED frame passes); sets fail=1 otherwise.
+check_tilt_sigmas() {
+    if "$PY" "$SRC/tilt_vs_truth.py" "$DBC_SIM" "$OUT/$name.log" "$OUT/$name.gt.csv" \
+        --max-sigmas 3 > "$OUT/$name.tilt"
+    then
+        printf '    %s\n' "$(tail -1 "$OUT/$name.tilt")"
+    else
+        fail=1; cat "$OUT/$name.tilt"
+    fi
 }
 decay=
 for shape in "20 0" "20 0.35" "35 0.1"; do
@@ -149,5 +161,12 @@ for pl in "16 magnitude" "20 magnitude" "12 power"; do
     drive powerlaw 200 0 "$2" yes
 done
 decay=
+# An exponential tail behind a front part (sl-sim `smear_mode_frac` of the 40-bin kernel: a
+# linear rise over 2 and 4 bins before the target): r1 2-4 bins early on every return.
+# Before session 19 both poles came out FITTED 3-9 TiltSigma off (14 and 17 FITTED PoleTilt
+# frames beyond 3 sigma; 12.5-15.3 deg for 10 towards the path, 2.0-6.1 for 10 away): the
+# stream now learns the front from its leaning-away returns (sl_profile.h, "Front part").
+drive exponential 40 0.05 magnitude yes
+drive exponential 40 0.1 magnitude yes
 [ $fail -eq 0 ] && echo "smear_shapes: OK" || echo "smear_shapes: FAILED"
 exit $fail

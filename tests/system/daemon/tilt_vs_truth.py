@@ -16,6 +16,12 @@ with psi_deg >= --min-psi (default 5), the circular |TiltDirection - phi_deg| <=
 (default 10). With --ambiguous-ok a pole without a FITTED frame may instead have AMBIGUOUS
 ones (the fit's honest answer when few observations do not separate the mirror hypotheses):
 the last is checked for Tilt only. Exit 0 when every pole passes.
+
+With --max-sigmas K the check is the frames' honesty instead: EVERY FITTED frame matched to
+a pole must hold the truth within K of its own sigmas, |Tilt - psi_deg| <= K TiltSigma and,
+unless the direction is reported as not determined (DirectionSigma 63), the direction within
+K DirectionSigma; a pole without a FITTED frame passes, as a log without PoleTilt frames
+does (no answer is not a wrong one).
 """
 import csv
 import math
@@ -30,7 +36,7 @@ TQ = {0: "FITTED", 1: "AMBIGUOUS", 2: "INSUFFICIENT_MOTION", 3: "TOO_FEW", 4: "I
 
 def main(argv):
     opts = {"--psi-tol": 1.0, "--phi-tol": 10.0, "--base-tol": 0.5, "--min-psi": 5.0,
-            "--height": 2.58}
+            "--height": 2.58, "--max-sigmas": 0.0}
     pos, i, args = [], 0, argv[1:]
     amb_ok = "--ambiguous-ok" in args
     args = [a for a in args if a != "--ambiguous-ok"]
@@ -61,7 +67,7 @@ def main(argv):
         elif d.name == "Status":
             groups.append((d.raw["Rotations"] - 1, tilts))
             tilts = []
-    if n_tilt == 0:
+    if n_tilt == 0 and opts["--max-sigmas"] <= 0.0:
         print("FAIL: no PoleTilt frame in the log")
         return 1
     with open(pos[2]) as fh:
@@ -81,7 +87,7 @@ def main(argv):
         k = min(rs, key=lambda q: abs(q - rot))
         return rs[k], abs(k - rot)
 
-    last, last_amb = {}, {}
+    last, last_amb, fitted = {}, {}, {}
     for rot, frames in groups:
         for d in frames:
             best = None
@@ -97,8 +103,11 @@ def main(argv):
                 continue
             if d.raw["Quality"] == 0:
                 last[best[1]] = (rot, best[2], d, best[0])
+                fitted.setdefault(best[1], []).append((rot, best[2], d))
             elif d.raw["Quality"] == 1:
                 last_amb[best[1]] = (rot, best[2], d, best[0])
+    if opts["--max-sigmas"] > 0.0:
+        return sigma_check(truth, fitted, opts["--max-sigmas"], n_tilt)
     bad = 0
     print(f"PoleTilt frames: {n_tilt}")
     print(f"{'pole':<10} {'rot':>4} {'psi':>6} {'Tilt':>6} {'err':>6} {'phi':>7} {'Dir':>5} {'err':>6} "
@@ -121,6 +130,31 @@ def main(argv):
               f"{'' if ok else '  FAIL'}")
     print(f"tilt_vs_truth: {len(truth)} poles, {bad} failures (psi {opts['--psi-tol']} deg, "
           f"direction {opts['--phi-tol']} deg)")
+    return 1 if bad else 0
+
+
+def sigma_check(truth, fitted, k, n_tilt):
+    """Every FITTED frame within k of its own sigmas (see the module's doc)."""
+    bad, n, worst = 0, 0, 0.0
+    for name in sorted(truth):
+        for rot, r, d in fitted.get(name, []):
+            n += 1
+            psi, phi = float(r["psi_deg"]), float(r["phi_deg"])
+            e_psi = abs(d.phys["Tilt"] - psi) / max(d.phys["TiltSigma"], 0.1)
+            e_phi = 0.0
+            if d.raw["DirectionSigma"] < 63:
+                dphi = (d.phys["TiltDirection"] - phi + 180.0) % 360.0 - 180.0
+                e_phi = abs(dphi) / max(d.phys["DirectionSigma"], 1.0)
+            worst = max(worst, e_psi, e_phi)
+            if e_psi > k or e_phi > k:
+                bad += 1
+                print(f"{name} rotation {rot + 1}: Tilt {d.phys['Tilt']:.1f} +- {d.phys['TiltSigma']:.1f}, "
+                      f"direction {d.phys['TiltDirection']:.0f} +- {d.phys['DirectionSigma']:.0f}; truth "
+                      f"{psi:.2f}, {phi:.1f}  FAIL")
+        if name not in fitted:
+            print(f"{name}: no FITTED frame")
+    print(f"tilt_vs_truth: {n_tilt} PoleTilt frames, {n} FITTED near the {len(truth)} poles, worst "
+          f"{worst:.1f} sigma, {bad} beyond {k:g}")
     return 1 if bad else 0
 
 
