@@ -664,11 +664,9 @@ static void learn_front(sl_profile_t *pr, uint32_t rise)
     }
 }
 
-// The rise of slot `si`'s own row ("Front part"): ramp_bins from its first bin at or above
-// the threshold at or after absolute bin `a1` - 3 (within FIT_BINS + 3 bins), over at most
-// FIT_BINS bins; `*strong`: the brightest of those bins is T/2 above the threshold.
-static SL_NOINLINE uint32_t own_rise(const sl_profile_t *pr, uint32_t si, uint32_t a1,
-                                     uint32_t threshold, bool *strong)
+// The first bin (absolute) of slot `si`'s row at or above the threshold, searched from
+// absolute bin `a1` - 3 over FIT_BINS + 3 bins; UINT32_MAX when there is none.
+static uint32_t row_first(const sl_profile_t *pr, uint32_t si, uint32_t a1, uint32_t threshold)
 {
     const sl_profile_slot_t *o = &pr->slot[si];
     const uint32_t thr = (uint32_t)o->frames * threshold;
@@ -677,10 +675,23 @@ static SL_NOINLINE uint32_t own_rise(const sl_profile_t *pr, uint32_t si, uint32
     while (j < end && j + 1U < SL_CFG_PROFILE_BINS && o->sum[j] < thr) {
         j++;
     }
+    return (j < end && j + 1U < SL_CFG_PROFILE_BINS && o->sum[j] >= thr) ? o->bin0 + j
+                                                                          : UINT32_MAX;
+}
+
+// The rise of slot `si`'s own row ("Front part"): ramp_bins from its first bin at or above
+// the threshold (row_first from absolute bin `a1`), over at most FIT_BINS bins; `*strong`:
+// the brightest of those bins is T/2 above the threshold.
+static SL_NOINLINE uint32_t own_rise(const sl_profile_t *pr, uint32_t si, uint32_t a1,
+                                     uint32_t threshold, bool *strong)
+{
+    const sl_profile_slot_t *o = &pr->slot[si];
     *strong = false;
-    if (j >= end || j + 1U >= SL_CFG_PROFILE_BINS || o->sum[j] < thr) {
+    const uint32_t f = row_first(pr, si, a1, threshold);
+    if (f == UINT32_MAX) {
         return 0U;
     }
+    const uint32_t j = f - o->bin0;
     const uint32_t lim = j + FIT_BINS < SL_CFG_PROFILE_BINS ? j + FIT_BINS : SL_CFG_PROFILE_BINS - 1U;
     uint32_t top = 0U;
     for (uint32_t k = j; k <= lim; k++) {
@@ -690,14 +701,45 @@ static SL_NOINLINE uint32_t own_rise(const sl_profile_t *pr, uint32_t si, uint32
     return ramp_bins(o->sum, j, lim, o->frames);
 }
 
+// Whether target `t`'s neighbouring azimuths in its group (watched, with rows) start where
+// its own row does (within a bin), and there is at least one: the pole's rows hold it at the
+// same ranges, as they do with a kernel's front part. A pole leaning across the line of
+// sight holds other heights at other ranges on each azimuth, and the beam's azimuth pattern
+// weighs its slanted piece so that a row's own return rises (measured: 2-4 bins on the
+// leaning-away returns of poles leaning along the path, without a front).
+static SL_NOINLINE bool starts_aligned(const sl_profile_t *pr, const sl_target_t *t,
+                                       uint32_t own_first, uint32_t threshold)
+{
+    const uint32_t az_n = pr->azimuths;
+    uint32_t seen = 0U;
+    for (uint32_t d = 0; d < 2U; d++) {
+        const uint32_t nb = d == 0U ? (t->az + az_n - 1U) % az_n : (t->az + 1U) % az_n;
+        if ((nb + az_n - t->az_first % az_n) % az_n >= t->az_count || nb == t->az) {
+            continue; // not in the group
+        }
+        const uint8_t ni = pr->slot_of[nb];
+        if (ni == SL_PROFILE_NONE || pr->slot[ni].frames == 0U) {
+            continue;
+        }
+        const uint32_t f = row_first(pr, ni, own_first, threshold);
+        if (f == UINT32_MAX || f + 1U < own_first || f > own_first + 1U) {
+            return false;
+        }
+        seen++;
+    }
+    return seen != 0U;
+}
+
 // Bins of a walked return's rise (`pb`, starting at absolute bin `a1`) that its r1 moves
 // past ("Front part"): min(its rise, the stream's front), r1 staying before r2. The rise is
 // the longer of its own azimuth's row's (one rotation's rows of an oblique pole may start
 // elsewhere) and the rows' sum's (less noise to break a rise's shallow steps). A leaning-
-// away return (`branch2`) strong enough to show a front counts its rise, once per slot.
+// away return (`branch2`) strong enough to show a front, whose neighbouring rows start
+// where its own does, counts its rise, once per slot.
 static SL_NOINLINE uint32_t front_skip(sl_profile_t *pr, uint32_t si, const uint16_t *sum,
                                        uint32_t n, uint32_t frames, uint32_t threshold,
-                                       const sl_profile_bounds_t *pb, uint32_t a1, bool branch2)
+                                       const sl_profile_bounds_t *pb, uint32_t a1, bool branch2,
+                                       const sl_target_t *t)
 {
     bool strong = false;
     const uint32_t own = own_rise(pr, si, a1, threshold, &strong);
@@ -707,7 +749,10 @@ static SL_NOINLINE uint32_t front_skip(sl_profile_t *pr, uint32_t si, const uint
     sl_profile_slot_t *o = &pr->slot[si];
     if (o->lead_seen == 0U && strong && branch2) {
         o->lead_seen = 1U;
-        learn_front(pr, rise);
+        const uint32_t f = row_first(pr, si, a1, threshold);
+        if (f != UINT32_MAX && starts_aligned(pr, t, f, threshold)) {
+            learn_front(pr, rise);
+        }
     }
     uint32_t skip = rise < pr->front_bins ? rise : pr->front_bins;
     if (pb->i1 + skip >= pb->i2) {
@@ -1143,7 +1188,8 @@ uint8_t sl_profile_refine(sl_profile_t *pr, const sl_board_t *board, uint32_t th
             const uint32_t skip =
                 front_skip(pr, si, sum, n, frames, threshold, &pb, (uint32_t)i1,
                            res.flag == (uint8_t)SL_INCLINE_VALID &&
-                               res.branch == (uint8_t)SL_INCLINE_BRANCH_2);
+                               res.branch == (uint8_t)SL_INCLINE_BRANCH_2,
+                           t);
             if (skip != 0U) {
                 // Where the pole starts within the rise, no rule here can say (a long own
                 // return's smear and a partly lit bin rise too): r1 at the middle of the

@@ -418,6 +418,11 @@ Outcome run_case(const std::string &board_name, const Case &k, bool realistic, i
                     f.fallback[SL_PROFILE_TAIL_CUT], f.fallback[SL_PROFILE_NO_TAIL],
                     f.fallback[SL_PROFILE_FEW_FRAMES], f.claims, f.claim_full, f.reserved,
                     f.reserve_full, p->prof.slope_q8 / 256.0);
+        const uint8_t *ln = p->prof.lead_n;
+        std::printf("  front part: %u bins (r1 moved on %u targets); rises of leaning-away "
+                    "returns 0..7+: %u %u %u %u %u %u %u %u\n",
+                    p->prof.front_bins, f.front_skipped, ln[0], ln[1], ln[2], ln[3], ln[4], ln[5],
+                    ln[6], ln[7]);
     }
     if (dump && ctx.fitted_ring.track_id != 0U) {
         dump_ring(ctx.fitted_ring, p->tilt.prm, k);

@@ -251,22 +251,30 @@
 /// branch 1 r1 is the top end on the +beta ray, at the elevation beam's edge, and the own
 /// return climbs with the beam's gain (3-6 bins on the sensor's value scale, measured on
 /// the realistic drive-by without a front).
+/// Nor where the pole leans across the line of sight: each azimuth then holds another piece
+/// of it at other ranges, and the azimuth beam's pattern weighs the slanted piece so that a
+/// row's own return rises too (2-4 bins on the leaning-away returns of poles leaning along
+/// the path, measured without a front); its neighbouring rows start at other ranges.
 /// So the stream's front is learned from branch 2 only, like the tail slope: a walked
 /// extraction (a tail was removed: a stream without smear, whose returns end in cliffs,
 /// never learns a front), not SLANT, reading branch 2, whose own row's brightest of its
 /// first 8 bins is at least T/2 above the threshold (a weaker return shows less of its
-/// front), adds its rise to `lead_n`, once per slot (a static sum is one return however
-/// often it is extracted; while moving every rotation's rows are new), the counts halved at
-/// SL_PROFILE_LEAD_KEEP. From SL_PROFILE_LEAD_MIN samples on (`cfg.prior_front_bins`
+/// front), and whose neighbouring azimuths in the group (at least one, watched) start within
+/// a bin of its own row (a kernel's front is the same on every row), adds its rise to
+/// `lead_n`, once per slot (a static sum is one return however often it is extracted; while
+/// moving every rotation's rows are new), the counts halved at SL_PROFILE_LEAD_KEEP. From SL_PROFILE_LEAD_MIN samples on (`cfg.prior_front_bins`
 /// before) the front is known when half of them rise by 3 bins or more, as `front_bins` =
 /// the smallest rise held by an eighth of them (at least 2: a low quantile, as a front shows
 /// on every return while noise lengthens only some rises); once known it is lost only when
-/// half rise by a bin at most. Measured on the realistic drive-by (branch-2 rises, median;
-/// shadowleand's exit log prints them): 3.3 dB/bin and power-law tails 1-2 on both value
-/// scales, trunks of 10-15 cm radius 2, a 2-bin linear front 3, a 4-bin one 4 (none of the
-/// first at 3 or more in half of their returns, none of the fronts below 2 in an eighth).
-/// A stream taken for one with a front by mistake keeps its truth within its sigma: r1 then
-/// moves by at most half the span its sigma holds.
+/// half rise by a bin at most. Measured on the realistic drive-by (branch-2 rises counted,
+/// median; shadowleand's exit log prints them): 3.3 dB/bin and power-law tails 1-2 on both
+/// value scales, trunks of 10-15 cm radius 1-2, single poles leaning along the path 2 (3 on
+/// the sensor's value scale, where a slow tail's accumulated smear lengthens them: 7 of 24
+/// such passes at 1 m/s learn a 2-bin front by mistake), a 4-bin linear front 4 (none below
+/// 4 in an eighth); a 2-bin front 2, so it is not learned (its rises are those of a pole
+/// without one). A stream taken for one with a front by mistake keeps its truth within its
+/// sigma: r1 then moves by at most half the span its sigma holds (the 7 passes' FITTED fits
+/// all within 2.14 of their sigmas).
 /// With a front known, every walked target's r1 (both branches, not SLANT) moves to the
 /// middle of its first min(front_bins, its rise) bins (`stats.front_skipped`), and its
 /// sigma holds the alpha at their ends (uniform: a long own return's accumulated smear and
@@ -275,10 +283,10 @@
 /// while moving (sl_profile_reserve) starts front_bins earlier than the track's r1 would
 /// have it. When the front becomes known `front_news` is set and the pipeline clears the
 /// 3D-tilt histories, as for a cut-off stream: their observations were taken with r1 up
-/// to the front's length early. Not done: a front of one bin (the harder bench's one-bin
-/// skirt at -6 dB), which no rise tells from a partly lit bin; the front of a SLANT
-/// target's union r1; a static scene's handful of poles never reach SL_PROFILE_LEAD_MIN
-/// (there only a prior applies).
+/// to the front's length early. Not done: fronts of 1-2 bins (the harder bench's one-bin
+/// skirt at -6 dB), which no rise tells from a partly lit bin and the smear its first bins
+/// accumulate; the front of a SLANT target's union r1; a static scene's handful of poles
+/// never reach SL_PROFILE_LEAD_MIN (there only a prior applies).
 
 /// ## Online calibration (D3)
 /// `slope_q8`: exponential mean (weight 1/8) of the self-fitted slopes of accepted

@@ -1311,6 +1311,8 @@ static void test_profile_a_stream_of_cut_off_returns_is_unverified(void **state)
 
 // ---- Front part (sl_profile.h, "Front part") -----------------------------------------
 
+static int g_nb_shift = 0; // bins the neighbouring azimuths' returns start later (front_rows)
+
 // One rotation's rows of azimuths az_lo..az_hi (RN bins): a pole's own power on bins [a, b]
 // (100 dB at its first bin, falling 1 dB per bin: a leaning-away pole is brightest at its
 // foot) smeared by an exponential tail of 3.3 dB per bin and, with `front` > 0, a front part
@@ -1348,9 +1350,11 @@ static void front_rows(uint16_t az_lo, uint16_t az_hi, int a, int b, int front, 
     uint32_t x = seed;
     for (uint16_t az = az_lo; feed && az <= az_hi; az++) {
         uint8_t row[RN];
+        // the neighbours' returns start g_nb_shift bins later (their first bins at the floor)
+        const int cut = az == 100U ? 0 : (int)*first + g_nb_shift;
         for (int k = 0; k < RN; k++) {
             x = x * 1103515245U + 12345U;
-            const int v = (int)syn[k] + (int)((x >> 16) % 3U) - 1;
+            const int v = (k < cut ? 10 : (int)syn[k]) + (int)((x >> 16) % 3U) - 1;
             row[k] = (uint8_t)(v < 0 ? 0 : v);
         }
         sl_profile_row(&pr, az, row, RN, bits, RN);
@@ -1384,8 +1388,10 @@ static sl_target_t front_drive(int a, int b, int front, int rotations)
 // tilts 3-9 TiltSigma off. Learned on the stream from leaning-away returns (branch 2, where
 // a pole's own return cannot rise: r1 is the foot of the perpendicular): from the 8th such
 // return the front is known, every walked r1 moves to the middle of its rise, and its sigma
-// holds the rise's ends: the truth within 3 sigma. Without a front, or from leaning-towards
-// returns (whose own power rises with the elevation beam), nothing is learned and r1 stays.
+// holds the rise's ends: the truth within 3 sigma. Without a front, from leaning-towards
+// returns (whose own power rises with the elevation beam), or from rows whose neighbours
+// start elsewhere (a pole leaning across the line of sight: the azimuth beam weighs its
+// slanted piece, and its own rows rise), nothing is learned and r1 stays.
 static void test_profile_a_front_part_is_learned_on_leaning_away_returns(void **state)
 {
     (void)state;
@@ -1430,6 +1436,15 @@ static void test_profile_a_front_part_is_learned_on_leaning_away_returns(void **
     t = front_drive(60, 69, 4, 12);
     assert_true(t.incline_branch == SL_INCLINE_BRANCH_1);
     assert_int_equal(pr.front_bins, 0);
+    // ... nor from a pole whose neighbouring rows start 2 bins later than its own
+    assert_int_equal(sl_profile_init(&pr, 400, 0, NULL), SL_OK);
+    g_nb_shift = 2;
+    t = front_drive(100, 104, 4, 12);
+    g_nb_shift = 0;
+    assert_int_equal(pr.front_bins, 0);
+    assert_int_equal(pr.lead_n[0] + pr.lead_n[1] + pr.lead_n[2] + pr.lead_n[3] + pr.lead_n[4] +
+                         pr.lead_n[5] + pr.lead_n[6] + pr.lead_n[7],
+                     0);
     // a front saved from an earlier run applies from the first return
     c.prior_front_bins = 4U;
     assert_int_equal(sl_profile_init(&pr, 400, 0, &c), SL_OK);

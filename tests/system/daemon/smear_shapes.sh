@@ -161,12 +161,13 @@ for pl in "16 magnitude" "20 magnitude" "12 power"; do
     drive powerlaw 200 0 "$2" yes
 done
 decay=
-# An exponential tail behind a front part (sl-sim `smear_mode_frac` of the 40-bin kernel: a
-# linear rise over 2 and 4 bins before the target): r1 2-4 bins early on every return.
-# Before session 19 both poles came out FITTED 3-9 TiltSigma off (14 and 17 FITTED PoleTilt
-# frames beyond 3 sigma; 12.5-15.3 deg for 10 towards the path, 2.0-6.1 for 10 away): the
-# stream now learns the front from its leaning-away returns (sl_profile.h, "Front part").
-drive exponential 40 0.05 magnitude yes
+# An exponential tail behind a front part (sl-sim `smear_mode_frac` 0.1 of the 40-bin kernel:
+# a linear rise over 4 bins before the target), on both value scales: r1 3-4 bins early on
+# every return. Before session 19 both poles came out FITTED 3-9 TiltSigma off (17 and 16
+# FITTED PoleTilt frames beyond 3 sigma; 14.3-15.3 deg for 10 towards the path, 2.0-2.9 for
+# 10 away): the stream now learns the front from its leaning-away returns (sl_profile.h,
+# "Front part"; a 2-bin front is not learned: README).
 drive exponential 40 0.1 magnitude yes
+drive exponential 40 0.1 power yes
 [ $fail -eq 0 ] && echo "smear_shapes: OK" || echo "smear_shapes: FAILED"
 exit $fail
