@@ -680,14 +680,15 @@ static uint32_t row_first(const sl_profile_t *pr, uint32_t si, uint32_t a1, uint
 }
 
 // The rise of slot `si`'s own row ("Front part"): ramp_bins from its first bin at or above
-// the threshold (row_first from absolute bin `a1`), over at most FIT_BINS bins; `*strong`:
-// the brightest of those bins is T/2 above the threshold.
+// the threshold (`*first`: row_first from absolute bin `a1`), over at most FIT_BINS bins;
+// `*strong`: the brightest of those bins is T/2 above the threshold.
 static SL_NOINLINE uint32_t own_rise(const sl_profile_t *pr, uint32_t si, uint32_t a1,
-                                     uint32_t threshold, bool *strong)
+                                     uint32_t threshold, bool *strong, uint32_t *first)
 {
     const sl_profile_slot_t *o = &pr->slot[si];
     *strong = false;
     const uint32_t f = row_first(pr, si, a1, threshold);
+    *first = f;
     if (f == UINT32_MAX) {
         return 0U;
     }
@@ -742,15 +743,15 @@ static SL_NOINLINE uint32_t front_skip(sl_profile_t *pr, uint32_t si, const uint
                                        const sl_target_t *t)
 {
     bool strong = false;
-    const uint32_t own = own_rise(pr, si, a1, threshold, &strong);
+    uint32_t f = UINT32_MAX;
+    const uint32_t own = own_rise(pr, si, a1, threshold, &strong, &f);
     const uint32_t in_sum =
         ramp_bins(sum, pb->i1, pb->i1 + FIT_BINS < n ? pb->i1 + FIT_BINS : n - 1U, frames);
     const uint32_t rise = own > in_sum ? own : in_sum;
     sl_profile_slot_t *o = &pr->slot[si];
     if (o->lead_seen == 0U && strong && branch2) {
         o->lead_seen = 1U;
-        const uint32_t f = row_first(pr, si, a1, threshold);
-        if (f != UINT32_MAX && starts_aligned(pr, t, f, threshold)) {
+        if (starts_aligned(pr, t, f, threshold)) { // strong: f is a bin
             learn_front(pr, rise);
         }
     }
@@ -1183,8 +1184,8 @@ uint8_t sl_profile_refine(sl_profile_t *pr, const sl_board_t *board, uint32_t th
         uint32_t lead = pb.i1;
         uint64_t front_um = 0U; // half the front part r1 moved past: the rest is its sigma
         if (!slant && pb.slope_src != SL_PROFILE_SLOPE_CLIFF) {
-            // Front part (sl_profile.h): a branch-2 return's rise is the stream's front;
-            // every walked target's r1 moves past it.
+            // Front part (sl_profile.h): a branch-2 return's rise, its neighbours starting
+            // where it does, is the stream's front; every walked target's r1 moves past it.
             const uint32_t skip =
                 front_skip(pr, si, sum, n, frames, threshold, &pb, (uint32_t)i1,
                            res.flag == (uint8_t)SL_INCLINE_VALID &&

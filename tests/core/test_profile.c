@@ -1383,8 +1383,8 @@ static sl_target_t front_drive(int a, int b, int front, int rotations)
 }
 
 // A smear kernel with a front part (a linear rise over 4 bins before the target, then an
-// exponential tail) puts r1 4 bins early on every return: a pole leaning away read +2 deg
-// for -5 at a sigma of 0.6 deg, and the 3D fit of a drive-by turned the bias into FITTED
+// exponential tail) puts r1 4 bins early on every return: here the pole leaning away reads
+// more than 3 sigma off, and on the realistic drive-by the 3D fit turned the bias into FITTED
 // tilts 3-9 TiltSigma off. Learned on the stream from leaning-away returns (branch 2, where
 // a pole's own return cannot rise: r1 is the foot of the perpendicular): from the 8th such
 // return the front is known, every walked r1 moves to the middle of its rise, and its sigma
