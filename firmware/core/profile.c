@@ -702,6 +702,19 @@ static SL_NOINLINE uint32_t own_rise(const sl_profile_t *pr, uint32_t si, uint32
     return ramp_bins(o->sum, j, lim, o->frames);
 }
 
+// Slot of target `t`'s neighbouring azimuth on side `d` (0: az - 1, 1: az + 1) when that
+// azimuth lies in t's detection group and is watched with rows; SL_PROFILE_NONE otherwise.
+static uint8_t group_neighbour(const sl_profile_t *pr, const sl_target_t *t, uint32_t d)
+{
+    const uint32_t az_n = pr->azimuths;
+    const uint32_t nb = d == 0U ? (t->az + az_n - 1U) % az_n : (t->az + 1U) % az_n;
+    if ((nb + az_n - t->az_first % az_n) % az_n >= t->az_count || nb == t->az) {
+        return (uint8_t)SL_PROFILE_NONE; // not in the group
+    }
+    const uint8_t ni = pr->slot_of[nb];
+    return (ni != SL_PROFILE_NONE && pr->slot[ni].frames != 0U) ? ni : (uint8_t)SL_PROFILE_NONE;
+}
+
 // Whether target `t`'s neighbouring azimuths in its group (watched, with rows) start where
 // its own row does (within a bin), and there is at least one: the pole's rows hold it at the
 // same ranges, as they do with a kernel's front part. A pole leaning across the line of
@@ -711,15 +724,10 @@ static SL_NOINLINE uint32_t own_rise(const sl_profile_t *pr, uint32_t si, uint32
 static SL_NOINLINE bool starts_aligned(const sl_profile_t *pr, const sl_target_t *t,
                                        uint32_t own_first, uint32_t threshold)
 {
-    const uint32_t az_n = pr->azimuths;
     uint32_t seen = 0U;
     for (uint32_t d = 0; d < 2U; d++) {
-        const uint32_t nb = d == 0U ? (t->az + az_n - 1U) % az_n : (t->az + 1U) % az_n;
-        if ((nb + az_n - t->az_first % az_n) % az_n >= t->az_count || nb == t->az) {
-            continue; // not in the group
-        }
-        const uint8_t ni = pr->slot_of[nb];
-        if (ni == SL_PROFILE_NONE || pr->slot[ni].frames == 0U) {
+        const uint8_t ni = group_neighbour(pr, t, d);
+        if (ni == SL_PROFILE_NONE) {
             continue;
         }
         const uint32_t f = row_first(pr, ni, own_first, threshold);
@@ -832,16 +840,10 @@ static uint32_t combine_neighbours(sl_profile_t *pr, const sl_target_t *t, uint8
     use[k++] = &pr->slot[si];
     uint32_t lo = pr->slot[si].bin0;
     uint32_t hi = lo + SL_CFG_PROFILE_BINS;
-    const uint32_t az_n = pr->azimuths;
     const uint32_t end0 = row_end(&pr->slot[si], t->bin_first, thr);
     for (uint32_t d = 0; d < 2U; d++) {
-        const uint32_t nb = d == 0U ? (t->az + az_n - 1U) % az_n : (t->az + 1U) % az_n;
-        if ((nb + az_n - t->az_first % az_n) % az_n >= t->az_count || nb == t->az) {
-            continue; // not in the group
-        }
-        const uint8_t ni = pr->slot_of[nb];
-        if (ni == SL_PROFILE_NONE || pr->slot[ni].frames == 0U ||
-            (uint32_t)pr->slot[ni].bin0 + 3U > t->bin_first) {
+        const uint8_t ni = group_neighbour(pr, t, d);
+        if (ni == SL_PROFILE_NONE || (uint32_t)pr->slot[ni].bin0 + 3U > t->bin_first) {
             continue;
         }
         const sl_profile_slot_t *q = &pr->slot[ni];
