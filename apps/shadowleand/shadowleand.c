@@ -756,14 +756,14 @@ static void log_stats(daemon_t *d, int level, const char *what)
             " no slot, %" PRIu32 " too few rows, %" PRIu32 " no tail (%" PRIu32
             " cut off), %" PRIu32
             " other; tilt observations %" PRIu32 " (%" PRIu32 " unverified left out, %" PRIu32
-            " outliers dropped)",
+            " outliers dropped from inconsistent fits, %" PRIu32 " from fits that stood)",
             what, ps->extracted, ps->spatial, ps->misaligned, ps->ramps,
             ps->fallback[SL_PROFILE_NO_SLOT],
             ps->fallback[SL_PROFILE_FEW_FRAMES], ps->fallback[SL_PROFILE_NO_TAIL], ps->cut_ends,
             ps->fallback[SL_PROFILE_LEAD_CUT] + ps->fallback[SL_PROFILE_NO_RUN] +
                 ps->fallback[SL_PROFILE_TAIL_CUT],
             g_pipe.tilt.stats.observations, g_pipe.tilt.stats.unverified,
-            g_pipe.tilt.stats.outliers);
+            g_pipe.tilt.stats.outliers, g_pipe.tilt.stats.gross);
     if (g_pipe.prof.slope_q8 != 0U) { // what --tail-slope takes on the next start
         sld_log(SLD_LOG_INFO, "%s: tail slope %.4f values/bin (%s; %" PRIu32 " fits taken, %" PRIu32
                 " refused)", what, g_pipe.prof.slope_q8 / 256.0,

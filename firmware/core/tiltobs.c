@@ -297,8 +297,9 @@ void sl_tiltobs_update(sl_tiltobs_t *o, const sl_track_t *tracks, const sl_targe
 }
 
 // The observation with the largest residual |tan(alpha_k) - pred_k| / sigma_k under the fit
-// `res` (pred = -(t . e_k), the reading the fit chose for mirrored ones). O(n).
-static SL_NOINLINE uint32_t worst_obs(const sl_tiltobs_ring_t *r)
+// `res` (pred = -(t . e_k), the reading the fit chose for mirrored ones) and the square of
+// that residual in sigmas, Q8 (`z2_q8`, saturating). O(n).
+static SL_NOINLINE uint32_t worst_obs(const sl_tiltobs_ring_t *r, uint32_t *z2_q8)
 {
     uint32_t worst = 0;
     int64_t wr = -1, ws = 1;
@@ -317,6 +318,8 @@ static SL_NOINLINE uint32_t worst_obs(const sl_tiltobs_ring_t *r)
             ws = sg;
         }
     }
+    const uint32_t z_q8 = (uint32_t)((wr < 0 ? 0 : wr) / ws); // Q24 / Q16 -> Q8, < 2^28
+    *z2_q8 = (z_q8 >= 0x10000U) ? UINT32_MAX : (z_q8 * z_q8) >> 8;
     return worst;
 }
 
@@ -380,6 +383,24 @@ static SL_NOINLINE uint32_t drop_unconfirmed(sl_tiltobs_ring_t *r)
     return n;
 }
 
+// In a fit that stands (FITTED or AMBIGUOUS), the worst observation (its squared residual
+// in sigmas `z2_q8`) is a gross outlier: z^2 > SL_TILTOBS_GROSS_Z2 x s^2, s^2 = max(1,
+// (chi2 - z^2) / (dof - 1)) the chi-square scale of the other observations (dof = n - 2,
+// n >= SL_TILTOBS_OUTLIER_MIN_N). O(1).
+static SL_NOINLINE bool gross(const sl_tiltobs_ring_t *r, uint32_t z2_q8)
+{
+    if (r->res.quality != (uint8_t)SL_TILT_FITTED && r->res.quality != (uint8_t)SL_TILT_AMBIGUOUS) {
+        return false;
+    }
+    const uint32_t chi2_q8 = r->res.chi2_q8;
+    const uint32_t rest_q8 = chi2_q8 > z2_q8 ? chi2_q8 - z2_q8 : 0U;
+    uint32_t s2_q8 = rest_q8 / ((uint32_t)r->count - 3U);
+    if (s2_q8 < 256U) {
+        s2_q8 = 256U;
+    }
+    return s2_q8 <= UINT32_MAX / SL_TILTOBS_GROSS_Z2 && z2_q8 > SL_TILTOBS_GROSS_Z2 * s2_q8;
+}
+
 void sl_tiltobs_fit_pending(sl_tiltobs_t *o)
 {
     SL_ASSERT(o != NULL);
@@ -412,26 +433,37 @@ void sl_tiltobs_fit_pending(sl_tiltobs_t *o)
             o->stats.fits++;
             done++;
         }
-        // One gross outlier (a bound the profile could not clean) makes a whole pass
-        // INCONSISTENT: drop the observation with the largest residual in sigmas and fit
-        // again, at most one in SL_TILTOBS_OUTLIER_DIV of the observations per ring (a
-        // pole that is not straight, or a wrong association, stays INCONSISTENT). The
-        // second fit counts against the bound: without room for it the ring stays fresh
-        // and starts the next call.
-        if (SL_CFG_TILT_FITS_PER_ROTATION >= 2 &&
-            r->res.quality == (uint8_t)SL_TILT_INCONSISTENT &&
-            r->count >= SL_TILTOBS_OUTLIER_MIN_N &&
+        // Outliers (sl_tiltobs.h, "Outlier rejection"). One gross outlier (a bound the
+        // profile could not clean) makes a whole pass INCONSISTENT, or, in a fit that stands,
+        // lies far beyond the scale of the other residuals: drop the observation with the
+        // largest residual in sigmas and fit again, at most one in SL_TILTOBS_OUTLIER_DIV
+        // of the observations per ring (a pole that is not straight, or a wrong
+        // association, stays INCONSISTENT). The second fit counts against the bound:
+        // without room for it the ring stays fresh and starts the next call. After a drop
+        // from a fit that stood the ring stays fresh: the next call looks for another.
+        bool again = false;
+        if (SL_CFG_TILT_FITS_PER_ROTATION >= 2 && r->count >= SL_TILTOBS_OUTLIER_MIN_N &&
             (uint32_t)r->dropped + 1U <= (uint32_t)r->count / SL_TILTOBS_OUTLIER_DIV) {
-            if (done >= (uint32_t)SL_CFG_TILT_FITS_PER_ROTATION) {
-                o->rr = (uint8_t)idx;
-                break;
+            uint32_t z2_q8;
+            const uint32_t w = worst_obs(r, &z2_q8);
+            const bool incons = r->res.quality == (uint8_t)SL_TILT_INCONSISTENT;
+            if (incons || gross(r, z2_q8)) {
+                if (done >= (uint32_t)SL_CFG_TILT_FITS_PER_ROTATION) {
+                    o->rr = (uint8_t)idx;
+                    break;
+                }
+                drop_obs(r, w);
+                r->dropped++;
+                if (incons) {
+                    o->stats.outliers++;
+                } else {
+                    o->stats.gross++;
+                    again = true;
+                }
+                (void)sl_tilt_fit(r->obs, r->count, &o->prm, &o->work, &r->res);
+                o->stats.fits++;
+                done++;
             }
-            drop_obs(r, worst_obs(r));
-            r->dropped++;
-            o->stats.outliers++;
-            (void)sl_tilt_fit(r->obs, r->count, &o->prm, &o->work, &r->res);
-            o->stats.fits++;
-            done++;
         }
         // A result (FITTED or AMBIGUOUS) stands on SL_TILT_MIN_OBS observations without a
         // ramp at a bound, else it is TOO_FEW, as sl_tilt_fit's (no values); nor is it a
@@ -451,9 +483,11 @@ void sl_tiltobs_fit_pending(sl_tiltobs_t *o)
                 o->stats.too_steep++;
             }
         }
-        r->fresh = 0U;
-        o->pending--;
         r->fitted = 1U;
+        if (!again) {
+            r->fresh = 0U;
+            o->pending--;
+        }
         o->rr = (uint8_t)((idx + 1U) % (uint32_t)SL_CFG_TILT_TRACKS);
     }
 }

@@ -403,12 +403,12 @@ Outcome run_case(const std::string &board_name, const Case &k, bool realistic, i
         const sl_tiltobs_stats_t &o = p->tilt.stats;
         std::printf("  stats: groups %u targets %u rejected near %u shadow %u wide %u broken %u short %u "
                     "rho %u weak %u; tracks created %u confirmed %u associated %u inconsistent %u "
-                    "dropped %u; tilt obs %u rejected %u no_target %u\n",
+                    "dropped %u; tilt obs %u rejected %u no_target %u outliers %u gross %u\n",
                     d.groups, d.targets, d.rejected[SL_DETECT_REJ_NEAR], d.rejected[SL_DETECT_REJ_SHADOW],
                     d.rejected[SL_DETECT_REJ_WIDE], d.rejected[SL_DETECT_REJ_BROKEN],
                     d.rejected[SL_DETECT_REJ_SHORT], d.rejected[SL_DETECT_REJ_RHO],
                     d.rejected[SL_DETECT_REJ_WEAK], t.created, t.confirmations, t.associated,
-                    t.inconsistent, t.dropped, o.observations, o.rejected, o.no_target);
+                    t.inconsistent, t.dropped, o.observations, o.rejected, o.no_target, o.outliers, o.gross);
         const sl_profile_stats_t &f = p->prof.stats;
         std::printf("  profile: refined %u (from neighbouring azimuths %u); fallback no_slot %u "
                     "lead_cut %u no_run %u tail_cut %u no_tail %u few_frames %u; claims %u "

@@ -45,8 +45,8 @@
 /// 3. `sl_tiltobs_fit_pending()`: the fit (`sl_tilt_fit`) runs on rings that received an
 ///    observation since their last fit, at most SL_CFG_TILT_FITS_PER_ROTATION per call
 ///    (round robin over the rings; the others keep their previous result until their turn;
-///    an INCONSISTENT fit may drop its worst observation and fit again, within the same
-///    bound, see "Outlier rejection" below):
+///    an INCONSISTENT fit, or one that stands with a gross outlier, may drop its worst
+///    observation and fit again, within the same bound, see "Outlier rejection" below):
 ///    never per azimuth. The pipeline calls it when control returns from the decoder (end
 ///    of sl_pipeline_feed / _on_msg / _finish), not from inside the rotation callback: the
 ///    fit's stack (~800 B on Cortex-M0) then does not add to the decoder's call chain. So a
@@ -114,9 +114,18 @@ typedef struct sl_tiltobs_ring {
 /// Outlier rejection (sl_tiltobs_fit_pending): a ring whose fit is INCONSISTENT and holds at
 /// least SL_TILTOBS_OUTLIER_MIN_N observations loses the one with the largest residual in
 /// sigmas and is fitted again, while the ring's drops stay within 1 / SL_TILTOBS_OUTLIER_DIV
-/// of its observations.
+/// of its observations (`stats.outliers`). One observation 6-8 sigma off among 30 good ones
+/// leaves chi2 / dof near 3, below the INCONSISTENT bound, and pulls a FITTED tilt; hence
+/// also the rule below (`stats.gross`): its scale is that of the OTHER residuals (the
+/// externally studentised residual), so the outlier cannot hide by inflating it.
 #define SL_TILTOBS_OUTLIER_MIN_N 8U
 #define SL_TILTOBS_OUTLIER_DIV 8U
+/// A fit that stands (FITTED or AMBIGUOUS) with at least SL_TILTOBS_OUTLIER_MIN_N
+/// observations loses its worst one when that one's squared residual in sigmas exceeds
+/// SL_TILTOBS_GROSS_Z2 (4 sigma) times the chi-square scale of the others, max(1, (chi2 -
+/// z^2) / (dof - 1)), within the same bound of drops; the next call fits the ring again
+/// and looks for another.
+#define SL_TILTOBS_GROSS_Z2 16U
 
 /// Counters (cumulative; never asserted).
 typedef struct sl_tiltobs_stats {
@@ -134,6 +143,7 @@ typedef struct sl_tiltobs_stats {
     uint32_t unverified;    ///< targets not stored under `verified_only`: bounds the range
                             ///< profile did not check (SL_TARGET_PROFILE / _NO_TAIL unset)
     uint32_t outliers;      ///< observations dropped from INCONSISTENT fits
+    uint32_t gross;         ///< observations dropped from fits that stood (FITTED/AMBIGUOUS)
     uint32_t too_steep;     ///< fits beyond `max_tan_q16`, reported INCONSISTENT
 } sl_tiltobs_stats_t;
 

@@ -16,6 +16,7 @@
 #include <cmocka.h>
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "shadowlean/sl_board.h"
@@ -129,6 +130,8 @@ static bool see(const sl_board_t *b, const drive_t *d, const pole_t *p, sl_targe
 // Bad far bounds injected into the first pole's targets: on the rotations where it is seen
 // for the k-th time with k % corrupt_every == corrupt_phase (corrupt_every 0: none).
 static int corrupt_every, corrupt_phase;
+// ... read that much long (0: 8 %).
+static double corrupt_scale;
 
 // Sightings a track needs before it is confirmed (the tracker's evidence, one per sighting;
 // 0 or 1: confirmed from the first); reset_at > 0: on its reset_at-th sighting the track's
@@ -187,7 +190,7 @@ static int drive_by(const pole_t *p, int n, double v, double w, int rotations, s
         if (ng > 0U && corrupt_every > 0 && seen % corrupt_every == corrupt_phase) {
             // a far bound read long by 8 % (a smear tail of ~5 bins left in it): alpha
             // ~15 deg high, 30 of its sigmas (the outliers of `sl-eval driveby --realistic`)
-            g[0].r2_um = (uint32_t)llround(g[0].r2_um * 1.08);
+            g[0].r2_um = (uint32_t)llround(g[0].r2_um * (corrupt_scale > 0.0 ? corrupt_scale : 1.08));
             tracks[0].r2_um = g[0].r2_um; // the track holds its target's bounds
         }
         sl_tiltobs_update(&obs, tracks, g, ng);
@@ -352,6 +355,46 @@ static void test_one_outlier_is_dropped_a_bent_pole_stays_inconsistent(void **st
     assert_true((uint32_t)r->dropped * SL_TILTOBS_OUTLIER_DIV <= (uint32_t)r->count + r->dropped);
     assert_int_equal(out.quality, SL_TILT_INCONSISTENT);
     corrupt_every = 0;
+}
+
+// A wrong observation that does not make the fit INCONSISTENT: a far bound 3 % long (alpha
+// 3-4 deg high, 7-8 of its 0.5 deg sigmas) among 16-32 good ones leaves chi2 / dof near 3,
+// so the fit stood FITTED and was pulled by it (0.4 deg of tilt and 1-2 deg of direction
+// here, more with fewer observations). Its residual against the scale of the others is far
+// beyond 4 sigma: it is dropped and the fit is the clean pass's. Clean passes drop nothing
+// (the sweeps above and the reference pass here: stats.gross 0).
+static void test_a_gross_outlier_in_a_fitted_pass_is_dropped(void **state)
+{
+    (void)state;
+    sl_track_t tracks[SL_CFG_MAX_TARGETS];
+    const pole_t p = {4.0, 3.0, 5.0, 135.0};
+    drive_by(&p, 1, 1.0, 0.0, 32, tracks);
+    assert_int_equal(obs.stats.gross, 0U);
+    const sl_tiltobs_ring_t *r = sl_tiltobs_find(&obs, 1);
+    assert_non_null(r);
+    sl_tiltobs_vehicle_t clean;
+    assert_true(sl_tiltobs_vehicle(&obs, r, &clean));
+    assert_int_equal(clean.quality, SL_TILT_FITTED);
+    corrupt_every = 1000;
+    corrupt_phase = 26; // late in the pass: the firmware's 16-observation ring still holds it
+    corrupt_scale = 1.03;
+    drive_by(&p, 1, 1.0, 0.0, 32, tracks);
+    corrupt_every = 0;
+    corrupt_scale = 0.0;
+    r = sl_tiltobs_find(&obs, 1);
+    assert_non_null(r);
+    sl_tiltobs_vehicle_t out;
+    assert_true(sl_tiltobs_vehicle(&obs, r, &out));
+    printf("gross: dropped %u (stats %u, inconsistent-path %u) psi %.2f (clean %.2f) phi %.1f (%.1f)\n",
+           r->dropped, obs.stats.gross, obs.stats.outliers, out.psi_cdeg / 100.0,
+           clean.psi_cdeg / 100.0, out.phi_cdeg / 100.0, clean.phi_cdeg / 100.0);
+    assert_int_equal(obs.stats.gross, 1U);
+    assert_int_equal(obs.stats.outliers, 0U);
+    assert_int_equal(r->dropped, 1U);
+    assert_int_equal(out.quality, SL_TILT_FITTED);
+    assert_true(abs(out.psi_cdeg - clean.psi_cdeg) <= 5);
+    assert_true(abs(out.phi_cdeg - clean.phi_cdeg) <= 50);
+    check_pole(&p, 1.0, 0.0, 32, 1, 1.0, 10.0);
 }
 
 // Runs after the three sweeps above (cmocka runs the tests in order).
@@ -782,6 +825,7 @@ int main(void)
         cmocka_unit_test(test_curved_path_10_deg_per_second),
         cmocka_unit_test(test_results_digest_is_target_independent),
         cmocka_unit_test(test_one_outlier_is_dropped_a_bent_pole_stays_inconsistent),
+        cmocka_unit_test(test_a_gross_outlier_in_a_fitted_pass_is_dropped),
         cmocka_unit_test(test_fits_are_bounded_per_rotation),
         cmocka_unit_test(test_lost_motion_and_lost_tracks_clear_history),
         cmocka_unit_test(test_more_tracks_than_rings_are_counted),
