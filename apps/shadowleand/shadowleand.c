@@ -756,7 +756,7 @@ static void log_stats(daemon_t *d, int level, const char *what)
             " no slot, %" PRIu32 " too few rows, %" PRIu32 " no tail (%" PRIu32
             " cut off), %" PRIu32
             " other; tilt observations %" PRIu32 " (%" PRIu32 " unverified left out, %" PRIu32
-            " outliers dropped from inconsistent fits, %" PRIu32 " from fits that stood)",
+            " outliers dropped from inconsistent fits, %" PRIu32 " from fitted ones)",
             what, ps->extracted, ps->spatial, ps->misaligned, ps->ramps,
             ps->fallback[SL_PROFILE_NO_SLOT],
             ps->fallback[SL_PROFILE_FEW_FRAMES], ps->fallback[SL_PROFILE_NO_TAIL], ps->cut_ends,

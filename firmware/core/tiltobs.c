@@ -383,13 +383,14 @@ static SL_NOINLINE uint32_t drop_unconfirmed(sl_tiltobs_ring_t *r)
     return n;
 }
 
-// In a fit that stands (FITTED or AMBIGUOUS), the worst observation (its squared residual
-// in sigmas `z2_q8`) is a gross outlier: z^2 > SL_TILTOBS_GROSS_Z2 x s^2, s^2 = max(1,
-// (chi2 - z^2) / (dof - 1)) the chi-square scale of the other observations (dof = n - 2,
-// n >= SL_TILTOBS_OUTLIER_MIN_N). O(1).
+// In a FITTED fit, the worst observation (its squared residual in sigmas `z2_q8`) is a gross
+// outlier: z^2 > SL_TILTOBS_GROSS_Z2 x s^2, s^2 = max(1, (chi2 - z^2) / (dof - 1)) the
+// chi-square scale of the other observations (dof = n - 2, n >= SL_TILTOBS_OUTLIER_MIN_N).
+// Not in an AMBIGUOUS one: there the worst residual under the better reading may be the very
+// observation that tells the two readings apart. O(1).
 static SL_NOINLINE bool gross(const sl_tiltobs_ring_t *r, uint32_t z2_q8)
 {
-    if (r->res.quality != (uint8_t)SL_TILT_FITTED && r->res.quality != (uint8_t)SL_TILT_AMBIGUOUS) {
+    if (r->res.quality != (uint8_t)SL_TILT_FITTED) {
         return false;
     }
     const uint32_t chi2_q8 = r->res.chi2_q8;
@@ -434,13 +435,13 @@ void sl_tiltobs_fit_pending(sl_tiltobs_t *o)
             done++;
         }
         // Outliers (sl_tiltobs.h, "Outlier rejection"). One gross outlier (a bound the
-        // profile could not clean) makes a whole pass INCONSISTENT, or, in a fit that stands,
+        // profile could not clean) makes a whole pass INCONSISTENT, or, in a FITTED fit,
         // lies far beyond the scale of the other residuals: drop the observation with the
         // largest residual in sigmas and fit again, at most one in SL_TILTOBS_OUTLIER_DIV
         // of the observations per ring (a pole that is not straight, or a wrong
         // association, stays INCONSISTENT). The second fit counts against the bound:
         // without room for it the ring stays fresh and starts the next call. After a drop
-        // from a fit that stood the ring stays fresh: the next call looks for another.
+        // from a FITTED fit the ring stays fresh: the next call looks for another.
         bool again = false;
         if (SL_CFG_TILT_FITS_PER_ROTATION >= 2 && r->count >= SL_TILTOBS_OUTLIER_MIN_N &&
             (uint32_t)r->dropped + 1U <= (uint32_t)r->count / SL_TILTOBS_OUTLIER_DIV) {

@@ -45,7 +45,7 @@
 /// 3. `sl_tiltobs_fit_pending()`: the fit (`sl_tilt_fit`) runs on rings that received an
 ///    observation since their last fit, at most SL_CFG_TILT_FITS_PER_ROTATION per call
 ///    (round robin over the rings; the others keep their previous result until their turn;
-///    an INCONSISTENT fit, or one that stands with a gross outlier, may drop its worst
+///    an INCONSISTENT fit, or a FITTED one with a gross outlier, may drop its worst
 ///    observation and fit again, within the same bound, see "Outlier rejection" below):
 ///    never per azimuth. The pipeline calls it when control returns from the decoder (end
 ///    of sl_pipeline_feed / _on_msg / _finish), not from inside the rotation callback: the
@@ -120,11 +120,12 @@ typedef struct sl_tiltobs_ring {
 /// externally studentised residual), so the outlier cannot hide by inflating it.
 #define SL_TILTOBS_OUTLIER_MIN_N 8U
 #define SL_TILTOBS_OUTLIER_DIV 8U
-/// A fit that stands (FITTED or AMBIGUOUS) with at least SL_TILTOBS_OUTLIER_MIN_N
-/// observations loses its worst one when that one's squared residual in sigmas exceeds
-/// SL_TILTOBS_GROSS_Z2 (4 sigma) times the chi-square scale of the others, max(1, (chi2 -
-/// z^2) / (dof - 1)), within the same bound of drops; the next call fits the ring again
-/// and looks for another.
+/// A FITTED fit with at least SL_TILTOBS_OUTLIER_MIN_N observations loses its worst one when
+/// that one's squared residual in sigmas exceeds SL_TILTOBS_GROSS_Z2 (4 sigma) times the
+/// chi-square scale of the others, max(1, (chi2 - z^2) / (dof - 1)), within the same bound
+/// of drops; the next call fits the ring again and looks for another. Not an AMBIGUOUS fit:
+/// there the worst residual under the better reading may be the very observation that
+/// tells the readings apart (dropping it could make a wrong reading FITTED).
 #define SL_TILTOBS_GROSS_Z2 16U
 
 /// Counters (cumulative; never asserted).
@@ -143,7 +144,7 @@ typedef struct sl_tiltobs_stats {
     uint32_t unverified;    ///< targets not stored under `verified_only`: bounds the range
                             ///< profile did not check (SL_TARGET_PROFILE / _NO_TAIL unset)
     uint32_t outliers;      ///< observations dropped from INCONSISTENT fits
-    uint32_t gross;         ///< observations dropped from fits that stood (FITTED/AMBIGUOUS)
+    uint32_t gross;         ///< observations dropped from FITTED fits (gross outliers)
     uint32_t too_steep;     ///< fits beyond `max_tan_q16`, reported INCONSISTENT
 } sl_tiltobs_stats_t;
 

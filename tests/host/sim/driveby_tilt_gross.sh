@@ -6,8 +6,8 @@
 # azimuth scaled to its brightest bin, the threshold at 16 % of it) leaves the dim lower end
 # of a return leaning away below the threshold: r2 up to 4 bins short, alpha 2-7 deg low at
 # a stated 0.5-0.9 deg, a handful of rotations per pass. Those observations do not make the
-# fit INCONSISTENT; they pulled three FITTED passes 1.01-1.57 deg off. A fit that stands
-# drops a gross outlier (sl_tiltobs.h, "Outlier rejection"): asserts every pass FITTED
+# fit INCONSISTENT; they pulled three FITTED passes 1.01-1.57 deg off. A FITTED fit drops a
+# gross outlier (sl_tiltobs.h, "Outlier rejection"): asserts every pass FITTED
 # within the issue's bounds (`--check`: 1.0 deg / 10 deg), at least one such drop, and every
 # FITTED fit along the passes within 3 of its stated sigmas (`--obs-log`).
 set -u
