@@ -22,6 +22,8 @@
 #include "shadowlean/sl_board.h"
 #include "shadowlean/sl_tiltobs.h"
 
+#include "../support/tilt_model.h"
+
 static const double PI = 3.14159265358979323846;
 static double rad(double d) { return d * PI / 180.0; }
 static double deg(double r) { return r * 180.0 / PI; }
@@ -99,31 +101,10 @@ static bool see(const sl_board_t *b, const drive_t *d, const pole_t *p, sl_targe
     const double rx = x + b->radar_x_um * 1e-6 * cos(yaw) - b->radar_y_um * 1e-6 * sin(yaw);
     const double ry = y + b->radar_x_um * 1e-6 * sin(yaw) + b->radar_y_um * 1e-6 * cos(yaw);
     const double d0 = hypot(qx - rx, qy - ry);
-    const double theta = b->geom[az].theta_bam32 * 360.0 / 4294967296.0;
-    const double beta = (double)(int32_t)b->geom[az].beta_bam32 * 360.0 / 4294967296.0;
-    if (d0 < 1.3 || hypot(p->bx - rx, p->by - ry) > H / tan(rad(theta))) {
+    if (d0 < 1.3 || hypot(p->bx - rx, p->by - ry) > H / tan(rad(sl_tm_theta_deg(b, az)))) {
         return false;
     }
-    const double a_true = atan2(qy - ry, qx - rx);
-    const double alpha = deg(atan(-(tx * cos(a_true) + ty * sin(a_true))));
-    const double foot = d0 * cos(rad(alpha));
-    const double r1 = (alpha >= beta) ? foot / cos(rad(beta - alpha)) : foot;
-    const double fold = (beta - theta) / 2.0;
-    const double read = (alpha < fold) ? beta - theta - alpha : alpha;
-    memset(g, 0, sizeof *g);
-    g->az = (uint16_t)az;
-    g->r1_um = (uint32_t)llround(r1 * 1e6);
-    // r2 from the model (sl_incline.h) for the alpha as read: branch 1 rho =
-    // cos(a - b) / cos(a + t), branch 2 rho = 1 / cos(a + t).
-    const double rho = (read >= beta) ? cos(rad(read - beta)) / cos(rad(read + theta))
-                                      : 1.0 / cos(rad(read + theta));
-    g->r2_um = (uint32_t)llround(r1 * rho * 1e6);
-    g->az_first = (uint16_t)az;
-    g->az_count = 1U;
-    g->alpha_cdeg = (int32_t)llround(read * 100.0);
-    g->sigma_cdeg = 50U;
-    g->incline_flag = (uint8_t)SL_INCLINE_VALID;
-    g->incline_branch = (uint8_t)((read >= beta) ? SL_INCLINE_BRANCH_1 : SL_INCLINE_BRANCH_2);
+    sl_tm_target(b, az, d0, atan2(qy - ry, qx - rx), tx, ty, g);
     return true;
 }
 

@@ -260,8 +260,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 
 #ifndef SL_FUZZ_LIBFUZZER
 // ------------------------------------------------------------------------ corpus replay
-#include <dirent.h>
-#include <sys/stat.h>
+#include "replay_files.h"
 
 static unsigned long g_inputs;
 static unsigned g_mutations;
@@ -357,6 +356,12 @@ static int run_file(const char *path, uint64_t seed)
     return 0;
 }
 
+// A directory entry's mutations are seeded by its name, a file argument's by its position.
+static int replay_one(const char *path, const char *name, unsigned long index)
+{
+    return run_file(path, name != NULL ? fnv(0, (const uint8_t *)name, strlen(name)) : index);
+}
+
 int main(int argc, char **argv)
 {
     int bad = 0;
@@ -366,29 +371,12 @@ int main(int argc, char **argv)
             g_mutations = (unsigned)strtoul(argv[++i], NULL, 10);
             continue;
         }
-        struct stat st;
-        if (stat(argv[i], &st) != 0) {
+        const int r = replay_path(argv[i], &files, replay_one);
+        if (r < 0) {
             fprintf(stderr, "fuzz_proto_replay: no such path %s\n", argv[i]);
             return 1;
         }
-        if (S_ISDIR(st.st_mode)) {
-            DIR *dir = opendir(argv[i]);
-            CHECK(dir != NULL);
-            struct dirent *e;
-            while ((e = readdir(dir)) != NULL) {
-                if (e->d_name[0] == '.') {
-                    continue;
-                }
-                char path[4096];
-                snprintf(path, sizeof path, "%s/%s", argv[i], e->d_name);
-                bad |= run_file(path, fnv(0, (const uint8_t *)e->d_name, strlen(e->d_name)));
-                files++;
-            }
-            closedir(dir);
-        } else {
-            bad |= run_file(argv[i], files);
-            files++;
-        }
+        bad |= r;
     }
     if (files == 0) {
         fprintf(stderr, "usage: fuzz_proto_replay [--mutations N] <file|dir>...\n");

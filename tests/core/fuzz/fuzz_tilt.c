@@ -22,9 +22,9 @@
 //           COARSE, bits 4-5 also the elongation (-20..40 mm), bits 6-7 the radius (50 mm;
 //           both set: the target's own alpha AMBIGUOUS).
 // A pole is seen from the moving vehicle on the azimuth of its bearing with the in-plane
-// inclination and r1 / r2 of the model (as tests/core/test_tiltobs.c draws them), then the
-// bytes perturb it: so the fuzzer reaches FITTED and AMBIGUOUS fits, outlier drops and the
-// fold as well as nonsense.
+// inclination and r1 / r2 of the model (tests/support/tilt_model.h, as test_tiltobs.c
+// draws them), then the bytes perturb it: so the fuzzer reaches FITTED and AMBIGUOUS fits,
+// outlier drops and the fold as well as nonsense.
 //
 // Invariants after every rotation: every ring's count <= its capacity, head < capacity, a
 // free ring empty, `pending` = the rings with `fresh` set, a ring's drops within its bound;
@@ -47,6 +47,8 @@
 
 #include "shadowlean/sl_board.h"
 #include "shadowlean/sl_tiltobs.h"
+
+#include "../../support/tilt_model.h"
 
 extern const sl_board_t sl_board_paper_sim;
 extern const sl_board_t sl_board_robotcar_leaf;
@@ -76,10 +78,6 @@ static uint8_t u8(reader_t *r)
 
 static int8_t i8(reader_t *r) { return (int8_t)u8(r); }
 
-static const double PI = 3.14159265358979323846;
-static double rad(double d) { return d * PI / 180.0; }
-static double deg(double x) { return x * 180.0 / PI; }
-
 typedef struct pole {
     double bx, by, psi, phi; // base (odometry frame, m), tilt and direction (deg)
 } pole_t;
@@ -90,36 +88,18 @@ static bool see(const sl_board_t *b, double rx, double ry, double yaw, const pol
                 sl_target_t *g)
 {
     const double H = b->radar_height_um * 1e-6;
-    const double tt = tan(rad(p->psi));
-    const double tx = tt * cos(rad(p->phi)), ty = tt * sin(rad(p->phi));
+    const double tt = tan(sl_tm_rad(p->psi));
+    const double tx = tt * cos(sl_tm_rad(p->phi)), ty = tt * sin(sl_tm_rad(p->phi));
     const double qx = p->bx + H * tx, qy = p->by + H * ty;
     const double d0 = hypot(qx - rx, qy - ry);
     if (d0 < 0.5 || d0 > 60.0) {
         return false;
     }
-    const double cw = -(deg(atan2(qy - ry, qx - rx)) - deg(yaw)) - b->radar_yaw_cdeg / 100.0;
+    const double cw =
+        -(sl_tm_deg(atan2(qy - ry, qx - rx)) - sl_tm_deg(yaw)) - b->radar_yaw_cdeg / 100.0;
     const double rel = fmod(fmod(cw, 360.0) + 720.0, 360.0);
     const int az = (int)floor(rel / (360.0 / b->azimuths) + 0.5) % b->azimuths;
-    const double theta = b->geom[az].theta_bam32 * 360.0 / 4294967296.0;
-    const double beta = (double)(int32_t)b->geom[az].beta_bam32 * 360.0 / 4294967296.0;
-    const double a_true = atan2(qy - ry, qx - rx);
-    const double alpha = deg(atan(-(tx * cos(a_true) + ty * sin(a_true))));
-    const double foot = d0 * cos(rad(alpha));
-    const double r1 = (alpha >= beta) ? foot / cos(rad(beta - alpha)) : foot;
-    const double fold = (beta - theta) / 2.0;
-    const double read = (alpha < fold) ? beta - theta - alpha : alpha;
-    const double rho = (read >= beta) ? cos(rad(read - beta)) / cos(rad(read + theta))
-                                      : 1.0 / cos(rad(read + theta));
-    memset(g, 0, sizeof *g);
-    g->az = (uint16_t)az;
-    g->az_first = (uint16_t)az;
-    g->az_count = 1U;
-    g->r1_um = (uint32_t)llround(r1 * 1e6);
-    g->r2_um = (uint32_t)llround(r1 * rho * 1e6);
-    g->alpha_cdeg = (int32_t)llround(read * 100.0);
-    g->sigma_cdeg = 50U;
-    g->incline_flag = (uint8_t)SL_INCLINE_VALID;
-    g->incline_branch = (uint8_t)((read >= beta) ? SL_INCLINE_BRANCH_1 : SL_INCLINE_BRANCH_2);
+    sl_tm_target(b, az, d0, atan2(qy - ry, qx - rx), tx, ty, g);
     return true;
 }
 
@@ -194,10 +174,10 @@ static void run_one(const uint8_t *data, size_t size)
         const uint32_t dt_us = (uint32_t)u8(&rd) * 4000U;              // 0..1.02 s
         sl_tiltobs_advance(&o, moving, speed_mm_s, yaw_cdeg_s, dt_us);
         const double dt = dt_us * 1e-6;
-        const double ym = yaw + rad(yaw_cdeg_s / 100.0) * dt / 2.0;
+        const double ym = yaw + sl_tm_rad(yaw_cdeg_s / 100.0) * dt / 2.0;
         x += speed_mm_s * 1e-3 * dt * cos(ym);
         y += speed_mm_s * 1e-3 * dt * sin(ym);
-        yaw += rad(yaw_cdeg_s / 100.0) * dt;
+        yaw += sl_tm_rad(yaw_cdeg_s / 100.0) * dt;
         sl_target_t g[4];
         uint32_t ng = 0U;
         for (uint32_t i = 0; i < (uint32_t)SL_CFG_MAX_TARGETS; i++) {
@@ -279,13 +259,14 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     return 0;
 }
 #else
-#include <dirent.h>
-#include <sys/stat.h>
+#include "replay_files.h"
 
 static unsigned long g_inputs;
 
-static int run_file(const char *path)
+static int run_file(const char *path, const char *name, unsigned long index)
 {
+    (void)name;
+    (void)index;
     FILE *f = fopen(path, "rb");
     if (f == NULL) {
         fprintf(stderr, "fuzz_tilt_replay: cannot open %s\n", path);
@@ -369,29 +350,12 @@ int main(int argc, char **argv)
             g_write_dir = argv[++i];
             continue;
         }
-        struct stat st;
-        if (stat(argv[i], &st) != 0) {
+        const int r = replay_path(argv[i], &files, run_file);
+        if (r < 0) {
             fprintf(stderr, "fuzz_tilt_replay: no such path %s\n", argv[i]);
             return 1;
         }
-        if (S_ISDIR(st.st_mode)) {
-            DIR *dir = opendir(argv[i]);
-            CHECK(dir != NULL);
-            struct dirent *e;
-            while ((e = readdir(dir)) != NULL) {
-                if (e->d_name[0] == '.') {
-                    continue;
-                }
-                char path[4096];
-                snprintf(path, sizeof path, "%s/%s", argv[i], e->d_name);
-                bad |= run_file(path);
-                files++;
-            }
-            closedir(dir);
-        } else {
-            bad |= run_file(argv[i]);
-            files++;
-        }
+        bad |= r;
     }
     if (files == 0 && random_n == 0) {
         fprintf(stderr, "usage: fuzz_tilt_replay [--random N [--write DIR]] [file|dir]...\n");
