@@ -383,16 +383,13 @@ static SL_NOINLINE uint32_t drop_unconfirmed(sl_tiltobs_ring_t *r)
     return n;
 }
 
-// In a FITTED fit, the worst observation (its squared residual in sigmas `z2_q8`) is a gross
-// outlier: z^2 > SL_TILTOBS_GROSS_Z2 x s^2, s^2 = max(1, (chi2 - z^2) / (dof - 1)) the
-// chi-square scale of the other observations (dof = n - 2, n >= SL_TILTOBS_OUTLIER_MIN_N).
-// Not in an AMBIGUOUS one: there the worst residual under the better reading may be the very
-// observation that tells the two readings apart. O(1).
+// In a FITTED fit (the caller's test), the worst observation (its squared residual in
+// sigmas `z2_q8`) is a gross outlier: z^2 > SL_TILTOBS_GROSS_Z2 x s^2, s^2 = max(1, (chi2 -
+// z^2) / (dof - 1)) the chi-square scale of the other observations (dof = n - 2, n >=
+// SL_TILTOBS_OUTLIER_MIN_N). Not in an AMBIGUOUS one: there the worst residual under the
+// better reading may be the very observation that tells the two readings apart. O(1).
 static SL_NOINLINE bool gross(const sl_tiltobs_ring_t *r, uint32_t z2_q8)
 {
-    if (r->res.quality != (uint8_t)SL_TILT_FITTED) {
-        return false;
-    }
     const uint32_t chi2_q8 = r->res.chi2_q8;
     const uint32_t rest_q8 = chi2_q8 > z2_q8 ? chi2_q8 - z2_q8 : 0U;
     uint32_t s2_q8 = rest_q8 / ((uint32_t)r->count - 3U);
@@ -443,11 +440,13 @@ void sl_tiltobs_fit_pending(sl_tiltobs_t *o)
         // without room for it the ring stays fresh and starts the next call. After a drop
         // from a FITTED fit the ring stays fresh: the next call looks for another.
         bool again = false;
-        if (SL_CFG_TILT_FITS_PER_ROTATION >= 2 && r->count >= SL_TILTOBS_OUTLIER_MIN_N &&
+        const bool incons = r->res.quality == (uint8_t)SL_TILT_INCONSISTENT;
+        if (SL_CFG_TILT_FITS_PER_ROTATION >= 2 &&
+            (incons || r->res.quality == (uint8_t)SL_TILT_FITTED) &&
+            r->count >= SL_TILTOBS_OUTLIER_MIN_N &&
             (uint32_t)r->dropped + 1U <= (uint32_t)r->count / SL_TILTOBS_OUTLIER_DIV) {
             uint32_t z2_q8;
             const uint32_t w = worst_obs(r, &z2_q8);
-            const bool incons = r->res.quality == (uint8_t)SL_TILT_INCONSISTENT;
             if (incons || gross(r, z2_q8)) {
                 if (done >= (uint32_t)SL_CFG_TILT_FITS_PER_ROTATION) {
                     o->rr = (uint8_t)idx;
