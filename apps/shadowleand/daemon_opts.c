@@ -164,6 +164,15 @@ static int apply(sld_opts_t *o, const char *section, const char *key, const char
             BAD("expected 0 (none) or 2 .. 7 bins");
         }
         o->front_bins = (uint8_t)v;
+    } else if (IS("daemon", "r2_offset_mm")) {
+        // sl_profile_cfg_t.prior_r2_offset_um: -100 .. +100 mm (0 = none)
+        char *end = NULL;
+        errno = 0;
+        const double v = strtod(val, &end);
+        if (errno != 0 || end == val || *end != '\0' || !(v >= -100.0 && v <= 100.0)) {
+            BAD("expected -100 .. +100 mm (0 = none)");
+        }
+        o->r2_offset_um = (int32_t)lround(v * 1000.0);
     } else if (IS("daemon", "stats_every")) {
         if (parse_seconds_ms(val, &o->stats_every_ms) != 0) BAD("expected seconds >= 0");
     } else if (IS("daemon", "status_period_ms")) {
@@ -371,6 +380,7 @@ static const cli_opt_t k_cli[] = {
     {"--stats-every", "daemon", "stats_every", 1, NULL},
     {"--tail-slope", "daemon", "tail_slope", 1, NULL},
     {"--front-bins", "daemon", "front_bins", 1, NULL},
+    {"--r2-offset", "daemon", "r2_offset_mm", 1, NULL},
     {"--status-period-ms", "daemon", "status_period_ms", 1, NULL},
     {"--duration", "daemon", "duration", 1, NULL},
     {"--exit-idle", "daemon", "exit_idle", 1, NULL},
@@ -443,6 +453,9 @@ void sld_opts_usage(void *fpv)
         "  --front-bins N           [daemon] front_bins       the radar's smear front part, bins, as an earlier run\n"
         "                                                     logged it (\"smear front part\"): used until the stream\n"
         "                                                     has learned its own (0 = none, default; 2..7)\n"
+        "  --r2-offset MM           [daemon] r2_offset_mm     the walk-end offset of r2 an earlier run learned on\n"
+        "                                                     upright poles (\"walk-end offset\"): used until the\n"
+        "                                                     stream has learned its own (0 = none, default)\n"
         "  --status-period-ms N     [daemon] status_period_ms Status frame period without data (1000)\n"
         "  --duration S             [daemon] duration         stop after S seconds (0 = never)\n"
         "  --exit-idle S            [daemon] exit_idle        radar: stop after S s without FFT data (once data came)\n"
@@ -625,6 +638,9 @@ void sld_opts_print(const sld_opts_t *o, void *fpv)
     }
     if (o->front_bins != 0U) {
         fprintf(fp, "front_bins = %u\n", (unsigned)o->front_bins);
+    }
+    if (o->r2_offset_um != 0) {
+        fprintf(fp, "r2_offset_mm = %.3f\n", (double)o->r2_offset_um / 1000.0);
     }
     fprintf(fp, "\n[input]\n");
     if (o->radar_host[0] != '\0') {

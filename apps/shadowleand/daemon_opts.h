@@ -85,6 +85,9 @@ typedef struct sld_opts {
     uint8_t front_bins;                ///< --front-bins N: the sensor's smear front part, bins,
                                        ///< saved from an earlier run (0 = none; 2..7)
                                        ///< [daemon] front_bins
+    int32_t r2_offset_um;              ///< --r2-offset MM: the walk-end offset of r2 learned
+                                       ///< on upright poles by an earlier run, um (0 = none;
+                                       ///< |mm| <= 100) [daemon] r2_offset_mm
 } sld_opts_t;
 
 /// Defaults: verbosity info, port 6317, timeouts as listed, everything else empty/off.

@@ -779,6 +779,14 @@ static void log_stats(daemon_t *d, int level, const char *what)
                 " targets", what, (unsigned)g_pipe.prof.front_bins, ln[0], ln[1], ln[2], ln[3],
                 ln[4], ln[5], ln[6], ln[7], g_pipe.prof.stats.front_skipped);
     }
+    if (g_pipe.prof.r2_offset_um != 0 || g_pipe.prof.stats.resid_samples != 0U) {
+        // what --r2-offset takes on the next start
+        sld_log(SLD_LOG_INFO, "%s: walk-end offset of r2 %+.3f mm (%s; %" PRIu32
+                " upright residuals counted)", what, g_pipe.prof.r2_offset_um / 1000.0,
+                g_pipe.prof.stats.resid_samples >= SL_PROFILE_RESID_MIN ? "learned on upright poles"
+                                                                       : "--r2-offset, not enough of its own yet",
+                g_pipe.prof.stats.resid_samples);
+    }
     const sl_drift_t *dw = &g_pipe.drift;
     sld_log(SLD_LOG_INFO, "%s: theta drift watch: %s %+.2f deg%s; samples %" PRIu32 ", no ground %" PRIu32
             ", occupied %" PRIu32 ", outliers %" PRIu32, what, dw->valid ? "estimate" : "no estimate",
@@ -1039,6 +1047,7 @@ int main(int argc, char **argv)
     d->pcfg.port.ctx = d;
     d->pcfg.profile_cfg.prior_slope_q8 = d->o.tail_slope_q8; // --tail-slope (0: none)
     d->pcfg.profile_cfg.prior_front_bins = d->o.front_bins;  // --front-bins (0: none)
+    d->pcfg.profile_cfg.prior_r2_offset_um = d->o.r2_offset_um; // --r2-offset (0: none)
     if (sl_pipeline_init(&g_pipe, d->board, &d->pcfg) != SL_OK) {
         sld_log(SLD_LOG_ERR, "pipeline for board %s: %s", d->board->name,
                 g_pipe.last_err_msg != NULL ? g_pipe.last_err_msg : "init failed");

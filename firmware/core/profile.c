@@ -30,6 +30,7 @@ void sl_profile_cfg_default(sl_profile_cfg_t *cfg)
     cfg->min_frames = 2U;
     cfg->prior_slope_q8 = 0U;
     cfg->prior_front_bins = 0U;
+    cfg->prior_r2_offset_um = 0;
 }
 
 sl_err_t sl_profile_init(sl_profile_t *pr, uint16_t azimuths, uint16_t near_bins,
@@ -47,7 +48,9 @@ sl_err_t sl_profile_init(sl_profile_t *pr, uint16_t azimuths, uint16_t near_bins
     if (c.max_frames < 2U || c.max_frames > 257U ||
         (c.prior_slope_q8 != 0U &&
          (c.prior_slope_q8 < SLOPE_MIN_Q8 || c.prior_slope_q8 > SLOPE_MAX_Q8)) ||
-        c.prior_front_bins == 1U || c.prior_front_bins >= SL_PROFILE_LEAD_HIST) {
+        c.prior_front_bins == 1U || c.prior_front_bins >= SL_PROFILE_LEAD_HIST ||
+        c.prior_r2_offset_um > SL_PROFILE_R2_OFFSET_MAX_UM ||
+        c.prior_r2_offset_um < -SL_PROFILE_R2_OFFSET_MAX_UM) {
         return SL_ERR_ARG;
     }
     memset(pr, 0, sizeof *pr);
@@ -57,6 +60,7 @@ sl_err_t sl_profile_init(sl_profile_t *pr, uint16_t azimuths, uint16_t near_bins
     memset(pr->slot_of, SL_PROFILE_NONE, sizeof pr->slot_of);
     pr->slope_q8 = c.prior_slope_q8; // cal_n 0: the first self-fit replaces it
     pr->front_bins = c.prior_front_bins; // until SL_PROFILE_LEAD_MIN rises of its own
+    pr->r2_offset_um = c.prior_r2_offset_um; // until SL_PROFILE_RESID_MIN samples of its own
     return SL_OK;
 }
 
@@ -664,6 +668,52 @@ static void learn_front(sl_profile_t *pr, uint32_t rise)
     }
 }
 
+// One walked return's residual r2 - r1 / cos(theta) (`r2_um` before the walk-end offset;
+// "Online calibration" in sl_profile.h): within one bin `b` either way (an upright pole) it
+// is counted, the counts halved at SL_PROFILE_RESID_KEEP, and from SL_PROFILE_RESID_MIN
+// samples on r2_offset_um = minus their mean.
+static SL_NOINLINE void learn_resid(sl_profile_t *pr, uint32_t r1_um, uint32_t r2_um,
+                                    const sl_incline_geom_t *g, uint32_t b)
+{
+    if (g->cos_theta_q30 <= 0 || b == 0U || b > (1UL << 20)) { // bins up to 1 m: 32-bit mean
+        return;
+    }
+    const uint64_t up = (((uint64_t)r1_um << 30) + ((uint32_t)g->cos_theta_q30 >> 1)) /
+                        (uint32_t)g->cos_theta_q30;
+    const int64_t res = (int64_t)r2_um - (int64_t)up;
+    if (res < -(int64_t)b || res >= (int64_t)b) {
+        return; // not near upright
+    }
+    const uint32_t cell = (uint32_t)(res + (int64_t)b) * (SL_PROFILE_RESID_CELLS / 2U) / b;
+    pr->resid_n[cell]++;
+    pr->stats.resid_samples++;
+    uint32_t total = 0U;
+    for (uint32_t k = 0; k < SL_PROFILE_RESID_CELLS; k++) {
+        total += pr->resid_n[k];
+    }
+    if (total >= SL_PROFILE_RESID_KEEP) {
+        total = 0U;
+        for (uint32_t k = 0; k < SL_PROFILE_RESID_CELLS; k++) {
+            pr->resid_n[k] = (uint8_t)(pr->resid_n[k] >> 1);
+            total += pr->resid_n[k];
+        }
+    }
+    if (total < SL_PROFILE_RESID_MIN) {
+        return;
+    }
+    // Their mean, from the cells' centres x_c = c + 1/2: residual = b (x / 8 - 1) = b (sum
+    // n_c (2c + 1) - 16 total) / (16 total). The mean, not the median: a walk's end is
+    // bimodal (the pole's last own bin, or the one before it), and what reads the bounds
+    // averages them (the tracker's fusion, the 3D fit's least squares), so it is the mean
+    // residual that biases what reaches the bus. (The numerator is within 16 total b: 32 bits.)
+    int32_t k = 0;
+    for (uint32_t c = 0; c < SL_PROFILE_RESID_CELLS; c++) {
+        k += (int32_t)pr->resid_n[c] * (int32_t)(2U * c + 1U);
+    }
+    k -= (int32_t)(SL_PROFILE_RESID_CELLS * total);
+    pr->r2_offset_um = -(k * (int32_t)b) / ((int32_t)SL_PROFILE_RESID_CELLS * (int32_t)total);
+}
+
 // The first bin (absolute) of slot `si`'s row at or above the threshold, searched from
 // absolute bin `a1` - 3 over FIT_BINS + 3 bins; UINT32_MAX when there is none.
 static uint32_t row_first(const sl_profile_t *pr, uint32_t si, uint32_t a1, uint32_t threshold)
@@ -1149,6 +1199,16 @@ uint8_t sl_profile_refine(sl_profile_t *pr, const sl_board_t *board, uint32_t th
     const int64_t r2_term = (int64_t)t->r2_um - (r2_hb_mask - (int64_t)t->elong_um);
     const int64_t r1_hb = (int64_t)(((2U * i1 + 1U) * b + 1U) / 2U);
     int64_t r2_hb = (int64_t)(((2U * i2 + 1U) * b + 1U) / 2U);
+    // The walk's end over rotations summed moved by what the stream's upright poles say it
+    // misses ("Online calibration"; within a bin either way); not one rotation's rows
+    // (moving), not a walk that took every bin after the first for tail (no end of the pole
+    // found: r2 = r1, INVALID, as before).
+    int32_t r2_off = 0;
+    if (!spatial && pb.slope_src != SL_PROFILE_SLOPE_CLIFF && pb.i2 > pb.i1) {
+        const int32_t bb = (int32_t)b;
+        r2_off = pr->r2_offset_um > bb ? bb : (pr->r2_offset_um < -bb ? -bb : pr->r2_offset_um);
+        r2_hb += r2_off;
+    }
     if (pb.slope_src == SL_PROFILE_SLOPE_CLIFF && pb.i2 > pb.i1) {
         // Sub-bin far edge (see sl_profile_fill_q16): the last own bin's lit fraction from
         // its power against the own bin before it.
@@ -1260,6 +1320,14 @@ uint8_t sl_profile_refine(sl_profile_t *pr, const sl_board_t *board, uint32_t th
                     pr->stats.ramps++;
                 }
             }
+        }
+        // An upright pole's residual ("Online calibration"): a walk's end over rotations
+        // summed, both bounds this return's own (not SLANT), no ramp at either; once per slot.
+        if (!spatial && !slant && pb.slope_src != SL_PROFILE_SLOPE_CLIFF &&
+            (t->flags & SL_TARGET_RAMP) == 0U && pr->slot[si].resid_seen == 0U) {
+            pr->slot[si].resid_seen = 1U;
+            learn_resid(pr, t->r1_um, (uint32_t)((int64_t)t->r2_um - r2_off),
+                        &board->geom[t->az], (uint32_t)b);
         }
         t->alpha_cdeg = res.alpha_cdeg;
         t->sigma_cdeg = res.sigma_cdeg;

@@ -32,7 +32,7 @@ void usage(FILE *out)
                  "  sl-eval realistic [--quick] [--json] [--json-out FILE] [--positions N] [--reps N] [--frames N]\n"
                  "                   [--calib N] [--range-bins N] [--threads N] [--extract bbox|pipeline|both]\n"
                  "                   [--pipe-last N] [--smear-decay DB] [--speckle-per-frame] [--no-profile]\n"
-                 "                   [--hard] [--hard-set NAME=VALUE]... [--power-scale]\n"
+                 "                   [--cold] [--hard] [--hard-set NAME=VALUE]... [--power-scale]\n"
                  "      Smear, speckle, noise floor, leakage, measured emission, n-frame\n"
                  "      segmentation, poles at 2.2-2.6 m: beside the paper's Table II.\n"
                  "      --extract pipeline|both: also the core pipeline (board paper-bench, speed 0, the\n"
@@ -40,7 +40,9 @@ void usage(FILE *out)
                  "      --smear-decay DB: exponential smear decay per bin (default 3.3); --speckle-per-frame:\n"
                  "      speckle drawn anew every frame (default frozen); --no-profile: the pipeline's mask\n"
                  "      bounds with the board's d(r) instead of the range-profile bounds; --frames N is\n"
-                 "      also the pipeline's window n.\n"
+                 "      also the pipeline's window n. The pipeline first runs the --calib N vertical\n"
+                 "      calibration poles (own seeds) as one radar's stream; the walk-end offset of r2 its\n"
+                 "      range profile learns there is every measurement's prior (--cold: none).\n"
                  "      --power-scale: rendered on the CTS350-X's value scale (0.5 dB per value, the noise\n"
                  "      exponential in power; output.log_quantity = power) with the effects' dB halved, so\n"
                  "      their values per bin are the same (also sl-eval driveby --realistic --power-scale).\n"
@@ -215,6 +217,8 @@ int cmd_realistic(int argc, char **argv)
             o.power_scale = true;
         } else if (a == "--no-profile") {
             o.pipe_profile = false;
+        } else if (a == "--cold") {
+            o.cold = true;
         } else if (a == "--pipe-last" && i + 1 < argc) {
             { const int n = std::atoi(argv[++i]); o.pipe_last = n > 0 ? n : 1; }
         } else if (a == "--extract" && i + 1 < argc) {

@@ -465,6 +465,7 @@ PipelineEval::PipelineEval(const PipeCfg &c) : m_(new Impl)
     if (c.profile >= 0) {
         pc.profile = c.profile != 0;
     }
+    pc.profile_cfg.prior_r2_offset_um = c.prior_r2_offset_um;
     const sl_err_t e = sl_pipeline_init(m_->p.get(), b, &pc);
     if (e != SL_OK) {
         const std::string msg = m_->p->last_err_msg != nullptr ? m_->p->last_err_msg : "?";
@@ -474,6 +475,19 @@ PipelineEval::PipelineEval(const PipeCfg &c) : m_(new Impl)
 }
 
 PipelineEval::~PipelineEval() { delete m_; }
+
+void PipelineEval::carry_walk_calibration(const PipelineEval &from)
+{
+    const sl_profile_t &f = from.m_->p->prof;
+    sl_profile_t &t = m_->p->prof;
+    std::memcpy(t.resid_n, f.resid_n, sizeof t.resid_n);
+    t.r2_offset_um = f.r2_offset_um;
+    t.stats.resid_samples = f.stats.resid_samples;
+}
+
+int32_t PipelineEval::r2_offset_um() const { return m_->p->prof.r2_offset_um; }
+
+uint32_t PipelineEval::resid_samples() const { return m_->p->prof.stats.resid_samples; }
 
 void PipelineEval::add_truth(const GtRow &g) { m_->truth.push_back(g); }
 
@@ -1537,8 +1551,14 @@ RealisticResult run_realistic(const RealisticOptions &o)
     std::vector<std::pair<double, double>> cal_paper, cal_ours;
     std::vector<Frames> cal_frames;
     std::vector<double> slopes;
-    // pipeline only: no bbox calibration (the core's own elongation table is used)
-    const int nc = o.bbox_table ? std::max(2, o.calib_positions) : 0;
+    // The calibration poles also run through the core pipeline, one after another as one
+    // radar's stream (what its range profile learns of its walk's end on upright poles is
+    // carried from each to the next: sl_profile.h, "Online calibration"); what it learned is
+    // every measurement's prior, as a vehicle that has driven before has it saved
+    // (shadowleand --r2-offset). Not with --cold, nor on the mask's bounds.
+    const bool pipe_cal = o.extract == Extract::Pipeline && o.pipe_profile && !o.cold;
+    std::unique_ptr<PipelineEval> cal_pipe;
+    const int nc = (o.bbox_table || pipe_cal) ? std::max(2, o.calib_positions) : 0;
     int done = 0;
     const int total = nc * 2 + 5 * o.positions * o.reps;
     for (int c = 0; c < nc; c++) {
@@ -1560,7 +1580,23 @@ RealisticResult run_realistic(const RealisticOptions &o)
             if (o.power_scale) {
                 scene_to_power_scale(s);
             }
-            const Frames f = run_frames(s, o.threads, thr);
+            std::unique_ptr<PipelineEval> pipe;
+            std::function<void(int, const uint8_t *, size_t)> on_bytes;
+            if (pipe_cal) {
+                PipeCfg pc = pipe_cfg_for_scene(s);
+                pc.mask_frames = o.frames;
+                pc.profile = 1;
+                pipe.reset(new PipelineEval(pc));
+                if (cal_pipe) {
+                    pipe->carry_walk_calibration(*cal_pipe);
+                }
+                on_bytes = [&pipe](int k, const uint8_t *d, size_t n) { pipe->feed(k, d, n); };
+            }
+            const Frames f = run_frames(s, o.threads, thr, on_bytes);
+            if (pipe) {
+                pipe->finish();
+                cal_pipe = std::move(pipe);
+            }
             done++;
             if (o.progress) {
                 std::fprintf(stderr, "\rsl-eval realistic: run %d/%d (calibration, vertical pole at %.2f m)   ", done, total, dist);
@@ -1657,6 +1693,10 @@ RealisticResult run_realistic(const RealisticOptions &o)
         }
         res.d_resid_m = cnt > 0 ? sum / cnt : 0.0;
     }
+    if (cal_pipe) {
+        res.pipe_resid_samples = cal_pipe->resid_samples();
+        res.pipe_r2_offset_um = res.pipe_resid_samples >= SL_PROFILE_RESID_MIN ? cal_pipe->r2_offset_um() : 0;
+    }
     // 2. inclination experiments
     Proc paper;
     paper.bounds = Proc::Bounds::Raw;
@@ -1689,6 +1729,7 @@ RealisticResult run_realistic(const RealisticOptions &o)
                     PipeCfg pc = pipe_cfg_for_scene(s);
                     pc.mask_frames = o.frames; // the window is the measurement's frames
                     pc.profile = o.pipe_profile ? 1 : 0;
+                    pc.prior_r2_offset_um = res.pipe_r2_offset_um;
                     if (!res.have_pipe) {
                         res.pipe_cfg = pc;
                         res.have_pipe = true;
@@ -1884,6 +1925,13 @@ void print_realistic_pipeline(std::FILE *f, const RealisticResult &r)
         std::fprintf(f, "Rendered on the sensor's value scale (--power-scale: 0.5 dB per value, exponential noise;\n"
                         "the effects' dB halved so their values per bin are the same).\n\n");
     }
+    if (r.pipe_resid_samples != 0U) {
+        std::fprintf(f, "Walk-end offset of r2 learned by the range profile on the calibration poles (upright, own\n"
+                        "seeds): %+.1f mm from %u upright residuals; every measurement starts from it (--cold: none).\n\n",
+                     r.pipe_r2_offset_um / 1000.0, static_cast<unsigned>(r.pipe_resid_samples));
+    } else {
+        std::fprintf(f, "Walk-end offset of r2: none (--cold, or the mask's bounds).\n\n");
+    }
     std::fprintf(f, "%-6s | %-18s | %-33s | %-33s | %-8s | %s\n", "true", "paper mean / std",
                  "core pipeline raw: mean / std", "core pipeline filtered: mean / std", "detected",
                  "rotations with target / checked; targets valid/amb/other; unmatched; n_eff");
@@ -2048,6 +2096,7 @@ std::string realistic_json(const RealisticResult &r)
     if (r.have_pipe) {
         o << ",\n  \"pipeline\": {\"label\": \"" << kPipelineLabel << "\", \"board\": \"" << r.pipe_cfg.board
           << "\", \"beam_deg\": " << jnum(r.pipe_cfg.beam_deg) << ", \"mask_frames\": " << r.pipe_mask_frames
+          << ", \"r2_offset_um\": " << r.pipe_r2_offset_um << ", \"resid_samples\": " << r.pipe_resid_samples
           << ", \"last_rotations\": " << r.pipe_last << ", \"rows\": [\n";
         for (int a = 0; a < 5; a++) {
             const RealisticPipe &p = r.pipe[a];

@@ -164,6 +164,7 @@ struct PipeCfg {
     int assoc_az = 3;           ///< a target is the pole's when |az - truth azimuth| <= this
     bool clip_ambiguous = false; ///< ErrStats: count AMBIGUOUS as the model's bound
     double rotation_hz = 4;     ///< for now_us (the pipeline measures the period itself)
+    int32_t prior_r2_offset_um = 0; ///< cfg.profile_cfg.prior_r2_offset_um (0: none)
 };
 
 /// Pipeline defaults for a simulated scene: its board, the simulated azimuth window as the
@@ -225,6 +226,13 @@ public:
     std::vector<Track> tracks() const;
     /// n_eff per reported rotation.
     std::map<int, int> frames_eff() const;
+    /// What the stream taught the range profile about its walk's end (sl_profile.h, "Online
+    /// calibration"), carried over from `from` as the same radar going on to another scene:
+    /// the residual histogram and the offset it gives.
+    void carry_walk_calibration(const PipelineEval &from);
+    /// The range profile's walk-end offset of r2 (um) and the upright residuals it counted.
+    int32_t r2_offset_um() const;
+    uint32_t resid_samples() const;
 
 private:
     struct Impl;
@@ -338,6 +346,8 @@ struct RealisticOptions {
     HardCondition hard_cond;    ///< its parameters (defaults: the documented condition)
     bool power_scale = false;   ///< the sensor's value scale (scene_to_power_scale; sl-eval
                                 ///< realistic --power-scale)
+    bool cold = false;          ///< pipeline: no calibration pass (the range profile's
+                                ///< walk-end offset starts from nothing in every measurement)
 };
 
 
@@ -377,6 +387,8 @@ struct RealisticResult {
     bool have_pipe = false, bbox_table = true;
     RealisticPipe pipe[5];      ///< core pipeline per true angle (have_pipe)
     PipeCfg pipe_cfg;           ///< the pipeline's configuration (first measurement's)
+    int32_t pipe_r2_offset_um = 0; ///< walk-end offset learned on the calibration poles
+    uint32_t pipe_resid_samples = 0; ///< ... from this many upright residuals (0: cold)
     int pipe_last = 4;
     unsigned pipe_mask_frames = 0; ///< board n (paper-bench)
     bool hard = false;          ///< the harder condition was run

@@ -295,7 +295,38 @@
 /// detection's tail bound (sl_detect_set_tail_slope: the shadow edge, the own extent of a
 /// pole leaning across the beam). It starts at `cfg.prior_slope_q8` when the application
 /// saved one (a fresh start otherwise waits for the first upright target's self-fit).
-/// Not done: residual r1/r2 offsets from upright poles (EXTRACTION.md D3): see the report.
+///
+/// `r2_offset_um`: the walk's end, corrected from upright poles (round 2, session 21). Where
+/// a walk over a smear tail stops is not where the pole ends: its last, partly lit bins hide
+/// under the smear of its bright ones (r2 short), and what the stream's r1 reads (a pole's
+/// front surface, a front skirt, a partly lit first bin) is not the axis either. Those
+/// errors depend on the sensor's range response and the poles more than on the lean, so the
+/// stream measures them where the truth is known without being told: on upright poles. For
+/// an upright pole r2 = r1 / cos(theta) (the foot of the perpendicular at the radar's height
+/// and the shadow ray); its residual r2 - r1 / cos(theta) is the bounds' error as the
+/// estimator sees it (it reads the ratio r2 / r1). Every target whose r2 ends a walk over
+/// rotations summed (a static scene), not SLANT, without a ramp at a bound, and whose
+/// residual lies within one bin either way is such a sample (one degree of lean moves the
+/// residual by half a bin at 2.4 m, by most of a bin at 4 m, so the gate keeps poles within
+/// one to two degrees of upright; the mean assumes the stream's near-upright poles lean as
+/// often one way as the other), counted in a histogram of 16 cells of an eighth of a bin
+/// over [-1, +1) bin (`resid_n`, halved at SL_PROFILE_RESID_KEEP), once per slot (a static
+/// sum is one return however often it is extracted). From SL_PROFILE_RESID_MIN samples on
+/// (`cfg.prior_r2_offset_um` before) every such walked r2 moves by minus their mean:
+/// `r2_offset_um`, applied within one bin either way (a stream whose near-upright poles all
+/// lean one way by a degree reads them upright; no calibration moves r2 by more than a bin).
+/// The mean, not the median: a walk's end is bimodal (the pole's last own bin or the one
+/// before it), and what reads the bounds averages them (the tracker's fusion, a bench's
+/// mean), so the mean residual is what biases it. Its sigma is unchanged (the walk's two
+/// bins). Not moved: returns that end in a cliff (their edges are the board's range sigma),
+/// a walk that took every bin after the first for tail (r2 = r1, INVALID as before), and
+/// one rotation's rows of neighbouring azimuths (moving): their walk runs on noisier sums
+/// with widened tests, and what they feed, the 3D fit's union extent (max r2 over the
+/// group's azimuths), has a residual of its own which the representative's does not measure
+/// (applied there, the realistic drive-by's observations went from -0.1 to +0.6 deg of bias
+/// on the magnitude scale, from -0.5 to 0 on the sensor's; not done: a residual of the union
+/// extent). `stats.resid_samples`; shadowleand's exit log prints the offset for
+/// `--r2-offset`.
 ///
 /// ## Ownership, memory, cost
 /// Caller-owned `sl_profile_t`, no allocation. RAM: SL_CFG_MAX_AZIMUTHS bytes + slots x
@@ -364,6 +395,16 @@ typedef enum sl_profile_fail {
 /// Samples at which the counts are halved (recent returns count).
 #define SL_PROFILE_LEAD_KEEP 32U
 
+/// Cells of the walk-end residual histogram ("Online calibration"): an eighth of a bin each
+/// over [-1, +1) bin.
+#define SL_PROFILE_RESID_CELLS 16U
+/// Samples from which the stream's own residual replaces cfg.prior_r2_offset_um.
+#define SL_PROFILE_RESID_MIN 8U
+/// Samples at which the residual counts are halved.
+#define SL_PROFILE_RESID_KEEP 64U
+/// Largest |cfg.prior_r2_offset_um| accepted (a larger one is no bin's): 100 mm.
+#define SL_PROFILE_R2_OFFSET_MAX_UM 100000
+
 /// Where the slope of an extraction came from.
 #define SL_PROFILE_SLOPE_FIT 1U ///< self-fitted on this profile
 #define SL_PROFILE_SLOPE_CAL 2U ///< the running calibration (tail too short to fit)
@@ -390,6 +431,11 @@ typedef struct sl_profile_cfg {
                               ///< `front_bins` an earlier run learned ("Front part"), used
                               ///< until the stream has SL_PROFILE_LEAD_MIN samples of its own.
                               ///< 0 or 2..SL_PROFILE_LEAD_HIST - 1.
+    int32_t prior_r2_offset_um; ///< walk-end correction of r2 to start from, um (default
+                                ///< 0: none): the `r2_offset_um` an earlier run learned
+                                ///< ("Online calibration"), used until the stream has
+                                ///< SL_PROFILE_RESID_MIN samples of its own; applied within
+                                ///< one bin either way. |value| <= SL_PROFILE_R2_OFFSET_MAX_UM.
 } sl_profile_cfg_t;
 
 void sl_profile_cfg_default(sl_profile_cfg_t *cfg);
@@ -403,6 +449,7 @@ typedef struct sl_profile_slot {
     uint8_t seen;  ///< an occupied bit in the window this rotation
     uint8_t live;
     uint8_t lead_seen; ///< this slot's rise counted for the front part (once per sum)
+    uint8_t resid_seen; ///< this slot's walk-end residual counted (once per sum)
 } sl_profile_slot_t;
 
 /// Result of one extraction (bins relative to the slot's bin0).
@@ -442,6 +489,7 @@ typedef struct sl_profile_stats {
     uint32_t cut_ends;      ///< cliffs the return falls ever faster into (cut off by a
                             ///< kernel's support or the beam, not ended: "Cut-off returns")
     uint32_t front_skipped; ///< targets whose r1 moved past the stream's front part
+    uint32_t resid_samples; ///< upright-pole residuals counted ("Online calibration")
 } sl_profile_stats_t;
 
 typedef struct sl_profile {
@@ -465,6 +513,10 @@ typedef struct sl_profile {
     uint8_t front_news;     ///< set when the front became known (the bounds before it
                             ///< are suspect); the pipeline clears it
     uint8_t lead_n[SL_PROFILE_LEAD_HIST]; ///< rises of branch-2 returns by length ("Front part")
+    uint8_t resid_n[SL_PROFILE_RESID_CELLS]; ///< walk-end residuals of upright poles by cell
+                                             ///< ("Online calibration")
+    int32_t r2_offset_um;   ///< added to every walked r2 ("Online calibration"; the prior
+                            ///< until SL_PROFILE_RESID_MIN samples, then the stream's own)
     uint8_t slot_of[SL_CFG_MAX_AZIMUTHS]; ///< slot index per azimuth, SL_PROFILE_NONE
     sl_profile_slot_t slot[SL_CFG_PROFILE_SLOTS];
     uint16_t scratch[SL_CFG_PROFILE_BINS]; ///< neighbours' rows summed (sl_profile_refine)
@@ -473,7 +525,8 @@ typedef struct sl_profile {
 
 /// Initialise (no slot in use). `cfg` NULL = defaults. @return SL_ERR_ARG for NULL `pr`,
 /// azimuths 0 or > SL_CFG_MAX_AZIMUTHS, max_frames outside 2..257, a prior_slope_q8 other
-/// than 0 outside 128..6144, a prior_front_bins of 1 or SL_PROFILE_LEAD_HIST and more.
+/// than 0 outside 128..6144, a prior_front_bins of 1 or SL_PROFILE_LEAD_HIST and more, a
+/// |prior_r2_offset_um| above SL_PROFILE_R2_OFFSET_MAX_UM.
 sl_err_t sl_profile_init(sl_profile_t *pr, uint16_t azimuths, uint16_t near_bins,
                          const sl_profile_cfg_t *cfg);
 
@@ -594,13 +647,16 @@ sl_profile_bounds_t sl_profile_extract_noisy(const uint16_t *sum, uint32_t n, ui
 
 /// Refine a detected target with the profile of its azimuth (while moving: this rotation's
 /// rows of it and its neighbours, see "While moving"): r1 from the leading edge, r2
-/// from the last own bin (half-bin centres, r2 sub-bin when the return ends in a cliff (6.), the target's radius terms kept, no d(r)), alpha
+/// from the last own bin (half-bin centres, r2 sub-bin when the return ends in a cliff (6.),
+/// a walk's end over summed rotations moved by `r2_offset_um` ("Online calibration"), the
+/// target's radius terms kept, no d(r)), alpha
 /// re-estimated; flag SL_TARGET_PROFILE, `elong_um` = the smear removed (mask r2 centre -
 /// profile r2 centre). A pole leaning across the beam (SL_TARGET_SLANT, sl_detect.h stage
 /// 4): its azimuth's run is the pole's lowest piece [bin_last - occupied + 1, bin_last], the
 /// leading edge searched from there, and only r2 is replaced (r1, the union's first bin,
 /// lies on other azimuths). Without a usable profile the target is left as it is (counted
-/// by reason). Updates the slope calibration. @return the extraction's sl_profile_fail_t.
+/// by reason). Updates the slope and walk-end calibrations. @return the extraction's
+/// sl_profile_fail_t.
 uint8_t sl_profile_refine(sl_profile_t *pr, const sl_board_t *board, uint32_t threshold,
                           sl_target_t *t);
 

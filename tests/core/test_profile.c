@@ -1453,6 +1453,126 @@ static void test_profile_a_front_part_is_learned_on_leaning_away_returns(void **
     assert_true(abs(t.alpha_cdeg - truth) <= 3 * (int32_t)t.sigma_cdeg);
 }
 
+// ---- Online calibration of the walk's end (sl_profile.h, "Online calibration") ----------
+
+// r2 - r1 / cos(26 deg): an upright pole's residual as the estimator sees it (um).
+static int64_t upright_resid(const sl_target_t *t)
+{
+    return (int64_t)t->r2_um - (int64_t)llround((double)t->r1_um / cos(26.0 * 3.14159265358979323846 / 180.0));
+}
+
+// The walk's end misses a pole's last bins (or not), and the stream's upright poles say by
+// how much: from the 8th upright return on, every walked r2 moves by minus the median of
+// their residuals (r2 - r1 / cos(theta)), and an upright pole then reads upright. Returns of
+// poles leaning by several degrees are outside the one-bin gate and teach nothing; a saved
+// offset applies from the first return; a residual stays within one bin whatever the stream.
+static int cmp_i64(const void *a, const void *b)
+{
+    const int64_t x = *(const int64_t *)a, y = *(const int64_t *)b;
+    return (x > y) - (x < y);
+}
+
+// One static scene (the vehicle parked): the pole of bins [a, b] watched on azimuth 100 for
+// 16 rotations, each row with its own +-1 value of speckle (seeds from `seed`), its sum
+// refined; the slots are freed first (the scene before is gone, what the stream learned is
+// kept). front_rows' rows carry no threshold bits, so the slot is kept however idle.
+static sl_target_t static_drive(int a, int b, uint32_t seed)
+{
+    const sl_board_t board = geom_board();
+    uint16_t first = 0, last = 0;
+    front_rows(99, 101, a, b, 0, 0U, false, &first, &last); // the mask's bounds
+    sl_profile_end_rotation(&pr, true);
+    sl_profile_end_rotation(&pr, false); // parked
+    pr.cfg.max_idle = UINT8_MAX;
+    (void)sl_profile_reserve(&pr, 100, first, 0U);
+    for (uint32_t r = 0; r < 16U; r++) {
+        front_rows(100, 100, a, b, 0, seed + 77U * r, true, &first, &last);
+        sl_profile_end_rotation(&pr, false);
+    }
+    sl_target_t t = mask_target(100, 100, 1, first, last);
+    assert_int_equal(sl_profile_refine(&pr, &board, 40, &t), SL_PROFILE_OK);
+    assert_int_equal(pr.stats.spatial, 0); // summed rotations, not one rotation's rows
+    return t;
+}
+
+// The median residual of `n` (odd, <= 15) static upright scenes (seeds from `seed`).
+static int64_t median_resid(int a, int b, int n, uint32_t seed)
+{
+    int64_t v[15];
+    for (int i = 0; i < n; i++) {
+        const sl_target_t t = static_drive(a, b, seed + 7919U * (uint32_t)i);
+        v[i] = upright_resid(&t);
+    }
+    qsort(v, (size_t)n, sizeof v[0], cmp_i64);
+    return v[n / 2];
+}
+
+// The walk's end over summed rotations misses a pole's last bins, and the stream's upright
+// poles say by how much: from the 8th upright return on, every such walked r2 moves by minus
+// the mean of their residuals (r2 - r1 / cos(theta)), and upright poles then read upright.
+// Returns of poles leaning by several degrees are outside the one-bin gate and teach nothing;
+// one rotation's rows (moving) neither teach nor move; a saved offset applies from the first
+// return; an offset stays within one bin.
+static void test_profile_the_walk_end_is_calibrated_on_upright_poles(void **state)
+{
+    (void)state;
+    sl_profile_cfg_t c;
+    sl_profile_cfg_default(&c);
+    assert_int_equal(c.prior_r2_offset_um, 0);
+    c.prior_r2_offset_um = SL_PROFILE_R2_OFFSET_MAX_UM + 1;
+    assert_int_equal(sl_profile_init(&pr, 400, 0, &c), SL_ERR_ARG);
+    c.prior_r2_offset_um = -SL_PROFILE_R2_OFFSET_MAX_UM - 1;
+    assert_int_equal(sl_profile_init(&pr, 400, 0, &c), SL_ERR_ARG);
+    // an upright pole at 2.63 m: own bins 60..66 (r2 / r1 = 1/cos(26 deg) ends in bin 67,
+    // whose lit third and the bins before it fade under the smear of the brighter ones)
+    assert_int_equal(sl_profile_init(&pr, 400, 0, NULL), SL_OK);
+    sl_target_t t = static_drive(60, 66, 500U);
+    const int64_t res0 = upright_resid(&t);
+    assert_int_equal(pr.r2_offset_um, 0);
+    assert_int_equal(pr.stats.resid_samples, 1);
+    assert_true((t.flags & SL_TARGET_COARSE) != 0U); // a walk's end: two bins
+    // seven more upright scenes: their median reads r2 short
+    const int64_t med0 = median_resid(60, 66, 7, 1U);
+    assert_true(med0 < -10000 && med0 > -43800);
+    // a few more: known from the 8th sample on, and what follows is upright within a
+    // sixteenth of a bin
+    (void)median_resid(60, 66, 5, 100U);
+    assert_true(pr.stats.resid_samples >= SL_PROFILE_RESID_MIN); // a ramp gives no sample
+    assert_true(pr.r2_offset_um > 10000 && pr.r2_offset_um < 43800);
+    const int32_t learned = pr.r2_offset_um;
+    const int64_t med1 = median_resid(60, 66, 9, 200U);
+    assert_true(llabs(med1) <= 43800 / 16);
+    // the same scene as the first: r2 moved by the offset, its sigma still the walk's
+    t = static_drive(60, 66, 500U);
+    assert_true(llabs(upright_resid(&t) - (res0 + pr.r2_offset_um)) <= 1);
+    assert_true((t.flags & SL_TARGET_COARSE) != 0U);
+    // one rotation's rows (moving) are neither a sample nor moved
+    const uint32_t n_before = pr.stats.resid_samples;
+    const sl_target_t tm = front_drive(60, 66, 0, 1);
+    assert_int_equal(pr.stats.resid_samples, n_before);
+    assert_int_equal(sl_profile_init(&pr, 400, 0, NULL), SL_OK);
+    const sl_target_t tm0 = front_drive(60, 66, 0, 1);
+    assert_int_equal(tm.r2_um, tm0.r2_um);
+    // a pole leaning away (bins 100..104 at 4.4 m: -8 deg) lies beyond the gate
+    assert_int_equal(sl_profile_init(&pr, 400, 0, NULL), SL_OK);
+    for (uint32_t i = 0; i < 12U; i++) {
+        t = static_drive(100, 104, 900U + 31U * i);
+    }
+    assert_true(t.alpha_cdeg < -600);
+    assert_int_equal(pr.stats.resid_samples, 0);
+    assert_int_equal(pr.r2_offset_um, 0);
+    // a saved offset applies from the first return
+    sl_profile_cfg_default(&c);
+    c.prior_r2_offset_um = learned;
+    assert_int_equal(sl_profile_init(&pr, 400, 0, &c), SL_OK);
+    t = static_drive(60, 66, 500U);
+    assert_true(llabs(upright_resid(&t) - (res0 + learned)) <= 1);
+    c.prior_r2_offset_um = -SL_PROFILE_R2_OFFSET_MAX_UM; // beyond a bin: applied as one bin
+    assert_int_equal(sl_profile_init(&pr, 400, 0, &c), SL_OK);
+    t = static_drive(60, 66, 500U);
+    assert_true(llabs(upright_resid(&t) - (res0 - 43800)) <= 1);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -1481,6 +1601,7 @@ int main(void)
         cmocka_unit_test(test_profile_ramps_widen_the_sigma_not_the_alpha),
         cmocka_unit_test(test_profile_a_stream_of_cut_off_returns_is_unverified),
         cmocka_unit_test(test_profile_a_front_part_is_learned_on_leaning_away_returns),
+        cmocka_unit_test(test_profile_the_walk_end_is_calibrated_on_upright_poles),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

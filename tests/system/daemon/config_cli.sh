@@ -21,7 +21,7 @@ has "$OUT/example.ini" "stats_every = 60.000"
 
 # 2. command line over config file
 "$D" --config "$CONF" --board paper-sim --input /some/capture.pcap --can vcan1 -v --stats-every 0.5 \
-    --gs-usb 1-1.4 --bitrate 250000 --targets-out t.jsonl --tail-slope 3.27 --front-bins 4 --print-config > "$OUT/over.ini" \
+    --gs-usb 1-1.4 --bitrate 250000 --targets-out t.jsonl --tail-slope 3.27 --front-bins 4 --r2-offset 12.66 --print-config > "$OUT/over.ini" \
     || fail "override rejected"
 has "$OUT/over.ini" "board = paper-sim"
 has "$OUT/over.ini" "capture = /some/capture.pcap"
@@ -35,6 +35,7 @@ has "$OUT/over.ini" "bitrate = 250000"
 has "$OUT/over.ini" "targets = t.jsonl"
 has "$OUT/over.ini" "tail_slope = 3.2695"            # 837 / 256: what the core keeps
 has "$OUT/over.ini" "front_bins = 4"
+has "$OUT/over.ini" "r2_offset_mm = 12.660"
 
 # 3. --print-config reads back to the same settings
 grep -v '^;' "$OUT/over.ini" > "$OUT/rt1.ini"
@@ -74,6 +75,8 @@ rejects "an implausible tail slope" "0.5 .. 24 values per bin" --board paper-sim
 rejects "a tail slope that is not a number" "daemon.tail_slope" --board paper-sim --input x --tail-slope steep
 rejects "a front part of one bin" "2 .. 7 bins" --board paper-sim --input x --front-bins 1
 rejects "a front part too long" "daemon.front_bins" --board paper-sim --input x --front-bins 8
+rejects "a walk-end offset beyond 100 mm" "-100 .. +100 mm" --board paper-sim --input x --r2-offset 150
+rejects "a walk-end offset that is not a number" "daemon.r2_offset_mm" --board paper-sim --input x --r2-offset far
 "$D" --board paper-sim --input x --can can0 --motion 2.5,-3 --print-config > "$OUT/motion.ini" || fail "--motion"
 has "$OUT/motion.ini" "motion = 2.500,-3.00"
 hasnt "$OUT/motion.ini" "motion_interface"
