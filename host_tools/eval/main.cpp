@@ -32,7 +32,7 @@ void usage(FILE *out)
                  "  sl-eval realistic [--quick] [--json] [--json-out FILE] [--positions N] [--reps N] [--frames N]\n"
                  "                   [--calib N] [--range-bins N] [--threads N] [--extract bbox|pipeline|both]\n"
                  "                   [--pipe-last N] [--smear-decay DB] [--speckle-per-frame] [--no-profile]\n"
-                 "                   [--cold] [--hard] [--hard-set NAME=VALUE]... [--power-scale]\n"
+                 "                   [--cold | --r2-offset MM] [--hard] [--hard-set NAME=VALUE]... [--power-scale]\n"
                  "      Smear, speckle, noise floor, leakage, measured emission, n-frame\n"
                  "      segmentation, poles at 2.2-2.6 m: beside the paper's Table II.\n"
                  "      --extract pipeline|both: also the core pipeline (board paper-bench, speed 0, the\n"
@@ -42,7 +42,8 @@ void usage(FILE *out)
                  "      bounds with the board's d(r) instead of the range-profile bounds; --frames N is\n"
                  "      also the pipeline's window n. The pipeline first runs the --calib N vertical\n"
                  "      calibration poles (own seeds) as one radar's stream; the walk-end offset of r2 its\n"
-                 "      range profile learns there is every measurement's prior (--cold: none).\n"
+                 "      range profile learns there is every measurement's prior (--cold: none;\n"
+                 "      --r2-offset MM: this one, as shadowleand --r2-offset, no calibration pass).\n"
                  "      --power-scale: rendered on the CTS350-X's value scale (0.5 dB per value, the noise\n"
                  "      exponential in power; output.log_quantity = power) with the effects' dB halved, so\n"
                  "      their values per bin are the same (also sl-eval driveby --realistic --power-scale).\n"
@@ -219,6 +220,14 @@ int cmd_realistic(int argc, char **argv)
             o.pipe_profile = false;
         } else if (a == "--cold") {
             o.cold = true;
+        } else if (a == "--r2-offset" && i + 1 < argc) {
+            char *end = nullptr;
+            const double mm = std::strtod(argv[++i], &end);
+            if (end == argv[i] || *end != '\0' || !(mm >= -100.0 && mm <= 100.0)) {
+                return sl_cli_bad_value("sl-eval", "--r2-offset", "must be -100 .. +100 mm", usage);
+            }
+            o.have_r2_offset = true;
+            o.r2_offset_um = static_cast<int32_t>(std::lround(mm * 1000.0));
         } else if (a == "--pipe-last" && i + 1 < argc) {
             { const int n = std::atoi(argv[++i]); o.pipe_last = n > 0 ? n : 1; }
         } else if (a == "--extract" && i + 1 < argc) {

@@ -1556,7 +1556,7 @@ RealisticResult run_realistic(const RealisticOptions &o)
     // carried from each to the next: sl_profile.h, "Online calibration"); what it learned is
     // every measurement's prior, as a vehicle that has driven before has it saved
     // (shadowleand --r2-offset). Not with --cold, nor on the mask's bounds.
-    const bool pipe_cal = o.extract == Extract::Pipeline && o.pipe_profile && !o.cold;
+    const bool pipe_cal = o.extract == Extract::Pipeline && o.pipe_profile && !o.cold && !o.have_r2_offset;
     std::unique_ptr<PipelineEval> cal_pipe;
     const int nc = (o.bbox_table || pipe_cal) ? std::max(2, o.calib_positions) : 0;
     int done = 0;
@@ -1696,6 +1696,8 @@ RealisticResult run_realistic(const RealisticOptions &o)
     if (cal_pipe) {
         res.pipe_resid_samples = cal_pipe->resid_samples();
         res.pipe_r2_offset_um = res.pipe_resid_samples >= SL_PROFILE_RESID_MIN ? cal_pipe->r2_offset_um() : 0;
+    } else if (o.have_r2_offset && o.pipe_profile) {
+        res.pipe_r2_offset_um = o.r2_offset_um; // given, as shadowleand --r2-offset
     }
     // 2. inclination experiments
     Proc paper;
@@ -1929,6 +1931,9 @@ void print_realistic_pipeline(std::FILE *f, const RealisticResult &r)
         std::fprintf(f, "Walk-end offset of r2 learned by the range profile on the calibration poles (upright, own\n"
                         "seeds): %+.1f mm from %u upright residuals; every measurement starts from it (--cold: none).\n\n",
                      r.pipe_r2_offset_um / 1000.0, static_cast<unsigned>(r.pipe_resid_samples));
+    } else if (r.pipe_r2_offset_um != 0) {
+        std::fprintf(f, "Walk-end offset of r2: %+.1f mm given (--r2-offset), no calibration pass.\n\n",
+                     r.pipe_r2_offset_um / 1000.0);
     } else {
         std::fprintf(f, "Walk-end offset of r2: none (--cold, or the mask's bounds).\n\n");
     }

@@ -348,6 +348,8 @@ struct RealisticOptions {
                                 ///< realistic --power-scale)
     bool cold = false;          ///< pipeline: no calibration pass (the range profile's
                                 ///< walk-end offset starts from nothing in every measurement)
+    bool have_r2_offset = false; ///< pipeline: no calibration pass, every measurement starts
+    int32_t r2_offset_um = 0;    ///< from this walk-end offset (sl-eval realistic --r2-offset)
 };
 
 
