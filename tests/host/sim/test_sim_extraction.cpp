@@ -31,6 +31,7 @@ extern "C" {
 
 extern "C" {
 #include "shadowlean/sl_board.h"
+#include "shadowlean/sl_profile.h"
 #include "shadowlean/sl_track.h"
 }
 
@@ -96,8 +97,26 @@ static void test_extraction_paper_condition_within_1_deg(void **)
     RealisticOptions o = quick();
     const RealisticResult r = run_realistic(o);
     double e[5];
-    std::printf("smear 3.3 dB/bin, frozen speckle, n = 16:\n");
+    std::printf("smear 3.3 dB/bin, frozen speckle, n = 16 (walk-end offset %+.1f mm from %u upright poles):\n",
+                r.pipe_r2_offset_um / 1000.0, static_cast<unsigned>(r.pipe_resid_samples));
     within(r, e, true, 1.0);
+    // The calibration pass taught the profile its walk's end (sl_profile.h, "Online
+    // calibration": r2 read short on upright poles), and the measurements are nearer the
+    // truth for it than with nothing calibrated.
+    assert_true(r.pipe_resid_samples >= SL_PROFILE_RESID_MIN);
+    assert_true(r.pipe_r2_offset_um > 0 && r.pipe_r2_offset_um < 43800);
+    o.cold = true;
+    const RealisticResult rc = run_realistic(o);
+    double ec[5], sum = 0, sum_cold = 0;
+    std::printf("same, --cold (nothing calibrated):\n");
+    within(rc, ec, false, 1.0);
+    for (int a = 0; a < 5; a++) {
+        sum += std::fabs(e[a]);
+        sum_cold += std::fabs(ec[a]);
+    }
+    std::printf("  average |mean error|: %.2f calibrated, %.2f cold\n", sum / 5, sum_cold / 5);
+    assert_true(sum < sum_cold);
+    o.cold = false;
     // The same captures without the profile: the mask's bounds and the board's d(r).
     o.pipe_profile = false;
     const RealisticResult r0 = run_realistic(o);
