@@ -311,7 +311,9 @@
 /// one to two degrees of upright; the mean assumes the stream's near-upright poles lean as
 /// often one way as the other), counted in a histogram of 16 cells of an eighth of a bin
 /// over [-1, +1) bin (`resid_n`, halved at SL_PROFILE_RESID_KEEP), once per slot (a static
-/// sum is one return however often it is extracted). From SL_PROFILE_RESID_MIN samples on
+/// sum is one return however often it is extracted; a pole whose slot is freed after
+/// `max_idle` rotations without evidence and claimed again counts again, so a parked
+/// vehicle's flickering pole can weigh more than one). From SL_PROFILE_RESID_MIN samples on
 /// (`cfg.prior_r2_offset_um` before) every such walked r2 moves by minus their mean:
 /// `r2_offset_um`, applied within one bin either way (a stream whose near-upright poles all
 /// lean one way by a degree reads them upright; no calibration moves r2 by more than a bin).
