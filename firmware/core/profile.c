@@ -627,24 +627,35 @@ static SL_NOINLINE bool falls_faster_near(const uint16_t *sum, uint32_t k, uint3
     return 2U * near >= 2U * far + frames * h * (n - h);
 }
 
+// One more sample in cell `k` of the histogram `h` (`n` cells of counts); the counts are
+// halved when they reach `keep` in all (recent samples count). @return the count in all.
+static uint32_t hist_count(uint8_t *h, uint32_t n, uint32_t k, uint32_t keep)
+{
+    h[k]++;
+    uint32_t total = 0U;
+    for (uint32_t i = 0; i < n; i++) {
+        total += h[i];
+    }
+    if (total >= keep) {
+        total = 0U;
+        for (uint32_t i = 0; i < n; i++) {
+            h[i] = (uint8_t)(h[i] >> 1);
+            total += h[i];
+        }
+    }
+    return total;
+}
+
 // One branch-2 return's rise into the stream's front part ("Front part" in sl_profile.h):
 // counted, the counts halved at SL_PROFILE_LEAD_KEEP, and the front re-read: known when half
 // of them rise by 3 bins or more, as the smallest rise held by an eighth of them (at least
 // 2); lost when half rise by a bin at most. `front_news` when it becomes known.
 static void learn_front(sl_profile_t *pr, uint32_t rise)
 {
-    pr->lead_n[rise < SL_PROFILE_LEAD_HIST ? rise : SL_PROFILE_LEAD_HIST - 1U]++;
-    uint32_t total = 0U;
-    for (uint32_t k = 0; k < SL_PROFILE_LEAD_HIST; k++) {
-        total += pr->lead_n[k];
-    }
-    if (total >= SL_PROFILE_LEAD_KEEP) {
-        total = 0U;
-        for (uint32_t k = 0; k < SL_PROFILE_LEAD_HIST; k++) {
-            pr->lead_n[k] = (uint8_t)(pr->lead_n[k] >> 1);
-            total += pr->lead_n[k];
-        }
-    }
+    const uint32_t total =
+        hist_count(pr->lead_n, SL_PROFILE_LEAD_HIST,
+                   rise < SL_PROFILE_LEAD_HIST ? rise : SL_PROFILE_LEAD_HIST - 1U,
+                   SL_PROFILE_LEAD_KEEP);
     if (total < SL_PROFILE_LEAD_MIN) {
         return;
     }
@@ -685,19 +696,9 @@ static SL_NOINLINE void learn_resid(sl_profile_t *pr, uint32_t r1_um, uint32_t r
         return; // not near upright
     }
     const uint32_t cell = (uint32_t)(res + (int64_t)b) * (SL_PROFILE_RESID_CELLS / 2U) / b;
-    pr->resid_n[cell]++;
     pr->stats.resid_samples++;
-    uint32_t total = 0U;
-    for (uint32_t k = 0; k < SL_PROFILE_RESID_CELLS; k++) {
-        total += pr->resid_n[k];
-    }
-    if (total >= SL_PROFILE_RESID_KEEP) {
-        total = 0U;
-        for (uint32_t k = 0; k < SL_PROFILE_RESID_CELLS; k++) {
-            pr->resid_n[k] = (uint8_t)(pr->resid_n[k] >> 1);
-            total += pr->resid_n[k];
-        }
-    }
+    const uint32_t total =
+        hist_count(pr->resid_n, SL_PROFILE_RESID_CELLS, cell, SL_PROFILE_RESID_KEEP);
     if (total < SL_PROFILE_RESID_MIN) {
         return;
     }
@@ -1203,8 +1204,9 @@ uint8_t sl_profile_refine(sl_profile_t *pr, const sl_board_t *board, uint32_t th
     // misses ("Online calibration"; within a bin either way); not one rotation's rows
     // (moving), not a walk that took every bin after the first for tail (no end of the pole
     // found: r2 = r1, INVALID, as before).
+    const bool walk_end = !spatial && pb.slope_src != SL_PROFILE_SLOPE_CLIFF;
     int32_t r2_off = 0;
-    if (!spatial && pb.slope_src != SL_PROFILE_SLOPE_CLIFF && pb.i2 > pb.i1) {
+    if (walk_end && pb.i2 > pb.i1) {
         const int32_t bb = (int32_t)b;
         r2_off = pr->r2_offset_um > bb ? bb : (pr->r2_offset_um < -bb ? -bb : pr->r2_offset_um);
         r2_hb += r2_off;
@@ -1323,8 +1325,8 @@ uint8_t sl_profile_refine(sl_profile_t *pr, const sl_board_t *board, uint32_t th
         }
         // An upright pole's residual ("Online calibration"): a walk's end over rotations
         // summed, both bounds this return's own (not SLANT), no ramp at either; once per slot.
-        if (!spatial && !slant && pb.slope_src != SL_PROFILE_SLOPE_CLIFF &&
-            (t->flags & SL_TARGET_RAMP) == 0U && pr->slot[si].resid_seen == 0U) {
+        if (walk_end && !slant && (t->flags & SL_TARGET_RAMP) == 0U &&
+            pr->slot[si].resid_seen == 0U) {
             pr->slot[si].resid_seen = 1U;
             learn_resid(pr, t->r1_um, (uint32_t)((int64_t)t->r2_um - r2_off),
                         &board->geom[t->az], (uint32_t)b);

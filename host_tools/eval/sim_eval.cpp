@@ -1601,8 +1601,8 @@ RealisticResult run_realistic(const RealisticOptions &o)
             if (o.progress) {
                 std::fprintf(stderr, "\rsl-eval realistic: run %d/%d (calibration, vertical pole at %.2f m)   ", done, total, dist);
             }
-            if (!f.have) {
-                continue;
+            if (!f.have || !o.bbox_table) {
+                continue; // pipeline only: no bbox calibration (the pole ran for the pipeline's)
             }
             const BinRun rm = window(f, f.mean, thr);
             const BinRun rc = window(f, f.all, 0.5);
