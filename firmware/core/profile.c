@@ -647,9 +647,9 @@ static uint32_t hist_count(uint8_t *h, uint32_t n, uint32_t k, uint32_t keep)
 }
 
 // One branch-2 return's rise into the stream's front part ("Front part" in sl_profile.h):
-// counted, the counts halved at SL_PROFILE_LEAD_KEEP, and the front re-read: known when half
-// of them rise by 3 bins or more, as the smallest rise held by an eighth of them (at least
-// 2); lost when half rise by a bin at most. `front_news` when it becomes known.
+// counted, the counts halved at SL_PROFILE_LEAD_KEEP, and the front re-read: known when the
+// smallest rise held by an eighth of them is 3 bins or more (7 of 8 rise so far), as that
+// rise; lost when half rise by a bin at most. `front_news` when it becomes known.
 static void learn_front(sl_profile_t *pr, uint32_t rise)
 {
     const uint32_t total =
@@ -668,7 +668,7 @@ static void learn_front(sl_profile_t *pr, uint32_t rise)
         q2 = (q2 == SL_PROFILE_LEAD_HIST && 2U * cum >= total) ? k : q2;
     }
     if (pr->front_bins == 0U) {
-        if (q2 >= 3U && q8 >= 2U) {
+        if (q8 >= 3U) { // (q2 >= q8)
             pr->front_bins = (uint8_t)q8;
             pr->front_news = 1U;
         }

@@ -263,18 +263,20 @@
 /// a bin of its own row (a kernel's front is the same on every row), adds its rise to
 /// `lead_n`, once per slot (a static sum is one return however often it is extracted; while
 /// moving every rotation's rows are new), the counts halved at SL_PROFILE_LEAD_KEEP. From SL_PROFILE_LEAD_MIN samples on (`cfg.prior_front_bins`
-/// before) the front is known when half of them rise by 3 bins or more, as `front_bins` =
-/// the smallest rise held by an eighth of them (at least 2: a low quantile, as a front shows
-/// on every return while noise lengthens only some rises); once known it is lost only when
-/// half rise by a bin at most. Measured on the realistic drive-by (branch-2 rises counted,
-/// median; shadowleand's exit log prints them): 3.3 dB/bin and power-law tails 1-2 on both
-/// value scales, trunks of 10-15 cm radius 1-2, single poles leaning along the path 2 (3 on
-/// the sensor's value scale, where a slow tail's accumulated smear lengthens them: 7 of 24
-/// such passes at 1 m/s learn a 2-bin front by mistake), a 4-bin linear front 4 (none below
-/// 4 in an eighth); a 2-bin front 2, so it is not learned (its rises are those of a pole
-/// without one). A stream taken for one with a front by mistake keeps its truth within its
-/// sigma: r1 then moves by at most half the span its sigma holds (the 7 passes' FITTED fits
-/// all within 2.14 of their sigmas).
+/// before) the front is known when 7 of 8 of them rise by 3 bins or more, as `front_bins` =
+/// the smallest rise held by an eighth of them (a low quantile: a front shows on every
+/// return, while noise and a pole's own geometry lengthen only some rises); once known it is
+/// lost only when half rise by a bin at most. Measured on the realistic drive-by (branch-2
+/// rises counted, median; shadowleand's exit log prints them): 3.3 dB/bin and power-law
+/// tails 1-2 on both value scales, trunks of 10-15 cm radius 1-2, single poles leaning along
+/// the path 2 (3 on the sensor's value scale, where a slow tail's accumulated smear
+/// lengthens them; until session 22 the front was known when HALF rose by 3 bins, and 7 of
+/// 24 such passes at 1 m/s learned a 2-bin front by mistake: their histories cleared
+/// mid-pass, direction errors up to 25 deg; their rises, 1-5 bins, put an eighth at 2), a
+/// 4-bin linear front 4 (none below 4 in an eighth); a 2-bin front 2, so it is not learned
+/// (its rises are those of a pole without one). A stream taken for one with a front by
+/// mistake keeps its truth within its sigma: r1 then moves by at most half the span its
+/// sigma holds.
 /// With a front known, every walked target's r1 (both branches, not SLANT) moves to the
 /// middle of its first min(front_bins, its rise) bins (`stats.front_skipped`), and its
 /// sigma holds the alpha at their ends (uniform: a long own return's accumulated smear and
