@@ -296,30 +296,43 @@ void sl_tiltobs_update(sl_tiltobs_t *o, const sl_track_t *tracks, const sl_targe
     }
 }
 
-// The observation with the largest residual |tan(alpha_k) - pred_k| / sigma_k under the fit
-// `res` (pred = -(t . e_k), the reading the fit chose for mirrored ones) and the square of
-// that residual in sigmas, Q8 (`z2_q8`, saturating). O(n).
+// |tan(alpha_k) - pred_k| of observation k under the fit `res` (pred = -(t . e_k)), Q24
+// (< 2^28): the reading the fit chose for it, or with `other` its other one (the fold's
+// mirror when the fit read it as measured, and the reverse). O(1).
+static SL_NOINLINE int64_t resid_q24(const sl_tiltobs_ring_t *r, uint32_t k, bool other)
+{
+    const sl_tilt_obs_t *ob = &r->obs[k];
+    const bool mir = (k < 32U && ((r->res.mirrored_mask >> k) & 1U) != 0U) != other;
+    const int64_t tan_q24 = (int64_t)(mir ? ob->tan_mirror_q12 : ob->tan_q12) * 4096;
+    const int64_t pred_q24 = -(((int64_t)r->res.tx_q24 * ob->cos_a_q15 +
+                                (int64_t)r->res.ty_q24 * ob->sin_a_q15) >> 15);
+    const int64_t d = tan_q24 - pred_q24;
+    return d < 0 ? -d : d;
+}
+
+// The square of a residual (Q24) in sigmas (Q16), Q8, saturating.
+static uint32_t z2_q8_of(int64_t ad_q24, uint32_t sigma_q16)
+{
+    const uint64_t z_q8 = (uint64_t)ad_q24 / sigma_q16; // < 2^28
+    return (z_q8 >= 0x10000U) ? UINT32_MAX : (uint32_t)((z_q8 * z_q8) >> 8);
+}
+
+// The observation with the largest residual in sigmas under the fit (the reading it chose)
+// and the square of that residual, Q8 (`z2_q8`, saturating). O(n).
 static SL_NOINLINE uint32_t worst_obs(const sl_tiltobs_ring_t *r, uint32_t *z2_q8)
 {
     uint32_t worst = 0;
-    int64_t wr = -1, ws = 1;
+    int64_t wr = 0, ws = 1;
     for (uint32_t k = 0; k < r->count; k++) {
-        const sl_tilt_obs_t *ob = &r->obs[k];
-        const bool mir = k < 32U && ((r->res.mirrored_mask >> k) & 1U) != 0U;
-        const int64_t tan_q24 = (int64_t)(mir ? ob->tan_mirror_q12 : ob->tan_q12) * 4096;
-        const int64_t pred_q24 = -(((int64_t)r->res.tx_q24 * ob->cos_a_q15 +
-                                    (int64_t)r->res.ty_q24 * ob->sin_a_q15) >> 15);
-        const int64_t d = tan_q24 - pred_q24;
-        const int64_t ad = d < 0 ? -d : d;          // < 2^28
-        const int64_t sg = (int64_t)ob->sigma_q16; // >= SL_TILT_SIGMA_MIN_Q16
-        if (ad * ws > wr * sg) {                    // ad / sg > wr / ws
+        const int64_t ad = resid_q24(r, k, false);
+        const int64_t sg = (int64_t)r->obs[k].sigma_q16; // >= SL_TILT_SIGMA_MIN_Q16
+        if (ad * ws > wr * sg) {                          // ad / sg > wr / ws
             worst = k;
             wr = ad;
             ws = sg;
         }
     }
-    const uint32_t z_q8 = (uint32_t)((wr < 0 ? 0 : wr) / ws); // Q24 / Q16 -> Q8, < 2^28
-    *z2_q8 = (z_q8 >= 0x10000U) ? UINT32_MAX : (z_q8 * z_q8) >> 8;
+    *z2_q8 = z2_q8_of(wr, (uint32_t)ws);
     return worst;
 }
 
@@ -383,11 +396,10 @@ static SL_NOINLINE uint32_t drop_unconfirmed(sl_tiltobs_ring_t *r)
     return n;
 }
 
-// In a FITTED fit (the caller's test), the worst observation (its squared residual in
-// sigmas `z2_q8`) is a gross outlier: z^2 > SL_TILTOBS_GROSS_Z2 x s^2, s^2 = max(1, (chi2 -
-// z^2) / (dof - 1)) the chi-square scale of the other observations (dof = n - 2, n >=
-// SL_TILTOBS_OUTLIER_MIN_N). Not in an AMBIGUOUS one: there the worst residual under the
-// better reading may be the very observation that tells the two readings apart. O(1).
+// The worst observation of a fit (its squared residual in sigmas `z2_q8`) is a gross
+// outlier: z^2 > SL_TILTOBS_GROSS_Z2 x s^2, s^2 = max(1, (chi2 - z^2) / (dof - 1)) the
+// chi-square scale of the other observations (dof = n - 2, n >= SL_TILTOBS_OUTLIER_MIN_N).
+// In an AMBIGUOUS fit the caller asks it of both readings (sl_tiltobs.h). O(1).
 static SL_NOINLINE bool gross(const sl_tiltobs_ring_t *r, uint32_t z2_q8)
 {
     const uint32_t chi2_q8 = r->res.chi2_q8;
@@ -397,6 +409,15 @@ static SL_NOINLINE bool gross(const sl_tiltobs_ring_t *r, uint32_t z2_q8)
         s2_q8 = 256U;
     }
     return s2_q8 <= UINT32_MAX / SL_TILTOBS_GROSS_Z2 && z2_q8 > SL_TILTOBS_GROSS_Z2 * s2_q8;
+}
+
+// In an AMBIGUOUS fit: observation k's OTHER reading under the same fit, squared in sigmas
+// (Q8; UINT32_MAX when it has none, not mirrorable), so that an observation gross under
+// both its readings can be told from one whose reading decides between the hypotheses.
+static uint32_t other_reading_z2(const sl_tiltobs_ring_t *r, uint32_t k)
+{
+    return r->obs[k].mirrorable == 0U ? UINT32_MAX
+                                      : z2_q8_of(resid_q24(r, k, true), r->obs[k].sigma_q16);
 }
 
 void sl_tiltobs_fit_pending(sl_tiltobs_t *o)
@@ -432,22 +453,24 @@ void sl_tiltobs_fit_pending(sl_tiltobs_t *o)
             done++;
         }
         // Outliers (sl_tiltobs.h, "Outlier rejection"). One gross outlier (a bound the
-        // profile could not clean) makes a whole pass INCONSISTENT, or, in a FITTED fit,
-        // lies far beyond the scale of the other residuals: drop the observation with the
-        // largest residual in sigmas and fit again, at most one in SL_TILTOBS_OUTLIER_DIV
-        // of the observations per ring (a pole that is not straight, or a wrong
-        // association, stays INCONSISTENT). The second fit counts against the bound:
-        // without room for it the ring stays fresh and starts the next call. After a drop
-        // from a FITTED fit the ring stays fresh: the next call looks for another.
+        // profile could not clean) makes a whole pass INCONSISTENT, or, in a FITTED fit (an
+        // AMBIGUOUS one: under both its readings), lies far beyond the scale of the other
+        // residuals: drop the observation with the largest residual in sigmas and fit
+        // again, at most one in SL_TILTOBS_OUTLIER_DIV of the observations per ring (a pole
+        // that is not straight, or a wrong association, stays INCONSISTENT). The second fit
+        // counts against the bound: without room for it the ring stays fresh and starts the
+        // next call. After a drop from a FITTED or AMBIGUOUS fit the ring stays fresh: the
+        // next call looks for another.
         bool again = false;
         const bool incons = r->res.quality == (uint8_t)SL_TILT_INCONSISTENT;
+        const bool amb = r->res.quality == (uint8_t)SL_TILT_AMBIGUOUS;
         if (SL_CFG_TILT_FITS_PER_ROTATION >= 2 &&
-            (incons || r->res.quality == (uint8_t)SL_TILT_FITTED) &&
+            (incons || amb || r->res.quality == (uint8_t)SL_TILT_FITTED) &&
             r->count >= SL_TILTOBS_OUTLIER_MIN_N &&
             (uint32_t)r->dropped + 1U <= (uint32_t)r->count / SL_TILTOBS_OUTLIER_DIV) {
             uint32_t z2_q8;
             const uint32_t w = worst_obs(r, &z2_q8);
-            if (incons || gross(r, z2_q8)) {
+            if (incons || (gross(r, z2_q8) && (!amb || gross(r, other_reading_z2(r, w))))) {
                 if (done >= (uint32_t)SL_CFG_TILT_FITS_PER_ROTATION) {
                     o->rr = (uint8_t)idx;
                     break;
