@@ -123,7 +123,13 @@ typedef struct sl_tiltobs_ring {
 /// A FITTED fit with at least SL_TILTOBS_OUTLIER_MIN_N observations loses its worst one when
 /// that one's squared residual in sigmas exceeds SL_TILTOBS_GROSS_Z2 (4 sigma) times the
 /// chi-square scale of the others, max(1, (chi2 - z^2) / (dof - 1)), within the same bound
-/// of drops; the next call fits the ring again and looks for another. An AMBIGUOUS fit only
+/// of drops; the next call fits the ring again and looks for another. The residuals are the
+/// DELETED ones, z^2 / (1 - h) with h = w e' M^-1 e the observation's leverage (M the
+/// weighted bearing moments; 1 - h held at 1/16 at least): what the observation's residual
+/// would be were it left out of the fit, so chi2 - z^2 / (1 - h) is exactly the others'
+/// chi-square; the worst observation is the one with the largest. An observation at an end
+/// of the pass's bearings pulls the fit towards itself and hid its own residual (one far
+/// bound 3 % long among 11 at 3 m/s: a FITTED direction 19 deg off at 5.9 deg of sigma). An AMBIGUOUS fit only
 /// when the worst observation is gross under BOTH its readings (as measured and as the
 /// fold's mirror, or its only one when it is not mirrorable), each against the same scale:
 /// an observation whose one reading fits while the other does not may be the very one that
