@@ -331,7 +331,9 @@ typedef struct lev_ctx {
 
 static SL_NOINLINE void lev_init(const sl_tiltobs_ring_t *r, lev_ctx_t *l)
 {
-    l->m11 = l->m12 = l->m22 = 0;
+    l->m11 = 0;
+    l->m12 = 0;
+    l->m22 = 0;
     for (uint32_t k = 0; k < r->count; k++) {
         const sl_tilt_obs_t *ob = &r->obs[k];
         const int64_t w = weight_q16(ob);
