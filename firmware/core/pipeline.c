@@ -613,11 +613,31 @@ static SL_NOINLINE uint32_t shadow_after_refine(sl_pipeline_t *p, uint32_t n)
     return k;
 }
 
+// Whether track `t`, updated this rotation, was so by a SLANT target (a pole leaning across
+// the line of sight, represented by the azimuth of its lowest visible point).
+static bool updated_by_slant(const sl_pipeline_t *p, const sl_track_t *t)
+{
+    if (t->updated == 0U) {
+        return false;
+    }
+    for (uint32_t j = 0; j < p->detect.n_targets; j++) {
+        const sl_target_t *g = &p->detect.targets[j];
+        if (g->az == t->az && g->r1_um == t->r1_um && g->r2_um == t->r2_um) {
+            return (g->flags & SL_TARGET_SLANT) != 0U;
+        }
+    }
+    return false;
+}
+
 // Moving: the profile watches, next rotation, the azimuths where each track updated now is
 // expected (its static-object prediction under one rotation's displacement, +-2 azimuths:
 // the representative azimuth moves by up to half a beam's return, and the refinement sums
 // the neighbours of whichever it is). Confirmed tracks first (also when missed this
-// rotation), then the others updated now.
+// rotation), then the others updated now; then, while slots are free, +-4 azimuths for the
+// tracks a SLANT target updated: a pole leaning across the line of sight is represented by
+// the azimuth of its lowest visible point, which moves within its 10-15 azimuths as the
+// vehicle passes (sl_track.h), and at 3 m/s lands 3-4 azimuths from the prediction on one
+// rotation in five (its rows then unwatched: SL_PROFILE_NO_SLOT, not a 3D-tilt observation).
 // Reversing: the prediction is for forward motion, and moving back by d is moving forward by
 // d along the opposite axis: the bearing turned by half a turn, predicted, turned back.
 static SL_NOINLINE void reserve_profiles(sl_pipeline_t *p)
@@ -626,13 +646,16 @@ static SL_NOINLINE void reserve_profiles(sl_pipeline_t *p)
     if (b == 0U) {
         return;
     }
-    for (uint32_t pass = 0; pass < 2U; pass++) {
+    for (uint32_t pass = 0; pass < 3U; pass++) {
         for (uint32_t i = 0; i < SL_CFG_MAX_TARGETS; i++) {
             const sl_track_t *t = &p->tracker.tracks[i];
             // a confirmed track missed this rotation is still predicted (dead reckoning:
             // its az / r1 moved to the prediction); an unconfirmed one only when updated
-            if (t->live == 0U || (pass == 0U) != (t->confirmed != 0U) ||
-                (t->confirmed == 0U && t->updated == 0U)) {
+            if (t->live == 0U ||
+                (pass < 2U && ((pass == 0U) != (t->confirmed != 0U) ||
+                               (t->confirmed == 0U && t->updated == 0U))) ||
+                (pass == 2U && (!updated_by_slant(p, t) ||
+                                p->prof.n_live + 4U > SL_CFG_PROFILE_SLOTS))) {
                 continue;
             }
             const uint32_t naz = p->det_board.azimuths;
@@ -644,7 +667,7 @@ static SL_NOINLINE void reserve_profiles(sl_pipeline_t *p)
             az = (uint16_t)(((uint32_t)az + naz - turn) % naz);
             const uint32_t bin = r / b;
             (void)sl_profile_reserve(&p->prof, az, (uint16_t)(bin > 0xFFFFU ? 0xFFFFU : bin),
-                                     2U);
+                                     pass < 2U ? 2U : 4U);
         }
     }
 }

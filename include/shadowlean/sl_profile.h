@@ -28,7 +28,8 @@
 /// ## While moving (one rotation, neighbouring azimuths)
 /// A moving pole is at another range and azimuth every rotation, so rotations cannot be
 /// summed. Instead, after each rotation the caller reserves, for every track, the azimuths
-/// where it is expected next (sl_profile_reserve: its static-object prediction +-2); evidence
+/// where it is expected next (sl_profile_reserve: its static-object prediction +-2; +-4
+/// for a pole leaning across the line of sight while slots are free); evidence
 /// claims nothing while moving. A target whose own slot holds fewer than `cfg.min_frames`
 /// rows is refined from the sum of this rotation's rows of its azimuth and its two
 /// neighbours when they belong to its detection group (adjacent azimuths, 0.9 deg apart,
