@@ -73,8 +73,11 @@
 /// Units: um, bam32 (2^32 per turn), cdeg (0.01 deg). No allocation, no float; every array
 /// is inside the struct. RAM: SL_CFG_TILT_TRACKS x (SL_CFG_TILT_OBS_PER_TRACK x 24 + 72)
 /// + 672 bytes (x86-64: firmware configuration 4 x 16: 2,496 B; host default 8 x 32: 7,392 B).
-/// Cost per rotation: O(tracks x targets) for the matching (only for updated tracks) + O(1) per observation (three table sine/cosine, two 64-bit divisions) + at most
-/// SL_CFG_TILT_FITS_PER_ROTATION fits (sl_tilt.h: O(n + m^2)). Not reentrant per instance.
+/// Cost per rotation: O(tracks x targets) for the matching (only for updated tracks) + O(1)
+/// per observation (three table sine/cosine, two 64-bit divisions) + at most
+/// SL_CFG_TILT_FITS_PER_ROTATION fits (sl_tilt.h: O(n + m^2)), each of 8 observations or
+/// more followed by the outlier test (O(n): three 64-bit divisions per observation for its
+/// deleted residual). Not reentrant per instance.
 #ifndef SHADOWLEAN_SL_TILTOBS_H
 #define SHADOWLEAN_SL_TILTOBS_H
 
@@ -129,9 +132,10 @@ typedef struct sl_tiltobs_ring {
 /// would be were it left out of the fit, so chi2 - z^2 / (1 - h) is exactly the others'
 /// chi-square; the worst observation is the one with the largest. An observation at an end
 /// of the pass's bearings pulls the fit towards itself and hid its own residual (one far
-/// bound 3 % long among 11 at 3 m/s: a FITTED direction 19 deg off at 5.9 deg of sigma). An AMBIGUOUS fit only
-/// when the worst observation is gross under BOTH its readings (as measured and as the
-/// fold's mirror, or its only one when it is not mirrorable), each against the same scale:
+/// bound 3 % long among 11 at 3 m/s: a FITTED direction 19 deg off at 5.9 deg of sigma).
+/// An AMBIGUOUS fit loses it only when the worst observation is gross under BOTH its
+/// readings (as measured and as the fold's mirror, or its only one when it is not
+/// mirrorable), each against the same scale:
 /// an observation whose one reading fits while the other does not may be the very one that
 /// tells the two hypotheses apart (dropping it could make a wrong reading FITTED), but one
 /// that fits neither reading tells them apart by nothing more than the scale it inflates,
