@@ -613,22 +613,6 @@ static SL_NOINLINE uint32_t shadow_after_refine(sl_pipeline_t *p, uint32_t n)
     return k;
 }
 
-// Whether track `t`, updated this rotation, was so by a SLANT target (a pole leaning across
-// the line of sight, represented by the azimuth of its lowest visible point).
-static bool updated_by_slant(const sl_pipeline_t *p, const sl_track_t *t)
-{
-    if (t->updated == 0U) {
-        return false;
-    }
-    for (uint32_t j = 0; j < p->detect.n_targets; j++) {
-        const sl_target_t *g = &p->detect.targets[j];
-        if (g->az == t->az && g->r1_um == t->r1_um && g->r2_um == t->r2_um) {
-            return (g->flags & SL_TARGET_SLANT) != 0U;
-        }
-    }
-    return false;
-}
-
 // Moving: the profile watches, next rotation, the azimuths where each track updated now is
 // expected (its static-object prediction under one rotation's displacement, +-2 azimuths:
 // the representative azimuth moves by up to half a beam's return, and the refinement sums
@@ -650,12 +634,18 @@ static SL_NOINLINE void reserve_profiles(sl_pipeline_t *p)
         for (uint32_t i = 0; i < SL_CFG_MAX_TARGETS; i++) {
             const sl_track_t *t = &p->tracker.tracks[i];
             // a confirmed track missed this rotation is still predicted (dead reckoning:
-            // its az / r1 moved to the prediction); an unconfirmed one only when updated
-            if (t->live == 0U ||
-                (pass < 2U && ((pass == 0U) != (t->confirmed != 0U) ||
-                               (t->confirmed == 0U && t->updated == 0U))) ||
-                (pass == 2U && (!updated_by_slant(p, t) ||
-                                p->prof.n_live + 4U > SL_CFG_PROFILE_SLOTS))) {
+            // its az / r1 moved to the prediction); an unconfirmed one only when updated;
+            // the wider watch for one a SLANT target updated, while slots are free
+            bool take;
+            if (pass == 0U) {
+                take = t->confirmed != 0U;
+            } else if (pass == 1U) {
+                take = t->confirmed == 0U && t->updated != 0U;
+            } else {
+                take = t->updated != 0U && t->last_slant != 0U &&
+                       p->prof.n_live + 4U <= SL_CFG_PROFILE_SLOTS;
+            }
+            if (t->live == 0U || !take) {
                 continue;
             }
             const uint32_t naz = p->det_board.azimuths;

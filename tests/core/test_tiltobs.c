@@ -338,6 +338,24 @@ static void test_one_outlier_is_dropped_a_bent_pole_stays_inconsistent(void **st
     corrupt_every = 0;
 }
 
+// drive_by() of pole `p` (track 1) with one far bound read 3 % long on its `phase`-th
+// sighting; its ring and the vehicle-frame result in `out`.
+static const sl_tiltobs_ring_t *drive_corrupted(const pole_t *p, double v, int rotations,
+                                                int phase, sl_track_t *tracks,
+                                                sl_tiltobs_vehicle_t *out)
+{
+    corrupt_every = 1000;
+    corrupt_phase = phase;
+    corrupt_scale = 1.03;
+    drive_by(p, 1, v, 0.0, rotations, tracks);
+    corrupt_every = 0;
+    corrupt_scale = 0.0;
+    const sl_tiltobs_ring_t *r = sl_tiltobs_find(&obs, 1);
+    assert_non_null(r);
+    assert_true(sl_tiltobs_vehicle(&obs, r, out));
+    return r;
+}
+
 // A wrong observation that does not make the fit INCONSISTENT: a far bound 3 % long (alpha
 // 3-4 deg high, 7-8 of its 0.5 deg sigmas) among 16-32 good ones leaves chi2 / dof near 3,
 // so the fit stood FITTED and was pulled by it (0.4 deg of tilt and 1-2 deg of direction
@@ -356,16 +374,9 @@ static void test_a_gross_outlier_in_a_fitted_pass_is_dropped(void **state)
     sl_tiltobs_vehicle_t clean;
     assert_true(sl_tiltobs_vehicle(&obs, r, &clean));
     assert_int_equal(clean.quality, SL_TILT_FITTED);
-    corrupt_every = 1000;
-    corrupt_phase = 26; // late in the pass: the firmware's 16-observation ring still holds it
-    corrupt_scale = 1.03;
-    drive_by(&p, 1, 1.0, 0.0, 32, tracks);
-    corrupt_every = 0;
-    corrupt_scale = 0.0;
-    r = sl_tiltobs_find(&obs, 1);
-    assert_non_null(r);
     sl_tiltobs_vehicle_t out;
-    assert_true(sl_tiltobs_vehicle(&obs, r, &out));
+    // late in the pass: the firmware's 16-observation ring still holds it
+    r = drive_corrupted(&p, 1.0, 32, 26, tracks, &out);
     printf("gross: dropped %u (stats %u, inconsistent-path %u) psi %.2f (clean %.2f) phi %.1f (%.1f)\n",
            r->dropped, obs.stats.gross, obs.stats.outliers, out.psi_cdeg / 100.0,
            clean.psi_cdeg / 100.0, out.phi_cdeg / 100.0, clean.phi_cdeg / 100.0);
@@ -405,16 +416,8 @@ static void test_a_gross_outlier_in_an_ambiguous_pass_is_dropped(void **state)
         assert_int_equal(r->count, 11U);
         assert_int_equal(r->dropped, 0U);
         for (int ph = 1; ph <= 10; ++ph) {
-            corrupt_every = 1000;
-            corrupt_phase = ph; // the ph-th sighting
-            corrupt_scale = 1.03;
-            drive_by(&p, 1, 3.0, 0.0, 16, tracks);
-            corrupt_every = 0;
-            corrupt_scale = 0.0;
-            r = sl_tiltobs_find(&obs, 1);
-            assert_non_null(r);
             sl_tiltobs_vehicle_t out;
-            assert_true(sl_tiltobs_vehicle(&obs, r, &out));
+            r = drive_corrupted(&p, 3.0, 16, ph, tracks, &out); // the ph-th sighting
             assert_int_equal(obs.stats.outliers, 0U);
             const bool same = abs(out.psi_cdeg - clean.psi_cdeg) <= 5 &&
                               abs(out.phi_cdeg - clean.phi_cdeg) <= 50;
