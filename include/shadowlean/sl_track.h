@@ -32,11 +32,17 @@
 /// `cfg.consist_az` azimuths (+ the yaw per rotation; measured to the target's detection
 /// group, az_first .. az_first + az_count - 1, 0 when the prediction falls inside it: the
 /// representative azimuth of a pole leaning across the line of sight moves within its
-/// 10-15 azimuths as the vehicle passes) and `cfg.consist_range_um`, capped at
+/// 10-15 azimuths as the vehicle passes) and `cfg.consist_range_um` (measured, likewise, to
+/// the target's range extent: from its group's union inner bound, r1 less ext_grow's bins
+/// before the representative run and a radius from width, to r2; 0 inside it: the nearest
+/// point of such a pole is the union's inner bound on a rotation that reads it SLANT and the
+/// representative run's first bin, 0.2-0.35 m further, on one that does not, while the
+/// static point the track followed stays on the pole, inside its extent), capped at
 /// `cfg.confirm_min + 2`; an association outside that tolerance resets it to 1 (the track
 /// jumped: what it followed does not move like a static object); a rotation without an
 /// association takes 1 off and moves the track's az / r1 to the prediction (dead reckoning,
-/// so a pole missed for a rotation is still predicted where it is). `confirmed` = evidence >= `cfg.confirm_min` (default 3, i.e.
+/// so a pole missed for a rotation is still predicted where it is).
+/// `confirmed` = evidence >= `cfg.confirm_min` (default 3, i.e.
 /// three rotations whose range AND bearing follow the ego motion). Scattered clutter at
 /// every azimuth associates now and then (the gates are wide while moving) but almost never
 /// where a static object would be, three times running, so its tracks never confirm. The
@@ -121,9 +127,10 @@ typedef struct sl_track_cfg {
     uint16_t hysteresis_cdeg;  ///< lowering margin below each threshold (default 100 = 1 deg)
     uint8_t confirm;           ///< consecutive valid updates needed to raise (default 3)
     bool caution_abs;          ///< CAUTION on |alpha| (default true, as sl_board.h says)
-    uint32_t consist_range_um; ///< |r1 - predicted r1| of a consistent update (default
-                               ///< 0.2 m: +-1 bin of quantisation on each side plus the
-                               ///< width-based radius correction's jitter)
+    uint32_t consist_range_um; ///< distance of the predicted r1 from the target's range
+                               ///< extent (union inner bound .. r2) of a consistent update
+                               ///< (default 0.2 m: +-1 bin of quantisation on each side
+                               ///< plus the width-based radius correction's jitter)
     uint16_t consist_az;       ///< |az - predicted az| of a consistent update, azimuths
                                ///< (default 3: the representative azimuth of a 2 deg beam
                                ///< return moves by up to half its 4-8 azimuths)
