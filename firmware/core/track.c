@@ -341,10 +341,14 @@ void sl_track_update(sl_tracker_t *tr, const sl_target_t *targets, uint32_t n,
             predict(tr, t);
         }
     }
-    // Greedy global nearest neighbour. Cost |d az| / ag + |d r| / rg, scaled by ag * rg.
+    // Greedy global nearest neighbour. Cost |d az| / ag + |d r| / rg, scaled by ag * rg,
+    // d az to the target's group (0 inside it: the representative of a pole leaning across
+    // the line of sight moves within the group's 10-15 azimuths; groups at one range do not
+    // overlap), ties broken by d az to its representative.
     for (;;) {
         uint32_t bi = 0, bj = 0;
         uint64_t best = UINT64_MAX;
+        uint32_t best_rep = UINT32_MAX;
         for (uint32_t i = 0; i < SL_CFG_MAX_TARGETS; i++) {
             const sl_track_t *t = &tr->tracks[i];
             if (t->live == 0U || t->updated != 0U) {
@@ -355,16 +359,18 @@ void sl_track_update(sl_tracker_t *tr, const sl_target_t *targets, uint32_t n,
                 if (used[j]) {
                     continue;
                 }
-                const uint32_t da = az_dist(t->pred_az, targets[j].az, naz);
-                const uint32_t dr = t->pred_r1_um > targets[j].r1_um
-                                        ? t->pred_r1_um - targets[j].r1_um
-                                        : targets[j].r1_um - t->pred_r1_um;
+                const sl_target_t *g = &targets[j];
+                const uint32_t da = az_dist_group(t->pred_az, g, naz);
+                const uint32_t dr = t->pred_r1_um > g->r1_um ? t->pred_r1_um - g->r1_um
+                                                             : g->r1_um - t->pred_r1_um;
                 if (da > ag || dr > rg) {
                     continue;
                 }
                 const uint64_t cost = (uint64_t)da * rg + (uint64_t)dr * ag;
-                if (cost < best) {
+                const uint32_t da_rep = az_dist(t->pred_az, g->az, naz);
+                if (cost < best || (cost == best && da_rep < best_rep)) {
                     best = cost;
+                    best_rep = da_rep;
                     bi = i;
                     bj = j;
                 }

@@ -9,8 +9,13 @@
 /// A target may continue a live track when both gates hold: circular azimuth distance
 /// `<= cfg.az_gate` azimuths and `|r1 - track r1| <= cfg.range_gate_um`, both measured from
 /// the track's predicted position (see "Static-object prediction" below; the last position
-/// itself when the vehicle stands still). Pairs are taken
-/// greedily by increasing normalised distance (|d az| / az_gate + |d r1| / range_gate), each
+/// itself when the vehicle stands still), the azimuth distance to the target's detection
+/// group (az_first .. az_first + az_count - 1, 0 when the prediction falls inside it: the
+/// representative of a pole leaning across the line of sight moves within its 10-15
+/// azimuths, 11 off the prediction on a 1 m/s drive-by, beyond the gate; groups at one range
+/// do not overlap). Pairs are taken
+/// greedily by increasing normalised distance (|d az| / az_gate + |d r1| / range_gate), ties
+/// by the azimuth distance to the representative, each
 /// track and target at most once (global nearest neighbour). Unmatched targets open new
 /// tracks while slots are free (`stats.full` otherwise). Tracks not matched for longer than
 /// `board->track_timeout_us` are dropped (0: dropped at the first update without a match).

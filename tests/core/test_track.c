@@ -396,6 +396,50 @@ static void test_track_checks_consistency_against_the_group_extent(void **state)
     assert_true(trk.stats.inconsistent >= 4U);
 }
 
+// Association measures the bearing to the target's group as well (sl-eval driveby
+// --realistic --power-scale, psi 20 leaning away, 3 m left of the path, 1 m/s: a SLANT
+// representative 11 azimuths from the prediction, which lies at the end of its 12-azimuth
+// group; beyond the 8-azimuth gate the track was lost and restarted, and the pass kept 10 of
+// its 25 observations). Here the group's target, not a return nearer the prediction but
+// outside the group, continues the track.
+static void test_track_associates_a_group_holding_the_prediction(void **state)
+{
+    (void)state;
+    assert_int_equal(sl_track_init(&trk, &board, NULL), SL_OK);
+    sl_track_set_motion(&trk, 250000U, 0U);
+    uint16_t az = 320;
+    uint32_t r = 3700000U;
+    uint64_t now = 1000000;
+    sl_target_t t0 = tgt(az, r, -1000, 80, SL_INCLINE_VALID);
+    sl_track_update(&trk, &t0, 1, now);
+    const uint16_t id = trk.tracks[0].id;
+    uint16_t paz;
+    uint32_t pr;
+    sl_track_predict_static(&board, az, r, 250000U, &paz, &pr);
+    assert_true(sl_track_gate_az(&trk, &trk.tracks[0]) < 11U);
+    sl_target_t ts[2];
+    ts[0] = tgt((uint16_t)((paz + 6U) % 400U), pr, 0, 80, SL_INCLINE_VALID); // nearer, alone
+    ts[1] = tgt((uint16_t)((paz + 400U - 11U) % 400U), pr + 10000U, -1000, 80, SL_INCLINE_VALID);
+    ts[1].az_first = ts[1].az;
+    ts[1].az_count = 12U; // [paz - 11, paz]
+    ts[1].flags = SL_TARGET_SLANT;
+    sl_track_update(&trk, ts, 2, now + 250000);
+    const sl_track_t *t = sl_track_find(&trk, id);
+    assert_non_null(t);
+    assert_int_equal(t->az, ts[1].az);
+    assert_int_equal(t->evidence, 2);
+    assert_int_equal(trk.stats.associated, 1);
+    assert_int_equal(trk.stats.created, 2); // the lone return opens its own track
+    // Alone, the group's target continues the track too (before: a new track).
+    assert_int_equal(sl_track_init(&trk, &board, NULL), SL_OK);
+    sl_track_set_motion(&trk, 250000U, 0U);
+    sl_track_update(&trk, &t0, 1, now);
+    sl_track_update(&trk, &ts[1], 1, now + 250000);
+    assert_int_equal(trk.stats.created, 1);
+    assert_int_equal(trk.stats.associated, 1);
+    assert_int_equal(trk.stats.inconsistent, 0);
+}
+
 // The same pole's nearest point seen two ways (sl-eval driveby, psi 20 deg leaning towards
 // the path, 4 m off it, 3 m/s): as a SLANT target its r1 is the group's union inner bound; as
 // a wide upright-looking group its r1 is the representative run's first bin, 0.3 m further,
@@ -617,6 +661,7 @@ int main(void)
         cmocka_unit_test_setup(test_track_restarts_on_the_first_profile_measurement, setup),
         cmocka_unit_test_setup(test_track_checks_consistency_against_the_group_extent, setup),
         cmocka_unit_test_setup(test_track_checks_consistency_against_the_range_extent, setup),
+        cmocka_unit_test_setup(test_track_associates_a_group_holding_the_prediction, setup),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
