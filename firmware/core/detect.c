@@ -181,6 +181,14 @@ uint32_t sl_detect_r1_sigma_um(const sl_target_t *t, uint32_t base_um)
     return sl_fx_isqrt64((uint64_t)base_um * base_um + (r * r + 1U) / 3U);
 }
 
+uint32_t sl_detect_union_r1_um(const sl_target_t *t, uint32_t bin_um)
+{
+    SL_ASSERT(t != NULL);
+    const uint64_t sub = (uint64_t)(t->ext_grow & 15U) * bin_um +
+                         ((t->flags & SL_TARGET_RADIUS_WIDTH) != 0U ? t->radius_um : 0U);
+    return (uint64_t)t->r1_um > sub ? (uint32_t)(t->r1_um - sub) : 0U;
+}
+
 // ---- groups
 
 static void ext_union(uint16_t *lo, uint16_t *hi, uint16_t f, uint16_t l)

@@ -122,7 +122,8 @@ static const sl_target_t *target_of(const sl_track_t *t, const sl_target_t *targ
 // half-bin and radius terms are constant offsets), r2 too, less the change of the
 // elongation d(r2) over the added bins (none after a profile refinement, which dropped d).
 // A radius estimated from the group's azimuthal width (RADIUS_WIDTH) is removed from both
-// bounds: on a leaning pole seen at an oblique bearing the width holds the lean's own spread
+// bounds (the inner one: sl_detect_union_r1_um, which the tracker's consistency test reads
+// too): on a leaning pole seen at an oblique bearing the width holds the lean's own spread
 // in bearing (a 1 cm pole reads as R = 0.15 m, the clamp), which would bias the very
 // inclination measured here; a board radius (RADIUS_BOARD) stays. A thick pole without a
 // board radius then reads from its front surface (R = 0.1 m at 5 m: ~0.3 deg).
@@ -133,7 +134,7 @@ static bool union_bounds(const sl_board_t *b, const sl_target_t *g, uint32_t *r1
     const uint32_t hi = (uint32_t)g->ext_grow >> 4;
     const uint32_t bin = b->bin_size_um;
     const bool width = (g->flags & SL_TARGET_RADIUS_WIDTH) != 0U;
-    const uint32_t sub1 = lo * bin + (width ? g->radius_um : 0U);
+    const uint32_t in1 = sl_detect_union_r1_um(g, bin); // 0: not positive
     const uint32_t add = hi * bin;
     // The representative's last half-bin centre (sl_detect.h, 5.): (bin_last + 1/2) b.
     const uint32_t r2_hb = g->r2_raw_um - bin / 2U;
@@ -145,11 +146,11 @@ static bool union_bounds(const sl_board_t *b, const sl_target_t *g, uint32_t *r1
         t2 += (int32_t)(g->r2_um - r2_hb) + g->elong_um;
     }
     const int64_t u2 = (int64_t)g->r2_um + add - t2;
-    if (lo >= SL_TARGET_EXT_SAT || hi >= SL_TARGET_EXT_SAT || g->r1_um <= sub1 ||
-        u2 <= (int64_t)(g->r1_um - sub1) || u2 > (int64_t)UINT32_MAX) {
+    if (lo >= SL_TARGET_EXT_SAT || hi >= SL_TARGET_EXT_SAT || in1 == 0U || u2 <= (int64_t)in1 ||
+        u2 > (int64_t)UINT32_MAX) {
         return false;
     }
-    *r1 = g->r1_um - sub1;
+    *r1 = in1;
     *r2 = (uint32_t)u2;
     return true;
 }

@@ -205,17 +205,14 @@ static uint32_t az_dist_group(uint32_t a, const sl_target_t *g, uint32_t n)
 }
 
 // Range from `r` to the target's range extent (0 inside it): from the inner bound of its
-// group's union (r1 less ext_grow's bins before the representative run and a radius from
-// width) to r2. The nearest point of a slender pole leaning across the line of sight lies on
+// group's union (sl_detect_union_r1_um) to r2. The nearest point of a slender pole leaning across the line of sight lies on
 // one azimuth of its group on one rotation and on another on the next (the union's inner
 // bound of a SLANT target, a representative run's first bin otherwise: 0.2-0.35 m apart on a
 // 20 deg lean at 3-4 m), while the static point the track followed stays on the pole, inside
 // its extent.
 static uint32_t range_dist_extent(uint32_t r, const sl_target_t *g, uint32_t bin_um)
 {
-    const uint64_t grow = (uint64_t)(g->ext_grow & 15U) * bin_um +
-                          ((g->flags & SL_TARGET_RADIUS_WIDTH) != 0U ? g->radius_um : 0U);
-    const uint32_t lo = (uint64_t)g->r1_um > grow ? (uint32_t)(g->r1_um - grow) : 0U;
+    const uint32_t lo = sl_detect_union_r1_um(g, bin_um);
     const uint32_t hi = g->r2_um > g->r1_um ? g->r2_um : g->r1_um;
     if (r < lo) {
         return lo - r;
@@ -367,8 +364,11 @@ void sl_track_update(sl_tracker_t *tr, const sl_target_t *targets, uint32_t n,
                     continue;
                 }
                 const uint64_t cost = (uint64_t)da * rg + (uint64_t)dr * ag;
+                if (cost > best) {
+                    continue;
+                }
                 const uint32_t da_rep = az_dist(t->pred_az, g->az, naz);
-                if (cost < best || (cost == best && da_rep < best_rep)) {
+                if (cost < best || da_rep < best_rep) {
                     best = cost;
                     best_rep = da_rep;
                     bi = i;

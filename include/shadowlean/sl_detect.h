@@ -513,6 +513,13 @@ void sl_detect_correct(const sl_board_t *board, const sl_detect_cfg_t *cfg, uint
 /// (uniform within +-R). Pure; one isqrt.
 uint32_t sl_detect_r1_sigma_um(const sl_target_t *t, uint32_t base_um);
 
+/// Inner bound (um) of the group's union extent: r1 less ext_grow's bins before the
+/// representative run (a saturated nibble counts as SL_TARGET_EXT_SAT bins) and a radius
+/// estimated from the azimuthal width (SL_TARGET_RADIUS_WIDTH: on a pole leaning across the
+/// line of sight the width holds the lean's own spread in bearing); a board radius stays.
+/// 0 when that would not be positive. `bin_um`: the bin size ext_grow counts in. Pure, O(1).
+uint32_t sl_detect_union_r1_um(const sl_target_t *t, uint32_t bin_um);
+
 /// The board's elongation d(r) in micrometres (piecewise linear over elong_range_um ->
 /// elong_d_um, constant beyond the ends, 0 with no table; truncated toward zero, <= 1 um).
 /// O(elong_points).

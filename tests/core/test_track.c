@@ -440,16 +440,11 @@ static void test_track_associates_a_group_holding_the_prediction(void **state)
     assert_int_equal(trk.stats.inconsistent, 0);
 }
 
-// The same pole's nearest point seen two ways (sl-eval driveby, psi 20 deg leaning towards
-// the path, 4 m off it, 3 m/s): as a SLANT target its r1 is the group's union inner bound; as
-// a wide upright-looking group its r1 is the representative run's first bin, 0.3 m further,
-// with the union's 7 bins before it in ext_grow. The prediction (from either) stays within
-// the target's range extent [union inner bound, r2]: consistent, the track confirms. A
-// return at the predicted azimuth whose extent ends 0.25-0.4 m short of or starts that far
-// beyond the prediction is not (an extent is no licence for any range).
-static void test_track_checks_consistency_against_the_range_extent(void **state)
+// Six rotations of a static pole at 3 m/s read alternately SLANT (r1 = the union's inner
+// bound) and as a wide group (r1 = the representative run's first bin, 7 bins further, with
+// `ext_grow` 7 bins before it, or 0 when the union is not reported); `confirmed` after each.
+static void drive_alternating_readings(uint8_t ext_grow, uint8_t confirmed[6])
 {
-    (void)state;
     assert_int_equal(sl_track_init(&trk, &board, NULL), SL_OK);
     sl_track_set_motion(&trk, 750000U, 0U);
     uint16_t az = 320;
@@ -464,42 +459,43 @@ static void test_track_checks_consistency_against_the_range_extent(void **state)
             t.flags = SL_TARGET_SLANT; // r1: the union's inner bound
         } else {
             t.r1_um = r + 7U * 43800U; // the representative run's first bin
-            t.ext_grow = 7U;
+            t.ext_grow = ext_grow;
         }
         sl_track_update(&trk, &t, 1, now);
-        assert_int_equal(trk.tracks[0].confirmed, k >= 2 ? 1 : 0);
+        confirmed[k] = trk.tracks[0].confirmed;
         sl_track_predict_static(&board, az, r, 750000U, &az, &r);
         now += 250000;
+    }
+}
+
+// The same pole's nearest point seen two ways (sl-eval driveby, psi 20 deg leaning towards
+// the path, 4 m off it, 3 m/s): as a SLANT target its r1 is the group's union inner bound; as
+// a wide upright-looking group its r1 is the representative run's first bin, 0.3 m further,
+// with the union's 7 bins before it in ext_grow. The prediction (from either) stays within
+// the target's range extent [union inner bound, r2]: consistent, the track confirms. A
+// return at the predicted azimuth whose extent ends 0.25-0.4 m short of or starts that far
+// beyond the prediction is not (an extent is no licence for any range).
+static void test_track_checks_consistency_against_the_range_extent(void **state)
+{
+    (void)state;
+    uint8_t confirmed[6];
+    drive_alternating_readings(7U, confirmed);
+    for (int k = 0; k < 6; k++) {
+        assert_int_equal(confirmed[k], k >= 2 ? 1 : 0);
     }
     assert_int_equal(trk.stats.inconsistent, 0);
     assert_int_equal(trk.stats.created, 1);
     // Without the union's bins in ext_grow the representative's r1 is 0.31 m off: inconsistent.
-    assert_int_equal(sl_track_init(&trk, &board, NULL), SL_OK);
-    sl_track_set_motion(&trk, 750000U, 0U);
-    az = 320;
-    r = 3800000U;
-    for (int k = 0; k < 6; k++) {
-        sl_target_t t = tgt(az, r, 1900, 80, SL_INCLINE_VALID);
-        t.az_first = (uint16_t)((az + 400 - 3) % 400);
-        t.az_count = 8U;
-        t.r2_um = r + 700000U;
-        if (k % 2 == 0) {
-            t.flags = SL_TARGET_SLANT;
-        } else {
-            t.r1_um = r + 7U * 43800U;
-        }
-        sl_track_update(&trk, &t, 1, now);
-        sl_track_predict_static(&board, az, r, 750000U, &az, &r);
-        now += 250000;
-    }
+    drive_alternating_readings(0U, confirmed);
     assert_int_equal(trk.stats.inconsistent, 3);
     // Returns at the predicted azimuth, two bins long, 0.25-0.4 m before or beyond it: all
     // associate (one track), none is consistent.
     assert_int_equal(sl_track_init(&trk, &board, NULL), SL_OK);
     sl_track_set_motion(&trk, 250000U, 0U);
     uint32_t seed = 777U;
-    az = 100;
-    r = 5000000U;
+    uint16_t az = 100;
+    uint32_t r = 5000000U;
+    uint64_t now = 1000000;
     for (int k = 0; k < 100; k++) {
         seed = seed * 1103515245U + 12345U;
         const uint32_t off = 250000U + (seed >> 8) % 150000U; // inside the range gate
