@@ -125,13 +125,16 @@ void sl_profile_row(sl_profile_t *pr, uint16_t az, const uint8_t *power, uint32_
         slot_add(pr, s, power, n);
         return;
     }
-    if (first >= hi || pr->moving != 0U) {
-        return; // moving: only the azimuths reserved for tracks are watched
+    if (first >= hi) {
+        return;
     }
     const uint32_t i = pr->n_live < SL_CFG_PROFILE_SLOTS ? free_slot(pr) : SL_CFG_PROFILE_SLOTS;
     if (i == SL_CFG_PROFILE_SLOTS) {
-        pr->stats.claim_full++;
+        pr->stats.claim_full += pr->moving == 0U ? 1U : 0U;
         return;
+    }
+    if (pr->moving != 0U && sl_bits_next_clear(bits, first, hi) + 2U > hi) {
+        return; // moving: a free slot for a run ending clear of the window's end
     }
     pr->n_live++;
     pr->stats.claims++;
@@ -1222,7 +1225,9 @@ uint8_t sl_profile_refine(sl_profile_t *pr, const sl_board_t *board, uint32_t th
     }
     t->r2_um = sl_fx_usat32(r2_hb + r2_term);
     t->elong_um = sl_fx_sat32(r2_hb_mask - r2_hb);
-    t->flags = (uint16_t)((t->flags & ~(SL_TARGET_ELONG | SL_TARGET_COARSE)) | SL_TARGET_PROFILE);
+    t->flags = (uint16_t)((t->flags & ~(SL_TARGET_ELONG | SL_TARGET_COARSE | SL_TARGET_WALKED)) |
+                          SL_TARGET_PROFILE |
+                          (pb.slope_src != SL_PROFILE_SLOPE_CLIFF ? SL_TARGET_WALKED : 0U));
     // Uncertainty of the bounds: a walk's end under a smear tail, and one rotation's edges
     // (neighbouring rows, moving), are known to two bins; a cliff or summed rotations'
     // leading edge to the board's range sigma; r1's radius from width adds its own size.

@@ -7,6 +7,7 @@
 
 #include "shadowlean/sl_fx.h"
 #include "shadowlean/sl_incline.h"
+#include "shadowlean/sl_profile.h"
 
 #include "compiler.h"
 
@@ -174,8 +175,15 @@ static void observe(sl_tiltobs_t *o, sl_tiltobs_ring_t *r, const sl_target_t *g,
     sl_incline_result_t inc;
     inc.flag = (uint8_t)SL_INCLINE_INVALID;
     if (union_bounds(b, g, &r1u, &r2u)) {
-        inc = sl_incline_estimate(r1u, r2u, &b->geom[azi], b->range_sigma_um,
-                                  b->theta_sigma_cdeg);
+        // The far bound at the end of a walk over a smear tail is known to two bins
+        // (sl_profile.h, "Uncertainty of the bounds"), the union's inner bound (the mask's
+        // first bins over the group) to the board's quantisation.
+        uint32_t sr = b->range_sigma_um;
+        const uint32_t coarse = sl_profile_coarse_sigma_um(b->bin_size_um);
+        if ((g->flags & SL_TARGET_WALKED) != 0U && coarse > sr) {
+            sr = sl_incline_bounds_sigma_um(r1u, r2u, sr, coarse);
+        }
+        inc = sl_incline_estimate(r1u, r2u, &b->geom[azi], sr, b->theta_sigma_cdeg);
     }
     if (inc.flag != (uint8_t)SL_INCLINE_VALID) {
         o->stats.rejected++;

@@ -290,6 +290,10 @@ typedef enum sl_detect_reject {
                                        ///< from the pole): the bound is anywhere along it,
                                        ///< sigma holds it; a 3D-tilt observation that does
                                        ///< not count towards a fit's minimum (sl_tiltobs.h)
+#define SL_TARGET_WALKED 0x1000U       ///< r2 is where the range profile's walk over a smear
+                                       ///< tail stopped (sl_profile.h, step 4): known to two
+                                       ///< bins (sl_profile_coarse_sigma_um), which the
+                                       ///< 3D-tilt observation's sigma holds (sl_tiltobs.h)
 
 /// Detection parameters that are not (yet) board fields.
 typedef struct sl_detect_cfg {

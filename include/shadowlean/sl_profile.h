@@ -29,9 +29,15 @@
 /// A moving pole is at another range and azimuth every rotation, so rotations cannot be
 /// summed. Instead, after each rotation the caller reserves, for every track, the azimuths
 /// where it is expected next (sl_profile_reserve: its static-object prediction +-2; +-4
-/// for a pole leaning across the line of sight while slots are free); evidence
-/// claims nothing while moving. A target whose own slot holds fewer than `cfg.min_frames`
-/// rows is refined from the sum of this rotation's rows of its azimuth and its two
+/// for a pole leaning across the line of sight while slots are free). Evidence claims
+/// only the slots left free after that, and only for a row whose first run in the window
+/// ends two bins or more before the window's end (the ground at the shadow edge, and a wide
+/// return that reaches it, never qualify): a pole's first sightings, which no track
+/// expects yet, are refined too (round 2 session 24: `sl-eval driveby --realistic`, 576
+/// passes, 297 -> 306 of 432, with the walked far bound's sigma of sl_tiltobs.h, without
+/// which such an early sighting lengthened a fit's baseline with a far bound read 1-1.7 bins
+/// long). A target whose own slot holds fewer than `cfg.min_frames` rows is refined from
+/// the sum of this rotation's rows of its azimuth and its two
 /// neighbours when they belong to its detection group (adjacent azimuths, 0.9 deg apart,
 /// lie inside one beam width, 1.8 deg: the same pole at the same ranges, each with its own
 /// speckle), over the bins all of them cover: three rows, `stats.spatial`. Not a neighbour
@@ -504,8 +510,8 @@ typedef struct sl_profile {
     uint16_t slope_q8;      ///< calibrated tail slope (0: none yet)
     uint16_t cal_n;         ///< fits taken into slope_q8 (saturating)
     uint16_t n_live;        ///< slots in use
-    uint8_t moving;         ///< the last sl_profile_end_rotation had `reset`: no claims on
-                            ///< evidence, only sl_profile_reserve
+    uint8_t moving;         ///< the last sl_profile_end_rotation had `reset`: claims on
+                            ///< evidence only for runs ending clear of the window's end
     uint8_t clean_n;        ///< returns seen to end in a cliff that does not cut them off,
                             ///< less cut-off ones until there are SL_PROFILE_CAL_SMEAR_N
                             ///< ("Cut-off returns"; saturating at 255): with
@@ -537,8 +543,10 @@ sl_err_t sl_profile_init(sl_profile_t *pr, uint16_t azimuths, uint16_t near_bins
 
 /// One azimuth row: `power` (n bins from bin 0, 8-bit), this frame's threshold bits `bits`
 /// (layout sl_thresh.h, at least ceil(min(n, win)/32) words) and the detector's search
-/// window end `win` for this azimuth. Adds the row to the azimuth's slot, claiming one when
-/// the row has an occupied bit in [near, win). Rows of an azimuth out of range are ignored.
+/// window end `win` for this azimuth. Adds the row to the azimuth's slot, claiming a free one
+/// when the row has an occupied bit in [near, win) (while moving: only when the first run
+/// there ends two bins or more before `win`; `claim_full` counts only when stopped). Rows of
+/// an azimuth out of range are ignored.
 void sl_profile_row(sl_profile_t *pr, uint16_t az, const uint8_t *power, uint32_t n,
                     const uint32_t *bits, uint32_t win);
 
@@ -554,8 +562,9 @@ void sl_profile_assign(sl_profile_t *pr, const sl_target_t *targets, uint32_t n)
 /// While moving (after sl_profile_end_rotation with `reset`, which frees every slot): watch
 /// the azimuths `az - half .. az + half` (circular) where a track is expected next rotation,
 /// with bin0 = `bin_first` - lead_bins, each in a free slot (`reserve_full` counts the ones
-/// left out). Evidence alone claims no slot while moving (wide returns and the ground at the
-/// shadow edge would take them all in azimuth order). @return the azimuths now watched.
+/// left out). Evidence claims only what is left free while moving, and never for a run
+/// that reaches the shadow edge (the ground there would take every slot in azimuth order).
+/// @return the azimuths now watched.
 /// O(half x slots).
 uint32_t sl_profile_reserve(sl_profile_t *pr, uint16_t az, uint16_t bin_first, uint32_t half);
 

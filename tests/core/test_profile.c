@@ -97,16 +97,28 @@ static void test_profile_halves_reset_and_counts_full(void **state)
     assert_int_equal(s->frames, 0);
     assert_int_equal(pr.slot_of[5], SL_PROFILE_NONE);
     assert_int_equal(pr.n_live, 0);
-    // while moving, evidence claims no slot (only sl_profile_reserve does)
-    sl_profile_row(&pr, 5, row, 64, bits, 64);
+    // while moving, evidence claims no slot for a run that reaches within two bins of the
+    // window's end (the ground at the shadow edge), nor counts a full table for it ...
+    uint32_t edge[2] = {0U, 0xC0000000U}; // bins 62, 63 of the window [0, 64)
+    sl_profile_row(&pr, 5, row, 64, edge, 64);
+    edge[1] = 0x40000000U; // bin 62: its run ends one bin before the end
+    sl_profile_row(&pr, 6, row, 64, edge, 64);
     assert_int_equal(pr.slot_of[5], SL_PROFILE_NONE);
+    assert_int_equal(pr.slot_of[6], SL_PROFILE_NONE);
     assert_int_equal(pr.stats.claims, 1);
+    // ... but a free slot for one that ends clear of it: a pole no track expects yet
+    edge[1] = 0x20000000U; // bin 61: two clear bins (62, 63) before the end
+    sl_profile_row(&pr, 7, row, 64, edge, 64);
+    assert_true(pr.slot_of[7] != SL_PROFILE_NONE);
+    assert_int_equal(pr.stats.claims, 2);
+    sl_profile_end_rotation(&pr, true); // still moving: freed
+    assert_int_equal(pr.slot_of[7], SL_PROFILE_NONE);
     sl_profile_end_rotation(&pr, false); // stopped: evidence claims again
     // every slot in use: the next azimuth with evidence is counted, not claimed
     for (uint16_t a = 10; a < 10 + SL_CFG_PROFILE_SLOTS + 1; a++) {
         sl_profile_row(&pr, a, row, 64, bits, 64);
     }
-    assert_int_equal(pr.stats.claims, 1 + SL_CFG_PROFILE_SLOTS);
+    assert_int_equal(pr.stats.claims, 2 + SL_CFG_PROFILE_SLOTS);
     assert_int_equal(pr.stats.claim_full, 1);
     assert_int_equal(sl_profile_init(&pr, 0, 0, NULL), SL_ERR_ARG);
     c.max_frames = 300;

@@ -21,6 +21,7 @@
 
 #include "shadowlean/sl_board.h"
 #include "shadowlean/sl_tiltobs.h"
+#include "shadowlean/sl_profile.h"
 
 #include "../support/tilt_model.h"
 
@@ -603,6 +604,48 @@ static void test_ramps_are_observed_marked(void **state)
     }
 }
 
+// A far bound at the end of a walk over a smear tail (SL_TARGET_WALKED) is known to two bins
+// (sl_profile_coarse_sigma_um): the observation's sigma of tan(alpha) holds it, the inner
+// bound keeps the board's; without the flag both bounds have the board's sigma.
+static void test_a_walked_far_bound_is_observed_with_its_sigma(void **state)
+{
+    (void)state;
+    const sl_board_t *b = board();
+    const int64_t bin = b->bin_size_um;
+    uint16_t sig[2] = {0U, 0U};
+    for (int walked = 0; walked < 2; ++walked) {
+        assert_int_equal(sl_tiltobs_init(&obs, b), SL_OK);
+        sl_tiltobs_advance(&obs, true, 1000, 0, 250000U);
+        sl_target_t g;
+        memset(&g, 0, sizeof g);
+        g.az = 100;
+        g.bin_first = 70U;
+        g.bin_last = 79U;
+        g.r1_um = (uint32_t)(70 * bin + bin / 2);
+        g.r2_um = (uint32_t)(80 * bin);
+        g.r2_raw_um = g.r2_um;
+        g.incline_flag = SL_INCLINE_VALID;
+        g.flags = (uint16_t)(SL_TARGET_PROFILE | (walked ? SL_TARGET_WALKED : 0U));
+        const sl_tiltobs_ring_t *r = observe_one(&g);
+        const uint32_t coarse = sl_profile_coarse_sigma_um(b->bin_size_um);
+        const uint32_t sr = walked ? sl_incline_bounds_sigma_um(g.r1_um, g.r2_um,
+                                                                b->range_sigma_um, coarse)
+                                   : b->range_sigma_um;
+        const sl_incline_result_t inc = sl_incline_estimate(g.r1_um, g.r2_um, &b->geom[100], sr,
+                                                            b->theta_sigma_cdeg);
+        assert_int_equal(inc.flag, SL_INCLINE_VALID);
+        sl_tilt_obs_t want;
+        assert_true(sl_tilt_obs_make(&want, 0, 0, 0U, g.r1_um, inc.alpha_bam32, inc.sigma_cdeg,
+                                     inc.branch, &b->geom[100]));
+        assert_int_equal(r->obs[0].sigma_q16, want.sigma_q16);
+        assert_int_equal(r->obs[0].tan_q12, want.tan_q12);
+        sig[walked] = r->obs[0].sigma_q16;
+    }
+    // r2 of two bins (sigma b / sqrt(3), twice the board's b / sqrt(12)) on a far bound 10 bins
+    // past r1: the sigma of tan(alpha) grows by about half (733 -> 1,099 in Q16)
+    assert_true((uint32_t)sig[1] * 5U > (uint32_t)sig[0] * 7U);
+}
+
 // A 1 m/s drive-by of one pole of `psi` deg (3 m out, leaning along +x) over 16 rotations,
 // FITTED; its ring.
 static sl_tiltobs_ring_t *fitted_ring(double psi)
@@ -873,6 +916,7 @@ int main(void)
         cmocka_unit_test(test_more_tracks_than_rings_are_counted),
         cmocka_unit_test(test_union_extent_is_observed),
         cmocka_unit_test(test_ramps_are_observed_marked),
+        cmocka_unit_test(test_a_walked_far_bound_is_observed_with_its_sigma),
         cmocka_unit_test(test_fits_beyond_the_largest_tilt_are_inconsistent),
         cmocka_unit_test(test_ramps_do_not_make_a_fit),
         cmocka_unit_test(test_degenerate_inputs),
