@@ -138,7 +138,12 @@ void sl_profile_row(sl_profile_t *pr, uint16_t az, const uint8_t *power, uint32_
     }
     pr->n_live++;
     pr->stats.claims++;
-    slot_add(pr, slot_start(pr, i, az, first), power, n);
+    sl_profile_slot_t *s = slot_start(pr, i, az, first);
+    // A first sighting while moving (no track expects it: clutter, a pole's far edge) does
+    // not teach the stream's front part: a false front moves every r1 and clears the 3D-tilt
+    // histories (front_news).
+    s->lead_seen = pr->moving;
+    slot_add(pr, s, power, n);
 }
 
 void sl_profile_end_rotation(sl_profile_t *pr, bool reset)

@@ -111,6 +111,8 @@ static void test_profile_halves_reset_and_counts_full(void **state)
     sl_profile_row(&pr, 7, row, 64, edge, 64);
     assert_true(pr.slot_of[7] != SL_PROFILE_NONE);
     assert_int_equal(pr.stats.claims, 2);
+    // such a first sighting does not teach the stream's front part (counted as seen)
+    assert_int_equal(pr.slot[pr.slot_of[7]].lead_seen, 1);
     sl_profile_end_rotation(&pr, true); // still moving: freed
     assert_int_equal(pr.slot_of[7], SL_PROFILE_NONE);
     sl_profile_end_rotation(&pr, false); // stopped: evidence claims again
@@ -118,6 +120,7 @@ static void test_profile_halves_reset_and_counts_full(void **state)
     for (uint16_t a = 10; a < 10 + SL_CFG_PROFILE_SLOTS + 1; a++) {
         sl_profile_row(&pr, a, row, 64, bits, 64);
     }
+    assert_int_equal(pr.slot[pr.slot_of[10]].lead_seen, 0); // stopped: its rise may teach
     assert_int_equal(pr.stats.claims, 2 + SL_CFG_PROFILE_SLOTS);
     assert_int_equal(pr.stats.claim_full, 1);
     assert_int_equal(sl_profile_init(&pr, 0, 0, NULL), SL_ERR_ARG);
