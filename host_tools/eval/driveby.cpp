@@ -220,10 +220,11 @@ void dump_ring(const sl_tiltobs_ring_t &r, const sl_tilt_params_t &prm, const Ca
         sg[k] = o.sigma_q16 / 65536.0;
         mir[k] = o.mirrorable;
         std::printf("  obs %2u: radar (%8.3f, %8.3f) m bearing %8.3f deg r1 %6.3f m alpha %7.3f "
-                    "mirror %7.3f sigma %6.3f deg m%d true %7.3f {%d,%d,%u,%d,%d,%d,%d,%u,%u},\n",
+                    "mirror %7.3f sigma %6.3f deg m%d%s true %7.3f {%d,%d,%u,%d,%d,%d,%d,%u,%u},\n",
                     k, o.radar_x_um * 1e-6, o.radar_y_um * 1e-6, a[k] * 180 / M_PI, o.r1_um * 1e-6,
                     std::atan(t0[k]) * 180 / M_PI, std::atan(t1[k]) * 180 / M_PI,
                     sg[k] / (1 + t0[k] * t0[k]) * 180 / M_PI, o.mirrorable,
+                    (o.mark & SL_TILT_OBS_RAMP) != 0U ? " ramp" : "",
                     -std::atan(ttrue * std::cos(a[k] - ptrue)) * 180 / M_PI,
                     o.radar_x_um, o.radar_y_um, o.r1_um, o.cos_a_q15, o.sin_a_q15, o.tan_q12,
                     o.tan_mirror_q12, o.sigma_q16, o.mirrorable);
