@@ -6,7 +6,8 @@
 // rotation the pole's track's fit is read in the vehicle frame (sl_tiltobs_vehicle, what
 // PoleTilt carries). The LAST FITTED result of the pass is compared with the simulator's
 // truth: psi (tilt_deg), phi (lean_deg - heading, CCW from forward), the base's lateral
-// offset. Prints one line per pole and a summary against the bounds.
+// offset. Prints one line per pole and a summary against the bounds, and how many
+// AMBIGUOUS passes held observations that cannot tell the mirror (mirror_separation).
 #include "driveby.h"
 
 #include <algorithm>
@@ -39,6 +40,8 @@ struct Outcome {
     double psi = 0, phi = 0, base_y = 0;
     int quality = -1, n_obs = 0, rotation = -1;
     uint16_t slope_q8 = 0, cal_n = 0; // the profile's tail calibration at the end of the pass
+    double separation = -1;           // mirror_separation() of the result's observations
+                                      // (-1: no ring; HUGE_VAL: no other reading differs)
 };
 
 // One pass's material for the plot: the fitted ring's observations and fit at the end of the
@@ -53,12 +56,12 @@ struct PlotData {
 struct RunCtx {
     sl_pipeline_t *p = nullptr;
     PlotData *plot = nullptr;
-    // --dump: every ring as of the previous rotation (what the fit read at the end of it),
-    // and the one behind the pass's reported result.
+    // Every ring as of the previous rotation (what the fit read at the end of it), and the
+    // one behind the pass's reported result (--dump prints it; the separation reads it).
     bool dump = false;
     sl_tiltobs_ring_t prev[SL_CFG_TILT_TRACKS]{};
     sl_tiltobs_ring_t fitted_ring{};
-    sl_tiltobs_ring_t other_ring{}; // --dump: the fullest ring when no fit was FITTED/AMBIGUOUS
+    sl_tiltobs_ring_t other_ring{}; // the fullest ring when no fit was FITTED/AMBIGUOUS
     FILE *obs_log = nullptr; // --obs-log: every new fit of the pole's ring, one JSON line
     const Case *kase = nullptr;
     sl_tilt_result_t logged[SL_CFG_TILT_TRACKS]{};
@@ -142,10 +145,8 @@ void on_rotation(void *ctx, const sl_pipeline_rotation_t *r)
         if (ring.count >= c->other_n) {
             c->other_n = ring.count;
             c->other_q = v.quality;
-            if (c->dump) { // --dump of a pass without a FITTED or AMBIGUOUS result
-                c->other_ring = c->prev[static_cast<size_t>(&ring - &t->ring[0])];
-                c->other_ring.res = ring.res;
-            }
+            c->other_ring = c->prev[static_cast<size_t>(&ring - &t->ring[0])];
+            c->other_ring.res = ring.res;
         }
         if (v.quality != SL_TILT_FITTED && v.quality != SL_TILT_AMBIGUOUS) {
             continue;
@@ -158,9 +159,7 @@ void on_rotation(void *ctx, const sl_pipeline_rotation_t *r)
         }
     }
     if (best == nullptr || be > 1.0) {
-        if (c->dump || c->obs_log != nullptr) {
-            std::copy(std::begin(t->ring), std::end(t->ring), std::begin(c->prev));
-        }
+        std::copy(std::begin(t->ring), std::end(t->ring), std::begin(c->prev));
         return;
     }
     Outcome o;
@@ -178,15 +177,134 @@ void on_rotation(void *ctx, const sl_pipeline_rotation_t *r)
             c->plot->have = true;
             c->plot->ring = *best;
         }
-        if (c->dump) { // the observations the fit read: the ring as of the previous rotation
-            const auto idx = static_cast<size_t>(best - &t->ring[0]);
-            c->fitted_ring = c->prev[idx];
-            c->fitted_ring.res = best->res;
+        // the observations the fit read: the ring as of the previous rotation
+        const auto idx = static_cast<size_t>(best - &t->ring[0]);
+        c->fitted_ring = c->prev[idx];
+        c->fitted_ring.res = best->res;
+    }
+    std::copy(std::begin(t->ring), std::end(t->ring), std::begin(c->prev));
+}
+
+// A ring's observations in the order they were recorded (oldest first).
+std::vector<sl_tilt_obs_t> ring_obs(const sl_tiltobs_ring_t &r)
+{
+    std::vector<sl_tilt_obs_t> obs(r.obs, r.obs + r.count); // ring order: oldest at head when full
+    if (r.count == SL_CFG_TILT_OBS_PER_TRACK) {
+        std::rotate(obs.begin(), obs.begin() + r.head, obs.end());
+    }
+    return obs;
+}
+
+// One reading of the fold: bit k of `ch` set = measurement k read as its mirror; the tilt
+// vector solved for it and its chi-square with the stated sigmas.
+struct FoldCand {
+    uint64_t ch;
+    double tx, ty, x2;
+};
+
+// Every reading sl_tilt_fit considers (sl_tilt.h, "The fold": the mirrored measurements are
+// one circular interval of the mirrorable ones in bearing order, or none, or all), each
+// solved by weighted least squares in double: the estimator's weights (sigma_min / sigma)^2,
+// chi-square with the stated sigmas. a: bearings (rad); t0 / t1: tan alpha as read / its
+// mirror; sg: sigma of tan alpha; mir: mirrorable. Sorted by chi-square, best first.
+std::vector<FoldCand> fold_readings(const std::vector<double> &a, const std::vector<double> &t0,
+                                    const std::vector<double> &t1, const std::vector<double> &sg,
+                                    const std::vector<int> &mir)
+{
+    const size_t n = a.size();
+    double w0 = 1e300;
+    for (size_t k = 0; k < n; ++k) {
+        w0 = std::min(w0, sg[k]);
+    }
+    std::vector<unsigned> ord;
+    double mc = 0, ms = 0;
+    for (unsigned k = 0; k < n; ++k) {
+        if (mir[k] != 0) {
+            ord.push_back(k);
+            mc += std::cos(a[k]);
+            ms += std::sin(a[k]);
         }
     }
-    if (c->dump || c->obs_log != nullptr) {
-        std::copy(std::begin(t->ring), std::end(t->ring), std::begin(c->prev));
+    const double ref = std::atan2(ms, mc);
+    std::stable_sort(ord.begin(), ord.end(), [&](unsigned x, unsigned y) {
+        return std::remainder(a[x] - ref, 2 * M_PI) < std::remainder(a[y] - ref, 2 * M_PI);
+    });
+    std::vector<FoldCand> cs;
+    const size_t m = ord.size();
+    for (size_t len = 0; len <= m; ++len) {
+        const size_t starts = (len == 0 || len == m) ? 1 : m;
+        for (size_t i = 0; i < starts; ++i) {
+            uint64_t ch = 0;
+            for (size_t j = 0; j < len; ++j) {
+                ch |= uint64_t{1} << ord[(i + j) % m];
+            }
+            double A = 0, B = 0, C = 0, U = 0, V = 0;
+            for (size_t k = 0; k < n; ++k) {
+                const double w = (w0 / sg[k]) * (w0 / sg[k]);
+                const double cc = std::cos(a[k]), ss = std::sin(a[k]);
+                const double tt = ((ch >> k) & 1U) ? t1[k] : t0[k];
+                A += w * cc * cc; B += w * cc * ss; C += w * ss * ss; U += w * cc * tt; V += w * ss * tt;
+            }
+            const double det = A * C - B * B;
+            if (!(det > 1e-12 * A * C)) {
+                continue; // one bearing: no reading determines t
+            }
+            const double tx = -(C * U - B * V) / det, ty = -(A * V - B * U) / det;
+            double x2 = 0;
+            for (size_t k = 0; k < n; ++k) {
+                const double tt = ((ch >> k) & 1U) ? t1[k] : t0[k];
+                const double res = (tt + tx * std::cos(a[k]) + ty * std::sin(a[k])) / sg[k];
+                x2 += res * res;
+            }
+            cs.push_back({ch, tx, ty, x2});
+        }
     }
+    std::sort(cs.begin(), cs.end(), [](const FoldCand &x, const FoldCand &y) { return x.x2 < y.x2; });
+    return cs;
+}
+
+// The mirror's separation at the truth: how far the observations of a pass could tell the
+// fold's other readings from the true pole if every reading were exact. The observations'
+// bearings, stated sigmas and fold (which are mirrorable, and each one's mirror line
+// beta - theta_k = alpha + alpha', from its two readings) are kept; the readings are
+// replaced by the true pole's in-plane inclination (each mirrorable one on the side of the
+// fold it was read on) and its mirror. The smallest chi-square of a reading whose tilt
+// vector is a different answer to sl_tilt_fit's ambiguity test (|t' - t| > max(0.035,
+// 0.3 |t|)) is the noncentrality of the mirror test: the chi-square difference the fit sees
+// on average when the errors are as stated. Below 9, no 3-sigma rule tells the mirror from
+// the truth on these observations; HUGE_VAL when no other reading differs (nothing read on
+// the fold's far branch). Straight passes only: the odometry frame is the vehicle's.
+double mirror_separation(const std::vector<sl_tilt_obs_t> &obs, const Case &kc)
+{
+    const double tn = std::tan(kc.psi * M_PI / 180), ph = kc.phi_v * M_PI / 180;
+    const double tx = tn * std::cos(ph), ty = tn * std::sin(ph);
+    const size_t n = obs.size();
+    std::vector<double> a(n), t0(n), t1(n), sg(n);
+    std::vector<int> mir(n);
+    for (size_t k = 0; k < n; ++k) {
+        const sl_tilt_obs_t &o = obs[k];
+        a[k] = std::atan2(o.sin_a_q15, o.cos_a_q15);
+        sg[k] = o.sigma_q16 / 65536.0;
+        mir[k] = o.mirrorable;
+        const double tt = -(tx * std::cos(a[k]) + ty * std::sin(a[k]));
+        t0[k] = t1[k] = tt;
+        if (o.mirrorable != 0U) {
+            const double m0 = o.tan_q12 / 4096.0, m1 = o.tan_mirror_q12 / 4096.0;
+            const double mt = std::tan(std::atan(m0) + std::atan(m1) - std::atan(tt));
+            if (std::fabs(mt - m0) < std::fabs(tt - m0)) { // read as the mirror of the truth
+                t0[k] = mt;
+            } else {
+                t1[k] = mt;
+            }
+        }
+    }
+    const double apart = std::max(0.035, 0.3 * tn);
+    for (const FoldCand &c : fold_readings(a, t0, t1, sg, mir)) {
+        if (std::hypot(c.tx - tx, c.ty - ty) > apart) {
+            return c.x2; // the best such reading (sorted)
+        }
+    }
+    return HUGE_VAL;
 }
 
 // --dump: the observations behind a pass's result and every interval reading of the fold,
@@ -196,10 +314,7 @@ void dump_ring(const sl_tiltobs_ring_t &r, const sl_tilt_params_t &prm, const Ca
 {
     const double ttrue = std::tan(kc.psi * M_PI / 180), ptrue = kc.phi_v * M_PI / 180;
     const unsigned n = r.count;
-    std::vector<sl_tilt_obs_t> obs(r.obs, r.obs + n); // ring order: oldest at head when full
-    if (n == SL_CFG_TILT_OBS_PER_TRACK) {
-        std::rotate(obs.begin(), obs.begin() + r.head, obs.end());
-    }
+    const std::vector<sl_tilt_obs_t> obs = ring_obs(r);
     sl_tilt_work_t wk;
     sl_tilt_result_t re;
     (void)sl_tilt_fit(obs.data(), obs.size(), &prm, &wk, &re);
@@ -229,60 +344,16 @@ void dump_ring(const sl_tiltobs_ring_t &r, const sl_tilt_params_t &prm, const Ca
                     o.radar_x_um, o.radar_y_um, o.r1_um, o.cos_a_q15, o.sin_a_q15, o.tan_q12,
                     o.tan_mirror_q12, o.sigma_q16, o.mirrorable);
     }
-    double w0 = 1e300;
-    for (unsigned k = 0; k < n; ++k) {
-        w0 = std::min(w0, sg[k]);
-    }
-    std::vector<unsigned> ord;
-    double mc = 0, ms = 0;
-    for (unsigned k = 0; k < n; ++k) {
-        if (mir[k] != 0) {
-            ord.push_back(k);
-            mc += std::cos(a[k]);
-            ms += std::sin(a[k]);
-        }
-    }
-    const double ref = std::atan2(ms, mc);
-    std::stable_sort(ord.begin(), ord.end(), [&](unsigned x, unsigned y) {
-        return std::remainder(a[x] - ref, 2 * M_PI) < std::remainder(a[y] - ref, 2 * M_PI);
-    });
-    struct Cand {
-        uint64_t ch;
-        double tx, ty, x2;
-    };
-    std::vector<Cand> cs;
-    const size_t m = ord.size();
-    for (size_t len = 0; len <= m; ++len) {
-        const size_t starts = (len == 0 || len == m) ? 1 : m;
-        for (size_t i = 0; i < starts; ++i) {
-            uint64_t ch = 0;
-            for (size_t j = 0; j < len; ++j) {
-                ch |= uint64_t{1} << ord[(i + j) % m];
-            }
-            double A = 0, B = 0, C = 0, U = 0, V = 0;
-            for (unsigned k = 0; k < n; ++k) {
-                const double w = (w0 / sg[k]) * (w0 / sg[k]);
-                const double cc = std::cos(a[k]), ss = std::sin(a[k]);
-                const double tt = ((ch >> k) & 1U) ? t1[k] : t0[k];
-                A += w * cc * cc; B += w * cc * ss; C += w * ss * ss; U += w * cc * tt; V += w * ss * tt;
-            }
-            const double det = A * C - B * B;
-            const double tx = -(C * U - B * V) / det, ty = -(A * V - B * U) / det;
-            double x2 = 0;
-            for (unsigned k = 0; k < n; ++k) {
-                const double tt = ((ch >> k) & 1U) ? t1[k] : t0[k];
-                const double res = (tt + tx * std::cos(a[k]) + ty * std::sin(a[k])) / sg[k];
-                x2 += res * res;
-            }
-            cs.push_back({ch, tx, ty, x2});
-        }
-    }
-    std::sort(cs.begin(), cs.end(), [](const Cand &x, const Cand &y) { return x.x2 < y.x2; });
+    const std::vector<FoldCand> cs = fold_readings(a, t0, t1, sg, mir);
     for (size_t i = 0; i < cs.size() && i < 12; ++i) {
         std::printf("  cand mask %08llx chi2 %9.2f psi %6.2f phi %7.1f\n",
                     static_cast<unsigned long long>(cs[i].ch), cs[i].x2,
                     std::atan(std::hypot(cs[i].tx, cs[i].ty)) * 180 / M_PI,
                     std::atan2(cs[i].ty, cs[i].tx) * 180 / M_PI);
+    }
+    if (n >= SL_TILT_MIN_OBS) {
+        std::printf("  separation at the truth: %.2f (below 9 these observations cannot tell the "
+                    "mirror from the truth at 3 sigma)\n", mirror_separation(obs, kc));
     }
 }
 
@@ -438,6 +509,10 @@ Outcome run_case(const std::string &board_name, const Case &k, bool realistic, i
     }
     o.slope_q8 = p->prof.slope_q8;
     o.cal_n = p->prof.cal_n;
+    const sl_tiltobs_ring_t &rr = ctx.fitted_ring.track_id != 0U ? ctx.fitted_ring : ctx.other_ring;
+    if (rr.track_id != 0U && rr.count >= SL_TILT_MIN_OBS) {
+        o.separation = mirror_separation(ring_obs(rr), k);
+    }
     return o;
 }
 
@@ -577,9 +652,14 @@ void usage(FILE *out)
                  "  with that value (repeatable; each pass keeps its seed of the whole sweep).\n"
                  "  --dump: after each pass, detection's rejections, the tracker's and the rings'\n"
                  "  counters (why a pass has no track), the observations behind its result and the\n"
-                 "  fit's interval readings of the fold (double precision), best first.\n"
+                 "  fit's interval readings of the fold (double precision), best first, and the\n"
+                 "  mirror's separation at the truth (below 9 the observations cannot tell it).\n"
                  "  --obs-log FILE: every new fit of the pole's ring during each pass as one JSON line\n"
-                 "  (the case, the observations the fit read as stored, the result).\n");
+                 "  (the case, the observations the fit read as stored, the result).\n"
+                 "  The last line counts the AMBIGUOUS passes whose observations could not tell\n"
+                 "  the mirror from the truth even if every reading were exact (the separation:\n"
+                 "  the smallest chi-square, with the stated sigmas, of a reading of the fold with\n"
+                 "  a different answer, on the true pole's readings at the pass's bearings).\n");
 }
 
 } // namespace
@@ -620,6 +700,8 @@ int cmd_driveby(int argc, char **argv)
             obs_log_path = argv[++i];
         } else if (a == "--dump") {
             dump = true;
+        } else if (a == "--quiet" || a == "-q") {
+            // accepted as by every sl-eval command; a sweep prints no progress to silence
         } else if ((a == "--psi" || a == "--phi" || a == "--offset") && i + 1 < argc) {
             double v = 0;
             if (!num(argv[++i], &v)) {
@@ -694,6 +776,7 @@ int cmd_driveby(int argc, char **argv)
     std::printf("%5s %5s %6s %6s | %-9s %3s %6s %6s %7s %7s %7s\n", "v", "psi", "phi", "offset",
                 "quality", "n", "psi^", "err", "phi^", "err", "off err");
     int n = 0, n_check = 0, n_ok = 0, n_fitted = 0, n_amb = 0;
+    int amb5 = 0, amb5_insep = 0, ok_insep = 0; // psi >= 5: AMBIGUOUS; separation below 9
     double max_psi = 0, max_phi = 0, max_off = 0;
     int seed = 1;
     for (double v : speeds) {
@@ -723,6 +806,10 @@ int cmd_driveby(int argc, char **argv)
                             ++n_check;
                             ok = o.fitted && std::fabs(e_psi) <= psi_tol && std::fabs(e_phi) <= phi_tol;
                             n_ok += ok ? 1 : 0;
+                            const bool insep = o.separation >= 0 && o.separation < 9.0;
+                            amb5 += o.ambiguous ? 1 : 0;
+                            amb5_insep += (o.ambiguous && insep) ? 1 : 0;
+                            ok_insep += (ok && insep) ? 1 : 0;
                             if (o.fitted) {
                                 max_psi = std::max(max_psi, std::fabs(e_psi));
                                 max_phi = std::max(max_phi, std::fabs(e_phi));
@@ -743,6 +830,10 @@ int cmd_driveby(int argc, char **argv)
     std::printf("driveby: %d passes, %d FITTED, %d AMBIGUOUS; psi >= 5: %d of %d within bounds; "
                 "max |err| of FITTED: psi %.2f deg, phi %.1f deg, offset %.2f m\n",
                 n, n_fitted, n_amb, n_ok, n_check, max_psi, max_phi, max_off);
+    std::printf("driveby separation: psi >= 5: %d AMBIGUOUS, %d of them on observations whose "
+                "mirror's separation at the truth is below 9 (no 3-sigma rule tells it from the "
+                "truth); %d within bounds on such observations\n",
+                amb5, amb5_insep, ok_insep);
     if (obs_log != nullptr) {
         std::fclose(obs_log);
     }

@@ -75,7 +75,8 @@ void usage(FILE *out)
                  "      --realistic: the tail slope self-fitted on a calibration pass first (--cold: none).\n"
                  "      --psi/--phi/--offset (repeatable): only those passes of the sweep; --dump: per pass\n"
                  "      the rejection counters, the observations behind the result and the fold's\n"
-                 "      interval readings; --obs-log: every fit of the pass as one JSON line.\n"
+                 "      interval readings and the mirror's separation at the truth; --obs-log: every fit\n"
+                 "      of the pass as one JSON line.\n"
                  "Progress goes to stderr when it is a terminal; -q/--quiet silences it.\n");
 }
 

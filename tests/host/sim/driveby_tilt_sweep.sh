@@ -8,7 +8,9 @@
 # observations back); every FITTED pass of psi >= 5 within 10 deg of direction (a FITTED
 # result is never a confident wrong direction: the passes left outside are AMBIGUOUS with
 # the right values, or FITTED within their sigmas a little over 1 deg of tilt); every FITTED
-# fit along the passes within 3 of its stated sigmas.
+# fit along the passes within 3 of its stated sigmas; the separation line (how many AMBIGUOUS
+# passes held observations that cannot tell the mirror from the truth even if exact) counts
+# the table's AMBIGUOUS passes.
 set -u
 EVAL=$1; FWS=$2; OUT=$3
 mkdir -p "$OUT"
@@ -24,4 +26,13 @@ bad=$(awk '$5 == "|" && $6 == "FITTED" && $2 >= 5 { p = $11 < 0 ? -$11 : $11; if
     "$OUT/sweep.txt")
 [ -z "$bad" ] || { echo "FAIL: FITTED more than 10 deg off in direction:"; echo "$bad"; exit 1; }
 python3 "$FWS" "$OUT/sweep.jsonl" || exit 1
-echo "driveby_tilt_sweep: $within of 432 within 1 deg / 10 deg, no FITTED direction off: OK"
+# The separation line: its AMBIGUOUS count is the table's (psi >= 5), and it splits them.
+grep '^driveby separation:' "$OUT/sweep.txt"
+amb=$(awk '$5 == "|" && $6 == "AMBIGUOUS" && $2 >= 5' "$OUT/sweep.txt" | wc -l)
+sep=$(sed -n 's/^driveby separation: psi >= 5: \([0-9]*\) AMBIGUOUS, \([0-9]*\) of them.*/\1 \2/p' "$OUT/sweep.txt")
+[ -n "$sep" ] || { echo "FAIL: no separation line"; exit 1; }
+set -- $sep
+[ "$1" -eq "$amb" ] && [ "$2" -le "$1" ] ||
+    { echo "FAIL: separation line counts $1 / $2 AMBIGUOUS, the table $amb"; exit 1; }
+echo "driveby_tilt_sweep: $within of 432 within 1 deg / 10 deg, no FITTED direction off;" \
+     "$amb AMBIGUOUS, $2 of them on observations that cannot separate the mirror: OK"
