@@ -195,6 +195,30 @@ std::vector<sl_tilt_obs_t> ring_obs(const sl_tiltobs_ring_t &r)
     return obs;
 }
 
+// What the fold's readings are solved from, one entry per observation: a: bearing (rad);
+// t0 / t1: tan alpha as read / its mirror; sg: sigma of tan alpha; mir: mirrorable.
+struct FoldInput {
+    std::vector<double> a, t0, t1, sg;
+    std::vector<int> mir;
+};
+
+// The observations as the fit read them.
+FoldInput fold_input(const std::vector<sl_tilt_obs_t> &obs)
+{
+    const size_t n = obs.size();
+    FoldInput f{std::vector<double>(n), std::vector<double>(n), std::vector<double>(n),
+                std::vector<double>(n), std::vector<int>(n)};
+    for (size_t k = 0; k < n; ++k) {
+        const sl_tilt_obs_t &o = obs[k];
+        f.a[k] = std::atan2(o.sin_a_q15, o.cos_a_q15);
+        f.t0[k] = o.tan_q12 / 4096.0;
+        f.t1[k] = o.tan_mirror_q12 / 4096.0;
+        f.sg[k] = o.sigma_q16 / 65536.0;
+        f.mir[k] = o.mirrorable;
+    }
+    return f;
+}
+
 // One reading of the fold: bit k of `ch` set = measurement k read as its mirror; the tilt
 // vector solved for it and its chi-square with the stated sigmas.
 struct FoldCand {
@@ -205,12 +229,11 @@ struct FoldCand {
 // Every reading sl_tilt_fit considers (sl_tilt.h, "The fold": the mirrored measurements are
 // one circular interval of the mirrorable ones in bearing order, or none, or all), each
 // solved by weighted least squares in double: the estimator's weights (sigma_min / sigma)^2,
-// chi-square with the stated sigmas. a: bearings (rad); t0 / t1: tan alpha as read / its
-// mirror; sg: sigma of tan alpha; mir: mirrorable. Sorted by chi-square, best first.
-std::vector<FoldCand> fold_readings(const std::vector<double> &a, const std::vector<double> &t0,
-                                    const std::vector<double> &t1, const std::vector<double> &sg,
-                                    const std::vector<int> &mir)
+// chi-square with the stated sigmas. Sorted by chi-square, best first.
+std::vector<FoldCand> fold_readings(const FoldInput &f)
 {
+    const std::vector<double> &a = f.a, &t0 = f.t0, &t1 = f.t1, &sg = f.sg;
+    const std::vector<int> &mir = f.mir;
     const size_t n = a.size();
     double w0 = 1e300;
     for (size_t k = 0; k < n; ++k) {
@@ -278,28 +301,22 @@ double mirror_separation(const std::vector<sl_tilt_obs_t> &obs, const Case &kc)
 {
     const double tn = std::tan(kc.psi * M_PI / 180), ph = kc.phi_v * M_PI / 180;
     const double tx = tn * std::cos(ph), ty = tn * std::sin(ph);
-    const size_t n = obs.size();
-    std::vector<double> a(n), t0(n), t1(n), sg(n);
-    std::vector<int> mir(n);
-    for (size_t k = 0; k < n; ++k) {
-        const sl_tilt_obs_t &o = obs[k];
-        a[k] = std::atan2(o.sin_a_q15, o.cos_a_q15);
-        sg[k] = o.sigma_q16 / 65536.0;
-        mir[k] = o.mirrorable;
-        const double tt = -(tx * std::cos(a[k]) + ty * std::sin(a[k]));
-        t0[k] = t1[k] = tt;
-        if (o.mirrorable != 0U) {
-            const double m0 = o.tan_q12 / 4096.0, m1 = o.tan_mirror_q12 / 4096.0;
+    FoldInput f = fold_input(obs);
+    for (size_t k = 0; k < obs.size(); ++k) {
+        const double m0 = f.t0[k], m1 = f.t1[k]; // as read
+        const double tt = -(tx * std::cos(f.a[k]) + ty * std::sin(f.a[k]));
+        f.t0[k] = f.t1[k] = tt;
+        if (f.mir[k] != 0) {
             const double mt = std::tan(std::atan(m0) + std::atan(m1) - std::atan(tt));
             if (std::fabs(mt - m0) < std::fabs(tt - m0)) { // read as the mirror of the truth
-                t0[k] = mt;
+                f.t0[k] = mt;
             } else {
-                t1[k] = mt;
+                f.t1[k] = mt;
             }
         }
     }
     const double apart = std::max(0.035, 0.3 * tn);
-    for (const FoldCand &c : fold_readings(a, t0, t1, sg, mir)) {
+    for (const FoldCand &c : fold_readings(f)) {
         if (std::hypot(c.tx - tx, c.ty - ty) > apart) {
             return c.x2; // the best such reading (sorted)
         }
@@ -325,15 +342,10 @@ void dump_ring(const sl_tiltobs_ring_t &r, const sl_tilt_params_t &prm, const Ca
                 re.quality, re.psi_cdeg / 100.0, re.phi_cdeg / 100.0, re.chi2_q8 / 256.0,
                 re.chi2_other_q8 / 256.0, re.mirrored_mask,
                 (re.tx_q24 == r.res.tx_q24 && re.ty_q24 == r.res.ty_q24) ? " (same)" : " (DIFFERS)");
-    std::vector<double> a(n), t0(n), t1(n), sg(n);
-    std::vector<int> mir(n);
+    const FoldInput f = fold_input(obs);
+    const std::vector<double> &a = f.a, &t0 = f.t0, &t1 = f.t1, &sg = f.sg;
     for (unsigned k = 0; k < n; ++k) {
         const sl_tilt_obs_t &o = obs[k];
-        a[k] = std::atan2(o.sin_a_q15, o.cos_a_q15);
-        t0[k] = o.tan_q12 / 4096.0;
-        t1[k] = o.tan_mirror_q12 / 4096.0;
-        sg[k] = o.sigma_q16 / 65536.0;
-        mir[k] = o.mirrorable;
         std::printf("  obs %2u: radar (%8.3f, %8.3f) m bearing %8.3f deg r1 %6.3f m alpha %7.3f "
                     "mirror %7.3f sigma %6.3f deg m%d%s true %7.3f {%d,%d,%u,%d,%d,%d,%d,%u,%u},\n",
                     k, o.radar_x_um * 1e-6, o.radar_y_um * 1e-6, a[k] * 180 / M_PI, o.r1_um * 1e-6,
@@ -344,7 +356,7 @@ void dump_ring(const sl_tiltobs_ring_t &r, const sl_tilt_params_t &prm, const Ca
                     o.radar_x_um, o.radar_y_um, o.r1_um, o.cos_a_q15, o.sin_a_q15, o.tan_q12,
                     o.tan_mirror_q12, o.sigma_q16, o.mirrorable);
     }
-    const std::vector<FoldCand> cs = fold_readings(a, t0, t1, sg, mir);
+    const std::vector<FoldCand> cs = fold_readings(f);
     for (size_t i = 0; i < cs.size() && i < 12; ++i) {
         std::printf("  cand mask %08llx chi2 %9.2f psi %6.2f phi %7.1f\n",
                     static_cast<unsigned long long>(cs[i].ch), cs[i].x2,
