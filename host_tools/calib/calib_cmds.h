@@ -33,4 +33,19 @@ struct ElongArgs {
 };
 int cmd_elongation(const ElongArgs &a);
 
+struct ResponseArgs {
+    std::string input;              ///< capture file or Oxford folder
+    std::string board;              ///< geometry for streams without a Configuration
+    std::string out_ini;            ///< the measured drops as a [response] section
+    double bin_size_m = 0;          ///< > 0: override the capture's / board's bin size
+    double min_range_m = 5.0;       ///< peaks and floor from this range on (beyond the body)
+    double max_range_m = 100.0;     ///< ... up to this range
+    bool linear = false;            ///< the value scale: linear in power (else log2)
+    double values_per_octave = 6.02; ///< log2 scale: values per octave of power
+    double max_diff = -1;           ///< >= 0: exit 1 when an offset differs from the
+    double down_to = 40;            ///< CTS350-X prior by more (down to this drop)
+    bool quiet = false;
+};
+int cmd_response(const ResponseArgs &a);
+
 } // namespace sl::calib

@@ -20,6 +20,15 @@
 //     [detect]. Truth: a list CSV (capture,range_m[,r2_m]) or one sl-sim truth CSV per
 //     capture (README.md). Without --board: paper-bench (the paper's calibration set-up).
 //
+//   sl-calib response CAPTURE|OXFORD_DIR --board NAME [--out-ini FILE] [--min-m M] [--max-m M]
+//        [--bin-size-m M] [--linear | --values-per-octave V] [--max-diff X [--down-to Y]]
+//     The radar's range response and noise floor, measured by the core's learner
+//     (sl_response.h) over every row from --min-m to --max-m (default 5-100 m; an Oxford folder
+//     is read row by row in full, a capture as far as its region of interest): isolated strong returns,
+//     the running median of their drop per offset; printed against the built-in CTS350-X
+//     lobe; --out-ini writes the [response] section; --max-diff exits 1 when an offset
+//     whose prior drop is at most --down-to values differs by more.
+//
 // Exit status: 0 done, 1 error (I/O, bad data), 2 usage.
 #include <cstdio>
 #include <cstdlib>
@@ -42,7 +51,10 @@ void usage(FILE *out)
         "  sl-calib elongation CAPTURE... --truth FILE [--truth FILE...] [--board NAME]\n"
         "      [--out-ini FILE] [--png FILE] [--csv FILE] [--points N] [--mask-frames N]\n"
         "      [--threshold T] [--bin-size-m M]      (default board: paper-bench)\n"
-        "  Both take -q/--quiet: no progress on stderr (shown only when it is a terminal).\n",
+        "  sl-calib response CAPTURE|OXFORD_DIR --board NAME [--out-ini FILE] [--min-m M]\n"
+        "      [--max-m M] [--bin-size-m M] [--linear | --values-per-octave V]\n"
+        "      [--max-diff VALUES [--down-to VALUES]]\n"
+        "  Each takes -q/--quiet: no progress on stderr (shown only when it is a terminal).\n",
         out);
 }
 
@@ -75,10 +87,11 @@ int main(int argc, char **argv)
         return info;
     }
     if (argc < 2) {
-        return sl_cli_usage_error("sl-calib", "missing command (shadow or elongation)", usage);
+        return sl_cli_usage_error("sl-calib", "missing command (shadow, elongation or response)",
+                                  usage);
     }
     const std::string cmd = argv[1];
-    if (cmd == "shadow" || cmd == "elongation") {
+    if (cmd == "shadow" || cmd == "elongation" || cmd == "response") {
         const int sub = sl_cli_info(argc - 1, argv + 1, "sl-calib", usage);
         if (sub != SL_CLI_CONTINUE) {
             return sub;
@@ -134,6 +147,55 @@ int main(int argc, char **argv)
             return sl_cli_usage_error("sl-calib", "shadow: missing --board NAME", usage);
         }
         return sl::calib::cmd_shadow(a);
+    }
+    if (cmd == "response") {
+        sl::calib::ResponseArgs a;
+        for (int i = 2; i < argc; i++) {
+            const std::string o = argv[i];
+            const bool has = i + 1 < argc;
+            double v = 0;
+            if (o == "--quiet" || o == "-q") {
+                a.quiet = true;
+            } else if (o == "--board" && has) {
+                a.board = argv[++i];
+            } else if (o == "--out-ini" && has) {
+                a.out_ini = argv[++i];
+            } else if (o == "--linear") {
+                a.linear = true;
+            } else if (o == "--bin-size-m" && has && num(argv[i + 1], v) && v > 0) {
+                a.bin_size_m = v;
+                i++;
+            } else if (o == "--min-m" && has && num(argv[i + 1], v) && v >= 0) {
+                a.min_range_m = v;
+                i++;
+            } else if (o == "--max-m" && has && num(argv[i + 1], v) && v > 0) {
+                a.max_range_m = v;
+                i++;
+            } else if (o == "--values-per-octave" && has && num(argv[i + 1], v) && v >= 1 &&
+                       v <= 16) {
+                a.values_per_octave = v;
+                i++;
+            } else if (o == "--max-diff" && has && num(argv[i + 1], v) && v >= 0) {
+                a.max_diff = v;
+                i++;
+            } else if (o == "--down-to" && has && num(argv[i + 1], v) && v > 0) {
+                a.down_to = v;
+                i++;
+            } else if ((o[0] != '-' || o == "-") && a.input.empty()) {
+                a.input = o;
+            } else {
+                return bad_arg(o, has, argv[i],
+                               {"--board", "--out-ini", "--bin-size-m", "--min-m", "--max-m",
+                                "--values-per-octave", "--max-diff", "--down-to"});
+            }
+        }
+        if (a.input.empty()) {
+            return sl_cli_usage_error("sl-calib", "response: missing CAPTURE|OXFORD_DIR", usage);
+        }
+        if (a.board.empty()) {
+            return sl_cli_usage_error("sl-calib", "response: missing --board NAME", usage);
+        }
+        return sl::calib::cmd_response(a);
     }
 #ifdef SL_CALIB_ELONG
     if (cmd == "elongation") {
