@@ -14,6 +14,7 @@
 #define TOL_Q8 4        // converged below 1/64 bin
 #define NORM_BITS 20    // the window's peak is normalised to ~2^20
 #define JT_MAX ((int64_t)1 << 20) // scaled Jacobian and residual clamp (Q14: 64)
+#define LEVEL_MAX ((uint64_t)1 << 36) // the level's bound (the window's powers are ~2^20)
 
 typedef struct pieces {
     int32_t x[SL_RFIT_PIECES + 1]; // breakpoints, bins Q8 (window coordinates)
@@ -29,6 +30,8 @@ typedef struct ctx {
     int64_t w_q16;  // looks, Q16
     uint16_t evals;
 } ctx_t;
+
+static int64_t mulsh(int64_t a, int64_t b, unsigned s);
 
 static uint32_t nrm(const ctx_t *c, uint32_t v)
 {
@@ -119,7 +122,7 @@ static int64_t nll(ctx_t *c, const pieces_t *p, uint64_t level)
         const int64_t ln = sl_fx_rshift_round64((int64_t)sl_lin_log2_q16(mu) * LN2_Q16, 16);
         acc += ln + (int64_t)((((uint64_t)y_at(c, k)) << 16) / mu);
     }
-    return sl_fx_rshift_round64(acc * c->w_q16, 16);
+    return mulsh(acc, c->w_q16, 16);
 }
 
 static int64_t clampj(int64_t v)
@@ -127,9 +130,11 @@ static int64_t clampj(int64_t v)
     return (v > JT_MAX) ? JT_MAX : ((v < -JT_MAX) ? -JT_MAX : v);
 }
 
-// x / mu in Q14 for |x| <= 2^42 and mu >= 1.
+// x / mu in Q14 (mu >= 1), clamped to +-JT_MAX.
 static int64_t over_mu_q14(int64_t x, uint64_t mu)
 {
+    const int64_t lim = (int64_t)1 << 48;
+    x = (x > lim) ? lim : ((x < -lim) ? -lim : x);
     const int64_t q = (x * 16384) / (int64_t)mu;
     return clampj(q);
 }
@@ -158,8 +163,8 @@ static void normal_eq(ctx_t *c, int32_t a, int32_t b, uint64_t level, normal_t *
         const uint64_t mu = mu_of(c, level, m0, k);
         const int64_t lm = (int64_t)(mu - (uint64_t)f_at(c, k)); // level x m0
         // d mu / d a per bin = level (m(a + d) - m(a - d)) / (2 d), d = 1/8 bin; m Q24
-        const int64_t da = sl_fx_rshift_round64((int64_t)level * ma * (128 / DELTA_Q8), 24);
-        const int64_t db = sl_fx_rshift_round64((int64_t)level * mb * (128 / DELTA_Q8), 24);
+        const int64_t da = mulsh((int64_t)level, ma * (128 / DELTA_Q8), 24);
+        const int64_t db = mulsh((int64_t)level, mb * (128 / DELTA_Q8), 24);
         int64_t j[3];
         j[0] = over_mu_q14(lm, mu);
         j[1] = over_mu_q14(da, mu);
@@ -289,8 +294,9 @@ static uint64_t scale_level(uint64_t level, int64_t dl_q16)
     } else {
         s = sl_lp_to_lin_q16((int32_t)((dl_q16 * 256) / LN2_Q16));
     }
-    const uint64_t v = sl_fx_urshift_round64(level * s, 16);
-    return (v == 0U) ? 1U : v;
+    const uint64_t v =
+        (level > (LEVEL_MAX << 16) / s) ? LEVEL_MAX : sl_fx_urshift_round64(level * s, 16);
+    return (v == 0U) ? 1U : ((v > LEVEL_MAX) ? LEVEL_MAX : v);
 }
 
 // Start from the moments of the power above the floor around the peak (-18 dB region).
@@ -395,9 +401,9 @@ static void covariance(ctx_t *c, int32_t a, int32_t b, uint64_t level, const ldl
         const uint64_t mu = mu_of(c, level, m0, k);
         const int64_t j0 = over_mu_q14((int64_t)(mu - (uint64_t)f_at(c, k)), mu);
         const int64_t j1 = over_mu_q14(
-            sl_fx_rshift_round64((int64_t)level * ma * (128 / DELTA_Q8), 24), mu);
+            mulsh((int64_t)level, ma * (128 / DELTA_Q8), 24), mu);
         const int64_t j2 = over_mu_q14(
-            sl_fx_rshift_round64((int64_t)level * mb * (128 / DELTA_Q8), 24), mu);
+            mulsh((int64_t)level, mb * (128 / DELTA_Q8), 24), mu);
         int64_t ta = sl_fx_rshift_round64(j1 - sl_fx_rshift_round64(f->l10 * j0, 16), 4);
         int64_t tb = sl_fx_rshift_round64(j2 - sl_fx_rshift_round64(f->l20 * j0, 16), 4);
         ta = (ta > 32767) ? 32767 : ((ta < -32767) ? -32767 : ta);
@@ -437,7 +443,15 @@ static void covariance(ctx_t *c, int32_t a, int32_t b, uint64_t level, const ldl
     out->sigma_a_q8 = sl_fx_isqrt64((uint64_t)c_aa);
     out->sigma_b_q8 = sl_fx_isqrt64((uint64_t)c_bb);
     if (out->sigma_a_q8 != 0U && out->sigma_b_q8 != 0U) {
-        int64_t corr = (c_ab * 32768) / ((int64_t)out->sigma_a_q8 * (int64_t)out->sigma_b_q8);
+        const int64_t den = (int64_t)out->sigma_a_q8 * (int64_t)out->sigma_b_q8; // < 2^62
+        int64_t corr;
+        if (c_ab >= den || -c_ab >= den) {
+            corr = (c_ab < 0) ? -32767 : 32767; // rounding at |corr| = 1
+        } else if (den < ((int64_t)1 << 40)) {
+            corr = (c_ab * 32768) / den;
+        } else {
+            corr = c_ab / (den >> 15);
+        }
         corr = (corr > 32767) ? 32767 : ((corr < -32767) ? -32767 : corr);
         out->corr_q15 = (int32_t)corr;
     }
@@ -460,7 +474,7 @@ static void deviance(ctx_t *c, int32_t a, int32_t b, uint64_t level, sl_rfit_out
         d += ratio - 65536 - ln;
     }
     // D = 2 w sum(...), Q8
-    const int64_t dq = sl_fx_rshift_round64(2 * d * c->w_q16, 24);
+    const int64_t dq = mulsh(2 * d, c->w_q16, 24);
     out->dev_q8 = (dq < 0) ? 0U : sl_fx_usat32(dq);
     // E = n (1 + 1 / (6 looks)); Var ~ 2 n s4 (the terms correlate as rho2^2); limit
     // E + 6 sqrt(Var) + 8
@@ -471,20 +485,23 @@ static void deviance(ctx_t *c, int32_t a, int32_t b, uint64_t level, sl_rfit_out
     out->dev_limit_q8 = (lim > UINT32_MAX) ? UINT32_MAX : (uint32_t)lim;
 }
 
+// The shift that brings the window's largest power (observed or floor) to ~2^NORM_BITS;
+// returns the observed maximum's bit length (0: no power at all).
 static int normalise(ctx_t *c)
 {
-    uint32_t ymax = 0;
+    uint32_t ymax = 0, vmax = 0;
     for (uint32_t k = 0; k < c->in->n; k++) {
-        if (c->in->y[k] > ymax) {
-            ymax = c->in->y[k];
-        }
+        const uint32_t f = (c->in->f != NULL) ? c->in->f[k] : c->in->floor;
+        ymax = (c->in->y[k] > ymax) ? c->in->y[k] : ymax;
+        vmax = (f > vmax) ? f : vmax;
     }
+    vmax = (ymax > vmax) ? ymax : vmax;
     int bits = 0;
-    while (bits < 32 && (ymax >> bits) != 0U) {
+    while (bits < 32 && (vmax >> bits) != 0U) {
         bits++;
     }
     c->sh = bits - NORM_BITS;
-    return bits;
+    return (ymax == 0U) ? 0 : bits;
 }
 
 sl_err_t sl_rfit(const sl_response_t *r, const sl_rfit_in_t *in, sl_rfit_out_t *out)
