@@ -18,7 +18,7 @@
 
 typedef struct pieces {
     int32_t x[SL_RFIT_PIECES + 1]; // breakpoints, bins Q8 (window coordinates)
-    int64_t coef[SL_RFIT_PIECES];  // mass / (width x CT), scaled so m_q24 = coef x dC >> 16
+    int32_t coef[SL_RFIT_PIECES];  // mass / (width x CT), scaled so m_q24 = coef x dC >> 16
     uint8_t np;
 } pieces_t;
 
@@ -52,12 +52,15 @@ static uint32_t f_at(const ctx_t *c, uint32_t k)
     return (f == 0U) ? 1U : f;
 }
 
-static int64_t piece_coef(const ctx_t *c, uint32_t mass_q16, int32_t w_q8)
+// mass_q16 x 2^32 / (w_q8 x CT): below 2^31 for any width >= 1/256 bin and a response
+// whose cumulative total CT is at least one tap's (2^22 x SUB).
+static int32_t piece_coef(const ctx_t *c, uint32_t mass_q16, int32_t w_q8)
 {
     if (w_q8 < 1) {
         w_q8 = 1;
     }
-    return (int64_t)((((uint64_t)mass_q16) << 32) / ((uint64_t)(uint32_t)w_q8 * c->ct));
+    const uint64_t v = (((uint64_t)mass_q16) << 32) / ((uint64_t)(uint32_t)w_q8 * c->ct);
+    return (v > INT32_MAX) ? INT32_MAX : (int32_t)v;
 }
 
 static void pieces_build(const ctx_t *c, int32_t a, int32_t b, pieces_t *p)
@@ -99,7 +102,7 @@ static int64_t model_at(const ctx_t *c, const pieces_t *p, uint32_t k)
     uint32_t hi = sl_response_cum(c->r, kq - p->x[0]);
     for (uint32_t i = 0; i < p->np; i++) {
         const uint32_t lo = sl_response_cum(c->r, kq - p->x[i + 1U]);
-        m += p->coef[i] * (int64_t)(hi - lo);
+        m += (int64_t)p->coef[i] * (int64_t)(hi - lo);
         hi = lo;
     }
     return sl_fx_rshift_round64(m, 16);
@@ -353,10 +356,12 @@ static bool start(const ctx_t *c, int32_t *a, int32_t *b, uint64_t *level)
     return true;
 }
 
-// a x b >> s for signed values, saturating at +-2^62.
+// a x b >> s for signed values, saturating at +-2^61 (a sum of two stays inside int64).
 static int64_t mulsh(int64_t a, int64_t b, unsigned s)
 {
-    const int64_t lim = (int64_t)1 << 62;
+    const int64_t lim = (int64_t)1 << 61;
+    a = (a < -lim) ? -lim : a;
+    b = (b < -lim) ? -lim : b;
     const int64_t ua = (a < 0) ? -a : a;
     const int64_t ub = (b < 0) ? -b : b;
     if (ua != 0 && ub > lim / ua) {
@@ -366,7 +371,7 @@ static int64_t mulsh(int64_t a, int64_t b, unsigned s)
 }
 
 #define RING SL_RESP_TAPS
-#define SAT ((int64_t)1 << 62)
+#define SAT ((int64_t)1 << 61)
 
 // The bounds' covariance: the sandwich N^-1 M N^-1 of the independence likelihood, M the
 // score's covariance under the speckle's correlation between bins (rho2 of sl_response.h),

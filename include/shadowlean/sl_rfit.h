@@ -55,10 +55,12 @@
 ///
 /// ## Ownership and cost
 /// Pure: reads the caller's arrays and `sl_response_t`, writes `*out`; no allocation, no
-/// state, reentrant. Stack < 1 KB (no arrays of `n` on the stack beyond SL_RFIT_MAX_N
-/// int32 values x 3). Cost: O(n x (SL_RFIT_ITERS x (SL_RFIT_HALVINGS + 4))) sample
-/// evaluations, each SL_RFIT_PIECES + 1 table reads; one 64-bit division and one log per
-/// sample per objective evaluation.
+/// state, reentrant. Work: at most SL_RFIT_ITERS Fisher steps, each one pass over the n
+/// samples with five model evaluations (SL_RFIT_PIECES + 1 table reads each) and up to
+/// SL_RFIT_HALVINGS + 1 objective evaluations (one 64-bit division and one log per sample);
+/// the covariance one more pass with the speckle correlation's lags (<= SL_RESP_TAPS per
+/// sample). Stack: 1.2 KB at most on Cortex-M0 -Os (sl_rfit 496 B + its covariance pass
+/// 728 B: five piece sets and the lag ring on the stack). Flash: firmware/size_budget.txt.
 #ifndef SHADOWLEAN_SL_RFIT_H
 #define SHADOWLEAN_SL_RFIT_H
 
