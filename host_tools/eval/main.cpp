@@ -11,6 +11,7 @@
 
 #include "capture.h"
 #include "driveby.h"
+#include "model_eval.h"
 #include "sim_eval.h"
 #include "sl_cli.h"
 #include "sl_progress.h"
@@ -61,11 +62,14 @@ void usage(FILE *out)
                  "  sl-eval run CAPTURE.colossus GT.csv [--board NAME] [--scene SCENE.ini]\n"
                  "             [--threshold T] [--beta DEG] [--raw|--half-bin] [--r1-add M] [--d M]\n"
                  "             [--extract bbox|pipeline] [--beam-deg DEG] [--speed M/S] [--no-width-radius]\n"
-                 "             [--calibration FILE]\n"
+                 "             [--calibration FILE] [--looks N] [--prior]\n"
                  "      Evaluates one capture made by sl-sim against its ground truth (raw or pcap, streamed;\n"
                  "      - = stdin). --extract pipeline: the core pipeline (beam, threshold and speed from\n"
                  "      --scene, or the options); --calibration: on the board's calibrated view (a vehicle's\n"
-                 "      INI or blob).\n"
+                 "      INI or blob). --extract model: the forward model of the return (the core's sensor\n"
+                 "      model learned from the capture's rows beyond the poles, or the CTS350-X prior with\n"
+                 "      --prior) fitted per pole and azimuth over the rotations summed (--looks: independent\n"
+                 "      speckle looks in the sum, default 1: frozen); the value scale from --scene.\n"
                  "  sl-eval driveby [--board NAME] [--quick] [--realistic] [--power-scale] [--no-profile]\n"
                  "                  [--speeds A,B] [--check]\n"
                  "                  [--plot FILE.png] [--psi DEG] [--phi DEG] [--offset M] [--dump]\n"
@@ -287,8 +291,8 @@ int cmd_run(int argc, char **argv)
     std::string cap, gtp, board, scene_path, calibration;
     double threshold = -1, beta = 0, r1_add = 0, d = 0;
     sl::Proc::Bounds bounds = sl::Proc::Bounds::HalfBin;
-    bool pipeline = false, no_width_radius = false;
-    double beam_deg = -1, speed = -1;
+    bool pipeline = false, model = false, no_width_radius = false, model_learn = true;
+    double beam_deg = -1, speed = -1, looks = 1;
     for (int i = 0; i < argc; i++) {
         const std::string a = argv[i];
         bool missing = false;
@@ -304,10 +308,19 @@ int cmd_run(int argc, char **argv)
             if (missing) {
                 return sl_cli_bad_value("sl-eval", "--extract", "needs a value", usage);
             }
-            if (m != "pipeline" && m != "bbox") {
-                return sl_cli_bad_value("sl-eval", "--extract", "must be bbox or pipeline", usage);
+            if (m != "pipeline" && m != "bbox" && m != "model") {
+                return sl_cli_bad_value("sl-eval", "--extract", "must be bbox, pipeline or model",
+                                        usage);
             }
             pipeline = m == "pipeline";
+            model = m == "model";
+        } else if (a == "--looks") {
+            looks = std::atof(next().c_str());
+            if (!missing && !(looks >= 1 && looks <= 255)) {
+                return sl_cli_bad_value("sl-eval", "--looks", "must be in [1, 255]", usage);
+            }
+        } else if (a == "--prior") {
+            model_learn = false;
         } else if (a == "--beam-deg") {
             beam_deg = std::atof(next().c_str());
         } else if (a == "--speed") {
@@ -357,6 +370,43 @@ int cmd_run(int argc, char **argv)
         b = sl::load_scene(scene_path).board;
     } else {
         b = sl::load_board(board.empty() ? "paper-sim" : board);
+    }
+    if (model) {
+        // The value scale of the capture: its scene's output mapping (linear energy, or
+        // round(c log10 N) of a power or a magnitude), the CTS350-X's without a scene.
+        sl::ModelEvalOptions mo;
+        mo.scale = sl_vscale_t{(uint8_t)SL_VSCALE_LOG2, 1541U};
+        if (!scene_path.empty()) {
+            const sl::Scene sc = sl::load_scene(scene_path);
+            if (sc.mapping == sl::OutputMapping::Linear) {
+                mo.scale = sl_vscale_t{(uint8_t)SL_VSCALE_LINEAR, 0U};
+            } else {
+                const double cpo = sc.log_db_per_decade * std::log10(2.0) / (sc.log_power ? 1.0 : 2.0);
+                mo.scale = sl_vscale_t{(uint8_t)SL_VSCALE_LOG2,
+                                       static_cast<uint16_t>(std::lround(cpo * 256.0))};
+            }
+        }
+        mo.looks = looks;
+        mo.learn = model_learn;
+        sl::ModelEval me(gt, b.bin_size_m, mo);
+        sl::CaptureRows rows([&](int rot, int az, const uint8_t *v, uint32_t n) { me.row(rot, az, v, n); });
+        if (!stream_file(
+                cap,
+                [&](const uint8_t *data, size_t n) {
+                    rows.feed(data, n);
+                    return true;
+                },
+                [&](const sl::Discontinuity &) { rows.finish(); })) {
+            return 1;
+        }
+        rows.finish();
+        std::string note;
+        const auto res = me.finish(note);
+        std::printf("model extraction: the forward model of the return fitted per pole and azimuth "
+                    "(rotations summed, %.0f look%s); %s\n", looks, looks == 1 ? "" : "s",
+                    note.c_str());
+        sl::print_model_eval(stdout, res);
+        return 0;
     }
     if (pipeline) {
         sl::PipeCfg pc;
