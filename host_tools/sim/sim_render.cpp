@@ -374,10 +374,18 @@ Simulator::Simulator(const Scene &scene) : s_(scene)
             double R = 0;
             if (s_.range_response == RangeResponse::Cts350x) {
                 if (std::fabs(o) <= half) {
+                    // a smooth lobe through the taps: Catmull-Rom on the drops (log power)
                     const double u = o + half;
-                    const size_t j = std::min(taps.size() - 2, static_cast<size_t>(std::floor(u)));
-                    const double fr = u - static_cast<double>(j);
-                    R = taps[j] + fr * (taps[j + 1] - taps[j]);
+                    const long j = std::min(static_cast<long>(taps.size()) - 2, static_cast<long>(std::floor(u)));
+                    const double t = u - static_cast<double>(j);
+                    auto D = [&](long q) {
+                        q = std::clamp(q, 0L, static_cast<long>(taps.size()) - 1);
+                        return std::log2(taps[static_cast<size_t>(q)]);
+                    };
+                    const double p0 = D(j - 1), p1 = D(j), p2 = D(j + 1), p3 = D(j + 2);
+                    const double l = 0.5 * ((2 * p1) + (-p0 + p2) * t + (2 * p0 - 5 * p1 + 4 * p2 - p3) * t * t +
+                                            (-p0 + 3 * p1 - 3 * p2 + p3) * t * t * t);
+                    R = std::min(1.0, std::exp2(l));
                 }
             } else if (std::fabs(o) <= half) {
                 const double w = sim_window_amplitude(s_.range_response, o / s_.range_cell_bins);

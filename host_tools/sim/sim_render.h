@@ -112,6 +112,10 @@ public:
     /// offset o bins from a point return's centre (1 at 0, 0 beyond the table). 0 when the
     /// scene has no range response.
     double range_response(double o_bins) const;
+    /// The 8-bit value of an integer N (a power or magnitude) on the log mapping:
+    /// round(c log10 N), or with output.log_curve = navtech round(c log10(2) (e + m)) for
+    /// N = 2^e (1 + m); 0 for N <= 1.
+    double log_value(long n) const;
     /// Half-width of the range response's table (bins).
     int range_response_half() const { return resp_half_; }
     /// Two-way knife-edge power factor |F(v)|^4 of a point at vehicle-frame azimuth az (deg),
@@ -133,8 +137,6 @@ private:
     /// the power per bin of the field through the response, adding the poles' sub-cells
     /// and the point returns.
     void response_power(int k, int i, const SimColumn &col, std::vector<double> &E) const;
-    /// The 8-bit value of an integer N on the log mapping (log10 or Navtech's log2).
-    double log_value(long n) const;
     void add_points(int k, int i, const RadarPose &pose, SimColumn &col) const;
     /// [clutter]: max(out, clutter value) on the band's cells of azimuth i, rotation k.
     void apply_clutter(int k, int i, uint8_t *out) const;
