@@ -18,15 +18,23 @@ double wrap180(double deg)
 
 double chassis_theta_deg(const BoardSpec &b, double az_vehicle_deg)
 {
+    return chassis_theta_deg(b, az_vehicle_deg, nullptr);
+}
+
+double chassis_theta_deg(const BoardSpec &b, double az_vehicle_deg, double *edge_m)
+{
     const double H = b.radar_height_m;
     if (b.chassis_type == "cylinder") {
+        if (edge_m != nullptr) {
+            *edge_m = b.cylinder_radius_m;
+        }
         return sim_r2d(std::atan2(H - b.cylinder_top_m, b.cylinder_radius_m));
     }
     // Same construction as BoardSpec::edge_along: ray (cos a, -sin a) in x-forward y-left;
     // the grazing edge is the crossing of least depression.
     const double a = sim_d2r(az_vehicle_deg);
     const double dx = std::cos(a), dy = -std::sin(a);
-    double best = std::numeric_limits<double>::infinity();
+    double best = std::numeric_limits<double>::infinity(), best_t = 0;
     const size_t n = b.polygon.size();
     for (size_t k = 0; k < n; k++) {
         const ChassisVertex &p = b.polygon[k];
@@ -43,7 +51,14 @@ double chassis_theta_deg(const BoardSpec &b, double az_vehicle_deg)
             continue;
         }
         const double h = p.edge_height_m + u * (q.edge_height_m - p.edge_height_m);
-        best = std::min(best, std::atan2(H - h, t));
+        const double ang = std::atan2(H - h, t);
+        if (ang < best) {
+            best = ang;
+            best_t = t;
+        }
+    }
+    if (edge_m != nullptr) {
+        *edge_m = best_t;
     }
     return std::isfinite(best) ? sim_r2d(best) : std::numeric_limits<double>::quiet_NaN();
 }

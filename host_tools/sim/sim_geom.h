@@ -45,6 +45,9 @@ inline V3 cross(V3 a, V3 b)
 /// clockwise from forward): the same construction as BoardSpec::theta_deg (which only takes
 /// azimuth indices). NaN when no chassis edge surrounds the radar on that azimuth.
 double chassis_theta_deg(const BoardSpec &b, double az_vehicle_deg);
+/// The same, and the horizontal distance from the radar to that grazing edge (m) in
+/// `*edge_m` (may be NULL).
+double chassis_theta_deg(const BoardSpec &b, double az_vehicle_deg, double *edge_m);
 
 /// A pole prepared for ray work.
 struct PoleGeom {

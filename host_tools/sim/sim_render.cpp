@@ -11,6 +11,7 @@
 #include <limits>
 
 #include "shadowlean/sl_proto.h"
+#include "shadowlean/sl_response.h"
 #include "sl_geom.h"
 
 namespace sl {
@@ -59,6 +60,8 @@ void SimColumn::reset(int bins)
     energy.assign(static_cast<size_t>(bins), 0.0);
     peak.assign(static_cast<size_t>(bins), 0.0F);
     touched.assign(static_cast<size_t>(bins), 0);
+    fine.clear();
+    points.clear();
 }
 
 // ------------------------------------------------------------------------------------------
@@ -80,7 +83,8 @@ namespace {
 
 constexpr uint64_t kSaltSpeckle = 0x5BEC1EULL, kSaltPhase = 0x9A5EULL, kSaltNoise = 0x4015EULL,
                    kSaltLeak = 0x1EA4ULL, kSaltClutter = 0xC1A77E4ULL, kSaltJitter = 0x717E5ULL,
-                   kSaltFrame = 0xF4A3EULL;
+                   kSaltFrame = 0xF4A3EULL, kSaltPhysBin = 0xB16C0DEULL,
+                   kSaltPhysFine = 0xF16EC0DEULL;
 
 void add_uniform(std::vector<double> &e, double bin, double a, double c, double E)
 {
@@ -125,7 +129,67 @@ double Phi(double q)
     return 0.5 * (q * std::sqrt(1 - q * q) + std::asin(q));
 }
 
+double sinc(double x)
+{
+    if (std::fabs(x) < 1e-12) {
+        return 1.0;
+    }
+    return std::sin(kSimPi * x) / (kSimPi * x);
+}
+
 } // namespace
+
+double sim_window_amplitude(RangeResponse w, double f)
+{
+    double a0 = 1, a1 = 0, a2 = 0;
+    switch (w) {
+    case RangeResponse::Hann: a0 = 0.5; a1 = 0.5; break;
+    case RangeResponse::Hamming: a0 = 0.54; a1 = 0.46; break;
+    case RangeResponse::Blackman: a0 = 0.42; a1 = 0.5; a2 = 0.08; break;
+    default: break;
+    }
+    // w[n] = a0 - a1 cos(2 pi n / N) + a2 cos(4 pi n / N): its transform is a sum of sincs
+    // one resolution cell apart
+    const double v = a0 * sinc(f) + 0.5 * a1 * (sinc(f - 1) + sinc(f + 1)) +
+                     0.5 * a2 * (sinc(f - 2) + sinc(f + 2));
+    return v / a0;
+}
+
+double sim_knife_edge_field(double v)
+{
+    constexpr double kMax = 12.0, kStep = 0.001;
+    static const std::vector<double> table = [] {
+        // C(v), S(v) by Simpson's rule from 0, then |F| = sqrt(((1/2 - C)^2 + (1/2 - S)^2) / 2)
+        const int n = static_cast<int>(std::lround(kMax / kStep));
+        std::vector<double> c(static_cast<size_t>(n) + 1, 0.0), sn(static_cast<size_t>(n) + 1, 0.0);
+        for (int k = 1; k <= n; k++) {
+            const double t0 = (k - 1) * kStep, t1 = k * kStep, tm = 0.5 * (t0 + t1);
+            auto fc = [](double t) { return std::cos(0.5 * kSimPi * t * t); };
+            auto fs = [](double t) { return std::sin(0.5 * kSimPi * t * t); };
+            c[static_cast<size_t>(k)] = c[static_cast<size_t>(k) - 1] + (fc(t0) + 4 * fc(tm) + fc(t1)) / 6 * kStep;
+            sn[static_cast<size_t>(k)] = sn[static_cast<size_t>(k) - 1] + (fs(t0) + 4 * fs(tm) + fs(t1)) / 6 * kStep;
+        }
+        std::vector<double> f(2 * static_cast<size_t>(n) + 1);
+        for (int k = -n; k <= n; k++) {
+            const double sg = k < 0 ? -1.0 : 1.0; // C and S are odd
+            const double cc = sg * c[static_cast<size_t>(std::abs(k))];
+            const double ss = sg * sn[static_cast<size_t>(std::abs(k))];
+            f[static_cast<size_t>(k + n)] =
+                std::sqrt(0.5 * ((0.5 - cc) * (0.5 - cc) + (0.5 - ss) * (0.5 - ss)));
+        }
+        return f;
+    }();
+    if (v >= kMax) {
+        return 1.0 / (kSimPi * std::sqrt(2.0) * v);
+    }
+    if (v <= -kMax) {
+        return 1.0;
+    }
+    const double u = (v + kMax) / kStep;
+    const size_t j = std::min(table.size() - 2, static_cast<size_t>(u));
+    const double fr = u - static_cast<double>(j);
+    return table[j] + fr * (table[j + 1] - table[j]);
+}
 
 void sim_splat_profile(std::vector<double> &e, double bin, double a, double c, double re, double E,
                        int first_bin)
@@ -277,6 +341,64 @@ Simulator::Simulator(const Scene &scene) : s_(scene)
         }
     }
 
+    // range response: the power R(o) a point return puts at offset o bins (1 at 0)
+    if (scene_physical_response(s_)) {
+        std::vector<double> taps; // cts350x: R at integer offsets
+        int half = 0;
+        if (s_.range_response == RangeResponse::None) {
+            resp_delta_ = true;
+        } else if (s_.range_response == RangeResponse::Cts350x) {
+            uint16_t drop[SL_RESP_TAPS];
+            sl_response_prior_cts350x(drop); // the core's table: one source of truth
+            half = SL_CFG_RESP_HALF;
+            for (int t = 0; t < SL_RESP_TAPS; t++) {
+                taps.push_back(std::pow(2.0, -drop[t] / 256.0));
+            }
+        } else {
+            half = std::min(64, std::max(20, static_cast<int>(std::ceil(7.0 * s_.range_cell_bins))));
+        }
+        const bool tail = s_.receiver_tail_bins > 0;
+        const double tail0 = tail ? std::pow(10.0, 0.1 * s_.receiver_tail_db) : 0.0;
+        int rhalf = half;
+        if (tail && !resp_delta_) {
+            // the tail down to -80 dB
+            const double o80 = s_.receiver_tail_bins * std::log(10.0) * 0.1 * (s_.receiver_tail_db + 80.0);
+            rhalf = std::max(half, std::min(200, static_cast<int>(std::ceil(o80))));
+        }
+        resp_half_ = resp_delta_ ? 0 : rhalf;
+        const int nt = 2 * resp_half_ * kRespSub + 1;
+        resp_pow_.assign(static_cast<size_t>(nt), 0.0);
+        resp_amp_.assign(static_cast<size_t>(nt), 0.0);
+        for (int t = 0; t < nt && !resp_delta_; t++) {
+            const double o = static_cast<double>(t - resp_half_ * kRespSub) / kRespSub;
+            double R = 0;
+            if (s_.range_response == RangeResponse::Cts350x) {
+                if (std::fabs(o) <= half) {
+                    // a smooth lobe through the taps: Catmull-Rom on the drops (log power)
+                    const double u = o + half;
+                    const long j = std::min(static_cast<long>(taps.size()) - 2, static_cast<long>(std::floor(u)));
+                    const double t = u - static_cast<double>(j);
+                    auto D = [&](long q) {
+                        q = std::clamp(q, 0L, static_cast<long>(taps.size()) - 1);
+                        return std::log2(taps[static_cast<size_t>(q)]);
+                    };
+                    const double p0 = D(j - 1), p1 = D(j), p2 = D(j + 1), p3 = D(j + 2);
+                    const double l = 0.5 * ((2 * p1) + (-p0 + p2) * t + (2 * p0 - 5 * p1 + 4 * p2 - p3) * t * t +
+                                            (-p0 + 3 * p1 - 3 * p2 + p3) * t * t * t);
+                    R = std::min(1.0, std::exp2(l));
+                }
+            } else if (std::fabs(o) <= half) {
+                const double w = sim_window_amplitude(s_.range_response, o / s_.range_cell_bins);
+                R = w * w;
+            }
+            if (tail && o > 0) {
+                R += tail0 * std::exp(-o / s_.receiver_tail_bins);
+            }
+            resp_pow_[static_cast<size_t>(t)] = R;
+            resp_amp_[static_cast<size_t>(t)] = std::sqrt(R);
+        }
+    }
+
     // pure noise: N = round(|n|) (magnitude) or round(|n|^2) (power, output.log_quantity), n
     // complex Gaussian, sigma per component
     if (s_.noise) {
@@ -288,7 +410,7 @@ Simulator::Simulator(const Scene &scene) : s_(scene)
         };
         for (int m = 0;; m++) {
             noise_cdf_.push_back(F(m + 0.5));
-            const double v = m <= 1 ? 0.0 : std::round(s_.log_db_per_decade * std::log10(m));
+            const double v = log_value(m);
             noise_val_.push_back(static_cast<uint8_t>(std::min(255.0, v)));
             if (1.0 - noise_cdf_.back() < 1e-15 || m > 100000) {
                 noise_cdf_.back() = 1.0;
@@ -306,7 +428,8 @@ Simulator::Simulator(const Scene &scene) : s_(scene)
             column_from(rg, i, static_cols_[static_cast<size_t>(i)]);
         }
     }
-    deterministic_ = !s_.noise && (!s_.speckle || (scene_speckle_static(s_) && s_.speckle_frame_db == 0.0));
+    deterministic_ = !s_.noise && (!s_.speckle || (scene_speckle_static(s_) && s_.speckle_frame_db == 0.0)) &&
+                     (s_.points.empty() || !static_cols_.empty());
     if (deterministic_) {
         out_cache_.resize(static_cast<size_t>(b.azimuths));
         SimColumn col;
@@ -364,6 +487,92 @@ double Simulator::azimuth_gain(double d) const
         return 0.0;
     }
     return std::exp(-0.5 * d * d / (sigma_az_ * sigma_az_));
+}
+
+double Simulator::log_value(long n) const
+{
+    if (n <= 1) {
+        return 0.0;
+    }
+    if (!s_.log_navtech) {
+        return std::round(s_.log_db_per_decade * std::log10(static_cast<double>(n)));
+    }
+    // Navtech: N = 2^e (1 + m), value = round(cpo (e + m)), exact at powers of two
+    int e = 0;
+    while (e < 62 && (2L << e) <= n) {
+        e++;
+    }
+    const double m = static_cast<double>(n) / static_cast<double>(1L << e) - 1.0;
+    return std::round(s_.log_db_per_decade * std::log10(2.0) * (e + m));
+}
+
+double Simulator::range_response(double o) const
+{
+    if (resp_pow_.empty()) {
+        return resp_delta_ && std::fabs(o) < 0.5 ? 1.0 : 0.0;
+    }
+    const double u = (o + resp_half_) * kRespSub;
+    if (u < 0 || u > static_cast<double>(resp_pow_.size() - 1)) {
+        return 0.0;
+    }
+    const size_t j = std::min(resp_pow_.size() - 2, static_cast<size_t>(u));
+    const double fr = u - static_cast<double>(j);
+    return resp_pow_[j] + fr * (resp_pow_[j + 1] - resp_pow_[j]);
+}
+
+double Simulator::knife_edge_gain(double az_deg, double e_deg, double r_m) const
+{
+    if (!s_.knife_edge) {
+        return 1.0;
+    }
+    double t = 0;
+    const double th = chassis_theta_deg(s_.board, az_deg, &t);
+    if (!std::isfinite(th) || !(t > 0)) {
+        return 1.0;
+    }
+    const double d1 = t / std::cos(sim_d2r(th)), d2 = r_m - d1;
+    if (d2 <= 1e-6) {
+        return 1.0;
+    }
+    const double lambda = 0.299792458 / s_.carrier_ghz;
+    // diffraction angle: how far below the ray over the edge (> 0: in the geometric shadow)
+    const double v = sim_d2r(-th - e_deg) * std::sqrt(2.0 * d1 * d2 / (lambda * (d1 + d2)));
+    const double f = sim_knife_edge_field(v);
+    return f * f * f * f; // two-way: out and back over the edge
+}
+
+void Simulator::add_points(int k, int i, const RadarPose &pose, SimColumn &col) const
+{
+    (void)k;
+    const double a_c = az_deg_[static_cast<size_t>(i)];
+    for (const auto &p : s_.points) {
+        const V3 P{p.x_m, p.y_m, p.z_m};
+        const V3 rel = P - pose.o;
+        const double rr = norm(rel);
+        if (rr < 1e-6) {
+            continue;
+        }
+        const double e = sim_r2d(std::atan2(rel.z, std::hypot(rel.x, rel.y)));
+        const double az = azimuth_of(pose, P);
+        double g = elevation_gain(e) * azimuth_gain(wrap180(az - a_c));
+        if (g <= 0) {
+            continue;
+        }
+        if (s_.knife_edge) {
+            g *= knife_edge_gain(az, e, rr);
+        } else {
+            const double th = chassis_theta_deg(s_.board, az);
+            if (!(e >= -th)) {
+                continue; // in the chassis shadow
+            }
+        }
+        const double x = rr / bin_m();
+        col.points.push_back({x, p.energy * g, rr});
+        const long j = static_cast<long>(std::floor(x));
+        if (j >= 0 && j < static_cast<long>(col.touched.size())) {
+            col.touched[static_cast<size_t>(j)] = 1;
+        }
+    }
 }
 
 std::vector<uint8_t> Simulator::config_message() const
@@ -541,8 +750,40 @@ void Simulator::splat_pole(const PoleView &pv, int i, SimColumn *col, double *r1
     };
     std::vector<Smp> sm;
     std::vector<double> ss;
-    for (const auto &run : pv.va.run) {
-        const double s0 = run.first, s1 = run.second;
+    const bool ke = s_.knife_edge && col != nullptr;
+    const bool fine = scene_physical_response(s_) && col != nullptr;
+    auto ke_at = [&](double s) {
+        const V3 P = pg.at(s);
+        const V3 rel = P - r.o;
+        return knife_edge_gain(azimuth_of(r, P), sim_r2d(std::atan2(rel.z, std::hypot(rel.x, rel.y))),
+                               norm(rel));
+    };
+    // knife-edge diffraction: a run cut by the chassis ray goes on into the geometric
+    // shadow until the two-way loss passes 60 dB (the truth's r1, r2 stay geometric)
+    std::vector<std::pair<double, double>> runs = pv.va.run;
+    std::vector<std::pair<double, double>> geo = pv.va.run;
+    if (ke) {
+        for (size_t q = 0; q < runs.size(); q++) {
+            const double ds = std::max(1e-4, sim_d2r(s_.pole_step_deg) *
+                                                 norm(pg.at(runs[q].first) - r.o));
+            if (pv.va.ends[q].first == SegEnd::Chassis) {
+                double sx = runs[q].first;
+                for (int it = 0; it < 100000 && sx > 0 && ke_at(sx) > 1e-6; it++) {
+                    sx = std::max(0.0, sx - ds);
+                }
+                runs[q].first = sx;
+            }
+            if (pv.va.ends[q].second == SegEnd::Chassis) {
+                double sx = runs[q].second;
+                for (int it = 0; it < 100000 && sx < pg.length && ke_at(sx) > 1e-6; it++) {
+                    sx = std::min(pg.length, sx + ds);
+                }
+                runs[q].second = sx;
+            }
+        }
+    }
+    for (size_t rq = 0; rq < runs.size(); rq++) {
+        const double s0 = runs[rq].first, s1 = runs[rq].second;
         auto elev = [&](double s) {
             const V3 d = pg.at(s) - r.o;
             return sim_r2d(std::atan2(d.z, std::hypot(d.x, d.y)));
@@ -572,23 +813,53 @@ void Simulator::splat_pole(const PoleView &pv, int i, SimColumn *col, double *r1
             const double tl = -std::sin(bw) * pg.lean.x + std::cos(bw) * pg.lean.y;
             const double rt = pg.radius * std::sqrt(1.0 + pg.tan_psi * pg.tan_psi * tl * tl);
             const double wdeg = sim_r2d(std::asin(std::min(1.0, rt / std::max(h, 1e-9))));
-            const double g = elevation_gain(e) * azimuth_gain(az);
+            double g = elevation_gain(e) * azimuth_gain(az);
+            if (ke) {
+                g *= ke_at(s);
+            }
             const double rf = pg.reflectivity * seg(s);
             sm.push_back({rr, re, e, rf * g * 2.0 * wdeg, rf * g});
-            r1 = std::min(r1, rr - re);
-            r2 = std::max(r2, rr);
+            if (!ke || (s >= geo[rq].first && s <= geo[rq].second)) {
+                r1 = std::min(r1, rr - re);
+                r2 = std::max(r2, rr);
+            }
         }
         if (col == nullptr) {
             continue;
+        }
+        // the range-response path: the energy on sub-cells of bin / kSimFineQ
+        std::vector<double> fe;
+        long f0 = 0;
+        if (fine) {
+            double lo = std::numeric_limits<double>::infinity(), hi = 0;
+            for (const Smp &A : sm) {
+                lo = std::min(lo, A.r - A.re);
+                hi = std::max(hi, A.r);
+            }
+            if (!(hi >= lo)) {
+                continue;
+            }
+            f0 = std::max(0L, static_cast<long>(std::floor(lo / bin * kSimFineQ)) - 1);
+            const long f1 = static_cast<long>(std::floor(hi / bin * kSimFineQ)) + 1;
+            fe.assign(static_cast<size_t>(std::max(1L, f1 - f0 + 1)), 0.0);
         }
         for (size_t j = 0; j + 1 < sm.size(); j++) {
             const Smp &A = sm[j], &B = sm[j + 1];
             const double E = 0.5 * (A.eps + B.eps) * std::fabs(B.e - A.e);
             const double re = 0.5 * (A.re + B.re);
-            sim_splat_profile(col->energy, bin, A.r, B.r, re, E, 0);
+            if (fine) {
+                sim_splat_profile(fe, bin / kSimFineQ, A.r, B.r, re, E, static_cast<int>(f0));
+            } else {
+                sim_splat_profile(col->energy, bin, A.r, B.r, re, E, 0);
+            }
             if (A.g > 0 || B.g > 0) {
                 touch(*col, bin, std::min(A.r, B.r) - re, std::max(A.r, B.r),
                       static_cast<float>(std::max(A.g, B.g)));
+            }
+        }
+        for (size_t q = 0; q < fe.size(); q++) {
+            if (fe[q] > 0) {
+                col->fine.emplace_back(f0 + static_cast<long>(q), fe[q]);
             }
         }
     }
@@ -622,7 +893,10 @@ void Simulator::ground_analytic(int i, SimColumn &col) const
         }
         const double th = chassis_theta_deg(b, az_deg_[static_cast<size_t>(i)] + d);
         const double lo_d = std::max(0.0, -s_.elev_top_deg);
-        const double hi_d = std::min(th, -s_.elev_bottom_deg);
+        // knife edge: the ground inside the geometric shadow is lit by diffraction (every
+        // depression of the wedge, weighted by the two-way loss)
+        const double hi_d = s_.knife_edge && std::isfinite(th) ? -s_.elev_bottom_deg
+                                                               : std::min(th, -s_.elev_bottom_deg);
         if (!(hi_d > lo_d)) {
             continue;
         }
@@ -638,7 +912,13 @@ void Simulator::ground_analytic(int i, SimColumn &col) const
             if (c <= a) {
                 continue;
             }
-            const double E = s_.ground_reflectivity * g * (C(c) - C(a));
+            double E = s_.ground_reflectivity * g * (C(c) - C(a));
+            if (s_.knife_edge) {
+                E *= knife_edge_gain(az_deg_[static_cast<size_t>(i)] + d, -0.5 * (a + c), (j + 0.5) * bin);
+                if (E < 1e-6 * s_.ground_reflectivity * g * (C(c) - C(a))) {
+                    continue;
+                }
+            }
             col.energy[static_cast<size_t>(j)] += E;
             if (E > 0) {
                 col.touched[static_cast<size_t>(j)] = 1;
@@ -762,6 +1042,9 @@ void Simulator::column_from(const RotationGeom &rg, int i, SimColumn &col) const
     for (const auto &pv : rg.per_az[static_cast<size_t>(i)]) {
         splat_pole(pv, i, &col, nullptr, nullptr);
     }
+    if (!s_.points.empty()) {
+        add_points(rg.k, i, pose, col);
+    }
 }
 
 void Simulator::geometry_column(int k, int i, SimColumn &col) const
@@ -801,6 +1084,16 @@ void Simulator::map_column(int k, int i, const SimColumn &col, uint8_t *out) con
                                              static_cast<uint64_t>(i), static_cast<uint64_t>(j)));
                 }
                 E[static_cast<size_t>(j)] *= std::pow(10.0, x);
+            }
+        }
+    }
+    if (scene_physical_response(s_)) {
+        response_power(k, i, col, E);
+    } else {
+        for (const SimPoint &p : col.points) {
+            const long j = static_cast<long>(std::floor(p.x_bins));
+            if (j >= 0 && j < nb) {
+                E[static_cast<size_t>(j)] += p.e;
             }
         }
     }
@@ -924,8 +1217,108 @@ void Simulator::map_column(int k, int i, const SimColumn &col, uint8_t *out) con
             im += s_.noise_sigma * sim_normal(sim_hash(hn, 1));
         }
         const long nq = std::lround(s_.log_power ? re * re + im * im : std::hypot(re, im));
-        const double v = nq <= 1 ? 0.0 : std::round(c * std::log10(static_cast<double>(nq)));
+        const double v = log_value(nq);
         out[j] = static_cast<uint8_t>(std::min(255.0, v));
+    }
+}
+
+// The range-response path. Sources: every bin's energy (ground, boxes; at the bin's centre),
+// the poles' sub-cells and the point returns. Physical speckle: each bin and sub-cell is a
+// resolution cell of many sub-scatterers, a circular complex Gaussian amplitude of mean power
+// its energy (drawn per rotation, or once when frozen); a point return is one scatterer of
+// amplitude sqrt(E) and carrier phase 4 pi r / lambda. The field per bin is the sum of the
+// amplitudes times sqrt(R) at their offset, the power |field|^2. Without physical speckle the
+// expected power sum E R(offset) (log-normal speckle, if on, already scaled the energies).
+void Simulator::response_power(int k, int i, const SimColumn &col, std::vector<double> &E) const
+{
+    const int nb = bins();
+    const bool phys = s_.speckle && s_.speckle_physical;
+    const bool frozen = scene_speckle_static(s_);
+    const uint64_t spk_seed = s_.speckle_seed != 0 ? s_.speckle_seed : sim_hash(s_.seed, kSaltSpeckle);
+    const uint64_t spk_k = frozen ? 0 : static_cast<uint64_t>(k) + 1;
+    const int H = resp_half_;
+    std::vector<double> fr(static_cast<size_t>(nb), 0.0), fi(static_cast<size_t>(nb), 0.0);
+    std::vector<double> P(static_cast<size_t>(nb), 0.0);
+    // a source at x bins (bin j spans [j, j + 1), so offset o = m + 1/2 - x) of energy e and
+    // complex amplitude (ar, ai)
+    auto add = [&](double x, double e, double ar, double ai) {
+        if (resp_delta_) {
+            const long m = static_cast<long>(std::floor(x));
+            if (m >= 0 && m < nb) {
+                fr[static_cast<size_t>(m)] += ar;
+                fi[static_cast<size_t>(m)] += ai;
+                P[static_cast<size_t>(m)] += e;
+            }
+            return;
+        }
+        const long m0 = std::max(0L, static_cast<long>(std::ceil(x - 0.5 - H)));
+        const long m1 = std::min(static_cast<long>(nb) - 1, static_cast<long>(std::floor(x - 0.5 + H)));
+        for (long m = m0; m <= m1; m++) {
+            const double u = (static_cast<double>(m) + 0.5 - x + H) * kRespSub;
+            const size_t t = std::min(resp_pow_.size() - 2, static_cast<size_t>(std::max(0.0, u)));
+            const double f = std::clamp(u - static_cast<double>(t), 0.0, 1.0);
+            if (phys) {
+                const double a = resp_amp_[t] + f * (resp_amp_[t + 1] - resp_amp_[t]);
+                fr[static_cast<size_t>(m)] += a * ar;
+                fi[static_cast<size_t>(m)] += a * ai;
+            } else {
+                P[static_cast<size_t>(m)] += e * (resp_pow_[t] + f * (resp_pow_[t + 1] - resp_pow_[t]));
+            }
+        }
+    };
+    auto gauss = [&](uint64_t salt, uint64_t cell, double e, double *ar, double *ai) {
+        const uint64_t h = sim_hash(spk_seed ^ salt, spk_k, static_cast<uint64_t>(i), cell);
+        const double sd = std::sqrt(0.5 * e);
+        *ar = sd * sim_normal(h);
+        *ai = sd * sim_normal(sim_hash(h, 1));
+    };
+    for (int j = 0; j < nb; j++) {
+        const double e = E[static_cast<size_t>(j)];
+        if (e > 0) {
+            double ar = std::sqrt(e), ai = 0;
+            if (phys) {
+                gauss(kSaltPhysBin, static_cast<uint64_t>(j), e, &ar, &ai);
+            }
+            add(j + 0.5, e, ar, ai);
+        }
+    }
+    if (!col.fine.empty()) {
+        std::vector<std::pair<long, double>> fine(col.fine);
+        std::sort(fine.begin(), fine.end());
+        for (size_t q = 0; q < fine.size();) {
+            const long cell = fine[q].first;
+            double e = 0;
+            for (; q < fine.size() && fine[q].first == cell; q++) {
+                e += fine[q].second;
+            }
+            if (s_.speckle && !s_.speckle_physical) {
+                // log-normal speckle: the draw of the bin the sub-cell lies in
+                const long j = cell / kSimFineQ;
+                double x = 0.1 * s_.speckle_db *
+                           sim_normal(sim_hash(spk_seed, spk_k, static_cast<uint64_t>(i), static_cast<uint64_t>(j)));
+                if (s_.speckle_frame_db > 0) {
+                    x += 0.1 * s_.speckle_frame_db *
+                         sim_normal(sim_hash(spk_seed ^ kSaltFrame, static_cast<uint64_t>(k) + 1,
+                                             static_cast<uint64_t>(i), static_cast<uint64_t>(j)));
+                }
+                e *= std::pow(10.0, x);
+            }
+            double ar = std::sqrt(e), ai = 0;
+            if (phys) {
+                gauss(kSaltPhysFine, static_cast<uint64_t>(cell), e, &ar, &ai);
+            }
+            add((static_cast<double>(cell) + 0.5) / kSimFineQ, e, ar, ai);
+        }
+    }
+    const double lambda = 0.299792458 / s_.carrier_ghz;
+    for (const SimPoint &p : col.points) {
+        const double ph = 4.0 * kSimPi * p.r_m / lambda;
+        const double a = std::sqrt(p.e);
+        add(p.x_bins, p.e, a * std::cos(ph), a * std::sin(ph));
+    }
+    for (int m = 0; m < nb; m++) {
+        const size_t u = static_cast<size_t>(m);
+        E[u] = phys ? fr[u] * fr[u] + fi[u] * fi[u] : P[u];
     }
 }
 

@@ -47,11 +47,25 @@
 
 namespace sl {
 
+/// Sub-cells per bin of the poles' scatterers on the range-response path.
+constexpr int kSimFineQ = 8;
+
+/// An isolated point return on one azimuth: position in bins (bin j spans [j, j + 1)),
+/// energy after the beam's gains, range (m, for its carrier phase).
+struct SimPoint {
+    double x_bins = 0, e = 0, r_m = 0;
+};
+
 /// Energies of one azimuth before effects (linear, deg^2 of lit solid angle x reflectivity).
 struct SimColumn {
     std::vector<double> energy;   ///< per bin
     std::vector<float> peak;      ///< per bin, max ray energy (AmplitudeModel::Peak)
     std::vector<uint8_t> touched; ///< 1 where an object's visible extent reaches the bin
+    /// Range-response path only (scene_physical_response): the poles' energy per sub-cell
+    /// (index = bin * kSimFineQ + sub-cell; a cell may appear more than once) ...
+    std::vector<std::pair<long, double>> fine;
+    /// ... and the point returns (on every path).
+    std::vector<SimPoint> points;
     void reset(int bins);
 };
 
@@ -94,6 +108,20 @@ public:
     double elevation_gain(double e_deg) const;
     /// Azimuth gain at offset d (deg) from the beam centre (0 outside the window).
     double azimuth_gain(double d_deg) const;
+    /// The range response in use (effects.range_response and the receiver tail): power at
+    /// offset o bins from a point return's centre (1 at 0, 0 beyond the table). 0 when the
+    /// scene has no range response.
+    double range_response(double o_bins) const;
+    /// The 8-bit value of an integer N (a power or magnitude) on the log mapping:
+    /// round(c log10 N), or with output.log_curve = navtech round(c log10(2) (e + m)) for
+    /// N = 2^e (1 + m); 0 for N <= 1.
+    double log_value(long n) const;
+    /// Half-width of the range response's table (bins).
+    int range_response_half() const { return resp_half_; }
+    /// Two-way knife-edge power factor |F(v)|^4 of a point at vehicle-frame azimuth az (deg),
+    /// elevation e (deg) and range r (m) behind the chassis edge (1 when knife_edge is off
+    /// or no edge is in that direction; the geometric shadow's hard cut is 0 / 1).
+    double knife_edge_gain(double az_deg, double e_deg, double r_m) const;
 
 private:
     struct PoleView;
@@ -105,6 +133,11 @@ private:
     void grid_ground_boxes(const RadarPose &r, int i, SimColumn &col) const;
     void splat_pole(const PoleView &pv, int i, SimColumn *col, double *r1s, double *r2s) const;
     void map_column(int k, int i, const SimColumn &col, uint8_t *out) const;
+    /// The range-response path: replaces the bin energies E (after log-normal speckle) by
+    /// the power per bin of the field through the response, adding the poles' sub-cells
+    /// and the point returns.
+    void response_power(int k, int i, const SimColumn &col, std::vector<double> &E) const;
+    void add_points(int k, int i, const RadarPose &pose, SimColumn &col) const;
     /// [clutter]: max(out, clutter value) on the band's cells of azimuth i, rotation k.
     void apply_clutter(int k, int i, uint8_t *out) const;
 
@@ -129,7 +162,21 @@ private:
     std::vector<uint8_t> noise_val_;
     std::vector<double> smear_kernel_;
     int smear_front_ = 0;
+    // range response: R(o) and sqrt(R(o)) on o = -half .. +half in steps of 1 / kRespSub
+    static constexpr int kRespSub = 64;
+    int resp_half_ = 0;
+    bool resp_delta_ = false; ///< physical speckle without a response: one bin per scatterer
+    std::vector<double> resp_pow_, resp_amp_;
 };
+
+/// Fresnel knife-edge field |F(v)| (one way, free space 1): 0.5 at the geometric shadow
+/// edge (v = 0), falling as ~0.225 / v deep in the shadow, rippling about 1 on the lit side
+/// (v < 0). From the Fresnel integrals (tabulated once, |v| <= 12; asymptotic beyond).
+double sim_knife_edge_field(double v);
+
+/// Amplitude response of a cosine-sum window's FFT to a point target at f resolution cells
+/// from the bin centre, normalised to 1 at f = 0 (rect, hann, hamming, blackman).
+double sim_window_amplitude(RangeResponse w, double f);
 
 /// Renders rotations [first, first + count) with `threads` workers (0 = hardware
 /// concurrency) and hands each one to `sink` IN ROTATION ORDER on the calling thread

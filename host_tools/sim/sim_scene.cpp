@@ -153,7 +153,7 @@ Scene build(const Parsed &p)
             continue;
         }
         if (name.rfind("pole.", 0) == 0 || name.rfind("box.", 0) == 0 ||
-            name.rfind("wall.", 0) == 0) {
+            name.rfind("wall.", 0) == 0 || name.rfind("point.", 0) == 0) {
             if (name.find('.') + 1 >= name.size()) {
                 throw SceneError(p.file + ": [" + name + "]: object sections need a name");
             }
@@ -161,7 +161,7 @@ Scene build(const Parsed &p)
         }
         throw SceneError(p.file + ": [" + name +
                          "]: unknown section (scene, vehicle, ground, beam, output, effects, clutter, "
-                         "pole.<name>, box.<name>, wall.<name>)");
+                         "pole.<name>, box.<name>, wall.<name>, point.<name>)");
     }
     auto sec = [&](const std::string &n) {
         auto it = p.sections.find(n);
@@ -234,7 +234,7 @@ Scene build(const Parsed &p)
         Sec c = sec("output");
         c.only({"amplitude", "mapping", "normalize", "peak_counts", "linear_scale",
                 "detect_floor", "log_db_per_decade", "log_quantity", "log_ref_energy",
-                "log_ref_value"});
+                "log_ref_value", "log_curve"});
         s.amplitude = c.choice<AmplitudeModel>(
             "amplitude", s.amplitude,
             {{"integral", AmplitudeModel::Integral}, {"peak", AmplitudeModel::Peak}});
@@ -250,6 +250,8 @@ Scene build(const Parsed &p)
                                      {{"magnitude", false}, {"power", true}});
         s.log_ref_energy = c.real("log_ref_energy", s.log_ref_energy, 1e-12, 1e12);
         s.log_ref_value = c.real("log_ref_value", s.log_ref_value, 1, 255);
+        s.log_navtech = c.choice<bool>("log_curve", s.log_navtech,
+                                       {{"log10", false}, {"navtech", true}});
     }
     {
         Sec c = sec("effects");
@@ -257,7 +259,8 @@ Scene build(const Parsed &p)
                 "smear_slow_decay_db", "smear_amp_decay_db", "smear_front_db", "speckle", "speckle_db", "speckle_frame_db",
                 "speckle_static", "speckle_seed", "noise", "noise_sigma", "leakage",
                 "leak_level", "leak_shoulder", "leak_edge_m", "leak_shoulder_end_m",
-                "leak_jitter"});
+                "leak_jitter", "speckle_model", "range_response", "range_cell_bins",
+                "receiver_tail_db", "receiver_tail_bins", "knife_edge", "carrier_ghz"});
         s.smear = c.boolean("smear", false);
         s.smear_shape = c.choice<int>("smear_shape", 0, {{"triangular", 0}, {"exponential", 1}, {"two-component", 2},
                                                               {"gaussian", 3}, {"maxwell", 4}, {"powerlaw", 5}});
@@ -276,6 +279,18 @@ Scene build(const Parsed &p)
             s.speckle_static = v == "auto" ? -1 : (c.boolean("speckle_static", false) ? 1 : 0);
         }
         s.speckle_seed = static_cast<uint64_t>(c.integer("speckle_seed", 0, 0, (1LL << 62)));
+        s.speckle_physical = c.choice<bool>("speckle_model", s.speckle_physical,
+                                            {{"lognormal", false}, {"physical", true}});
+        s.range_response = c.choice<RangeResponse>(
+            "range_response", s.range_response,
+            {{"none", RangeResponse::None}, {"rect", RangeResponse::Rect},
+             {"hann", RangeResponse::Hann}, {"hamming", RangeResponse::Hamming},
+             {"blackman", RangeResponse::Blackman}, {"cts350x", RangeResponse::Cts350x}});
+        s.range_cell_bins = c.real("range_cell_bins", s.range_cell_bins, 0.5, 9);
+        s.receiver_tail_db = c.real("receiver_tail_db", s.receiver_tail_db, -120, 0);
+        s.receiver_tail_bins = c.real("receiver_tail_bins", s.receiver_tail_bins, 0, 200);
+        s.knife_edge = c.boolean("knife_edge", false);
+        s.carrier_ghz = c.real("carrier_ghz", s.carrier_ghz, 1, 1000);
         s.noise = c.boolean("noise", false);
         s.noise_sigma = c.real("noise_sigma", s.log_power ? kNoiseSigmaPower : s.noise_sigma, 0, 1e6);
         s.leakage = c.boolean("leakage", false);
@@ -339,6 +354,18 @@ Scene build(const Parsed &p)
             b.height_m = c.real("height_m", 1, 0.001, 1000);
             b.reflectivity = c.real("reflectivity", b.reflectivity, 0, 1e9);
             s.boxes.push_back(b);
+        } else if (kind == "point") {
+            c.only({"x_m", "y_m", "z_m", "energy"});
+            ScenePoint q;
+            q.name = obj;
+            if (!c.has("x_m") || !c.has("y_m")) {
+                c.fail("x_m", "x_m and y_m are required");
+            }
+            q.x_m = c.real("x_m", 0, -1e5, 1e5);
+            q.y_m = c.real("y_m", 0, -1e5, 1e5);
+            q.z_m = c.real("z_m", q.z_m, 0, 1000);
+            q.energy = c.real("energy", q.energy, 0, 1e15);
+            s.points.push_back(q);
         } else if (kind == "wall") {
             c.only({"x1_m", "y1_m", "x2_m", "y2_m", "height_m", "thickness_m", "reflectivity"});
             const double x1 = c.real("x1_m", 0, -1e5, 1e5), y1 = c.real("y1_m", 0, -1e5, 1e5);
@@ -420,7 +447,8 @@ void validate_scene(Scene &s)
         fail("effects.noise / effects.leakage need output.mapping = log (they are defined in "
              "the sensor's log-magnitude domain)");
     }
-    if (s.amplitude == AmplitudeModel::Peak && (s.smear || s.mapping == OutputMapping::Log)) {
+    if (s.amplitude == AmplitudeModel::Peak &&
+        (s.smear || s.mapping == OutputMapping::Log || scene_physical_response(s))) {
         fail("output.amplitude = peak (RadaRays max-per-cell) works with mapping = linear and "
              "no smear only");
     }
@@ -473,6 +501,11 @@ Scene parse_scene_string(const std::string &text, const std::string &name)
         throw SceneError(name + ":" + std::to_string(rc) + ": syntax error on this line");
     }
     return build(p);
+}
+
+bool scene_physical_response(const Scene &s)
+{
+    return s.range_response != RangeResponse::None || (s.speckle && s.speckle_physical);
 }
 
 double scene_bin_size_m(const Scene &s) { return s.board.bin_size_m; }

@@ -50,6 +50,18 @@ struct SceneBox {
     double reflectivity = 0.5;
 };
 
+/// An isolated point return (a post, a sign, a kerb stone): one scatterer at a world point.
+struct ScenePoint {
+    std::string name;
+    double x_m = 0, y_m = 0, z_m = 0.5; ///< world position
+    double energy = 1000;               ///< return at the beam's peak gain, in the scene's
+                                        ///< energy units (output.log_ref_energy reads
+                                        ///< output.log_ref_value)
+};
+
+/// The range response a return is spread with (effects.range_response).
+enum class RangeResponse { None, Rect, Hann, Hamming, Blackman, Cts350x };
+
 enum class ElevationProfile { Ideal, Measured };
 enum class AmplitudeModel { Integral, Peak };
 enum class OutputMapping { Linear, Log };
@@ -76,6 +88,7 @@ struct Scene {
     // objects
     std::vector<ScenePole> poles;
     std::vector<SceneBox> boxes;
+    std::vector<ScenePoint> points; ///< [point.<name>]: isolated point returns
     // [ground]
     bool ground = true;
     double ground_reflectivity = 0.05;
@@ -109,6 +122,10 @@ struct Scene {
                                    ///< value, Rayleigh noise; the round-1 model, the default)
     double log_ref_energy = 1.0;   ///< Log: this energy (deg^2) ...
     double log_ref_value = 100;    ///< ... reads this value (noise-free)
+    bool log_navtech = false;      ///< Log: value = round(cpo (e + m)) for N = 2^e (1 + m),
+                                   ///< cpo = log_db_per_decade log10 2 (Navtech's piecewise-
+                                   ///< linear log2; output.log_curve = navtech) instead of
+                                   ///< round(c log10 N)
     // [effects]
     bool smear = false;
     int smear_shape = 0;           ///< 0 triangular (RadaRays), 1 exponential tail,
@@ -136,6 +153,17 @@ struct Scene {
     double speckle_frame_db = 0;   ///< > 0: a further log-normal fluctuation drawn anew every
                                    ///< rotation (1 sigma, dB), on top of the pattern above
     uint64_t speckle_seed = 0;     ///< 0: derived from seed
+    bool speckle_physical = false; ///< speckle_model = physical: complex Gaussian scatterer
+                                   ///< amplitudes summed coherently through the range
+                                   ///< response (fully developed: exponential power)
+    // physical range response: the field per bin is the sum of the scatterers' complex
+    // amplitudes times the amplitude response sqrt(R) at their offset (see scenes/README.md)
+    RangeResponse range_response = RangeResponse::None;
+    double range_cell_bins = 6;    ///< window responses: bins per resolution cell (1 / T)
+    double receiver_tail_db = -30; ///< receiver tail: R(o > 0) += 10^(db/10) exp(-o / bins) ...
+    double receiver_tail_bins = 0; ///< ... its e-folding length in bins (0: no tail)
+    bool knife_edge = false;       ///< Fresnel knife-edge diffraction at the chassis edge
+    double carrier_ghz = 76.5;     ///< carrier frequency of the diffraction (CTS350-X: 76-77)
     bool noise = false;
     double noise_sigma = 1.62;     ///< complex Gaussian per component: 35 % of the noise reads
                                    ///< 0 (P(round N <= 1)); default 1.62 for magnitude, 1.32 for
@@ -189,5 +217,8 @@ double scene_az_sigma_deg(const Scene &s);
 double scene_az_cutoff_deg(const Scene &s);
 /// True when speckle is frozen over rotations (static scene or speckle_static = 1).
 bool scene_speckle_static(const Scene &s);
+/// True when returns go through the coherent range-response path (a range response or
+/// physical speckle).
+bool scene_physical_response(const Scene &s);
 
 } // namespace sl
