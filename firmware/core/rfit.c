@@ -488,6 +488,19 @@ static void deviance(ctx_t *c, int32_t a, int32_t b, uint64_t level, sl_rfit_out
     const uint64_t sq_q8 = sl_fx_isqrt64(2U * (uint64_t)c->in->n * c->r->s4_q8 * 256U);
     const uint64_t lim = e_q8 + 6U * sq_q8 + 8U * 256U;
     out->dev_limit_q8 = (lim > UINT32_MAX) ? UINT32_MAX : (uint32_t)lim;
+    const uint64_t disp = (e_q8 == 0U) ? 256U : ((uint64_t)out->dev_q8 * 256U) / e_q8;
+    out->dispersion_q8 = (disp < 256U) ? 256U : ((disp > UINT32_MAX) ? UINT32_MAX : (uint32_t)disp);
+}
+
+// Sigmas scaled by sqrt(dispersion) (quasi-likelihood), saturating.
+static uint32_t disperse(uint32_t sigma_q8, uint32_t disp_q8)
+{
+    if (sigma_q8 == UINT32_MAX) {
+        return sigma_q8;
+    }
+    const uint64_t r_q8 = sl_fx_isqrt64((uint64_t)disp_q8 * 256U); // sqrt(disp), Q8
+    const uint64_t v = ((uint64_t)sigma_q8 * r_q8 + 128U) >> 8;
+    return (v >= UINT32_MAX) ? UINT32_MAX : (uint32_t)v;
 }
 
 // The shift that brings the window's largest power (observed or floor) to ~2^NORM_BITS;
@@ -592,6 +605,8 @@ sl_err_t sl_rfit(const sl_response_t *r, const sl_rfit_in_t *in, sl_rfit_out_t *
     out->level = (c.sh >= 0) ? sl_fx_usat32((int64_t)(level << (unsigned)c.sh))
                              : sl_fx_usat32((int64_t)(level >> (unsigned)(-c.sh)));
     deviance(&c, a, b, level, out);
+    out->sigma_a_q8 = disperse(out->sigma_a_q8, out->dispersion_q8);
+    out->sigma_b_q8 = disperse(out->sigma_b_q8, out->dispersion_q8);
     out->evals = c.evals;
     if (out->dev_q8 > out->dev_limit_q8) {
         out->quality = (uint8_t)SL_RFIT_OUT_OF_MODEL;

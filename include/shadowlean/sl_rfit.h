@@ -37,6 +37,9 @@
 /// bound down (a return shorter than the response is wide, one frozen speckle draw, a weak
 /// return), the information is small and the sigma wide: a caller propagates it to the lean's
 /// sigma and sends the lean with it, never as a confident number.
+/// Where the return departs from the model by more than its noise explains (the deviance D
+/// below above its expectation E), the bounds are known less well than the model says: both
+/// sigmas are scaled by sqrt(D / E) (quasi-likelihood dispersion), never below the model's.
 /// `quality`:
 /// - SL_RFIT_OK: converged, the deviance within what the noise explains;
 /// - SL_RFIT_OUT_OF_MODEL: the deviance D = 2 w sum (y/mu - 1 - ln(y/mu)) exceeds
@@ -113,6 +116,8 @@ typedef struct sl_rfit_out {
     int64_t nll_q16;            ///< J at the optimum, nats Q16
     uint32_t dev_q8;            ///< the deviance D, Q8
     uint32_t dev_limit_q8;      ///< its OUT_OF_MODEL limit, Q8
+    uint32_t dispersion_q8;     ///< D over its expectation E, at least 1, Q8: the sigmas
+                                ///< above are scaled by its square root
     uint8_t quality;            ///< sl_rfit_quality_t
     uint8_t iters;              ///< iterations used
     uint16_t evals;             ///< objective evaluations used
