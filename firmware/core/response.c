@@ -59,15 +59,25 @@ static uint32_t log2_frac_q16(uint32_t m_q16)
     return lo + (((hi - lo) * t + 128U) >> 8);
 }
 
+// Index of the highest set bit of x > 0 (a binary search: six steps).
+static int top_bit(uint64_t x)
+{
+    int n = 0;
+    for (int s = 32; s > 0; s >>= 1) {
+        if ((x >> (unsigned)s) != 0U) {
+            x >>= (unsigned)s;
+            n += s;
+        }
+    }
+    return n;
+}
+
 int32_t sl_lin_log2_q16(uint64_t x)
 {
     if (x == 0U) {
         return -65536 * 32;
     }
-    int n = 63;
-    while ((x >> n) == 0U) {
-        n--;
-    }
+    const int n = top_bit(x);
     uint32_t m_q16;
     if (n >= 16) {
         m_q16 = (uint32_t)((x >> (n - 16)) & 0xFFFFU);
@@ -82,18 +92,7 @@ int32_t sl_lin_to_lp(uint64_t x)
     if (x == 0U) {
         return -256 * 32;
     }
-    int n = 63;
-    while ((x >> n) == 0U) {
-        n--;
-    }
-    // mantissa in Q16: (x / 2^n - 1)
-    uint32_t m_q16;
-    if (n >= 16) {
-        m_q16 = (uint32_t)((x >> (n - 16)) & 0xFFFFU);
-    } else {
-        m_q16 = (uint32_t)((x << (16 - n)) & 0xFFFFU);
-    }
-    return (int32_t)(n * 256) + (int32_t)((log2_frac_q16(m_q16) + 128U) >> 8);
+    return (int32_t)(((uint32_t)sl_lin_log2_q16(x) + 128U) >> 8); // x >= 1: non-negative
 }
 
 uint32_t sl_lp_to_lin_q16(int32_t lp)

@@ -8,7 +8,6 @@
 #include "shadowlean/sl_fx.h"
 
 #define LN2_Q16 45426   // ln 2, Q16
-#define DELTA_Q8 32     // Jacobian difference: 1/8 bin
 #define MIN_W_Q8 32     // b >= a + 1/8 bin
 #define MAX_STEP_Q8 1024 // at most 4 bins per iteration
 #define TOL_Q8 4        // converged below 1/64 bin
@@ -18,7 +17,10 @@
 
 typedef struct pieces {
     int32_t x[SL_RFIT_PIECES + 1]; // breakpoints, bins Q8 (window coordinates)
-    int32_t coef[SL_RFIT_PIECES];  // mass / (width x CT), scaled so m_q24 = coef x dC >> 16
+    int32_t coef[SL_RFIT_PIECES];  // mass / (width x CT), scaled so m_q24 = coef x dC >> 24
+    uint32_t inv_w[SL_RFIT_PIECES]; // 2^32 / width (width in bins Q8)
+    int32_t dxa[SL_RFIT_PIECES + 1]; // d x_j / d a, Q16
+    int32_t dxb[SL_RFIT_PIECES + 1]; // d x_j / d b, Q16
     uint8_t np;
 } pieces_t;
 
@@ -52,14 +54,13 @@ static uint32_t f_at(const ctx_t *c, uint32_t k)
     return (f == 0U) ? 1U : f;
 }
 
-// mass_q16 x 2^32 / (w_q8 x CT): below 2^31 for any width >= 1/256 bin and a response
-// whose cumulative total CT is at least one tap's (2^22 x SUB).
+// mass_q16 x 2^40 / (w_q8 x CT), saturating (a width of 1/256 bin under a one-tap response).
 static int32_t piece_coef(const ctx_t *c, uint32_t mass_q16, int32_t w_q8)
 {
     if (w_q8 < 1) {
         w_q8 = 1;
     }
-    const uint64_t v = (((uint64_t)mass_q16) << 32) / ((uint64_t)(uint32_t)w_q8 * c->ct);
+    const uint64_t v = (((uint64_t)mass_q16) << 40) / ((uint64_t)(uint32_t)w_q8 * c->ct);
     return (v > INT32_MAX) ? INT32_MAX : (int32_t)v;
 }
 
@@ -69,29 +70,93 @@ static void pieces_build(const ctx_t *c, int32_t a, int32_t b, pieces_t *p)
         p->np = 1U;
         p->x[0] = a;
         p->x[1] = b;
-        p->coef[0] = piece_coef(c, 65536U, b - a);
-        return;
-    }
-    // Equal-mass pieces of g(X) ~ X / sqrt(X^2 - A0^2): M(X) = sqrt(X^2 - A0^2), so the
-    // p-th breakpoint is sqrt(A0^2 + (p/P)^2 (B0^2 - A0^2)).
-    const int64_t o = (int64_t)c->in->origin_q8;
-    const int64_t a0 = o + a;
-    const int64_t b0 = o + b;
-    const uint64_t a2 = (uint64_t)(a0 * a0);
-    const uint64_t m2 = (uint64_t)(b0 * b0) - a2;
-    p->np = (uint8_t)SL_RFIT_PIECES;
-    p->x[0] = a;
-    for (uint32_t i = 1; i < SL_RFIT_PIECES; i++) {
-        const uint64_t t = a2 + m2 * i * i / ((uint64_t)SL_RFIT_PIECES * SL_RFIT_PIECES);
-        p->x[i] = (int32_t)((int64_t)sl_fx_isqrt64(t) - o);
-        if (p->x[i] < p->x[i - 1U]) {
-            p->x[i] = p->x[i - 1U];
+        p->dxa[0] = 65536;
+        p->dxb[0] = 0;
+        p->dxa[1] = 0;
+        p->dxb[1] = 65536;
+    } else {
+        // Equal-mass pieces of g(X) ~ X / sqrt(X^2 - A0^2): M(X) = sqrt(X^2 - A0^2), so the
+        // j-th breakpoint is X_j = sqrt(A0^2 + t^2 (B0^2 - A0^2)), t = j / P, with
+        // d X_j / d A0 = A0 (1 - t^2) / X_j and d X_j / d B0 = t^2 B0 / X_j.
+        const int64_t o = (int64_t)c->in->origin_q8;
+        const int64_t a0 = o + a;
+        const int64_t b0 = o + b;
+        const uint64_t a2 = (uint64_t)(a0 * a0);
+        const uint64_t m2 = (uint64_t)(b0 * b0) - a2;
+        p->np = (uint8_t)SL_RFIT_PIECES;
+        p->x[0] = a;
+        p->dxa[0] = 65536;
+        p->dxb[0] = 0;
+        const uint64_t pp = (uint64_t)SL_RFIT_PIECES * SL_RFIT_PIECES;
+        for (uint32_t i = 1; i < SL_RFIT_PIECES; i++) {
+            const uint64_t t2 = (uint64_t)i * i; // t^2 x P^2
+            const uint64_t xs = sl_fx_isqrt64(a2 + m2 * t2 / pp);
+            p->x[i] = (int32_t)((int64_t)xs - o);
+            if (p->x[i] < p->x[i - 1U]) {
+                p->x[i] = p->x[i - 1U];
+            }
+            const uint64_t den = (xs == 0U) ? 1U : xs;
+            p->dxa[i] = (int32_t)(((uint64_t)a0 * (pp - t2) * 65536U) / (pp * den));
+            p->dxb[i] = (int32_t)(((uint64_t)b0 * t2 * 65536U) / (pp * den));
         }
+        p->x[SL_RFIT_PIECES] = b;
+        p->dxa[SL_RFIT_PIECES] = 0;
+        p->dxb[SL_RFIT_PIECES] = 65536;
     }
-    p->x[SL_RFIT_PIECES] = b;
-    for (uint32_t i = 0; i < SL_RFIT_PIECES; i++) {
-        p->coef[i] = piece_coef(c, 65536U / SL_RFIT_PIECES, p->x[i + 1U] - p->x[i]);
+    const uint32_t mass = 65536U / p->np;
+    for (uint32_t i = 0; i < p->np; i++) {
+        int32_t w = p->x[i + 1U] - p->x[i];
+        w = (w < 1) ? 1 : w;
+        p->coef[i] = piece_coef(c, mass, w);
+        p->inv_w[i] = (uint32_t)(((uint64_t)1 << 32) / (uint32_t)w - (w == 1 ? 1U : 0U));
     }
+}
+
+// The response at offset u (bins Q8), tap_q22 interpolated; 0 outside the taps.
+static int64_t resp_at(const sl_response_t *r, int32_t u_q8)
+{
+    const int32_t v = u_q8 + SL_CFG_RESP_HALF * 256;
+    if (v < 0 || v >= (SL_RESP_TAPS - 1) * 256) {
+        return 0;
+    }
+    const uint32_t i = (uint32_t)v >> 8;
+    const uint32_t t = (uint32_t)v & 255U;
+    return (int64_t)(((uint64_t)r->tap_q22[i] * (256U - t) + (uint64_t)r->tap_q22[i + 1U] * t +
+                      128U) >> 8);
+}
+
+// The model and its derivatives by a and b at sample k, Q24 (per bin). A piece p adds
+// coef_p (C(k - x_p) - C(k - x_p+1)); moving a breakpoint moves the piece's end (the response
+// there, dC/du = SUB R) and its width (coef ~ 1 / width).
+static int64_t model_grad_at(const ctx_t *c, const pieces_t *p, uint32_t k, int64_t *dm_da,
+                             int64_t *dm_db)
+{
+    const int32_t kq = (int32_t)(k * 256U);
+    int64_t m = 0, ga = 0, gb = 0;
+    uint32_t hi = sl_response_cum(c->r, kq - p->x[0]);
+    int64_t r_hi = resp_at(c->r, kq - p->x[0]);
+    for (uint32_t i = 0; i < p->np; i++) {
+        const uint32_t lo = sl_response_cum(c->r, kq - p->x[i + 1U]);
+        const int64_t r_lo = resp_at(c->r, kq - p->x[i + 1U]);
+        const int64_t mp = (int64_t)p->coef[i] * (int64_t)(hi - lo); // Q48
+        m += mp;
+        // d/dx_i and d/dx_i+1 of this piece, Q24 per bin
+        const int64_t wterm = sl_fx_rshift_round64(sl_fx_rshift_round64(mp, 24) * 256 *
+                                                       (int64_t)p->inv_w[i], 32);
+        // C(k - x) falls as x grows (dC/dx = -SUB R); the width grows with x_i+1
+        const int64_t d_lo =
+            wterm - sl_fx_rshift_round64((int64_t)p->coef[i] * SL_RESP_SUB * r_hi, 24);
+        const int64_t d_hi =
+            sl_fx_rshift_round64((int64_t)p->coef[i] * SL_RESP_SUB * r_lo, 24) - wterm;
+        // |d| < 2^40 (the model is a fraction over widths >= 1/256 bin), |dx| <= 2^17
+        ga += sl_fx_rshift_round64(d_lo * p->dxa[i] + d_hi * p->dxa[i + 1U], 16);
+        gb += sl_fx_rshift_round64(d_lo * p->dxb[i] + d_hi * p->dxb[i + 1U], 16);
+        hi = lo;
+        r_hi = r_lo;
+    }
+    *dm_da = ga;
+    *dm_db = gb;
+    return sl_fx_rshift_round64(m, 24);
 }
 
 // The model at sample k, Q24 of the return's total power.
@@ -105,7 +170,7 @@ static int64_t model_at(const ctx_t *c, const pieces_t *p, uint32_t k)
         m += (int64_t)p->coef[i] * (int64_t)(hi - lo);
         hi = lo;
     }
-    return sl_fx_rshift_round64(m, 16);
+    return sl_fx_rshift_round64(m, 24);
 }
 
 static uint64_t mu_of(const ctx_t *c, uint64_t level, int64_t m_q24, uint32_t k)
@@ -151,23 +216,18 @@ typedef struct normal {
 // (1, bins, bins).
 static void normal_eq(ctx_t *c, int32_t a, int32_t b, uint64_t level, normal_t *ne)
 {
-    pieces_t p0, pa, pb, qa, qb;
+    pieces_t p0;
     pieces_build(c, a, b, &p0);
-    pieces_build(c, a + DELTA_Q8, b, &pa);
-    pieces_build(c, a - DELTA_Q8, b, &qa);
-    pieces_build(c, a, b + DELTA_Q8, &pb);
-    pieces_build(c, a, b - DELTA_Q8, &qb);
     memset(ne, 0, sizeof(*ne));
     int64_t g38[3] = {0, 0, 0}; // score, Q38
     for (uint32_t k = 0; k < c->in->n; k++) {
-        const int64_t m0 = model_at(c, &p0, k);
-        const int64_t ma = model_at(c, &pa, k) - model_at(c, &qa, k);
-        const int64_t mb = model_at(c, &pb, k) - model_at(c, &qb, k);
+        int64_t ma, mb;
+        const int64_t m0 = model_grad_at(c, &p0, k, &ma, &mb);
         const uint64_t mu = mu_of(c, level, m0, k);
         const int64_t lm = (int64_t)(mu - (uint64_t)f_at(c, k)); // level x m0
-        // d mu / d a per bin = level (m(a + d) - m(a - d)) / (2 d), d = 1/8 bin; m Q24
-        const int64_t da = mulsh((int64_t)level, ma * (128 / DELTA_Q8), 24);
-        const int64_t db = mulsh((int64_t)level, mb * (128 / DELTA_Q8), 24);
+        // d mu / d a per bin = level d m / d a (m Q24)
+        const int64_t da = mulsh((int64_t)level, ma, 24);
+        const int64_t db = mulsh((int64_t)level, mb, 24);
         int64_t j[3];
         j[0] = over_mu_q14(lm, mu);
         j[1] = over_mu_q14(da, mu);
@@ -391,24 +451,17 @@ static void covariance(ctx_t *c, int32_t a, int32_t b, uint64_t level, const ldl
     if (g_a >= SAT || g_b >= SAT) {
         return;
     }
-    pieces_t p0, pa, pb, qa, qb;
+    pieces_t p0;
     pieces_build(c, a, b, &p0);
-    pieces_build(c, a + DELTA_Q8, b, &pa);
-    pieces_build(c, a - DELTA_Q8, b, &qa);
-    pieces_build(c, a, b + DELTA_Q8, &pb);
-    pieces_build(c, a, b - DELTA_Q8, &qb);
     int16_t ra[RING], rb[RING]; // projected Jacobians of the last RING samples, Q10
     int64_t m_aa = 0, m_bb = 0, m_ab = 0; // Q28 (Q10 x Q10 x Q15 >> 7)
     for (uint32_t k = 0; k < c->in->n; k++) {
-        const int64_t m0 = model_at(c, &p0, k);
-        const int64_t ma = model_at(c, &pa, k) - model_at(c, &qa, k);
-        const int64_t mb = model_at(c, &pb, k) - model_at(c, &qb, k);
+        int64_t ma, mb;
+        const int64_t m0 = model_grad_at(c, &p0, k, &ma, &mb);
         const uint64_t mu = mu_of(c, level, m0, k);
         const int64_t j0 = over_mu_q14((int64_t)(mu - (uint64_t)f_at(c, k)), mu);
-        const int64_t j1 = over_mu_q14(
-            mulsh((int64_t)level, ma * (128 / DELTA_Q8), 24), mu);
-        const int64_t j2 = over_mu_q14(
-            mulsh((int64_t)level, mb * (128 / DELTA_Q8), 24), mu);
+        const int64_t j1 = over_mu_q14(mulsh((int64_t)level, ma, 24), mu);
+        const int64_t j2 = over_mu_q14(mulsh((int64_t)level, mb, 24), mu);
         int64_t ta = sl_fx_rshift_round64(j1 - sl_fx_rshift_round64(f->l10 * j0, 16), 4);
         int64_t tb = sl_fx_rshift_round64(j2 - sl_fx_rshift_round64(f->l20 * j0, 16), 4);
         ta = (ta > 32767) ? 32767 : ((ta < -32767) ? -32767 : ta);
@@ -551,6 +604,7 @@ sl_err_t sl_rfit(const sl_response_t *r, const sl_rfit_in_t *in, sl_rfit_out_t *
     pieces_build(&c, a, b, &p);
     int64_t j = nll(&c, &p, level);
     bool converged = false;
+    bool fresh = false; // ne and f hold the information at (a, b, level)
     normal_t ne;
     ldl_t f;
     uint8_t it = 0;
@@ -566,6 +620,10 @@ sl_err_t sl_rfit(const sl_response_t *r, const sl_rfit_in_t *in, sl_rfit_out_t *
         int32_t db = clamp_step(sl_fx_rshift_round64(x[2], 8));
         int64_t dl = x[0];
         converged = sl_fx_abs32(da) < TOL_Q8 && sl_fx_abs32(db) < TOL_Q8 && dl < 655 && dl > -655;
+        if (converged) {
+            fresh = true; // the information at this point is the one just computed
+            break;        // the step is below the bounds' resolution
+        }
         bool moved = false;
         for (int h = 0; h <= SL_RFIT_HALVINGS; h++) {
             int32_t na = a + da, nb = b + db;
@@ -584,13 +642,20 @@ sl_err_t sl_rfit(const sl_response_t *r, const sl_rfit_in_t *in, sl_rfit_out_t *
             da /= 2;
             db /= 2;
             dl /= 2;
+            if (sl_fx_abs32(da) < TOL_Q8 && sl_fx_abs32(db) < TOL_Q8 && dl < 655 && dl > -655) {
+                break; // what is left of the step is below the resolution
+            }
         }
         if (!moved) {
             converged = true; // no descent left at the objective's resolution
+            fresh = true;
+            break;
         }
     }
-    normal_eq(&c, a, b, level, &ne);
-    f = factor(&ne);
+    if (!fresh) {
+        normal_eq(&c, a, b, level, &ne);
+        f = factor(&ne);
+    }
     out->a_q8 = a;
     out->b_q8 = b;
     out->iters = it;

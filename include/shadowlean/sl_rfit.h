@@ -25,8 +25,9 @@
 /// (rotations of a scene whose speckle changes, neighbouring rows inside the beam; 1 for one
 /// frozen draw however many rotations were summed: the caller says which) and ncorr the
 /// response's speckle correlation length (neighbouring bins are not independent draws).
-/// Solved by Fisher scoring (Gauss-Newton with weights 1 / mu^2, the model's Jacobian from
-/// differences of 1/8 bin), the level A eliminated in closed form at each step's weights;
+/// Solved by Fisher scoring (Gauss-Newton with weights 1 / mu^2, the model's Jacobian
+/// analytic: moving a bound moves a piece's end and its width), the level A a third
+/// parameter (its logarithm) of each step;
 /// start: the moments of the power above the floor (centroid and variance less the
 /// response's own); steps halved while J grows (at most SL_RFIT_HALVINGS), at most
 /// SL_RFIT_ITERS iterations. a and b are kept inside the window and b >= a + 1/8 bin.
@@ -59,11 +60,12 @@
 /// ## Ownership and cost
 /// Pure: reads the caller's arrays and `sl_response_t`, writes `*out`; no allocation, no
 /// state, reentrant. Work: at most SL_RFIT_ITERS Fisher steps, each one pass over the n
-/// samples with five model evaluations (SL_RFIT_PIECES + 1 table reads each) and up to
-/// SL_RFIT_HALVINGS + 1 objective evaluations (one 64-bit division and one log per sample);
-/// the covariance one more pass with the speckle correlation's lags (<= SL_RESP_TAPS per
-/// sample). Stack: 1.2 KB at most on Cortex-M0 -Os (sl_rfit 496 B + its covariance pass
-/// 728 B: five piece sets and the lag ring on the stack). Flash: firmware/size_budget.txt.
+/// samples evaluating the model and its analytic derivatives by a and b (SL_RFIT_PIECES + 1
+/// reads of the cumulative response and of the response each), then up to
+/// SL_RFIT_HALVINGS + 1 objective evaluations (the model, one 64-bit division and one log
+/// per sample); the covariance one more pass with the speckle correlation's lags
+/// (<= SL_RESP_TAPS per sample). Stack: about 1.4 KB at most on Cortex-M0 -Os (sl_rfit,
+/// its covariance pass with the lag ring, the model). Flash: firmware/size_budget.txt.
 #ifndef SHADOWLEAN_SL_RFIT_H
 #define SHADOWLEAN_SL_RFIT_H
 
