@@ -26,7 +26,8 @@
 //     (sl_response.h) over every row from --min-m to --max-m (default 5-100 m; an Oxford folder
 //     is read row by row in full, a capture as far as its region of interest): isolated strong returns,
 //     the running median of their drop per offset; printed against the built-in CTS350-X
-//     lobe; --out-ini writes the [response] section; --max-diff exits 1 when an offset
+//     lobe; --out-ini writes it as an INI [response] section (drops_q8: the 41 values
+//     sl_response_set() takes); --max-diff exits 1 when an offset
 //     whose prior drop is at most --down-to values differs by more.
 //
 // Exit status: 0 done, 1 error (I/O, bad data), 2 usage.
