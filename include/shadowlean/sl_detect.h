@@ -165,7 +165,7 @@
 ///      here is the number of contiguous azimuths around the representative one whose run
 ///      reaches into the 3-bin slab [bin_first, bin_first + 2] (a round pole's silhouette
 ///      lies ~R behind its front; a leaning pole spreads in bearing along its
-///      length, so the whole group's width overstates the diameter; EXTRACTION.md D4),
+///      length, so the whole group's width overstates the diameter; docs/DESIGN.md, "Detection"),
 ///      R = r1 * tan(w / 2) with w = (az_count - 1) * step - beam, set to 0 when the beam's
 ///      half footprint r1 * beam / 2 exceeds 4 R (the beam cannot resolve the diameter), the smallest arc consistent with az_count
 ///      azimuth samples less the beam's own spread (small angle; clamped to

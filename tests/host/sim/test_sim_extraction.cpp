@@ -158,7 +158,7 @@ static void test_extraction_shallow_smear_found_at_the_shadow_edge(void **)
 }
 
 // Per-frame speckle: the profile is a mean, not the AND's minimum statistic, so the estimate
-// does not drift with n (the mask's r2 shortens with n: EXTRACTION.md s.1 cause 3).
+// does not drift with n (the mask's r2 shortens with n: docs/DESIGN.md, "Range extraction").
 static void test_extraction_does_not_drift_with_n_under_per_frame_speckle(void **)
 {
     double e[2][5];
