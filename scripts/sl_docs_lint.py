@@ -6,8 +6,9 @@
 
 Files: `git ls-files` in SOURCE_DIR (without git: every file under it but .git and build/).
 Rules, one message per hit as FILE:LINE: RULE: text:
-  chronology   development history in shipped text: a numbered session or round
-               ("session 17", "round 2"; a TCP or pcap session is not one), "this session"
+  chronology   development history in shipped text: a numbered session or round (the
+               word, a space, a number; a TCP or pcap session is not one), or "this",
+               "last", "previous", "earlier", "next" or "development" before either word
   shared-path  a path into a folder beside the checkout (dot-dot, then "shared", then a slash):
                a clone does not have it
   left-out     the experiment-log phrase "tried" + "and left out"
