@@ -10,7 +10,7 @@
 # sigma below 1 deg: DANGER on CAN, before the ramps of sl_profile.h); every LeanWarning
 # must now stay within the true lean's level by 3 of its LeanSigma (warning_vs_truth.py).
 # A pole the module does not report passes (a miss is not a false warning; the wider
-# kernels, 35 and 50 bins, are missed every time: see the README).
+# kernels, 35 and 50 bins, are missed every time: docs/DESIGN.md, "Range extraction").
 set -u
 SL_SIM=$1; DAEMON=$2; PY=$3; SRC=$4; OUT=$5
 rm -rf "$OUT"; mkdir -p "$OUT"
