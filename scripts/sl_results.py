@@ -9,6 +9,8 @@ RUNS = {
                "sim_table1_must_show, sim_table1_pipeline"),
     "realistic": ("sl-eval realistic --extract both --threads 1 --quiet --json-out docs/results/realistic.json",
                   "sim_realistic_pipeline, sim_extraction_smear_robust"),
+    "realistic_power": ("sl-eval realistic --power-scale --extract pipeline --threads 1 --quiet "
+                        "--json-out docs/results/realistic_power.json", "sim_extraction_smear_robust"),
     "realistic_hard_quick": ("sl-eval realistic --hard --extract both --quick --range-bins 160 --threads 1 --quiet "
                              "--json-out docs/results/realistic_hard_quick.json", "sim_hard_acceptance"),
     "driveby_noise_free": ("sl-eval driveby --quiet --json-out docs/results/driveby_noise_free.json",
@@ -19,6 +21,8 @@ RUNS = {
     "driveby_realistic_96_power": ("sl-eval driveby --realistic --power-scale --speeds 1,3 --offset 3 --offset -3 "
                                    "--psi 5 --psi 10 --psi 20 --json-out docs/results/driveby_realistic_96_power.json",
                                    "sim_driveby_tilt_along_the_path"),
+    "driveby_realistic": ("sl-eval driveby --realistic --json-out docs/results/driveby_realistic.json",
+                          "sim_driveby_tilt_realistic"),
     "driveby_realistic_3ms": ("sl-eval driveby --realistic --speeds 3 --offset 3 --offset -3 --psi 5 --psi 10 --psi 20 "
                               "--json-out docs/results/driveby_realistic_3ms.json", "sim_driveby_tilt_realistic_3ms"),
 }
@@ -178,20 +182,27 @@ def reproduce(res):
 
 
 def render(res):
-    """[(page, part, body)] for sl_docs_gen.py."""
+    """[(page, part, body)] for sl_docs_gen.py. A part whose JSON is not in docs/results/
+    names the command that writes it."""
     h = headline(res)
     parts = [("README.md", "results-headline", h), ("docs/RESULTS.md", "results-headline", h)]
-    if "table1" in res:
-        parts.append(("docs/RESULTS.md", "results-table1", table1_tables(res["table1"])))
-    if "realistic" in res:
-        parts.append(("docs/RESULTS.md", "results-realistic", realistic_tables(res["realistic"])))
-    if "realistic_hard_quick" in res:
-        parts.append(("docs/RESULTS.md", "results-hard", realistic_tables(res["realistic_hard_quick"])))
+    sections = [("table1", "results-table1", table1_tables),
+                ("realistic", "results-realistic", realistic_tables),
+                ("realistic_power", "results-realistic-power", realistic_tables),
+                ("realistic_hard_quick", "results-hard", realistic_tables)]
     for name, title in (("driveby_noise_free", "Noise-free sweep"),
                         ("driveby_realistic_96", "Smear and speckle, 1 and 3 m/s"),
                         ("driveby_realistic_96_power", "The same on the sensor's value scale (0.5 dB per value)"),
-                        ("driveby_realistic_3ms", "Smear and speckle, 3 m/s, poles 3 m either side")):
+                        ("driveby_realistic_3ms", "Smear and speckle, 3 m/s, poles 3 m either side"),
+                        ("driveby_realistic", "Smear and speckle, the whole sweep")):
+        sections.append((name, "results-" + name.replace("_", "-"),
+                         lambda d, t=title: driveby_tables(d, t)))
+    for name, part, fn in sections:
         if name in res:
-            parts.append(("docs/RESULTS.md", "results-" + name.replace("_", "-"), driveby_tables(res[name], title)))
+            body = fn(res[name])
+        else:
+            body = (f"Not in docs/results/ yet: {cmd(name)} writes it (then "
+                    "`python3 scripts/sl_docs_gen.py results`).")
+        parts.append(("docs/RESULTS.md", part, body))
     parts.append(("docs/RESULTS.md", "results-reproduce", reproduce(res)))
     return parts
