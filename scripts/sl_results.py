@@ -145,8 +145,8 @@ def realistic_tables(re_):
                    if p["r2_offset_um"] != 0 else
                    f"none ({p['resid_samples']} residuals, too few to calibrate)")
         out += ["", f"Core pipeline: board {p['board']}, n = {p['mask_frames']}; the walk-end offset of r2 learned on "
-                f"the upright calibration poles: {learned}. The paper's rows are its estimates on the real sensor, "
-                "ours on the simulator."]
+                f"the upright calibration poles: {learned}."
+                + (" The paper's rows are its estimates on the real sensor, ours on the simulator." if rows_ else "")]
     return "\n".join(out)
 
 
