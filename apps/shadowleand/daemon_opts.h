@@ -4,7 +4,7 @@
 ///
 /// Precedence: built-in defaults < config file (`--config FILE`) < command line. Every
 /// setting has a command-line option and a config-file key (table in `sld_opts_usage()`
-/// and in the README). The config file is an INI file read with inih (`ini_parse`):
+/// and in docs/DAEMON.md, generated from k_cli). The config file is an INI file read with inih (`ini_parse`):
 ///
 ///     [daemon]   board, calibration, user, syslog, verbosity, stats_every, duration, exit_idle,
 ///                status_period_ms

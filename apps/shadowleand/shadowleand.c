@@ -1249,7 +1249,7 @@ int main(int argc, char **argv)
     }
     const bool input_ok = d->is_radar || capture_report(d);
     shutdown_all(d);
-    // Exit status (README "Exit statuses"): 1 unreadable input, 4 an output could not be
+    // Exit status (docs/DAEMON.md, "Exit statuses"): 1 unreadable input, 4 an output could not be
     // written (CAN log, targets), 3 capture mode without a usable rotation or with a
     // configuration fault raised, 0 otherwise (2: bad options, before this point).
     const bool log_failed = d->log_on && d->log.stats.errors != 0U;

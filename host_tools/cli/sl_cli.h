@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
 /* sl_cli.h: the command-line conventions shared by every shadowlean executable
- * (README "Exit statuses and conventions"). Header-only, C11 and C++17.
+ * (docs/TOOLS.md, "Conventions"). Header-only, C11 and C++17.
  *
  *   --help (and -h)  the usage on stdout, exit 0
  *   --version        "<program> <version>" on stdout, exit 0 (SL_VERSION_STRING)

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
 /* sl_progress.h: progress of long runs on stderr, shared by sl-view, sl-eval, sl-calib and
- * sl-sim (README "Exit statuses and conventions"). Header-only C++17.
+ * sl-sim (docs/TOOLS.md, "Conventions"). Header-only C++17.
  *
  *   - printed only when stderr is a terminal (isatty(2)): a pipe, a file or a CI log gets
  *     nothing, so outputs stay diff-able;

@@ -83,6 +83,19 @@ const char *quality_name(int q)
     }
 }
 
+// The PoleTilt Quality value table's name ("none": no track), for --json.
+const char *quality_json(int q)
+{
+    switch (q) {
+    case SL_TILT_FITTED: return "FITTED";
+    case SL_TILT_AMBIGUOUS: return "AMBIGUOUS";
+    case SL_TILT_INSUFFICIENT_MOTION: return "INSUFFICIENT_MOTION";
+    case SL_TILT_TOO_FEW: return "TOO_FEW";
+    case SL_TILT_INCONSISTENT: return "INCONSISTENT";
+    default: return "none";
+    }
+}
+
 // --obs-log: one JSON line per new fit of a ring placed within 1 m of the pole: the case,
 // the observations the fit read (the ring as of the previous rotation) and the result.
 void log_fits(RunCtx *c)
@@ -639,7 +652,7 @@ void usage(FILE *out)
                  "usage: sl-eval driveby [--board NAME] [--quick] [--realistic] [--power-scale] [--no-profile] [--cold]\n"
                  "                       [--speeds A,B,..]\n"
                  "                       [--check] [--plot FILE.png] [--psi DEG] [--phi DEG]\n"
-                 "                       [--offset M] [--dump] [--obs-log FILE]\n"
+                 "                       [--offset M] [--dump] [--obs-log FILE] [--json] [--json-out FILE]\n"
                  "  Simulated drive-bys, one pole per pass, through the core pipeline with the pass's\n"
                  "  speed as motion input; the last FITTED 3D tilt of each pass against the truth.\n"
                  "  Default sweep: speeds 1, 2, 3 m/s; psi 3, 5, 10, 20 deg; phi every 45 deg; offsets\n"
@@ -668,6 +681,8 @@ void usage(FILE *out)
                  "  mirror's separation at the truth (below 9 the observations cannot tell it).\n"
                  "  --obs-log FILE: every new fit of the pole's ring during each pass as one JSON line\n"
                  "  (the case, the observations the fit read as stored, the result).\n"
+                 "  --json: print one JSON object (schema shadowlean-eval-driveby/1, docs/JSON_OUTPUTS.md)\n"
+                 "  instead of the table; --json-out FILE: write it to FILE as well as the table.\n"
                  "  The last line counts the AMBIGUOUS passes whose observations could not tell\n"
                  "  the mirror from the truth even if every reading were exact (the separation:\n"
                  "  the smallest chi-square, with the stated sigmas, of a reading of the fold with\n"
@@ -683,8 +698,8 @@ int cmd_driveby(int argc, char **argv)
     std::string plot;
     std::vector<double> speeds = {1.0, 2.0, 3.0};
     std::vector<double> only_psi, only_phi, only_off;
-    bool dump = false;
-    std::string obs_log_path;
+    bool dump = false, json = false;
+    std::string obs_log_path, json_out;
     auto num = [](const char *s, double *v) {
         char *end = nullptr;
         *v = std::strtod(s, &end);
@@ -710,6 +725,10 @@ int cmd_driveby(int argc, char **argv)
             plot = argv[++i];
         } else if (a == "--obs-log" && i + 1 < argc) {
             obs_log_path = argv[++i];
+        } else if (a == "--json") {
+            json = true;
+        } else if (a == "--json-out" && i + 1 < argc) {
+            json_out = argv[++i];
         } else if (a == "--dump") {
             dump = true;
         } else if (a == "--quiet" || a == "-q") {
@@ -741,9 +760,11 @@ int cmd_driveby(int argc, char **argv)
         const Case cal{1.0, 0.0, 0.0, -2.5};
         const Outcome c = run_case(board, cal, realistic, 100000);
         g_prior_slope_q8 = c.cal_n != 0U ? c.slope_q8 : 0U;
-        std::printf("tail slope prior: %.2f values/bin, self-fitted %u times on a calibration pass "
-                    "(an upright pole 2.5 m right of the path, its own seed; --cold: none)\n",
-                    g_prior_slope_q8 / 256.0, static_cast<unsigned>(c.cal_n));
+        if (!json) {
+            std::printf("tail slope prior: %.2f values/bin, self-fitted %u times on a calibration pass "
+                        "(an upright pole 2.5 m right of the path, its own seed; --cold: none)\n",
+                        g_prior_slope_q8 / 256.0, static_cast<unsigned>(c.cal_n));
+        }
         if (g_prior_slope_q8 == 0U) {
             std::fprintf(stderr, "sl-eval: driveby: the calibration pass fitted no tail slope\n");
             return 1;
@@ -782,11 +803,23 @@ int cmd_driveby(int argc, char **argv)
         phi_step = 90.0;
     }
     const double psi_tol = realistic ? 2.0 : 1.0, phi_tol = realistic ? 20.0 : 10.0;
-    std::printf("sl-eval driveby: board %s, %s, bounds for psi >= 5 deg: |psi err| <= %.1f deg, "
-                "|phi err| <= %.0f deg\n",
-                board.c_str(), realistic ? "smear + speckle" : "noise-free", psi_tol, phi_tol);
-    std::printf("%5s %5s %6s %6s | %-9s %3s %6s %6s %7s %7s %7s\n", "v", "psi", "phi", "offset",
-                "quality", "n", "psi^", "err", "phi^", "err", "off err");
+    FILE *const txt = json ? nullptr : stdout; // --json: the JSON object alone on stdout
+    if (txt != nullptr) {
+        std::fprintf(txt, "sl-eval driveby: board %s, %s, bounds for psi >= 5 deg: |psi err| <= %.1f deg, "
+                          "|phi err| <= %.0f deg\n",
+                     board.c_str(), realistic ? "smear + speckle" : "noise-free", psi_tol, phi_tol);
+        std::fprintf(txt, "%5s %5s %6s %6s | %-9s %3s %6s %6s %7s %7s %7s\n", "v", "psi", "phi", "offset",
+                     "quality", "n", "psi^", "err", "phi^", "err", "off err");
+    }
+    std::string jpasses; // --json / --json-out: one object per pass
+    auto jnum = [](double x) {
+        char b[48];
+        if (!std::isfinite(x)) {
+            return std::string("null");
+        }
+        std::snprintf(b, sizeof b, "%.4f", x);
+        return std::string(b);
+    };
     int n = 0, n_check = 0, n_ok = 0, n_fitted = 0, n_amb = 0;
     int amb5 = 0, amb5_insep = 0, ok_insep = 0; // psi >= 5: AMBIGUOUS; separation below 9
     double max_psi = 0, max_phi = 0, max_off = 0;
@@ -830,22 +863,68 @@ int cmd_driveby(int argc, char **argv)
                         if (o.fitted) {
                             max_off = std::max(max_off, std::fabs(e_off));
                         }
-                        std::printf("%5.1f %5.1f %6.0f %+6.1f | %-9s %3d %6.2f %+6.2f %7.1f %+7.1f %+7.2f%s\n",
-                                    v, psi, phi, k.offset, q, o.n_obs, o.psi, e_psi, o.phi, e_phi,
-                                    e_off, ok ? "" : "  OUT");
-                        std::fflush(stdout);
+                        if (txt != nullptr) {
+                            std::fprintf(txt, "%5.1f %5.1f %6.0f %+6.1f | %-9s %3d %6.2f %+6.2f %7.1f %+7.1f %+7.2f%s\n",
+                                         v, psi, phi, k.offset, q, o.n_obs, o.psi, e_psi, o.phi, e_phi,
+                                         e_off, ok ? "" : "  OUT");
+                            std::fflush(txt);
+                        }
+                        if (json || !json_out.empty()) {
+                            const bool est = o.fitted || o.ambiguous;
+                            jpasses += std::string(jpasses.empty() ? "" : ",\n") + "    {\"speed_mps\": " + jnum(v) +
+                                       ", \"psi_deg\": " + jnum(psi) + ", \"phi_deg\": " + jnum(phi) +
+                                       ", \"offset_m\": " + jnum(k.offset) + ", \"quality\": \"" + quality_json(o.quality) +
+                                       "\", \"observations\": " + std::to_string(o.n_obs) +
+                                       ", \"psi_est_deg\": " + (est ? jnum(o.psi) : "null") +
+                                       ", \"phi_est_deg\": " + (est ? jnum(o.phi) : "null") +
+                                       ", \"psi_err_deg\": " + (est ? jnum(e_psi) : "null") +
+                                       ", \"phi_err_deg\": " + (est ? jnum(e_phi) : "null") +
+                                       ", \"offset_err_m\": " + (est ? jnum(e_off) : "null") +
+                                       ", \"checked\": " + (psi >= 5.0 ? "true" : "false") +
+                                       ", \"within_bounds\": " + (psi >= 5.0 && ok ? "true" : "false") +
+                                       ", \"separation\": " +
+                                       (o.separation < 0 ? "null" : jnum(std::min(o.separation, 1e9))) + "}";
+                        }
                     }
                 }
             }
         }
     }
-    std::printf("driveby: %d passes, %d FITTED, %d AMBIGUOUS; psi >= 5: %d of %d within bounds; "
-                "max |err| of FITTED: psi %.2f deg, phi %.1f deg, offset %.2f m\n",
-                n, n_fitted, n_amb, n_ok, n_check, max_psi, max_phi, max_off);
-    std::printf("driveby separation: psi >= 5: %d AMBIGUOUS, %d of them on observations whose "
-                "mirror's separation at the truth is below 9 (no 3-sigma rule tells it from the "
-                "truth); %d within bounds on such observations\n",
-                amb5, amb5_insep, ok_insep);
+    if (txt != nullptr) {
+        std::fprintf(txt, "driveby: %d passes, %d FITTED, %d AMBIGUOUS; psi >= 5: %d of %d within bounds; "
+                          "max |err| of FITTED: psi %.2f deg, phi %.1f deg, offset %.2f m\n",
+                     n, n_fitted, n_amb, n_ok, n_check, max_psi, max_phi, max_off);
+        std::fprintf(txt, "driveby separation: psi >= 5: %d AMBIGUOUS, %d of them on observations whose "
+                          "mirror's separation at the truth is below 9 (no 3-sigma rule tells it from the "
+                          "truth); %d within bounds on such observations\n",
+                     amb5, amb5_insep, ok_insep);
+    }
+    if (json || !json_out.empty()) {
+        const std::string doc =
+            std::string("{\n  \"schema\": \"shadowlean-eval-driveby/1\",\n  \"experiment\": \"driveby\",\n") +
+            "  \"board\": \"" + board + "\",\n  \"condition\": \"" + (realistic ? "realistic" : "noise-free") +
+            "\",\n  \"value_scale\": \"" + (g_power_scale ? "power" : "linear") + "\",\n  \"extraction\": \"" +
+            (g_no_profile ? "mask" : "profile") + "\",\n  \"quick\": " + (quick ? "true" : "false") +
+            ",\n  \"tail_slope_prior\": " + jnum(g_prior_slope_q8 / 256.0) + ",\n  \"bounds\": {\"psi_deg\": " +
+            jnum(psi_tol) + ", \"phi_deg\": " + jnum(phi_tol) + "},\n  \"summary\": {\"passes\": " +
+            std::to_string(n) + ", \"fitted\": " + std::to_string(n_fitted) + ", \"ambiguous\": " +
+            std::to_string(n_amb) + ", \"checked\": " + std::to_string(n_check) + ", \"within_bounds\": " +
+            std::to_string(n_ok) + ", \"max_abs_err_psi_deg\": " + jnum(max_psi) +
+            ", \"max_abs_err_phi_deg\": " + jnum(max_phi) + ", \"max_abs_err_offset_m\": " + jnum(max_off) +
+            ", \"ambiguous_checked\": " + std::to_string(amb5) + ", \"ambiguous_inseparable\": " +
+            std::to_string(amb5_insep) + ", \"within_bounds_inseparable\": " + std::to_string(ok_insep) +
+            "},\n  \"passes\": [\n" + jpasses + "\n  ]\n}\n";
+        if (json) {
+            std::fputs(doc.c_str(), stdout);
+        }
+        if (!json_out.empty()) {
+            FILE *f = std::fopen(json_out.c_str(), "w");
+            if (f == nullptr || std::fputs(doc.c_str(), f) < 0 || std::fclose(f) != 0) {
+                std::fprintf(stderr, "sl-eval: cannot write %s\n", json_out.c_str());
+                return 1;
+            }
+        }
+    }
     if (obs_log != nullptr) {
         std::fclose(obs_log);
     }

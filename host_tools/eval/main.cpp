@@ -73,7 +73,7 @@ void usage(FILE *out)
                  "  sl-eval driveby [--board NAME] [--quick] [--realistic] [--power-scale] [--no-profile]\n"
                  "                  [--speeds A,B] [--check]\n"
                  "                  [--plot FILE.png] [--psi DEG] [--phi DEG] [--offset M] [--dump]\n"
-                 "                  [--obs-log FILE] [--cold]\n"
+                 "                  [--obs-log FILE] [--cold] [--json] [--json-out FILE]\n"
                  "      3D tilt (psi, phi, base offset) fitted over simulated drive-bys against the truth.\n"
                  "      Noise-free passes render no smear: the board's elongation table d(r) is not applied.\n"
                  "      --realistic: the tail slope self-fitted on a calibration pass first (--cold: none).\n"

@@ -302,7 +302,7 @@ bool plot_table1(const std::string &png, const Table1Result &r, std::string &err
 
 /// The harder realistic condition (sl-eval realistic --hard, issue 11). The sensor and the
 /// installation differ from what the processing assumes; nothing here is fitted to a
-/// processing path (values: docs/EXTRACTION.md section 3 and the paper's bench).
+/// processing path (values: docs/RESULTS.md and the paper's bench).
 struct HardCondition {
     // smear (scene smear_shape two-component)
     double fast_decay_db = 3.3;  ///< main exponential (dB per bin), as the Table II condition

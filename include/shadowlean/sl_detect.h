@@ -48,7 +48,7 @@
 ///    (SHADOW): it forms groups of its own, rejected WEAK. Runs without an amplitude row
 ///    and runs at the shadow edge (not graded) link to either. Measured on
 ///    `daemon_clutter_never_hides_a_pole` (sensor effects, 1 m/s, the pole leaning towards
-///    the path): 22 of its 27 clean rotations with clutter before, 25 now. A
+///    the path). A
 ///    group remembers, per azimuth, the union extent [first, last] and the occupied count
 ///    of its runs there, for up to SL_CFG_DETECT_MAX_SPAN azimuths (wider: rejected WIDE).
 /// 3. **Representative azimuth**: the azimuth of the group with the most occupied bins
@@ -147,10 +147,8 @@
 ///    a SLANT target (that frame is one azimuth's run). `cfg.max_lean_tan_q16` = 0 keeps
 ///    every wider group WIDE. A SLANT target may start a track: weak clutter cannot, as a
 ///    group of weak runs is rejected WEAK whatever its shape, and since stage 2 grades the
-///    runs it cannot join a pole's group either (a SLANT target used to need a confirmed
-///    track expected on its azimuths; with the grading that gate is gone:
-///    `daemon_clutter_never_hides_a_pole` holds without it, and `sl-eval driveby` has 359
-///    of 432 noise-free passes within 1 deg / 10 deg instead of 272).
+///    runs it cannot join a pole's group either, so no confirmed track is needed first
+///    (`daemon_clutter_never_hides_a_pole`; results: docs/RESULTS.md).
 /// 5. **Corrections** (sl_detect_correct(), MATH.md s.4), b = bin_size_um:
 ///    - raw bounds: r1_raw = bin_first * b (near edge of the first occupied bin),
 ///      r2_raw = (bin_last + 1) * b (far edge of the last occupied bin);
@@ -165,7 +163,7 @@
 ///      here is the number of contiguous azimuths around the representative one whose run
 ///      reaches into the 3-bin slab [bin_first, bin_first + 2] (a round pole's silhouette
 ///      lies ~R behind its front; a leaning pole spreads in bearing along its
-///      length, so the whole group's width overstates the diameter; EXTRACTION.md D4),
+///      length, so the whole group's width overstates the diameter; docs/DESIGN.md, "Detection"),
 ///      R = r1 * tan(w / 2) with w = (az_count - 1) * step - beam, set to 0 when the beam's
 ///      half footprint r1 * beam / 2 exceeds 4 R (the beam cannot resolve the diameter), the smallest arc consistent with az_count
 ///      azimuth samples less the beam's own spread (small angle; clamped to

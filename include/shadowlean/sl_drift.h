@@ -72,17 +72,15 @@
 /// the mask's end become stable-free (the join) n rotations after it. Then as above:
 /// within n + 32 = 48 rotations (12 s at 4 Hz) of the step either way
 /// (calib_drift_theta_step_2deg_raises_theta_drift_within_48_rotations: +2 deg;
-/// calib_drift_theta_step_minus_2deg_... and _minus_6deg_past_the_mask_...: -2 and -6 deg,
-/// measured 18 and 25 rotations on paper-sim).
+/// calib_drift_theta_step_minus_2deg_... and _minus_6deg_past_the_mask_...: -2 and -6 deg).
 ///
 /// Units: theta and drift in 0.01 deg (Health.ThetaDrift sends 0.1 deg).
 /// Cost: per azimuth one compare in the pipeline (is this the watched azimuth?) and one
 /// pointer in the scan's row (the message); per rotation the tail (sl_thresh_u8 over
 /// SL_DRIFT_EXTRA_BINS bins, word-wise), one azimuth's stable rows from the mask, the join
 /// and O(bins / 32) word operations and one 64-bit division for the sample, O(sectors^2)
-/// for the median. Measured (thumb ctests, per azimuth, simulated / Oxford capture): M0
-/// 2,902 / 2,682 -> 2,910 / 2,689, M4F 1,577 / 1,462 -> 1,583 / 1,467 with the two-sided
-/// watch. RAM: sizeof(sl_drift_t)
+/// for the median (the whole pipeline's per-azimuth figures: docs/PERFORMANCE.md, the thumb
+/// ctests). RAM: sizeof(sl_drift_t)
 /// = 60 B (the tail: 8 B more). No allocation, no float.
 /// Limits: two-sided only where the raw message carries SL_DRIFT_EXTRA_BINS bins past the
 /// mask (the CTS350-X sends its whole range); needs ground returns above the threshold at the shadow's edge

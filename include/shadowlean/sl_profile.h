@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
 /// @file sl_profile.h
 /// @brief Range profiles beside the bit mask: amplitude kept where a pole is, smear-aware
-/// bounds from it (EXTRACTION.md D1-D3).
+/// bounds from it (docs/DESIGN.md, "Range extraction").
 ///
 /// The threshold + n-frame AND of the mask keeps one bit per bin, so r2 is where the smear
 /// tail crosses the threshold, and the tail's length depends on the level the pole leaves
@@ -33,10 +33,8 @@
 /// only the slots left free after that, and only for a row whose first run in the window
 /// ends two bins or more before the window's end (the ground at the shadow edge, and a wide
 /// return that reaches it, never qualify): a pole's first sightings, which no track
-/// expects yet, are refined too (round 2 session 24: `sl-eval driveby --realistic`, 576
-/// passes, 297 -> 306 of 432, with the walked far bound's sigma of sl_tiltobs.h, without
-/// which such an early sighting lengthened a fit's baseline with a far bound read 1-1.7 bins
-/// long). A target whose own slot holds fewer than `cfg.min_frames` rows is refined from
+/// expects yet, are refined too (their walked far bound carries the two-bin sigma of
+/// sl_tiltobs.h, SL_TARGET_WALKED). A target whose own slot holds fewer than `cfg.min_frames` rows is refined from
 /// the sum of this rotation's rows of its azimuth and its two
 /// neighbours when they belong to its detection group (adjacent azimuths, 0.9 deg apart,
 /// lie inside one beam width, 1.8 deg: the same pole at the same ranges, each with its own
@@ -44,7 +42,7 @@
 /// whose return ends more than 2 bins from the target's (a row's end: its last bin within
 /// T/4 values of its own highest): an oblique pole ends 5-7 bins apart on neighbouring
 /// azimuths, and its tail laid over the target's own bins reads as the target's tail
-/// (`stats.misaligned`; session 18). One row left (no neighbour in the group, or none
+/// (`stats.misaligned`). One row left (no neighbour in the group, or none
 /// ending where it ends) is too few to walk a tail over or calibrate on (FEW_FRAMES),
 /// except a return that ends in a cliff no smear tail makes (the step after it falls by
 /// more than two of the steepest plausible slopes) and is not cut off: NO_TAIL with the
@@ -95,7 +93,7 @@
 ///    value per bin: such a tail (convex in the log: a power law, or a fast component
 ///    under a slow one) bends within the fit window, and against the fit's slope its
 ///    shallower far steps read as the pole's own (r2 4-9 bins long,
-///    `test_profile_a_tail_that_steepens_towards_the_pole`; session 18).
+///    `test_profile_a_tail_that_steepens_towards_the_pole`).
 ///    The bin where the walk stops is the last own bin: r2. When the first fit window
 ///    reached into the pole's own bins (a short tail), the fit is repeated on the tail the
 ///    walk found (>= 4 bins) and the walk done again.
@@ -127,15 +125,11 @@
 ///    branch 1, r1 (1 - cos(alpha - beta)) past it (the top end on the +beta ray). The first
 ///    bin's lit fraction follows from its power over the second's; the third bin checks
 ///    the model, and a shape it does not explain (a flat box, a bright scatterer, clipping)
-///    keeps the first bin's centre (`stats.lead_kept`). Measured on sim_static_sweep
-///    (noise-free, 40 positions): mean |r1 - front surface| 4.5-6.8 mm (the centre: 11);
-///    the pole's radius, which rounds the foot's peak, is what the models leave out.
-///    Tried and left out: the same reading on smeared returns, with the fitted tail's
-///    per-bin ratio removed from the second and third bins first. It moved the harder
-///    bench's 0 / +5 / +10 deg means from +1.16 / +1.23 / +1.27 to +0.99 / +1.10 / +1.21 deg
-///    but made the estimate depend on n under per-frame speckle (mean shift n = 4 -> 16 of
-///    0.32 deg at -5 and 0 deg, 0.07 and 0.15 without it): a ratio of two noisy bins through
-///    a convex model is biased by their variance.
+///    keeps the first bin's centre (`stats.lead_kept`). The pole's radius, which rounds the
+///    foot's peak, is what the models leave out (`sim_static_sweep`; figures in
+///    docs/RESULTS.md). Not on smeared returns: a ratio of two noisy bins through a convex
+///    model is biased by their variance, which makes the estimate depend on n under
+///    per-frame speckle (docs/DESIGN.md).
 /// The value scale (log of power) only enters through the ratio 1/6 and T/4; nothing depends
 /// on the simulator's kernel, the board's d(r) or n.
 ///
@@ -190,15 +184,12 @@
 ///   profile does not rise into r2 (a kernel linear in power falls by less than a value
 ///   per bin near the pole: flat after rounding). Whether or not a drop ends the run: a
 ///   weaker, longer smear component (or a weaker part of the pole) can carry the run past
-///   the kernel's end, and the walk then removes only that (session 17; before, a walk's
-///   ramp needed a drop, and 1-3 PoleLean frames per triangular drive-by were 5-30
-///   LeanSigma off). A stream without smear (the noise-free demo) keeps the board's sigma
+///   the kernel's end, and the walk then removes only that. A stream without smear (the noise-free demo) keeps the board's sigma
 ///   on its cliffs.
 /// Counted in `stats.ramps`, flagged SL_TARGET_COARSE. On the paper's bench with a 20-bin
-/// triangular kernel, poles of -10 to +10 deg read +22 to +34 deg at a sigma below 1 deg
-/// (DANGER on CAN); their sigma is now 4-15 deg and no level is raised. Exponential and
-/// two-component tails that fade into the floor have no such ramp (the reduced Table II
-/// and harder-bench runs are unchanged).
+/// triangular kernel the ramps' sigma keeps every level down (poles of -10 to +10 deg;
+/// `daemon_triangular_smear_never_a_false_warning`). Exponential and two-component tails
+/// that fade into the floor have no such ramp.
 /// Cut-off returns. The log of a power that reaches zero falls ever faster: a kernel of
 /// finite support (RadaRays' is linear in power) ends every return in a cliff after bins
 /// that fall faster and faster, and so does a slanted pole's run where it leaves the beam.
@@ -209,9 +200,8 @@
 /// bounds, unverified whatever the stream (NO_TAIL | CUT, COARSE; `stats.cut_ends`).
 /// Until the stream is known clean, a cut-off cliff also takes back one clean one (`clean_n`):
 /// a stream becomes clean on SL_PROFILE_CAL_SMEAR_N more clean cliffs than cut-off ones (a
-/// kernel's end under noise passes the cut test only now and then; with 4 clean cliffs among
-/// cut-off ones a triangular stream counted as clean and its next cliffs, the mask's bounds,
-/// went out as verified: Lean +27 at 0.6 for +9). Once clean, only `cut_n` undoes it.
+/// kernel's end under noise passes the cut test only now and then, and a stream taken for
+/// clean would send its next cliffs, the mask's bounds, as verified). Once clean, only `cut_n` undoes it.
 /// `cut_n` counts cut-off cliffs less the others (0..255); from SL_PROFILE_CAL_SMEAR_N on
 /// (sl_profile_cut) the stream's returns are cut off: its smear is no tail the walk can
 /// remove (what it would take for a tail may be the kernel's own shape), so every target
@@ -221,17 +211,13 @@
 /// no such evidence (a short tail after flatter own bins falls faster near its end too),
 /// and a cut-off cliff alone does not make a stream so (the beam cuts some returns of a
 /// slanted pole; the 3D fit's union extent does not depend on one azimuth's cut).
-/// Measured on `driveby_realistic.ini` with 20- and 35-bin triangular kernels on both value
-/// scales (`daemon_triangular_smear_never_a_false_warning`): 8-10 LeanWarning frames above
-/// the true level before (DANGER for the pole leaning away, through a 3D fit of the kernel
-/// ends), none after; exponential streams, the demo and the Oxford scans show no cut.
-/// The first rotations of such a stream, before SL_PROFILE_CAL_SMEAR_N net cut-off cliffs,
-/// sent 0-3 PoleLean frames per pass beyond 4 LeanSigma (a cliff in a stream counted clean,
-/// and walks that stopped in the kernel's flattening end); since session 17 (above, and
-/// "Ramps") 14 of the 15 measured variants send none, and a 35-bin kernel without a front
-/// part one (a walk that removed nothing: its tail fit straddled a 20-value drop into a
-/// weak part of the return, whose first steps fall by less than a value). And a slanted
-/// pole approaching in
+/// Held on `driveby_realistic.ini` with 20- and 35-bin triangular kernels on both value
+/// scales (`daemon_triangular_smear_never_a_false_warning`: no LeanWarning above the true
+/// level); exponential streams, the demo and the Oxford scans show no cut.
+/// Limitation: the first rotations of such a stream, before SL_PROFILE_CAL_SMEAR_N net
+/// cut-off cliffs, can send a PoleLean frame beyond 4 LeanSigma (a 35-bin kernel without a
+/// front part: a walk whose tail fit straddles a 20-value drop into a weak part of the
+/// return, whose first steps fall by less than a value). And a slanted pole approaching in
 /// a noise-free stream is cut by the beam on several rotations in a row, which the count
 /// cannot tell from a kernel (the stream counts as cut for a few rotations).
 /// The two sigmas combine as sigma_rho^2 = (s2^2 + rho^2 s1^2) / r1^2 into the one sigma
@@ -240,12 +226,12 @@
 /// let its fused variance fall below the measurement's (sl_track.h, "Filter"). Alpha is
 /// unchanged; only its sigma (PoleLean's LeanSigma) and the tracker's weights change.
 ///
-/// ## Front part: a kernel's rise before the target (session 19)
+/// ## Front part: a kernel's rise before the target
 /// A smear kernel with a front part (power before the target: a range response with a
 /// leading skirt, RadaRays' kernels, an exponential tail behind a linear rise) makes every
 /// return climb over the front's length before the pole, and r1, the first bin above the
 /// threshold, then lies that many bins early (100-180 mm for a 4-bin linear front on a
-/// return 60 values above the threshold: both poles of a drive-by FITTED 3-9 TiltSigma off).
+/// return 60 values above the threshold, enough to turn a drive-by's 3D fit).
 /// The rise of a return is its steps of at least one value per bin (per frame of the sum)
 /// from its first bin above the threshold on (ramp_bins), the longer of its own azimuth's
 /// row's (one rotation's rows of an oblique pole may start at other ranges, which breaks the
@@ -277,9 +263,7 @@
 /// rises counted, median; shadowleand's exit log prints them): 3.3 dB/bin and power-law
 /// tails 1-2 on both value scales, trunks of 10-15 cm radius 1-2, single poles leaning along
 /// the path 2 (3 on the sensor's value scale, where a slow tail's accumulated smear
-/// lengthens them; until session 22 the front was known when HALF rose by 3 bins, and 7 of
-/// 24 such passes at 1 m/s learned a 2-bin front by mistake: their histories cleared
-/// mid-pass, direction errors up to 25 deg; their rises, 1-5 bins, put an eighth at 2), a
+/// lengthens them; their rises, 1-5 bins, put an eighth at 2: hence 7 of 8, not half), a
 /// 4-bin linear front 4 (none below 4 in an eighth); a 2-bin front 2, so it is not learned
 /// (its rises are those of a pole without one). A stream taken for one with a front by
 /// mistake keeps its truth within its sigma: r1 then moves by at most half the span its
@@ -293,10 +277,8 @@
 /// have it. When the front becomes known `front_news` is set and the pipeline clears the
 /// 3D-tilt histories, as for a cut-off stream: their observations were taken with r1 up
 /// to the front's length early. A slot claimed on evidence while moving (a first sighting
-/// no track expects: clutter, a pole's far edge) teaches nothing: with such claims, a
-/// sensor-scale drive-by at 1 m/s learned a 2-bin front mid-pass, which moved r1 on 22
-/// targets and cleared 11 of 32 observations (a tilt of 5 deg read 3.4, its direction not
-/// determined). Not done: fronts of 1-2 bins (the harder bench's one-bin
+/// no track expects: clutter, a pole's far edge) teaches nothing: such a rise would teach a
+/// front mid-pass, move r1 and clear the 3D-tilt histories. Not done: fronts of 1-2 bins (the harder bench's one-bin
 /// skirt at -6 dB), which no rise tells from a partly lit bin and the smear its first bins
 /// accumulate; the front of a SLANT target's union r1; a static scene's handful of poles
 /// never reach SL_PROFILE_LEAD_MIN (there only a prior applies).
@@ -309,7 +291,7 @@
 /// pole leaning across the beam). It starts at `cfg.prior_slope_q8` when the application
 /// saved one (a fresh start otherwise waits for the first upright target's self-fit).
 ///
-/// `r2_offset_um`: the walk's end, corrected from upright poles (round 2, session 21). Where
+/// `r2_offset_um`: the walk's end, corrected from upright poles. Where
 /// a walk over a smear tail stops is not where the pole ends: its last, partly lit bins hide
 /// under the smear of its bright ones (r2 short), and what the stream's r1 reads (a pole's
 /// front surface, a front skirt, a partly lit first bin) is not the axis either. Those
@@ -334,13 +316,12 @@
 /// before it), and what reads the bounds averages them (the tracker's fusion, a bench's
 /// mean), so the mean residual is what biases it. Its sigma is unchanged (the walk's two
 /// bins). Not moved: returns that end in a cliff (their edges are the board's range sigma),
-/// a walk that took every bin after the first for tail (r2 = r1, INVALID as before), and
+/// a walk that took every bin after the first for tail (r2 = r1, INVALID), and
 /// one rotation's rows of neighbouring azimuths (moving): their walk runs on noisier sums
 /// with widened tests, and what they feed, the 3D fit's union extent (max r2 over the
 /// group's azimuths), has a residual of its own which the representative's does not measure
-/// (applied there, the realistic drive-by's observations went from -0.1 to +0.6 deg of bias
-/// on the magnitude scale, from -0.5 to 0 on the sensor's; not done: a residual of the union
-/// extent). `stats.resid_samples`; shadowleand's exit log prints the offset for
+/// (applied there, it biases the realistic drive-by's observations on the magnitude scale;
+/// not done: a residual of the union extent). `stats.resid_samples`; shadowleand's exit log prints the offset for
 /// `--r2-offset`.
 ///
 /// ## Ownership, memory, cost

@@ -34,8 +34,8 @@
 /// bounds, the group's union extent and the azimuth cells add errors that are neither
 /// Gaussian nor independent from one rotation to the next, and a pass's residuals often
 /// exceed the sigmas (the fits of `sl-eval driveby`: chi2 / dof median 1.0, 90th percentile
-/// 1.9, 99th 5.6). A fixed chi-square difference of 9 then let the mirror win by chance
-/// with a margin of 10-17 and say FITTED (issue #12: psi 7-8 deg for a 20 deg pole). So the
+/// 1.9, 99th 5.6). A fixed chi-square difference of 9 would let the mirror win by chance
+/// with a margin of 10-17 and say FITTED (`test_issue12_recorded_mirror_passes_are_not_fitted`). So the
 /// chi-square's scale is estimated from the best fit's residuals, s^2 = max(1, chi2 / dof)
 /// (dof = n - 2; the same inflation as the sigmas), and with a scale estimated from dof
 /// residuals the 3-sigma test of the difference is Student's t: margin = t^2 s^2, t^2 the
@@ -48,8 +48,8 @@
 /// bound stays in its bin over several rotations, the union extent and the azimuth cells
 /// change stepwise), so they do not average out as 1 / sqrt(n); over a few close bearings
 /// such a drift is a trend in bearing, which the fit turns into tilt across the line of sight
-/// (issue #12: fits of the first 5-14 observations of `sl-eval driveby` passes said FITTED
-/// 3-7 deg or 30-116 deg off, up to 17 of their sigmas). So each direction p's variance is
+/// (a fit of a pass's first 5-14 observations can read several degrees, or the direction
+/// tens of degrees, off by many of its covariance sigmas). So each direction p's variance is
 /// the covariance of the fit (inflated by chi2 / dof > 1) PLUS the square of the worst-case
 /// effect of a bias of up to each measurement's own sigma, shaped in any way over the pass:
 ///     b_p = sum(w_k sigma_k |p' M^-1 e_k|) / W     (M the weighted bearing moment matrix)

@@ -61,11 +61,10 @@
 ///    A FITTED or AMBIGUOUS result needs SL_TILT_MIN_OBS observations without a ramp at a
 ///    bound (SL_TILT_OBS_RAMP, from SL_TARGET_RAMP: the bound lies anywhere along the
 ///    ramp), else it is TOO_FEW. Observations with ramps stay in the fit (one rotation's
-///    rows of a pole leaning towards the path often rise after r1: excluding them cost 6 of
-///    the 96 realistic drive-by passes), but a kernel the profile cannot read, whose every
-///    bound is a ramp, no longer makes a FITTED tilt of the few that are not (RadaRays'
-///    Maxwell-Boltzmann kernel with a 10-bin front part: 19-25 deg at TiltSigma 0.8-6 for
-///    poles of 10, and DANGER for the one leaning away). And a FITTED or AMBIGUOUS result
+///    rows of a pole leaning towards the path often rise after r1, and excluding them loses
+///    realistic drive-by passes), but a kernel the profile cannot read, whose every bound
+///    is a ramp, makes no FITTED tilt of the few that are not (RadaRays' Maxwell-Boltzmann
+///    kernel with a 10-bin front part would read poles of 10 deg far too steep). And a FITTED or AMBIGUOUS result
 ///    whose tilt exceeds `max_tan_q16` (the largest lean the detector keeps a pole for,
 ///    30 deg) is INCONSISTENT (`stats.too_steep`): no pole leans so far, and a kernel of
 ///    finite support whose ends the profile reads as the pole's puts r1 and r2 up to a

@@ -66,7 +66,7 @@
 ///              repeat:  P = max(P, sigma_z^2) when the target's corrected r1 and r2 equal
 ///                       the previous valid measurement's (a static scene quantised the
 ///                       same way every rotation is one measurement, not many: variance
-///                       floor while the bins repeat, EXTRACTION.md D6); the same
+///                       floor while the bins repeat, docs/DESIGN.md, "Tracking"); the same
 ///                       floor for a target flagged SL_TARGET_COARSE (a bound known to
 ///                       two bins, whose error repeats on every rotation: sl_profile.h,
 ///                       "Uncertainty of the bounds")

@@ -1154,7 +1154,7 @@ static void test_detect_agrees_with_the_generated_paper_sim_board(void **state)
 }
 
 // A leaning pole spreads in bearing along its length: the group is wide, but the column at
-// its inner edge is narrow. The radius comes from that column (EXTRACTION.md D4), not from
+// its inner edge is narrow. The radius comes from that column (docs/DESIGN.md, "Detection"), not from
 // the group (which would give the clamp).
 static void test_detect_radius_from_the_column_at_the_inner_edge(void **state)
 {

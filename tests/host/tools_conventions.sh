@@ -1,7 +1,7 @@
 #!/bin/sh
 # SPDX-License-Identifier: MIT
 # tools_conventions.sh VERSION WORKDIR EXE[@SUBCOMMAND]...
-# The command-line conventions of README "Exit statuses and conventions", for every
+# The command-line conventions of docs/TOOLS.md, "Conventions", for every
 # executable given (tests/host/CMakeLists.txt lists every EXECUTABLE target):
 #   --help and -h     usage on stdout (a line starting "usage"), nothing on stderr, exit 0
 #   --version         exactly "<program> VERSION" on stdout, nothing on stderr, exit 0

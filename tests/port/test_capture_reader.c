@@ -226,7 +226,7 @@ static void build_pcap(pcapw_t *w, const uint8_t *s, size_t n)
 static void check_pcap_result(const collected_t *got, const slp_capture_report_t *r, const uint8_t *s,
                               size_t n)
 {
-    // session 1 without segment 20, then session 2 complete
+    // TCP session 1 without segment 20, then TCP session 2 complete
     const size_t lost = 20 * SEG;
     assert_int_equal(got->size, 2 * n - SEG);
     assert_memory_equal(got->data, s, lost);

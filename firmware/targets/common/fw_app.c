@@ -28,7 +28,7 @@ typedef struct fw_state {
     fw_result_t *res;
 } fw_state_t;
 
-static sl_pipeline_t g_pipeline; // the whole RAM of the module (sizeof in the README)
+static sl_pipeline_t g_pipeline; // the whole RAM of the module (sizeof: docs/PERFORMANCE.md)
 static fw_state_t g_state;
 
 static sl_err_t port_can_tx(void *ctx, const sl_can_frame_t *f)

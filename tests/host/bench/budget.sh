@@ -4,10 +4,10 @@
 # valgrind's callgrind (host_tools/bench/callgrind.sh over sl-bench, the firmware
 # configuration compiled -O2 whatever the build type; no timing):
 #   <= 2,500 instructions per azimuth and <= 1.0 M per rotation (paper-sim: 400 azimuths) on
-#   - scenes/bench_eight_poles.ini: 8 tracked targets, static (README "Speed and memory");
+#   - scenes/bench_eight_poles.ini: 8 tracked targets, static (docs/PERFORMANCE.md);
 #   - scenes/driveby_two_poles.ini with its [clutter] band enabled at 1 m/s: the clutter
 #     test's capture (tests/system/daemon/clutter_driveby.sh), the heaviest detection load
-#     the project has (README "Clutter").
+#     the project has (docs/DESIGN.md, "Clutter").
 # Prints each capture's figures; fails on the first one over the budget.
 set -eu
 sim=$1 build=$2 src=$3 dir=$4

@@ -1,7 +1,7 @@
 #!/bin/sh
 # SPDX-License-Identifier: MIT
-# make_calib_img.sh BUILD_DIR: regenerates docs/img/calib_lower_body.png (README, "Calibrate
-# your vehicle") with the shipped tools: sl-sim on tests/host/calib/data/lower_body_empty.ini,
+# make_calib_img.sh BUILD_DIR: regenerates docs/img/calib_lower_body.png (docs/CALIBRATION.md, "Measuring
+# a vehicle") with the shipped tools: sl-sim on tests/host/calib/data/lower_body_empty.ini,
 # then sl-calib shadow --png. Run from anywhere; writes only that picture.
 set -eu
 B=$1

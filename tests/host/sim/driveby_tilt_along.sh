@@ -3,14 +3,14 @@
 # driveby_tilt_along.sh SL_EVAL FITS_WITHIN_SIGMA_PY OUT_DIR
 # Poles leaning along the path (forward, 0 deg) and forward-right across the line of sight
 # (315 deg), 3 m left of it, psi 5 / 10 / 20 at 1 and 3 m/s: 12 passes of `sl-eval driveby
-# --realistic` (the seeds of the README's 96-pass sweep), on the 8-bit log magnitude and on
-# the sensor's value scale. Asserted: every pass FITTED within the issue's realistic bounds
-# (2 deg / 20 deg, `--check`), every FITTED fit along the passes within 3 of its sigmas, and
-# no front part learned on the sensor's value scale (the scene has none). Before round 2
-# session 22 four of the 24 failed: on the value scale such poles' rises of 1-5 bins taught a
-# 2-bin front mid-pass (history cleared: 5 deg read 25 deg off in direction at 1 m/s; a
-# 3 m/s psi-20 pass INCONSISTENT), and at 3 m/s a pole leaning across the line of sight went
-# unwatched where its lowest point's azimuth left the +-2 reserved (TOO_FEW on both scales).
+# --realistic` (the seeds of the 96-pass realistic sweep, docs/RESULTS.md), on the 8-bit log
+# magnitude and on the sensor's value scale. Asserted: every pass FITTED within the realistic
+# bounds (2 deg / 20 deg, `--check`), every FITTED fit along the passes within 3 of its sigmas,
+# and no front part learned on the sensor's value scale (the scene has none). Why: on the value
+# scale such poles' rises of 1-5 bins must not be read as a smear front (a front learned
+# mid-pass clears the history and turns the direction), and at 3 m/s a pole leaning across
+# the line of sight must stay watched as its lowest point's azimuth moves (docs/DESIGN.md,
+# "Range extraction" and "3D tilt").
 set -u
 EVAL=$1; FWS=$2; OUT=$3
 mkdir -p "$OUT"

@@ -30,9 +30,8 @@ out=$(check "$OUT/mask.txt" | wc -l)
 # Poles leaning 15 deg, most of them across the line of sight: detection keeps a smeared
 # slanted group as SLANT from its runs' own extents once the tail slope is known (sl_detect.h
 # stage 4), which the calibration pass of sl-eval (an upright pole, its own seed) provides as
-# a saved prior would. 3 of 16 within before the own extents; 12 after them (6 with --cold);
-# 10 since a fit needs five observations without a ramp at a bound (round 2, session 17:
-# two 3 m/s passes of exactly five, one of them a ramp, are TOO_FEW; sl_tiltobs.h, 3.).
+# a saved prior would. A fit needs five observations without a ramp at a bound (sl_tiltobs.h,
+# 3.), so a 3 m/s pass with exactly five, one of them a ramp, is TOO_FEW.
 # Every FITTED pass within the bounds, at least 10 FITTED.
 "$EVAL" driveby --realistic --quick --psi 15 > "$OUT/slant.txt" 2>&1 || { cat "$OUT/slant.txt"; exit 1; }
 cat "$OUT/slant.txt"

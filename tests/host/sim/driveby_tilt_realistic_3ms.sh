@@ -8,9 +8,9 @@
 # 6-10 rotations and its first sightings, which no track expects yet, are refined only by
 # slots claimed on evidence while moving (sl_profile.h, "While moving"), whose walked far
 # bounds the 3D-tilt history holds to two bins (SL_TARGET_WALKED, sl_tiltobs.h). Asserted:
-# at least 33 of 48 within 2 deg / 20 deg (31 before round 2 session 24; the others are
-# AMBIGUOUS or TOO_FEW); no FITTED pass more than 20 deg off in direction; every FITTED fit
-# along the passes within 3 of its stated sigmas (89 fits, worst 1.16 sigma; 1.59 before).
+# at least 33 of 48 within 2 deg / 20 deg (the others are AMBIGUOUS or TOO_FEW); no FITTED
+# pass more than 20 deg off in direction; every FITTED fit along the passes within 3 of its
+# stated sigmas.
 set -u
 EVAL=$1; FWS=$2; OUT=$3
 mkdir -p "$OUT"

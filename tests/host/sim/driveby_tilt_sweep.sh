@@ -1,11 +1,10 @@
 #!/bin/sh
 # SPDX-License-Identifier: MIT
 # driveby_tilt_sweep.sh SL_EVAL FITS_WITHIN_SIGMA_PY OUT_DIR
-# Issue 12's noise-free sweep, whole: `sl-eval driveby` (576 passes: 1, 2 and 3 m/s; psi 3, 5,
+# The noise-free sweep, whole: `sl-eval driveby` (576 passes: 1, 2 and 3 m/s; psi 3, 5,
 # 10 and 20 deg; directions every 45 deg; 2, 3 and 4 m either side of the path). Asserted:
-# at least 413 of the 432 poles with psi >= 5 within 1 deg / 10 deg (the README's count:
-# 410 before round 2 session 23's tracker extents, which gave the three TOO_FEW passes their
-# observations back); every FITTED pass of psi >= 5 within 10 deg of direction (a FITTED
+# at least 413 of the 432 poles with psi >= 5 within 1 deg / 10 deg (docs/RESULTS.md gives
+# the current count); every FITTED pass of psi >= 5 within 10 deg of direction (a FITTED
 # result is never a confident wrong direction: the passes left outside are AMBIGUOUS with
 # the right values, or FITTED within their sigmas a little over 1 deg of tilt); every FITTED
 # fit along the passes within 3 of its stated sigmas; the separation line (how many AMBIGUOUS

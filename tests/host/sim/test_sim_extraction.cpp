@@ -4,11 +4,11 @@
 // variations, with one and the same configuration (no constant refitted per condition):
 // smear decay 3.3 and 4.5 dB per bin, speckle drawn anew every frame at n = 4 and 16.
 // Reduced runs (3 positions x 2 repetitions, 160 bins per azimuth) to stay well under a
-// minute each; the full runs are in the README (Results).
+// minute each; the full runs are in docs/RESULTS.md.
 // Asserted per true angle (at -10 deg the estimator's ambiguity fold at (beta - theta) / 2
 // = -11.5 deg flags part of the measurements AMBIGUOUS, counted at the bound: that angle is
 // only required to stay within 1.6 deg): |mean error| <= 1.0 deg on the paper condition
-// (6 measurements per angle; the full run's figure is in the README), <= 1.5 deg on the
+// (6 measurements per angle; the full run's figure is in docs/RESULTS.md), <= 1.5 deg on the
 // variations (the criterion), std <= 1.5 deg, the pole found in >= 5 of 6
 // measurements; the n = 4 -> 16 shift <= 0.5 deg. On the paper condition the
 // same bounds with the profile off are NOT met (the mask + board d(r) path is biased), so
@@ -158,7 +158,7 @@ static void test_extraction_shallow_smear_found_at_the_shadow_edge(void **)
 }
 
 // Per-frame speckle: the profile is a mean, not the AND's minimum statistic, so the estimate
-// does not drift with n (the mask's r2 shortens with n: EXTRACTION.md s.1 cause 3).
+// does not drift with n (the mask's r2 shortens with n: docs/DESIGN.md, "Range extraction").
 static void test_extraction_does_not_drift_with_n_under_per_frame_speckle(void **)
 {
     double e[2][5];

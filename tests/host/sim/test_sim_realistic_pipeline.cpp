@@ -6,7 +6,7 @@
 // (3 positions x 1 repetition, 160 bins per azimuth, no bbox calibration) to stay a few seconds.
 // Asserted: detection in most measurements, the static window, and that the estimates are
 // ordered like the truth. Accuracy is asserted by sim_extraction_smear_robust
-// (test_sim_extraction.cpp); the full runs are in the README (Results).
+// (test_sim_extraction.cpp); the full runs are in docs/RESULTS.md.
 #include <cmath>
 #include <cstdarg>
 #include <cstddef>

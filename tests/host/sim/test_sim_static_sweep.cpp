@@ -51,7 +51,7 @@ struct Cell {
     // Edge bins on the pole's azimuth (rotation 0): the fraction of r2's bin the axis fills
     // and its value with the bin before; the fraction of the first bin in front of the
     // front surface (axis r1 - radius) and its value with the bin after. The data a
-    // sub-bin edge model has to explain (EXTRACTION.md).
+    // sub-bin edge model has to explain (docs/DESIGN.md).
     double fill2 = NAN, fill1 = NAN;
     int v2 = -1, v2_prev = -1, v1 = -1, v1_next = -1;
 };

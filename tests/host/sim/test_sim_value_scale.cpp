@@ -9,7 +9,7 @@
 // fractions of the next values (6, 9, 12, 14, 15: N = 2 .. 6). Asserted: the power scale
 // (output.log_quantity = power) within 35 % of the real fraction at every one of them, the
 // magnitude scale off by more than half at N = 2 and with no tail (N >= 5 almost never).
-// The data path comes from the command line (CMake: ../shared/data/real).
+// The data path comes from the command line (CMake: SL_OXFORD_RADAR_DIR, tests/CMakeLists.txt).
 #include <cmath>
 #include <cstdarg>
 #include <cstddef>

@@ -1,16 +1,16 @@
 #!/bin/sh
 # SPDX-License-Identifier: MIT
-# Regenerates the README pictures in docs/img from a host build:
+# Regenerates the documentation's pictures in docs/img from a host build:
 #   tests/host/view/make_docs_img.sh BUILD_DIR [OUT_DIR=docs/img] [WORK_DIR=BUILD_DIR/docs-img-work]
-# Needs sl-sim, sl-calib, sl-view in BUILD_DIR and the Oxford scans in
-# ../shared/data/real/oxford_radar_robotcar beside the repository (or $SL_OXFORD_DIR).
+# Needs sl-sim, sl-calib, sl-view in BUILD_DIR and the Oxford Radar RobotCar scans in
+# $SL_OXFORD_DIR (default: the build's SL_OXFORD_RADAR_DIR from its CMakeCache.txt).
 # Takes about a minute.
 set -eu
 B=$(cd "$1" && pwd)
 SRC=$(cd "$(dirname "$0")/../../.." && pwd)
 OUT=${2:-$SRC/docs/img}
 W=${3:-$B/docs-img-work}
-OX=${SL_OXFORD_DIR:-$SRC/../shared/data/real/oxford_radar_robotcar}
+OX=${SL_OXFORD_DIR:-$(sed -n 's/^SL_OXFORD_RADAR_DIR:PATH=//p' "$B/CMakeCache.txt")}
 SIM=$B/host_tools/sim/sl-sim
 CAL=$B/host_tools/calib/sl-calib
 VIEW=$B/host_tools/view/sl-view

@@ -4,7 +4,7 @@
 #
 # The one QEMU harness of the VM tests (the user-mode Linux one is uml_run.sh beside it):
 # prepares the throw-away test VM once (build_vm.sh: a stock Debian kernel and a busybox
-# initramfs, cached in CACHE_DIR), then boots it (TCG; this machine's /dev/kvm cannot boot a
+# initramfs, cached in CACHE_DIR), then boots it (TCG: a /dev/kvm may not boot a
 # stock kernel) with the host's / read-only and OUT_DIR read-write over virtio-9p; the
 # initramfs chroots into the host's root and runs GUEST_SCRIPT, whose variables the caller
 # wrote into OUT_DIR/vm.env and whose results it leaves in OUT_DIR (OUT_DIR/console.log:

@@ -1,7 +1,7 @@
 #!/bin/sh
 # SPDX-License-Identifier: MIT
 # demo_leans.sh SL_SIM SHADOWLEAND PYTHON SRC_DIR OUT_DIR
-# The README's demo scene (scenes/demo_three_poles.ini: a parked vehicle, noise-free, so every
+# The demo's scene (scenes/demo_three_poles.ini: a parked vehicle, noise-free, so every
 # rotation is quantised the same way) through the daemon: every pole's decoded PoleLean lean
 # within 1.0 deg of the simulator's truth (issue 11), from the first frame sent for it to the
 # last (lean_vs_truth.py --all-frames).

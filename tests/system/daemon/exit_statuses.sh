@@ -1,7 +1,7 @@
 #!/bin/sh
 # SPDX-License-Identifier: MIT
 # exit_statuses.sh SL_SIM SHADOWLEAND PYTHON SRC_DIR OUT_DIR
-# Capture mode exit statuses (README "Exit statuses"), each with what CAN says:
+# Capture mode exit statuses (docs/DAEMON.md, "Exit statuses"), each with what CAN says:
 #   0 ok; 1 unreadable input; 2 bad options; 3 no usable rotation or a configuration fault
 #   (Health CONFIG_MISMATCH / RANGE_RESOLUTION_MISMATCH); 4 an output could not be written
 #   (--can-log /dev/full).

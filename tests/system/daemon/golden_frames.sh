@@ -2,7 +2,7 @@
 # SPDX-License-Identifier: MIT
 # golden_frames.sh SL_SIM SL_REPLAY SHADOWLEAND SRC_DIR OUT_DIR OXFORD_DIR [--pipe|--regen]
 # Behaviour pinned byte for byte: the CAN frames (candump -L log, data clock) the daemon
-# writes for the README's demo scene (scenes/demo_three_poles.ini through sl-sim) and for the
+# writes for the demo scene (scenes/demo_three_poles.ini through sl-sim) and for the
 # 11 real Oxford scans (sl-replay from-oxford), each read from a file (and with --pipe from
 # a pipe on stdin, `--input -`, as fast as possible and --realtime), must equal tests/system/daemon/golden/<name>.candump. The golden logs were written by
 # the daemon at "Layers step 1" (a pure move of main 1eb0496), before the capture reader

@@ -10,7 +10,7 @@
 # sigma below 1 deg: DANGER on CAN, before the ramps of sl_profile.h); every LeanWarning
 # must now stay within the true lean's level by 3 of its LeanSigma (warning_vs_truth.py).
 # A pole the module does not report passes (a miss is not a false warning; the wider
-# kernels, 35 and 50 bins, are missed every time: see the README).
+# kernels, 35 and 50 bins, are missed every time: docs/DESIGN.md, "Range extraction").
 set -u
 SL_SIM=$1; DAEMON=$2; PY=$3; SRC=$4; OUT=$5
 rm -rf "$OUT"; mkdir -p "$OUT"
@@ -46,11 +46,10 @@ check_sigmas() {
     fi
 }
 # The paper's bench with a tail that steepens towards the pole (sl-sim `smear_shape =
-# powerlaw`: (1 + j)^-p, its first bin 20 dB down, then ever slower; 200 bins). Before
-# session 18 every PoleLean frame of the three poles was 5.9-13.7 LeanSigma off and the
-# upright pole raised CAUTION (+8.0 deg at 1.1): the walk's fits straddled the bend
-# (sl_profile.h step 4). Every PoleLean frame within 4 LeanSigma of the truth, every
-# LeanWarning within the true lean's level.
+# powerlaw`: (1 + j)^-p, its first bin 20 dB down, then ever slower; 200 bins): a walk whose
+# fits straddle the bend reads every lean several LeanSigma off and raises a warning on an
+# upright pole (sl_profile.h step 4). Asserted: every PoleLean frame within 4 LeanSigma of
+# the truth, every LeanWarning within the true lean's level.
 for lean in -10 0 10; do
     if [ "$lean" -lt 0 ]; then tilt=${lean#-}; dir=90; else tilt=$lean; dir=270; fi
     name="powerlaw_d20_a$lean"
@@ -68,23 +67,21 @@ for lean in -10 0 10; do
     check_sigmas "$DBC"
 done
 # While driving (scenes/driveby_realistic.ini, --motion 1.0: two poles leaning 10 deg towards
-# and away from the path), on both value scales: a target is one rotation's rows, whose cliff
-# read as the pole's end gave Lean +12 to +35 deg at a LeanSigma of 0.5 and, through the 3D
-# fit, DANGER for the pole leaning away (8-10 LeanWarning frames above the true level, before
-# "Cut-off returns" of sl_profile.h). Every LeanWarning must stay within the true lean's
-# level by 3 of its LeanSigma, and both poles must be reported (lean_warning_sides.py); and
-# every PoleLean frame within 4 of its LeanSigma of the truth (lean_sigma_vs_truth.py; a
-# saturated LeanSigma, "I cannot tell", passes): the first rotations, before the stream was
-# known to cut its returns off, sent 1-3 frames per pass 5-30 LeanSigma off (session 17:
-# a cut-off cliff takes a clean one back; a walk's end that falls faster near r2 is a ramp).
+# and away from the path), on both value scales: a target is one rotation's rows, and a cliff
+# read as the pole's end would give leans far too large at a small LeanSigma and, through the
+# 3D fit, DANGER for the pole leaning away ("Cut-off returns" of sl_profile.h). Every
+# LeanWarning must stay within the true lean's level by 3 of its LeanSigma, and both poles
+# must be reported (lean_warning_sides.py); and every PoleLean frame within 4 of its
+# LeanSigma of the truth (lean_sigma_vs_truth.py; a saturated LeanSigma, "I cannot tell",
+# passes), including the first rotations, before the stream is known to cut its returns off
+# (a cut-off cliff takes a clean one back; a walk's end that falls faster near r2 is a ramp).
 # RadaRays' other two kernel families (sl-sim `smear_shape = gaussian | maxwell`), 50 bins:
 # the profile cannot read them either (the leans are unknown: LeanSigma saturated), and no
-# LeanWarning may rise above the true level. Before session 17 the 3D fit took their mask
-# bounds and ramps at the board's range sigma: FITTED tilts of 19 to 45+ deg at TiltSigma
-# 0.4-6, and DANGER for the pole leaning away (4, 2 and 12 frames; a fit now needs five
-# observations without a ramp, and no tilt beyond the detector's 30 deg: sl_tiltobs.h, 3.).
-# Their PoleLean frames are not checked here (a 10-bin front part of the
-# Maxwell kernel still leaves a few walks several LeanSigma off; README), and the 25-bin front
+# LeanWarning may rise above the true level: a 3D fit needs five observations without a
+# ramp, and no tilt beyond the detector's 30 deg (sl_tiltobs.h, 3.), so mask bounds and
+# ramps cannot make a confident large tilt. Their PoleLean frames are not checked here (a
+# 10-bin front part of the Maxwell kernel leaves a few walks several LeanSigma off:
+# docs/DESIGN.md, "Range extraction", limitations), and the 25-bin front
 # parts leave the pole right of the path unreported (missed, not false: --one-side-ok).
 DBC_SIM="$ROOT/boards/paper-sim/shadowlean.dbc"
 drive() { # KERNEL WIDTH FRONT SCALE CHECK_SIGMAS [--one-side-ok]; $decay: smear_decay_db
@@ -150,11 +147,10 @@ drive gaussian 50 0.5 magnitude no --one-side-ok
 drive maxwell 50 0.4 magnitude no --one-side-ok
 drive maxwell 50 0.2 power no
 # A tail that steepens towards the pole (sl-sim `smear_shape = powerlaw`: (1 + j)^-p, its
-# first bin 12-20 dB down, then ever slower; 200 bins: it fades into the floor). Before
-# session 18, 6-26 PoleLean frames per pass 4-11 LeanSigma off: the walk's first fit
-# straddled the bend (r2 long for the pole leaning away), and neighbouring rows of an
-# oblique pole, whose return ends 5-7 bins apart, were summed (r2 8-13 bins short for the
-# pole leaning towards the path). sl_profile.h step 4 and "While moving".
+# first bin 12-20 dB down, then ever slower; 200 bins: it fades into the floor). A walk
+# whose first fit straddles the bend reads r2 long for the pole leaning away, and summing
+# neighbouring rows of an oblique pole, whose return ends 5-7 bins apart, reads r2 short
+# for the pole leaning towards the path (sl_profile.h step 4 and "While moving").
 for pl in "16 magnitude" "20 magnitude" "12 power"; do
     set -- $pl
     decay=$1
@@ -163,10 +159,9 @@ done
 decay=
 # An exponential tail behind a front part (sl-sim `smear_mode_frac` 0.1 of the 40-bin kernel:
 # a linear rise over 4 bins before the target), on both value scales: r1 3-4 bins early on
-# every return. Before session 19 both poles came out FITTED 3-9 TiltSigma off (17 and 16
-# FITTED PoleTilt frames beyond 3 sigma; 14.3-15.3 deg for 10 towards the path, 2.0-2.9 for
-# 10 away): the stream now learns the front from its leaning-away returns (sl_profile.h,
-# "Front part"; a 2-bin front is not learned: README).
+# every return. Unless the front is known, both poles come out FITTED several TiltSigma
+# off; the stream learns the front from its leaning-away returns (sl_profile.h, "Front
+# part"; a 2-bin front is not learned: docs/DESIGN.md, "Range extraction").
 drive exponential 40 0.1 magnitude yes
 drive exponential 40 0.1 power yes
 [ $fail -eq 0 ] && echo "smear_shapes: OK" || echo "smear_shapes: FAILED"

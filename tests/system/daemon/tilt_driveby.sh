@@ -68,10 +68,9 @@ run reverse -1.0 "$OUT/reverse.ini" || fail=1
 "$PY" "$SRC/lean_sigma_vs_truth.py" "$DBC" "$OUT/reverse.log" "$OUT/reverse.gt.csv" --max-sigmas 4 || fail=1
 # The realistic drive-by on the sensor's value scale (output.log_quantity = power: 0.5 dB per
 # value, exponential noise; the effects' dB halved so their values per bin stay): no
-# LeanWarning above the true lean's level (before session 14: DANGER on 8 frames for the pole
-# leaning away, Lean +19 at LeanSigma 0.6) and every PoleLean frame within 4 of its LeanSigma
-# of the truth (before session 15: 16 of 46 beyond, up to 25 LeanSigma). Its 3D fits are not
-# yet within the bounds on this scale (README, "The sensor's value scale").
+# LeanWarning above the true lean's level and every PoleLean frame within 4 of its LeanSigma
+# of the truth. Its 3D fits are not held to the realistic bounds on this scale
+# (docs/RESULTS.md, limitations).
 sed 's/^normalize = none/normalize = none\nlog_quantity = power/; s/^smear_decay_db = 3.3/smear_decay_db = 1.65\nspeckle_db = 1.0/' \
     "$ROOT/scenes/driveby_realistic.ini" > "$OUT/power.ini"
 grep -q '^log_quantity = power' "$OUT/power.ini" && grep -q '^speckle_db = 1.0' "$OUT/power.ini" ||

@@ -4,7 +4,8 @@
 # against its schema in docs/schema (validate_json.py), on real outputs:
 #   shadowleand --targets-out: the demo scene (targets and tracks) and the Oxford scans;
 #   sl-inspect --json --rotations: a raw capture and the same as pcapng (pcap report);
-#   sl-eval table1 / realistic --json (reduced runs, --extract both: the pipeline sections).
+#   sl-eval table1 / realistic --json (reduced runs, --extract both: the pipeline sections);
+#   sl-eval driveby --json (two passes of the quick sweep).
 set -u
 DAEMON=$1; SIM=$2; REPLAY=$3; INSPECT=$4; EVAL=$5; PY=$6; SRC=$7; OUT=$8; OX=$9
 S="$SRC/docs/schema"
@@ -48,5 +49,8 @@ run "$EVAL" realistic --hard --positions 1 --reps 1 --frames 4 --calib 2 --range
     --threads 1 --quiet --json-out "$OUT/realistic_hard.json" > /dev/null
 run $V "$S/eval.schema.json" "$OUT/realistic_hard.json" --expect-schema shadowlean-eval-realistic/1 \
     --require rows --require pipeline.rows --require hard
+run "$EVAL" driveby --quick --speeds 1 --psi 15 --offset 3 --phi 90 --quiet --json > "$OUT/driveby.json"
+run $V "$S/eval.schema.json" "$OUT/driveby.json" --expect-schema shadowlean-eval-driveby/1 \
+    --require passes --require summary
 [ $fail -eq 0 ] && echo "json_outputs: ok"
 exit $fail
