@@ -6,8 +6,9 @@
                              [--count N] [--idle-exit S] [--check]
 
 Exit status: 0 ok, 1 error (file unreadable or malformed, bus cannot be opened, no frame
-the DBC knows, or with --check any E2E error: CRC, invalid or repeated counter, lost
-frames, wrong length), 2 usage."""
+the DBC knows, or with --check any frame the E2E Profile 11 check does not accept (ERROR:
+CRC, Data ID nibble, counter 15, wrong length; REPEATED; WRONG_SEQUENCE) or frames lost),
+2 usage. --max-delta-counter N (1..14, default 1): counter steps 2..N are OK_SOME_LOST."""
 import argparse
 import sys
 
@@ -38,8 +39,10 @@ def _parser():
     g.add_argument("--table", action="store_true", help="PoleLean rows per rotation")
     d.add_argument("--last", type=int, metavar="K", help="--table: only the last K rotations")
     d.add_argument("--check", action="store_true",
-                   help="verify CRC and counter sequence per message; E2E counts at the end; "
-                   "exit 1 on any error")
+                   help="E2E Profile 11 check per message (CRC, Data ID nibble, counter "
+                   "sequence); the status counts at the end; exit 1 on any error")
+    d.add_argument("--max-delta-counter", type=int, default=1, metavar="N",
+                   help="--check: largest counter step still OK_SOME_LOST (1..14, default 1)")
     v = sub.add_parser("live", help="decode frames from a live bus (python-can)",
                        description="Decode frames as they arrive on a CAN bus (python-can).")
     v.add_argument("--dbc", required=True, help="the board's DBC")
@@ -50,6 +53,7 @@ def _parser():
                    "(other ids are printed but not counted)")
     v.add_argument("--idle-exit", type=float, metavar="S", help="stop after S seconds without a frame")
     v.add_argument("--check", action="store_true", help="as for decode")
+    v.add_argument("--max-delta-counter", type=int, default=1, metavar="N", help="as for decode")
     return p
 
 
@@ -57,7 +61,7 @@ def _decode(a):
     db = load_dbc(a.dbc)
     decoded = decode_frames(db, read_candump(a.log))
     known = sum(1 for _, x in decoded if x is not None)
-    mon = E2EMonitor(db) if a.check else None
+    mon = E2EMonitor(db, max_delta_counter=a.max_delta_counter) if a.check else None
     if a.summary:
         print_summary(decoded)
     elif a.table:
@@ -85,7 +89,7 @@ def _verdict(mon):
 
 def _live(a):
     db = load_dbc(a.dbc)
-    mon = E2EMonitor(db) if a.check else None
+    mon = E2EMonitor(db, max_delta_counter=a.max_delta_counter) if a.check else None
     try:
         bus = open_bus(a.channel, a.interface)
     except Exception as e:  # python-can raises OSError, CanError, ValueError...
@@ -115,6 +119,10 @@ def main(argv=None):
     if a.cmd is None:
         _parser().print_usage(sys.stderr)
         print(f"{PROG}: a COMMAND is needed (decode, live)", file=sys.stderr)
+        return 2
+    if not 1 <= a.max_delta_counter <= 14:
+        _parser().print_usage(sys.stderr)
+        print(f"{PROG}: --max-delta-counter {a.max_delta_counter}: 1..14", file=sys.stderr)
         return 2
     if a.cmd == "decode" and a.last is not None and not a.table:
         _parser().print_usage(sys.stderr)
