@@ -281,6 +281,10 @@ std::string make_dbc(const BoardSpec &b)
               << decimal(int64_t(s.raw_max) * s.factor_num, s.factor_den) << "] "
               << q(s.unit) << " " << rx_node << "\n";
         }
+        if (ids.e2e[mi].mode == SL_CAN_E2E_MODE_NIBBLE) {
+            // Profile 11C: the Data ID's bits 8..11 in frame bits 12..15 (free in this layout).
+            o << " SG_ DataIdNibble : 12|4@1+ (1,0) [0|15] \"\" " << rx_node << "\n";
+        }
         o << "\n";
     }
     o << "\n";
@@ -306,6 +310,12 @@ std::string make_dbc(const BoardSpec &b)
             if (!c.empty()) {
                 o << "CM_ SG_ " << ids.id[mi] << " " << m.signals[si].name << " " << q(c) << ";\n";
             }
+        }
+        if (ids.e2e[mi].mode == SL_CAN_E2E_MODE_NIBBLE) {
+            o << "CM_ SG_ " << ids.id[mi] << " DataIdNibble "
+              << q("E2E Profile 11C: bits 8..11 of the Data ID (always " +
+                   std::to_string((ids.e2e[mi].data_id >> 8) & 0x0FU) + ").")
+              << ";\n";
         }
     }
 
