@@ -31,7 +31,7 @@ def format_frame(f, d, e2e=None):
         return f"{f.t:.6f} {d.name:<13} wrong length ({n})"
     sigs = " ".join(f"{k}={d.named.get(k, round(v, 3))}" for k, v in d.phys.items()
                     if k not in ("Crc", "Counter"))
-    tail = "" if e2e is None or e2e in ("OK", "INITIAL") else f" e2e={e2e}"
+    tail = "" if e2e is None or e2e == "OK" else f" e2e={e2e}"
     return f"{f.t:.6f} {d.name:<13} ctr={d.counter:<2} crc={'ok' if d.crc_ok else 'BAD'}{tail} {sigs}"
 
 
