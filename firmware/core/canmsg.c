@@ -836,7 +836,6 @@ sl_err_t sl_can_motion_rx_feed(sl_can_motion_rx_t *rx, const sl_can_frame_t *f, 
         (void)sl_can_e2e_check(&rx->e2e, &rx->cfg, NULL);
         sl_can_e2e_rx_reset(&rx->e2e);
         rx->have_value = false; // stale anyway (sl_can_motion_rx_get), and not renewed by a sync
-        rx->stats.timeouts++;
     }
     const sl_can_e2e_status_t st = sl_can_e2e_check(&rx->e2e, &rx->cfg, f);
     switch (st) {
@@ -845,7 +844,6 @@ sl_err_t sl_can_motion_rx_feed(sl_can_motion_rx_t *rx, const sl_can_frame_t *f, 
         (void)sl_can_decode_vehicle_motion(f, &rx->cfg, &rx->last); // cannot fail: checked
         rx->last_t_us = t_us;
         rx->have_value = true;
-        rx->stats.used++;
         return SL_OK;
     case SL_CAN_E2E_INITIAL:
         // First frame since init or a reception gap: nothing to check its counter against,

@@ -680,15 +680,14 @@ sl_err_t sl_can_decode_pole_tilt(const sl_can_frame_t *f, const sl_can_e2e_cfg_t
 typedef struct sl_can_motion_rx {
     uint32_t id_dbc;             ///< expected id, board/DBC style
     sl_can_e2e_cfg_t cfg;        ///< Data ID and mode
-    sl_can_e2e_rx_t e2e;
+    sl_can_e2e_rx_t e2e;         ///< statuses counted in e2e.stats (reception gaps: NO_NEW_DATA;
+                                 ///< values used: OK + OK_SOME_LOST)
     sl_can_vehicle_motion_t last;///< last used value (valid when have_value)
-    uint64_t last_t_us;          ///< time of the last used (or INITIAL) frame
     bool have_value;
+    uint64_t last_t_us;          ///< time of the last used (or INITIAL) frame
     uint64_t timeout_us;         ///< no valid frame for this long: NO_NEW_DATA, sequence resets
     struct {
         uint32_t other_ids;      ///< frames with another id (ignored, counted)
-        uint32_t timeouts;       ///< sequence resets after a reception gap (= NO_NEW_DATA checks)
-        uint32_t used;           ///< frames whose value was used (OK, OK_SOME_LOST)
     } stats;
 } sl_can_motion_rx_t;
 

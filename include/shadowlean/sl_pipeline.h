@@ -403,9 +403,9 @@ _Static_assert(sizeof(sl_pipeline_t) <= 65536U, "sl_pipeline_t: 64 KiB RAM budge
 /// Any azimuth count, bins and n with the default target/candidate capacities: the mask
 /// dominates; everything else except the tilt history (sl_tiltobs_t, sized by
 /// SL_CFG_TILT_TRACKS x SL_CFG_TILT_OBS_PER_TRACK: 2.5 KB firmware, 7.4 KB host) stays under
-/// 17,536 B (17,420 B in the host configuration, with detection's link table, 168 B, its
-/// per-azimuth peaks, 776 B, and the CAN sender's and VehicleMotion receiver's E2E
-/// configuration and Profile 11 status counts, 176 B).
+/// 17,536 B (17,412 B in the host configuration, with detection's link table, 168 B, its
+/// per-azimuth peaks, 776 B, the CAN sender's E2E configuration, 24 B, and the
+/// VehicleMotion receiver with its Profile 11 state, 104 B).
 #if SL_CFG_MAX_TARGETS <= 32 && SL_CFG_DETECT_MAX_CANDIDATES <= 32 && SL_CFG_DETECT_MAX_SPAN <= 24 \
     && SL_CFG_MAX_AZIMUTHS <= 400
 #if defined(__cplusplus)

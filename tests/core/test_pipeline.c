@@ -1187,6 +1187,60 @@ static void test_pipeline_takes_motion_from_can_and_the_setter(void **state)
     assert_int_equal(rec.nt[4], 4);
 }
 
+/// The Fault of the Health frame (after its Status) the pipeline sends at `now`.
+static uint16_t health_fault(uint64_t now)
+{
+    assert_int_equal(sl_pipeline_send_status(&pl, now), SL_OK);
+    sl_can_health_t h;
+    assert_int_equal(sl_can_decode_health(&rec.can[rec.ncan - 1], E2E(HEALTH), &h), SL_OK);
+    return h.fault;
+}
+
+// Health reports VehicleMotion frames the E2E check rejected (MOTION_E2E) in the Health
+// frame after them, and only there: a repetition, a jump beyond the board's max delta
+// counter and a corrupted CRC each set the bit; frames in sequence do not.
+static void test_pipeline_reports_motion_e2e_rejections_on_health(void **state)
+{
+    (void)state;
+    rec_reset(0);
+    const sl_pipeline_cfg_t c = cfg_for(B);
+    assert_int_equal(sl_pipeline_init(&pl, B, &c), SL_OK);
+    sl_can_ids_t ids;
+    sl_can_ids_from_board(&ids, B);
+    sl_can_tx_t vtx;
+    assert_int_equal(sl_can_tx_init(&vtx, &ids), SL_OK);
+    assert_int_equal(pl.motion_rx.e2e.max_delta_counter, B->can_max_delta_counter_motion);
+    uint64_t now = 1000000U;
+    sl_can_frame_t f = motion_frame(&vtx, 50, 0);
+    assert_int_equal(sl_pipeline_on_can_rx(&pl, &f, now), SL_OK); // INITIAL
+    now += 20000U;
+    f = motion_frame(&vtx, 50, 0);
+    assert_int_equal(sl_pipeline_on_can_rx(&pl, &f, now), SL_OK); // OK
+    assert_int_equal(health_fault(now) & SL_CAN_FAULT_MOTION_E2E, 0);
+    assert_int_equal(sl_pipeline_on_can_rx(&pl, &f, now + 1000U), SL_ERR_STATE); // REPEATED
+    assert_int_equal(health_fault(now) & SL_CAN_FAULT_MOTION_E2E, SL_CAN_FAULT_MOTION_E2E);
+    now += 20000U;
+    f = motion_frame(&vtx, 50, 0);
+    assert_int_equal(sl_pipeline_on_can_rx(&pl, &f, now), SL_OK); // OK
+    assert_int_equal(health_fault(now) & SL_CAN_FAULT_MOTION_E2E, 0);
+    for (unsigned k = 0; k < B->can_max_delta_counter_motion; k++) {
+        (void)motion_frame(&vtx, 50, 0); // lost on the bus
+    }
+    now += 20000U;
+    f = motion_frame(&vtx, 50, 0);
+    assert_int_equal(sl_pipeline_on_can_rx(&pl, &f, now), SL_ERR_STATE); // WRONG_SEQUENCE
+    assert_int_equal(health_fault(now) & SL_CAN_FAULT_MOTION_E2E, SL_CAN_FAULT_MOTION_E2E);
+    now += 20000U;
+    f = motion_frame(&vtx, 50, 0);
+    f.data[0] ^= 0x5AU;
+    assert_int_equal(sl_pipeline_on_can_rx(&pl, &f, now), SL_ERR_MALFORMED); // ERROR
+    assert_int_equal(health_fault(now) & SL_CAN_FAULT_MOTION_E2E, SL_CAN_FAULT_MOTION_E2E);
+    assert_int_equal(health_fault(now) & SL_CAN_FAULT_MOTION_E2E, 0);
+    const uint32_t *n = pl.motion_rx.e2e.stats.status;
+    assert_int_equal(n[SL_CAN_E2E_REPEATED] + n[SL_CAN_E2E_WRONG_SEQUENCE] + n[SL_CAN_E2E_ERROR], 3);
+    assert_int_equal(pl.stats.motion_rejected, 3);
+}
+
 // ---------------------------------------------------------------------------- drive-by
 
 // The vehicle drives along +y (forward) at `v` m/s; a pole stands 2.8 m to the right,
@@ -1677,6 +1731,7 @@ int main(void)
         cmocka_unit_test(test_pipeline_idle_status_frames_continue_the_e2e_sequence),
         cmocka_unit_test(test_pipeline_adds_port_drops_saturating_into_the_next_status),
         cmocka_unit_test(test_pipeline_window_follows_speed_and_yaw),
+        cmocka_unit_test(test_pipeline_reports_motion_e2e_rejections_on_health),
         cmocka_unit_test(test_pipeline_takes_motion_from_can_and_the_setter),
         cmocka_unit_test(test_pipeline_drive_by_detects_the_pole_only_with_motion_input),
         cmocka_unit_test(test_pipeline_rejects_boards_that_need_more_mask_bins),
