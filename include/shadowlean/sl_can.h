@@ -201,10 +201,10 @@
 /// 360 deg first (370 deg is 10 deg), which is not clamping.
 ///
 /// Cost: every encode/decode is O(64) bit operations plus one 64-bit division per scaled
-/// signal (libgcc __aeabi_ldivmod on 32-bit cores) and one 8-byte bitwise CRC; no
+/// signal (libgcc __aeabi_ldivmod on 32-bit cores) and one 9-byte bitwise CRC; no
 /// allocation. Stack (Cortex-M0, -Os, from -fstack-usage): encoder 64 bytes + 48 + 40 in
 /// its helpers + the libgcc division, under 256 bytes; decoders under 96 bytes.
-/// Flash (Cortex-M0, -Os): canmsg.c 4.7 KB (layout table and strings included), crc8.c 88 B.
+/// Flash (Cortex-M0, -Os): canmsg.c 7.2 KB (layout table and strings included), crc8.c 88 B.
 /// Reentrant; one `sl_can_tx_t` per sender, one `sl_can_e2e_rx_t` per received message id.
 /// Not ISR-safe on a shared `sl_can_tx_t` without a lock.
 #ifndef SHADOWLEAN_SL_CAN_H
@@ -269,7 +269,7 @@ typedef enum sl_can_msg {
 /// Default CAN ids (11-bit). They avoid the ids of a Continental ARS408 radar on the same
 /// bus (its inputs and outputs 0x200-0x27F, 0x300-0x37F, 0x400-0x47F, 0x600-0x67F,
 /// 0x700-0x77F: the bases 0x200-0x204, 0x300-0x301, 0x400-0x408, 0x600-0x60F, 0x700-0x702
-/// plus 0x10 x its sensor id 0..7). docs/CAN_AND_USB.md says how to change them.
+/// plus 0x10 x its sensor id 0..7). docs/CAN.md says how to change them (board file).
 #define SL_CAN_ID_DEFAULT_POLE_LEAN 0x5C0U
 #define SL_CAN_ID_DEFAULT_LEAN_WARNING 0x5C1U
 #define SL_CAN_ID_DEFAULT_STATUS 0x5C2U
