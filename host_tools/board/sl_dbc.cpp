@@ -100,7 +100,10 @@ const std::map<std::string, std::string> kMessageComments = {
                "without data. Counters are totals since start and stop at their maximum "
                "(Saturated = 1)."},
     {"VehicleMotion", "Input from the vehicle for the motion-aware masks: speed and yaw "
-                      "rate with E2E protection; CRC errors and counter jumps are counted."},
+                      "rate with E2E protection. The module's Profile 11 check uses OK and "
+                      "OK_SOME_LOST frames (counter step up to the board's max delta counter), "
+                      "counts REPEATED, WRONG_SEQUENCE and ERROR frames (Health bit MOTION_E2E) "
+                      "and never uses them, nor the first frame after a start or a 500 ms gap."},
     {"PoleTilt",
      "While driving (a motion input is present): one frame per confirmed target and radar "
      "rotation that has an observation history (GenMsgSendType CyclicIfActive): the pole's "
