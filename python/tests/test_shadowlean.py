@@ -333,6 +333,10 @@ class Cli(unittest.TestCase):
         self.assertIn("--bogus", err)
         rc, _, err = run_cli([])
         self.assertEqual(rc, 2)
+        # A max delta counter outside Profile 11's 1..14 is a usage error, not a silent clamp.
+        rc, _, err = run_cli(["decode", "x.log", "--dbc", "y.dbc", "--check", "--max-delta-counter", "15"])
+        self.assertEqual(rc, 2)
+        self.assertIn("1..14", err)
         rc, _, err = run_cli(["decode", "/nonexistent.log", "--dbc", dbc_of("paper-sim")])
         self.assertEqual(rc, 1)
         self.assertIn("/nonexistent.log", err)
