@@ -105,15 +105,25 @@ local function load_dbc(path)
     return msgs, nil
 end
 
-function p.prefs_changed()
+local reported = nil -- the DBC error already reported (once per path)
+
+local function reload()
     db, db_error = load_dbc(p.prefs.dbc)
+    if db_error ~= nil and reported ~= db_error then
+        reported = db_error
+        report_failure(db_error .. " (set the preference shadowlean.dbc to the board's DBC)")
+    end
+end
+
+function p.prefs_changed()
+    reload()
     seq, memo = {}, {}
 end
 
 function p.init()
     seq, memo = {}, {}
-    if db == nil and db_error == nil then
-        db, db_error = load_dbc(p.prefs.dbc)
+    if db == nil then
+        reload()
     end
 end
 

@@ -13,7 +13,8 @@ Debian's tshark on SocketCAN pcap files (link type 227) written here:
   3. can_gen_frames' frames for paper-sim-29bit (29-bit ids, Health in Profile 11C): the
      same, on extended frames;
   4. a repetition, a lost frame and a corrupted CRC are REPEATED, WRONG_SEQUENCE (or
-     OK_SOME_LOST with shadowlean.max_delta_counter 3) and ERROR.
+     OK_SOME_LOST with shadowlean.max_delta_counter 3) and ERROR;
+  5. a DBC that cannot be read is reported by name, and no frame is claimed.
 
     wireshark_can_dissector_test.py --tshark T --dissector LUA --src SRC --gen CAN_GEN_FRAMES --work DIR
 """
@@ -168,6 +169,13 @@ def main():
     got = [r["e2e"] for r in tshark(args, pcap, dbc, ["-o", "shadowlean.max_delta_counter:3"])]
     want[3] = "OK_SOME_LOST"
     check(got == want, f"faults, max delta counter 3: {got}")
+
+    # 5. No DBC.
+    r = subprocess.run([args.tshark, "-n", "-X", "lua_script:" + args.dissector, "-o",
+                        "shadowlean.dbc:/nonexistent/board.dbc", "-r", pcap, "-T", "fields", "-e",
+                        "shadowlean.message"], capture_output=True, text=True, env=dict(os.environ, HOME=args.work))
+    check("cannot open DBC /nonexistent/board.dbc" in r.stderr and not r.stdout.strip(),
+          "a missing DBC is reported by name and claims no frame")
     print(f"{len(failures)} failure(s)")
     return 1 if failures else 0
 
