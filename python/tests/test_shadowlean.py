@@ -68,6 +68,20 @@ class Crc(unittest.TestCase):
         self.assertNotEqual(sl.e2e_crc(0x123, bytes.fromhex("cc10000000000000")), 0xCC)
         self.assertNotEqual(sl.e2e_crc(0x123, bytes.fromhex("7721000000000000"), sl.MODE_NIBBLE), 0x77)
 
+    def test_every_message_matches_its_vectors(self):
+        # 8 zero bytes but the counter (0, then 1), each message's Data ID from the board's
+        # DBC in its mode; the same table as unit_canmsg and the dissector test (CRC bytes
+        # from tests/system/daemon/p11_frames.py, the AUTOSAR library chaining).
+        vectors = {"PoleLean": (0x03, 0x5E), "LeanWarning": (0xAC, 0xF1), "Status": (0xC9, 0x94),
+                   "VehicleMotion": (0xEF, 0xB2), "Health": (0x8A, 0xD7), "PoleTilt": (0x25, 0x78)}
+        db = sl.load_dbc(dbc_of("paper-sim"))
+        for fr in db.frames:
+            data_id = int(fr.attributes["SlE2EDataId"])
+            for ctr in (0, 1):
+                self.assertEqual(sl.protect(data_id, bytes(8), ctr)[0], vectors[fr.name][ctr], fr.name)
+        self.assertEqual(sl.protect(0x0355, bytes(8), 0, sl.MODE_NIBBLE), bytes.fromhex("5c30000000000000"))
+        self.assertEqual(sl.protect(0x0355, bytes(8), 1, sl.MODE_NIBBLE), bytes.fromhex("0131000000000000"))
+
     def test_worked_example_of_sl_can_h(self):
         # Status, Data ID 0x0053 (11A), bytes 1..7 = 30 02 00 00 00 00 00 -> CRC 0x93.
         self.assertEqual(sl.e2e_crc(0x0053, bytes.fromhex("0030020000000000")), 0x93)

@@ -134,6 +134,33 @@ static void test_canmsg_e2e_crc_matches_independent_profile_11_vectors(void **st
     assert_int_equal(sl_can_decode_health(&f, &both, &back), SL_ERR_MALFORMED);
 }
 
+// Per-message vectors: 8 zero bytes but the counter (0, then 1), each message's default
+// Data ID in 11A, and Health with paper-sim-29bit's Data ID 0x0355 in 11C. The CRC bytes
+// come from tests/system/daemon/p11_frames.py (the AUTOSAR library chaining, pinned there
+// to the published vectors); the Python suite and the dissector test assert the same table.
+static void test_canmsg_e2e_crc_of_every_message_matches_its_vectors(void **state)
+{
+    (void)state;
+    static const struct {
+        sl_can_msg_t msg;
+        uint8_t crc[2]; // counter 0, counter 1
+    } v[] = {
+        {SL_CAN_MSG_POLE_LEAN, {0x03, 0x5E}},      {SL_CAN_MSG_LEAN_WARNING, {0xAC, 0xF1}},
+        {SL_CAN_MSG_STATUS, {0xC9, 0x94}},         {SL_CAN_MSG_VEHICLE_MOTION, {0xEF, 0xB2}},
+        {SL_CAN_MSG_HEALTH, {0x8A, 0xD7}},         {SL_CAN_MSG_POLE_TILT, {0x25, 0x78}},
+    };
+    for (size_t k = 0; k < sizeof v / sizeof v[0]; k++) {
+        for (uint8_t c = 0; c < 2U; c++) {
+            const uint8_t d[8] = {0, c, 0, 0, 0, 0, 0, 0};
+            assert_int_equal(sl_can_e2e_crc(&sl_can_e2e_defaults[v[k].msg], d), v[k].crc[c]);
+        }
+    }
+    const sl_can_e2e_cfg_t h11c = {0x0355U, SL_CAN_E2E_MODE_NIBBLE};
+    const uint8_t d0[8] = {0, 0x30}, d1[8] = {0, 0x31};
+    assert_int_equal(sl_can_e2e_crc(&h11c, d0), 0x5C);
+    assert_int_equal(sl_can_e2e_crc(&h11c, d1), 0x01);
+}
+
 static void test_canmsg_tx_init_refuses_nibble_mode_over_signals_and_shared_data_ids(void **state)
 {
     (void)state;
@@ -1024,6 +1051,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_canmsg_crc8_0x1d_gives_the_sae_j1850_and_gsm_a_check_values),
         cmocka_unit_test(test_canmsg_e2e_crc_matches_independent_profile_11_vectors),
+        cmocka_unit_test(test_canmsg_e2e_crc_of_every_message_matches_its_vectors),
         cmocka_unit_test(test_canmsg_tx_init_refuses_nibble_mode_over_signals_and_shared_data_ids),
         cmocka_unit_test(test_canmsg_e2e_crc_mixes_both_data_id_bytes_first),
         cmocka_unit_test(test_canmsg_crc_worked_example),

@@ -8,6 +8,9 @@ Debian's tshark on SocketCAN pcap files (link type 227) written here:
      package, zariiii9003/autosar-e2e test/test_p01.py): 8 zero bytes, Data ID 0x123,
      11A CC 00 / 91 01, 11C 2A 10 / 77 11 verify (computed CRC = the vector), and their
      negative vectors (CC 10 in 11A, 77 21 in 11C) are ERROR;
+  1b. the project's per-message vectors (8 zero bytes but the counter 0 / 1, each message's
+     Data ID from the paper-sim DBC; Health 0x0355 in 11C from paper-sim-29bit's), the same
+     table as unit_canmsg and the Python suite;
   2. the daemon's demo log (paper-sim DBC): every frame a shadowlean message, CRC good,
      INITIAL then OK per message, every signal equal to the Python package's decode;
   3. can_gen_frames' frames for paper-sim-29bit (29-bit ids, Health in Profile 11C): the
@@ -132,9 +135,29 @@ def main():
               f"Profile 11 vector {'11A' if cid == 0x123 else '11C'} Data ID 0x123 {h}: CRC {row['crc']}"
               f" (computed {row['crc_calc']}), {row['e2e']}")
 
-    # 2. The daemon's demo log.
+    # 1b. Per-message vectors.
     dbc = os.path.join(args.src, "boards", "paper-sim", "shadowlean.dbc")
     db = sl.load_dbc(dbc)
+    table = {"PoleLean": (0x03, 0x5E), "LeanWarning": (0xAC, 0xF1), "Status": (0xC9, 0x94),
+             "VehicleMotion": (0xEF, 0xB2), "Health": (0x8A, 0xD7), "PoleTilt": (0x25, 0x78)}
+    frames = [(fr.arbitration_id.id, False, bytes([table[fr.name][c], c]) + bytes(6), fr.name, c)
+              for fr in db.frames for c in (0, 1)]
+    pcap = os.path.join(args.work, "messages.pcap")
+    write_pcap(pcap, [f[:3] for f in frames])
+    rows = tshark(args, pcap, dbc)
+    bad = [f"{n} counter {c}: {r}" for (_, _, _, n, c), r in zip(frames, rows)
+           if r["msg"] != n or r["crc"] != "good" or r["e2e"] != ("INITIAL" if c == 0 else "OK")]
+    check(len(rows) == 12 and not bad, "per-message vectors (6 messages x counter 0, 1) verify" +
+          ("" if not bad else ": " + "; ".join(bad[:3])))
+    h = next(fr for fr in sl.load_dbc(os.path.join(args.src, "boards", "paper-sim-29bit", "shadowlean.dbc")).frames
+             if fr.name == "Health")
+    pcap = os.path.join(args.work, "health11c.pcap")
+    write_pcap(pcap, [(h.arbitration_id.id, True, bytes.fromhex(x)) for x in ("5c30000000000000", "0131000000000000")])
+    rows = tshark(args, pcap, os.path.join(args.src, "boards", "paper-sim-29bit", "shadowlean.dbc"))
+    check([(r["crc"], r["e2e"]) for r in rows] == [("good", "INITIAL"), ("good", "OK")],
+          f"Health 11C (Data ID 0x0355, 29-bit id) vectors 5C 30 / 01 31 verify: {[(r['crc'], r['e2e']) for r in rows]}")
+
+    # 2. The daemon's demo log.
     frames = sl.read_candump(os.path.join(args.src, "tests", "system", "daemon", "golden", "demo_three_poles.candump"))
     pcap = os.path.join(args.work, "demo.pcap")
     write_pcap(pcap, [(f.can_id, f.is_eff, f.data) for f in frames])
