@@ -10,7 +10,10 @@ Data ID's bits 8..11.
 E2EMonitor classifies each frame with the Profile 11 check statuses: OK (counter step 1),
 OK_SOME_LOST (step 2..max_delta_counter), REPEATED (step 0), WRONG_SEQUENCE (a larger
 step), ERROR (length, CRC, Data ID nibble or counter 15), INITIAL (the first frame of a
-message: nothing to compare its counter with); one sequence per message."""
+message, or the first after a reception gap: nothing to compare its counter with); one
+sequence per message. With a timeout, a gap of more than `timeout` seconds (frame times)
+since a message's last accepted frame is one NO_NEW_DATA, counted when the next frame
+arrives, and restarts its sequence, as the module's VehicleMotion receiver does."""
 from dataclasses import dataclass
 
 MODE_BOTH = "both"      # Profile 11A
@@ -72,6 +75,7 @@ class E2EStats:
     repeated: int = 0
     wrong_sequence: int = 0
     error: int = 0
+    no_new_data: int = 0
     bad_length: int = 0
     crc_errors: int = 0
     bad_nibble: int = 0
@@ -92,9 +96,13 @@ class E2EMonitor:
     message name. The modulo of each message comes from its DBC Counter signal (db given)
     or is 15; `max_delta_counter` (1..14) is the largest step that is OK_SOME_LOST."""
 
-    def __init__(self, db=None, modulo=15, max_delta_counter=1):
+    def __init__(self, db=None, modulo=15, max_delta_counter=1, timeout=None):
         if not 1 <= max_delta_counter <= 14:
             raise ValueError(f"max_delta_counter {max_delta_counter}: 1..14")
+        if timeout is not None and not timeout > 0:
+            raise ValueError(f"timeout {timeout}: > 0 seconds")
+        self.timeout = timeout
+        self._last_t = {}      # name -> time of the last accepted (OK, OK_SOME_LOST, INITIAL) frame
         self._db = db
         self._default_modulo = modulo
         self.max_delta_counter = max_delta_counter
@@ -130,13 +138,25 @@ class E2EMonitor:
         st.error += 1
         return "ERROR"
 
-    def check(self, decoded, data=None):
-        """One frame (a dbc.Decoded, or None for an unknown id): its status, one of
-        E2E_STATUSES, or "UNKNOWN_ID"."""
+    def check(self, decoded, data=None, t=None):
+        """One frame (a dbc.Decoded, or None for an unknown id) received at time `t`
+        (seconds; needed for the timeout): its status, one of E2E_STATUSES, or
+        "UNKNOWN_ID"."""
         if decoded is None:
             self.unknown += 1
             return "UNKNOWN_ID"
         st = self.stats.setdefault(decoded.name, E2EStats())
+        last_t = self._last_t.get(decoded.name)
+        if self.timeout is not None and t is not None and last_t is not None and t - last_t > self.timeout:
+            st.no_new_data += 1  # a reception gap: the counter sequence means nothing now
+            self._last.pop(decoded.name, None)
+            self._last_t.pop(decoded.name, None)
+        status = self._check(st, decoded)
+        if status in ("OK", "OK_SOME_LOST", "INITIAL") and t is not None:
+            self._last_t[decoded.name] = t
+        return status
+
+    def _check(self, st, decoded):
         if not decoded.length_ok:
             return self._error(st, "bad_length")
         if not decoded.crc_ok:

@@ -214,6 +214,19 @@ class E2E(unittest.TestCase):
             self.assertEqual(mon.check(d, data), want)
         self.assertEqual(mon.stats["Health"].bad_nibble, 1)
 
+    def test_reception_gap_is_no_new_data_and_restarts_the_sequence(self):
+        # With a 0.5 s timeout (the module's VehicleMotion receiver's): Status frames 250 ms
+        # apart are in sequence; after a 2 s gap even a repetition is INITIAL, as after a
+        # start (nothing to check it against), and the gap is one NO_NEW_DATA.
+        mon = sl.E2EMonitor(self.db, timeout=0.5)
+        seq = [(self.status[0], 0.0), (self.status[1], 0.25), (self.status[1], 2.25), (self.status[2], 2.5)]
+        v = [mon.check(sl.decode(self.db, f.can_id, f.is_eff, f.data), f.data, t) for f, t in seq]
+        self.assertEqual(v, ["INITIAL", "OK", "INITIAL", "OK"])
+        self.assertEqual(mon.stats["Status"].no_new_data, 1)
+        self.assertEqual(mon.errors(), 0)
+        with self.assertRaises(ValueError):
+            sl.E2EMonitor(self.db, timeout=0)
+
     def test_wrong_length_and_unknown_id(self):
         f = self.status[1]
         v, mon = self.verdicts([f._replace(data=f.data[:7]), f._replace(can_id=0x7FF), f._replace(data=None)])
@@ -273,7 +286,7 @@ class PythonCanBus(unittest.TestCase):
         self.assertEqual(rc, 0, err)
         self.assertEqual(sum(1 for x in out.splitlines() if "crc=ok" in x), len(frames))
         self.assertEqual(sum(1 for x in out.splitlines() if "(unknown id)" in x), 1)  # stops at N
-        self.assertRegex(out, r"\nStatus\s+\d+\s+0\s+1\s+0\s+0\s+0\s+0\s+0\s+0\s+0\s+0\n")
+        self.assertRegex(out, r"\nStatus\s+\d+\s+0\s+1\s+0\s+0\s+0\s+0\s+0\s+0\s+0\s+0\s+0\n")
 
     def test_idle_limit_ends_a_silent_bus(self):
         chan = f"sl-idle-{os.getpid()}"
@@ -296,7 +309,7 @@ class Cli(unittest.TestCase):
         self.assertEqual(rc, 0, err)
         self.assertIn("crc=ok", out)
         self.assertNotIn("crc=BAD", out)
-        self.assertRegex(out, r"\nStatus\s+\d+\s+0\s+1\s+0\s+0\s+0\s+0\s+0\s+0\s+0\s+0\n")
+        self.assertRegex(out, r"\nStatus\s+\d+\s+0\s+1\s+0\s+0\s+0\s+0\s+0\s+0\s+0\s+0\s+0\n")
 
     def test_decode_check_fails_on_a_corrupt_log(self):
         lines = open(os.path.join(GOLDEN, "demo_three_poles.candump")).read().splitlines()
