@@ -9,7 +9,7 @@
 #   component daemon: sbin/shadowleand, lib/systemd/system/shadowleand.service,
 #                     share/shadowlean/{shadowleand.conf,dbc/<board>.dbc,schema/targets.schema.json},
 #                     man8 page
-#   component tools:  bin/sl-* host tools, man1 pages, share/shadowlean/wireshark/colossus.lua,
+#   component tools:  bin/sl-* host tools, man1 pages, share/shadowlean/wireshark/{colossus,shadowlean_can}.lua,
 #                     share/shadowlean/schema/{inspect,eval}.schema.json
 #   component python: lib/python3/dist-packages/shadowlean (the CAN consumer package,
 #                     python/; Debian's python3 path, as python3-* packages install it)
@@ -130,6 +130,7 @@ foreach(t sl-tables sl-dbc sl-alpha sl-replay sl-inspect sl-sim sl-eval sl-view 
 endforeach()
 if(SL_BUILD_HOST_TOOLS)
   install(FILES ${PROJECT_SOURCE_DIR}/packaging/wireshark/colossus.lua
+    ${PROJECT_SOURCE_DIR}/packaging/wireshark/shadowlean_can.lua
     DESTINATION ${CMAKE_INSTALL_DATADIR}/shadowlean/wireshark COMPONENT tools)
   install(FILES ${PROJECT_SOURCE_DIR}/docs/schema/inspect.schema.json
     ${PROJECT_SOURCE_DIR}/docs/schema/eval.schema.json

@@ -9,7 +9,7 @@ Library (re-exported from the package):
     db = load_dbc(path)
     frames = read_candump(path)            # [Frame(t, iface, can_id, is_eff, data)]
     d = decode(db, can_id, is_eff, data)   # Decoded(name, phys{}, raw{}, named{}, crc_ok, ...)
-    crc8_j1850(bytes)                      # CRC-8 SAE J1850; the E2E CRC is over [Data ID, data[1..7]]
+    e2e_crc(data_id, data, mode)           # the E2E Profile 11 CRC of a frame
 
 Command line (the same as `python3 -m shadowlean decode LOG --dbc BOARD.dbc ...`):
     sl_can_decode.py BOARD.dbc LOG              every frame, decoded
@@ -23,7 +23,7 @@ _here = os.path.dirname(os.path.abspath(__file__))
 if os.path.isdir(os.path.join(_here, "..", "python", "shadowlean")):
     sys.path.insert(0, os.path.join(_here, "..", "python"))  # the source tree's package
 
-from shadowlean import (LEVEL, LINK, QUALITY, Decoded, Frame, crc8_j1850, decode,  # noqa: E402,F401
+from shadowlean import (LEVEL, LINK, QUALITY, Decoded, Frame, decode, e2e_crc,  # noqa: E402,F401
                         decode_log, frame_of, groups, load_dbc, print_summary, print_table,
                         read_candump)
 from shadowlean.__main__ import main as _main  # noqa: E402

@@ -87,6 +87,13 @@ def bit_span(s):
     return f"byte {first // 8} bit {first % 8} .. byte {last // 8} bit {last % 8}"
 
 
+def can_id(raw):
+    """A DBC message id as a reader writes it: 29-bit ids (the DBC sets bit 31) with 'ext'."""
+    if raw & 0x80000000:
+        return f"0x{raw & 0x1FFFFFFF:08X} ext"
+    return f"0x{raw:03X}"
+
+
 def md(text):
     return text.replace("|", "\\|").replace("\n", " ")
 
@@ -107,14 +114,14 @@ def gen_can():
         bm, _, _, bb = parse_dbc(rd(f"boards/{b}/shadowlean.dbc"))
         ids = {m["name"]: m["id"] for m in bm}
         out.append(f"| `{b}` | {bb} | " + " | ".join(
-            f"0x{ids[m['name']]:03X}" if m["name"] in ids else "-" for m in msgs) + " |")
+            can_id(ids[m["name"]]) if m["name"] in ids else "-" for m in msgs) + " |")
     for m in msgs:
         a = m["attrs"]
         send = enum.get(int(a["GenMsgSendType"]), a["GenMsgSendType"]) if "GenMsgSendType" in a else "-"
         cyc = a.get("GenMsgCycleTime", "-")
         idle = a.get("SlIdleCycleTime")
         did = int(a["SlE2EDataId"]) if "SlE2EDataId" in a else None
-        out += ["", f"### {m['name']} (0x{m['id']:03X})", "",
+        out += ["", f"### {m['name']} ({can_id(m['id'])})", "",
                 f"Sender {m['sender']}, DLC {m['dlc']}, {send}, cycle {cyc} ms"
                 + (f", idle cycle {idle} ms" if idle else "")
                 + (f", E2E Data ID 0x{did:02X}" if did is not None else "") + ".", "",

@@ -794,14 +794,18 @@ static void log_stats(daemon_t *d, int level, const char *what)
             dw->stats.occupied, dw->stats.outliers);
     if (s->can_rx != 0) {
         const sl_can_e2e_rx_t *e2e = &g_pipe.motion_rx.e2e;
-        sld_log(level, "%s: VehicleMotion E2E: %" PRIu32 " accepted, %" PRIu32 " CRC errors, %" PRIu32
-                " repeated, %" PRIu32 " bad counter, %" PRIu32 " bad DLC, %" PRIu32 " counter jumps (%" PRIu32
-                " lost), %" PRIu32 " timeouts, %" PRIu32 " other ids, %" PRIu32
-                " only synchronising (first after a start or a gap: value unused)",
-                what, e2e->stats.accepted, e2e->stats.crc_errors, e2e->stats.repeated, e2e->stats.bad_counter,
-                e2e->stats.bad_dlc, e2e->stats.counter_jumps, e2e->stats.lost_frames,
-                g_pipe.motion_rx.stats.timeouts, g_pipe.motion_rx.stats.other_ids,
-                g_pipe.motion_rx.stats.sync_only);
+        const uint32_t *n = e2e->stats.status;
+        sld_log(level, "%s: VehicleMotion E2E (Profile 11, max delta counter %u): OK %" PRIu32
+                ", OK_SOME_LOST %" PRIu32 " (%" PRIu32 " frames lost), INITIAL %" PRIu32
+                " (first after a start or a gap: value unused), REPEATED %" PRIu32
+                ", WRONG_SEQUENCE %" PRIu32 ", ERROR %" PRIu32 " (CRC %" PRIu32 ", DLC %" PRIu32
+                ", counter 15 %" PRIu32 ", Data ID nibble %" PRIu32 "), NO_NEW_DATA %" PRIu32
+                " (reception gaps); %" PRIu32 " other ids",
+                what, (unsigned)e2e->max_delta_counter, n[SL_CAN_E2E_OK], n[SL_CAN_E2E_OK_SOME_LOST],
+                e2e->stats.lost_frames, n[SL_CAN_E2E_INITIAL], n[SL_CAN_E2E_REPEATED],
+                n[SL_CAN_E2E_WRONG_SEQUENCE], n[SL_CAN_E2E_ERROR], e2e->stats.crc_errors,
+                e2e->stats.bad_dlc, e2e->stats.bad_counter, e2e->stats.bad_nibble,
+                n[SL_CAN_E2E_NO_NEW_DATA], g_pipe.motion_rx.stats.other_ids);
     }
     if (d->exit_undrained != 0) {
         sld_log(SLD_LOG_WARN, "%s: CAN: %" PRIu32 " frames undrained at exit (dropped)", what, d->exit_undrained);

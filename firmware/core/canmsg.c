@@ -36,6 +36,7 @@ static const sl_can_value_name_t fault_names[] = {
     {SL_CAN_FAULT_CAN_RATE_LIMITED, "CAN_RATE_LIMITED"},
     {SL_CAN_FAULT_TARGET_SLOTS_OVERFLOW, "TARGET_SLOTS_OVERFLOW"},
     {SL_CAN_FAULT_THETA_DRIFT, "THETA_DRIFT"},
+    {SL_CAN_FAULT_MOTION_E2E, "MOTION_E2E"},
 };
 
 #define NV(a) ((uint8_t)(sizeof(a) / sizeof((a)[0])))
@@ -293,6 +294,29 @@ static void set_id(sl_can_frame_t *f, uint32_t id_dbc)
     }
 }
 
+const sl_can_e2e_cfg_t sl_can_e2e_defaults[SL_CAN_MSG_COUNT] = {
+    {SL_CAN_DATA_ID_POLE_LEAN, (uint8_t)SL_CAN_E2E_MODE_BOTH},
+    {SL_CAN_DATA_ID_LEAN_WARNING, (uint8_t)SL_CAN_E2E_MODE_BOTH},
+    {SL_CAN_DATA_ID_STATUS, (uint8_t)SL_CAN_E2E_MODE_BOTH},
+    {SL_CAN_DATA_ID_VEHICLE_MOTION, (uint8_t)SL_CAN_E2E_MODE_BOTH},
+    {SL_CAN_DATA_ID_HEALTH, (uint8_t)SL_CAN_E2E_MODE_BOTH},
+    {SL_CAN_DATA_ID_POLE_TILT, (uint8_t)SL_CAN_E2E_MODE_BOTH},
+};
+
+_Static_assert(SL_BOARD_CAN_MSGS == SL_CAN_MSG_COUNT, "board CAN tables cover every message");
+
+void sl_can_ids_default(sl_can_ids_t *ids)
+{
+    SL_ASSERT(ids != NULL);
+    ids->id[SL_CAN_MSG_POLE_LEAN] = SL_CAN_ID_DEFAULT_POLE_LEAN;
+    ids->id[SL_CAN_MSG_LEAN_WARNING] = SL_CAN_ID_DEFAULT_LEAN_WARNING;
+    ids->id[SL_CAN_MSG_STATUS] = SL_CAN_ID_DEFAULT_STATUS;
+    ids->id[SL_CAN_MSG_VEHICLE_MOTION] = SL_CAN_ID_DEFAULT_VEHICLE_MOTION;
+    ids->id[SL_CAN_MSG_HEALTH] = SL_CAN_ID_DEFAULT_HEALTH;
+    ids->id[SL_CAN_MSG_POLE_TILT] = SL_CAN_ID_DEFAULT_POLE_TILT;
+    memcpy(ids->e2e, sl_can_e2e_defaults, sizeof ids->e2e);
+}
+
 void sl_can_ids_from_board(sl_can_ids_t *ids, const struct sl_board *board)
 {
     SL_ASSERT(ids != NULL && board != NULL);
@@ -302,6 +326,32 @@ void sl_can_ids_from_board(sl_can_ids_t *ids, const struct sl_board *board)
     ids->id[SL_CAN_MSG_VEHICLE_MOTION] = board->can_id_vehicle_motion;
     ids->id[SL_CAN_MSG_HEALTH] = board->can_id_health;
     ids->id[SL_CAN_MSG_POLE_TILT] = board->can_id_pole_tilt;
+    for (unsigned m = 0; m < (unsigned)SL_CAN_MSG_COUNT; m++) {
+        ids->e2e[m].data_id = board->can_data_id[m];
+        ids->e2e[m].mode = board->can_data_id_mode[m];
+    }
+}
+
+/// Mode 11C sends the Data ID nibble in frame bits 12..15: only where no signal is.
+static bool nibble_free(sl_can_msg_t m)
+{
+    const sl_can_message_desc_t *md = &messages[m];
+    for (unsigned i = 0; i < md->n_signals; i++) {
+        const unsigned lo = md->signals[i].start;
+        const unsigned hi = lo + md->signals[i].length; // exclusive
+        if (lo < 16U && hi > 12U) {
+            return false;
+        }
+    }
+    return true;
+}
+
+static bool e2e_cfg_valid(const sl_can_e2e_cfg_t *c, sl_can_msg_t m)
+{
+    if (c->mode == (uint8_t)SL_CAN_E2E_MODE_BOTH) {
+        return true;
+    }
+    return c->mode == (uint8_t)SL_CAN_E2E_MODE_NIBBLE && c->data_id <= 0x0FFFU && nibble_free(m);
 }
 
 sl_err_t sl_can_tx_init(sl_can_tx_t *tx, const sl_can_ids_t *ids)
@@ -310,11 +360,11 @@ sl_err_t sl_can_tx_init(sl_can_tx_t *tx, const sl_can_ids_t *ids)
         return SL_ERR_ARG;
     }
     for (unsigned i = 0; i < (unsigned)SL_CAN_MSG_COUNT; i++) {
-        if (!id_valid(ids->id[i])) {
+        if (!id_valid(ids->id[i]) || !e2e_cfg_valid(&ids->e2e[i], (sl_can_msg_t)i)) {
             return SL_ERR_ARG;
         }
         for (unsigned j = 0; j < i; j++) {
-            if (ids->id[i] == ids->id[j]) {
+            if (ids->id[i] == ids->id[j] || ids->e2e[i].data_id == ids->e2e[j].data_id) {
                 return SL_ERR_ARG;
             }
         }
@@ -329,9 +379,13 @@ static void finish(sl_can_tx_t *tx, sl_can_msg_t m, uint8_t d[8], bool clamped,
                    sl_can_frame_t *out)
 {
     const sl_can_message_desc_t *md = &messages[m];
+    const sl_can_e2e_cfg_t *e2e = &tx->ids.e2e[m];
     const uint8_t ctr = tx->counter[m];
     put_sig(d, &md->signals[S_COUNTER], ctr);
-    d[0] = sl_can_e2e_crc(md->data_id, d);
+    if (e2e->mode == (uint8_t)SL_CAN_E2E_MODE_NIBBLE) {
+        put_bits(d, 12U, 4U, (uint32_t)(e2e->data_id >> 8) & 0x0FU); // 11C: bits 8..11
+    }
+    d[0] = sl_can_e2e_crc(e2e, d);
     tx->counter[m] = (uint8_t)((ctr + 1U) % SL_CAN_COUNTER_MODULO);
     tx->stats.frames++;
     if (clamped) {
@@ -495,10 +549,18 @@ sl_err_t sl_can_encode_vehicle_motion(sl_can_tx_t *tx, const sl_can_vehicle_moti
 // ---------------------------------------------------------------------------------------
 // E2E receiver and decoders
 
-void sl_can_e2e_rx_init(sl_can_e2e_rx_t *rx)
+void sl_can_e2e_rx_init(sl_can_e2e_rx_t *rx, uint8_t max_delta_counter)
 {
     SL_ASSERT(rx != NULL);
     memset(rx, 0, sizeof *rx);
+    uint8_t m = max_delta_counter;
+    if (m < 1U) {
+        m = 1U;
+    } else if (m > SL_CAN_COUNTER_MODULO - 1U) {
+        m = (uint8_t)(SL_CAN_COUNTER_MODULO - 1U);
+    }
+    rx->max_delta_counter = m;
+    rx->last_status = (uint8_t)SL_CAN_E2E_NO_NEW_DATA;
 }
 
 void sl_can_e2e_rx_reset(sl_can_e2e_rx_t *rx)
@@ -508,8 +570,36 @@ void sl_can_e2e_rx_reset(sl_can_e2e_rx_t *rx)
     rx->last_counter = 0U;
 }
 
-/// dlc, flags, CRC, counter 15. Returns SL_OK or SL_ERR_MALFORMED; counts when `rx`.
-static sl_err_t frame_check(sl_can_e2e_rx_t *rx, uint8_t data_id, const sl_can_frame_t *f)
+bool sl_can_e2e_status_ok(sl_can_e2e_status_t st)
+{
+    return st == SL_CAN_E2E_OK || st == SL_CAN_E2E_OK_SOME_LOST;
+}
+
+const char *sl_can_e2e_status_name(sl_can_e2e_status_t st)
+{
+    switch (st) {
+    case SL_CAN_E2E_OK:
+        return "OK";
+    case SL_CAN_E2E_OK_SOME_LOST:
+        return "OK_SOME_LOST";
+    case SL_CAN_E2E_INITIAL:
+        return "INITIAL";
+    case SL_CAN_E2E_REPEATED:
+        return "REPEATED";
+    case SL_CAN_E2E_WRONG_SEQUENCE:
+        return "WRONG_SEQUENCE";
+    case SL_CAN_E2E_ERROR:
+        return "ERROR";
+    case SL_CAN_E2E_NO_NEW_DATA:
+        return "NO_NEW_DATA";
+    }
+    return "?";
+}
+
+/// dlc, flags, CRC, Data ID nibble, counter 15. Returns SL_OK or SL_ERR_MALFORMED;
+/// counts the reason when `rx`.
+static sl_err_t frame_check(sl_can_e2e_rx_t *rx, const sl_can_e2e_cfg_t *cfg,
+                            const sl_can_frame_t *f)
 {
     if (f->dlc != 8U || (f->flags & (SL_CAN_FLAG_RTR | SL_CAN_FLAG_ERR)) != 0U) {
         if (rx != NULL) {
@@ -517,9 +607,16 @@ static sl_err_t frame_check(sl_can_e2e_rx_t *rx, uint8_t data_id, const sl_can_f
         }
         return SL_ERR_MALFORMED;
     }
-    if (sl_can_e2e_crc(data_id, f->data) != f->data[0]) {
+    if (sl_can_e2e_crc(cfg, f->data) != f->data[0]) {
         if (rx != NULL) {
             rx->stats.crc_errors++;
+        }
+        return SL_ERR_MALFORMED;
+    }
+    if (cfg->mode == (uint8_t)SL_CAN_E2E_MODE_NIBBLE &&
+        (unsigned)(f->data[1] >> 4) != ((unsigned)(cfg->data_id >> 8) & 0x0FU)) {
+        if (rx != NULL) {
+            rx->stats.bad_nibble++;
         }
         return SL_ERR_MALFORMED;
     }
@@ -532,44 +629,60 @@ static sl_err_t frame_check(sl_can_e2e_rx_t *rx, uint8_t data_id, const sl_can_f
     return SL_OK;
 }
 
-sl_err_t sl_can_e2e_check(sl_can_e2e_rx_t *rx, uint8_t data_id, const sl_can_frame_t *f)
+static sl_can_e2e_status_t e2e_status(sl_can_e2e_rx_t *rx, const sl_can_e2e_cfg_t *cfg,
+                                      const sl_can_frame_t *f)
 {
-    if (rx == NULL || f == NULL) {
-        return SL_ERR_ARG;
+    if (f == NULL) {
+        return SL_CAN_E2E_NO_NEW_DATA;
     }
-    const sl_err_t e = frame_check(rx, data_id, f);
-    if (e != SL_OK) {
-        return e;
+    if (frame_check(rx, cfg, f) != SL_OK) {
+        return SL_CAN_E2E_ERROR;
     }
     const uint8_t c = (uint8_t)(f->data[1] & 0x0FU);
-    if (rx->synced) {
-        const unsigned delta = (c + SL_CAN_COUNTER_MODULO - rx->last_counter) % SL_CAN_COUNTER_MODULO;
-        if (delta == 0U) {
-            rx->stats.repeated++;
-            return SL_ERR_STATE;
-        }
-        if (delta > 1U) {
-            rx->stats.counter_jumps++;
-            rx->stats.lost_frames += delta - 1U;
-        }
-    }
+    const bool synced = rx->synced;
+    const unsigned delta = (c + SL_CAN_COUNTER_MODULO - rx->last_counter) % SL_CAN_COUNTER_MODULO;
     rx->synced = true;
-    rx->last_counter = c;
-    rx->stats.accepted++;
-    return SL_OK;
+    rx->last_counter = c; // Profile 11: the state follows every frame with a valid CRC
+    if (!synced) {
+        return SL_CAN_E2E_INITIAL;
+    }
+    if (delta == 0U) {
+        return SL_CAN_E2E_REPEATED;
+    }
+    if (delta > 1U) {
+        rx->stats.lost_frames += delta - 1U;
+    }
+    if (delta == 1U) {
+        return SL_CAN_E2E_OK;
+    }
+    return (delta <= rx->max_delta_counter) ? SL_CAN_E2E_OK_SOME_LOST : SL_CAN_E2E_WRONG_SEQUENCE;
 }
 
-static sl_err_t decode_check(const sl_can_frame_t *f, const void *out, sl_can_msg_t m)
+sl_can_e2e_status_t sl_can_e2e_check(sl_can_e2e_rx_t *rx, const sl_can_e2e_cfg_t *cfg,
+                                     const sl_can_frame_t *f)
 {
-    if (f == NULL || out == NULL) {
+    SL_ASSERT(rx != NULL && cfg != NULL);
+    if (rx == NULL || cfg == NULL) {
+        return SL_CAN_E2E_ERROR;
+    }
+    const sl_can_e2e_status_t st = e2e_status(rx, cfg, f);
+    rx->stats.status[st]++;
+    rx->last_status = (uint8_t)st;
+    return st;
+}
+
+static sl_err_t decode_check(const sl_can_frame_t *f, const sl_can_e2e_cfg_t *e2e, const void *out)
+{
+    if (f == NULL || e2e == NULL || out == NULL) {
         return SL_ERR_ARG;
     }
-    return frame_check(NULL, messages[m].data_id, f);
+    return frame_check(NULL, e2e, f);
 }
 
-sl_err_t sl_can_decode_pole_lean(const sl_can_frame_t *f, sl_can_pole_lean_t *out)
+sl_err_t sl_can_decode_pole_lean(const sl_can_frame_t *f, const sl_can_e2e_cfg_t *e2e,
+                                 sl_can_pole_lean_t *out)
 {
-    const sl_err_t e = decode_check(f, out, SL_CAN_MSG_POLE_LEAN);
+    const sl_err_t e = decode_check(f, e2e, out);
     if (e != SL_OK) {
         return e;
     }
@@ -587,9 +700,10 @@ sl_err_t sl_can_decode_pole_lean(const sl_can_frame_t *f, sl_can_pole_lean_t *ou
     return SL_OK;
 }
 
-sl_err_t sl_can_decode_lean_warning(const sl_can_frame_t *f, sl_can_lean_warning_t *out)
+sl_err_t sl_can_decode_lean_warning(const sl_can_frame_t *f, const sl_can_e2e_cfg_t *e2e,
+                                    sl_can_lean_warning_t *out)
 {
-    const sl_err_t e = decode_check(f, out, SL_CAN_MSG_LEAN_WARNING);
+    const sl_err_t e = decode_check(f, e2e, out);
     if (e != SL_OK) {
         return e;
     }
@@ -608,9 +722,10 @@ sl_err_t sl_can_decode_lean_warning(const sl_can_frame_t *f, sl_can_lean_warning
     return SL_OK;
 }
 
-sl_err_t sl_can_decode_status(const sl_can_frame_t *f, sl_can_status_t *out)
+sl_err_t sl_can_decode_status(const sl_can_frame_t *f, const sl_can_e2e_cfg_t *e2e,
+                              sl_can_status_t *out)
 {
-    const sl_err_t e = decode_check(f, out, SL_CAN_MSG_STATUS);
+    const sl_err_t e = decode_check(f, e2e, out);
     if (e != SL_OK) {
         return e;
     }
@@ -626,9 +741,10 @@ sl_err_t sl_can_decode_status(const sl_can_frame_t *f, sl_can_status_t *out)
     return SL_OK;
 }
 
-sl_err_t sl_can_decode_vehicle_motion(const sl_can_frame_t *f, sl_can_vehicle_motion_t *out)
+sl_err_t sl_can_decode_vehicle_motion(const sl_can_frame_t *f, const sl_can_e2e_cfg_t *e2e,
+                                      sl_can_vehicle_motion_t *out)
 {
-    const sl_err_t e = decode_check(f, out, SL_CAN_MSG_VEHICLE_MOTION);
+    const sl_err_t e = decode_check(f, e2e, out);
     if (e != SL_OK) {
         return e;
     }
@@ -642,9 +758,10 @@ sl_err_t sl_can_decode_vehicle_motion(const sl_can_frame_t *f, sl_can_vehicle_mo
     return SL_OK;
 }
 
-sl_err_t sl_can_decode_pole_tilt(const sl_can_frame_t *f, sl_can_pole_tilt_t *out)
+sl_err_t sl_can_decode_pole_tilt(const sl_can_frame_t *f, const sl_can_e2e_cfg_t *e2e,
+                                 sl_can_pole_tilt_t *out)
 {
-    const sl_err_t e = decode_check(f, out, SL_CAN_MSG_POLE_TILT);
+    const sl_err_t e = decode_check(f, e2e, out);
     if (e != SL_OK) {
         return e;
     }
@@ -664,9 +781,10 @@ sl_err_t sl_can_decode_pole_tilt(const sl_can_frame_t *f, sl_can_pole_tilt_t *ou
     return SL_OK;
 }
 
-sl_err_t sl_can_decode_health(const sl_can_frame_t *f, sl_can_health_t *out)
+sl_err_t sl_can_decode_health(const sl_can_frame_t *f, const sl_can_e2e_cfg_t *e2e,
+                              sl_can_health_t *out)
 {
-    const sl_err_t e = decode_check(f, out, SL_CAN_MSG_HEALTH);
+    const sl_err_t e = decode_check(f, e2e, out);
     if (e != SL_OK) {
         return e;
     }
@@ -683,11 +801,14 @@ sl_err_t sl_can_decode_health(const sl_can_frame_t *f, sl_can_health_t *out)
 // ---------------------------------------------------------------------------------------
 // VehicleMotion receiver
 
-void sl_can_motion_rx_init(sl_can_motion_rx_t *rx, uint32_t id_dbc, uint64_t timeout_us)
+void sl_can_motion_rx_init(sl_can_motion_rx_t *rx, uint32_t id_dbc, const sl_can_e2e_cfg_t *cfg,
+                           uint8_t max_delta_counter, uint64_t timeout_us)
 {
-    SL_ASSERT(rx != NULL);
+    SL_ASSERT(rx != NULL && cfg != NULL);
     memset(rx, 0, sizeof *rx);
     rx->id_dbc = id_dbc;
+    rx->cfg = *cfg;
+    sl_can_e2e_rx_init(&rx->e2e, max_delta_counter);
     rx->timeout_us = timeout_us;
 }
 
@@ -709,29 +830,35 @@ sl_err_t sl_can_motion_rx_feed(sl_can_motion_rx_t *rx, const sl_can_frame_t *f, 
         rx->stats.other_ids++;
         return SL_ERR_ARG;
     }
-    // After a reception gap the counter sequence means nothing: restart it.
+    // After a reception gap the counter sequence means nothing: the gap is a receive
+    // cycle without new data, and the sequence restarts.
     if (rx->e2e.synced && t_us > rx->last_t_us && t_us - rx->last_t_us > rx->timeout_us) {
+        (void)sl_can_e2e_check(&rx->e2e, &rx->cfg, NULL);
         sl_can_e2e_rx_reset(&rx->e2e);
         rx->have_value = false; // stale anyway (sl_can_motion_rx_get), and not renewed by a sync
-        rx->stats.timeouts++;
     }
-    const bool checked = rx->e2e.synced; // the counter can be checked against a previous one
-    const sl_err_t e = sl_can_e2e_check(&rx->e2e, SL_CAN_DATA_ID_VEHICLE_MOTION, f);
-    if (e != SL_OK) {
-        return e;
-    }
-    if (!checked) {
+    const sl_can_e2e_status_t st = sl_can_e2e_check(&rx->e2e, &rx->cfg, f);
+    switch (st) {
+    case SL_CAN_E2E_OK:
+    case SL_CAN_E2E_OK_SOME_LOST:
+        (void)sl_can_decode_vehicle_motion(f, &rx->cfg, &rx->last); // cannot fail: checked
+        rx->last_t_us = t_us;
+        rx->have_value = true;
+        return SL_OK;
+    case SL_CAN_E2E_INITIAL:
         // First frame since init or a reception gap: nothing to check its counter against,
         // so a stale or repeated frame would pass as fresh. It only synchronises the
         // sequence; values are used from the next frame that continues it.
         rx->last_t_us = t_us;
-        rx->stats.sync_only++;
         return SL_OK;
+    case SL_CAN_E2E_REPEATED:
+    case SL_CAN_E2E_WRONG_SEQUENCE:
+        return SL_ERR_STATE; // no new data: neither the value nor its time is renewed
+    case SL_CAN_E2E_ERROR:
+    case SL_CAN_E2E_NO_NEW_DATA:
+        break;
     }
-    (void)sl_can_decode_vehicle_motion(f, &rx->last); // cannot fail: checked above
-    rx->last_t_us = t_us;
-    rx->have_value = true;
-    return SL_OK;
+    return SL_ERR_MALFORMED;
 }
 
 bool sl_can_motion_rx_get(const sl_can_motion_rx_t *rx, uint64_t now_us,

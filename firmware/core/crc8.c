@@ -1,33 +1,32 @@
 // SPDX-License-Identifier: MIT
-// CRC-8 SAE J1850 (poly 0x1D, init 0xFF, xorout 0xFF, no reflection) and the E2E CRC of
-// sl_can.h. Bitwise, no table: 8 bytes per frame make a 256-byte table not worth its flash.
+// CRC-8 with polynomial 0x1D and the AUTOSAR E2E Profile 11 CRC of sl_can.h. Bitwise, no
+// table: 9 bytes per frame make a 256-byte table not worth its flash.
 #include "shadowlean/sl_can.h"
 
-static uint8_t crc_add(uint8_t reg, uint8_t byte)
+uint8_t sl_can_crc8_0x1d(uint8_t crc, const uint8_t *data, size_t len)
 {
-    reg ^= byte;
-    for (unsigned i = 0; i < 8U; i++) {
-        reg = (uint8_t)(((reg & 0x80U) != 0U) ? ((unsigned)reg << 1) ^ 0x1DU : (unsigned)reg << 1);
+    uint8_t reg = crc;
+    for (size_t i = 0; i < len; i++) {
+        reg ^= data[i];
+        for (unsigned b = 0; b < 8U; b++) {
+            reg = (uint8_t)(((reg & 0x80U) != 0U) ? ((unsigned)reg << 1) ^ 0x1DU
+                                                  : (unsigned)reg << 1);
+        }
     }
     return reg;
 }
 
-uint8_t sl_can_crc8_j1850(const uint8_t *data, size_t len)
+uint8_t sl_can_e2e_crc(const sl_can_e2e_cfg_t *cfg, const uint8_t data[8])
 {
-    uint8_t reg = 0xFFU;
-    for (size_t i = 0; i < len; i++) {
-        reg = crc_add(reg, data[i]);
+    if (cfg == NULL) {
+        return 0U;
     }
-    return (uint8_t)(reg ^ 0xFFU);
-}
-
-uint8_t sl_can_e2e_crc(uint8_t data_id, const uint8_t data[8])
-{
-    // One run over [data_id, data[1..7]]: the Data ID is mixed in first, the CRC slot
-    // (byte 0) is skipped.
-    uint8_t reg = crc_add(0xFFU, data_id);
-    for (size_t i = 1; i < 8U; i++) {
-        reg = crc_add(reg, data[i]);
-    }
-    return (uint8_t)(reg ^ 0xFFU);
+    // Profile 11: start value 0x00, no final XOR; the Data ID's low byte first, then its
+    // high byte (11A) or 0x00 (11C), then every data byte but the CRC slot (byte 0).
+    const uint8_t id[2] = {
+        (uint8_t)(cfg->data_id & 0xFFU),
+        (cfg->mode == (uint8_t)SL_CAN_E2E_MODE_NIBBLE) ? 0U : (uint8_t)(cfg->data_id >> 8),
+    };
+    const uint8_t reg = sl_can_crc8_0x1d(0x00U, id, sizeof id);
+    return sl_can_crc8_0x1d(reg, &data[1], 7U);
 }

@@ -233,6 +233,9 @@ uint16_t sl_pipeline_faults(const sl_pipeline_t *p)
     if (p->drift.fault) {
         f |= (uint16_t)SL_CAN_FAULT_THETA_DRIFT;
     }
+    if (p->stats.motion_rejected != p->snap.motion_rejected) {
+        f |= (uint16_t)SL_CAN_FAULT_MOTION_E2E;
+    }
     return f;
 }
 
@@ -286,6 +289,7 @@ static void emit_status(sl_pipeline_t *p)
     p->snap.can_dropped = p->stats.can_dropped;
     p->snap.disorder = p->scan.stats.disorder;
     p->snap.target_overflow = p->detect.stats.target_overflow;
+    p->snap.motion_rejected = p->stats.motion_rejected;
     if (hok) {
         can_out(p, &hf);
     }
@@ -920,7 +924,9 @@ sl_err_t sl_pipeline_init(sl_pipeline_t *p, const sl_board_t *board,
         set_err(p, e, (uint8_t)SL_PIPELINE_STAGE_INIT, "a stage rejected the board or cfg");
         return e;
     }
-    sl_can_motion_rx_init(&p->motion_rx, board->can_id_vehicle_motion, c->motion_timeout_us);
+    sl_can_motion_rx_init(&p->motion_rx, board->can_id_vehicle_motion,
+                          &ids.e2e[SL_CAN_MSG_VEHICLE_MOTION], board->can_max_delta_counter_motion,
+                          c->motion_timeout_us);
     const sl_scan_cfg_t sc = {
         .roi_bins = (uint16_t)bins,
         .pow16_shift = c->pow16_shift,

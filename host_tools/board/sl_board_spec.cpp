@@ -48,7 +48,16 @@ const std::set<std::string> kKnown = {
     "detect.danger_lean_deg", "detect.track_timeout_s", "detect.elongation",
     "can.bitrate", "can.id_pole_lean", "can.id_lean_warning", "can.id_status",
     "can.id_vehicle_motion", "can.id_health", "can.id_pole_tilt",
+    "can.data_id_pole_lean", "can.data_id_lean_warning", "can.data_id_status",
+    "can.data_id_vehicle_motion", "can.data_id_health", "can.data_id_pole_tilt",
+    "can.data_id_mode_pole_lean", "can.data_id_mode_lean_warning", "can.data_id_mode_status",
+    "can.data_id_mode_vehicle_motion", "can.data_id_mode_health", "can.data_id_mode_pole_tilt",
+    "can.max_delta_counter_vehicle_motion",
 };
+
+// The board keys' message names, in sl_can_msg_t order.
+const char *const kCanMsgKeys[6] = {"pole_lean",      "lean_warning", "status",
+                                    "vehicle_motion", "health",       "pole_tilt"};
 
 class Reader {
 public:
@@ -324,23 +333,82 @@ BoardSpec load_board(const std::string &name_or_path)
     }
 
     b.can_bitrate = static_cast<int>(r.integer("can.bitrate", 10000, 1000000, 500000L));
+    // An id is 11-bit ("0x5C0"), or 29-bit with the suffix "ext" ("0x18FF5A00 ext"), stored
+    // DBC style (bit 31 set).
     auto can_id = [&](const char *key, unsigned def) {
-        const long v = r.integer(key, 0, 0x7FF, static_cast<long>(def));
+        if (!r.has(key)) {
+            return def;
+        }
+        std::string s = r.str(key);
+        bool ext = false;
+        const size_t sp = s.find_first_of(" \t");
+        if (sp != std::string::npos) {
+            const std::string word = s.substr(s.find_first_not_of(" \t", sp));
+            if (word != "ext") {
+                r.fail(key, "'" + s + "': an id is a number, optionally followed by 'ext' (29-bit)");
+            }
+            ext = true;
+            s = s.substr(0, sp);
+        }
+        char *end = nullptr;
+        const unsigned long v = std::strtoul(s.c_str(), &end, 0);
+        if (end == s.c_str() || *end != '\0' || s[0] == '-') {
+            r.fail(key, "'" + s + "' is not an integer");
+        }
+        if (ext) {
+            if (v > 0x1FFFFFFFUL) {
+                r.fail(key, s + " does not fit a 29-bit id (0 .. 0x1FFFFFFF)");
+            }
+            return static_cast<unsigned>(v | 0x80000000UL);
+        }
+        if (v > 0x7FFUL) {
+            r.fail(key, s + " does not fit an 11-bit id (0 .. 0x7FF); a 29-bit id needs the "
+                            "suffix 'ext' (e.g. " + s + " ext)");
+        }
         return static_cast<unsigned>(v);
     };
-    b.can_id_pole_lean = can_id("can.id_pole_lean", 0x620);
-    b.can_id_lean_warning = can_id("can.id_lean_warning", 0x621);
-    b.can_id_status = can_id("can.id_status", 0x622);
-    b.can_id_vehicle_motion = can_id("can.id_vehicle_motion", 0x300);
+    b.can_id_pole_lean = can_id("can.id_pole_lean", 0x5C0);
+    b.can_id_lean_warning = can_id("can.id_lean_warning", 0x5C1);
+    b.can_id_status = can_id("can.id_status", 0x5C2);
+    b.can_id_vehicle_motion = can_id("can.id_vehicle_motion", 0x5B0);
     if (!r.has("can.id_health")) {
-        r.fail("can.id_health", "missing (required: the Health message's CAN id, e.g. 0x623)");
+        r.fail("can.id_health", "missing (required: the Health message's CAN id, e.g. 0x5C3)");
     }
-    b.can_id_health = can_id("can.id_health", 0x623);
+    b.can_id_health = can_id("can.id_health", 0x5C3);
     if (!r.has("can.id_pole_tilt")) {
         r.fail("can.id_pole_tilt",
-               "missing (required: the PoleTilt message's CAN id, e.g. 0x624)");
+               "missing (required: the PoleTilt message's CAN id, e.g. 0x5C4)");
     }
-    b.can_id_pole_tilt = can_id("can.id_pole_tilt", 0x624);
+    b.can_id_pole_tilt = can_id("can.id_pole_tilt", 0x5C4);
+    std::set<unsigned> data_ids;
+    for (unsigned m = 0; m < 6U; m++) {
+        const std::string msg = kCanMsgKeys[m];
+        const std::string kid = "can.data_id_" + msg, kmode = "can.data_id_mode_" + msg;
+        b.can_data_id[m] = static_cast<unsigned>(
+            r.integer(kid, 0, 0xFFFF, static_cast<long>(b.can_data_id[m])));
+        if (r.has(kmode)) {
+            const std::string mode = r.str(kmode);
+            if (mode == "both") {
+                b.can_data_id_mode[m] = 0;
+            } else if (mode == "nibble") {
+                b.can_data_id_mode[m] = 1;
+            } else {
+                r.fail(kmode, "'" + mode + "': both (Profile 11A) or nibble (Profile 11C)");
+            }
+        }
+        if (b.can_data_id_mode[m] == 1U && b.can_data_id[m] > 0x0FFFU) {
+            r.fail(kid, "mode nibble (11C) sends bits 8..11 of the Data ID: it must be <= 0x0FFF");
+        }
+        if (b.can_data_id_mode[m] == 1U && msg != "health") {
+            r.fail(kmode, "nibble (11C) sends the Data ID in frame bits 12..15, where this "
+                          "message has signals; only health has them free");
+        }
+        if (!data_ids.insert(b.can_data_id[m]).second) {
+            r.fail(kid, "every message needs its own Data ID");
+        }
+    }
+    b.can_max_delta_counter_motion = static_cast<unsigned>(
+        r.integer("can.max_delta_counter_vehicle_motion", 1, 14, 2L));
     const std::set<unsigned> ids = {b.can_id_pole_lean, b.can_id_lean_warning, b.can_id_status,
                                     b.can_id_vehicle_motion, b.can_id_health,
                                     b.can_id_pole_tilt};

@@ -49,9 +49,17 @@ struct BoardSpec {
     std::vector<ElongPoint> elongation;
     // CAN
     int can_bitrate = 500000;
-    unsigned can_id_pole_lean = 0x620, can_id_lean_warning = 0x621, can_id_status = 0x622,
-             can_id_vehicle_motion = 0x300, can_id_health = 0x623,
-             can_id_pole_tilt = 0x624;
+    // CAN ids in board/DBC style: 11-bit as is, 29-bit with bit 31 set (board file:
+    // "0x18FF5A00 ext"). Defaults: SL_CAN_ID_DEFAULT_* (sl_can.h).
+    unsigned can_id_pole_lean = 0x5C0, can_id_lean_warning = 0x5C1, can_id_status = 0x5C2,
+             can_id_vehicle_motion = 0x5B0, can_id_health = 0x5C3,
+             can_id_pole_tilt = 0x5C4;
+    // E2E Profile 11 per message, indexed by sl_can_msg_t (PoleLean, LeanWarning, Status,
+    // VehicleMotion, Health, PoleTilt): 16-bit Data ID and mode (0 = 11A both, 1 = 11C
+    // nibble); the VehicleMotion receiver's max delta counter.
+    unsigned can_data_id[6] = {0x0051, 0x0052, 0x0053, 0x0054, 0x0055, 0x0056};
+    unsigned can_data_id_mode[6] = {0, 0, 0, 0, 0, 0};
+    unsigned can_max_delta_counter_motion = 2;
 
     /// Opening angle theta (deg) of azimuth index i: the depression of the ray that grazes
     /// the chassis edge. NaN when the chassis does not surround the radar on that azimuth.

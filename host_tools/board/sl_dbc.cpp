@@ -71,15 +71,19 @@ const char *kVehicle = "VEHICLE";
 const char *kNetworkComment =
     "shadowlean: pole-lean estimation from a vehicle radar's chassis shadow. "
     "Classic CAN, DLC 8, all signals little-endian (Intel), physical = raw x factor. "
-    "E2E protection (AUTOSAR E2E Profile 1 style) on every message: byte 0 = Crc, "
-    "bits 8..11 = Counter. Crc = CRC-8 SAE J1850 (poly 0x1D, init 0xFF, final XOR 0xFF, "
-    "not reflected; check value of ASCII 123456789 = 0x4B) computed over 8 bytes: the "
-    "message's Data ID (attribute SlE2EDataId, not transmitted) first, then data bytes 1..7. "
-    "Counter counts 0..14 per message and wraps to 0 (modulo 15); 15 is never sent and is "
-    "rejected. A receiver accepts delta (counter - previous) mod 15 = 1, counts delta >= 2 "
-    "as lost frames, rejects delta 0 (repetition). Worked example: Status (Data ID 0x53) "
-    "with Counter 0, LinkState 3, Rotations 2 has bytes 1..7 = 30 02 00 00 00 00 00; CRC "
-    "input 53 30 02 00 00 00 00 00 gives 0x95; frame = 95 30 02 00 00 00 00 00. "
+    "E2E protection on every message: AUTOSAR E2E Profile 11 with its default offsets, "
+    "byte 0 = Crc, bits 8..11 = Counter, in mode 11C (nibble) bits 12..15 = the Data ID's "
+    "bits 8..11. Each message's 16-bit Data ID is its attribute SlE2EDataId (not "
+    "transmitted) and its mode the attribute SlE2EMode (Both = 11A, Nibble = 11C). "
+    "Crc = CRC-8 poly 0x1D, start value 0x00, not reflected, no final XOR, over the Data "
+    "ID's low byte, then its high byte (11A) or 0x00 (11C), then data bytes 1..7. Counter "
+    "counts 0..14 per message and wraps to 0 (modulo 15); 15 is never sent and is an "
+    "error. A Profile 11 receiver classifies a counter step of 1 as OK, 2..MaxDeltaCounter "
+    "as OK_SOME_LOST, 0 as REPEATED, larger as WRONG_SEQUENCE. Vectors: 8 zero bytes, Data "
+    "ID 0x123, counter 0: Crc 0xCC (11A), 0x2A with byte 1 = 0x10 (11C). Worked example: "
+    "Status (Data ID 0x0053, 11A) with Counter 0, LinkState 3, Rotations 2 has bytes 1..7 "
+    "= 30 02 00 00 00 00 00; CRC input 53 00 30 02 00 00 00 00 00 gives 0x93; frame = 93 30 "
+    "02 00 00 00 00 00. "
     "Out-of-range values are clamped to the signal range and flagged (Clamped / Saturated "
     "bit), never wrapped; azimuths are reduced modulo 360 deg. Reserved bits are 0.";
 
@@ -96,7 +100,10 @@ const std::map<std::string, std::string> kMessageComments = {
                "without data. Counters are totals since start and stop at their maximum "
                "(Saturated = 1)."},
     {"VehicleMotion", "Input from the vehicle for the motion-aware masks: speed and yaw "
-                      "rate with E2E protection; CRC errors and counter jumps are counted."},
+                      "rate with E2E protection. The module's Profile 11 check uses OK and "
+                      "OK_SOME_LOST frames (counter step up to the board's max delta counter), "
+                      "counts REPEATED, WRONG_SEQUENCE and ERROR frames (Health bit MOTION_E2E) "
+                      "and never uses them, nor the first frame after a start or a 500 ms gap."},
     {"PoleTilt",
      "While driving (a motion input is present): one frame per confirmed target and radar "
      "rotation that has an observation history (GenMsgSendType CyclicIfActive): the pole's "
@@ -109,7 +116,8 @@ const std::map<std::string, std::string> kMessageComments = {
 
 // key "Message.Signal"
 const std::map<std::string, std::string> kSignalComments = {
-    {"*.Crc", "E2E CRC-8 SAE J1850 over [Data ID, bytes 1..7]; see the network comment."},
+    {"*.Crc", "E2E Profile 11 CRC-8 (poly 0x1D, start 0x00, no XOR) over [Data ID low byte, "
+              "high byte or 0x00, bytes 1..7]; see the network comment."},
     {"*.Counter", "E2E counter 0..14 per message, modulo 15; 15 is invalid."},
     {"PoleLean.Quality", "Estimate quality."},
     {"PoleLean.Clamped", "1: at least one value of this frame hit its signal range limit "
@@ -147,8 +155,10 @@ const std::map<std::string, std::string> kSignalComments = {
      "(frames dropped by the CAN outputs), 32 RANGE_RESOLUTION_MISMATCH (radar bin size "
      "differs from the board's by more than 1 %), 64 AZIMUTH_DISORDER (azimuths stepped back "
      "beyond the reorder window), 128 CAN_RATE_LIMITED (frames withheld by the output "
-     "ceiling), 256 TARGET_SLOTS_OVERFLOW (more candidates than target slots). Bits 9..15 "
-     "reserved (0)."},
+     "ceiling), 256 TARGET_SLOTS_OVERFLOW (more candidates than target slots), 512 "
+     "THETA_DRIFT (the live theta differs from the calibration's), 1024 MOTION_E2E "
+     "(VehicleMotion frames rejected by the E2E check: ERROR, REPEATED, WRONG_SEQUENCE). "
+     "Bits 11..15 reserved (0)."},
     {"Health.Reconnects", "Radar link reconnects since start (saturating at 255)."},
     {"Health.CandidatesDropped", "Detection candidates dropped for lack of target slots since "
                                  "start (saturating at 4095)."},
@@ -196,30 +206,27 @@ std::string layout_table(const sl_can_message_desc_t &m)
           << decimal(int64_t(s.raw_max) * s.factor_num, s.factor_den) << "]"
           << (s.unit[0] != '\0' ? std::string(" ") + s.unit : std::string());
     }
-    o << ". E2E Data ID " << hex(m.data_id, 2) << ".";
+    o << ".";
     return o.str();
 }
 
-uint32_t board_id(const BoardSpec &b, sl_can_msg_t m)
+} // namespace
+
+sl_can_ids_t can_ids(const BoardSpec &b)
 {
-    switch (m) {
-    case SL_CAN_MSG_POLE_LEAN:
-        return b.can_id_pole_lean;
-    case SL_CAN_MSG_LEAN_WARNING:
-        return b.can_id_lean_warning;
-    case SL_CAN_MSG_STATUS:
-        return b.can_id_status;
-    case SL_CAN_MSG_VEHICLE_MOTION:
-        return b.can_id_vehicle_motion;
-    case SL_CAN_MSG_HEALTH:
-        return b.can_id_health;
-    case SL_CAN_MSG_POLE_TILT:
-        return b.can_id_pole_tilt;
-    case SL_CAN_MSG_COUNT:
-        break;
+    sl_can_ids_t ids{};
+    const unsigned id[SL_CAN_MSG_COUNT] = {b.can_id_pole_lean,      b.can_id_lean_warning,
+                                           b.can_id_status,         b.can_id_vehicle_motion,
+                                           b.can_id_health,         b.can_id_pole_tilt};
+    for (unsigned m = 0; m < SL_CAN_MSG_COUNT; m++) {
+        ids.id[m] = id[m];
+        ids.e2e[m].data_id = static_cast<uint16_t>(b.can_data_id[m]);
+        ids.e2e[m].mode = static_cast<uint8_t>(b.can_data_id_mode[m]);
     }
-    throw std::invalid_argument("bad message index");
+    return ids;
 }
+
+namespace {
 
 std::string db_name(const std::string &board)
 {
@@ -235,15 +242,13 @@ std::string db_name(const std::string &board)
 std::string make_dbc(const BoardSpec &b)
 {
     // Ids: validated the way the core's sl_can_tx_init() does.
-    sl_can_ids_t ids{};
-    for (unsigned m = 0; m < SL_CAN_MSG_COUNT; m++) {
-        ids.id[m] = board_id(b, static_cast<sl_can_msg_t>(m));
-    }
+    const sl_can_ids_t ids = can_ids(b);
     sl_can_tx_t tx;
     if (sl_can_tx_init(&tx, &ids) != SL_OK) {
         throw std::invalid_argument("board " + b.name +
                                     ": CAN ids must be distinct 11-bit ids (or 29-bit ids with "
-                                    "bit 31 set)");
+                                    "bit 31 set), Data IDs distinct, mode 11C only on Health "
+                                    "with a Data ID <= 0x0FFF");
     }
     if (b.max_targets > static_cast<int>(SL_CAN_TARGET_ID_MAX) + 1) {
         throw std::invalid_argument("board " + b.name + ": max_targets " +
@@ -279,6 +284,10 @@ std::string make_dbc(const BoardSpec &b)
               << decimal(int64_t(s.raw_max) * s.factor_num, s.factor_den) << "] "
               << q(s.unit) << " " << rx_node << "\n";
         }
+        if (ids.e2e[mi].mode == SL_CAN_E2E_MODE_NIBBLE) {
+            // Profile 11C: the Data ID's bits 8..11 in frame bits 12..15 (free in this layout).
+            o << " SG_ DataIdNibble : 12|4@1+ (1,0) [0|15] \"\" " << rx_node << "\n";
+        }
         o << "\n";
     }
     o << "\n";
@@ -294,13 +303,22 @@ std::string make_dbc(const BoardSpec &b)
       << ";\n";
     for (unsigned mi = 0; mi < SL_CAN_MSG_COUNT; mi++) {
         const sl_can_message_desc_t &m = *sl_can_layout(static_cast<sl_can_msg_t>(mi));
-        o << "CM_ BO_ " << ids.id[mi] << " " << q(kMessageComments.at(m.name) + " " + layout_table(m))
-          << ";\n";
+        std::ostringstream e2e;
+        e2e << " E2E Profile 11: Data ID " << hex(ids.e2e[mi].data_id, 4) << ", mode "
+            << (ids.e2e[mi].mode == SL_CAN_E2E_MODE_NIBBLE ? "11C (nibble)" : "11A (both)") << ".";
+        o << "CM_ BO_ " << ids.id[mi] << " "
+          << q(kMessageComments.at(m.name) + " " + layout_table(m) + e2e.str()) << ";\n";
         for (unsigned si = 0; si < m.n_signals; si++) {
             const std::string c = signal_comment(m.name, m.signals[si].name);
             if (!c.empty()) {
                 o << "CM_ SG_ " << ids.id[mi] << " " << m.signals[si].name << " " << q(c) << ";\n";
             }
+        }
+        if (ids.e2e[mi].mode == SL_CAN_E2E_MODE_NIBBLE) {
+            o << "CM_ SG_ " << ids.id[mi] << " DataIdNibble "
+              << q("E2E Profile 11C: bits 8..11 of the Data ID (always " +
+                   std::to_string((ids.e2e[mi].data_id >> 8) & 0x0FU) + ").")
+              << ";\n";
         }
     }
 
@@ -314,7 +332,10 @@ std::string make_dbc(const BoardSpec &b)
          "\"SpontaneousWithRepetition\",\"CyclicIfActiveAndSpontaneous\","
          "\"CyclicIfActiveAndSpontaneousWithDelay\",\"NoMsgSendType\";\n";
     o << "BA_DEF_ BO_  \"SlIdleCycleTime\" INT 0 65535;\n";
-    o << "BA_DEF_ BO_  \"SlE2EDataId\" INT 0 255;\n";
+    o << "BA_DEF_ BO_  \"SlE2EDataId\" INT 0 65535;\n";
+    o << "BA_DEF_ BO_  \"SlE2EMode\" ENUM  \"Both\",\"Nibble\";\n";
+    o << "BA_DEF_ BO_  \"VFrameFormat\" ENUM  \"StandardCAN\",\"ExtendedCAN\",\"reserved\","
+         "\"J1939PG\";\n";
     o << "BA_DEF_DEF_  \"BusType\" \"CAN\";\n";
     o << "BA_DEF_DEF_  \"DBName\" \"\";\n";
     o << "BA_DEF_DEF_  \"Baudrate\" 500000;\n";
@@ -322,6 +343,8 @@ std::string make_dbc(const BoardSpec &b)
     o << "BA_DEF_DEF_  \"GenMsgSendType\" \"NoMsgSendType\";\n";
     o << "BA_DEF_DEF_  \"SlIdleCycleTime\" 0;\n";
     o << "BA_DEF_DEF_  \"SlE2EDataId\" 0;\n";
+    o << "BA_DEF_DEF_  \"SlE2EMode\" \"Both\";\n";
+    o << "BA_DEF_DEF_  \"VFrameFormat\" \"StandardCAN\";\n";
     o << "BA_ \"BusType\" \"CAN\";\n";
     o << "BA_ \"DBName\" " << q(db_name(b.name)) << ";\n";
     o << "BA_ \"Baudrate\" " << b.can_bitrate << ";\n";
@@ -332,7 +355,12 @@ std::string make_dbc(const BoardSpec &b)
         if (m.idle_cycle_ms != 0) {
             o << "BA_ \"SlIdleCycleTime\" BO_ " << ids.id[mi] << " " << m.idle_cycle_ms << ";\n";
         }
-        o << "BA_ \"SlE2EDataId\" BO_ " << ids.id[mi] << " " << unsigned(m.data_id) << ";\n";
+        o << "BA_ \"SlE2EDataId\" BO_ " << ids.id[mi] << " " << unsigned(ids.e2e[mi].data_id)
+          << ";\n";
+        o << "BA_ \"SlE2EMode\" BO_ " << ids.id[mi] << " " << unsigned(ids.e2e[mi].mode) << ";\n";
+        if ((ids.id[mi] & SL_CAN_DBC_EFF_BIT) != 0U) {
+            o << "BA_ \"VFrameFormat\" BO_ " << ids.id[mi] << " 1;\n";
+        }
     }
 
     for (unsigned mi = 0; mi < SL_CAN_MSG_COUNT; mi++) {

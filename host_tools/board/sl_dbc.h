@@ -11,18 +11,22 @@
 // LeanWarning, Status (SHADOWLEAN -> VEHICLE) and VehicleMotion (VEHICLE -> SHADOWLEAN),
 // CM_ comments (network: E2E profile with worked example; every message: its layout
 // table and Data ID; every signal), BA_DEF_/BA_DEF_DEF_/BA_ (BusType, Baudrate, DBName,
-// GenMsgCycleTime, SlE2EDataId), VAL_ value tables.
+// GenMsgCycleTime, SlE2EDataId, SlE2EMode, VFrameFormat for 29-bit ids), VAL_ value tables.
 #pragma once
 
 #include <stdexcept>
 #include <string>
 
+#include "shadowlean/sl_can.h"
 #include "sl_board_spec.h"
 
 namespace sl {
 
+/// The board's CAN ids (DBC style), Data IDs and modes, as the core's sender takes them.
+sl_can_ids_t can_ids(const BoardSpec &b);
+
 /// Version string written into the DBC's VERSION line.
-constexpr const char *kDbcGeneratorVersion = "sl-dbc 1.0";
+constexpr const char *kDbcGeneratorVersion = "sl-dbc 1.1";
 
 /// DBC text for board `b`. Throws std::invalid_argument when the board cannot be
 /// described (a CAN id that is not 11-bit or DBC-style 29-bit, equal ids, or more

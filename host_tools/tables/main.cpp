@@ -86,6 +86,13 @@ std::string hex32(uint32_t v)
     return o.str();
 }
 
+std::string hex16(uint16_t v)
+{
+    std::ostringstream o;
+    o << "0x" << std::hex << std::uppercase << std::setw(4) << std::setfill('0') << v;
+    return o.str();
+}
+
 struct Tables {
     std::vector<sl_incline_geom_t> geom;
     std::vector<int> theta_cdeg;
@@ -191,6 +198,11 @@ sl_board_t make_board(const sl::BoardSpec &b, const Tables &t, const std::string
     v.can_id_vehicle_motion = static_cast<uint32_t>(b.can_id_vehicle_motion);
     v.can_id_health = static_cast<uint32_t>(b.can_id_health);
     v.can_id_pole_tilt = static_cast<uint32_t>(b.can_id_pole_tilt);
+    for (size_t m = 0; m < SL_BOARD_CAN_MSGS; m++) {
+        v.can_data_id[m] = static_cast<uint16_t>(b.can_data_id[m]);
+        v.can_data_id_mode[m] = static_cast<uint8_t>(b.can_data_id_mode[m]);
+    }
+    v.can_max_delta_counter_motion = static_cast<uint8_t>(b.can_max_delta_counter_motion);
     v.geom = t.geom.data();
     v.theta_cdeg = t.theta_cdeg16.data();
     v.shadow_um = t.shadow_um.data();
@@ -272,7 +284,18 @@ void write_source(const sl_board_t &v, const std::string &path, const std::strin
       << "    .can_id_status = " << v.can_id_status << "u,\n"
       << "    .can_id_vehicle_motion = " << v.can_id_vehicle_motion << "u,\n"
       << "    .can_id_health = " << v.can_id_health << "u,\n"
-      << "    .can_id_pole_tilt = " << v.can_id_pole_tilt << "u,\n"
+      << "    .can_id_pole_tilt = " << v.can_id_pole_tilt << "u,\n";
+    o << "    .can_data_id = {";
+    for (size_t m = 0; m < SL_BOARD_CAN_MSGS; m++) {
+        o << (m ? ", " : "") << hex16(v.can_data_id[m]) << "u";
+    }
+    o << "},\n    .can_data_id_mode = {";
+    for (size_t m = 0; m < SL_BOARD_CAN_MSGS; m++) {
+        o << (m ? ", " : "") << unsigned(v.can_data_id_mode[m]) << "u";
+    }
+    o << "},\n"
+      << "    .can_max_delta_counter_motion = " << unsigned(v.can_max_delta_counter_motion)
+      << "u,\n"
       << "    .geom = geom,\n"
       << "    .theta_cdeg = theta_cdeg,\n"
       << "    .shadow_um = shadow_um,\n"

@@ -25,6 +25,9 @@
 extern "C" {
 #endif
 
+/// Messages with a CAN id, Data ID and mode on a board (SL_CAN_MSG_COUNT in sl_can.h).
+#define SL_BOARD_CAN_MSGS 6
+
 /// A board: read-only constants, usually `static const` in flash.
 typedef struct sl_board {
     const char *name;              ///< e.g. "paper-sim"
@@ -60,12 +63,23 @@ typedef struct sl_board {
     int32_t elong_d_um[SL_CFG_MAX_ELONG_POINTS];      ///< outward bias d at each r2
     // --- CAN
     uint32_t can_bitrate;          ///< bit/s
-    uint32_t can_id_pole_lean;     ///< 11-bit ids (or 29-bit with bit 31 set, DBC style)
+    uint32_t can_id_pole_lean;     ///< 11-bit ids, or 29-bit ids with bit 31 set (DBC style;
+                                   ///< board file: `0x18FF5A00 ext`)
     uint32_t can_id_lean_warning;
     uint32_t can_id_status;
     uint32_t can_id_vehicle_motion;
     uint32_t can_id_health;        ///< Health message (required board key can.id_health)
     uint32_t can_id_pole_tilt;     ///< PoleTilt message (required board key can.id_pole_tilt)
+    /// E2E Profile 11 Data ID of each message (board keys can.data_id_*), indexed by
+    /// sl_can_msg_t (PoleLean, LeanWarning, Status, VehicleMotion, Health, PoleTilt).
+    uint16_t can_data_id[SL_BOARD_CAN_MSGS];
+    /// E2E Profile 11 Data ID mode of each message (sl_can_e2e_mode_t: 0 = 11A both,
+    /// 1 = 11C nibble; board keys can.data_id_mode_*), indexed as can_data_id.
+    uint8_t can_data_id_mode[SL_BOARD_CAN_MSGS];
+    /// VehicleMotion receiver: largest accepted counter step (1..14; board key
+    /// can.max_delta_counter_vehicle_motion). Steps 2..this are OK_SOME_LOST, larger ones
+    /// WRONG_SEQUENCE (sl_can.h).
+    uint8_t can_max_delta_counter_motion;
     // --- generated per-azimuth tables, `azimuths` entries each
     const sl_incline_geom_t *geom; ///< trig + branch bounds per azimuth
     const int16_t *theta_cdeg;     ///< opening angle theta per azimuth, 0.01 deg

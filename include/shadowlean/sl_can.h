@@ -12,36 +12,50 @@
 /// data byte k / 8 (so raw value bit 0 is at bit s). `u` = unsigned, `s` = two's complement.
 /// physical = raw x factor (every offset is 0).
 ///
-/// ## E2E protection (AUTOSAR E2E Profile 1 style) - every message
+/// ## E2E protection (AUTOSAR E2E Profile 11) - every message
 ///
 /// | byte/bits | signal  | meaning |
 /// |-----------|---------|---------|
-/// | 0 (0..7)  | Crc     | CRC-8 SAE J1850 of [DataID, data[1], ..., data[7]] |
+/// | 0 (0..7)  | Crc     | CRC-8 (below) of [Data ID low byte, Data ID high byte or 0x00, data[1], ..., data[7]] |
 /// | 8..11     | Counter | per message type: 0, 1, ..., 14, 0, ... (modulo 15; 15 is never sent) |
+/// | 12..15    | DataIdNibble | mode 11C only: bits 8..11 of the Data ID (the message's own signals otherwise) |
 ///
-/// CRC-8 SAE J1850: polynomial 0x1D (x^8+x^4+x^3+x^2+1), initial value 0xFF, no
-/// reflection, final XOR 0xFF. Check value: CRC of the ASCII bytes "123456789" = 0x4B.
-/// The per-message Data ID (`SL_CAN_DATA_ID_*`, not transmitted) is the FIRST byte fed
-/// to the CRC, followed by data bytes 1..7 (byte 0, the CRC itself, is skipped): one CRC
-/// run over 8 bytes. A frame of the wrong message type, or a frame copied from another
-/// message id, therefore fails the CRC even when its bytes are otherwise plausible.
+/// This is AUTOSAR E2E Profile 11 with its default offsets (CRC at bit 0, counter at bit
+/// 8, Data ID nibble at bit 12), so a receiver that configures an AUTOSAR E2E library for
+/// Profile 11 with the message's Data ID and mode accepts the frames as they are.
+/// CRC: polynomial 0x1D (SAE J1850's, x^8+x^4+x^3+x^2+1), start value 0x00, no
+/// reflection, no final XOR (the Profile 11 chaining of Crc_CalculateCRC8 comes to
+/// exactly this), over 9 bytes: the 16-bit Data ID's low byte, then its high byte (mode
+/// 11A "both") or 0x00 (mode 11C "nibble", where the Data ID's bits 8..11 travel in bits
+/// 12..15 of the frame and its bits 12..15 must be 0), then data bytes 1..7 (byte 0, the
+/// CRC itself, is skipped). The Data ID is per message and per board (board keys
+/// `can.data_id_*` and `can.data_id_mode_*`, DBC attributes SlE2EDataId and SlE2EMode);
+/// the defaults are SL_CAN_DATA_ID_* in mode 11A. Mode 11C needs bits 12..15 free: only
+/// Health has them (sl_can_tx_init() refuses 11C for another message). A frame of the
+/// wrong message type, or a frame copied to another message id, fails the CRC even when
+/// its bytes are otherwise plausible.
 ///
-/// Worked example (checked by test_canmsg_crc_worked_example): a Status frame
-/// (Data ID 0x53) whose bytes 1..7 are `30 02 00 00 00 00 00` (Counter 0, LinkState 3 =
-/// STREAMING, Rotations 2). CRC input = `53 30 02 00 00 00 00 00`, CRC = 0x95, so the
-/// frame is `95 30 02 00 00 00 00 00`.
+/// Vectors of independent Profile 11 implementations (unit tests of the C core, the
+/// Python package and the dissector): 8 zero bytes, Data ID 0x123, counter 0 -> CRC 0xCC
+/// (11A) and, with byte 1 = 0x10, 0x2A (11C); counter 1: 0x91 (11A), 0x77 (11C).
+/// Worked example (test_canmsg_crc_worked_example): a Status frame (Data ID 0x0053, 11A)
+/// whose bytes 1..7 are `30 02 00 00 00 00 00` (Counter 0, LinkState 3 = STREAMING,
+/// Rotations 2). CRC input = `53 00 30 02 00 00 00 00 00`, CRC = 0x93, so the frame is
+/// `93 30 02 00 00 00 00 00`.
 ///
 /// The counter starts at 0 after `sl_can_tx_init()` and advances by one per frame of that
 /// message type (all PoleLean frames of a rotation share one counter). A receiver
-/// (`sl_can_e2e_check()`) accepts delta = (counter - previous) mod 15 of 1, counts
-/// delta >= 2 as a counter jump (delta - 1 frames lost), rejects delta 0 as a repetition
-/// and rejects counter 15 and CRC mismatches as malformed.
+/// (`sl_can_e2e_check()`) classifies every frame with the Profile 11 check statuses:
+/// ERROR (dlc, flags, CRC, Data ID nibble or counter 15), REPEATED (counter step 0), OK
+/// (step 1), OK_SOME_LOST (step 2..max_delta_counter), WRONG_SEQUENCE (a larger step),
+/// NO_NEW_DATA (a check without a frame); the first frame after init or a reset is
+/// INITIAL (nothing to compare its counter with).
 ///
 /// ## PoleLean (board `can.id_pole_lean`, SHADOWLEAN -> VEHICLE, one frame per target)
 ///
 /// | start | len | signal     | type | factor | range (physical)  | unit | note |
 /// |------:|----:|------------|------|--------|-------------------|------|------|
-/// |  0 | 8  | Crc        | u | 1    | 0..255         |     | E2E, Data ID 0x51 |
+/// |  0 | 8  | Crc        | u | 1    | 0..255         |     | E2E, Data ID 0x0051 |
 /// |  8 | 4  | Counter    | u | 1    | 0..14          |     | E2E |
 /// | 12 | 3  | Quality    | u | 1    | 0..4           |     | sl_can_quality_t |
 /// | 15 | 1  | Clamped    | u | 1    | 0..1           |     | 1 = a value below hit its range limit |
@@ -72,7 +86,7 @@
 ///
 /// | start | len | signal    | type | factor | range (physical) | unit | note |
 /// |------:|----:|-----------|------|--------|------------------|------|------|
-/// |  0 | 8  | Crc       | u | 1    | 0..255          |     | E2E, Data ID 0x52 |
+/// |  0 | 8  | Crc       | u | 1    | 0..255          |     | E2E, Data ID 0x0052 |
 /// |  8 | 4  | Counter   | u | 1    | 0..14           |     | E2E |
 /// | 12 | 2  | Level     | u | 1    | 0..2            |     | sl_can_level_t |
 /// | 14 | 1  | Clamped   | u | 1    | 0..1            |     | |
@@ -88,7 +102,7 @@
 ///
 /// | start | len | signal          | type | range        | note |
 /// |------:|----:|-----------------|------|--------------|------|
-/// |  0 | 8  | Crc             | u | 0..255       | E2E, Data ID 0x53 |
+/// |  0 | 8  | Crc             | u | 0..255       | E2E, Data ID 0x0053 |
 /// |  8 | 4  | Counter         | u | 0..14        | E2E |
 /// | 12 | 3  | LinkState       | u | 0..4         | sl_can_link_state_t |
 /// | 15 | 1  | Saturated       | u | 0..1         | 1 = a counter below is stuck at its maximum |
@@ -101,9 +115,9 @@
 ///
 /// | start | len | signal            | type | range    | note |
 /// |------:|----:|-------------------|------|----------|------|
-/// |  0 | 8  | Crc               | u | 0..255   | E2E, Data ID 0x55 |
+/// |  0 | 8  | Crc               | u | 0..255   | E2E, Data ID 0x0055 |
 /// |  8 | 4  | Counter           | u | 0..14    | E2E |
-/// | 12 | 4  | (reserved)        |   | 0        | |
+/// | 12 | 4  | (reserved)        |   | 0        | the Data ID nibble in mode 11C |
 /// | 16 | 16 | Fault             | u | bitfield | SL_CAN_FAULT_* below, one bit per condition |
 /// | 32 | 8  | Reconnects        | u | 0..255   | radar link re-opened since start (saturating) |
 /// | 40 | 12 | CandidatesDropped | u | 0..4095  | detection candidates dropped for lack of target slots (saturating) |
@@ -135,6 +149,8 @@
 /// - bit9 THETA_DRIFT: the live ground-return start says theta differs from the loaded
 ///   calibration's by more than 1 deg, for SL_DRIFT_PERSIST rotations (sl_drift.h): the
 ///   mount moved or the vehicle is loaded; every lean is skewed by about the ThetaDrift value.
+/// - bit10 MOTION_E2E: VehicleMotion frames were rejected by the E2E check (ERROR,
+///   REPEATED or WRONG_SEQUENCE; sl_can_motion_rx_feed()): the motion input is unreliable.
 ///
 /// ## PoleTilt (board `can.id_pole_tilt`, SHADOWLEAN -> VEHICLE, one frame per tracked pole while driving)
 ///
@@ -145,7 +161,7 @@
 ///
 /// | start | len | signal         | type | factor | range (physical) | unit | note |
 /// |------:|----:|----------------|------|--------|------------------|------|------|
-/// |  0 | 8  | Crc            | u | 1    | 0..255          |     | E2E, Data ID 0x56 |
+/// |  0 | 8  | Crc            | u | 1    | 0..255          |     | E2E, Data ID 0x0056 |
 /// |  8 | 4  | Counter        | u | 1    | 0..14           |     | E2E |
 /// | 12 | 3  | Quality        | u | 1    | 0..4            |     | sl_can_tilt_quality_t |
 /// | 15 | 1  | Clamped        | u | 1    | 0..1            |     | 1 = a value below hit its range limit |
@@ -166,7 +182,7 @@
 ///
 /// | start | len | signal       | type | factor | range            | unit  | note |
 /// |------:|----:|--------------|------|--------|------------------|-------|------|
-/// |  0 | 8  | Crc          | u | 1    | 0..255           |       | E2E, Data ID 0x54 |
+/// |  0 | 8  | Crc          | u | 1    | 0..255           |       | E2E, Data ID 0x0054 |
 /// |  8 | 4  | Counter      | u | 1    | 0..14            |       | E2E |
 /// | 12 | 1  | SpeedValid   | u | 1    | 0..1             |       | |
 /// | 13 | 1  | YawRateValid | u | 1    | 0..1             |       | |
@@ -185,10 +201,10 @@
 /// 360 deg first (370 deg is 10 deg), which is not clamping.
 ///
 /// Cost: every encode/decode is O(64) bit operations plus one 64-bit division per scaled
-/// signal (libgcc __aeabi_ldivmod on 32-bit cores) and one 8-byte bitwise CRC; no
+/// signal (libgcc __aeabi_ldivmod on 32-bit cores) and one 9-byte bitwise CRC; no
 /// allocation. Stack (Cortex-M0, -Os, from -fstack-usage): encoder 64 bytes + 48 + 40 in
 /// its helpers + the libgcc division, under 256 bytes; decoders under 96 bytes.
-/// Flash (Cortex-M0, -Os): canmsg.c 4.7 KB (layout table and strings included), crc8.c 88 B.
+/// Flash (Cortex-M0, -Os): canmsg.c 7.2 KB (layout table and strings included), crc8.c 88 B.
 /// Reentrant; one `sl_can_tx_t` per sender, one `sl_can_e2e_rx_t` per received message id.
 /// Not ISR-safe on a shared `sl_can_tx_t` without a lock.
 #ifndef SHADOWLEAN_SL_CAN_H
@@ -242,12 +258,27 @@ typedef enum sl_can_msg {
     SL_CAN_MSG_COUNT = 6,
 } sl_can_msg_t;
 
-#define SL_CAN_DATA_ID_POLE_LEAN 0x51U      ///< E2E Data ID (first CRC byte)
-#define SL_CAN_DATA_ID_LEAN_WARNING 0x52U
-#define SL_CAN_DATA_ID_STATUS 0x53U
-#define SL_CAN_DATA_ID_VEHICLE_MOTION 0x54U
-#define SL_CAN_DATA_ID_HEALTH 0x55U
-#define SL_CAN_DATA_ID_POLE_TILT 0x56U ///< every message has its own Data ID
+/// Default E2E Data IDs (16-bit, mode 11A), used when the board file does not set one.
+#define SL_CAN_DATA_ID_POLE_LEAN 0x0051U
+#define SL_CAN_DATA_ID_LEAN_WARNING 0x0052U
+#define SL_CAN_DATA_ID_STATUS 0x0053U
+#define SL_CAN_DATA_ID_VEHICLE_MOTION 0x0054U
+#define SL_CAN_DATA_ID_HEALTH 0x0055U
+#define SL_CAN_DATA_ID_POLE_TILT 0x0056U ///< every message has its own Data ID
+
+/// Default CAN ids (11-bit). They avoid the ids of a Continental ARS408 radar on the same
+/// bus (its inputs and outputs 0x200-0x27F, 0x300-0x37F, 0x400-0x47F, 0x600-0x67F,
+/// 0x700-0x77F: the bases 0x200-0x204, 0x300-0x301, 0x400-0x408, 0x600-0x60F, 0x700-0x702
+/// plus 0x10 x its sensor id 0..7). docs/CAN.md says how to change them (board file).
+#define SL_CAN_ID_DEFAULT_POLE_LEAN 0x5C0U
+#define SL_CAN_ID_DEFAULT_LEAN_WARNING 0x5C1U
+#define SL_CAN_ID_DEFAULT_STATUS 0x5C2U
+#define SL_CAN_ID_DEFAULT_VEHICLE_MOTION 0x5B0U
+#define SL_CAN_ID_DEFAULT_HEALTH 0x5C3U
+#define SL_CAN_ID_DEFAULT_POLE_TILT 0x5C4U
+
+/// Default largest accepted counter step of the VehicleMotion receiver (one lost frame).
+#define SL_CAN_MAX_DELTA_COUNTER_DEFAULT 2U
 
 #define SL_CAN_COUNTER_MODULO 15U ///< counters run 0..14; 15 is invalid on the wire
 
@@ -326,7 +357,8 @@ typedef enum sl_can_link_state {
 #define SL_CAN_FAULT_CAN_RATE_LIMITED 0x0080U
 #define SL_CAN_FAULT_TARGET_SLOTS_OVERFLOW 0x0100U
 #define SL_CAN_FAULT_THETA_DRIFT 0x0200U
-#define SL_CAN_FAULT_DEFINED 0x03FFU ///< bits 10..15 are reserved (sent as 0)
+#define SL_CAN_FAULT_MOTION_E2E 0x0400U
+#define SL_CAN_FAULT_DEFINED 0x07FFU ///< bits 11..15 are reserved (sent as 0)
 
 /// LINK_FLAPPING: this many reconnects within this window.
 #define SL_CAN_FLAP_RECONNECTS 3U
@@ -468,54 +500,102 @@ typedef struct sl_can_vehicle_motion {
 } sl_can_vehicle_motion_t;
 
 // ---------------------------------------------------------------------------------------
-// CRC and E2E
+// CRC and E2E (AUTOSAR E2E Profile 11)
 
-/// CRC-8 SAE J1850 (poly 0x1D, init 0xFF, final XOR 0xFF) of `len` bytes. `data` may be
-/// NULL when `len` is 0. Cost: 8 shift/xor steps per byte, no table.
-uint8_t sl_can_crc8_j1850(const uint8_t *data, size_t len);
+/// Profile 11 Data ID mode.
+typedef enum sl_can_e2e_mode {
+    SL_CAN_E2E_MODE_BOTH = 0,   ///< 11A: both Data ID bytes go into the CRC; nothing is sent
+    SL_CAN_E2E_MODE_NIBBLE = 1, ///< 11C: low byte and 0x00 go into the CRC; bits 8..11 of the
+                                ///< Data ID are sent in frame bits 12..15 (Data ID <= 0x0FFF)
+} sl_can_e2e_mode_t;
 
-/// The E2E CRC of a frame payload: CRC-8 SAE J1850 of [data_id, data[1..7]] (data[0] is
-/// the CRC slot and is not read).
-uint8_t sl_can_e2e_crc(uint8_t data_id, const uint8_t data[8]);
+/// The E2E configuration of one message: its Data ID and mode.
+typedef struct sl_can_e2e_cfg {
+    uint16_t data_id; ///< 16-bit Data ID (not transmitted; <= 0x0FFF in mode 11C)
+    uint8_t mode;     ///< sl_can_e2e_mode_t
+} sl_can_e2e_cfg_t;
 
-/// E2E receiver state for one message id. Zero-initialise or call sl_can_e2e_rx_init().
+/// The default configuration of every message (SL_CAN_DATA_ID_*, mode 11A), indexed by
+/// sl_can_msg_t.
+extern const sl_can_e2e_cfg_t sl_can_e2e_defaults[SL_CAN_MSG_COUNT];
+
+/// CRC-8 with polynomial 0x1D, no reflection: the register `crc` after `len` more bytes,
+/// with no start value or final XOR applied (the caller chooses them: SAE J1850 is
+/// `sl_can_crc8_0x1d(0xFF, d, n) ^ 0xFF`, check value 0x4B; Profile 11 starts at 0x00 and
+/// applies no XOR). `data` may be NULL when `len` is 0. Cost: 8 shift/xor steps per byte.
+uint8_t sl_can_crc8_0x1d(uint8_t crc, const uint8_t *data, size_t len);
+
+/// The Profile 11 CRC a frame payload must carry in data[0] (data[0] is not read; in mode
+/// 11C data[1]'s high nibble is read as it is: the encoder puts the Data ID nibble there
+/// first). Returns 0 for a NULL `cfg`. Cost: one CRC over 9 bytes.
+uint8_t sl_can_e2e_crc(const sl_can_e2e_cfg_t *cfg, const uint8_t data[8]);
+
+/// Profile 11 check status of one received frame (or of a receive cycle without one).
+typedef enum sl_can_e2e_status {
+    SL_CAN_E2E_OK = 0,             ///< counter step 1: new data in sequence
+    SL_CAN_E2E_OK_SOME_LOST = 1,   ///< counter step 2..max_delta_counter: new data, frames lost
+    SL_CAN_E2E_INITIAL = 2,        ///< first valid frame after init or a reset: sequence synchronised
+    SL_CAN_E2E_REPEATED = 3,       ///< counter step 0: the same data again
+    SL_CAN_E2E_WRONG_SEQUENCE = 4, ///< counter step above max_delta_counter (the sequence
+                                   ///< continues from this frame's counter)
+    SL_CAN_E2E_ERROR = 5,          ///< dlc, RTR/error frame, CRC, Data ID nibble or counter 15
+    SL_CAN_E2E_NO_NEW_DATA = 6,    ///< no frame in this receive cycle
+} sl_can_e2e_status_t;
+#define SL_CAN_E2E_STATUS_COUNT 7U
+
+/// E2E receiver state for one message id. Initialise with sl_can_e2e_rx_init().
 /// Fields read-only to the application.
 typedef struct sl_can_e2e_rx {
-    uint8_t last_counter; ///< counter of the last accepted frame
-    bool synced;          ///< false until the first accepted frame (or after a reset)
+    uint8_t last_counter;      ///< counter of the last frame with a valid CRC
+    uint8_t max_delta_counter; ///< largest counter step that is still OK_SOME_LOST (1..14)
+    bool synced;               ///< false until the first valid frame (or after a reset)
+    uint8_t last_status;       ///< sl_can_e2e_status_t of the last check
     struct {
-        uint32_t accepted;      ///< frames that passed
-        uint32_t crc_errors;    ///< CRC mismatch: rejected
-        uint32_t bad_dlc;       ///< dlc != 8 or RTR/ERR/EFF mismatch: rejected
-        uint32_t bad_counter;   ///< counter 15: rejected
-        uint32_t repeated;      ///< same counter as the previous frame: rejected
-        uint32_t counter_jumps; ///< accepted frames after a gap (delta >= 2)
-        uint32_t lost_frames;   ///< sum of (delta - 1) over the jumps
+        uint32_t status[SL_CAN_E2E_STATUS_COUNT]; ///< checks per sl_can_e2e_status_t
+        uint32_t crc_errors;    ///< ERROR: CRC mismatch
+        uint32_t bad_dlc;       ///< ERROR: dlc != 8 or an RTR / error frame
+        uint32_t bad_counter;   ///< ERROR: counter 15
+        uint32_t bad_nibble;    ///< ERROR: Data ID nibble differs (mode 11C)
+        uint32_t lost_frames;   ///< sum of (step - 1) over OK_SOME_LOST and WRONG_SEQUENCE
     } stats;
 } sl_can_e2e_rx_t;
 
-/// Reset the receiver: the next valid frame is accepted without a sequence check
-/// (use after a reception timeout). Keeps the stats. O(1).
+/// Reset the receiver: the next valid frame is INITIAL whatever its counter (use after a
+/// reception timeout). Keeps the stats. O(1).
 void sl_can_e2e_rx_reset(sl_can_e2e_rx_t *rx);
 
-/// Zero everything. O(1).
-void sl_can_e2e_rx_init(sl_can_e2e_rx_t *rx);
+/// Zero everything and set the largest accepted counter step (clamped to 1..14). O(1).
+void sl_can_e2e_rx_init(sl_can_e2e_rx_t *rx, uint8_t max_delta_counter);
 
-/// Check one received frame's E2E protection and sequence (the caller has matched the id).
-/// @return SL_OK (accepted; a counter jump is counted but accepted), SL_ERR_MALFORMED
-///         (dlc, flags, counter 15 or CRC: rejected, counted), SL_ERR_STATE (repeated
-///         counter: rejected, counted). Cost: one CRC over 8 bytes.
-sl_err_t sl_can_e2e_check(sl_can_e2e_rx_t *rx, uint8_t data_id, const sl_can_frame_t *f);
+/// Frames of this status carry new data a receiver may use (OK, OK_SOME_LOST).
+bool sl_can_e2e_status_ok(sl_can_e2e_status_t st);
+
+/// A constant name for a status ("OK", "OK_SOME_LOST", ..., "NO_NEW_DATA"; "?" otherwise).
+const char *sl_can_e2e_status_name(sl_can_e2e_status_t st);
+
+/// The Profile 11 check of one receive cycle (the caller has matched the id): `f` is the
+/// frame received in this cycle, or NULL when none arrived (NO_NEW_DATA). Counts the
+/// status in `rx->stats` and keeps it in `rx->last_status`. The counter state follows
+/// every frame with a valid CRC (REPEATED and WRONG_SEQUENCE included), as in Profile 11.
+/// A NULL `rx` or `cfg` is a caller bug (SL_ASSERT); it returns SL_CAN_E2E_ERROR when
+/// assertions are off. Cost: one CRC over 9 bytes.
+sl_can_e2e_status_t sl_can_e2e_check(sl_can_e2e_rx_t *rx, const sl_can_e2e_cfg_t *cfg,
+                                     const sl_can_frame_t *f);
 
 // ---------------------------------------------------------------------------------------
 // Transmitter
 
-/// Message ids in board/DBC style: 11-bit ids as is, 29-bit ids with bit 31 set.
+/// Message identities in board/DBC style: 11-bit ids as is, 29-bit ids with bit 31 set;
+/// with each message's E2E configuration.
 typedef struct sl_can_ids {
-    uint32_t id[SL_CAN_MSG_COUNT]; ///< indexed by sl_can_msg_t
+    uint32_t id[SL_CAN_MSG_COUNT];          ///< indexed by sl_can_msg_t
+    sl_can_e2e_cfg_t e2e[SL_CAN_MSG_COUNT]; ///< indexed by sl_can_msg_t
 } sl_can_ids_t;
 
-/// The six ids of a board (`can_id_*` fields). O(1).
+/// The defaults: SL_CAN_ID_DEFAULT_* and sl_can_e2e_defaults. O(1).
+void sl_can_ids_default(sl_can_ids_t *ids);
+
+/// The ids, Data IDs and modes of a board (`can_id_*`, `can_data_id*` fields). O(1).
 void sl_can_ids_from_board(sl_can_ids_t *ids, const struct sl_board *board);
 
 /// Sender state: ids and one E2E counter per message type. Fields read-only.
@@ -529,7 +609,9 @@ typedef struct sl_can_tx {
 } sl_can_tx_t;
 
 /// Initialise a sender. @return SL_ERR_ARG when an id is not a valid 11-bit id or 29-bit
-/// id with bit 31 set, or two ids are equal; SL_OK otherwise. O(1).
+/// id with bit 31 set, two ids are equal, two Data IDs are equal, a mode is not 11A or
+/// 11C, or a message in mode 11C has a Data ID above 0x0FFF or signals in bits 12..15
+/// (only Health has them free); SL_OK otherwise. O(1).
 sl_err_t sl_can_tx_init(sl_can_tx_t *tx, const sl_can_ids_t *ids);
 
 /// Encode one PoleLean frame into `out` (id, dlc 8, data, E2E) and advance the counter.
@@ -566,48 +648,59 @@ sl_err_t sl_can_encode_vehicle_motion(sl_can_tx_t *tx, const sl_can_vehicle_moti
                                       sl_can_frame_t *out);
 
 // ---------------------------------------------------------------------------------------
-// Decoders: check dlc/flags, CRC and counter 15 (not the sequence: use sl_can_e2e_check
-// or sl_can_motion_rx_feed for that) and convert to physical integer units
-// (raw x factor; e.g. Lean raw 123 -> 1230 cdeg, RangeInner raw 132 -> 2640000 um).
-// They do not check the id.
+// Decoders: check dlc/flags, CRC, Data ID nibble and counter 15 with the message's E2E
+// configuration `e2e` (not the sequence: use sl_can_e2e_check or sl_can_motion_rx_feed
+// for that) and convert to physical integer units (raw x factor; e.g. Lean raw 123 ->
+// 1230 cdeg, RangeInner raw 132 -> 2640000 um). They do not check the id.
 // @return SL_OK or SL_ERR_MALFORMED (nothing useful written) / SL_ERR_ARG (NULL).
 
-sl_err_t sl_can_decode_pole_lean(const sl_can_frame_t *f, sl_can_pole_lean_t *out);
-sl_err_t sl_can_decode_lean_warning(const sl_can_frame_t *f, sl_can_lean_warning_t *out);
-sl_err_t sl_can_decode_status(const sl_can_frame_t *f, sl_can_status_t *out);
-sl_err_t sl_can_decode_vehicle_motion(const sl_can_frame_t *f, sl_can_vehicle_motion_t *out);
-sl_err_t sl_can_decode_health(const sl_can_frame_t *f, sl_can_health_t *out);
-sl_err_t sl_can_decode_pole_tilt(const sl_can_frame_t *f, sl_can_pole_tilt_t *out);
+sl_err_t sl_can_decode_pole_lean(const sl_can_frame_t *f, const sl_can_e2e_cfg_t *e2e,
+                                 sl_can_pole_lean_t *out);
+sl_err_t sl_can_decode_lean_warning(const sl_can_frame_t *f, const sl_can_e2e_cfg_t *e2e,
+                                    sl_can_lean_warning_t *out);
+sl_err_t sl_can_decode_status(const sl_can_frame_t *f, const sl_can_e2e_cfg_t *e2e,
+                              sl_can_status_t *out);
+sl_err_t sl_can_decode_vehicle_motion(const sl_can_frame_t *f, const sl_can_e2e_cfg_t *e2e,
+                                      sl_can_vehicle_motion_t *out);
+sl_err_t sl_can_decode_health(const sl_can_frame_t *f, const sl_can_e2e_cfg_t *e2e,
+                              sl_can_health_t *out);
+sl_err_t sl_can_decode_pole_tilt(const sl_can_frame_t *f, const sl_can_e2e_cfg_t *e2e,
+                                 sl_can_pole_tilt_t *out);
 
-/// VehicleMotion receiver for the motion-aware masks: id match, E2E check (CRC errors and
-/// counter jumps counted in `e2e.stats`), latest accepted value with its time.
-/// The first frame after init or after a reception gap (no accepted frame for `timeout_us`)
-/// has no counter to be checked against: a stale or repeated frame would pass as fresh, so
-/// it only synchronises the sequence (`stats.sync_only`) and its value is not used; values
-/// are used from the next frame that continues the sequence (one frame period later, 20 ms
-/// at the DBC's cycle time). A gap also drops the last value.
+/// VehicleMotion receiver for the motion-aware masks: id match, the Profile 11 check
+/// (sl_can_e2e_check(), statuses counted in `e2e.stats`), latest used value with its time.
+/// Values of OK and OK_SOME_LOST frames are used; REPEATED, WRONG_SEQUENCE and ERROR
+/// frames are not. The first frame after init or after a reception gap (no used or
+/// INITIAL frame for `timeout_us`) is INITIAL: it has no counter to be checked against, so a
+/// stale or repeated frame would pass as fresh; it only synchronises the sequence and its
+/// value is not used (values are used from the next frame that continues it, one frame
+/// period later, 20 ms at the DBC's cycle time). A gap is one NO_NEW_DATA check (counted
+/// when the next frame arrives) and also drops the last value.
 /// Fields read-only to the application.
 typedef struct sl_can_motion_rx {
     uint32_t id_dbc;             ///< expected id, board/DBC style
-    sl_can_e2e_rx_t e2e;
-    sl_can_vehicle_motion_t last;///< last accepted value (valid when have_value)
-    uint64_t last_t_us;          ///< time of the last accepted frame
+    sl_can_e2e_cfg_t cfg;        ///< Data ID and mode
+    sl_can_e2e_rx_t e2e;         ///< statuses counted in e2e.stats (reception gaps: NO_NEW_DATA;
+                                 ///< values used: OK + OK_SOME_LOST)
+    sl_can_vehicle_motion_t last;///< last used value (valid when have_value)
     bool have_value;
-    uint64_t timeout_us;         ///< no accepted frame for this long: sequence resets
+    uint64_t last_t_us;          ///< time of the last used (or INITIAL) frame
+    uint64_t timeout_us;         ///< no valid frame for this long: NO_NEW_DATA, sequence resets
     struct {
         uint32_t other_ids;      ///< frames with another id (ignored, counted)
-        uint32_t timeouts;       ///< sequence resets after a reception gap
-        uint32_t sync_only;      ///< frames that only synchronised the sequence (value unused)
     } stats;
 } sl_can_motion_rx_t;
 
 /// Initialise. `timeout_us` is both the staleness limit of sl_can_motion_rx_get() and
-/// the gap after which the counter sequence restarts. O(1).
-void sl_can_motion_rx_init(sl_can_motion_rx_t *rx, uint32_t id_dbc, uint64_t timeout_us);
+/// the gap after which the counter sequence restarts; `max_delta_counter` (1..14) is the
+/// largest counter step that is OK_SOME_LOST rather than WRONG_SEQUENCE. O(1).
+void sl_can_motion_rx_init(sl_can_motion_rx_t *rx, uint32_t id_dbc, const sl_can_e2e_cfg_t *cfg,
+                           uint8_t max_delta_counter, uint64_t timeout_us);
 
-/// Feed one received frame at time `t_us`. @return SL_OK (accepted: its value used, or, for
-/// the first frame of a sequence, the sequence synchronised), SL_ERR_ARG (another id:
-/// ignored, counted in stats.other_ids), or the sl_can_e2e_check() error. O(1).
+/// Feed one received frame at time `t_us`. @return SL_OK (OK / OK_SOME_LOST: value used;
+/// INITIAL: sequence synchronised), SL_ERR_ARG (another id: ignored, counted in
+/// stats.other_ids), SL_ERR_MALFORMED (ERROR) or SL_ERR_STATE (REPEATED, WRONG_SEQUENCE);
+/// the status is in `e2e.last_status`. O(1).
 sl_err_t sl_can_motion_rx_feed(sl_can_motion_rx_t *rx, const sl_can_frame_t *f, uint64_t t_us);
 
 /// The latest accepted motion if it is younger than the timeout at `now_us`. O(1).
@@ -643,7 +736,7 @@ typedef struct sl_can_signal_desc {
 /// One message.
 typedef struct sl_can_message_desc {
     const char *name;         ///< DBC message name, e.g. "PoleLean"
-    uint8_t data_id;          ///< E2E Data ID
+    uint16_t data_id;         ///< default E2E Data ID (the board's may differ)
     uint16_t cycle_ms;        ///< nominal cycle time (GenMsgCycleTime)
     uint16_t idle_cycle_ms;   ///< cycle without radar data (SlIdleCycleTime); 0 = not sent then
     uint8_t send_type;        ///< sl_can_send_type_t (GenMsgSendType)

@@ -301,9 +301,11 @@ typedef struct sl_pipeline_stats {
                                  ///< port reported later (sl_pipeline_add_can_dropped);
                                  ///< saturates at UINT32_MAX
     uint32_t can_rx;             ///< frames given to sl_pipeline_on_can_rx
-    uint32_t motion_accepted;    ///< VehicleMotion frames accepted from CAN (E2E passed)
+    uint32_t motion_accepted;    ///< VehicleMotion frames accepted from CAN (E2E OK,
+                                 ///< OK_SOME_LOST or INITIAL)
     uint32_t motion_set_calls;   ///< sl_pipeline_set_motion() calls (not counted above)
-    uint32_t motion_rejected;    ///< VehicleMotion frames failing E2E / dlc
+    uint32_t motion_rejected;    ///< VehicleMotion frames rejected by E2E (ERROR, REPEATED,
+                                 ///< WRONG_SEQUENCE): Health fault MOTION_E2E
     uint32_t geometry_rejected;  ///< Configurations whose geometry does not match the board
     uint32_t rows_dropped;       ///< rows ignored after such a Configuration (until one matches)
     uint32_t restarts;           ///< radar restarts seen (geometry change, finish)
@@ -377,7 +379,7 @@ typedef struct sl_pipeline {
     uint64_t reconnect_t_us[SL_CAN_FLAP_RECONNECTS]; ///< times of the last reconnects
     struct {
         uint32_t fft, resyncs, malformed, bad_azimuth, empty_rows, can_dropped, disorder,
-            target_overflow;
+            target_overflow, motion_rejected;
     } snap;                      ///< internal: counters at the last Health
     uint32_t bits[SL_MASK_WORDS]; ///< thresholded row (internal)
     uint32_t occ[SL_MASK_WORDS];  ///< stable-occupied row (internal)
@@ -401,15 +403,16 @@ _Static_assert(sizeof(sl_pipeline_t) <= 65536U, "sl_pipeline_t: 64 KiB RAM budge
 /// Any azimuth count, bins and n with the default target/candidate capacities: the mask
 /// dominates; everything else except the tilt history (sl_tiltobs_t, sized by
 /// SL_CFG_TILT_TRACKS x SL_CFG_TILT_OBS_PER_TRACK: 2.5 KB firmware, 7.4 KB host) stays under
-/// 17 KiB (17,268 B in the host configuration since detection's link table, 168 B, and its
-/// per-azimuth peaks, 776 B).
+/// 17,536 B (17,412 B in the host configuration, with detection's link table, 168 B, its
+/// per-azimuth peaks, 776 B, the CAN sender's E2E configuration, 24 B, and the
+/// VehicleMotion receiver with its Profile 11 state, 104 B).
 #if SL_CFG_MAX_TARGETS <= 32 && SL_CFG_DETECT_MAX_CANDIDATES <= 32 && SL_CFG_DETECT_MAX_SPAN <= 24 \
     && SL_CFG_MAX_AZIMUTHS <= 400
 #if defined(__cplusplus)
-static_assert(sizeof(sl_pipeline_t) <= sizeof(sl_mask_t) + sizeof(sl_tiltobs_t) + 17408U,
+static_assert(sizeof(sl_pipeline_t) <= sizeof(sl_mask_t) + sizeof(sl_tiltobs_t) + 17536U,
               "sl_pipeline_t budget");
 #else
-_Static_assert(sizeof(sl_pipeline_t) <= sizeof(sl_mask_t) + sizeof(sl_tiltobs_t) + 17408U,
+_Static_assert(sizeof(sl_pipeline_t) <= sizeof(sl_mask_t) + sizeof(sl_tiltobs_t) + 17536U,
                "sl_pipeline_t budget");
 #endif
 #endif
@@ -453,7 +456,8 @@ void sl_pipeline_set_decoder_stats(sl_pipeline_t *p, const sl_proto_stats_t *sta
 /// stream; mask history is kept (a radar restart is handled like a gap). O(azimuths).
 sl_err_t sl_pipeline_finish(sl_pipeline_t *p, uint64_t now_us);
 
-/// One frame from the vehicle bus. VehicleMotion (board id): E2E-checked, then used.
+/// One frame from the vehicle bus. VehicleMotion (board id): E2E-checked (Profile 11 with
+/// the board's Data ID, mode and max delta counter; sl_can_motion_rx_feed()), then used.
 /// @return SL_OK (accepted), SL_ERR_ARG (NULL or another id: ignored), or the E2E error
 /// (SL_ERR_MALFORMED / SL_ERR_STATE: rejected, counted). O(1).
 sl_err_t sl_pipeline_on_can_rx(sl_pipeline_t *p, const sl_can_frame_t *f, uint64_t now_us);

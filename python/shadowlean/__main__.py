@@ -6,8 +6,11 @@
                              [--count N] [--idle-exit S] [--check]
 
 Exit status: 0 ok, 1 error (file unreadable or malformed, bus cannot be opened, no frame
-the DBC knows, or with --check any E2E error: CRC, invalid or repeated counter, lost
-frames, wrong length), 2 usage."""
+the DBC knows, or with --check any frame the E2E Profile 11 check does not accept (ERROR:
+CRC, Data ID nibble, counter 15, wrong length; REPEATED; WRONG_SEQUENCE) or frames lost),
+2 usage. --max-delta-counter N (1..14, default 1): counter steps 2..N are OK_SOME_LOST;
+--timeout S: a gap of more than S seconds in a message is NO_NEW_DATA (not an error) and
+restarts its sequence."""
 import argparse
 import sys
 
@@ -38,8 +41,13 @@ def _parser():
     g.add_argument("--table", action="store_true", help="PoleLean rows per rotation")
     d.add_argument("--last", type=int, metavar="K", help="--table: only the last K rotations")
     d.add_argument("--check", action="store_true",
-                   help="verify CRC and counter sequence per message; E2E counts at the end; "
-                   "exit 1 on any error")
+                   help="E2E Profile 11 check per message (CRC, Data ID nibble, counter "
+                   "sequence); the status counts at the end; exit 1 on any error")
+    d.add_argument("--max-delta-counter", type=int, default=1, metavar="N",
+                   help="--check: largest counter step still OK_SOME_LOST (1..14, default 1)")
+    d.add_argument("--timeout", type=float, metavar="S",
+                   help="--check: a gap of more than S seconds in a message is NO_NEW_DATA "
+                   "and restarts its sequence (default: none)")
     v = sub.add_parser("live", help="decode frames from a live bus (python-can)",
                        description="Decode frames as they arrive on a CAN bus (python-can).")
     v.add_argument("--dbc", required=True, help="the board's DBC")
@@ -50,6 +58,8 @@ def _parser():
                    "(other ids are printed but not counted)")
     v.add_argument("--idle-exit", type=float, metavar="S", help="stop after S seconds without a frame")
     v.add_argument("--check", action="store_true", help="as for decode")
+    v.add_argument("--max-delta-counter", type=int, default=1, metavar="N", help="as for decode")
+    v.add_argument("--timeout", type=float, metavar="S", help="as for decode")
     return p
 
 
@@ -57,7 +67,7 @@ def _decode(a):
     db = load_dbc(a.dbc)
     decoded = decode_frames(db, read_candump(a.log))
     known = sum(1 for _, x in decoded if x is not None)
-    mon = E2EMonitor(db) if a.check else None
+    mon = E2EMonitor(db, max_delta_counter=a.max_delta_counter, timeout=a.timeout) if a.check else None
     if a.summary:
         print_summary(decoded)
     elif a.table:
@@ -66,7 +76,7 @@ def _decode(a):
         print_frames(decoded, monitor=mon)
     if mon is not None and (a.summary or a.table):
         for f, x in decoded:
-            mon.check(x, f.data)
+            mon.check(x, f.data, f.t)
     if known == 0:
         print(f"{PROG}: {a.log}: no frame of this DBC ({len(decoded)} frames)", file=sys.stderr)
         return 1
@@ -85,7 +95,7 @@ def _verdict(mon):
 
 def _live(a):
     db = load_dbc(a.dbc)
-    mon = E2EMonitor(db) if a.check else None
+    mon = E2EMonitor(db, max_delta_counter=a.max_delta_counter, timeout=a.timeout) if a.check else None
     try:
         bus = open_bus(a.channel, a.interface)
     except Exception as e:  # python-can raises OSError, CanError, ValueError...
@@ -96,7 +106,7 @@ def _live(a):
         for f in frames_from_bus(bus, timeout=0.2, idle_limit=a.idle_exit):
             d = decode(db, f.can_id, f.is_eff, f.data)
             known += d is not None
-            e2e = mon.check(d, f.data) if mon is not None else None
+            e2e = mon.check(d, f.data, f.t) if mon is not None else None
             print(format_frame(f, d, e2e), flush=True)
             if a.count is not None and known >= a.count:
                 break
@@ -115,6 +125,14 @@ def main(argv=None):
     if a.cmd is None:
         _parser().print_usage(sys.stderr)
         print(f"{PROG}: a COMMAND is needed (decode, live)", file=sys.stderr)
+        return 2
+    if a.timeout is not None and not a.timeout > 0:
+        _parser().print_usage(sys.stderr)
+        print(f"{PROG}: --timeout {a.timeout}: seconds > 0", file=sys.stderr)
+        return 2
+    if not 1 <= a.max_delta_counter <= 14:
+        _parser().print_usage(sys.stderr)
+        print(f"{PROG}: --max-delta-counter {a.max_delta_counter}: 1..14", file=sys.stderr)
         return 2
     if a.cmd == "decode" and a.last is not None and not a.table:
         _parser().print_usage(sys.stderr)

@@ -2,8 +2,9 @@
 """The board's generated DBC, read with Debian's python3-canmatrix, and frame decoding.
 
 Nothing about the layout is written here: message names, signals, scaling, value tables,
-the E2E Data ID (message attribute SlE2EDataId) and the counter modulo (the Counter
-signal's maximum + 1) all come from the DBC."""
+the E2E Profile 11 Data ID and mode (message attributes SlE2EDataId and SlE2EMode), the
+frame format (29-bit ids: DBC ids with bit 31 set, attribute VFrameFormat) and the counter
+modulo (the Counter signal's maximum + 1) all come from the DBC."""
 import contextlib
 import io
 from dataclasses import dataclass, field
@@ -14,7 +15,7 @@ with contextlib.redirect_stderr(io.StringIO()), contextlib.redirect_stdout(io.St
     import canmatrix
     import canmatrix.formats
 
-from .e2e import e2e_crc
+from .e2e import MODE_NIBBLE, e2e_crc, mode_of
 
 # Value-table names for the text reports (the DBC's VAL_ tables carry the same names).
 LINK = {0: "DISCONNECTED", 1: "CONNECTING", 2: "WAIT_CONFIG", 3: "STREAMING", 4: "SILENT"}
@@ -34,9 +35,11 @@ def load_dbc(path):
 @dataclass
 class Decoded:
     """One decoded frame. phys: signal -> physical value; raw: signal -> raw integer;
-    named: signal -> value-table name (where the DBC has one). crc_ok: the E2E CRC matches
-    (Data ID of this message); reencode_ok: canmatrix encodes the raw values back to the
-    same bytes; length_ok: the payload has the message's DLC (otherwise nothing decoded)."""
+    named: signal -> value-table name (where the DBC has one). crc_ok: the Profile 11 CRC
+    matches (Data ID and mode of this message); nibble_ok: in mode 11C, bits 12..15 carry
+    the Data ID's bits 8..11 (always True in 11A); reencode_ok: canmatrix encodes the raw
+    values back to the same bytes; length_ok: the payload has the message's DLC (otherwise
+    nothing decoded)."""
     name: str
     can_id: int
     phys: dict = field(default_factory=dict)
@@ -45,7 +48,9 @@ class Decoded:
     crc_ok: bool = False
     reencode_ok: bool = False
     length_ok: bool = False
+    nibble_ok: bool = False
     data_id: int = 0
+    mode: str = "both"
     counter: int = -1
 
 
@@ -72,6 +77,7 @@ def decode(db, can_id, eff, data):
         return None
     d = Decoded(fr.name, can_id)
     d.data_id = int(fr.attributes.get("SlE2EDataId", 0))
+    d.mode = mode_of(fr.attributes.get("SlE2EMode", "Both"))
     if data is None or len(data) != fr.size:
         return d
     d.length_ok = True
@@ -82,7 +88,8 @@ def decode(db, can_id, eff, data):
         if v.named_value is not None:
             d.named[k] = v.named_value
     d.counter = d.raw.get("Counter", -1)
-    d.crc_ok = data[0] == e2e_crc(d.data_id, data)
+    d.crc_ok = data[0] == e2e_crc(d.data_id, data, d.mode)
+    d.nibble_ok = d.mode != MODE_NIBBLE or (data[1] >> 4) == ((d.data_id >> 8) & 0x0F)
     d.reencode_ok = bytes(fr.encode({k: v.raw_value for k, v in sig.items()})) == bytes(data)
     return d
 

@@ -31,7 +31,7 @@ def format_frame(f, d, e2e=None):
         return f"{f.t:.6f} {d.name:<13} wrong length ({n})"
     sigs = " ".join(f"{k}={d.named.get(k, round(v, 3))}" for k, v in d.phys.items()
                     if k not in ("Crc", "Counter"))
-    tail = "" if e2e is None or e2e == "ok" else f" e2e={e2e}"
+    tail = "" if e2e is None or e2e == "OK" else f" e2e={e2e}"
     return f"{f.t:.6f} {d.name:<13} ctr={d.counter:<2} crc={'ok' if d.crc_ok else 'BAD'}{tail} {sigs}"
 
 
@@ -39,7 +39,7 @@ def print_frames(decoded, out=None, monitor=None):
     """Every frame, one line each; with an E2EMonitor, its verdict on each frame."""
     out = out or sys.stdout
     for f, d in decoded:
-        e2e = monitor.check(d, f.data) if monitor is not None else None
+        e2e = monitor.check(d, f.data, f.t) if monitor is not None else None
         out.write(format_frame(f, d, e2e) + "\n")
 
 
@@ -92,13 +92,17 @@ def print_table(decoded, out=None, last=None):
 
 
 def print_e2e(monitor, out=None):
-    """The E2E counts per message."""
+    """The E2E Profile 11 status counts per message (ERROR split into its reasons)."""
     out = out or sys.stdout
-    out.write(f"{'message':<14} {'accepted':>8} {'crc':>5} {'counter':>7} {'repeated':>8} "
-              f"{'jumps':>5} {'lost':>5} {'length':>6}\n")
+    out.write(f"E2E Profile 11, max delta counter {monitor.max_delta_counter}"
+              + (f", timeout {monitor.timeout:g} s" if monitor.timeout is not None else "") + "\n")
+    out.write(f"{'message':<14} {'OK':>5} {'SOME_LOST':>9} {'INITIAL':>7} {'REPEATED':>8} "
+              f"{'WRONG_SEQ':>9} {'ERROR':>5} {'crc':>4} {'length':>6} {'counter':>7} "
+              f"{'nibble':>6} {'lost':>5} {'NO_DATA':>7}\n")
     for name in sorted(monitor.stats):
         s = monitor.stats[name]
-        out.write(f"{name:<14} {s.accepted:>8} {s.crc_errors:>5} {s.bad_counter:>7} {s.repeated:>8} "
-                  f"{s.counter_jumps:>5} {s.lost_frames:>5} {s.bad_length:>6}\n")
+        out.write(f"{name:<14} {s.ok:>5} {s.ok_some_lost:>9} {s.initial:>7} {s.repeated:>8} "
+                  f"{s.wrong_sequence:>9} {s.error:>5} {s.crc_errors:>4} {s.bad_length:>6} "
+                  f"{s.bad_counter:>7} {s.bad_nibble:>6} {s.lost_frames:>5} {s.no_new_data:>7}\n")
     if monitor.unknown:
         out.write(f"unknown ids: {monitor.unknown} frame(s)\n")

@@ -10,12 +10,15 @@
 
 #include "shadowlean/sl_can.h"
 
-#define ID_POLE 0x620U
-#define ID_WARN 0x621U
-#define ID_STATUS 0x622U
-#define ID_MOTION 0x300U
-#define ID_HEALTH 0x623U
-#define ID_TILT 0x624U
+/// The default E2E configuration of message SL_CAN_MSG_<m>.
+#define E2E(m) (&sl_can_e2e_defaults[SL_CAN_MSG_##m])
+
+#define ID_POLE SL_CAN_ID_DEFAULT_POLE_LEAN
+#define ID_WARN SL_CAN_ID_DEFAULT_LEAN_WARNING
+#define ID_STATUS SL_CAN_ID_DEFAULT_STATUS
+#define ID_MOTION SL_CAN_ID_DEFAULT_VEHICLE_MOTION
+#define ID_HEALTH SL_CAN_ID_DEFAULT_HEALTH
+#define ID_TILT SL_CAN_ID_DEFAULT_POLE_TILT
 
 static uint64_t rng_state = 0x9E3779B97F4A7C15ull;
 static uint32_t rnd32(void)
@@ -34,7 +37,10 @@ static int64_t rnd_range(int64_t lo, int64_t hi)
 
 static void tx_setup(sl_can_tx_t *tx)
 {
-    sl_can_ids_t ids = {{ID_POLE, ID_WARN, ID_STATUS, ID_MOTION, ID_HEALTH, ID_TILT}};
+    sl_can_ids_t ids;
+    sl_can_ids_default(&ids);
+    const uint32_t id[SL_CAN_MSG_COUNT] = {ID_POLE, ID_WARN, ID_STATUS, ID_MOTION, ID_HEALTH, ID_TILT};
+    memcpy(ids.id, id, sizeof id);
     assert_int_equal(sl_can_tx_init(tx, &ids), SL_OK);
 }
 
@@ -54,38 +60,150 @@ static int64_t clamp64(int64_t v, int64_t lo, int64_t hi)
     return v < lo ? lo : v > hi ? hi : v;
 }
 
-static void test_canmsg_crc8_check_value_is_0x4b(void **state)
+static void test_canmsg_crc8_0x1d_gives_the_sae_j1850_and_gsm_a_check_values(void **state)
 {
     (void)state;
     const uint8_t check[] = {'1', '2', '3', '4', '5', '6', '7', '8', '9'};
-    assert_int_equal(sl_can_crc8_j1850(check, sizeof check), 0x4B);
-    assert_int_equal(sl_can_crc8_j1850(NULL, 0), 0x00); // 0xFF ^ 0xFF
+    // SAE J1850 (start 0xFF, final XOR 0xFF) and the Profile 11 form (start 0x00, no XOR,
+    // the catalogue's CRC-8/GSM-A): the same register, two conventions.
+    assert_int_equal(sl_can_crc8_0x1d(0xFFU, check, sizeof check) ^ 0xFFU, 0x4B);
+    assert_int_equal(sl_can_crc8_0x1d(0x00U, check, sizeof check), 0x37);
+    assert_int_equal(sl_can_crc8_0x1d(0x5AU, NULL, 0), 0x5A);
     // AUTOSAR CRC library test vectors for CRC8 SAE J1850.
     const uint8_t v1[] = {0x00, 0x00, 0x00, 0x00};
     const uint8_t v2[] = {0xF2, 0x01, 0x83};
     const uint8_t v3[] = {0x0F, 0xAA, 0x00, 0x55};
     const uint8_t v4[] = {0xFF, 0xFF, 0xFF, 0xFF};
-    assert_int_equal(sl_can_crc8_j1850(v1, sizeof v1), 0x59);
-    assert_int_equal(sl_can_crc8_j1850(v2, sizeof v2), 0x37);
-    assert_int_equal(sl_can_crc8_j1850(v3, sizeof v3), 0x79);
-    assert_int_equal(sl_can_crc8_j1850(v4, sizeof v4), 0x74);
+    assert_int_equal(sl_can_crc8_0x1d(0xFFU, v1, sizeof v1) ^ 0xFFU, 0x59);
+    assert_int_equal(sl_can_crc8_0x1d(0xFFU, v2, sizeof v2) ^ 0xFFU, 0x37);
+    assert_int_equal(sl_can_crc8_0x1d(0xFFU, v3, sizeof v3) ^ 0xFFU, 0x79);
+    assert_int_equal(sl_can_crc8_0x1d(0xFFU, v4, sizeof v4) ^ 0xFFU, 0x74);
 }
 
-static void test_canmsg_e2e_crc_mixes_data_id_first(void **state)
+// AUTOSAR E2E Profile 11 vectors of two implementations that are not this one: the
+// `autosar-e2e` Rust crate (src/profiles/profile11.rs, tests basic_both_example and
+// basic_nibble_example) and the `autosar-e2e` Python package (zariiii9003/autosar-e2e,
+// test/test_p01.py, modes BOTH and NIBBLE): 8 zero bytes, Data ID 0x123.
+static void test_canmsg_e2e_crc_matches_independent_profile_11_vectors(void **state)
+{
+    (void)state;
+    const sl_can_e2e_cfg_t both = {0x123U, SL_CAN_E2E_MODE_BOTH};
+    const sl_can_e2e_cfg_t nibble = {0x123U, SL_CAN_E2E_MODE_NIBBLE};
+    uint8_t d[8] = {0};
+    assert_int_equal(sl_can_e2e_crc(&both, d), 0xCC); // counter 0
+    d[1] = 0x01;
+    assert_int_equal(sl_can_e2e_crc(&both, d), 0x91); // counter 1
+    d[1] = 0x10; // Data ID bits 8..11 in the high nibble, counter 0
+    assert_int_equal(sl_can_e2e_crc(&nibble, d), 0x2A);
+    d[1] = 0x11;
+    assert_int_equal(sl_can_e2e_crc(&nibble, d), 0x77);
+    // The receiver accepts exactly those frames; the Python package's negative vectors
+    // (a nibble of 2 instead of 1, a counter bit flipped under an 11A CRC) are errors.
+    const uint8_t ok_both[2][8] = {{0xCC, 0x00}, {0x91, 0x01}};
+    const uint8_t ok_nibble[2][8] = {{0x2A, 0x10}, {0x77, 0x11}};
+    sl_can_e2e_rx_t rb, rn;
+    sl_can_e2e_rx_init(&rb, 1U);
+    sl_can_e2e_rx_init(&rn, 1U);
+    sl_can_frame_t f = {.id = 0x123U, .dlc = 8U};
+    for (unsigned k = 0; k < 2U; k++) {
+        const sl_can_e2e_status_t want = (k == 0U) ? SL_CAN_E2E_INITIAL : SL_CAN_E2E_OK;
+        memcpy(f.data, ok_both[k], 8U);
+        assert_int_equal(sl_can_e2e_check(&rb, &both, &f), want);
+        memcpy(f.data, ok_nibble[k], 8U);
+        assert_int_equal(sl_can_e2e_check(&rn, &nibble, &f), want);
+    }
+    const uint8_t bad_both[8] = {0xCC, 0x10};
+    const uint8_t bad_nibble[8] = {0x77, 0x21};
+    memcpy(f.data, bad_both, 8U);
+    assert_int_equal(sl_can_e2e_check(&rb, &both, &f), SL_CAN_E2E_ERROR);
+    memcpy(f.data, bad_nibble, 8U);
+    assert_int_equal(sl_can_e2e_check(&rn, &nibble, &f), SL_CAN_E2E_ERROR);
+    assert_int_equal(rn.stats.crc_errors, 1); // the nibble is inside the CRC too
+    // The encoder's 11C frame on Health (the only message with bits 12..15 free).
+    sl_can_ids_t ids;
+    sl_can_ids_default(&ids);
+    ids.e2e[SL_CAN_MSG_HEALTH] = nibble;
+    sl_can_tx_t tx;
+    assert_int_equal(sl_can_tx_init(&tx, &ids), SL_OK);
+    const sl_can_health_t h = {0};
+    assert_int_equal(sl_can_encode_health(&tx, &h, &f), SL_OK);
+    const uint8_t want[8] = {0x2A, 0x10, 0, 0, 0, 0, 0, 0};
+    assert_memory_equal(f.data, want, 8);
+    sl_can_health_t back;
+    assert_int_equal(sl_can_decode_health(&f, &nibble, &back), SL_OK);
+    assert_int_equal(sl_can_decode_health(&f, &both, &back), SL_ERR_MALFORMED);
+}
+
+// Per-message vectors: 8 zero bytes but the counter (0, then 1), each message's default
+// Data ID in 11A, and Health with paper-sim-29bit's Data ID 0x0355 in 11C. The CRC bytes
+// come from tests/system/daemon/p11_frames.py (the AUTOSAR library chaining, pinned there
+// to the published vectors); the Python suite and the dissector test assert the same table.
+static void test_canmsg_e2e_crc_of_every_message_matches_its_vectors(void **state)
+{
+    (void)state;
+    static const struct {
+        sl_can_msg_t msg;
+        uint8_t crc[2]; // counter 0, counter 1
+    } v[] = {
+        {SL_CAN_MSG_POLE_LEAN, {0x03, 0x5E}},      {SL_CAN_MSG_LEAN_WARNING, {0xAC, 0xF1}},
+        {SL_CAN_MSG_STATUS, {0xC9, 0x94}},         {SL_CAN_MSG_VEHICLE_MOTION, {0xEF, 0xB2}},
+        {SL_CAN_MSG_HEALTH, {0x8A, 0xD7}},         {SL_CAN_MSG_POLE_TILT, {0x25, 0x78}},
+    };
+    for (size_t k = 0; k < sizeof v / sizeof v[0]; k++) {
+        for (uint8_t c = 0; c < 2U; c++) {
+            const uint8_t d[8] = {0, c, 0, 0, 0, 0, 0, 0};
+            assert_int_equal(sl_can_e2e_crc(&sl_can_e2e_defaults[v[k].msg], d), v[k].crc[c]);
+        }
+    }
+    const sl_can_e2e_cfg_t h11c = {0x0355U, SL_CAN_E2E_MODE_NIBBLE};
+    const uint8_t d0[8] = {0, 0x30}, d1[8] = {0, 0x31};
+    assert_int_equal(sl_can_e2e_crc(&h11c, d0), 0x5C);
+    assert_int_equal(sl_can_e2e_crc(&h11c, d1), 0x01);
+}
+
+static void test_canmsg_tx_init_refuses_nibble_mode_over_signals_and_shared_data_ids(void **state)
+{
+    (void)state;
+    sl_can_tx_t tx;
+    sl_can_ids_t ids;
+    sl_can_ids_default(&ids);
+    // PoleLean carries Quality and Clamped in bits 12..15: 11C would overwrite them.
+    ids.e2e[SL_CAN_MSG_POLE_LEAN].mode = SL_CAN_E2E_MODE_NIBBLE;
+    assert_int_equal(sl_can_tx_init(&tx, &ids), SL_ERR_ARG);
+    sl_can_ids_default(&ids);
+    ids.e2e[SL_CAN_MSG_HEALTH].mode = SL_CAN_E2E_MODE_NIBBLE;
+    ids.e2e[SL_CAN_MSG_HEALTH].data_id = 0x1055U; // bits 12..15 cannot be sent
+    assert_int_equal(sl_can_tx_init(&tx, &ids), SL_ERR_ARG);
+    ids.e2e[SL_CAN_MSG_HEALTH].data_id = 0x0F55U;
+    assert_int_equal(sl_can_tx_init(&tx, &ids), SL_OK);
+    ids.e2e[SL_CAN_MSG_HEALTH].mode = 2U;
+    assert_int_equal(sl_can_tx_init(&tx, &ids), SL_ERR_ARG);
+    sl_can_ids_default(&ids);
+    ids.e2e[SL_CAN_MSG_STATUS].data_id = ids.e2e[SL_CAN_MSG_HEALTH].data_id;
+    assert_int_equal(sl_can_tx_init(&tx, &ids), SL_ERR_ARG);
+}
+
+static void test_canmsg_e2e_crc_mixes_both_data_id_bytes_first(void **state)
 {
     (void)state;
     uint8_t d[8] = {0xEE, 0x31, 0x42, 0x53, 0x64, 0x75, 0x86, 0x97};
-    const uint8_t seq[8] = {SL_CAN_DATA_ID_POLE_LEAN, 0x31, 0x42, 0x53, 0x64, 0x75, 0x86, 0x97};
-    assert_int_equal(sl_can_e2e_crc(SL_CAN_DATA_ID_POLE_LEAN, d), sl_can_crc8_j1850(seq, 8));
+    const sl_can_e2e_cfg_t cfg = {0x1A51U, SL_CAN_E2E_MODE_BOTH};
+    const uint8_t seq[9] = {0x51, 0x1A, 0x31, 0x42, 0x53, 0x64, 0x75, 0x86, 0x97};
+    assert_int_equal(sl_can_e2e_crc(&cfg, d), sl_can_crc8_0x1d(0x00U, seq, 9));
     // Byte 0 (the CRC slot) is not part of the CRC.
-    const uint8_t c = sl_can_e2e_crc(SL_CAN_DATA_ID_POLE_LEAN, d);
+    const uint8_t c = sl_can_e2e_crc(&cfg, d);
     d[0] = 0x00;
-    assert_int_equal(sl_can_e2e_crc(SL_CAN_DATA_ID_POLE_LEAN, d), c);
-    // Every other Data ID gives another CRC for the same bytes (the CRC is a bijection of
-    // its first byte for fixed following bytes).
-    for (unsigned id = 0; id < 256U; id++) {
-        if (id != SL_CAN_DATA_ID_POLE_LEAN) {
-            assert_int_not_equal(sl_can_e2e_crc((uint8_t)id, d), c);
+    assert_int_equal(sl_can_e2e_crc(&cfg, d), c);
+    // Every other low byte, and every other high byte in 11A, gives another CRC for the
+    // same bytes (the CRC register is a bijection of one input byte when the rest is fixed).
+    for (unsigned b = 0; b < 256U; b++) {
+        sl_can_e2e_cfg_t o = {(uint16_t)((cfg.data_id & 0xFF00U) | b), SL_CAN_E2E_MODE_BOTH};
+        if (o.data_id != cfg.data_id) {
+            assert_int_not_equal(sl_can_e2e_crc(&o, d), c);
+        }
+        o.data_id = (uint16_t)((b << 8) | (cfg.data_id & 0xFFU));
+        if (o.data_id != cfg.data_id) {
+            assert_int_not_equal(sl_can_e2e_crc(&o, d), c);
         }
     }
 }
@@ -93,13 +211,13 @@ static void test_canmsg_e2e_crc_mixes_data_id_first(void **state)
 static void test_canmsg_crc_worked_example(void **state)
 {
     (void)state;
-    // The example of the sl_can.h header comment.
+    // The example of the sl_can.h header comment and the DBC: Status, Data ID 0x0053, 11A.
     sl_can_tx_t tx;
     tx_setup(&tx);
     sl_can_status_t st = {.link_state = SL_CAN_LINK_STREAMING, .rotations = 2};
     sl_can_frame_t f;
     assert_int_equal(sl_can_encode_status(&tx, &st, &f), SL_OK);
-    const uint8_t want[8] = {0x95, 0x30, 0x02, 0x00, 0x00, 0x00, 0x00, 0x00};
+    const uint8_t want[8] = {0x93, 0x30, 0x02, 0x00, 0x00, 0x00, 0x00, 0x00};
     assert_memory_equal(f.data, want, 8);
     assert_int_equal(f.id, ID_STATUS);
     assert_int_equal(f.dlc, 8);
@@ -128,7 +246,7 @@ static void test_canmsg_pole_lean_golden_bytes(void **state)
     for (unsigned i = 0; i < 8; i++) {
         want[i] = (uint8_t)(v >> (8 * i));
     }
-    want[0] = sl_can_e2e_crc(SL_CAN_DATA_ID_POLE_LEAN, want);
+    want[0] = sl_can_e2e_crc(E2E(POLE_LEAN), want);
     assert_memory_equal(f.data, want, 8);
 }
 
@@ -171,7 +289,7 @@ static void test_canmsg_pole_tilt_layout_encode_decode(void **state)
     assert_int_equal(f.id, ID_TILT);
     assert_int_equal(f.dlc, 8);
     sl_can_pole_tilt_t out;
-    assert_int_equal(sl_can_decode_pole_tilt(&f, &out), SL_OK);
+    assert_int_equal(sl_can_decode_pole_tilt(&f, E2E(POLE_TILT), &out), SL_OK);
     assert_int_equal(out.quality, SL_CAN_TILT_FITTED);
     assert_int_equal(out.target_id, 5);
     assert_int_equal(out.tilt_cdeg, 1230);      // 123 x 0.1
@@ -181,7 +299,7 @@ static void test_canmsg_pole_tilt_layout_encode_decode(void **state)
     assert_int_equal(out.base_x_um, 1250000);   // 24.6 -> 25 x 0.05
     assert_int_equal(out.base_y_um, -2500000);  // -50.2 -> -50
     assert_false(out.clamped);
-    assert_int_equal(f.data[0], sl_can_e2e_crc(SL_CAN_DATA_ID_POLE_TILT, f.data));
+    assert_int_equal(f.data[0], sl_can_e2e_crc(E2E(POLE_TILT), f.data));
     // Random round trips against the reference rounding.
     for (int k = 0; k < 20000; k++) {
         in.target_id = (uint8_t)rnd_range(0, 15);
@@ -193,7 +311,7 @@ static void test_canmsg_pole_tilt_layout_encode_decode(void **state)
         in.base_x_um = (int32_t)rnd_range(-8000000, 8000000);
         in.base_y_um = (int32_t)rnd_range(-8000000, 8000000);
         assert_int_equal(sl_can_encode_pole_tilt(&tx, &in, &f), SL_OK);
-        assert_int_equal(sl_can_decode_pole_tilt(&f, &out), SL_OK);
+        assert_int_equal(sl_can_decode_pole_tilt(&f, E2E(POLE_TILT), &out), SL_OK);
         bool cl = false;
         const int64_t tilt = ref_round(in.tilt_cdeg, 10);
         const int64_t sig = ref_round(in.tilt_sigma_cdeg, 20);
@@ -219,7 +337,7 @@ static void test_canmsg_pole_tilt_layout_encode_decode(void **state)
         in.tilt_cdeg = 1000;
         in.base_x_um = 9000000; // would clamp if it were sent
         assert_int_equal(sl_can_encode_pole_tilt(&tx, &in, &f), SL_OK);
-        assert_int_equal(sl_can_decode_pole_tilt(&f, &out), SL_OK);
+        assert_int_equal(sl_can_decode_pole_tilt(&f, E2E(POLE_TILT), &out), SL_OK);
         assert_int_equal(out.quality, q > 4 ? SL_CAN_TILT_INCONSISTENT : q);
         assert_int_equal(out.tilt_cdeg, 0);
         assert_int_equal(out.base_x_um, 0);
@@ -230,9 +348,9 @@ static void test_canmsg_pole_tilt_layout_encode_decode(void **state)
     in.quality = 0;
     assert_int_equal(sl_can_encode_pole_tilt(&tx, &in, &f), SL_OK);
     sl_can_pole_lean_t pl;
-    assert_int_equal(sl_can_decode_pole_lean(&f, &pl), SL_ERR_MALFORMED);
+    assert_int_equal(sl_can_decode_pole_lean(&f, E2E(POLE_LEAN), &pl), SL_ERR_MALFORMED);
     assert_int_equal(sl_can_encode_pole_tilt(NULL, &in, &f), SL_ERR_ARG);
-    assert_int_equal(sl_can_decode_pole_tilt(NULL, &out), SL_ERR_ARG);
+    assert_int_equal(sl_can_decode_pole_tilt(NULL, E2E(POLE_TILT), &out), SL_ERR_ARG);
 }
 
 static void test_canmsg_layout_table_is_consistent(void **state)
@@ -316,7 +434,7 @@ static void test_canmsg_pole_lean_round_trips_every_raw_value(void **state)
             .range_outer_um = (uint32_t)(clamp64(2100 - raw, 0, 511) * 20000),
         };
         assert_int_equal(sl_can_encode_pole_lean(&tx, &in, &f), SL_OK);
-        assert_int_equal(sl_can_decode_pole_lean(&f, &out), SL_OK);
+        assert_int_equal(sl_can_decode_pole_lean(&f, E2E(POLE_LEAN), &out), SL_OK);
         assert_int_equal(out.target_id, in.target_id);
         assert_int_equal(out.quality, in.quality);
         assert_int_equal(out.azimuth_cdeg, in.azimuth_cdeg);
@@ -347,7 +465,7 @@ static void test_canmsg_pole_lean_random_values_within_half_lsb(void **state)
             .range_outer_um = (uint32_t)rnd_range(0, 10229999),
         };
         assert_int_equal(sl_can_encode_pole_lean(&tx, &in, &f), SL_OK);
-        assert_int_equal(sl_can_decode_pole_lean(&f, &out), SL_OK);
+        assert_int_equal(sl_can_decode_pole_lean(&f, E2E(POLE_LEAN), &out), SL_OK);
         assert_false(out.clamped);
         assert_int_equal(out.lean_cdeg, ref_round(in.lean_cdeg, 10) * 10);
         assert_true(out.lean_cdeg - in.lean_cdeg <= 5 && in.lean_cdeg - out.lean_cdeg <= 5);
@@ -371,20 +489,20 @@ static void test_canmsg_ranges_are_rounded_once_from_um(void **state)
     const sl_can_pole_lean_t p = {.range_inner_um = 2649900, .range_outer_um = 2650100};
     assert_int_equal(sl_can_encode_pole_lean(&tx, &p, &f), SL_OK);
     sl_can_pole_lean_t po;
-    assert_int_equal(sl_can_decode_pole_lean(&f, &po), SL_OK);
+    assert_int_equal(sl_can_decode_pole_lean(&f, E2E(POLE_LEAN), &po), SL_OK);
     assert_int_equal(po.range_inner_um, 2640000);
     assert_int_equal(po.range_outer_um, 2660000);
     // Exact half (2.65 m = 132.5 LSB) rounds up, as every signal does.
     const sl_can_pole_lean_t half = {.range_inner_um = 2650000, .range_outer_um = 2669999};
     assert_int_equal(sl_can_encode_pole_lean(&tx, &half, &f), SL_OK);
-    assert_int_equal(sl_can_decode_pole_lean(&f, &po), SL_OK);
+    assert_int_equal(sl_can_decode_pole_lean(&f, E2E(POLE_LEAN), &po), SL_OK);
     assert_int_equal(po.range_inner_um, 2660000);
     assert_int_equal(po.range_outer_um, 2660000);
     // LeanWarning.Range (0.01 m): 2.6449 m -> 264.49 -> 2.64 m (via mm: 2645 -> 2.65 m).
     const sl_can_lean_warning_t w = {.has_target = true, .range_um = 2644900};
     assert_int_equal(sl_can_encode_lean_warning(&tx, &w, &f), SL_OK);
     sl_can_lean_warning_t wo;
-    assert_int_equal(sl_can_decode_lean_warning(&f, &wo), SL_OK);
+    assert_int_equal(sl_can_decode_lean_warning(&f, E2E(LEAN_WARNING), &wo), SL_OK);
     assert_int_equal(wo.range_um, 2640000);
     assert_false(wo.clamped);
     // Within half an LSB of the um input everywhere (the whole RangeInner range, 1 um steps
@@ -393,7 +511,7 @@ static void test_canmsg_ranges_are_rounded_once_from_um(void **state)
         for (uint32_t d = 9990; d <= 10010; d++) {
             const sl_can_pole_lean_t q = {.range_inner_um = raw * 20000U + d};
             assert_int_equal(sl_can_encode_pole_lean(&tx, &q, &f), SL_OK);
-            assert_int_equal(sl_can_decode_pole_lean(&f, &po), SL_OK);
+            assert_int_equal(sl_can_decode_pole_lean(&f, E2E(POLE_LEAN), &po), SL_OK);
             assert_int_equal(po.range_inner_um, (raw + (d >= 10000U ? 1U : 0U)) * 20000U);
         }
     }
@@ -445,7 +563,7 @@ static void test_canmsg_clamps_and_flags_out_of_range_values(void **state)
                                  .lean_cdeg = cases[i].lean, .lean_sigma_cdeg = cases[i].sigma,
                                  .range_inner_um = cases[i].r1, .range_outer_um = cases[i].r2};
         assert_int_equal(sl_can_encode_pole_lean(&tx, &in, &f), SL_OK);
-        assert_int_equal(sl_can_decode_pole_lean(&f, &out), SL_OK);
+        assert_int_equal(sl_can_decode_pole_lean(&f, E2E(POLE_LEAN), &out), SL_OK);
         assert_int_equal(out.lean_cdeg, cases[i].want_lean);
         assert_int_equal(out.lean_sigma_cdeg, cases[i].want_sigma);
         assert_int_equal(out.range_inner_um, cases[i].want_r1);
@@ -469,7 +587,7 @@ static void test_canmsg_azimuth_wraps_modulo_a_turn_not_clamped(void **state)
     for (size_t i = 0; i < sizeof in_az / sizeof in_az[0]; i++) {
         sl_can_pole_lean_t in = {.azimuth_cdeg = in_az[i]};
         assert_int_equal(sl_can_encode_pole_lean(&tx, &in, &f), SL_OK);
-        assert_int_equal(sl_can_decode_pole_lean(&f, &out), SL_OK);
+        assert_int_equal(sl_can_decode_pole_lean(&f, E2E(POLE_LEAN), &out), SL_OK);
         int64_t a = (int64_t)in_az[i] % 36000;
         a += (a < 0) ? 36000 : 0;
         const int64_t want = (ref_round(a, 20) % 1800) * 20;
@@ -478,7 +596,7 @@ static void test_canmsg_azimuth_wraps_modulo_a_turn_not_clamped(void **state)
     }
     sl_can_pole_lean_t in = {.azimuth_cdeg = 35990}; // 359.9 deg -> 360.0 -> 0
     sl_can_encode_pole_lean(&tx, &in, &f);
-    sl_can_decode_pole_lean(&f, &out);
+    sl_can_decode_pole_lean(&f, E2E(POLE_LEAN), &out);
     assert_int_equal(out.azimuth_cdeg, 0);
 }
 
@@ -500,7 +618,7 @@ static void test_canmsg_lean_warning_round_trips_and_clamps(void **state)
         };
         assert_int_equal(sl_can_encode_lean_warning(&tx, &in, &f), SL_OK);
         assert_int_equal(f.id, ID_WARN);
-        assert_int_equal(sl_can_decode_lean_warning(&f, &out), SL_OK);
+        assert_int_equal(sl_can_decode_lean_warning(&f, E2E(LEAN_WARNING), &out), SL_OK);
         assert_int_equal(out.level, in.level);
         assert_true(out.has_target);
         assert_int_equal(out.target_id, in.target_id);
@@ -515,7 +633,7 @@ static void test_canmsg_lean_warning_round_trips_and_clamps(void **state)
     sl_can_lean_warning_t in = {.level = 7, .has_target = true, .lean_cdeg = 15000,
                                 .range_um = 30000000, .lean_sigma_cdeg = 100};
     sl_can_encode_lean_warning(&tx, &in, &f);
-    assert_int_equal(sl_can_decode_lean_warning(&f, &out), SL_OK);
+    assert_int_equal(sl_can_decode_lean_warning(&f, E2E(LEAN_WARNING), &out), SL_OK);
     assert_int_equal(out.level, SL_CAN_LEVEL_DANGER);
     assert_int_equal(out.lean_cdeg, 2047 * 5);
     assert_int_equal(out.range_um, 20470000);
@@ -524,7 +642,7 @@ static void test_canmsg_lean_warning_round_trips_and_clamps(void **state)
     sl_can_lean_warning_t none = {.level = SL_CAN_LEVEL_NONE, .has_target = false,
                                   .target_id = 3, .lean_cdeg = 999, .range_um = 77000};
     sl_can_encode_lean_warning(&tx, &none, &f);
-    assert_int_equal(sl_can_decode_lean_warning(&f, &out), SL_OK);
+    assert_int_equal(sl_can_decode_lean_warning(&f, E2E(LEAN_WARNING), &out), SL_OK);
     assert_false(out.has_target);
     assert_int_equal(out.target_id, 0);
     assert_int_equal(out.lean_cdeg, 0);
@@ -549,7 +667,7 @@ static void test_canmsg_status_counters_saturate_and_flag(void **state)
                               .decoder_resyncs = (uint32_t)rnd_range(0, 255),
                               .can_dropped = (uint32_t)rnd_range(0, 255)};
         sl_can_encode_status(&tx, &in, &f);
-        assert_int_equal(sl_can_decode_status(&f, &out), SL_OK);
+        assert_int_equal(sl_can_decode_status(&f, E2E(STATUS), &out), SL_OK);
         assert_int_equal(out.link_state, in.link_state);
         assert_int_equal(out.rotations, in.rotations);
         assert_int_equal(out.azimuths_missing, in.azimuths_missing);
@@ -561,7 +679,7 @@ static void test_canmsg_status_counters_saturate_and_flag(void **state)
                                  .azimuths_missing = UINT32_MAX, .decoder_resyncs = 256,
                                  .can_dropped = 1000};
     sl_can_encode_status(&tx, &big, &f);
-    assert_int_equal(sl_can_decode_status(&f, &out), SL_OK);
+    assert_int_equal(sl_can_decode_status(&f, E2E(STATUS), &out), SL_OK);
     assert_true(out.saturated);
     assert_int_equal(out.rotations, 262143);
     assert_int_equal(out.azimuths_missing, 16383);
@@ -570,7 +688,7 @@ static void test_canmsg_status_counters_saturate_and_flag(void **state)
     assert_int_equal(out.link_state, SL_CAN_LINK_SILENT);
     const sl_can_status_t bad_link = {.link_state = 9};
     sl_can_encode_status(&tx, &bad_link, &f);
-    sl_can_decode_status(&f, &out);
+    sl_can_decode_status(&f, E2E(STATUS), &out);
     assert_int_equal(out.link_state, SL_CAN_LINK_DISCONNECTED);
     assert_true(out.saturated);
     assert_int_equal(tx.stats.clamped_frames, 2);
@@ -593,19 +711,19 @@ static void test_canmsg_health_round_trips_saturates_and_keeps_reserved_bits_zer
         assert_int_equal(sl_can_encode_health(&tx, &in, &f), SL_OK);
         assert_int_equal(f.id, ID_HEALTH);
         assert_int_equal(f.dlc, 8);
-        assert_int_equal(sl_can_decode_health(&f, &out), SL_OK);
+        assert_int_equal(sl_can_decode_health(&f, E2E(HEALTH), &out), SL_OK);
         assert_int_equal(out.fault, in.fault);
         assert_int_equal(out.reconnects, in.reconnects);
         assert_int_equal(out.candidates_dropped, in.candidates_dropped);
         assert_int_equal(f.data[1] & 0xF0U, 0);   // reserved 12|4
         assert_int_equal(f.data[6] & 0xF0U, 0);   // ThetaDrift 52|8: 0 here
         assert_int_equal(f.data[7], 0);           // ... and reserved 60|4
-        assert_int_equal(f.data[0], sl_can_e2e_crc(SL_CAN_DATA_ID_HEALTH, f.data));
+        assert_int_equal(f.data[0], sl_can_e2e_crc(E2E(HEALTH), f.data));
     }
     assert_int_equal(tx.stats.clamped_frames, 0);
     const sl_can_health_t big = {.fault = 0xFFFFU, .reconnects = 256, .candidates_dropped = 5000};
     sl_can_encode_health(&tx, &big, &f);
-    assert_int_equal(sl_can_decode_health(&f, &out), SL_OK);
+    assert_int_equal(sl_can_decode_health(&f, E2E(HEALTH), &out), SL_OK);
     assert_int_equal(out.fault, SL_CAN_FAULT_DEFINED);
     assert_int_equal(out.reconnects, 255);
     assert_int_equal(out.candidates_dropped, 4095);
@@ -619,14 +737,14 @@ static void test_canmsg_health_round_trips_saturates_and_keeps_reserved_bits_zer
     assert_int_equal(f.data[4], 0x03);
     assert_int_equal(f.data[5], 0xBC);
     assert_int_equal(f.data[6], 0x0A);
-    assert_int_equal(sl_can_decode_health(NULL, NULL), SL_ERR_ARG);
+    assert_int_equal(sl_can_decode_health(NULL, E2E(HEALTH), NULL), SL_ERR_ARG);
     assert_int_equal(sl_can_encode_health(NULL, &g, &f), SL_ERR_ARG);
     f.data[0] ^= 1U;
-    assert_int_equal(sl_can_decode_health(&f, &out), SL_ERR_MALFORMED);
+    assert_int_equal(sl_can_decode_health(&f, E2E(HEALTH), &out), SL_ERR_MALFORMED);
     const sl_can_message_desc_t *md = sl_can_layout(SL_CAN_MSG_HEALTH);
     assert_string_equal(md->name, "Health");
     assert_int_equal(md->data_id, SL_CAN_DATA_ID_HEALTH);
-    assert_int_equal(md->signals[2].n_values, 10); // bit 9 THETA_DRIFT (sl_drift.h)
+    assert_int_equal(md->signals[2].n_values, 11); // bit 9 THETA_DRIFT, bit 10 MOTION_E2E
     for (unsigned k = 0; k < md->signals[2].n_values; k++) {
         assert_int_equal(md->signals[2].values[k].value, 1U << k);
     }
@@ -642,7 +760,7 @@ static void test_canmsg_health_theta_drift_round_trips_and_saturates(void **stat
     for (int32_t raw = -128; raw <= 127; raw++) {
         const sl_can_health_t in = {.theta_drift_cdeg = (int16_t)(raw * 10)};
         assert_int_equal(sl_can_encode_health(&tx, &in, &f), SL_OK);
-        assert_int_equal(sl_can_decode_health(&f, &out), SL_OK);
+        assert_int_equal(sl_can_decode_health(&f, E2E(HEALTH), &out), SL_OK);
         assert_int_equal(out.theta_drift_cdeg, in.theta_drift_cdeg);
         assert_int_equal(f.data[7] & 0xF0U, 0); // reserved 60|4
     }
@@ -657,11 +775,11 @@ static void test_canmsg_health_theta_drift_round_trips_and_saturates(void **stat
     // 0.05 deg rounds half up to 0.1; -0.05 to 0.0; beyond +-12.8 deg saturates (clamped)
     const sl_can_health_t h1 = {.theta_drift_cdeg = 5};
     sl_can_encode_health(&tx, &h1, &f);
-    sl_can_decode_health(&f, &out);
+    sl_can_decode_health(&f, E2E(HEALTH), &out);
     assert_int_equal(out.theta_drift_cdeg, 10);
     const sl_can_health_t big = {.theta_drift_cdeg = -2000};
     sl_can_encode_health(&tx, &big, &f);
-    sl_can_decode_health(&f, &out);
+    sl_can_decode_health(&f, E2E(HEALTH), &out);
     assert_int_equal(out.theta_drift_cdeg, -1280);
     assert_int_equal(tx.stats.clamped_frames, 1);
 }
@@ -679,7 +797,7 @@ static void test_canmsg_vehicle_motion_round_trips_full_range(void **state)
                                       .yaw_rate_valid = (raw & 2) != 0};
         assert_int_equal(sl_can_encode_vehicle_motion(&tx, &in, &f), SL_OK);
         assert_int_equal(f.id, ID_MOTION);
-        assert_int_equal(sl_can_decode_vehicle_motion(&f, &out), SL_OK);
+        assert_int_equal(sl_can_decode_vehicle_motion(&f, E2E(VEHICLE_MOTION), &out), SL_OK);
         assert_int_equal(out.speed_mm_s, in.speed_mm_s);
         assert_int_equal(out.yaw_rate_cdeg_s, in.yaw_rate_cdeg_s);
         assert_int_equal(out.speed_valid, in.speed_valid);
@@ -688,18 +806,18 @@ static void test_canmsg_vehicle_motion_round_trips_full_range(void **state)
     assert_int_equal(tx.stats.clamped_frames, 0);
     const sl_can_vehicle_motion_t fast = {.speed_mm_s = 400000, .yaw_rate_cdeg_s = -40000};
     sl_can_encode_vehicle_motion(&tx, &fast, &f);
-    sl_can_decode_vehicle_motion(&f, &out);
+    sl_can_decode_vehicle_motion(&f, E2E(VEHICLE_MOTION), &out);
     assert_int_equal(out.speed_mm_s, 327670);
     assert_int_equal(out.yaw_rate_cdeg_s, -32768);
     assert_int_equal(tx.stats.clamped_frames, 1);
     // 1.235 m/s = 123.5 LSB rounds half up to 124 -> 1240 mm/s; -1.235 -> -123.5 -> -123
     const sl_can_vehicle_motion_t half = {.speed_mm_s = 1235};
     sl_can_encode_vehicle_motion(&tx, &half, &f);
-    sl_can_decode_vehicle_motion(&f, &out);
+    sl_can_decode_vehicle_motion(&f, E2E(VEHICLE_MOTION), &out);
     assert_int_equal(out.speed_mm_s, 1240);
     const sl_can_vehicle_motion_t nhalf = {.speed_mm_s = -1235};
     sl_can_encode_vehicle_motion(&tx, &nhalf, &f);
-    sl_can_decode_vehicle_motion(&f, &out);
+    sl_can_decode_vehicle_motion(&f, E2E(VEHICLE_MOTION), &out);
     assert_int_equal(out.speed_mm_s, -1230);
 }
 
@@ -733,97 +851,128 @@ static void test_canmsg_e2e_detects_every_single_bit_error(void **state)
                                   .range_outer_um = 3300000, .azimuth_cdeg = 9000};
     sl_can_encode_pole_lean(&tx, &p, &f);
     sl_can_e2e_rx_t rx;
-    sl_can_e2e_rx_init(&rx);
+    sl_can_e2e_rx_init(&rx, 1U);
     for (unsigned bit = 0; bit < 64U; bit++) {
         sl_can_frame_t g = f;
         g.data[bit / 8U] ^= (uint8_t)(1U << (bit % 8U));
-        assert_int_equal(sl_can_e2e_check(&rx, SL_CAN_DATA_ID_POLE_LEAN, &g), SL_ERR_MALFORMED);
+        assert_int_equal(sl_can_e2e_check(&rx, E2E(POLE_LEAN), &g), SL_CAN_E2E_ERROR);
         sl_can_pole_lean_t out;
-        assert_int_equal(sl_can_decode_pole_lean(&g, &out), SL_ERR_MALFORMED);
+        assert_int_equal(sl_can_decode_pole_lean(&g, E2E(POLE_LEAN), &out), SL_ERR_MALFORMED);
     }
     assert_int_equal(rx.stats.crc_errors, 64);
-    assert_int_equal(rx.stats.accepted, 0);
+    assert_int_equal(rx.stats.status[SL_CAN_E2E_ERROR], 64);
+    assert_false(rx.synced); // errors never touch the sequence
     // The right frame under another Data ID (e.g. received on the Status id) is rejected.
-    assert_int_equal(sl_can_e2e_check(&rx, SL_CAN_DATA_ID_STATUS, &f), SL_ERR_MALFORMED);
+    assert_int_equal(sl_can_e2e_check(&rx, E2E(STATUS), &f), SL_CAN_E2E_ERROR);
     sl_can_status_t st;
-    assert_int_equal(sl_can_decode_status(&f, &st), SL_ERR_MALFORMED);
-    assert_int_equal(sl_can_e2e_check(&rx, SL_CAN_DATA_ID_POLE_LEAN, &f), SL_OK);
+    assert_int_equal(sl_can_decode_status(&f, E2E(STATUS), &st), SL_ERR_MALFORMED);
+    assert_int_equal(sl_can_e2e_check(&rx, E2E(POLE_LEAN), &f), SL_CAN_E2E_INITIAL);
     // Wrong DLC, RTR and error frames.
     sl_can_frame_t g = f;
     g.dlc = 7;
-    assert_int_equal(sl_can_e2e_check(&rx, SL_CAN_DATA_ID_POLE_LEAN, &g), SL_ERR_MALFORMED);
+    assert_int_equal(sl_can_e2e_check(&rx, E2E(POLE_LEAN), &g), SL_CAN_E2E_ERROR);
     g = f;
     g.flags = SL_CAN_FLAG_RTR;
-    assert_int_equal(sl_can_e2e_check(&rx, SL_CAN_DATA_ID_POLE_LEAN, &g), SL_ERR_MALFORMED);
+    assert_int_equal(sl_can_e2e_check(&rx, E2E(POLE_LEAN), &g), SL_CAN_E2E_ERROR);
     assert_int_equal(rx.stats.bad_dlc, 2);
     // Counter 15 with a correct CRC.
     g = f;
     g.data[1] = (uint8_t)((g.data[1] & 0xF0U) | 0x0FU);
-    g.data[0] = sl_can_e2e_crc(SL_CAN_DATA_ID_POLE_LEAN, g.data);
-    assert_int_equal(sl_can_e2e_check(&rx, SL_CAN_DATA_ID_POLE_LEAN, &g), SL_ERR_MALFORMED);
+    g.data[0] = sl_can_e2e_crc(E2E(POLE_LEAN), g.data);
+    assert_int_equal(sl_can_e2e_check(&rx, E2E(POLE_LEAN), &g), SL_CAN_E2E_ERROR);
     assert_int_equal(rx.stats.bad_counter, 1);
+    // A receive cycle without a frame.
+    assert_int_equal(sl_can_e2e_check(&rx, E2E(POLE_LEAN), NULL), SL_CAN_E2E_NO_NEW_DATA);
+    assert_int_equal(rx.stats.status[SL_CAN_E2E_NO_NEW_DATA], 1);
+    assert_int_equal(rx.last_status, SL_CAN_E2E_NO_NEW_DATA);
 }
 
-static void test_canmsg_e2e_counts_jumps_and_rejects_repeats(void **state)
+// The Profile 11 statuses of a sequence with max delta counter 3: step 1 OK, 2..3
+// OK_SOME_LOST, 0 REPEATED, 4 and more WRONG_SEQUENCE; the counter state follows every
+// frame with a valid CRC, so the frame after a WRONG_SEQUENCE one continues from it.
+static void test_canmsg_e2e_classifies_steps_with_the_max_delta_counter(void **state)
 {
     (void)state;
     sl_can_tx_t tx;
     tx_setup(&tx);
     sl_can_e2e_rx_t rx;
-    sl_can_e2e_rx_init(&rx);
+    sl_can_e2e_rx_init(&rx, 3U);
     sl_can_frame_t fr[40];
     const sl_can_status_t s = {.link_state = SL_CAN_LINK_STREAMING};
     for (unsigned i = 0; i < 40U; i++) {
         sl_can_encode_status(&tx, &s, &fr[i]);
     }
-    assert_int_equal(sl_can_e2e_check(&rx, SL_CAN_DATA_ID_STATUS, &fr[0]), SL_OK);
-    assert_int_equal(sl_can_e2e_check(&rx, SL_CAN_DATA_ID_STATUS, &fr[1]), SL_OK);
-    assert_int_equal(sl_can_e2e_check(&rx, SL_CAN_DATA_ID_STATUS, &fr[1]), SL_ERR_STATE);
-    assert_int_equal(rx.stats.repeated, 1);
-    // Lose 3 frames (2, 3, 4), across no wrap.
-    assert_int_equal(sl_can_e2e_check(&rx, SL_CAN_DATA_ID_STATUS, &fr[5]), SL_OK);
-    assert_int_equal(rx.stats.counter_jumps, 1);
-    assert_int_equal(rx.stats.lost_frames, 3);
+    const sl_can_e2e_cfg_t *c = E2E(STATUS);
+    assert_int_equal(sl_can_e2e_check(&rx, c, &fr[0]), SL_CAN_E2E_INITIAL);
+    assert_int_equal(sl_can_e2e_check(&rx, c, &fr[1]), SL_CAN_E2E_OK);
+    assert_int_equal(sl_can_e2e_check(&rx, c, &fr[1]), SL_CAN_E2E_REPEATED);
+    assert_int_equal(sl_can_e2e_check(&rx, c, &fr[4]), SL_CAN_E2E_OK_SOME_LOST); // step 3
+    assert_int_equal(rx.stats.lost_frames, 2);
+    assert_int_equal(sl_can_e2e_check(&rx, c, &fr[9]), SL_CAN_E2E_WRONG_SEQUENCE); // step 5
+    assert_int_equal(sl_can_e2e_check(&rx, c, &fr[10]), SL_CAN_E2E_OK);
     // In sequence across the 14 -> 0 wrap.
-    for (unsigned i = 6; i < 20U; i++) {
-        assert_int_equal(sl_can_e2e_check(&rx, SL_CAN_DATA_ID_STATUS, &fr[i]), SL_OK);
+    for (unsigned i = 11; i < 20U; i++) {
+        assert_int_equal(sl_can_e2e_check(&rx, c, &fr[i]), SL_CAN_E2E_OK);
     }
-    assert_int_equal(rx.stats.counter_jumps, 1);
-    // Lose 7 frames (20..26), then 5 across the 14 -> 0 wrap (28..32).
-    assert_int_equal(sl_can_e2e_check(&rx, SL_CAN_DATA_ID_STATUS, &fr[27]), SL_OK);
-    assert_int_equal(sl_can_e2e_check(&rx, SL_CAN_DATA_ID_STATUS, &fr[33]), SL_OK);
-    assert_int_equal(rx.stats.counter_jumps, 3);
-    assert_int_equal(rx.stats.lost_frames, 3 + 7 + 5);
-    // After a reset the next frame is accepted whatever its counter (even a repeat).
+    // Frame i carries counter i mod 15: 19 (counter 4) -> 27 (12) is a step of 8; 27 -> 29
+    // (14) is 2; 29 -> 31 (counter 1) is 2 over the 14 -> 0 wrap.
+    assert_int_equal(sl_can_e2e_check(&rx, c, &fr[27]), SL_CAN_E2E_WRONG_SEQUENCE);
+    assert_int_equal(sl_can_e2e_check(&rx, c, &fr[29]), SL_CAN_E2E_OK_SOME_LOST);
+    assert_int_equal(sl_can_e2e_check(&rx, c, &fr[31]), SL_CAN_E2E_OK_SOME_LOST);
+    assert_int_equal(rx.stats.status[SL_CAN_E2E_OK], 11);
+    assert_int_equal(rx.stats.status[SL_CAN_E2E_OK_SOME_LOST], 3);
+    assert_int_equal(rx.stats.status[SL_CAN_E2E_WRONG_SEQUENCE], 2);
+    assert_int_equal(rx.stats.status[SL_CAN_E2E_REPEATED], 1);
+    assert_int_equal(rx.stats.lost_frames, 2 + 4 + 7 + 1 + 1);
+    // After a reset the next frame is INITIAL whatever its counter (even a repeat).
     sl_can_e2e_rx_reset(&rx);
-    assert_int_equal(sl_can_e2e_check(&rx, SL_CAN_DATA_ID_STATUS, &fr[33]), SL_OK);
-    assert_int_equal(rx.stats.accepted, 2 + 1 + 14 + 2 + 1);
+    assert_int_equal(sl_can_e2e_check(&rx, c, &fr[31]), SL_CAN_E2E_INITIAL);
+    assert_int_equal(rx.stats.status[SL_CAN_E2E_INITIAL], 2);
+    // The max delta counter is clamped to 1..14; 1 makes every gap a WRONG_SEQUENCE.
+    sl_can_e2e_rx_init(&rx, 0U);
+    assert_int_equal(rx.max_delta_counter, 1);
+    sl_can_e2e_rx_init(&rx, 200U);
+    assert_int_equal(rx.max_delta_counter, 14);
+    assert_true(sl_can_e2e_status_ok(SL_CAN_E2E_OK_SOME_LOST));
+    assert_false(sl_can_e2e_status_ok(SL_CAN_E2E_INITIAL));
+    assert_string_equal(sl_can_e2e_status_name(SL_CAN_E2E_WRONG_SEQUENCE), "WRONG_SEQUENCE");
+    assert_string_equal(sl_can_e2e_status_name((sl_can_e2e_status_t)99), "?");
 }
 
 static void test_canmsg_tx_init_validates_ids(void **state)
 {
     (void)state;
     sl_can_tx_t tx;
-    sl_can_ids_t bad = {{0x800U, 1U, 2U, 3U}};
-    assert_int_equal(sl_can_tx_init(&tx, &bad), SL_ERR_ARG);
-    sl_can_ids_t dup = {{5U, 6U, 5U, 7U}};
-    assert_int_equal(sl_can_tx_init(&tx, &dup), SL_ERR_ARG);
-    sl_can_ids_t eff_bad = {{0x80000000UL | 0x20000000UL, 1U, 2U, 3U}};
-    assert_int_equal(sl_can_tx_init(&tx, &eff_bad), SL_ERR_ARG);
-    sl_can_ids_t eff = {{0x80000000UL | 0x18FF1234UL, 0x7FFU, 0U, 0x123U, 0x124U, 0x125U}};
-    assert_int_equal(sl_can_tx_init(&tx, &eff), SL_OK);
-    assert_int_equal(sl_can_tx_init(NULL, &eff), SL_ERR_ARG);
+    sl_can_ids_t ids;
+    sl_can_ids_default(&ids);
+    ids.id[SL_CAN_MSG_POLE_LEAN] = 0x800U;
+    assert_int_equal(sl_can_tx_init(&tx, &ids), SL_ERR_ARG);
+    sl_can_ids_default(&ids);
+    ids.id[SL_CAN_MSG_STATUS] = ids.id[SL_CAN_MSG_POLE_LEAN];
+    assert_int_equal(sl_can_tx_init(&tx, &ids), SL_ERR_ARG);
+    sl_can_ids_default(&ids);
+    ids.id[SL_CAN_MSG_POLE_LEAN] = 0x80000000UL | 0x20000000UL;
+    assert_int_equal(sl_can_tx_init(&tx, &ids), SL_ERR_ARG);
+    const uint32_t eff[SL_CAN_MSG_COUNT] = {0x80000000UL | 0x18FF1234UL, 0x7FFU, 0U, 0x123U,
+                                            0x124U, 0x125U};
+    memcpy(ids.id, eff, sizeof eff);
+    assert_int_equal(sl_can_tx_init(&tx, &ids), SL_OK);
+    assert_int_equal(sl_can_tx_init(NULL, &ids), SL_ERR_ARG);
     sl_can_frame_t f;
     const sl_can_pole_lean_t p = {0};
     sl_can_encode_pole_lean(&tx, &p, &f);
     assert_int_equal(f.id, 0x18FF1234UL);
     assert_int_equal(f.flags, SL_CAN_FLAG_EFF);
+    sl_can_pole_lean_t back;
+    assert_int_equal(sl_can_decode_pole_lean(&f, E2E(POLE_LEAN), &back), SL_OK);
     const sl_can_status_t s = {0};
     sl_can_encode_status(&tx, &s, &f);
     assert_int_equal(f.id, 0);
     assert_int_equal(f.flags, 0);
     assert_int_equal(sl_can_encode_status(NULL, &s, &f), SL_ERR_ARG);
-    assert_int_equal(sl_can_decode_status(NULL, NULL), SL_ERR_ARG);
+    assert_int_equal(sl_can_decode_status(NULL, E2E(STATUS), NULL), SL_ERR_ARG);
+    sl_can_status_t back_status;
+    assert_int_equal(sl_can_decode_status(&f, NULL, &back_status), SL_ERR_ARG);
 }
 
 static void test_canmsg_motion_rx_checks_id_sequence_and_age(void **state)
@@ -832,7 +981,7 @@ static void test_canmsg_motion_rx_checks_id_sequence_and_age(void **state)
     sl_can_tx_t tx;
     tx_setup(&tx);
     sl_can_motion_rx_t rx;
-    sl_can_motion_rx_init(&rx, ID_MOTION, 100000U);
+    sl_can_motion_rx_init(&rx, ID_MOTION, E2E(VEHICLE_MOTION), 2U, 100000U);
     sl_can_vehicle_motion_t mv;
     assert_false(sl_can_motion_rx_get(&rx, 0, &mv));
     sl_can_frame_t f[10];
@@ -841,61 +990,70 @@ static void test_canmsg_motion_rx_checks_id_sequence_and_age(void **state)
                                             .speed_valid = true, .yaw_rate_valid = true};
         sl_can_encode_vehicle_motion(&tx, &in, &f[i]);
     }
+    const uint32_t *n = rx.e2e.stats.status;
     uint64_t t = 1000000;
-    // The first frame only synchronises the sequence: its value is not used.
-    assert_int_equal(sl_can_motion_rx_feed(&rx, &f[9], t - 20000), SL_OK);
-    assert_int_equal(rx.stats.sync_only, 1);
+    // The first frame only synchronises the sequence (INITIAL): its value is not used.
+    assert_int_equal(sl_can_motion_rx_feed(&rx, &f[8], t - 20000), SL_OK);
+    assert_int_equal(n[SL_CAN_E2E_INITIAL], 1);
     assert_false(sl_can_motion_rx_get(&rx, t - 20000, &mv));
-    // The next one continues it (a jump: 9 -> 0 over the modulo 15, frames lost): used.
-    assert_int_equal(sl_can_motion_rx_feed(&rx, &f[0], t), SL_OK);
-    assert_int_equal(rx.e2e.stats.counter_jumps, 1);
+    // A step of 7 is WRONG_SEQUENCE at max delta 2 (not used; the sequence continues from
+    // it), then a step of 2 is OK_SOME_LOST: used.
+    assert_int_equal(sl_can_motion_rx_feed(&rx, &f[0], t - 10000), SL_ERR_STATE); // 8 -> 0: step 7
+    assert_int_equal(n[SL_CAN_E2E_WRONG_SEQUENCE], 1);
+    assert_false(sl_can_motion_rx_get(&rx, t - 10000, &mv)); // WRONG_SEQUENCE: not used
+    assert_int_equal(sl_can_motion_rx_feed(&rx, &f[2], t), SL_OK); // 0 -> 2: step 2
+    assert_int_equal(n[SL_CAN_E2E_OK_SOME_LOST], 1);
     assert_true(sl_can_motion_rx_get(&rx, t + 100000, &mv));
-    assert_int_equal(mv.speed_mm_s, 0);
+    assert_int_equal(mv.speed_mm_s, 2000);
     assert_false(sl_can_motion_rx_get(&rx, t + 100001, &mv));
     // Another id is ignored and counted.
-    sl_can_frame_t other = f[1];
+    sl_can_frame_t other = f[3];
     other.id = ID_STATUS;
     assert_int_equal(sl_can_motion_rx_feed(&rx, &other, t), SL_ERR_ARG);
     assert_int_equal(rx.stats.other_ids, 1);
-    other = f[1];
+    other = f[3];
     other.flags = SL_CAN_FLAG_EFF; // same number as a 29-bit id is another id
     assert_int_equal(sl_can_motion_rx_feed(&rx, &other, t), SL_ERR_ARG);
-    // A corrupted frame is rejected and the last good value kept.
-    sl_can_frame_t bad = f[1];
+    // A corrupted frame is an ERROR and the last good value is kept.
+    sl_can_frame_t bad = f[3];
     bad.data[3] ^= 0x40U;
     assert_int_equal(sl_can_motion_rx_feed(&rx, &bad, t + 10000), SL_ERR_MALFORMED);
     assert_int_equal(rx.e2e.stats.crc_errors, 1);
+    assert_int_equal(rx.e2e.last_status, SL_CAN_E2E_ERROR);
     assert_true(sl_can_motion_rx_get(&rx, t + 10000, &mv));
-    assert_int_equal(mv.speed_mm_s, 0);
-    // Frames 1 and 2 lost: a jump of 2.
+    assert_int_equal(mv.speed_mm_s, 2000);
+    // In sequence: OK.
     assert_int_equal(sl_can_motion_rx_feed(&rx, &f[3], t + 20000), SL_OK);
-    assert_int_equal(rx.e2e.stats.counter_jumps, 2);
-    assert_int_equal(rx.e2e.stats.lost_frames, 5 + 2);
+    assert_int_equal(n[SL_CAN_E2E_OK], 1);
     assert_true(sl_can_motion_rx_get(&rx, t + 20000, &mv));
     assert_int_equal(mv.speed_mm_s, 3000);
     assert_int_equal(mv.yaw_rate_cdeg_s, -150);
     assert_true(mv.speed_valid && mv.yaw_rate_valid);
-    // Repeat rejected.
+    // A repetition is REPEATED: rejected, and it does not renew the value's age.
     assert_int_equal(sl_can_motion_rx_feed(&rx, &f[3], t + 30000), SL_ERR_STATE);
-    // After a gap longer than the timeout, the sequence restarts: no jump counted, and the
-    // first frame after the gap (here a stale repetition of frame 3, 3.0 m/s)
-    // only synchronises: never used, whatever its counter.
+    assert_int_equal(n[SL_CAN_E2E_REPEATED], 1);
+    assert_false(sl_can_motion_rx_get(&rx, t + 120001, &mv));
+    // After a gap longer than the timeout: one NO_NEW_DATA, the sequence restarts, and the
+    // first frame after the gap (here a stale repetition of frame 3, 3.0 m/s) is INITIAL:
+    // never used, whatever its counter.
     assert_int_equal(sl_can_motion_rx_feed(&rx, &f[3], t + 500000), SL_OK);
-    assert_int_equal(rx.stats.timeouts, 1);
-    assert_int_equal(rx.stats.sync_only, 2);
-    assert_int_equal(rx.e2e.stats.counter_jumps, 2);
+    assert_int_equal(n[SL_CAN_E2E_NO_NEW_DATA], 1);
+    assert_int_equal(n[SL_CAN_E2E_INITIAL], 2);
     assert_false(sl_can_motion_rx_get(&rx, t + 500000, &mv));
     assert_int_equal(sl_can_motion_rx_feed(&rx, &f[4], t + 520000), SL_OK);
     assert_true(sl_can_motion_rx_get(&rx, t + 520000, &mv));
     assert_int_equal(mv.speed_mm_s, 4000);
-    assert_int_equal(rx.e2e.stats.counter_jumps, 2);
+    assert_int_equal(n[SL_CAN_E2E_OK] + n[SL_CAN_E2E_OK_SOME_LOST], 3);
 }
 
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_canmsg_crc8_check_value_is_0x4b),
-        cmocka_unit_test(test_canmsg_e2e_crc_mixes_data_id_first),
+        cmocka_unit_test(test_canmsg_crc8_0x1d_gives_the_sae_j1850_and_gsm_a_check_values),
+        cmocka_unit_test(test_canmsg_e2e_crc_matches_independent_profile_11_vectors),
+        cmocka_unit_test(test_canmsg_e2e_crc_of_every_message_matches_its_vectors),
+        cmocka_unit_test(test_canmsg_tx_init_refuses_nibble_mode_over_signals_and_shared_data_ids),
+        cmocka_unit_test(test_canmsg_e2e_crc_mixes_both_data_id_bytes_first),
         cmocka_unit_test(test_canmsg_crc_worked_example),
         cmocka_unit_test(test_canmsg_pole_lean_golden_bytes),
         cmocka_unit_test(test_canmsg_layout_table_is_consistent),
@@ -911,7 +1069,7 @@ int main(void)
         cmocka_unit_test(test_canmsg_health_round_trips_saturates_and_keeps_reserved_bits_zero),
         cmocka_unit_test(test_canmsg_counter_wraps_modulo_15_per_message),
         cmocka_unit_test(test_canmsg_e2e_detects_every_single_bit_error),
-        cmocka_unit_test(test_canmsg_e2e_counts_jumps_and_rejects_repeats),
+        cmocka_unit_test(test_canmsg_e2e_classifies_steps_with_the_max_delta_counter),
         cmocka_unit_test(test_canmsg_tx_init_validates_ids),
         cmocka_unit_test(test_canmsg_pole_tilt_layout_encode_decode),
         cmocka_unit_test(test_canmsg_motion_rx_checks_id_sequence_and_age),

@@ -27,6 +27,15 @@
 
 #include "shadowlean/sl_pipeline.h"
 
+/// The default E2E configuration of message SL_CAN_MSG_<m> (the boards under test use it).
+#define E2E(m) (&sl_can_e2e_defaults[SL_CAN_MSG_##m])
+
+/// The receiver took the frame as part of its sequence (the first one, or any later step).
+static bool e2e_accepted(sl_can_e2e_status_t st)
+{
+    return st == SL_CAN_E2E_OK || st == SL_CAN_E2E_OK_SOME_LOST || st == SL_CAN_E2E_INITIAL;
+}
+
 #define PI 3.14159265358979323846
 #define DEG (PI / 180.0)
 
@@ -656,7 +665,7 @@ static void test_pipeline_can_frames_decode_to_the_targets(void **state)
     assert_int_equal(rec.rotations, 24);
     sl_can_e2e_rx_t rx[4];
     for (int i = 0; i < 4; i++) {
-        sl_can_e2e_rx_init(&rx[i]);
+        sl_can_e2e_rx_init(&rx[i], SL_CAN_COUNTER_MODULO - 1U);
     }
     int pole_frames[MAXROT] = {0}, statuses = 0, warnings = 0, healths = 0;
     const int n = B->mask_frames, confirm = c.confirm_hits;
@@ -664,9 +673,9 @@ static void test_pipeline_can_frames_decode_to_the_targets(void **state)
         const sl_can_frame_t *f = &rec.can[i];
         const int k = rec.can_rot[i];
         if (f->id == B->can_id_pole_lean) {
-            assert_int_equal(sl_can_e2e_check(&rx[0], SL_CAN_DATA_ID_POLE_LEAN, f), SL_OK);
+            assert_true(e2e_accepted(sl_can_e2e_check(&rx[0], E2E(POLE_LEAN), f)));
             sl_can_pole_lean_t m;
-            assert_int_equal(sl_can_decode_pole_lean(f, &m), SL_OK);
+            assert_int_equal(sl_can_decode_pole_lean(f, E2E(POLE_LEAN), &m), SL_OK);
             pole_frames[k]++;
             // The target of this rotation at that azimuth (0.2 deg LSB, az step 0.9 deg).
             const sl_target_t *t = NULL;
@@ -690,9 +699,9 @@ static void test_pipeline_can_frames_decode_to_the_targets(void **state)
             }
             assert_false(m.clamped);
         } else if (f->id == B->can_id_lean_warning) {
-            assert_int_equal(sl_can_e2e_check(&rx[1], SL_CAN_DATA_ID_LEAN_WARNING, f), SL_OK);
+            assert_true(e2e_accepted(sl_can_e2e_check(&rx[1], E2E(LEAN_WARNING), f)));
             sl_can_lean_warning_t w;
-            assert_int_equal(sl_can_decode_lean_warning(f, &w), SL_OK);
+            assert_int_equal(sl_can_decode_lean_warning(f, E2E(LEAN_WARNING), &w), SL_OK);
             warnings++;
             if (k < n - 1 + confirm - 1) {
                 assert_false(w.has_target); // no confirmed track yet
@@ -707,9 +716,9 @@ static void test_pipeline_can_frames_decode_to_the_targets(void **state)
                 assert_int_equal(rec.level[k], SL_WARN_DANGER);
             }
         } else if (f->id == B->can_id_status) {
-            assert_int_equal(sl_can_e2e_check(&rx[2], SL_CAN_DATA_ID_STATUS, f), SL_OK);
+            assert_true(e2e_accepted(sl_can_e2e_check(&rx[2], E2E(STATUS), f)));
             sl_can_status_t st;
-            assert_int_equal(sl_can_decode_status(f, &st), SL_OK);
+            assert_int_equal(sl_can_decode_status(f, E2E(STATUS), &st), SL_OK);
             statuses++;
             assert_int_equal(st.link_state, SL_CAN_LINK_STREAMING);
             assert_int_equal(st.rotations, (uint32_t)k + 1U);
@@ -717,9 +726,9 @@ static void test_pipeline_can_frames_decode_to_the_targets(void **state)
             assert_int_equal(st.decoder_resyncs, 0);
             assert_int_equal(st.can_dropped, 0);
         } else if (f->id == B->can_id_health) {
-            assert_int_equal(sl_can_e2e_check(&rx[3], SL_CAN_DATA_ID_HEALTH, f), SL_OK);
+            assert_true(e2e_accepted(sl_can_e2e_check(&rx[3], E2E(HEALTH), f)));
             sl_can_health_t h;
-            assert_int_equal(sl_can_decode_health(f, &h), SL_OK);
+            assert_int_equal(sl_can_decode_health(f, E2E(HEALTH), &h), SL_OK);
             healths++;
             assert_int_equal(h.fault, 0); // a clean stream raises no fault
             assert_int_equal(h.reconnects, 0);
@@ -736,7 +745,7 @@ static void test_pipeline_can_frames_decode_to_the_targets(void **state)
         assert_int_equal(pole_frames[k], k >= n - 1 + confirm - 1 ? 4 : 0);
     }
     for (int i = 0; i < 3; i++) {
-        assert_int_equal(rx[i].stats.counter_jumps, 0);
+        assert_int_equal(rx[i].stats.status[SL_CAN_E2E_OK_SOME_LOST], 0);
         assert_int_equal(rx[i].stats.crc_errors, 0);
     }
     assert_int_equal(pl.stats.can_dropped, 0);
@@ -930,7 +939,7 @@ static void test_pipeline_counts_busy_can_frames_as_drops(void **state)
     for (int i = 0; i < rec.ncan; i++) {
         if (rec.can[i].id == B->can_id_status) {
             sl_can_status_t st;
-            assert_int_equal(sl_can_decode_status(&rec.can[i], &st), SL_OK);
+            assert_int_equal(sl_can_decode_status(&rec.can[i], E2E(STATUS), &st), SL_OK);
             assert_true(st.can_dropped >= last);
             last = st.can_dropped;
             statuses++;
@@ -956,7 +965,7 @@ static void test_pipeline_idle_status_frames_continue_the_e2e_sequence(void **st
     assert_int_equal(rec.ncan, 2); // Status, then Health
     assert_int_equal(rec.can[1].id, B->can_id_health);
     sl_can_status_t st;
-    assert_int_equal(sl_can_decode_status(&rec.can[0], &st), SL_OK);
+    assert_int_equal(sl_can_decode_status(&rec.can[0], E2E(STATUS), &st), SL_OK);
     assert_int_equal(rec.can[0].id, B->can_id_status);
     assert_int_equal(st.link_state, SL_CAN_LINK_CONNECTING);
     assert_int_equal(st.rotations, 0);
@@ -978,7 +987,7 @@ static void test_pipeline_idle_status_frames_continue_the_e2e_sequence(void **st
             const int before = rec.ncan;
             assert_int_equal(sl_pipeline_send_status(&pl, now + 1000U), SL_OK);
             assert_int_equal(rec.ncan, before + 2);
-            assert_int_equal(sl_can_decode_status(&rec.can[before], &st), SL_OK);
+            assert_int_equal(sl_can_decode_status(&rec.can[before], E2E(STATUS), &st), SL_OK);
             assert_int_equal(st.rotations, pl.stats.rotations);
             assert_int_equal(st.azimuths_missing, pl.stats.azimuths_missing);
             assert_int_equal(st.decoder_resyncs, pl.proto.stats.resyncs);
@@ -994,15 +1003,15 @@ static void test_pipeline_idle_status_frames_continue_the_e2e_sequence(void **st
     assert_int_equal(sl_pipeline_finish(&pl, 99000000U), SL_OK);
     assert_int_equal(rec.rotations, 24);
     sl_can_e2e_rx_t rx;
-    sl_can_e2e_rx_init(&rx);
+    sl_can_e2e_rx_init(&rx, SL_CAN_COUNTER_MODULO - 1U);
     int statuses = 0;
     uint32_t last_rot = 0;
     for (int j = 0; j < rec.ncan; j++) {
         if (rec.can[j].id != B->can_id_status) {
             continue;
         }
-        assert_int_equal(sl_can_e2e_check(&rx, SL_CAN_DATA_ID_STATUS, &rec.can[j]), SL_OK);
-        assert_int_equal(sl_can_decode_status(&rec.can[j], &st), SL_OK);
+        assert_true(e2e_accepted(sl_can_e2e_check(&rx, E2E(STATUS), &rec.can[j])));
+        assert_int_equal(sl_can_decode_status(&rec.can[j], E2E(STATUS), &st), SL_OK);
         assert_int_equal(st.counter, (uint8_t)(statuses % 15));
         assert_true(st.rotations >= last_rot);
         last_rot = st.rotations;
@@ -1010,8 +1019,8 @@ static void test_pipeline_idle_status_frames_continue_the_e2e_sequence(void **st
     }
     assert_int_equal(statuses, 24 + idle);
     assert_true(statuses > 30); // wrapped modulo 15 twice
-    assert_int_equal(rx.stats.counter_jumps, 0);
-    assert_int_equal(rx.stats.repeated, 0);
+    assert_int_equal(rx.stats.status[SL_CAN_E2E_OK_SOME_LOST], 0);
+    assert_int_equal(rx.stats.status[SL_CAN_E2E_REPEATED], 0);
     assert_int_equal(last_rot, 24);
     assert_int_equal(pl.stats.can_frames, (uint32_t)rec.ncan);
     // A refused idle Status (and its Health) is a drop like any other frame, reported by
@@ -1023,12 +1032,12 @@ static void test_pipeline_idle_status_frames_continue_the_e2e_sequence(void **st
     rec.busy_every = 0;
     const int before = rec.ncan;
     assert_int_equal(sl_pipeline_send_status(&pl, 99200000U), SL_OK);
-    assert_int_equal(sl_can_decode_status(&rec.can[before], &st), SL_OK);
+    assert_int_equal(sl_can_decode_status(&rec.can[before], E2E(STATUS), &st), SL_OK);
     assert_int_equal(st.can_dropped, 2);
     sl_can_health_t h;
-    assert_int_equal(sl_can_decode_health(&rec.can[before + 1], &h), SL_OK);
+    assert_int_equal(sl_can_decode_health(&rec.can[before + 1], E2E(HEALTH), &h), SL_OK);
     assert_true((h.fault & SL_CAN_FAULT_CAN_OUTPUT_ERRORS) != 0U);
-    assert_int_equal(sl_can_e2e_check(&rx, SL_CAN_DATA_ID_STATUS, &rec.can[before]), SL_OK);
+    assert_true(e2e_accepted(sl_can_e2e_check(&rx, E2E(STATUS), &rec.can[before])));
     assert_int_equal(rx.stats.lost_frames, 1); // the refused frame used its counter value
 }
 
@@ -1045,7 +1054,7 @@ static void test_pipeline_adds_port_drops_saturating_into_the_next_status(void *
     sl_pipeline_add_can_dropped(&pl, 7);
     assert_int_equal(pl.stats.can_dropped, 7);
     assert_int_equal(sl_pipeline_send_status(&pl, 1000U), SL_OK);
-    assert_int_equal(sl_can_decode_status(&rec.can[0], &st), SL_OK);
+    assert_int_equal(sl_can_decode_status(&rec.can[0], E2E(STATUS), &st), SL_OK);
     assert_int_equal(st.can_dropped, 7);
     assert_false(st.saturated);
     // A refusal adds one per frame (Status and its Health).
@@ -1055,7 +1064,7 @@ static void test_pipeline_adds_port_drops_saturating_into_the_next_status(void *
     assert_int_equal(pl.stats.can_dropped, 9); // Status and Health refused
     sl_pipeline_add_can_dropped(&pl, 299); // 308: above the 8-bit field
     assert_int_equal(sl_pipeline_send_status(&pl, 3000U), SL_OK);
-    assert_int_equal(sl_can_decode_status(&rec.can[2], &st), SL_OK);
+    assert_int_equal(sl_can_decode_status(&rec.can[2], E2E(STATUS), &st), SL_OK);
     assert_int_equal(st.can_dropped, 255);
     assert_true(st.saturated);
     // The 32-bit total saturates instead of wrapping to a small number.
@@ -1066,7 +1075,7 @@ static void test_pipeline_adds_port_drops_saturating_into_the_next_status(void *
     sl_pipeline_add_can_dropped(&pl, UINT32_MAX);
     assert_int_equal(pl.stats.can_dropped, UINT32_MAX);
     assert_int_equal(sl_pipeline_send_status(&pl, 4000U), SL_OK);
-    assert_int_equal(sl_can_decode_status(&rec.can[4], &st), SL_OK);
+    assert_int_equal(sl_can_decode_status(&rec.can[4], E2E(STATUS), &st), SL_OK);
     assert_int_equal(st.can_dropped, 255);
     assert_true(st.saturated);
 }
@@ -1133,7 +1142,7 @@ static void test_pipeline_takes_motion_from_can_and_the_setter(void **state)
             // the next one, a bus cycle later, continues it and is used.
             sl_can_frame_t f = motion_frame(&vtx, 3000, 0);
             assert_int_equal(sl_pipeline_on_can_rx(&pl, &f, now - 20000U), SL_OK);
-            assert_int_equal(pl.motion_rx.stats.sync_only, 1);
+            assert_int_equal(pl.motion_rx.e2e.stats.status[SL_CAN_E2E_INITIAL], 1);
             f = motion_frame(&vtx, 50, 0); // 5 cm/s: n_eff 4
             assert_int_equal(sl_pipeline_on_can_rx(&pl, &f, now), SL_OK);
             f.data[3] ^= 1U; // corrupted: rejected by the CRC
@@ -1176,6 +1185,60 @@ static void test_pipeline_takes_motion_from_can_and_the_setter(void **state)
     // at azimuth 300 (odd rotations): the limit of single-frame detection while moving.
     assert_int_equal(rec.nt[5], 5);
     assert_int_equal(rec.nt[4], 4);
+}
+
+/// The Fault of the Health frame (after its Status) the pipeline sends at `now`.
+static uint16_t health_fault(uint64_t now)
+{
+    assert_int_equal(sl_pipeline_send_status(&pl, now), SL_OK);
+    sl_can_health_t h;
+    assert_int_equal(sl_can_decode_health(&rec.can[rec.ncan - 1], E2E(HEALTH), &h), SL_OK);
+    return h.fault;
+}
+
+// Health reports VehicleMotion frames the E2E check rejected (MOTION_E2E) in the Health
+// frame after them, and only there: a repetition, a jump beyond the board's max delta
+// counter and a corrupted CRC each set the bit; frames in sequence do not.
+static void test_pipeline_reports_motion_e2e_rejections_on_health(void **state)
+{
+    (void)state;
+    rec_reset(0);
+    const sl_pipeline_cfg_t c = cfg_for(B);
+    assert_int_equal(sl_pipeline_init(&pl, B, &c), SL_OK);
+    sl_can_ids_t ids;
+    sl_can_ids_from_board(&ids, B);
+    sl_can_tx_t vtx;
+    assert_int_equal(sl_can_tx_init(&vtx, &ids), SL_OK);
+    assert_int_equal(pl.motion_rx.e2e.max_delta_counter, B->can_max_delta_counter_motion);
+    uint64_t now = 1000000U;
+    sl_can_frame_t f = motion_frame(&vtx, 50, 0);
+    assert_int_equal(sl_pipeline_on_can_rx(&pl, &f, now), SL_OK); // INITIAL
+    now += 20000U;
+    f = motion_frame(&vtx, 50, 0);
+    assert_int_equal(sl_pipeline_on_can_rx(&pl, &f, now), SL_OK); // OK
+    assert_int_equal(health_fault(now) & SL_CAN_FAULT_MOTION_E2E, 0);
+    assert_int_equal(sl_pipeline_on_can_rx(&pl, &f, now + 1000U), SL_ERR_STATE); // REPEATED
+    assert_int_equal(health_fault(now) & SL_CAN_FAULT_MOTION_E2E, SL_CAN_FAULT_MOTION_E2E);
+    now += 20000U;
+    f = motion_frame(&vtx, 50, 0);
+    assert_int_equal(sl_pipeline_on_can_rx(&pl, &f, now), SL_OK); // OK
+    assert_int_equal(health_fault(now) & SL_CAN_FAULT_MOTION_E2E, 0);
+    for (unsigned k = 0; k < B->can_max_delta_counter_motion; k++) {
+        (void)motion_frame(&vtx, 50, 0); // lost on the bus
+    }
+    now += 20000U;
+    f = motion_frame(&vtx, 50, 0);
+    assert_int_equal(sl_pipeline_on_can_rx(&pl, &f, now), SL_ERR_STATE); // WRONG_SEQUENCE
+    assert_int_equal(health_fault(now) & SL_CAN_FAULT_MOTION_E2E, SL_CAN_FAULT_MOTION_E2E);
+    now += 20000U;
+    f = motion_frame(&vtx, 50, 0);
+    f.data[0] ^= 0x5AU;
+    assert_int_equal(sl_pipeline_on_can_rx(&pl, &f, now), SL_ERR_MALFORMED); // ERROR
+    assert_int_equal(health_fault(now) & SL_CAN_FAULT_MOTION_E2E, SL_CAN_FAULT_MOTION_E2E);
+    assert_int_equal(health_fault(now) & SL_CAN_FAULT_MOTION_E2E, 0);
+    const uint32_t *n = pl.motion_rx.e2e.stats.status;
+    assert_int_equal(n[SL_CAN_E2E_REPEATED] + n[SL_CAN_E2E_WRONG_SEQUENCE] + n[SL_CAN_E2E_ERROR], 3);
+    assert_int_equal(pl.stats.motion_rejected, 3);
 }
 
 // ---------------------------------------------------------------------------- drive-by
@@ -1560,7 +1623,7 @@ static void test_pipeline_slot_overflow_keeps_the_poles_and_is_counted_on_can(vo
     sl_can_health_t last_h;
     memset(&last_h, 0, sizeof last_h);
     sl_can_e2e_rx_t rxh;
-    sl_can_e2e_rx_init(&rxh);
+    sl_can_e2e_rx_init(&rxh, SL_CAN_COUNTER_MODULO - 1U);
     for (int i = 0; i < rec.ncan; i++) {
         const sl_can_frame_t *f = &rec.can[i];
         if (f->id == B->can_id_status) {
@@ -1569,15 +1632,15 @@ static void test_pipeline_slot_overflow_keeps_the_poles_and_is_counted_on_can(vo
             assert_int_equal(rec.can[i + 1].id, B->can_id_health);
         } else if (f->id == B->can_id_health) {
             n_health++;
-            assert_int_equal(sl_can_e2e_check(&rxh, SL_CAN_DATA_ID_HEALTH, f), SL_OK);
-            assert_int_equal(sl_can_decode_health(f, &last_h), SL_OK);
+            assert_true(e2e_accepted(sl_can_e2e_check(&rxh, E2E(HEALTH), f)));
+            assert_int_equal(sl_can_decode_health(f, E2E(HEALTH), &last_h), SL_OK);
             const int k = rec.can_rot[i];
             const bool overflow = k >= first;
             assert_int_equal((last_h.fault & SL_CAN_FAULT_TARGET_SLOTS_OVERFLOW) != 0, overflow);
             assert_int_equal(last_h.candidates_dropped, overflow ? (uint32_t)(6 * (k - first + 1)) : 0U);
         } else if (f->id == B->can_id_pole_lean && rec.can_rot[i] == 19) {
             sl_can_pole_lean_t pl_f;
-            assert_int_equal(sl_can_decode_pole_lean(f, &pl_f), SL_OK);
+            assert_int_equal(sl_can_decode_pole_lean(f, E2E(POLE_LEAN), &pl_f), SL_OK);
             const int32_t az = pl_f.azimuth_cdeg - B->radar_yaw_cdeg;
             seen300 |= az >= 26800 && az <= 27200;
             seen350 |= az >= 31300 && az <= 31700;
@@ -1668,6 +1731,7 @@ int main(void)
         cmocka_unit_test(test_pipeline_idle_status_frames_continue_the_e2e_sequence),
         cmocka_unit_test(test_pipeline_adds_port_drops_saturating_into_the_next_status),
         cmocka_unit_test(test_pipeline_window_follows_speed_and_yaw),
+        cmocka_unit_test(test_pipeline_reports_motion_e2e_rejections_on_health),
         cmocka_unit_test(test_pipeline_takes_motion_from_can_and_the_setter),
         cmocka_unit_test(test_pipeline_drive_by_detects_the_pole_only_with_motion_input),
         cmocka_unit_test(test_pipeline_rejects_boards_that_need_more_mask_bins),

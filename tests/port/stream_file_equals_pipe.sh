@@ -14,7 +14,7 @@ rm -rf "$OUT"; mkdir -p "$OUT"
     { echo "FAIL: file input exit status $?"; exit 1; }
 cat "$OUT/s.colossus" | "$@" "$D" --board paper-sim --input - --can-log "$OUT/pipe.log" -q ||
     { echo "FAIL: pipe input exit status $?"; exit 1; }
-n=$(grep -c " 621#" "$OUT/file.log")
+n=$(grep -c " 5C1#" "$OUT/file.log")
 [ "$n" -ge 20 ] || { echo "FAIL: $n Status frames (621) for 24 rotations"; cat "$OUT/file.log" | head; exit 1; }
 cmp "$OUT/file.log" "$OUT/pipe.log" || { echo "FAIL: pipe input gives other frames"; exit 1; }
 echo "file == pipe: $(wc -l < "$OUT/file.log") frames, $n Status"

@@ -16,6 +16,7 @@
 
 #include "candump_log.h"
 #include "sl_board_spec.h"
+#include "sl_dbc.h"
 #include "shadowlean/sl_can.h"
 
 namespace {
@@ -50,13 +51,7 @@ int main(int argc, char **argv)
         const sl::BoardSpec b = sl::load_board(argv[1]);
         const long n = std::stol(argv[2]);
         rng.seed(std::stoull(argv[3]));
-        sl_can_ids_t ids{};
-        ids.id[SL_CAN_MSG_POLE_LEAN] = b.can_id_pole_lean;
-        ids.id[SL_CAN_MSG_LEAN_WARNING] = b.can_id_lean_warning;
-        ids.id[SL_CAN_MSG_STATUS] = b.can_id_status;
-        ids.id[SL_CAN_MSG_VEHICLE_MOTION] = b.can_id_vehicle_motion;
-        ids.id[SL_CAN_MSG_HEALTH] = b.can_id_health;
-        ids.id[SL_CAN_MSG_POLE_TILT] = b.can_id_pole_tilt;
+        const sl_can_ids_t ids = sl::can_ids(b);
         sl_can_tx_t tx;
         if (sl_can_tx_init(&tx, &ids) != SL_OK) {
             std::cerr << "can_gen_frames: bad ids\n";

@@ -13,7 +13,7 @@ values are derived from the inputs with exact Decimal arithmetic. Checks per fra
 - every signal: decoded physical value within one LSB of the (clamped) input, and the
   raw value equal to round-half-up(input / factor) clamped to the DBC [min|max];
 - Clamped / Saturated equals "some input had to be clamped";
-- Crc = CRC-8 SAE J1850 over [SlE2EDataId, bytes 1..7]; Counter = n-th frame of that
+- Crc = the E2E Profile 11 CRC (SlE2EDataId, SlE2EMode); Counter = n-th frame of that
   message mod 15;
 - canmatrix re-encodes the decoded raw values to exactly the same 8 bytes.
 Exit status 0 when all frames pass; prints the first mismatches otherwise.
@@ -104,7 +104,7 @@ def expected_raw(sig, kind, value):
     if kind == "flag":
         return int(value), False
     if kind == "fault":
-        return int(value) & 0x3FF, False  # bits 10..15 reserved: never sent
+        return int(value) & 0x7FF, False  # bits 11..15 reserved: never sent
     if kind in ("id", "quality", "level", "link", "tquality"):
         v = int(value)
         if v <= rmax:

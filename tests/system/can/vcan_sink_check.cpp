@@ -40,6 +40,7 @@
 #include "socketcan.h"
 #include "candump_log.h"
 #include "sl_board_spec.h"
+#include "sl_dbc.h"
 #include "shadowlean/sl_can.h"
 #include "check.hpp"
 
@@ -209,13 +210,7 @@ int main(int argc, char **argv)
     const char *ifn = iface.c_str();
     Gen gen;
     const sl::BoardSpec b = sl::load_board(board);
-    sl_can_ids_t ids{};
-    ids.id[SL_CAN_MSG_POLE_LEAN] = b.can_id_pole_lean;
-    ids.id[SL_CAN_MSG_LEAN_WARNING] = b.can_id_lean_warning;
-    ids.id[SL_CAN_MSG_STATUS] = b.can_id_status;
-    ids.id[SL_CAN_MSG_VEHICLE_MOTION] = b.can_id_vehicle_motion;
-    ids.id[SL_CAN_MSG_HEALTH] = b.can_id_health;
-    ids.id[SL_CAN_MSG_POLE_TILT] = b.can_id_pole_tilt;
+    const sl_can_ids_t ids = sl::can_ids(b);
     CHECK(sl_can_tx_init(&gen.tx, &ids) == SL_OK);
 
     sl::CandumpWriter produced, sent_log;

@@ -16,7 +16,7 @@ rm -rf "$OUT"; mkdir -p "$OUT"
 "$PY" - "$OUT/can.log" <<'PYEOF'
 import sys
 frames = [l.split()[2] for l in open(sys.argv[1]) if l.strip()]
-status = [(k, f) for k, f in enumerate(frames) if f.split("#")[0] == "622"]  # paper-sim id_status
+status = [(k, f) for k, f in enumerate(frames) if f.split("#")[0] == "5C2"]  # paper-sim id_status
 bad = [(k, int(f.split("#")[1][14:16], 16)) for k, f in status if int(f.split("#")[1][14:16], 16) != min(k, 255)]
 print(f"can_drops_counted_once: {len(frames)} frames, {len(status)} Status, CanDropped of the last {int(status[-1][1].split('#')[1][14:16], 16) if status else None}")
 if len(status) < 10 or bad:

@@ -9,8 +9,8 @@
 Independent of the C encoder: layout and scaling come only from the DBC, the CRC is
 recomputed here, the expected frames are derived from the JSON records with the mapping
 documented in sl_pipeline.h. Checks:
-- every frame: id known to the DBC, DLC 8, Crc = CRC-8 SAE J1850 over [SlE2EDataId,
-  bytes 1..7], Counter = previous + 1 mod 15 per message, canmatrix re-encodes the
+- every frame: id known to the DBC, DLC 8, Crc = the E2E Profile 11 CRC (SlE2EDataId,
+  SlE2EMode; the Python package's decoder), Counter = previous + 1 mod 15 per message, canmatrix re-encodes the
   decoded raw values to the same bytes;
 - frames come in rotation groups PoleLean* LeanWarning Status Health, one per JSON
   rotation record, in order (Status + Health without a group are idle Status frames:

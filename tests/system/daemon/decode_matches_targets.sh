@@ -39,7 +39,7 @@ open(sys.argv[2], "w").write("".join(json.dumps(l) + "\n" for l in lines))
 PY
 must_fail "a changed lean" "$OUT/can.log" "$OUT/bad_lean.jsonl"
 # 3. the first PoleLean frame dropped
-awk '!done && $3 ~ /^620#/ { done = 1; next } { print }' "$OUT/can.log" > "$OUT/bad_drop.log"
+awk '!done && $3 ~ /^5C0#/ { done = 1; next } { print }' "$OUT/can.log" > "$OUT/bad_drop.log"
 must_fail "a missing PoleLean frame" "$OUT/bad_drop.log" "$OUT/targets.jsonl"
 
 # pcap input: same frames, same targets.

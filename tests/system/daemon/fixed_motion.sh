@@ -24,8 +24,8 @@ out = sys.argv[1]
 def rots(name):
     return [json.loads(l) for l in open(os.path.join(out, name))][1:]
 still, moving = rots("still.jsonl"), rots("moving.jsonl")
-n_still = sum(1 for l in open(os.path.join(out, "still.log")) if " 620#" in l)
-n_moving = sum(1 for l in open(os.path.join(out, "moving.log")) if " 620#" in l)
+n_still = sum(1 for l in open(os.path.join(out, "still.log")) if " 5C0#" in l)
+n_moving = sum(1 for l in open(os.path.join(out, "moving.log")) if " 5C0#" in l)
 errs = []
 if n_still != 0 or any(r["motion_valid"] for r in still):
     errs.append(f"without motion: {n_still} PoleLean frames, motion_valid {[r['motion_valid'] for r in still][:3]}")

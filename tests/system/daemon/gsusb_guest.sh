@@ -4,7 +4,7 @@
 # fake candleLight of tests/system/gsusb (dummy_hcd + configfs + FunctionFS, echo + reply mode) and
 # runs shadowleand --gs-usb 1d50:606f on a capture (24 rotations, 6 s) in real time, next to
 # --can-log.
-# Settings from $OUT/vm.env: SL_DAEMON, SL_GSDIR, SL_CAPTURE.
+# Settings from $OUT/vm.env: SL_DAEMON, SL_GSDIR, SL_CAPTURE, SL_BOARD.
 . "$OUT/vm.env"
 . "$SL_GSDIR/fake_device.sh"
 fake_candlelight_up "$SL_GSDIR" daemon normal
@@ -12,7 +12,7 @@ t "fake candleLight bound (kernel gs_usb: can0); starting shadowleand --gs-usb"
 # --gs-usb-max-age-ms 0: a TCG guest on a loaded host can be descheduled for longer than
 # the 200 ms age limit; this test checks the transport and its accounting (every frame
 # logged is confirmed by the device), not the age limit (tests/system/gsusb: stall scenarios).
-"$SL_DAEMON" --board paper-sim --input "$SL_CAPTURE" --realtime --gs-usb 1d50:606f --gs-usb-max-age-ms 0 \
+"$SL_DAEMON" --board "$SL_BOARD" --input "$SL_CAPTURE" --realtime --gs-usb 1d50:606f --gs-usb-max-age-ms 0 \
     --can-log "$OUT/daemon.log" --targets-out "$OUT/targets.jsonl" > daemon.out 2>&1
 echo $? > rc_daemon
 t "shadowleand exit $(cat rc_daemon)"

@@ -1,12 +1,17 @@
 #!/usr/bin/python3
 # SPDX-License-Identifier: MIT
-"""VehicleMotion frames with faults, as cansend arguments (one per line), from the board's
-DBC (python3-canmatrix encodes, the CRC is computed here). One cycle of 30 lines:
-- good frames: Speed 0.05 m/s, E2E counters that advance by 1, except a jump of 3 every
-  4 good frames (2 frames "lost": accepted, counted as a counter jump);
-- every 3rd line a bad-CRC frame (CRC byte XOR 0x5A) carrying Speed 1.0 m/s: must be
-  rejected, never used (it would make n_eff 1);
-- every 10th line a repetition of the previous good counter with Speed 1.0 m/s: rejected.
+"""VehicleMotion frames with faults, one per line: a cansend argument and the Profile 11
+check status a receiver with max delta counter 2 gives it in sequence. The layout comes
+from the board's DBC (python3-canmatrix encodes the signals); the E2E protection is built
+here with p11_frames.py (AUTOSAR library chaining, the DBC's SlE2EDataId / SlE2EMode).
+One pass of 13 lines; its counter steps add up to 15, so passes repeat seamlessly:
+- good frames, Speed 0.05 m/s, counter step 1: OK;
+- a good frame after a step of 2 (one frame lost): OK_SOME_LOST, used;
+- a bad-CRC frame (CRC byte XOR 0x5A) carrying Speed 1.0 m/s: ERROR, never used;
+- a repetition of the last good counter carrying 1.0 m/s: REPEATED, never used;
+- a frame after a step of 4 carrying 1.0 m/s: WRONG_SEQUENCE, never used (the sequence
+  continues from it: the next good frame is OK).
+A receiver that used any rejected frame would see 1.0 m/s.
 
     motion_fault_frames.py BOARD.dbc > frames.txt
 """
@@ -15,15 +20,34 @@ import os
 import sys
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "..", "..", "scripts"))
+sys.path.insert(0, os.path.dirname(__file__))
 import sl_can_decode as scd  # noqa: E402
+from p11_frames import p11_protect  # noqa: E402
+
+# (kind, counter step from the last frame with a valid CRC, speed, expected status)
+PASS = [
+    ("good", 1, "0.05", "OK"),
+    ("good", 1, "0.05", "OK"),
+    ("bad_crc", 1, "1.0", "ERROR"),
+    ("good", 1, "0.05", "OK"),
+    ("repeat", 0, "1.0", "REPEATED"),
+    ("good", 1, "0.05", "OK"),
+    ("good", 2, "0.05", "OK_SOME_LOST"),
+    ("jump", 4, "1.0", "WRONG_SEQUENCE"),
+    ("good", 1, "0.05", "OK"),
+    ("good", 1, "0.05", "OK"),
+    ("good", 1, "0.05", "OK"),
+    ("good", 1, "0.05", "OK"),
+    ("good", 1, "0.05", "OK"),
+]
+assert sum(step for kind, step, _, _ in PASS if kind != "bad_crc") == 15
 
 
-def frame(fr, data_id, speed, ctr, bad_crc=False):
+def frame(fr, data_id, nibble, speed, ctr, bad_crc=False):
     phys = {"Speed": decimal.Decimal(speed), "YawRate": 0, "SpeedValid": 1, "YawRateValid": 1,
-            "Counter": ctr, "Crc": 0}
+            "Counter": 0, "Crc": 0}
     raw = {s.name: s.phys2raw(phys.get(s.name, 0)) for s in fr.signals}
-    data = bytearray(fr.encode(raw))
-    data[0] = scd.crc8_j1850(bytes([data_id]) + bytes(data[1:]))
+    data = bytearray(p11_protect(fr.encode(raw), data_id, ctr, nibble))
     if bad_crc:
         data[0] ^= 0x5A
     ident = fr.arbitration_id.id
@@ -35,19 +59,13 @@ def main(argv):
     db = scd.load_dbc(argv[1])
     fr = next(f for f in db.frames if f.name == "VehicleMotion")
     data_id = int(fr.attributes["SlE2EDataId"])
-    ctr, good, last_good = 0, 0, 0
-    for line in range(1, 31):
-        if line % 10 == 0:
-            # repetition of the last good frame's counter: rejected (not ctr - 1, which after
-            # a jump is a forward step the receiver rightly accepts)
-            print(frame(fr, data_id, "1.0", last_good))
-        elif line % 3 == 0:
-            print(frame(fr, data_id, "1.0", ctr, bad_crc=True))  # bad CRC: rejected
-        else:
-            print(frame(fr, data_id, "0.05", ctr))
-            last_good = ctr
-            good += 1
-            ctr = (ctr + (3 if good % 4 == 0 else 1)) % 15  # a counter jump every 4 good frames
+    nibble = str(fr.attributes.get("SlE2EMode", "Both")).strip('"') in ("Nibble", "1")
+    ctr = 14  # the first pass starts at counter 0
+    for kind, step, speed, status in PASS:
+        c = (ctr + (step if kind != "bad_crc" else 1)) % 15
+        print(frame(fr, data_id, nibble, speed, c, bad_crc=kind == "bad_crc"), status)
+        if kind != "bad_crc":
+            ctr = c
     return 0
 
 

@@ -80,11 +80,11 @@ rot=${s#*| }
     --targets-out "$OUT/int.jsonl" 2> "$OUT/int.err" &
 DPID=$!
 i=0
-while [ "$(count ' 622#' "$OUT/int.log")" -lt 2 ] && [ $i -lt 100 ]; do sleep 0.1; i=$((i + 1)); done
+while [ "$(count ' 5C2#' "$OUT/int.log")" -lt 2 ] && [ $i -lt 100 ]; do sleep 0.1; i=$((i + 1)); done
 kill -INT $DPID; wait $DPID; rc=$?; DPID=""
 cat "$OUT/int.err"
 [ $rc -eq 0 ] || { echo "FAIL: exit status $rc after SIGINT"; exit 1; }
 grep -q "stopping (SIGINT)" "$OUT/int.err" || { echo "FAIL: no clean stop logged"; exit 1; }
-tail -2 "$OUT/int.log" | head -1 | grep -q ' 622#' && tail -1 "$OUT/int.log" | grep -q ' 623#' ||
+tail -2 "$OUT/int.log" | head -1 | grep -q ' 5C2#' && tail -1 "$OUT/int.log" | grep -q ' 5C3#' ||
     { echo "FAIL: the log does not end with a Status frame and its Health frame"; exit 1; }
 "$PY" "$SRC/check_can_vs_targets.py" "$DBC" "$OUT/int.log" "$OUT/int.jsonl" || exit 1

@@ -11,6 +11,6 @@ rm -rf "$OUT"; mkdir -p "$OUT"
 "$DAEMON" --board paper-sim --input "$OUT/s.colossus" --realtime --can-log "$OUT/rt.log" --targets-out "$OUT/rt.jsonl" -q || exit 1
 [ -s "$OUT/fast.log" ] || { echo "FAIL: empty log"; exit 1; }
 cmp "$OUT/fast.log" "$OUT/rt.log" && cmp "$OUT/fast.jsonl" "$OUT/rt.jsonl" || { echo "FAIL: --realtime differs"; exit 1; }
-n=$(grep -c " 620#" "$OUT/fast.log")
+n=$(grep -c " 5C0#" "$OUT/fast.log")
 [ "$n" -gt 0 ] || { echo "FAIL: no PoleLean frame to compare"; exit 1; }
 echo "realtime == fast: $(wc -l < "$OUT/fast.log") frames ($n PoleLean)"

@@ -16,7 +16,7 @@ DBC="$SRC/../../../boards/paper-sim/shadowlean.dbc"
     --targets-out "$OUT/t.jsonl" 2> "$OUT/d.err" &
 DPID=$!
 i=0
-while [ "$(grep -c ' 622#' "$OUT/can.log" 2>/dev/null || echo 0)" -lt 2 ] && [ $i -lt 200 ]; do
+while [ "$(grep -c ' 5C2#' "$OUT/can.log" 2>/dev/null || echo 0)" -lt 2 ] && [ $i -lt 200 ]; do
     sleep 0.05; i=$((i + 1))
 done
 kill -STOP $DPID

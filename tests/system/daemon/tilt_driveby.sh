@@ -82,6 +82,6 @@ echo "== power (the sensor's value scale, --motion 1.0)"
 "$PY" "$SRC/lean_sigma_vs_truth.py" "$DBC" "$OUT/power.log" "$OUT/power.gt.csv" --max-sigmas 4 || fail=1
 # No motion input: no PoleTilt frame (the demo and Oxford frames stay as they were).
 "$D" --board paper-sim --input "$OUT/slow.colossus" --can-log "$OUT/still.log" -q || fail=1
-n=$(grep -c " 624#" "$OUT/still.log")
+n=$(grep -c " 5C4#" "$OUT/still.log")
 [ "$n" -eq 0 ] || { echo "FAIL: $n PoleTilt frames without a motion input"; fail=1; }
 exit $fail

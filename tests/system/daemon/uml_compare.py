@@ -4,7 +4,10 @@
 daemon's own --can-log of the same runs, field by field (id, 11/29-bit, DLC, data, order;
 not the timestamps), plus the VehicleMotion input of the real-time run.
 
-    uml_compare.py OUTDIR MOTION_ID_HEX
+    uml_compare.py OUTDIR BOARD.dbc
+
+VehicleMotion frames on the bus (id and 11/29-bit format from the DBC) are the test's input,
+not the daemon's output.
 
 OUTDIR holds candump.log, daemon_fast.log, daemon_rt.log, targets_rt.jsonl (uml_guest.sh).
 """
@@ -23,7 +26,9 @@ def key(f):
 
 
 def main(argv):
-    out, motion_id = argv[1], int(argv[2], 16)
+    out = argv[1]
+    motion = next(fr for fr in scd.load_dbc(argv[2]).frames if fr.name == "VehicleMotion")
+    motion_id, motion_eff = motion.arbitration_id.id, bool(motion.arbitration_id.extended)
     rec = scd.read_candump(os.path.join(out, "candump.log"))
     seg, cur = {}, None
     for f in rec:
@@ -38,7 +43,7 @@ def main(argv):
     errors = []
     for marker, log, what in (("SYNC", "daemon_fast.log", "run 1 (fast)"),
                               ("MID", "daemon_rt.log", "run 2 (realtime)")):
-        bus = [f for f in seg.get(marker, []) if not (f[2] == motion_id and not f[3])]
+        bus = [f for f in seg.get(marker, []) if not (f[2] == motion_id and f[3] == motion_eff)]
         mine = scd.read_candump(os.path.join(out, log))
         n_motion = len(seg.get(marker, [])) - len(bus)
         if not mine:

@@ -1,8 +1,8 @@
 #!/bin/sh
 # SPDX-License-Identifier: MIT
-# uml_guest.sh DAEMON CAPTURE SHORT_CAPTURE MOTION_FRAMES OUTDIR: runs INSIDE user-mode Linux
+# uml_guest.sh DAEMON CAPTURE SHORT_CAPTURE MOTION_FRAMES OUTDIR BOARD: runs INSIDE user-mode Linux
 # (tests/support/vm/uml_run.sh, vcan0 up). `candump -L vcan0` records the bus while:
-#   run 1: shadowleand --input CAPTURE --can vcan0 --can-log daemon_fast.log (as fast as
+#   run 1: shadowleand --board BOARD --input CAPTURE --can vcan0 --can-log daemon_fast.log (as fast as
 #          possible; --motion-can none);
 #   run 2: shadowleand --input SHORT_CAPTURE --realtime --can vcan0 --can-log daemon_rt.log
 #          while VehicleMotion frames (MOTION_FRAMES: one cansend argument per line, E2E
@@ -15,11 +15,11 @@
 # Marker frames 7FF#... (SYNC / MID / END) delimit the runs in candump's recording without
 # timing assumptions (the same trick as tests/system/can/uml_sink_guest.sh).
 set -u
-daemon=$1; cap=$2; short=$3; motion=$4; out=$5
+daemon=$1; cap=$2; short=$3; motion=$4; out=$5; board=$6
 . "$(dirname "$0")/../../support/vm/candump_guest.sh"
 candump_start "$out/candump.log" vcan0
 candump_mark 53594E43 || exit 1                               # "SYNC"
-"$daemon" --board paper-sim --input "$cap" --can vcan0 --can-log "$out/daemon_fast.log" \
+"$daemon" --board "$board" --input "$cap" --can vcan0 --can-log "$out/daemon_fast.log" \
     --targets-out "$out/targets_fast.jsonl" --motion-can none --stats-every 0 \
     2> "$out/daemon_fast.err"
 rc=$?
@@ -34,7 +34,7 @@ rm -f "$out/motion.pass"
       : > "$out/motion.pass"
   done ) &
 sender=$!
-"$daemon" --board paper-sim --input "$short" --realtime --can vcan0 --can-log "$out/daemon_rt.log" \
+"$daemon" --board "$board" --input "$short" --realtime --can vcan0 --can-log "$out/daemon_rt.log" \
     --targets-out "$out/targets_rt.jsonl" 2> "$out/daemon_rt.err" &
 dpid=$!
 used() { _n=$(grep -c '"motion_valid":true' "$out/targets_rt.jsonl" 2>/dev/null); echo "${_n:-0}"; }

@@ -2,13 +2,16 @@
 # SPDX-License-Identifier: MIT
 # uml_motion_guest.sh DAEMON CAPTURE MOTION_FRAMES OUTDIR: runs INSIDE user-mode Linux
 # (tests/support/vm/uml_run.sh, vcan0 up). shadowleand replays CAPTURE in real time with --can vcan0
-# (VehicleMotion read from vcan0) while MOTION_FRAMES (motion_fault_frames.py: good frames,
-# bad CRCs, repetitions, counter jumps) go onto vcan0 every 20 ms (canplayer), from the daemon's first
-# rotation until 4 rotations used the motion input AND the whole file (every kind of fault)
-# was sent at least once (a slow guest on a loaded host may need many rotations for one
-# pass: the stop must not depend on how fast cansend runs); then the sender stops (a reception
-# timeout: the window must fall back to the board's n), and 6 rotations later the daemon is
-# stopped with SIGINT (exit 0). Ordering by the daemon's own output files, not by timing.
+# (VehicleMotion read from vcan0) while MOTION_FRAMES (motion_fault_frames.py: Profile 11
+# frames that are OK, OK_SOME_LOST, ERROR, REPEATED and WRONG_SEQUENCE in sequence) go onto
+# vcan0 every 20 ms (canplayer), from the daemon's first rotation until 4 rotations used the
+# motion input AND the whole file (every kind of fault) was sent at least once (a slow guest
+# on a loaded host may need many rotations for one pass: the stop must not depend on how
+# fast cansend runs); then the sender stops (a reception timeout: the window must fall back
+# to the board's n); 6 rotations later (1.5 s of radar time, beyond the 500 ms timeout) one
+# more pass goes out, whose first frame follows a gap (one NO_NEW_DATA, then INITIAL), and
+# 6 rotations after it ended the daemon is stopped with SIGINT (exit 0). Ordering by the
+# daemon's own output files and by canplayer's exit, not by timing.
 set -u
 daemon=$1; cap=$2; motion=$3; out=$4
 "$daemon" --board paper-sim --input "$cap" --realtime --can vcan0 --can-log "$out/motion.log" \
@@ -40,10 +43,16 @@ echo "sender stopped after $(used) rotations with motion"
 # The fallback to static: wait (by the daemon's output, not by time) until 6 more rotations
 # are out -- more than the 500 ms motion timeout at 4 Hz -- then stop the daemon cleanly.
 rots() { _n=$(grep -c '"type":"rotation"' "$out/motion.jsonl" 2>/dev/null); echo "${_n:-0}"; }
-r0=$(rots); i=0
-while [ "$(rots)" -lt $((r0 + 6)) ] && [ $i -lt 1200 ] && kill -0 $dpid 2>/dev/null; do
-    sleep 0.05; i=$((i + 1))
-done
+six_more() {
+    r0=$(rots); i=0
+    while [ "$(rots)" -lt $((r0 + 6)) ] && [ $i -lt 1200 ] && kill -0 $dpid 2>/dev/null; do
+        sleep 0.05; i=$((i + 1))
+    done
+}
+six_more
+canplayer -I "$out/motion.pass.log"
+echo "one more pass sent after the gap"
+six_more
 kill -INT $dpid 2>/dev/null
 wait $dpid
 rc=$?

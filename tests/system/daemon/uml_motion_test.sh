@@ -1,14 +1,15 @@
 #!/bin/sh
 # SPDX-License-Identifier: MIT
 # uml_motion_test.sh UML_RUN SHADOWLEAND SL_SIM PYTHON SRC_DIR OUT_DIR
-# Issue 14: VehicleMotion with bad CRCs, repeated counters, counter jumps and a reception
-# timeout over a real vcan0 inside user-mode Linux (uml_motion_guest.sh). On the host:
-# nothing crashed (exit 0); every rotation that used motion used the good frames' speed
-# (0.05 m/s -> n_eff 4), never the rejected frames' 1.0 m/s (n_eff 1); the rejections and
-# jumps are counted in the daemon's E2E statistics (also after a reception gap, where the
-# first frame only synchronises: a repetition carrying 1.0 m/s is never used, whatever the
-# guest's speed); after the sender stopped the window fell
-# back to static (the last rotation: no motion, n_eff 16).
+# VehicleMotion frames built with AUTOSAR E2E Profile 11 by the test (p11_frames.py) with
+# bad CRCs, repeated counters, small and large counter jumps and a reception gap over a real
+# vcan0 inside user-mode Linux (uml_motion_guest.sh). On the host: nothing crashed (exit 0);
+# every rotation that used motion used the good frames' speed (0.05 m/s -> n_eff 4), never
+# the rejected frames' 1.0 m/s (n_eff 1); the daemon's Profile 11 statistics count every
+# status the frames were built for: OK, OK_SOME_LOST (step 2 at the board's max delta
+# counter 2), ERROR (CRC), REPEATED, WRONG_SEQUENCE (step 4), INITIAL and NO_NEW_DATA (the
+# gap; the first frame after it only synchronises, whatever the guest's speed); after the
+# sender stopped the window fell back to static (the last rotation: no motion, n_eff 16).
 # Exit 77 (ctest skip) when linux.uml is not installed.
 set -u
 uml_run=$1; daemon=$2; sim=$3; py=$4; src=$(cd "$5" && pwd); out=$6
@@ -38,18 +39,24 @@ if bad:
 last = rots[-1] if rots else {}
 if last.get("motion_valid") or last.get("frames_eff") != 16:
     errors.append(f"no fallback to static after the timeout: last rotation {last}")
-m = re.findall(r"exit: VehicleMotion E2E: (\d+) accepted, (\d+) CRC errors, (\d+) repeated, \d+ bad counter, "
-               r"\d+ bad DLC, (\d+) counter jumps .*, (\d+) only synchronising", err)
+m = re.findall(r"exit: VehicleMotion E2E \(Profile 11, max delta counter (\d+)\): OK (\d+), OK_SOME_LOST (\d+) "
+               r"\(\d+ frames lost\), INITIAL (\d+) .*?, REPEATED (\d+), WRONG_SEQUENCE (\d+), ERROR (\d+) "
+               r"\(CRC (\d+), .*\), NO_NEW_DATA (\d+)", err)
 if not m:
     errors.append("no VehicleMotion E2E statistics at exit")
 else:
-    acc, crc, rep, jumps, sync = map(int, m[-1])
-    print(f"VehicleMotion over vcan0: {acc} accepted, {crc} CRC errors, {rep} repeated, {jumps} counter jumps; "
+    mdc, ok, lost, init, rep, wseq, error, crc, nnd = map(int, m[-1])
+    print(f"VehicleMotion over vcan0 (max delta counter {mdc}): OK {ok}, OK_SOME_LOST {lost}, INITIAL {init}, "
+          f"REPEATED {rep}, WRONG_SEQUENCE {wseq}, ERROR {error} (CRC {crc}), NO_NEW_DATA {nnd}; "
           f"{len(used)} of {len(rots)} rotations used motion (50 mm/s, n_eff 4), last rotation n_eff {last.get('frames_eff')}")
-    if crc < 1 or rep < 1 or jumps < 1 or acc < 1:
-        errors.append("bad CRCs, repetitions and counter jumps must all be counted")
-    if sync < 1:
-        errors.append("the first frame must only synchronise the sequence")
+    if mdc != 2:
+        errors.append(f"max delta counter {mdc}, the board file says 2")
+    for name, n in (("OK", ok), ("OK_SOME_LOST", lost), ("REPEATED", rep), ("WRONG_SEQUENCE", wseq),
+                    ("ERROR (CRC)", crc), ("NO_NEW_DATA", nnd)):
+        if n < 1:
+            errors.append(f"no frame classified {name}")
+    if init < 2:
+        errors.append(f"INITIAL {init}: the first frame and the first after the gap must only synchronise")
 for e in errors:
     print("FAIL:", e)
 sys.exit(1 if errors else 0)

@@ -22,7 +22,7 @@ for f in include/shadowlean/sl_pipeline.h include/shadowlean/sl_port.h include/s
          lib/cmake/shadowlean/shadowleanConfig.cmake lib/cmake/shadowlean/shadowleanConfigVersion.cmake \
          lib/pkgconfig/shadowlean-core.pc sbin/shadowleand bin/sl-tables bin/sl-replay bin/sl-inspect \
          share/shadowlean/dbc/paper-sim.dbc share/shadowlean/shadowleand.conf \
-         share/shadowlean/wireshark/colossus.lua lib/systemd/system/shadowleand.service \
+         share/shadowlean/wireshark/colossus.lua share/shadowlean/wireshark/shadowlean_can.lua lib/systemd/system/shadowleand.service \
          share/shadowlean/schema/targets.schema.json share/shadowlean/schema/inspect.schema.json \
          share/doc/shadowleand/copyright share/doc/shadowlean-dev/copyright; do
     [ -e "$P/$f" ] || fail "not installed: $f"
