@@ -183,7 +183,8 @@ static void run_random(unsigned long count)
         for (int i = 0; i < SL_RESP_TAPS; i++) {
             const int o = i - SL_CFG_RESP_HALF;
             const unsigned w = 2U + rnd() % 6U;
-            buf[len++] = wild ? rnd() : (uint8_t)((unsigned)(o * o) * 8U / (w * w) > 255U ? 255U : (unsigned)(o * o) * 8U / (w * w));
+            const unsigned drop = (unsigned)(o * o) * 8U / (w * w);
+            buf[len++] = wild ? rnd() : (uint8_t)(drop > 255U ? 255U : drop);
         }
         const unsigned nn = 8U + n % (SL_RFIT_MAX_N - 7U);
         const unsigned c = rnd() % nn;
@@ -191,7 +192,8 @@ static void run_random(unsigned long count)
         for (unsigned i = 0; i < nn; i++) {
             const int dd = (int)i - (int)c;
             const int e = (int)amp - dd * dd / 8;
-            buf[len++] = wild ? rnd() : (uint8_t)(e < 6 ? 6 + rnd() % 2U : e);
+            const unsigned ev = (e < 6) ? 6U + rnd() % 2U : (unsigned)e;
+            buf[len++] = wild ? rnd() : (uint8_t)ev;
             buf[len++] = rnd();
         }
         const unsigned row = rnd() % 4U == 0U ? 0U : 200U + rnd() % 800U;
