@@ -197,12 +197,10 @@ void sl_response_prior_cts350x(uint16_t drop_q8[SL_RESP_TAPS])
 {
     for (int o = -HALF; o <= HALF; o++) {
         int src = o;
-        if (src < -20) {
-            src = -20;
-        }
-        if (src > 20) {
-            src = 20;
-        }
+#if SL_CFG_RESP_HALF > 20
+        // beyond the measured offsets: the last measured drop
+        src = (src < -20) ? -20 : ((src > 20) ? 20 : src);
+#endif
         drop_q8[o + HALF] = k_cts350x_q8[src + 20];
     }
 }
@@ -254,7 +252,8 @@ static void derive(sl_response_t *r)
         const int t = j % SL_RESP_SUB;
         uint32_t here;
         if (i >= SL_RESP_TAPS - 1) {
-            here = (i == SL_RESP_TAPS - 1 && t == 0) ? r->tap_q22[i] : 0U;
+            // the last tap at its own position, 0 beyond the taps
+            here = (j == (SL_RESP_TAPS - 1) * SL_RESP_SUB) ? r->tap_q22[SL_RESP_TAPS - 1] : 0U;
         } else {
             here = (uint32_t)(((uint64_t)r->tap_q22[i] * (uint32_t)(SL_RESP_SUB - t) +
                                (uint64_t)r->tap_q22[i + 1] * (uint32_t)t + SL_RESP_SUB / 2U) /
@@ -345,8 +344,10 @@ sl_err_t sl_response_set(sl_response_t *r, const uint16_t drop_q8[SL_RESP_TAPS],
 // step of c / n converges to the median; the floor of one LSB keeps it following slow drift).
 static int32_t median_step(uint32_t n)
 {
-    const uint32_t s = 4096U / (n + 32U);
-    return (int32_t)((s < 1U) ? 1U : s);
+    if (n >= 4064U) {
+        return 1;
+    }
+    return (int32_t)(4096U / (n + 32U));
 }
 
 static void median_update(int32_t *est, int32_t sample, uint32_t n)

@@ -398,7 +398,7 @@ static bool start(const ctx_t *c, int32_t *a, int32_t *b, uint64_t *level)
     for (int i = 0; i < SL_RESP_TAPS; i++) {
         const uint32_t t = c->r->tap_q22[i] >> 7;
         if (t >= 512U) {
-            const int64_t o = i - SL_CFG_RESP_HALF;
+            const int64_t o = (int64_t)i - (int64_t)SL_CFG_RESP_HALF;
             t0 += t;
             t2 += (uint64_t)t * (uint64_t)(o * o);
         }
@@ -419,13 +419,12 @@ static bool start(const ctx_t *c, int32_t *a, int32_t *b, uint64_t *level)
 // a x b >> s for signed values, saturating at +-2^61 (a sum of two stays inside int64).
 static int64_t mulsh(int64_t a, int64_t b, unsigned s)
 {
-    const int64_t lim = (int64_t)1 << 61;
-    a = (a < -lim) ? -lim : a;
-    b = (b < -lim) ? -lim : b;
-    const int64_t ua = (a < 0) ? -a : a;
-    const int64_t ub = (b < 0) ? -b : b;
-    if (ua != 0 && ub > lim / ua) {
-        return ((a < 0) != (b < 0)) ? -lim : lim;
+    const uint64_t lim = (uint64_t)1 << 61;
+    const bool neg = (a < 0) != (b < 0);
+    const uint64_t ua = (a < 0) ? (uint64_t)0 - (uint64_t)a : (uint64_t)a;
+    const uint64_t ub = (b < 0) ? (uint64_t)0 - (uint64_t)b : (uint64_t)b;
+    if (ua != 0U && ub > lim / ua) {
+        return neg ? -(int64_t)lim : (int64_t)lim;
     }
     return sl_fx_rshift_round64(a * b, s);
 }
@@ -473,7 +472,7 @@ static void covariance(ctx_t *c, int32_t a, int32_t b, uint64_t level, const ldl
         for (uint32_t d = 0; d <= lags; d++) {
             const uint32_t s = (k - d) % RING;
             const int64_t w = c->r->rho2_q15[d];
-            const int64_t f2 = (d == 0U) ? 1 : 2; // both orders of a pair
+            const int64_t f2 = (d == 0U) ? (int64_t)1 : (int64_t)2; // both orders of a pair
             m_aa += f2 * ((ta * ra[s] * w) >> 7);
             m_bb += f2 * ((tb * rb[s] * w) >> 7);
             m_ab += (d == 0U) ? ((ta * tb * w) >> 7) : (((ta * rb[s] + tb * ra[s]) * w) >> 7);
@@ -504,7 +503,7 @@ static void covariance(ctx_t *c, int32_t a, int32_t b, uint64_t level, const ldl
         const int64_t den = (int64_t)out->sigma_a_q8 * (int64_t)out->sigma_b_q8; // < 2^62
         int64_t corr;
         if (c_ab >= den || -c_ab >= den) {
-            corr = (c_ab < 0) ? -32767 : 32767; // rounding at |corr| = 1
+            corr = (c_ab < 0) ? (int64_t)-32767 : (int64_t)32767; // rounding at |corr| = 1
         } else if (den < ((int64_t)1 << 40)) {
             corr = (c_ab * 32768) / den;
         } else {
@@ -575,6 +574,44 @@ static int normalise(ctx_t *c)
     return (ymax == 0U) ? 0 : bits;
 }
 
+// One Fisher step from (a, b, level) with the step halved while J grows; returns true when
+// the fit is done (the step below the bounds' resolution, or no descent left).
+static bool fisher_step(ctx_t *c, const normal_t *ne, const ldl_t *f, int32_t *a, int32_t *b,
+                        uint64_t *level, int64_t *j, bool *converged)
+{
+    int64_t x[3];
+    solve(f, ne->g, x);
+    int32_t da = clamp_step(sl_fx_rshift_round64(x[1], 8));
+    int32_t db = clamp_step(sl_fx_rshift_round64(x[2], 8));
+    int64_t dl = x[0];
+    if (sl_fx_abs32(da) < TOL_Q8 && sl_fx_abs32(db) < TOL_Q8 && dl < 655 && dl > -655) {
+        *converged = true; // the step is below the bounds' resolution
+        return true;
+    }
+    pieces_t p;
+    bool small = false; // what is left of the step is below the resolution
+    for (int h = 0; h <= SL_RFIT_HALVINGS && !small; h++) {
+        int32_t na = *a + da, nb = *b + db;
+        keep_inside(c, &na, &nb);
+        const uint64_t nl = scale_level(*level, dl);
+        pieces_build(c, na, nb, &p);
+        const int64_t jn = nll(c, &p, nl);
+        if (jn <= *j) {
+            *a = na;
+            *b = nb;
+            *level = nl;
+            *j = jn;
+            return false;
+        }
+        da /= 2;
+        db /= 2;
+        dl /= 2;
+        small = sl_fx_abs32(da) < TOL_Q8 && sl_fx_abs32(db) < TOL_Q8 && dl < 655 && dl > -655;
+    }
+    *converged = true; // no descent left at the objective's resolution
+    return true;
+}
+
 sl_err_t sl_rfit(const sl_response_t *r, const sl_rfit_in_t *in, sl_rfit_out_t *out)
 {
     if (r == NULL || in == NULL || out == NULL || in->y == NULL || in->n < 8U ||
@@ -608,48 +645,16 @@ sl_err_t sl_rfit(const sl_response_t *r, const sl_rfit_in_t *in, sl_rfit_out_t *
     normal_t ne;
     ldl_t f;
     uint8_t it = 0;
-    for (; it < SL_RFIT_ITERS && !converged; it++) {
+    bool done = false;
+    for (; it < SL_RFIT_ITERS && !done; it++) {
         normal_eq(&c, a, b, level, &ne);
         f = factor(&ne);
+        fresh = true; // ne and f are the information at (a, b, level) until a step moves it
         if (!f.ok) {
-            break;
-        }
-        int64_t x[3];
-        solve(&f, ne.g, x);
-        int32_t da = clamp_step(sl_fx_rshift_round64(x[1], 8));
-        int32_t db = clamp_step(sl_fx_rshift_round64(x[2], 8));
-        int64_t dl = x[0];
-        converged = sl_fx_abs32(da) < TOL_Q8 && sl_fx_abs32(db) < TOL_Q8 && dl < 655 && dl > -655;
-        if (converged) {
-            fresh = true; // the information at this point is the one just computed
-            break;        // the step is below the bounds' resolution
-        }
-        bool moved = false;
-        for (int h = 0; h <= SL_RFIT_HALVINGS; h++) {
-            int32_t na = a + da, nb = b + db;
-            keep_inside(&c, &na, &nb);
-            const uint64_t nl = scale_level(level, dl);
-            pieces_build(&c, na, nb, &p);
-            const int64_t jn = nll(&c, &p, nl);
-            if (jn <= j) {
-                a = na;
-                b = nb;
-                level = nl;
-                j = jn;
-                moved = true;
-                break;
-            }
-            da /= 2;
-            db /= 2;
-            dl /= 2;
-            if (sl_fx_abs32(da) < TOL_Q8 && sl_fx_abs32(db) < TOL_Q8 && dl < 655 && dl > -655) {
-                break; // what is left of the step is below the resolution
-            }
-        }
-        if (!moved) {
-            converged = true; // no descent left at the objective's resolution
-            fresh = true;
-            break;
+            done = true;
+        } else {
+            done = fisher_step(&c, &ne, &f, &a, &b, &level, &j, &converged);
+            fresh = done;
         }
     }
     if (!fresh) {
