@@ -147,16 +147,16 @@
 /// ## Cost
 /// - Per azimuth O(ROI bins / 32 x mask planes): threshold, mask update, decoder, scan and
 ///   one detection row; per rotation O(azimuths) plus O(targets) estimates and tracking.
-///   Budgets (firmware/size_budget.txt, the `thumb` tests): 3,000 instructions per azimuth
-///   on Cortex-M0, 1,500 / 1,600 on Cortex-M4F; 2,500 on x86-64 with 8 tracked targets.
+///   Budgets per CPU (firmware/size_budget.txt and the `thumb` tests; the table is
+///   docs/INTEGRATION.md, "Footprint"); on x86-64 the `bench_*` ctests hold their own.
 /// - Latency: the rotation is complete when the next rotation's first azimuth arrives (one
 ///   azimuth period, 0.625 ms at 1600 Hz), then O(targets) work in that feed call.
 /// - Measured instruction counts, latency and throughput: docs/PERFORMANCE.md ("Core
 ///   modules", "Pipeline").
 /// Stack (computed from the call graph by ctest check_stack_cortex_m0/_m4f, libgcc frames
-/// included, Cortex-M -Os firmware configuration): worst case 1,004 B on Cortex-M0 and
-/// 816 B on Cortex-M4F from sl_pipeline_feed(), plus the port callbacks' own stack on top of
-/// at most 664 B (M0) / 552 B (M4F) at their call site. Budget 1,024 B (M0).
+/// included, Cortex-M -Os firmware configuration): the worst case from sl_pipeline_feed()
+/// is held to the budget in docs/INTEGRATION.md ("Footprint"; the ctests print the measured
+/// depth and the depth at the port callbacks' call site), plus the callbacks' own stack.
 ///
 /// ## Execution context: which call may run where
 /// One pipeline belongs to one execution context (a task, or the main loop), the *owner*:
