@@ -1072,7 +1072,7 @@ void Simulator::map_column(int k, int i, const SimColumn &col, uint8_t *out) con
     }
     // speckle belongs to the scatterers (interference inside a resolution cell); the smear
     // is the sensor's deterministic range response applied to what they return
-    if (s_.speckle) {
+    if (s_.speckle && !s_.speckle_physical) {
         for (int j = 0; j < nb; j++) {
             if (E[static_cast<size_t>(j)] > 0) {
                 const double g = sim_normal(sim_hash(spk_seed, spk_k, static_cast<uint64_t>(i),

@@ -5,6 +5,7 @@
 // the chassis edge, point returns and the Navtech value curve. With the paths of sl-sim and
 // sl-calib on the command line, also: a Hann response rendered by sl-sim and measured by
 // sl-calib response (the tool of the real scans) has the window's half-power width.
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdarg>
@@ -230,6 +231,17 @@ void test_points_and_value_curve(void **state)
     }
     assert_true(plain.log_value(3) == 9.0);
     assert_true(plain.log_value(0) == 0.0 && plain.log_value(1) == 0.0);
+    // the values that never occur on the real scans below 20 (1-5, 7, 8, 10, 11, 13, 16) are
+    // exactly those no integer power reaches on this curve (round(20 log10 6) = 16 would)
+    std::vector<int> hit(256, 0);
+    for (long n = 0; n < 100000; n++) {
+        hit[static_cast<size_t>(plain.log_value(n))] = 1;
+    }
+    const std::vector<int> missing = {1, 2, 3, 4, 5, 7, 8, 10, 11, 13, 16};
+    for (int v = 0; v < 20; v++) {
+        const bool miss = std::find(missing.begin(), missing.end(), v) != missing.end();
+        assert_int_equal(hit[static_cast<size_t>(v)], miss ? 0 : 1);
+    }
 }
 
 // Runs a command, returns its stdout.
