@@ -350,9 +350,9 @@ Simulator::Simulator(const Scene &scene) : s_(scene)
         } else if (s_.range_response == RangeResponse::Cts350x) {
             uint16_t drop[SL_RESP_TAPS];
             sl_response_prior_cts350x(drop); // the core's table: one source of truth
-            // beyond the table's +-SL_CFG_RESP_HALF the lobe falls on at the slope of its
-            // last two taps, for as many bins again
-            half = 2 * SL_CFG_RESP_HALF;
+            // the table's +-SL_CFG_RESP_HALF taps; with a skirt, beyond them the lobe falls on
+            // at the slope of its last two taps for range_skirt_bins more
+            half = SL_CFG_RESP_HALF + static_cast<int>(std::lround(s_.range_skirt_bins));
             for (int t = 0; t < SL_RESP_TAPS; t++) {
                 taps.push_back(std::pow(2.0, -drop[t] / 256.0));
             }

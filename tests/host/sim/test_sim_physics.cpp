@@ -93,12 +93,15 @@ void test_cts350x_table_is_the_cores(void **state)
     const double w = half_power_width(sim);
     std::printf("CTS350-X table: half-power width %.3f bins\n", w);
     assert_true(w > 7.5 && w < 8.6);
-    // beyond the table: falling on at the slope of its last two taps, 0 past twice its width
+    assert_true(sim.range_response(SL_CFG_RESP_HALF + 1) == 0.0);
+    // with a skirt of 20 bins: beyond the table falling on at the slope of its last two
+    // taps, 0 past twice its width
+    sl::Simulator sk(sl::parse_scene_string(base_scene("range_response = cts350x\nrange_skirt_bins = 20\n")));
     for (int side = -1; side <= 1; side += 2) {
-        const double r20 = sim.range_response(side * SL_CFG_RESP_HALF);
-        const double r19 = sim.range_response(side * (SL_CFG_RESP_HALF - 1));
-        assert_true(std::fabs(sim.range_response(side * (SL_CFG_RESP_HALF + 1)) / (r20 * r20 / r19) - 1) < 1e-6);
-        assert_true(sim.range_response(side * (2 * SL_CFG_RESP_HALF + 1)) == 0.0);
+        const double r20 = sk.range_response(side * SL_CFG_RESP_HALF);
+        const double r19 = sk.range_response(side * (SL_CFG_RESP_HALF - 1));
+        assert_true(std::fabs(sk.range_response(side * (SL_CFG_RESP_HALF + 1)) / (r20 * r20 / r19) - 1) < 1e-6);
+        assert_true(sk.range_response(side * (2 * SL_CFG_RESP_HALF + 1)) == 0.0);
     }
 }
 
