@@ -350,7 +350,9 @@ Simulator::Simulator(const Scene &scene) : s_(scene)
         } else if (s_.range_response == RangeResponse::Cts350x) {
             uint16_t drop[SL_RESP_TAPS];
             sl_response_prior_cts350x(drop); // the core's table: one source of truth
-            half = SL_CFG_RESP_HALF;
+            // the table's +-SL_CFG_RESP_HALF taps; with a skirt, beyond them the lobe falls on
+            // at the slope of its last two taps for range_skirt_bins more
+            half = SL_CFG_RESP_HALF + static_cast<int>(std::lround(s_.range_skirt_bins));
             for (int t = 0; t < SL_RESP_TAPS; t++) {
                 taps.push_back(std::pow(2.0, -drop[t] / 256.0));
             }
@@ -375,11 +377,21 @@ Simulator::Simulator(const Scene &scene) : s_(scene)
             if (s_.range_response == RangeResponse::Cts350x) {
                 if (std::fabs(o) <= half) {
                     // a smooth lobe through the taps: Catmull-Rom on the drops (log power)
-                    const double u = o + half;
-                    const long j = std::min(static_cast<long>(taps.size()) - 2, static_cast<long>(std::floor(u)));
+                    const long nt = static_cast<long>(taps.size());
+                    const double u = o + SL_CFG_RESP_HALF;
+                    const long j = static_cast<long>(std::floor(u));
                     const double t = u - static_cast<double>(j);
                     auto D = [&](long q) {
-                        q = std::clamp(q, 0L, static_cast<long>(taps.size()) - 1);
+                        if (q < 0) {
+                            return std::log2(taps[0]) + static_cast<double>(-q) *
+                                                            (std::log2(taps[0]) - std::log2(taps[1]));
+                        }
+                        if (q >= nt) {
+                            return std::log2(taps[static_cast<size_t>(nt - 1)]) +
+                                   static_cast<double>(q - nt + 1) *
+                                       (std::log2(taps[static_cast<size_t>(nt - 1)]) -
+                                        std::log2(taps[static_cast<size_t>(nt - 2)]));
+                        }
                         return std::log2(taps[static_cast<size_t>(q)]);
                     };
                     const double p0 = D(j - 1), p1 = D(j), p2 = D(j + 1), p3 = D(j + 2);
@@ -1072,7 +1084,7 @@ void Simulator::map_column(int k, int i, const SimColumn &col, uint8_t *out) con
     }
     // speckle belongs to the scatterers (interference inside a resolution cell); the smear
     // is the sensor's deterministic range response applied to what they return
-    if (s_.speckle) {
+    if (s_.speckle && !s_.speckle_physical) {
         for (int j = 0; j < nb; j++) {
             if (E[static_cast<size_t>(j)] > 0) {
                 const double g = sim_normal(sim_hash(spk_seed, spk_k, static_cast<uint64_t>(i),

@@ -24,13 +24,22 @@
 //   boxes and ground; azimuths with a box in the window render their ground this way too.
 //   Poles are hidden by boxes and by other poles; poles do not hide ground or boxes
 //   (slender: negligible).
+// - Point returns ([point.<name>]): one scatterer each at its exact range, weighted by the
+//   elevation and azimuth gains.
+// - Range response (effects.range_response, optional): a window's FFT response or the
+//   CTS350-X table of the core (sl_response_prior_cts350x); with physical speckle every
+//   resolution cell (a bin of ground, 1/8 bin of a pole) is a circular complex Gaussian
+//   amplitude and the field per bin is the coherent sum through sqrt(R) (exponential powers,
+//   frozen when parked); without it the expected power. Knife-edge diffraction (optional)
+//   replaces the chassis ray's hard cut by the two-way Fresnel loss |F(v)|^4.
 // - Effects (optional): log-normal speckle on the scatterers' energy (frozen for a static
-//   scene), then the range smear kernel on energy (RadaRays' triangular kernel with mode
+//   scene), the range response above, then the range smear kernel on energy (RadaRays' triangular kernel with mode
 //   weight 1, or an exponential tail in dB per bin), near-field leakage (fixed pattern),
 //   complex Gaussian noise, and the sensor's log-magnitude 8-bit mapping
 //   value = round(c log10 N) with N an integer magnitude, or with output.log_quantity = power
 //   an integer power (the CTS350-X: 0.5 dB per value, exponential noise) (Oxford: 0, 6, 9, 12, 14, 15, 17,
-//   18 ...; 35 % zeros with the default noise sigma).
+//   18 ...; 35 % zeros with the default noise sigma); output.log_curve = navtech: Navtech's
+//   piecewise-linear log2 instead of log10.
 // Randomness is counter-based (seed, rotation, azimuth, bin): rotations can be rendered in
 // any order or in parallel and give identical bytes.
 #pragma once

@@ -259,7 +259,7 @@ Scene build(const Parsed &p)
                 "smear_slow_decay_db", "smear_amp_decay_db", "smear_front_db", "speckle", "speckle_db", "speckle_frame_db",
                 "speckle_static", "speckle_seed", "noise", "noise_sigma", "leakage",
                 "leak_level", "leak_shoulder", "leak_edge_m", "leak_shoulder_end_m",
-                "leak_jitter", "speckle_model", "range_response", "range_cell_bins",
+                "leak_jitter", "speckle_model", "range_response", "range_cell_bins", "range_skirt_bins",
                 "receiver_tail_db", "receiver_tail_bins", "knife_edge", "carrier_ghz"});
         s.smear = c.boolean("smear", false);
         s.smear_shape = c.choice<int>("smear_shape", 0, {{"triangular", 0}, {"exponential", 1}, {"two-component", 2},
@@ -287,6 +287,7 @@ Scene build(const Parsed &p)
              {"hann", RangeResponse::Hann}, {"hamming", RangeResponse::Hamming},
              {"blackman", RangeResponse::Blackman}, {"cts350x", RangeResponse::Cts350x}});
         s.range_cell_bins = c.real("range_cell_bins", s.range_cell_bins, 0.5, 9);
+        s.range_skirt_bins = c.real("range_skirt_bins", s.range_skirt_bins, 0, 40);
         s.receiver_tail_db = c.real("receiver_tail_db", s.receiver_tail_db, -120, 0);
         s.receiver_tail_bins = c.real("receiver_tail_bins", s.receiver_tail_bins, 0, 200);
         s.knife_edge = c.boolean("knife_edge", false);

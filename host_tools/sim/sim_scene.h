@@ -160,6 +160,8 @@ struct Scene {
     // amplitudes times the amplitude response sqrt(R) at their offset (see scenes/README.md)
     RangeResponse range_response = RangeResponse::None;
     double range_cell_bins = 6;    ///< window responses: bins per resolution cell (1 / T)
+    double range_skirt_bins = 0;   ///< cts350x: the lobe goes on this many bins beyond the
+                                   ///< table's +-20 taps at the slope of its last two (0: ends)
     double receiver_tail_db = -30; ///< receiver tail: R(o > 0) += 10^(db/10) exp(-o / bins) ...
     double receiver_tail_bins = 0; ///< ... its e-folding length in bins (0: no tail)
     bool knife_edge = false;       ///< Fresnel knife-edge diffraction at the chassis edge

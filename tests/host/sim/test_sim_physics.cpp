@@ -5,6 +5,7 @@
 // the chassis edge, point returns and the Navtech value curve. With the paths of sl-sim and
 // sl-calib on the command line, also: a Hann response rendered by sl-sim and measured by
 // sl-calib response (the tool of the real scans) has the window's half-power width.
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdarg>
@@ -93,6 +94,15 @@ void test_cts350x_table_is_the_cores(void **state)
     std::printf("CTS350-X table: half-power width %.3f bins\n", w);
     assert_true(w > 7.5 && w < 8.6);
     assert_true(sim.range_response(SL_CFG_RESP_HALF + 1) == 0.0);
+    // with a skirt of 20 bins: beyond the table falling on at the slope of its last two
+    // taps, 0 past twice its width
+    sl::Simulator sk(sl::parse_scene_string(base_scene("range_response = cts350x\nrange_skirt_bins = 20\n")));
+    for (int side = -1; side <= 1; side += 2) {
+        const double r20 = sk.range_response(side * SL_CFG_RESP_HALF);
+        const double r19 = sk.range_response(side * (SL_CFG_RESP_HALF - 1));
+        assert_true(std::fabs(sk.range_response(side * (SL_CFG_RESP_HALF + 1)) / (r20 * r20 / r19) - 1) < 1e-6);
+        assert_true(sk.range_response(side * (2 * SL_CFG_RESP_HALF + 1)) == 0.0);
+    }
 }
 
 // Values of the ground bins 6-20 m of every azimuth of rotation k.
@@ -230,6 +240,17 @@ void test_points_and_value_curve(void **state)
     }
     assert_true(plain.log_value(3) == 9.0);
     assert_true(plain.log_value(0) == 0.0 && plain.log_value(1) == 0.0);
+    // the values that never occur on the real scans below 20 (1-5, 7, 8, 10, 11, 13, 16) are
+    // exactly those no integer power reaches on this curve (round(20 log10 6) = 16 would)
+    std::vector<int> hit(256, 0);
+    for (long n = 0; n < 100000; n++) {
+        hit[static_cast<size_t>(plain.log_value(n))] = 1;
+    }
+    const std::vector<int> missing = {1, 2, 3, 4, 5, 7, 8, 10, 11, 13, 16};
+    for (int v = 0; v < 20; v++) {
+        const bool miss = std::find(missing.begin(), missing.end(), v) != missing.end();
+        assert_int_equal(hit[static_cast<size_t>(v)], miss ? 0 : 1);
+    }
 }
 
 // Runs a command, returns its stdout.
