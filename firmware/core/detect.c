@@ -150,8 +150,8 @@ void sl_detect_correct(const sl_board_t *board, const sl_detect_cfg_t *cfg, uint
         radius = width > beam_bam ? half_arc_um(r1_hb, width - beam_bam) : 0U;
         t->flags |= SL_TARGET_RADIUS_WIDTH;
         // A beam footprint wider than four times the estimated diameter cannot resolve
-        // it: one azimuth step more or less is then most of the estimate (EXTRACTION.md
-        // D4; a 60 mm pole under a 1.8 deg beam at 4 m is still resolved).
+        // it: one azimuth step more or less is then most of the estimate (docs/DESIGN.md,
+        // "Detection"; a 60 mm pole under a 1.8 deg beam at 4 m is still resolved).
         if (half_arc_um(r1_hb, beam_bam) > 4U * radius) {
             radius = 0U;
         }
@@ -482,7 +482,8 @@ int sl_detect_clutter_reason(const sl_board_t *board, const sl_target_t *t, uint
         }
         // The test is on the measured run, not on the elongation-corrected r2: a return
         // whose corrected r2 falls at or below r1 (INVALID) or below the fold may still be
-        // a pole leaning away, smeared less than the model says (EXTRACTION.md).
+        // a pole leaning away, smeared less than the model says (docs/DESIGN.md, "Range
+        // extraction").
         const uint64_t rho = rho_measured_q28(t, rho_q28);
         if ((t->incline_flag == (uint8_t)SL_INCLINE_INVALID) && (rho <= ((uint64_t)1U << 28))) {
             return SL_DETECT_REJ_RHO; // r1 >= r2 even as measured
@@ -728,7 +729,7 @@ static void finalize(sl_detect_t *d, sl_detect_cand_t *c)
     t.bin_first = rep->first;
     t.bin_last = rep->last;
     t.occupied = (uint8_t)(rep->count < 0xFFU ? rep->count : 0xFFU);
-    // Radius width (D4 of EXTRACTION.md): the contiguous columns around the representative
+    // Radius width (docs/DESIGN.md, "Detection"): the contiguous columns around the representative
     // azimuth whose run reaches into the slab [first, first + RADIUS_SLAB_BINS] at the
     // pole's inner edge, not the whole group, which a leaning pole widens in bearing along
     // its length.
