@@ -501,23 +501,23 @@ bool sl_response_update(sl_response_t *r)
     return changed;
 }
 
-uint32_t sl_response_at_q15(const sl_response_t *r, int32_t x_q8)
+uint32_t sl_response_at_q22(const sl_response_t *r, int32_t x_q8)
 {
     const int32_t u = x_q8 + HALF * 256; // from the first tap
-    if (r == NULL || u < 0 || u > (SL_RESP_TAPS - 1) * 256) {
-        return 0U;
-    }
-    if (u == (SL_RESP_TAPS - 1) * 256) {
-        return (r->tap_q22[SL_RESP_TAPS - 1] + 64U) >> 7;
+    if (r == NULL || u < 0 || u >= (SL_RESP_TAPS - 1) * 256) {
+        return 0U; // the last tap itself counts as beyond: the cumulative ends there too
     }
     const uint32_t i = (uint32_t)u >> 8;
     const uint32_t t = (uint32_t)u & 255U;
     const uint64_t v = (uint64_t)r->tap_q22[i] * (256U - t) + (uint64_t)r->tap_q22[i + 1U] * t;
-    return (uint32_t)((v + (1U << 14)) >> 15); // Q22 x Q8 -> Q15
+    return (uint32_t)((v + 128U) >> 8);
 }
 
 uint32_t sl_response_cum(const sl_response_t *r, int32_t u_q8)
 {
+    if (r == NULL) {
+        return 0U;
+    }
     const int32_t last = (SL_RESP_TAPS - 1) * SL_RESP_SUB;
     const int32_t s = (u_q8 + HALF * 256) * SL_RESP_SUB; // sub-steps, Q8
     if (s <= 0) {

@@ -112,19 +112,6 @@ static void pieces_build(const ctx_t *c, int32_t a, int32_t b, pieces_t *p)
     }
 }
 
-// The response at offset u (bins Q8), tap_q22 interpolated; 0 outside the taps.
-static int64_t resp_at(const sl_response_t *r, int32_t u_q8)
-{
-    const int32_t v = u_q8 + SL_CFG_RESP_HALF * 256;
-    if (v < 0 || v >= (SL_RESP_TAPS - 1) * 256) {
-        return 0;
-    }
-    const uint32_t i = (uint32_t)v >> 8;
-    const uint32_t t = (uint32_t)v & 255U;
-    return (int64_t)(((uint64_t)r->tap_q22[i] * (256U - t) + (uint64_t)r->tap_q22[i + 1U] * t +
-                      128U) >> 8);
-}
-
 // The model and its derivatives by a and b at sample k, Q24 (per bin). A piece p adds
 // coef_p (C(k - x_p) - C(k - x_p+1)); moving a breakpoint moves the piece's end (the response
 // there, dC/du = SUB R) and its width (coef ~ 1 / width).
@@ -134,10 +121,10 @@ static int64_t model_grad_at(const ctx_t *c, const pieces_t *p, uint32_t k, int6
     const int32_t kq = (int32_t)(k * 256U);
     int64_t m = 0, ga = 0, gb = 0;
     uint32_t hi = sl_response_cum(c->r, kq - p->x[0]);
-    int64_t r_hi = resp_at(c->r, kq - p->x[0]);
+    int64_t r_hi = (int64_t)sl_response_at_q22(c->r, kq - p->x[0]);
     for (uint32_t i = 0; i < p->np; i++) {
         const uint32_t lo = sl_response_cum(c->r, kq - p->x[i + 1U]);
-        const int64_t r_lo = resp_at(c->r, kq - p->x[i + 1U]);
+        const int64_t r_lo = (int64_t)sl_response_at_q22(c->r, kq - p->x[i + 1U]);
         const int64_t mp = (int64_t)p->coef[i] * (int64_t)(hi - lo); // Q48
         m += mp;
         // d/dx_i and d/dx_i+1 of this piece, Q24 per bin

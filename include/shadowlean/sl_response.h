@@ -49,7 +49,7 @@
 ///   where the scene dominates (a wall) read high; bands are independent.
 ///
 /// ## Ownership, memory, cost
-/// Caller-owned, no allocation, no float. RAM: sizeof(sl_response_t) (~2.3 KB with the
+/// Caller-owned, no allocation, no float. RAM: sizeof(sl_response_t) (about 2.2 KB with the
 /// defaults). sl_response_learn_row: O(max_bin - min_bin) with a 2 x isolation window per
 /// candidate peak (at most `cfg.max_peaks_per_row` accepted); sl_response_update: O(taps x
 /// SL_RESP_SUB). Not reentrant per instance.
@@ -193,12 +193,14 @@ bool sl_response_update(sl_response_t *r);
 /// exponential noise). INT32_MIN when the band has no samples yet.
 int32_t sl_response_floor_lp(const sl_response_t *r, uint32_t bin);
 
-/// The linear response at offset x (bins, Q8, centre 0) in Q15 (centre 32768): the taps
-/// interpolated, 0 outside.
-uint32_t sl_response_at_q15(const sl_response_t *r, int32_t x_q8);
+/// The linear response at offset x (bins, Q8, centre 0) in Q22 (centre 2^22): the taps
+/// interpolated, 0 from the last tap on and before the first (as the cumulative integrates
+/// it). 0 for NULL. O(1).
+uint32_t sl_response_at_q22(const sl_response_t *r, int32_t x_q8);
 
 /// Integral of the linear response over (-inf, u] (u in bins Q8), in tap_q22 x (1/SUB bin):
-/// the cumulative table interpolated; 0 before -HALF, `cum[SL_RESP_CUM-1]` after +HALF+1.
+/// the cumulative table interpolated; 0 before -HALF, `cum[SL_RESP_CUM-1]` from +HALF on;
+/// 0 for NULL. O(1).
 uint32_t sl_response_cum(const sl_response_t *r, int32_t u_q8);
 
 /// Half-power width of the response in use, bins Q8 (each side's -3 dB crossing, linear

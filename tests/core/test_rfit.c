@@ -104,6 +104,18 @@ static void test_response_prior_is_the_measured_lobe(void **state)
     const double nc = r.ncorr_q8 / 256.0;
     assert_true(nc > 10.2 && nc < 13.8);
     assert_int_equal(r.source, SL_RESPONSE_PRIOR);
+    // the response and its cumulative are one function: 2^22 at the centre, 0 beyond the taps,
+    // and the cumulative's slope SUB x the response (a finite difference of 1/8 bin)
+    assert_int_equal(sl_response_at_q22(&r, 0), 1U << 22);
+    assert_int_equal(sl_response_at_q22(&r, SL_CFG_RESP_HALF * 256), 0U);
+    assert_int_equal(sl_response_at_q22(&r, -SL_CFG_RESP_HALF * 256 - 1), 0U);
+    assert_int_equal(sl_response_cum(&r, -SL_CFG_RESP_HALF * 256 - 5), 0U);
+    assert_int_equal(sl_response_cum(&r, SL_CFG_RESP_HALF * 256 + 5), r.cum[SL_RESP_CUM - 1]);
+    for (int32_t u = -SL_CFG_RESP_HALF * 256 + 16; u < SL_CFG_RESP_HALF * 256 - 16; u += 77) {
+        const double slope = (double)sl_response_cum(&r, u + 16) - (double)sl_response_cum(&r, u - 16);
+        const double want = SL_RESP_SUB * (double)sl_response_at_q22(&r, u) / 8.0;
+        assert_true(fabs(slope - want) <= 0.05 * want + 64.0); // a tap's kink inside the step
+    }
     // the cumulative's total is the taps' area
     sl_ro_resp_t o;
     sl_ro_resp_from_drops(r.drop_q8, &o);
