@@ -19,12 +19,14 @@
 ///
 /// ## Objective and solution
 /// Speckle makes each independent look's power exponential around mu (Gamma with L looks when
-/// L independent looks are averaged), so the fit minimises the negative log-likelihood
-///   J = w sum_k (ln mu_k + y_k / mu_k),  w = looks / ncorr
-/// where y_k is the observed mean power, `looks` the independent looks averaged into it
-/// (rotations of a scene whose speckle changes, neighbouring rows inside the beam; 1 for one
-/// frozen draw however many rotations were summed: the caller says which) and ncorr the
-/// response's speckle correlation length (neighbouring bins are not independent draws).
+/// L independent looks are averaged), so the fit minimises the negative log-likelihood of the
+/// samples taken as independent
+///   J = L sum_k (ln mu_k + y_k / mu_k)
+/// where y_k is the observed mean power and L = `looks` the independent looks averaged into
+/// it (rotations of a scene whose speckle changes, neighbouring rows inside the beam; 1 for
+/// one frozen draw however many rotations were summed: the caller says which). Neighbouring
+/// bins are not independent draws (one draw spans the response's correlation length); that
+/// enters the covariance below, not the estimate.
 /// Solved by Fisher scoring (Gauss-Newton with weights 1 / mu^2, the model's Jacobian
 /// analytic: moving a bound moves a piece's end and its width), the level A a third
 /// parameter (its logarithm) of each step;
@@ -33,20 +35,23 @@
 /// SL_RFIT_ITERS iterations. a and b are kept inside the window and b >= a + 1/8 bin.
 ///
 /// ## Uncertainty and quality
-/// The covariance of (a, b) is the inverse of the Fisher information at the optimum (the
-/// level profiled out): `sigma_a_q8`, `sigma_b_q8`, `cov_ab_q16`. Where the data do not pin a
-/// bound down (a return shorter than the response is wide, one frozen speckle draw, a weak
-/// return), the information is small and the sigma wide: a caller propagates it to the lean's
-/// sigma and sends the lean with it, never as a confident number.
+/// The covariance of (a, b), the level profiled out, is the sandwich N^-1 M N^-1 of that
+/// independence likelihood: N its Fisher information, M the score's covariance with the
+/// speckle's correlation between bins (`rho2_q15` of sl_response.h): `sigma_a_q8`,
+/// `sigma_b_q8`, `corr_q15`. Where the data do not pin a bound down (a return shorter than
+/// the response is wide, one frozen speckle draw, a weak return), the information is small
+/// and the sigma wide: a caller propagates it to the lean's sigma and sends the lean with
+/// it, never as a confident number.
 /// Where the return departs from the model by more than its noise explains (the deviance D
 /// below above its expectation E), the bounds are known less well than the model says: both
 /// sigmas are scaled by sqrt(D / E) (quasi-likelihood dispersion), never below the model's.
 /// `quality`:
 /// - SL_RFIT_OK: converged, the deviance within what the noise explains;
-/// - SL_RFIT_OUT_OF_MODEL: the deviance D = 2 w sum (y/mu - 1 - ln(y/mu)) exceeds
-///   E + 6 sqrt(2 E) + 8, E = (n / ncorr) (1 + 1 / (6 looks)) its expectation under the
-///   model: a return the model does not explain (two targets, a cut-off return, clutter);
-///   the bounds are returned but must not be trusted;
+/// - SL_RFIT_OUT_OF_MODEL: the deviance D = 2 L sum (y/mu - 1 - ln(y/mu)) exceeds
+///   E + 6 sqrt(V) + 8, E = n (1 + 1 / (6 L)) its expectation under the model and
+///   V = 2 n `s4` its variance with the bins' correlation: a return the model does not
+///   explain (two targets, a cut-off return, clutter); the bounds are returned but must not
+///   be trusted;
 /// - SL_RFIT_NO_SIGNAL: no power above the floor to fit (the sums of y - f <= 0);
 /// - SL_RFIT_NOT_CONVERGED: the iteration limit was reached with steps still above 1/64 bin.
 ///
