@@ -267,14 +267,11 @@ static int run_file(const char *path, const char *name, unsigned long index)
 {
     (void)name;
     (void)index;
-    FILE *f = fopen(path, "rb");
-    if (f == NULL) {
-        fprintf(stderr, "fuzz_tilt_replay: cannot open %s\n", path);
+    static uint8_t buf[1U << 16];
+    size_t n = 0;
+    if (replay_read("fuzz_tilt_replay", path, buf, sizeof buf, &n) != 0) {
         return 1;
     }
-    static uint8_t buf[1U << 16];
-    const size_t n = fread(buf, 1, sizeof buf, f);
-    fclose(f);
     run_one(buf, n);
     g_inputs++;
     return 0;
@@ -285,15 +282,10 @@ static int run_file(const char *path, const char *name, unsigned long index)
 static uint64_t g_rng = 0x9E3779B97F4A7C15ULL;
 static uint8_t rnd(void)
 {
-    g_rng ^= g_rng >> 12;
-    g_rng ^= g_rng << 25;
-    g_rng ^= g_rng >> 27;
-    return (uint8_t)((g_rng * 2685821657736338717ULL) >> 56);
+    return replay_rnd(&g_rng);
 }
 
-static const char *g_write_dir; // --write DIR: keep the random inputs as files (seeds)
-
-static void run_random(unsigned long n)
+static void run_random(unsigned long n, const char *write_dir)
 {
     static uint8_t buf[4096];
     for (unsigned long k = 0; k < n; k++) {
@@ -324,12 +316,8 @@ static void run_random(unsigned long n)
                 buf[len++] = wild ? rnd() : (uint8_t)(rnd() & 0x3FU);
             }
         }
-        if (g_write_dir != NULL) {
-            char path[4096];
-            snprintf(path, sizeof path, "%s/random_%04lu.bin", g_write_dir, k);
-            FILE *f = fopen(path, "wb");
-            CHECK(f != NULL && fwrite(buf, 1, len, f) == len);
-            fclose(f);
+        if (write_dir != NULL) { // keep it as a libFuzzer run's seed
+            replay_write(write_dir, k, buf, len);
         }
         run_one(buf, len);
         g_inputs++;
@@ -338,30 +326,13 @@ static void run_random(unsigned long n)
 
 int main(int argc, char **argv)
 {
-    int bad = 0;
-    unsigned long random_n = 0;
-    unsigned long files = 0;
-    for (int i = 1; i < argc; i++) {
-        if (strcmp(argv[i], "--random") == 0 && i + 1 < argc) {
-            random_n = strtoul(argv[++i], NULL, 10);
-            continue;
-        }
-        if (strcmp(argv[i], "--write") == 0 && i + 1 < argc) {
-            g_write_dir = argv[++i];
-            continue;
-        }
-        const int r = replay_path(argv[i], &files, run_file);
-        if (r < 0) {
-            fprintf(stderr, "fuzz_tilt_replay: no such path %s\n", argv[i]);
-            return 1;
-        }
-        bad |= r;
-    }
-    if (files == 0 && random_n == 0) {
-        fprintf(stderr, "usage: fuzz_tilt_replay [--random N [--write DIR]] [file|dir]...\n");
+    replay_args_t a;
+    if (replay_args(argc, argv, "fuzz_tilt_replay", run_file, &a) != 0) {
         return 1;
     }
-    run_random(random_n);
+    const unsigned long files = a.files;
+    const int bad = a.bad;
+    run_random(a.random_n, a.write_dir);
     printf("fuzz_tilt_replay: %lu inputs (%lu files), all invariants held; %lu observations, "
            "%lu fits, rings ending FITTED %lu / AMBIGUOUS %lu, drops %lu inconsistent + %lu gross\n",
            g_inputs, files, g_obs, g_fits, g_fitted, g_ambiguous, g_drops, g_gross);
