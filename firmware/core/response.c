@@ -46,7 +46,8 @@ static const uint16_t k_cts350x_q8[41] = {
 
 #define HALF SL_CFG_RESP_HALF
 #define LP_ONE 256
-#define LP_DB(db10) ((int32_t)(((db10) * 256 + 15) / 30)) // tenths of dB -> log2 Q8 (approx 3.01 dB/oct)
+// tenths of dB -> log2 Q8 (3.0 dB per octave: the thresholds below are round figures)
+#define LP_DB(db10) ((int32_t)(((db10) * 256 + 15) / 30))
 #define INV_LN2_LP 135 // 256 log2(1 / ln 2): an exponential's mean over its median
 
 // log2(1 + m) for m in Q16 [0, 65536), Q16.
@@ -266,7 +267,8 @@ static void derive(sl_response_t *r)
         prev = here;
     }
     // area in bins Q8: acc / SUB / 2^22 x 2^8
-    r->area_q8 = (uint32_t)(((uint64_t)acc + ((uint64_t)SL_RESP_SUB << 13)) / ((uint64_t)SL_RESP_SUB << 14));
+    r->area_q8 = (uint32_t)(((uint64_t)acc + ((uint64_t)SL_RESP_SUB << 13)) /
+                            ((uint64_t)SL_RESP_SUB << 14));
     const uint64_t nc = (s2 == 0U) ? 256U : (s1 * s1 * 256U) / s2;
     r->ncorr_q8 = (uint16_t)((nc > 65535U) ? 65535U : nc);
     // Speckle: the field through the amplitude response h = sqrt(R); the powers of two bins
@@ -462,7 +464,8 @@ int sl_response_learn_row(sl_response_t *r, const uint8_t *row, uint32_t bins, u
         const int32_t lp_pk = sl_vscale_lp(&r->scale, v);
         const int32_t fl = sl_response_floor_lp(r, k);
         if (fl != INT32_MIN && lp_pk - fl >= r->cfg.peak_min_lp && last - k <= 4U) {
-            if (isolated(r, row, (int32_t)k, -1, lp_pk) && isolated(r, row, (int32_t)last, 1, lp_pk)) {
+            if (isolated(r, row, (int32_t)k, -1, lp_pk) &&
+                isolated(r, row, (int32_t)last, 1, lp_pk)) {
                 learn_peak(r, row, (int32_t)k, (int32_t)last, lp_pk);
                 r->stats.peaks++;
                 accepted++;

@@ -112,50 +112,42 @@ static void pieces_build(const ctx_t *c, int32_t a, int32_t b, pieces_t *p)
     }
 }
 
-// The model and its derivatives by a and b at sample k, Q24 (per bin). A piece p adds
-// coef_p (C(k - x_p) - C(k - x_p+1)); moving a breakpoint moves the piece's end (the response
-// there, dC/du = SUB R) and its width (coef ~ 1 / width).
-static int64_t model_grad_at(const ctx_t *c, const pieces_t *p, uint32_t k, int64_t *dm_da,
-                             int64_t *dm_db)
+// The model at sample k, Q24 of the return's total power, and (when dm_da and dm_db are
+// given) its derivatives by a and b, Q24 per bin. A piece p adds
+// coef_p (C(k - x_p) - C(k - x_p+1)); moving a breakpoint moves the piece's end (the
+// response there, dC/du = SUB R) and its width (coef ~ 1 / width).
+static int64_t model_at(const ctx_t *c, const pieces_t *p, uint32_t k, int64_t *dm_da,
+                        int64_t *dm_db)
 {
     const int32_t kq = (int32_t)(k * 256U);
+    const bool grad = dm_da != NULL && dm_db != NULL;
     int64_t m = 0, ga = 0, gb = 0;
     uint32_t hi = sl_response_cum(c->r, kq - p->x[0]);
-    int64_t r_hi = (int64_t)sl_response_at_q22(c->r, kq - p->x[0]);
+    int64_t r_hi = grad ? (int64_t)sl_response_at_q22(c->r, kq - p->x[0]) : 0;
     for (uint32_t i = 0; i < p->np; i++) {
         const uint32_t lo = sl_response_cum(c->r, kq - p->x[i + 1U]);
-        const int64_t r_lo = (int64_t)sl_response_at_q22(c->r, kq - p->x[i + 1U]);
         const int64_t mp = (int64_t)p->coef[i] * (int64_t)(hi - lo); // Q48
         m += mp;
-        // d/dx_i and d/dx_i+1 of this piece, Q24 per bin
-        const int64_t wterm = sl_fx_rshift_round64(sl_fx_rshift_round64(mp, 24) * 256 *
-                                                       (int64_t)p->inv_w[i], 32);
-        // C(k - x) falls as x grows (dC/dx = -SUB R); the width grows with x_i+1
-        const int64_t d_lo =
-            wterm - sl_fx_rshift_round64((int64_t)p->coef[i] * SL_RESP_SUB * r_hi, 24);
-        const int64_t d_hi =
-            sl_fx_rshift_round64((int64_t)p->coef[i] * SL_RESP_SUB * r_lo, 24) - wterm;
-        // |d| < 2^40 (the model is a fraction over widths >= 1/256 bin), |dx| <= 2^17
-        ga += sl_fx_rshift_round64(d_lo * p->dxa[i] + d_hi * p->dxa[i + 1U], 16);
-        gb += sl_fx_rshift_round64(d_lo * p->dxb[i] + d_hi * p->dxb[i + 1U], 16);
         hi = lo;
-        r_hi = r_lo;
+        if (grad) {
+            const int64_t r_lo = (int64_t)sl_response_at_q22(c->r, kq - p->x[i + 1U]);
+            // d/dx_i and d/dx_i+1 of this piece, Q24 per bin
+            const int64_t wterm = sl_fx_rshift_round64(sl_fx_rshift_round64(mp, 24) * 256 *
+                                                           (int64_t)p->inv_w[i], 32);
+            // C(k - x) falls as x grows (dC/dx = -SUB R); the width grows with x_i+1
+            const int64_t d_lo =
+                wterm - sl_fx_rshift_round64((int64_t)p->coef[i] * SL_RESP_SUB * r_hi, 24);
+            const int64_t d_hi =
+                sl_fx_rshift_round64((int64_t)p->coef[i] * SL_RESP_SUB * r_lo, 24) - wterm;
+            // |d| < 2^40 (the model is a fraction over widths >= 1/256 bin), |dx| <= 2^17
+            ga += sl_fx_rshift_round64(d_lo * p->dxa[i] + d_hi * p->dxa[i + 1U], 16);
+            gb += sl_fx_rshift_round64(d_lo * p->dxb[i] + d_hi * p->dxb[i + 1U], 16);
+            r_hi = r_lo;
+        }
     }
-    *dm_da = ga;
-    *dm_db = gb;
-    return sl_fx_rshift_round64(m, 24);
-}
-
-// The model at sample k, Q24 of the return's total power.
-static int64_t model_at(const ctx_t *c, const pieces_t *p, uint32_t k)
-{
-    const int32_t kq = (int32_t)(k * 256U);
-    int64_t m = 0;
-    uint32_t hi = sl_response_cum(c->r, kq - p->x[0]);
-    for (uint32_t i = 0; i < p->np; i++) {
-        const uint32_t lo = sl_response_cum(c->r, kq - p->x[i + 1U]);
-        m += (int64_t)p->coef[i] * (int64_t)(hi - lo);
-        hi = lo;
+    if (dm_da != NULL && dm_db != NULL) {
+        *dm_da = ga;
+        *dm_db = gb;
     }
     return sl_fx_rshift_round64(m, 24);
 }
@@ -173,7 +165,7 @@ static int64_t nll(ctx_t *c, const pieces_t *p, uint64_t level)
     c->evals++;
     int64_t acc = 0; // sum of ln mu + y/mu, Q16
     for (uint32_t k = 0; k < c->in->n; k++) {
-        const uint64_t mu = mu_of(c, level, model_at(c, p, k), k);
+        const uint64_t mu = mu_of(c, level, model_at(c, p, k, NULL, NULL), k);
         const int64_t ln = sl_fx_rshift_round64((int64_t)sl_lin_log2_q16(mu) * LN2_Q16, 16);
         acc += ln + (int64_t)((((uint64_t)y_at(c, k)) << 16) / mu);
     }
@@ -194,6 +186,20 @@ static int64_t over_mu_q14(int64_t x, uint64_t mu)
     return clampj(q);
 }
 
+// The model's Jacobian at sample k scaled by 1 / mu, Q14: j[0] = level m (by ln level),
+// j[1] = level dm/da, j[2] = level dm/db (per bin); returns mu.
+static uint64_t jacobian_at(const ctx_t *c, const pieces_t *p, uint64_t level, uint32_t k,
+                            int64_t j[3])
+{
+    int64_t ma, mb;
+    const int64_t m0 = model_at(c, p, k, &ma, &mb);
+    const uint64_t mu = mu_of(c, level, m0, k);
+    j[0] = over_mu_q14((int64_t)(mu - (uint64_t)f_at(c, k)), mu); // level x m0
+    j[1] = over_mu_q14(mulsh((int64_t)level, ma, 24), mu);
+    j[2] = over_mu_q14(mulsh((int64_t)level, mb, 24), mu);
+    return mu;
+}
+
 typedef struct normal {
     int64_t n[3][3]; // Fisher information (unweighted), Q28
     int64_t g[3];    // score, Q28
@@ -208,17 +214,8 @@ static void normal_eq(ctx_t *c, int32_t a, int32_t b, uint64_t level, normal_t *
     memset(ne, 0, sizeof(*ne));
     int64_t g38[3] = {0, 0, 0}; // score, Q38
     for (uint32_t k = 0; k < c->in->n; k++) {
-        int64_t ma, mb;
-        const int64_t m0 = model_grad_at(c, &p0, k, &ma, &mb);
-        const uint64_t mu = mu_of(c, level, m0, k);
-        const int64_t lm = (int64_t)(mu - (uint64_t)f_at(c, k)); // level x m0
-        // d mu / d a per bin = level d m / d a (m Q24)
-        const int64_t da = mulsh((int64_t)level, ma, 24);
-        const int64_t db = mulsh((int64_t)level, mb, 24);
         int64_t j[3];
-        j[0] = over_mu_q14(lm, mu);
-        j[1] = over_mu_q14(da, mu);
-        j[2] = over_mu_q14(db, mu);
+        const uint64_t mu = jacobian_at(c, &p0, level, k, j);
         // the residual in Q24: near the optimum it is a few 1e-5 of mu per sample
         int64_t rt = (((int64_t)y_at(c, k) - (int64_t)mu) * 16777216) / (int64_t)mu;
         if (rt > ((int64_t)64 << 24)) {
@@ -442,14 +439,10 @@ static void covariance(ctx_t *c, int32_t a, int32_t b, uint64_t level, const ldl
     int16_t ra[RING], rb[RING]; // projected Jacobians of the last RING samples, Q10
     int64_t m_aa = 0, m_bb = 0, m_ab = 0; // Q28 (Q10 x Q10 x Q15 >> 7)
     for (uint32_t k = 0; k < c->in->n; k++) {
-        int64_t ma, mb;
-        const int64_t m0 = model_grad_at(c, &p0, k, &ma, &mb);
-        const uint64_t mu = mu_of(c, level, m0, k);
-        const int64_t j0 = over_mu_q14((int64_t)(mu - (uint64_t)f_at(c, k)), mu);
-        const int64_t j1 = over_mu_q14(mulsh((int64_t)level, ma, 24), mu);
-        const int64_t j2 = over_mu_q14(mulsh((int64_t)level, mb, 24), mu);
-        int64_t ta = sl_fx_rshift_round64(j1 - sl_fx_rshift_round64(f->l10 * j0, 16), 4);
-        int64_t tb = sl_fx_rshift_round64(j2 - sl_fx_rshift_round64(f->l20 * j0, 16), 4);
+        int64_t j[3];
+        (void)jacobian_at(c, &p0, level, k, j);
+        int64_t ta = sl_fx_rshift_round64(j[1] - sl_fx_rshift_round64(f->l10 * j[0], 16), 4);
+        int64_t tb = sl_fx_rshift_round64(j[2] - sl_fx_rshift_round64(f->l20 * j[0], 16), 4);
         ta = (ta > 32767) ? 32767 : ((ta < -32767) ? -32767 : ta);
         tb = (tb > 32767) ? 32767 : ((tb < -32767) ? -32767 : tb);
         const uint32_t slot = k % RING;
@@ -507,7 +500,7 @@ static void deviance(ctx_t *c, int32_t a, int32_t b, uint64_t level, sl_rfit_out
     pieces_build(c, a, b, &p);
     int64_t d = 0; // Q16
     for (uint32_t k = 0; k < c->in->n; k++) {
-        const uint64_t mu = mu_of(c, level, model_at(c, &p, k), k);
+        const uint64_t mu = mu_of(c, level, model_at(c, &p, k, NULL, NULL), k);
         uint32_t y = y_at(c, k);
         if (y == 0U) {
             y = 1U;
@@ -603,7 +596,8 @@ sl_err_t sl_rfit(const sl_response_t *r, const sl_rfit_in_t *in, sl_rfit_out_t *
 {
     if (r == NULL || in == NULL || out == NULL || in->y == NULL || in->n < 8U ||
         in->n > SL_RFIT_MAX_N || in->looks_q8 < 256U || (in->f == NULL && in->floor == 0U) ||
-        in->shape > (uint8_t)SL_RFIT_FOOT || (in->shape == (uint8_t)SL_RFIT_FOOT && in->origin_q8 == 0U)) {
+        in->shape > (uint8_t)SL_RFIT_FOOT ||
+        (in->shape == (uint8_t)SL_RFIT_FOOT && in->origin_q8 == 0U)) {
         return SL_ERR_ARG;
     }
     memset(out, 0, sizeof(*out));
@@ -698,7 +692,7 @@ sl_err_t sl_rfit_model(const sl_response_t *r, uint8_t shape, uint32_t origin_q8
     pieces_t p;
     pieces_build(&c, a_q8, (b_q8 - a_q8 < 1) ? a_q8 + 1 : b_q8, &p);
     for (uint32_t k = 0; k < n; k++) {
-        const int64_t m = sl_fx_rshift_round64(model_at(&c, &p, k), 8);
+        const int64_t m = sl_fx_rshift_round64(model_at(&c, &p, k, NULL, NULL), 8);
         m_q16[k] = (m < 0) ? 0U : sl_fx_usat32(m);
     }
     return SL_OK;

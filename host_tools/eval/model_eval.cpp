@@ -111,8 +111,7 @@ std::map<int, ModelPoleResult> ModelEval::finish(std::string &note)
         double floor_p = 0;
         const int32_t flp = sl_response_floor_lp(&resp_, static_cast<uint32_t>(start + n / 2));
         if (o_.learn && flp != INT32_MIN) {
-            floor_p = o_.scale.kind == SL_VSCALE_LINEAR ? std::exp2(flp / 256.0)
-                                                        : std::exp2(flp / 256.0);
+            floor_p = std::exp2(flp / 256.0); // lp is log2 of power on either scale
         } else {
             std::vector<double> w(mean.begin() + start, mean.begin() + start + n);
             std::sort(w.begin(), w.end());
