@@ -1,0 +1,699 @@
+// SPDX-License-Identifier: MIT
+// The ground from the shadow's edge: edges per sector, the plane, the hazards (sl_ground.h).
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <string.h>
+
+#include "shadowlean/sl_fx.h"
+#include "shadowlean/sl_ground.h"
+#include "shadowlean/sl_incline.h"
+#include "shadowlean/sl_tilt.h"
+
+#define K_SECT ((uint32_t)SL_CFG_GROUND_SECTORS)
+#define W_EXP 28         // weights: 2^W_EXP / sigma^2, sigma in 1/16 mm
+#define SIG2_MIN 256U    // sigma >= 1 mm (16^2 in (1/16 mm)^2)
+
+void sl_ground_cfg_default(sl_ground_cfg_t *cfg, const sl_board_t *board)
+{
+    SL_ASSERT(cfg != NULL);
+    const sl_vscale_t s = SL_VSCALE_CTS350X;
+    memset(cfg, 0, sizeof *cfg);
+    cfg->scale = s;
+    cfg->threshold = board != NULL ? board->threshold : 40U;
+    cfg->margin_bins = 10U;
+    cfg->plateau_bins = 16U;
+    cfg->floor_bins = 8U;
+    cfg->search_in_bins = 32U;
+    cfg->search_out_bins = 48U;
+    cfg->avg_rotations = 8U;
+    cfg->avg_dist_um = 200000U;
+    cfg->sigma_min_q8 = 26U;
+    cfg->stale_rotations = 8U;
+    cfg->confirm = 3U;
+    cfg->drop_um = 150000U;
+    cfg->step_um = 80000U;
+    cfg->good_sigma_mm = 20U;
+    cfg->good_sigma_cdeg = 30U;
+    cfg->front_um = 0;
+}
+
+// First azimuth of sector k: ceil(k A / K).
+static uint16_t sector_first(const sl_ground_t *g, uint32_t k)
+{
+    return (uint16_t)((k * g->board->azimuths + K_SECT - 1U) / K_SECT);
+}
+
+// The azimuth sector k reads this rotation.
+static uint16_t sector_az(const sl_ground_t *g, uint32_t k)
+{
+    const uint32_t a = sector_first(g, k);
+    const uint32_t len = (uint32_t)sector_first(g, k + 1U) - a;
+    return (uint16_t)(a + (len > 0U ? (uint32_t)g->phase % len : 0U));
+}
+
+static void want_sector(sl_ground_t *g, uint32_t k)
+{
+    g->next_sector = (uint8_t)k;
+    g->next_az = k < K_SECT ? sector_az(g, k) : UINT16_MAX;
+}
+
+sl_err_t sl_ground_init(sl_ground_t *g, const sl_board_t *board, const sl_ground_cfg_t *cfg)
+{
+    if (g == NULL || board == NULL || board->azimuths < K_SECT || board->geom == NULL ||
+        board->bin_size_um == 0U) {
+        return SL_ERR_ARG;
+    }
+    sl_ground_cfg_t c;
+    if (cfg != NULL) {
+        c = *cfg;
+    } else {
+        sl_ground_cfg_default(&c, board);
+    }
+    if (c.margin_bins == 0U || c.margin_bins > 32U || c.plateau_bins == 0U ||
+        c.plateau_bins > 64U || c.floor_bins == 0U || c.floor_bins > 64U ||
+        c.avg_rotations == 0U || c.confirm == 0U || c.drop_um == 0U || c.drop_um > 10000000U || c.step_um == 0U ||
+        c.step_um > 10000000U ||
+        c.stale_rotations == 0U || sl_vscale_lp(&c.scale, 1U) == INT32_MIN) {
+        return SL_ERR_ARG;
+    }
+    memset(g, 0, sizeof *g);
+    g->cfg = c;
+    g->board = board;
+    g->bin_um = board->bin_size_um;
+    for (uint32_t k = 0; k < K_SECT; k++) {
+        g->sec[k].age = UINT8_MAX;
+    }
+    want_sector(g, 0U);
+    return SL_OK;
+}
+
+void sl_ground_set_bin_size(sl_ground_t *g, uint32_t bin_um)
+{
+    SL_ASSERT(g != NULL);
+    if (bin_um != 0U) {
+        g->bin_um = bin_um;
+    }
+}
+
+// Shift for sl_vscale_power so that the largest value's power is about 2^23.
+static int power_shift(const sl_vscale_t *s, uint8_t vmax)
+{
+    const int32_t lp = sl_vscale_lp(s, vmax);
+    int sh = (int)(lp >> 8) - 23;
+    return sh < -16 ? -16 : (sh > 48 ? 48 : sh);
+}
+
+static int64_t sum_power(const sl_vscale_t *s, const uint8_t *row, int32_t a, int32_t b, int sh)
+{
+    int64_t acc = 0;
+    for (int32_t k = a; k < b; k++) {
+        acc += (int64_t)sl_vscale_power(s, row[k], sh);
+    }
+    return acc;
+}
+
+int32_t sl_ground_edge_q8(const sl_ground_cfg_t *cfg, const uint8_t *row, uint32_t bins,
+                          int32_t e0_q8, uint32_t near_bins)
+{
+    SL_ASSERT(cfg != NULL && row != NULL);
+    const int32_t n = bins > 0x7FFFU ? 0x7FFF : (int32_t)bins;
+    const int32_t thr = (int32_t)cfg->threshold;
+    const int32_t m = cfg->margin_bins;
+    const int32_t e0 = e0_q8 >> 8;
+    int32_t lo = e0 - (int32_t)cfg->search_in_bins;
+    if (lo < (int32_t)near_bins) {
+        lo = (int32_t)near_bins;
+    }
+    const int32_t hi = e0 + (int32_t)cfg->search_out_bins;
+    if (hi + m + (int32_t)cfg->plateau_bins > n || hi - lo < 4) {
+        return SL_GROUND_EDGE_SHORT;
+    }
+    // 1. coarse: the ground run reaching the window's end (single-bin gaps allowed)
+    int32_t c = hi - 1;
+    if ((int32_t)row[c] < thr) {
+        c--;
+        if ((int32_t)row[c] < thr) {
+            return SL_GROUND_EDGE_NO_GROUND;
+        }
+    }
+    while (c > lo) {
+        if ((int32_t)row[c - 1] >= thr) {
+            c--;
+        } else if (c - 2 >= lo && (int32_t)row[c - 2] >= thr) {
+            c -= 2;
+        } else {
+            break;
+        }
+    }
+    if (c <= lo) {
+        return SL_GROUND_EDGE_BAD; // ground from the window's start on: no edge inside
+    }
+    // 2. something standing in the shadow on this azimuth
+    for (int32_t k = (int32_t)near_bins; k + 1 < c - 2; k++) {
+        if ((int32_t)row[k] >= thr && (int32_t)row[k + 1] >= thr) {
+            return SL_GROUND_EDGE_OCCUPIED;
+        }
+    }
+    // 3. the half-power point: the area estimator, twice
+    int32_t e_q8 = 0;
+    for (int it = 0; it < 2; it++) {
+        int32_t a0 = c - m;
+        const int32_t a1 = c + m;
+        if (a0 < (int32_t)near_bins + 1) {
+            a0 = (int32_t)near_bins + 1;
+        }
+        int32_t f0 = a0 - (int32_t)cfg->floor_bins;
+        if (f0 < (int32_t)near_bins) {
+            f0 = (int32_t)near_bins;
+        }
+        const int32_t p1 = a1 + (int32_t)cfg->plateau_bins;
+        if (p1 > n || a1 >= n) {
+            return SL_GROUND_EDGE_SHORT;
+        }
+        uint8_t vmax = 0U;
+        for (int32_t k = f0; k < p1; k++) {
+            vmax = row[k] > vmax ? row[k] : vmax;
+        }
+        const int sh = power_shift(&cfg->scale, vmax);
+        const int64_t f = f0 < a0 ? sum_power(&cfg->scale, row, f0, a0, sh) / (a0 - f0) : 0;
+        const int32_t np = p1 - a1;
+        uint64_t sq = 0U;
+        int64_t sa = 0;
+        for (int32_t k = a1; k < p1; k++) {
+            const uint64_t pk = sl_vscale_power(&cfg->scale, row[k], sh);
+            sa += (int64_t)pk;
+            sq += pk * pk;
+        }
+        const int64_t A = sa / np;
+        if (A <= 2 * f || A <= 0) {
+            return SL_GROUND_EDGE_BAD;
+        }
+        const int64_t s = sum_power(&cfg->scale, row, a0, a1, sh) - f * (a1 - a0);
+        int64_t q = (s * 256) / (A - f);
+        // 1 / (A - f) from a noisy A is biased high by Var(A) / (A - f)^2 (first order):
+        // Var(A) from the plateau's own scatter (its bins taken as independent)
+        if (np > 1) {
+            const uint64_t a2 = (uint64_t)A * (uint64_t)A * (uint64_t)np;
+            const uint64_t var = sq > a2 ? (sq - a2) / (uint64_t)(np - 1) : 0U;
+            const uint64_t af = (uint64_t)(A - f);
+            const uint64_t rel_q16 = ((var / (uint64_t)np) << 16) / (af * af / 1U + 1U);
+            q -= (int64_t)(((uint64_t)(q < 0 ? -q : q) * (rel_q16 > 32768U ? 32768U : rel_q16)) >> 16) *
+                 (q < 0 ? -1 : 1);
+        }
+        e_q8 = (int32_t)(((int64_t)a1 << 8) - q);
+        if (e_q8 < (a0 << 8) || e_q8 > (a1 << 8)) {
+            return SL_GROUND_EDGE_BAD;
+        }
+        c = (e_q8 + 128) >> 8;
+        if (c - m <= (int32_t)near_bins) {
+            return SL_GROUND_EDGE_BAD;
+        }
+    }
+    return e_q8;
+}
+
+static uint8_t avg_n(const sl_ground_t *g)
+{
+    uint32_t n = g->cfg.avg_rotations;
+    if (g->moving && g->step_um > 0U) {
+        const uint32_t d = g->cfg.avg_dist_um / g->step_um;
+        n = d < 1U ? 1U : (d < n ? d : n);
+    }
+    return (uint8_t)n;
+}
+
+static void add_sample(sl_ground_t *g, uint32_t k, uint16_t az, int32_t e_q8)
+{
+    const sl_board_t *b = g->board;
+    const sl_incline_geom_t *geo = &b->geom[az];
+    const int64_t s_um = ((int64_t)e_q8 * (int64_t)g->bin_um) >> 8;
+    if (s_um <= 0 || s_um > 30000000) {
+        g->stats.bad_edge++;
+        return;
+    }
+    const int32_t rho_um = (int32_t)((s_um * geo->cos_theta_q30) >> 30);
+    const int32_t d_um = (int32_t)((s_um * geo->sin_theta_q30) >> 30);
+    const int64_t phi_cdeg = (int64_t)az * 36000 / b->azimuths + b->radar_yaw_cdeg;
+    const sl_bam32_t phi = (sl_bam32_t)(uint32_t)(int32_t)((phi_cdeg * 4294967296LL) / 36000);
+    sl_q30_t sp, cp;
+    sl_tilt_sincos_q30(phi, &sp, &cp);
+    const int32_t x_um = (int32_t)(((int64_t)rho_um * cp) >> 30);
+    const int32_t y_um = (int32_t)(-(((int64_t)rho_um * sp) >> 30));
+    sl_ground_sector_t *s = &g->sec[k];
+    g->stats.samples++;
+    s->fresh = true;
+    s->age = 0U;
+    if (s->n == 0U) {
+        s->x_um = x_um;
+        s->y_um = y_um;
+        s->d_um = d_um;
+        s->var_q = 0U;
+        s->n = 1U;
+        s->nv = 1U;
+        return;
+    }
+    // the mean over avg_n() samples, the scatter over avg_rotations samples
+    const uint32_t nm = avg_n(g);
+    const uint32_t n1 = (uint32_t)s->n + 1U > nm ? nm : (uint32_t)s->n + 1U;
+    const uint32_t nv = (uint32_t)s->nv + 1U > g->cfg.avg_rotations ? g->cfg.avg_rotations
+                                                                    : (uint32_t)s->nv + 1U;
+    const int32_t dd = d_um - s->d_um;
+    s->x_um += (x_um - s->x_um) / (int32_t)n1;
+    s->y_um += (y_um - s->y_um) / (int32_t)n1;
+    s->d_um += dd / (int32_t)n1;
+    // var = (1 - 1/nv) (var + dd^2 / nv), in (10 um)^2; a deviation counts at most
+    // 3 sigma (3 sqrt(var), at least 1 cm) so that one change of the ground (a sector
+    // driving onto a drop-off) does not make the sector's sigma hide it
+    int64_t dq = dd / 10;
+    int64_t cap = 3 * (int64_t)sl_fx_isqrt64(s->var_q);
+    cap = cap < 1000 ? 1000 : (cap > 65535 ? 65535 : cap);
+    dq = dq > cap ? cap : (dq < -cap ? -cap : dq);
+    const uint64_t v = (uint64_t)s->var_q + (uint64_t)(dq * dq) / nv;
+    const uint64_t vn = v * (nv - 1U) / nv;
+    s->var_q = vn > UINT32_MAX ? UINT32_MAX : (uint32_t)vn;
+    s->n = (uint8_t)n1;
+    s->nv = (uint8_t)nv;
+}
+
+void sl_ground_row(sl_ground_t *g, uint16_t az, const uint8_t *row, uint32_t bins)
+{
+    SL_ASSERT(g != NULL);
+    while (g->next_sector < K_SECT && az > g->next_az) {
+        want_sector(g, (uint32_t)g->next_sector + 1U); // the wanted row was lost
+    }
+    if (g->next_sector >= K_SECT || az != g->next_az) {
+        return;
+    }
+    const uint32_t k = g->next_sector;
+    want_sector(g, k + 1U);
+    if (row == NULL) {
+        g->stats.short_rows++;
+        return;
+    }
+    const sl_board_t *b = g->board;
+    // e0: the flat ground's edge, H / sin(theta) in bins Q8
+    const int64_t num = ((int64_t)b->radar_height_um << 38) / b->geom[az].sin_theta_q30;
+    const int32_t e0_q8 = (int32_t)(num / (int64_t)g->bin_um);
+    const uint32_t near_bins =
+        (uint32_t)(((uint64_t)b->near_exclusion_bins * b->bin_size_um + g->bin_um - 1U) / g->bin_um);
+    const int32_t e = sl_ground_edge_q8(&g->cfg, row, bins, e0_q8, near_bins);
+    switch (e) {
+    case SL_GROUND_EDGE_NO_GROUND:
+        g->stats.no_ground++;
+        return;
+    case SL_GROUND_EDGE_OCCUPIED:
+        g->stats.occupied++;
+        return;
+    case SL_GROUND_EDGE_BAD:
+        g->stats.bad_edge++;
+        return;
+    case SL_GROUND_EDGE_SHORT:
+        g->stats.short_rows++;
+        return;
+    default:
+        break;
+    }
+    add_sample(g, k, az, e);
+}
+
+void sl_ground_set_motion(sl_ground_t *g, bool valid, int32_t speed_mm_s, uint32_t rotation_us)
+{
+    SL_ASSERT(g != NULL);
+    g->moving = false;
+    g->step_um = 0U;
+    g->step_x_um = 0;
+    if (!valid) {
+        return;
+    }
+    const int64_t st = (int64_t)speed_mm_s * (int64_t)rotation_us / 1000;
+    g->step_x_um = sl_fx_sat32(st);
+    g->step_um = (uint32_t)(st < 0 ? -st : st);
+    g->moving = g->step_um > 0U;
+}
+
+// (num x 2^k) / den for den > 0, |num| < 2^62, saturating at +-2^62; k may be negative.
+static int64_t muldiv_pow2(int64_t num, int64_t den, int k)
+{
+    if (den <= 0) {
+        return 0;
+    }
+    const bool neg = num < 0;
+    uint64_t un = (uint64_t)(neg ? -num : num);
+    const uint64_t ud = (uint64_t)den;
+    if (k < 0) {
+        un = k <= -63 ? 0U : un >> (unsigned)-k;
+        k = 0;
+    }
+    uint64_t q = un / ud;
+    uint64_t r = un % ud;
+    const uint64_t lim = (uint64_t)1 << 62;
+    for (int i = 0; i < k; i++) {
+        if (q >= lim >> 1) {
+            q = lim;
+            break;
+        }
+        r <<= 1;
+        q <<= 1;
+        if (r >= ud) {
+            r -= ud;
+            q |= 1U;
+        }
+    }
+    return neg ? -(int64_t)q : (int64_t)q;
+}
+
+// A sector's variance of d, (1/16 mm)^2: the scatter of its mean plus the floor.
+static uint32_t sector_sig2(const sl_ground_t *g, const sl_ground_sector_t *s, uint16_t az)
+{
+    // var_q is (10 um)^2 = (0.16 x 1/16 mm)^2: x 0.0256 = x 64 / 2500
+    const uint64_t v = (uint64_t)s->var_q * 64U / 2500U / (s->n > 0U ? s->n : 1U);
+    // floor: sigma_min_q8 bins x bin x sin(theta), 1/16 mm
+    const int64_t fl = ((int64_t)g->cfg.sigma_min_q8 * g->bin_um / 256 *
+                        g->board->geom[az].sin_theta_q30 >> 30) * 16 / 1000;
+    uint64_t s2 = v + (uint64_t)(fl * fl);
+    if (s->nv < 3U) {
+        // scatter not yet known: the response's half-power width (8 bins) as the sigma
+        const int64_t pr = ((int64_t)8 * g->bin_um * g->board->geom[az].sin_theta_q30 >> 30) *
+                           16 / 1000;
+        s2 += (uint64_t)(pr * pr);
+    }
+    if (s2 < SIG2_MIN) {
+        s2 = SIG2_MIN;
+    }
+    return s2 > UINT32_MAX ? UINT32_MAX : (uint32_t)s2;
+}
+
+typedef struct fit_out {
+    int64_t a_raw_q12;     // slope x 2^16 (d in 1/16 mm per mm: x 2^12)
+    int64_t b_raw_q12;
+    int32_t h_q4;          // depth at the radar's foot, 1/16 mm
+    uint64_t var_a_q32;    // slope variance x 2^32
+    uint64_t var_b_q32;
+    uint64_t var_h_q8;     // (1/16 mm)^2
+    uint8_t n;
+    uint8_t quads;
+} fit_out_t;
+
+static int32_t x_mm(const sl_ground_sector_t *s)
+{
+    return s->x_um / 1000;
+}
+static int32_t y_mm(const sl_ground_sector_t *s)
+{
+    return s->y_um / 1000;
+}
+static int32_t d_q4(const sl_ground_sector_t *s)
+{
+    return (int32_t)(((int64_t)s->d_um * 16) / 1000);
+}
+
+// Weighted least squares of d = h + a x + b y over the sectors with in_fit set.
+static bool fit_plane(const sl_ground_t *g, const uint32_t *w, fit_out_t *o)
+{
+    int64_t sw = 0, sx = 0, sy = 0, sd = 0;
+    uint32_t n = 0U;
+    uint8_t quads = 0U;
+    for (uint32_t k = 0; k < K_SECT; k++) {
+        const sl_ground_sector_t *s = &g->sec[k];
+        if (!s->in_fit) {
+            continue;
+        }
+        sw += w[k];
+        sx += (int64_t)w[k] * x_mm(s);
+        sy += (int64_t)w[k] * y_mm(s);
+        sd += (int64_t)w[k] * d_q4(s);
+        n++;
+        quads |= (uint8_t)(1U << ((x_mm(s) >= 0 ? 0U : 1U) + (y_mm(s) >= 0 ? 0U : 2U)));
+    }
+    o->n = (uint8_t)n;
+    o->quads = (uint8_t)((quads & 1U) + ((quads >> 1) & 1U) + ((quads >> 2) & 1U) + ((quads >> 3) & 1U));
+    if (n < SL_GROUND_MIN_SECTORS || o->quads < 3U || sw <= 0) {
+        return false;
+    }
+    const int32_t mx = (int32_t)(sx / sw), my = (int32_t)(sy / sw), md = (int32_t)(sd / sw);
+    int64_t xx = 0, xy = 0, yy = 0, xd = 0, yd = 0;
+    for (uint32_t k = 0; k < K_SECT; k++) {
+        const sl_ground_sector_t *s = &g->sec[k];
+        if (!s->in_fit) {
+            continue;
+        }
+        const int64_t cx = x_mm(s) - mx, cy = y_mm(s) - my, cd = d_q4(s) - md;
+        xx += (int64_t)w[k] * cx * cx;
+        xy += (int64_t)w[k] * cx * cy;
+        yy += (int64_t)w[k] * cy * cy;
+        xd += (int64_t)w[k] * cx * cd;
+        yd += (int64_t)w[k] * cy * cd;
+    }
+    // scale the moments to < 2^26 so that the 2 x 2 products fit
+    int64_t mmax = xx;
+    mmax = yy > mmax ? yy : mmax;
+    mmax = (xy < 0 ? -xy : xy) > mmax ? (xy < 0 ? -xy : xy) : mmax;
+    mmax = (xd < 0 ? -xd : xd) > mmax ? (xd < 0 ? -xd : xd) : mmax;
+    mmax = (yd < 0 ? -yd : yd) > mmax ? (yd < 0 ? -yd : yd) : mmax;
+    int sh = 0;
+    while ((mmax >> sh) >= ((int64_t)1 << 26)) {
+        sh++;
+    }
+    xx >>= sh;
+    xy >>= sh;
+    yy >>= sh;
+    xd >>= sh;
+    yd >>= sh;
+    const int64_t det = xx * yy - xy * xy;
+    if (det <= 0) {
+        return false;
+    }
+    o->a_raw_q12 = muldiv_pow2(yy * xd - xy * yd, det, 12);
+    o->b_raw_q12 = muldiv_pow2(xx * yd - xy * xd, det, 12);
+    // Var(a) in raw units = 2^(W_EXP - sh) yy / det; x 2^24 (raw) = x 2^32 (true, Q16^2)
+    o->var_a_q32 = (uint64_t)muldiv_pow2(yy, det, W_EXP - sh + 24);
+    o->var_b_q32 = (uint64_t)muldiv_pow2(xx, det, W_EXP - sh + 24);
+    const int64_t cov_q32 = -muldiv_pow2(xy, det, W_EXP - sh + 24);
+    o->h_q4 = (int32_t)(md - ((o->a_raw_q12 * mx) >> 12) - ((o->b_raw_q12 * my) >> 12));
+    // Var(h at the foot) = 1 / W + mx^2 Var(a) + my^2 Var(b) + 2 mx my Cov(a, b);
+    // slopes' variances are per (1/16 mm / mm)^2 x 2^24: x mm^2 / 2^24
+    int64_t vh = muldiv_pow2(1, sw, W_EXP);
+    vh += ((int64_t)mx * mx * (int64_t)(o->var_a_q32 >> 8)) >> 16;
+    vh += ((int64_t)my * my * (int64_t)(o->var_b_q32 >> 8)) >> 16;
+    vh += (2 * (int64_t)mx * my * (cov_q32 >> 8)) >> 16;
+    o->var_h_q8 = vh > 0 ? (uint64_t)vh : 0U;
+    return true;
+}
+
+static int32_t resid_q4(const sl_ground_sector_t *s, const fit_out_t *o)
+{
+    return d_q4(s) - o->h_q4 - (int32_t)((o->a_raw_q12 * x_mm(s)) >> 12) -
+           (int32_t)((o->b_raw_q12 * y_mm(s)) >> 12);
+}
+
+static int32_t slope_cdeg(int64_t q16)
+{
+    const sl_bam32_t a = sl_incline_atan2_bam32(sl_fx_sat32(q16), 65536);
+    return (int32_t)sl_fx_rshift_round64((int64_t)(int32_t)a * 36000, 32);
+}
+
+static uint16_t sigma_cdeg(uint64_t var_q32)
+{
+    // sigma (slope, Q16) -> rad -> 0.01 deg (x 18000 / pi = 22918 / 4)
+    const uint64_t q16 = sl_fx_isqrt64(var_q32);
+    const uint64_t c = (q16 * 22918U + (1U << 17)) >> 18;
+    return c > UINT16_MAX ? UINT16_MAX : (uint16_t)c;
+}
+
+static uint16_t sat_u16(uint64_t v)
+{
+    return v > UINT16_MAX ? UINT16_MAX : (uint16_t)v;
+}
+
+static void hazards(sl_ground_t *g, const fit_out_t *o, const uint32_t *sig2, const uint16_t *azs)
+{
+    const int32_t drop = (int32_t)(g->cfg.drop_um * 16U / 1000U);
+    const int32_t step = (int32_t)(g->cfg.step_um * 16U / 1000U);
+    for (uint32_t k = 0; k < K_SECT; k++) {
+        sl_ground_sector_t *s = &g->sec[k];
+        if (s->n == 0U || s->age > g->cfg.stale_rotations) {
+            s->kind = SL_GROUND_FLAT;
+            s->votes = 0U;
+            continue;
+        }
+        const int32_t r = resid_q4(s, o);
+        const uint64_t v = (uint64_t)sig2[k] + o->var_h_q8;
+        const uint32_t sg = sl_fx_isqrt64(v);
+        s->resid_mm = r / 16;
+        s->sigma_mm = sat_u16(sg / 16U);
+        if (!s->fresh) {
+            continue;
+        }
+        const int32_t ar = r < 0 ? -r : r;
+        uint8_t now = s->kind;
+        const int32_t lim = r > 0 ? drop : step;
+        if (ar > lim && (uint32_t)ar > 3U * sg) {
+            now = r > 0 ? SL_GROUND_DROP : SL_GROUND_STEP;
+        } else if (ar * 3 < lim * 2) {
+            now = SL_GROUND_FLAT;
+        }
+        if (now == s->kind) {
+            s->votes = 0U;
+        } else {
+            if (s->votes == 0U || s->vote_kind != now) {
+                s->votes = 0U;
+                s->vote_kind = now;
+                // where the ground at the plane's level ends: the ring point less the
+                // residual's horizontal share
+                const sl_incline_geom_t *geo = &g->board->geom[azs[k]];
+                const int64_t rho = (int64_t)sl_fx_isqrt64((uint64_t)((int64_t)s->x_um * s->x_um +
+                                                                      (int64_t)s->y_um * s->y_um));
+                const int64_t back = geo->sin_theta_q30 > 0
+                                         ? (int64_t)r * 1000 / 16 * geo->cos_theta_q30 /
+                                               geo->sin_theta_q30
+                                         : 0;
+                s->dist_um = sl_fx_sat32(rho - back);
+            }
+            s->votes++;
+            if (s->votes >= g->cfg.confirm) {
+                s->kind = now;
+                s->votes = 0U;
+            }
+        }
+    }
+}
+
+void sl_ground_end_rotation(sl_ground_t *g)
+{
+    SL_ASSERT(g != NULL);
+    uint32_t w[SL_CFG_GROUND_SECTORS];
+    uint32_t sig2[SL_CFG_GROUND_SECTORS];
+    uint16_t azs[SL_CFG_GROUND_SECTORS];
+    uint32_t n_flat = 0U;
+    for (uint32_t k = 0; k < K_SECT; k++) {
+        sl_ground_sector_t *s = &g->sec[k];
+        if (s->age < UINT8_MAX && !s->fresh) {
+            s->age++;
+        }
+        // travel since a hazard's onset, towards the sector's direction
+        if (g->moving && (s->votes > 0U || s->kind != SL_GROUND_FLAT)) {
+            const int32_t cdeg = sl_ground_sector_cdeg(g, k);
+            sl_q30_t sp, cp;
+            sl_tilt_sincos_q30((sl_bam32_t)(uint32_t)(int32_t)(((int64_t)cdeg * 4294967296LL) / 36000),
+                               &sp, &cp);
+            s->dist_um = sl_fx_sat32((int64_t)s->dist_um - (((int64_t)g->step_x_um * cp) >> 30));
+        }
+        azs[k] = sector_az(g, k);
+        s->in_fit = s->n > 0U && s->age <= g->cfg.stale_rotations;
+        sig2[k] = s->in_fit ? sector_sig2(g, s, azs[k]) : UINT32_MAX;
+        w[k] = s->in_fit ? (uint32_t)(((uint64_t)1 << W_EXP) / sig2[k]) : 0U;
+        if (s->in_fit && s->kind == SL_GROUND_FLAT) {
+            n_flat++;
+        }
+    }
+    // sectors with a confirmed hazard stay out of the plane while enough others remain
+    if (n_flat >= SL_GROUND_MIN_SECTORS) {
+        for (uint32_t k = 0; k < K_SECT; k++) {
+            if (g->sec[k].kind != SL_GROUND_FLAT) {
+                g->sec[k].in_fit = false;
+            }
+        }
+    }
+    fit_out_t o;
+    memset(&o, 0, sizeof o);
+    bool ok = fit_plane(g, w, &o);
+    if (ok) {
+        // robust: the sectors far off the plane leave it
+        const uint32_t lim = g->cfg.drop_um < g->cfg.step_um ? g->cfg.drop_um : g->cfg.step_um;
+        const int32_t half = (int32_t)(lim * 8U / 1000U);
+        bool out = false;
+        for (uint32_t k = 0; k < K_SECT; k++) {
+            sl_ground_sector_t *s = &g->sec[k];
+            if (!s->in_fit) {
+                continue;
+            }
+            const int32_t r = resid_q4(s, &o);
+            const int32_t ar = r < 0 ? -r : r;
+            if (ar > half && (uint64_t)ar * (uint64_t)ar > 9U * (uint64_t)sig2[k]) {
+                s->in_fit = false;
+                out = true;
+            }
+        }
+        if (out) {
+            fit_out_t o2;
+            memset(&o2, 0, sizeof o2);
+            if (fit_plane(g, w, &o2)) {
+                o = o2;
+            }
+        }
+        // dispersion: chi2 / dof above 1 widens the sigmas
+        uint64_t chi2 = 0U;
+        for (uint32_t k = 0; k < K_SECT; k++) {
+            if (g->sec[k].in_fit) {
+                const int64_t r = resid_q4(&g->sec[k], &o);
+                chi2 += (uint64_t)(r * r) * w[k];
+            }
+        }
+        chi2 >>= 12; // / 2^W_EXP, x 2^16
+        const uint64_t dof = (uint64_t)o.n - 3U;
+        const uint64_t disp_q16 = chi2 / dof;
+        if (disp_q16 > 65536U) {
+            o.var_a_q32 = o.var_a_q32 > (UINT64_MAX >> 20) ? UINT64_MAX >> 4 : (o.var_a_q32 * disp_q16) >> 16;
+            o.var_b_q32 = o.var_b_q32 > (UINT64_MAX >> 20) ? UINT64_MAX >> 4 : (o.var_b_q32 * disp_q16) >> 16;
+            o.var_h_q8 = o.var_h_q8 > (UINT64_MAX >> 20) ? UINT64_MAX >> 4 : (o.var_h_q8 * disp_q16) >> 16;
+        }
+    }
+    sl_ground_plane_t *pl = &g->plane;
+    if (ok) {
+        g->stats.planes++;
+        pl->sectors = o.n;
+        pl->height_mm = o.h_q4 / 16;
+        pl->slope_x_q16 = sl_fx_sat32(o.a_raw_q12);
+        pl->slope_y_q16 = sl_fx_sat32(o.b_raw_q12);
+        pl->pitch_cdeg = slope_cdeg(-o.a_raw_q12);
+        pl->roll_cdeg = slope_cdeg(o.b_raw_q12);
+        pl->height_sigma_mm = sat_u16(sl_fx_isqrt64(o.var_h_q8) / 16U);
+        pl->pitch_sigma_cdeg = sigma_cdeg(o.var_a_q32);
+        pl->roll_sigma_cdeg = sigma_cdeg(o.var_b_q32);
+        const bool good = pl->height_sigma_mm <= g->cfg.good_sigma_mm &&
+                          pl->pitch_sigma_cdeg <= g->cfg.good_sigma_cdeg &&
+                          pl->roll_sigma_cdeg <= g->cfg.good_sigma_cdeg;
+        pl->quality = good ? (uint8_t)SL_GROUND_GOOD : (uint8_t)SL_GROUND_COARSE;
+        hazards(g, &o, sig2, azs);
+    } else {
+        g->stats.no_plane++;
+        memset(pl, 0, sizeof *pl);
+        pl->quality = SL_GROUND_NONE;
+        for (uint32_t k = 0; k < K_SECT; k++) {
+            if (g->sec[k].age > g->cfg.stale_rotations) {
+                g->sec[k].kind = SL_GROUND_FLAT;
+            }
+        }
+    }
+    for (uint32_t k = 0; k < K_SECT; k++) {
+        g->sec[k].fresh = false;
+    }
+    g->phase = (uint16_t)(g->phase + 1U);
+    want_sector(g, 0U);
+}
+
+int sl_ground_worst(const sl_ground_t *g)
+{
+    SL_ASSERT(g != NULL);
+    int best = -1;
+    int32_t best_r = -1;
+    for (uint32_t k = 0; k < K_SECT; k++) {
+        const sl_ground_sector_t *s = &g->sec[k];
+        const int32_t ar = s->resid_mm < 0 ? -s->resid_mm : s->resid_mm;
+        if (s->kind != SL_GROUND_FLAT && ar > best_r) {
+            best = (int)k;
+            best_r = ar;
+        }
+    }
+    return best;
+}
+
+int32_t sl_ground_sector_cdeg(const sl_ground_t *g, uint32_t k)
+{
+    SL_ASSERT(g != NULL);
+    const uint32_t a2 = (uint32_t)sector_first(g, k) + (uint32_t)sector_first(g, k + 1U);
+    int32_t c = (int32_t)((uint64_t)a2 * 18000U / g->board->azimuths) + g->board->radar_yaw_cdeg;
+    c %= 36000;
+    return c < 0 ? c + 36000 : c;
+}

@@ -1,0 +1,270 @@
+// SPDX-License-Identifier: MIT
+/// @file sl_ground.h
+/// @brief The ground from the shadow's edge: where the ground return starts around the
+/// vehicle gives the vehicle's attitude over the ground (height, pitch, roll) and, where one
+/// sector departs from that plane, the terrain (DROP: lower, STEP: higher).
+///
+/// ## Geometry (one model of the ring, shared with the drift watch)
+/// The ray over the chassis edge of azimuth `az` leaves the radar at depression theta(az)
+/// (the board's table, vehicle frame). Where it meets the ground, the ground return starts:
+/// slant range s. In the vehicle frame (ISO 8855: x forward, y left, z up; origin at the
+/// radar) that point is at
+///     rho = s cos(theta),  x = rho cos(phi),  y = -rho sin(phi),  d = s sin(theta)
+/// (phi the azimuth in the vehicle frame, clockwise from forward; d the depth of the point
+/// below the radar). A ground plane below the radar is d = h + a x + b y, so every sector
+/// is one linear equation in (h, a, b) and the weighted least-squares fit over the ring is
+/// exact for a plane (no small-angle step): h the radar's height above the ground at its
+/// foot, pitch = atan(a) (nose DOWN positive, ISO: the ground ahead nearer below the
+/// radar), roll = atan(b) (right side DOWN positive, ISO: the ground on the left further
+/// below). The residual of a sector, d - (h + a x + b y), is the ground's height below
+/// the plane there: > 0 lower (a ditch, a drop-off), < 0 higher (a kerb, a bank, a step).
+///
+/// What each change explains (sl_drift.h reads the same edges, one azimuth per rotation):
+/// - the body sinking or rising uniformly (load): every s scales alike: h changes, the
+///   residuals and theta do not. The drift watch, which takes h = the board's height,
+///   reads the same rows as a uniform theta change; the two are told apart by h: when
+///   |h - board height| is within the fit's sigma the drift watch's reading is a theta
+///   change (the mount, the calibration), else a height change (load, suspension);
+/// - the vehicle pitching or rolling on its suspension, or standing on a slope: a first
+///   harmonic of s over the azimuth: pitch and roll. A radar mount tilted on the vehicle
+///   changes theta in exactly that pattern and is read as attitude (the ring alone cannot
+///   tell them apart: a mount that moved is the drift watch's, parked on level ground);
+/// - one sector's edge moving alone (the others on their plane): terrain, that sector's
+///   residual.
+/// The edges are the board's geometry read backwards: a wrong theta(az) table is a
+/// residual pattern that is the same on every rotation and every ground.
+///
+/// ## One sample (sl_ground_row, one azimuth per sector per rotation)
+/// Sector k (SL_CFG_GROUND_SECTORS equal sectors of the rotation) reads, in rotation n,
+/// azimuth first(k) + n mod len(k): over the rotations every azimuth of the sector. The
+/// row is the raw message's 8-bit values (the whole range: the edge may lie past the
+/// masked bins). Around the expected edge e0 = H / sin(theta) / bin (the board's flat
+/// ground):
+/// 1. coarse start c: the start of the run of bins >= `threshold` (single-bin gaps
+///    allowed) that reaches the window's outer end, searched over
+///    [e0 - search_in_bins, e0 + search_out_bins); none: "no ground";
+/// 2. occupied: two adjacent bins >= threshold in [near_exclusion, c - 2) (a target stands
+///    in the shadow on this azimuth): the sector is skipped this rotation;
+/// 3. the edge with sub-bin precision, as the half-power point of the ground's step
+///    through the range response: with powers y (sl_vscale_power) over
+///    [c - m, c + m) (m = `margin_bins`, the response's half extent: the CTS350-X's
+///    -20 dB point is 10 bins), the floor f the mean power of the `floor_bins` bins before
+///    it and the ground's level A the mean power of the `plateau_bins` bins after it,
+///        e = (c + m) - sum_k (y_k - f) / (A - f)
+///    (a step of height A - f convolved with any symmetric response integrates to
+///    (A - f)(c + m - e) over the window: the area estimator, exact at the half-power
+///    point and far less sensitive to speckle than a threshold crossing); iterated once
+///    with c = round(e). Rejected ("bad edge") when A <= 2 f (no contrast) or e leaves
+///    the window;
+/// 4. the sector's estimate: an exponentially weighted mean of its samples over
+///    min(`avg_rotations`, the rotations the vehicle needs to move `avg_dist_um`) samples,
+///    and the weighted mean square deviation of the samples from it: the sector's sigma
+///    is the observed scatter of its samples (speckle, clutter, the vehicle's own
+///    motion), sqrt(var / samples averaged), never below `sigma_min_q8`.
+///
+/// ## The plane and the hazards (sl_ground_end_rotation)
+/// - sectors with an estimate no older than `stale_rotations` enter a weighted fit (weight
+///   1 / sigma_d^2, sigma_d = sigma_s sin(theta)); at least SL_GROUND_MIN_SECTORS, covering
+///   three quadrants of the vehicle, else no plane (quality NONE);
+/// - robust: the sectors whose residual exceeds half the hazard threshold and 3 sigma
+///   (half of the smaller threshold) leave the fit and it is solved again (a drop-off over a few sectors does not tilt the
+///   plane); the residuals of every sector are then taken against that plane;
+/// - sigmas: the fit's covariance (integer WLS), scaled by sqrt(chi2 / dof) when the
+///   scatter about the plane exceeds what the sectors' sigmas explain;
+/// - quality: GOOD when every sigma is within `good_sigma_*`, COARSE otherwise; NONE
+///   without a plane. A number the module cannot stand behind is sent COARSE or NONE;
+/// - DROP / STEP per sector: the residual beyond `drop_um` (lower) or `step_um` (higher)
+///   and beyond 3 sigma (sigma of the sector and of the plane there) in `confirm`
+///   consecutive samples raises it; within 2/3 of the threshold on its side in `confirm`
+///   samples, or no sample for `stale_rotations`, clears it (hysteresis);
+/// - distance: while moving (sl_ground_set_motion), each hazard carries the horizontal
+///   distance from the radar to the point where it was first seen, less the distance driven
+///   towards it since (odometry, projected on the sector's direction), less `front_um`
+///   (the radar to the vehicle's front along x): the edge of a drop-off lies between the
+///   last ring position that saw the ground at the plane and the first that did not, so
+///   this is an upper bound by at most one rotation's travel.
+///
+/// ## Units, numbers, cost, RAM
+/// Heights, ranges: mm (int32); edges: bins Q8; slopes Q16; angles 0.01 deg. Integer only
+/// (64-bit sums, no division in the row path but one per sample); bit-identical on every
+/// target. sl_ground_row: O(window) = O(2 search + plateau + floor + 2 margin) byte reads
+/// and O(2 margin + plateau + floor) power conversions, one 64-bit division; the pipeline
+/// calls it for SL_CFG_GROUND_SECTORS rows per rotation. sl_ground_end_rotation:
+/// O(sectors) twice, one 2 x 2 solve, O(64) division steps. RAM: sizeof(sl_ground_t)
+/// (about 0.8 KB with 32 sectors). Stack: no arrays, a few 64-bit locals.
+/// Limits: a plane is only fitted where the ground returns above the threshold at the
+/// shadow's edge on three quadrants; frozen speckle (a parked vehicle, a static scene)
+/// leaves each sector a fixed error that only the other azimuths of the sector average;
+/// vertical faces (a wall, a parked car) at the edge read as STEP.
+#ifndef SHADOWLEAN_SL_GROUND_H
+#define SHADOWLEAN_SL_GROUND_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "shadowlean/sl_board.h"
+#include "shadowlean/sl_err.h"
+#include "shadowlean/sl_response.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/// Sectors of the ring (equal shares of the rotation).
+#ifndef SL_CFG_GROUND_SECTORS
+#define SL_CFG_GROUND_SECTORS 32
+#endif
+#if SL_CFG_GROUND_SECTORS < 8 || SL_CFG_GROUND_SECTORS > 64
+#error "SL_CFG_GROUND_SECTORS must be in [8, 64]"
+#endif
+/// Sectors needed for a plane.
+#define SL_GROUND_MIN_SECTORS 6U
+
+/// Plane quality (GroundPlane.Quality).
+typedef enum sl_ground_quality {
+    SL_GROUND_NONE = 0,   ///< no plane: too few sectors (no number to use)
+    SL_GROUND_COARSE = 1, ///< a plane, sigmas beyond the cfg's good limits
+    SL_GROUND_GOOD = 2,   ///< a plane within the good limits
+} sl_ground_quality_t;
+
+/// Hazard kind of a sector (GroundHazard.Kind).
+typedef enum sl_ground_kind {
+    SL_GROUND_FLAT = 0, ///< nothing confirmed
+    SL_GROUND_DROP = 1, ///< ground lower than the plane
+    SL_GROUND_STEP = 2, ///< ground higher than the plane
+} sl_ground_kind_t;
+
+typedef struct sl_ground_cfg {
+    sl_vscale_t scale;        ///< 8-bit value -> power (default SL_VSCALE_CTS350X)
+    uint16_t threshold;       ///< ground bins: value >= this (default: the board's)
+    uint8_t margin_bins;      ///< response half extent m (default 10, CTS350-X -20 dB)
+    uint8_t plateau_bins;     ///< bins of ground level after the window (default 16)
+    uint8_t floor_bins;       ///< bins of floor before the window (default 8)
+    uint8_t search_in_bins;   ///< coarse search before e0 (default 32)
+    uint8_t search_out_bins;  ///< ... and after it (default 48)
+    uint8_t avg_rotations;    ///< samples averaged per sector at most (default 8)
+    uint32_t avg_dist_um;     ///< ... and while moving, over this distance (default 0.2 m)
+    uint16_t sigma_min_q8;    ///< floor of a sector's sigma, bins Q8 (default 0.1 bin = 26)
+    uint8_t stale_rotations;  ///< a sector's estimate is used this long (default 8)
+    uint8_t confirm;          ///< samples to raise / clear a hazard (default 3)
+    uint32_t drop_um;         ///< DROP: ground lower than the plane by more (default 0.15 m)
+    uint32_t step_um;         ///< STEP: ground higher than the plane by more (default 0.08 m)
+    uint16_t good_sigma_mm;   ///< GOOD: sigma(h) within this (default 20 mm)
+    uint16_t good_sigma_cdeg; ///< ... and sigma(pitch), sigma(roll) within this (30 = 0.3 deg)
+    int32_t front_um;         ///< radar to the vehicle's front along x (default 0)
+} sl_ground_cfg_t;
+
+/// One sector's state (read-only to the application).
+typedef struct sl_ground_sector {
+    int32_t x_um;          ///< averaged ground point at the edge: forward of the radar
+    int32_t y_um;          ///< ... left of the radar
+    int32_t d_um;          ///< ... depth below the radar
+    uint32_t var_q;        ///< weighted mean square deviation of d's samples, (10 um)^2
+    int32_t resid_mm;      ///< ground below the plane (> 0 lower), last fit
+    int32_t dist_um;       ///< hazard: radar to where the ground at the plane's level ends,
+                           ///< less the travel towards it since (see above)
+    uint16_t sigma_mm;     ///< the residual's sigma (sector and plane), last fit
+    uint8_t n;             ///< samples in the mean (<= avg_n)
+    uint8_t nv;            ///< samples in the scatter (<= avg_rotations)
+    uint8_t age;           ///< rotations since the last sample (saturating)
+    uint8_t kind;          ///< sl_ground_kind_t confirmed
+    uint8_t votes;         ///< consecutive samples against `kind`
+    uint8_t vote_kind;     ///< what they vote for
+    bool fresh;            ///< a sample this rotation
+    bool in_fit;           ///< used by the last plane
+} sl_ground_sector_t;
+
+typedef struct sl_ground_plane {
+    uint8_t quality;       ///< sl_ground_quality_t
+    uint8_t sectors;       ///< sectors in the fit
+    int32_t height_mm;     ///< radar above the plane, at its foot
+    int32_t pitch_cdeg;    ///< nose down > 0 (ISO 8855)
+    int32_t roll_cdeg;     ///< right side down > 0 (ISO 8855)
+    uint16_t height_sigma_mm;
+    uint16_t pitch_sigma_cdeg;
+    uint16_t roll_sigma_cdeg;
+    int32_t slope_x_q16;   ///< a: depth per forward distance
+    int32_t slope_y_q16;   ///< b: depth per left distance
+} sl_ground_plane_t;
+
+typedef struct sl_ground_stats {
+    uint32_t samples;      ///< edges measured
+    uint32_t no_ground;    ///< rows without a ground run in the window
+    uint32_t occupied;     ///< rows with a target in the shadow (skipped)
+    uint32_t bad_edge;     ///< rows whose edge fit failed (no contrast, out of window)
+    uint32_t short_rows;   ///< rows too short for the window
+    uint32_t planes;       ///< rotations with a plane
+    uint32_t no_plane;     ///< rotations without one
+} sl_ground_stats_t;
+
+typedef struct sl_ground {
+    sl_ground_cfg_t cfg;
+    const sl_board_t *board;     ///< borrowed
+    uint32_t bin_um;             ///< bin size in use
+    uint16_t next_az;            ///< next azimuth to read this rotation
+    uint8_t next_sector;         ///< its sector (SL_CFG_GROUND_SECTORS: done)
+    uint16_t phase;              ///< rotation counter for the azimuth within each sector
+    bool moving;                 ///< motion known and non-zero this rotation
+    uint32_t step_um;            ///< distance driven in the last rotation
+    int32_t step_x_um;           ///< ... its forward component (signed)
+    sl_ground_plane_t plane;
+    sl_ground_sector_t sec[SL_CFG_GROUND_SECTORS];
+    sl_ground_stats_t stats;
+} sl_ground_t;
+
+/// Defaults above for `board` (NULL: threshold 40). O(1).
+void sl_ground_cfg_default(sl_ground_cfg_t *cfg, const sl_board_t *board);
+
+/// Init for `board` (borrowed) and `cfg` (copied; NULL: defaults). SL_ERR_ARG for NULL
+/// `g`/`board`, a board without azimuths or theta table, or a cfg out of range
+/// (margin_bins 0 or > 32, plateau_bins or floor_bins 0 or > 64, avg_rotations 0,
+/// confirm 0, drop_um or step_um 0 or > 10 m, an invalid scale). O(sectors).
+sl_err_t sl_ground_init(sl_ground_t *g, const sl_board_t *board, const sl_ground_cfg_t *cfg);
+
+/// The radar's bin size (a Configuration's; 0 is ignored). O(1).
+void sl_ground_set_bin_size(sl_ground_t *g, uint32_t bin_um);
+
+/// The azimuth whose row sl_ground_row wants next (none left this rotation: UINT16_MAX).
+/// The caller compares each row's index with it (one compare per row). O(1).
+static inline uint16_t sl_ground_want(const sl_ground_t *g)
+{
+    return g->next_az;
+}
+
+/// One row (azimuth `az`, `bins` 8-bit values from range 0). Reads it when `az` is the
+/// wanted azimuth; rows past the wanted one (the wanted row was lost) skip to the next
+/// sector's. O(window) for a read row, O(1) otherwise.
+void sl_ground_row(sl_ground_t *g, uint16_t az, const uint8_t *row, uint32_t bins);
+
+/// Motion during the rotation now ending (speed mm/s, > 0 forward; rotation period us);
+/// `valid` false: unknown (distances are not advanced, averaging as parked). O(1).
+void sl_ground_set_motion(sl_ground_t *g, bool valid, int32_t speed_mm_s, uint32_t rotation_us);
+
+/// End of the rotation: the sectors' ages, the plane, the residuals, the hazards, the
+/// next rotation's azimuths. O(sectors).
+void sl_ground_end_rotation(sl_ground_t *g);
+
+/// Hazard sector with the largest |residual| among the confirmed ones, or -1. O(sectors).
+int sl_ground_worst(const sl_ground_t *g);
+
+/// Azimuth of sector k's centre in the vehicle frame, 0.01 deg clockwise from forward
+/// (board's radar yaw included), in [0, 36000). O(1).
+int32_t sl_ground_sector_cdeg(const sl_ground_t *g, uint32_t k);
+
+/// One edge from a row (the sample of step 1-3 above), for tests and tools: the edge in
+/// slant bins Q8 searched around `e0_q8`, or a negative sl_ground_edge_err_t. Pure. The
+/// row's bins [0, bins). O(window).
+typedef enum sl_ground_edge_err {
+    SL_GROUND_EDGE_NO_GROUND = -1,
+    SL_GROUND_EDGE_OCCUPIED = -2,
+    SL_GROUND_EDGE_BAD = -3,
+    SL_GROUND_EDGE_SHORT = -4,
+} sl_ground_edge_err_t;
+int32_t sl_ground_edge_q8(const sl_ground_cfg_t *cfg, const uint8_t *row, uint32_t bins,
+                          int32_t e0_q8, uint32_t near_bins);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif // SHADOWLEAN_SL_GROUND_H
