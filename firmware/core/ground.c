@@ -27,7 +27,7 @@ void sl_ground_cfg_default(sl_ground_cfg_t *cfg, const sl_board_t *board)
     cfg->search_in_bins = 32U;
     cfg->search_out_bins = 48U;
     cfg->avg_rotations = 8U;
-    cfg->avg_dist_um = 200000U;
+    cfg->avg_dist_um = 750000U;
     cfg->sigma_min_q8 = 26U;
     cfg->stale_rotations = 8U;
     cfg->confirm = 3U;
@@ -81,6 +81,15 @@ sl_err_t sl_ground_init(sl_ground_t *g, const sl_board_t *board, const sl_ground
     g->cfg = c;
     g->board = board;
     g->bin_um = board->bin_size_um;
+    g->az_step_bam = (uint32_t)(((uint64_t)1 << 32) / board->azimuths);
+    g->yaw_bam = (uint32_t)(int32_t)(((int64_t)board->radar_yaw_cdeg * 4294967296LL) / 36000);
+    // power of a value i below the window's largest, Q16 (SL_VSCALE_LOG2)
+    for (uint32_t i = 0; i < SL_GROUND_LUT; i++) {
+        const int32_t lp = (int32_t)((i * 65536U) / (c.scale.cpo_q8 != 0U ? c.scale.cpo_q8 : 1U));
+        const uint32_t v = sl_lp_to_lin_q16(-lp);
+        g->pow_q16[i] = (uint16_t)(v > UINT16_MAX ? UINT16_MAX : v);
+    }
+    sl_ground_set_bin_size(g, board->bin_size_um);
     for (uint32_t k = 0; k < K_SECT; k++) {
         g->sec[k].age = UINT8_MAX;
     }
@@ -91,122 +100,167 @@ sl_err_t sl_ground_init(sl_ground_t *g, const sl_board_t *board, const sl_ground
 void sl_ground_set_bin_size(sl_ground_t *g, uint32_t bin_um)
 {
     SL_ASSERT(g != NULL);
-    if (bin_um != 0U) {
+    if (bin_um != 0U && g->board != NULL) {
         g->bin_um = bin_um;
+        // e0 = H / sin(theta) / bin in bins Q8 = e0_num / sin_q30
+        g->e0_num = (int64_t)(((uint64_t)g->board->radar_height_um << 38) / bin_um);
+        g->near_bins = (uint16_t)(((uint64_t)g->board->near_exclusion_bins *
+                                       g->board->bin_size_um + bin_um - 1U) / bin_um);
     }
 }
 
-// Shift for sl_vscale_power so that the largest value's power is about 2^23.
-static int power_shift(const sl_vscale_t *s, uint8_t vmax)
+// Power of a value relative to the window's largest value `vmax`, Q16 (LOG2: the table,
+// 0 more than SL_GROUND_LUT values below; LINEAR: the value itself).
+static uint32_t power_of(const sl_ground_t *g, uint8_t v, uint8_t vmax)
 {
-    const int32_t lp = sl_vscale_lp(s, vmax);
-    int sh = (int)(lp >> 8) - 23;
-    return sh < -16 ? -16 : (sh > 48 ? 48 : sh);
-}
-
-static int64_t sum_power(const sl_vscale_t *s, const uint8_t *row, int32_t a, int32_t b, int sh)
-{
-    int64_t acc = 0;
-    for (int32_t k = a; k < b; k++) {
-        acc += (int64_t)sl_vscale_power(s, row[k], sh);
+    if (g->cfg.scale.kind == (uint8_t)SL_VSCALE_LINEAR) {
+        return v;
     }
-    return acc;
+    const uint32_t i = (uint32_t)vmax - v;
+    return i < SL_GROUND_LUT ? g->pow_q16[i] : 0U;
 }
 
-int32_t sl_ground_edge_q8(const sl_ground_cfg_t *cfg, const uint8_t *row, uint32_t bins,
-                          int32_t e0_q8, uint32_t near_bins)
+// Two adjacent bins set in bits [lo, end) (b and b + 1 both inside), word-wise.
+static bool pair_in(const uint32_t *bits, uint32_t lo, uint32_t end)
 {
-    SL_ASSERT(cfg != NULL && row != NULL);
+    if (end < lo + 2U) {
+        return false;
+    }
+    for (uint32_t w = lo >> 5; (w << 5) < end; w++) {
+        const uint32_t next = ((w + 1U) << 5) < end ? bits[w + 1U] : 0U;
+        uint32_t pairs = bits[w] & ((bits[w] >> 1) | (next << 31));
+        const uint32_t base = w << 5;
+        if (lo > base) {
+            pairs &= ~0U << (lo - base);
+        }
+        if (end - 1U < base + 32U) {
+            const uint32_t n = end - 1U - base;
+            pairs &= (n == 0U) ? 0U : (~0U >> (32U - n));
+        }
+        if (pairs != 0U) {
+            return true;
+        }
+    }
+    return false;
+}
+
+int32_t sl_ground_edge_q8(const sl_ground_t *g, const uint8_t *row, uint32_t bins,
+                          const uint32_t *bits, uint32_t bits_n, int32_t e0_q8)
+{
+    SL_ASSERT(g != NULL && row != NULL);
+    const sl_ground_cfg_t *cfg = &g->cfg;
+    const int32_t near = g->near_bins;
     const int32_t n = bins > 0x7FFFU ? 0x7FFF : (int32_t)bins;
     const int32_t thr = (int32_t)cfg->threshold;
     const int32_t m = cfg->margin_bins;
+    const int32_t np = cfg->plateau_bins;
     const int32_t e0 = e0_q8 >> 8;
     int32_t lo = e0 - (int32_t)cfg->search_in_bins;
-    if (lo < (int32_t)near_bins) {
-        lo = (int32_t)near_bins;
+    if (lo < near + 1) {
+        lo = near + 1;
     }
     const int32_t hi = e0 + (int32_t)cfg->search_out_bins;
-    if (hi + m + (int32_t)cfg->plateau_bins > n || hi - lo < 4) {
+    if (hi + m + np > n || e0 <= lo) {
         return SL_GROUND_EDGE_SHORT;
     }
-    // 1. coarse: the ground run reaching the window's end (single-bin gaps allowed)
-    int32_t c = hi - 1;
-    if ((int32_t)row[c] < thr) {
-        c--;
-        if ((int32_t)row[c] < thr) {
+    // 1. coarse start c: from e0, back through the ground run (single-bin gaps), or on to
+    // the first two adjacent ground bins
+    int32_t c = e0;
+    if ((int32_t)row[c] >= thr) {
+        while (c > lo) {
+            if ((int32_t)row[c - 1] >= thr) {
+                c--;
+            } else if ((int32_t)row[c - 2] >= thr && c - 2 >= lo) {
+                c -= 2;
+            } else {
+                break;
+            }
+        }
+        if (c <= lo) {
+            return SL_GROUND_EDGE_BAD; // ground from the window's start on: no edge inside
+        }
+    } else {
+        while (c < hi && ((int32_t)row[c] < thr || (int32_t)row[c + 1] < thr)) {
+            c++;
+        }
+        if (c >= hi) {
             return SL_GROUND_EDGE_NO_GROUND;
         }
     }
-    while (c > lo) {
-        if ((int32_t)row[c - 1] >= thr) {
-            c--;
-        } else if (c - 2 >= lo && (int32_t)row[c - 2] >= thr) {
-            c -= 2;
-        } else {
-            break;
-        }
+    // 2. something standing in the shadow on this azimuth: two adjacent bins >= threshold
+    // in [near, c - m) (the response's rise before the edge and speckle gaps that end the
+    // coarse run late stay out of it)
+    const int32_t oe = c - m;
+    const int32_t ob = bits != NULL ? (oe < (int32_t)bits_n ? oe : (int32_t)bits_n) : near;
+    if (bits != NULL && ob > near && pair_in(bits, (uint32_t)near, (uint32_t)ob)) {
+        return SL_GROUND_EDGE_OCCUPIED;
     }
-    if (c <= lo) {
-        return SL_GROUND_EDGE_BAD; // ground from the window's start on: no edge inside
-    }
-    // 2. something standing in the shadow on this azimuth
-    for (int32_t k = (int32_t)near_bins; k + 1 < c - 2; k++) {
+    for (int32_t k = ob > near ? ob - 1 : near; k + 1 < oe; k++) {
         if ((int32_t)row[k] >= thr && (int32_t)row[k + 1] >= thr) {
             return SL_GROUND_EDGE_OCCUPIED;
         }
     }
-    // 3. the half-power point: the area estimator, twice
+    // 3. the half-power point: the area estimator (again when it moved the window)
     int32_t e_q8 = 0;
     for (int it = 0; it < 2; it++) {
-        int32_t a0 = c - m;
+        const int32_t a0 = c - m > near ? c - m : near + 1;
         const int32_t a1 = c + m;
-        if (a0 < (int32_t)near_bins + 1) {
-            a0 = (int32_t)near_bins + 1;
-        }
-        int32_t f0 = a0 - (int32_t)cfg->floor_bins;
-        if (f0 < (int32_t)near_bins) {
-            f0 = (int32_t)near_bins;
-        }
-        const int32_t p1 = a1 + (int32_t)cfg->plateau_bins;
-        if (p1 > n || a1 >= n) {
+        const int32_t f0 = a0 - (int32_t)cfg->floor_bins > near ? a0 - (int32_t)cfg->floor_bins
+                                                                : near;
+        const int32_t p1 = a1 + np;
+        if (p1 > n || a0 >= a1) {
             return SL_GROUND_EDGE_SHORT;
         }
         uint8_t vmax = 0U;
         for (int32_t k = f0; k < p1; k++) {
             vmax = row[k] > vmax ? row[k] : vmax;
         }
-        const int sh = power_shift(&cfg->scale, vmax);
-        const int64_t f = f0 < a0 ? sum_power(&cfg->scale, row, f0, a0, sh) / (a0 - f0) : 0;
-        const int32_t np = p1 - a1;
+        // one pass: the floor's, the window's and the plateau's sums
+        uint32_t sf = 0U, sw = 0U, sa = 0U;
         uint64_t sq = 0U;
-        int64_t sa = 0;
-        for (int32_t k = a1; k < p1; k++) {
-            const uint64_t pk = sl_vscale_power(&cfg->scale, row[k], sh);
-            sa += (int64_t)pk;
-            sq += pk * pk;
+        int32_t lit = 0;
+        for (int32_t k = f0; k < p1; k++) {
+            const uint32_t pk = power_of(g, row[k], vmax);
+            if (k < a0) {
+                sf += pk;
+            } else if (k < a1) {
+                sw += pk;
+            } else {
+                sa += pk;
+                sq += (uint64_t)pk * pk;
+                lit += (int32_t)row[k] >= thr ? 1 : 0;
+            }
         }
-        const int64_t A = sa / np;
-        if (A <= 2 * f || A <= 0) {
+        if (2 * lit < np) {
+            return SL_GROUND_EDGE_BAD; // not a run of ground after the edge
+        }
+        const uint32_t f = f0 < a0 ? sf / (uint32_t)(a0 - f0) : 0U;
+        const uint32_t A = sa / (uint32_t)np;
+        if (A <= 2U * f || A == 0U) {
             return SL_GROUND_EDGE_BAD;
         }
-        const int64_t s = sum_power(&cfg->scale, row, a0, a1, sh) - f * (a1 - a0);
-        int64_t q = (s * 256) / (A - f);
+        const int64_t s = (int64_t)sw - (int64_t)f * (a1 - a0);
+        const uint32_t af = A - f;
+        int64_t q = (s * 256) / (int64_t)af;
         // 1 / (A - f) from a noisy A is biased high by Var(A) / (A - f)^2 (first order):
         // Var(A) from the plateau's own scatter (its bins taken as independent)
-        if (np > 1) {
-            const uint64_t a2 = (uint64_t)A * (uint64_t)A * (uint64_t)np;
-            const uint64_t var = sq > a2 ? (sq - a2) / (uint64_t)(np - 1) : 0U;
-            const uint64_t af = (uint64_t)(A - f);
-            const uint64_t rel_q16 = ((var / (uint64_t)np) << 16) / (af * af / 1U + 1U);
-            q -= (int64_t)(((uint64_t)(q < 0 ? -q : q) * (rel_q16 > 32768U ? 32768U : rel_q16)) >> 16) *
-                 (q < 0 ? -1 : 1);
-        }
+        const uint64_t a2 = (uint64_t)A * A * (uint64_t)np;
+        const uint64_t var = sq > a2 ? (sq - a2) / (uint64_t)(np > 1 ? np - 1 : 1) : 0U;
+        uint64_t rel_q16 = ((var / (uint64_t)np) << 16) / ((uint64_t)af * af);
+        rel_q16 = rel_q16 > 32768U ? 32768U : rel_q16;
+        q -= (q * (int64_t)rel_q16) / 65536;
         e_q8 = (int32_t)(((int64_t)a1 << 8) - q);
         if (e_q8 < (a0 << 8) || e_q8 > (a1 << 8)) {
             return SL_GROUND_EDGE_BAD;
         }
-        c = (e_q8 + 128) >> 8;
-        if (c - m <= (int32_t)near_bins) {
+        // the window's tails: with the edge within 3 bins of its centre the response's
+        // mass beyond either end (m = 10, sigma 3.4 bins) moves e by < 0.03 bin
+        const int32_t c2 = (e_q8 + 128) >> 8;
+        if (c2 - c <= 3 && c - c2 <= 3) {
+            break;
+        }
+        c = c2;
+        if (c - m <= near) {
             return SL_GROUND_EDGE_BAD;
         }
     }
@@ -234,8 +288,7 @@ static void add_sample(sl_ground_t *g, uint32_t k, uint16_t az, int32_t e_q8)
     }
     const int32_t rho_um = (int32_t)((s_um * geo->cos_theta_q30) >> 30);
     const int32_t d_um = (int32_t)((s_um * geo->sin_theta_q30) >> 30);
-    const int64_t phi_cdeg = (int64_t)az * 36000 / b->azimuths + b->radar_yaw_cdeg;
-    const sl_bam32_t phi = (sl_bam32_t)(uint32_t)(int32_t)((phi_cdeg * 4294967296LL) / 36000);
+    const sl_bam32_t phi = (sl_bam32_t)(uint32_t)((uint32_t)az * g->az_step_bam + g->yaw_bam);
     sl_q30_t sp, cp;
     sl_tilt_sincos_q30(phi, &sp, &cp);
     const int32_t x_um = (int32_t)(((int64_t)rho_um * cp) >> 30);
@@ -244,6 +297,17 @@ static void add_sample(sl_ground_t *g, uint32_t k, uint16_t az, int32_t e_q8)
     g->stats.samples++;
     s->fresh = true;
     s->age = 0U;
+    // this sample on the last plane (within half the threshold on its side): the ground at the
+    // plane's level still reached the ring here; the travel since is counted from now
+    const sl_ground_plane_t *pl = &g->plane;
+    if (pl->quality != (uint8_t)SL_GROUND_NONE) {
+        const int64_t dp = (int64_t)pl->height_mm * 1000 + (((int64_t)pl->slope_x_q16 * x_um +
+                                                              (int64_t)pl->slope_y_q16 * y_um) >> 16);
+        const int64_t r = (int64_t)d_um - dp;
+        if (r * 2 < (int64_t)g->cfg.drop_um && -r * 2 < (int64_t)g->cfg.step_um) {
+            s->since_mm = 0U;
+        }
+    }
     if (s->n == 0U) {
         s->x_um = x_um;
         s->y_um = y_um;
@@ -276,7 +340,8 @@ static void add_sample(sl_ground_t *g, uint32_t k, uint16_t az, int32_t e_q8)
     s->nv = (uint8_t)nv;
 }
 
-void sl_ground_row(sl_ground_t *g, uint16_t az, const uint8_t *row, uint32_t bins)
+void sl_ground_row(sl_ground_t *g, uint16_t az, const uint8_t *row, uint32_t bins,
+                   const uint32_t *bits, uint32_t bits_n)
 {
     SL_ASSERT(g != NULL);
     while (g->next_sector < K_SECT && az > g->next_az) {
@@ -291,13 +356,14 @@ void sl_ground_row(sl_ground_t *g, uint16_t az, const uint8_t *row, uint32_t bin
         g->stats.short_rows++;
         return;
     }
-    const sl_board_t *b = g->board;
+    const int32_t sin_q30 = g->board->geom[az].sin_theta_q30;
+    if (sin_q30 <= 0) {
+        g->stats.bad_edge++;
+        return;
+    }
     // e0: the flat ground's edge, H / sin(theta) in bins Q8
-    const int64_t num = ((int64_t)b->radar_height_um << 38) / b->geom[az].sin_theta_q30;
-    const int32_t e0_q8 = (int32_t)(num / (int64_t)g->bin_um);
-    const uint32_t near_bins =
-        (uint32_t)(((uint64_t)b->near_exclusion_bins * b->bin_size_um + g->bin_um - 1U) / g->bin_um);
-    const int32_t e = sl_ground_edge_q8(&g->cfg, row, bins, e0_q8, near_bins);
+    const int32_t e0_q8 = (int32_t)(g->e0_num / sin_q30);
+    const int32_t e = sl_ground_edge_q8(g, row, bins, bits, bits_n, e0_q8);
     switch (e) {
     case SL_GROUND_EDGE_NO_GROUND:
         g->stats.no_ground++;
@@ -519,19 +585,23 @@ static void hazards(sl_ground_t *g, const fit_out_t *o, const uint32_t *sig2, co
         }
         const int32_t r = resid_q4(s, o);
         const uint64_t v = (uint64_t)sig2[k] + o->var_h_q8;
-        const uint32_t sg = sl_fx_isqrt64(v);
         s->resid_mm = r / 16;
-        s->sigma_mm = sat_u16(sg / 16U);
+        const int32_t ar = r < 0 ? -r : r;
+        const int32_t lim = r > 0 ? drop : step;
+        // the sigma (a square root) where it is reported: beyond the clearing level
+        s->sigma_mm = ar * 3 >= lim * 2 || s->kind != SL_GROUND_FLAT
+                          ? sat_u16(sl_fx_isqrt64(v) / 16U)
+                          : 0U;
         if (!s->fresh) {
             continue;
         }
-        const int32_t ar = r < 0 ? -r : r;
-        uint8_t now = s->kind;
-        const int32_t lim = r > 0 ? drop : step;
-        if (ar > lim && (uint32_t)ar > 3U * sg) {
+        uint8_t now;
+        if (ar > lim && (uint64_t)ar * (uint64_t)ar > 9U * v) {
             now = r > 0 ? SL_GROUND_DROP : SL_GROUND_STEP;
         } else if (ar * 3 < lim * 2) {
             now = SL_GROUND_FLAT;
+        } else {
+            continue; // between the clearing level and the threshold: no vote either way
         }
         if (now == s->kind) {
             s->votes = 0U;
@@ -539,16 +609,25 @@ static void hazards(sl_ground_t *g, const fit_out_t *o, const uint32_t *sig2, co
             if (s->votes == 0U || s->vote_kind != now) {
                 s->votes = 0U;
                 s->vote_kind = now;
-                // where the ground at the plane's level ends: the ring point less the
-                // residual's horizontal share
+                // where the ray over the chassis edge meets the plane: the ground at the
+                // plane's level ends inside that (rho = h / (tan(theta) - slope along))
                 const sl_incline_geom_t *geo = &g->board->geom[azs[k]];
                 const int64_t rho = (int64_t)sl_fx_isqrt64((uint64_t)((int64_t)s->x_um * s->x_um +
                                                                       (int64_t)s->y_um * s->y_um));
-                const int64_t back = geo->sin_theta_q30 > 0
-                                         ? (int64_t)r * 1000 / 16 * geo->cos_theta_q30 /
-                                               geo->sin_theta_q30
-                                         : 0;
-                s->dist_um = sl_fx_sat32(rho - back);
+                int64_t along_q16 = 0;
+                if (rho > 0) {
+                    along_q16 = (o->a_raw_q12 * s->x_um + o->b_raw_q12 * s->y_um) / rho;
+                }
+                const int64_t tan_q16 =
+                    geo->cos_theta_q30 > 0
+                        ? ((int64_t)geo->sin_theta_q30 << 16) / geo->cos_theta_q30
+                        : (int64_t)1 << 30;
+                const int64_t den = tan_q16 - along_q16;
+                const int64_t ring = den > 0 ? (((int64_t)o->h_q4 * 1000 / 16) << 16) / den : rho;
+                // the ground's end crossed the ring between the last sample on the plane and
+                // the next one (one step later): the middle of that, less the travel since
+                s->dist_um = sl_fx_sat32(ring + (int64_t)(g->step_um / 2U) -
+                                         (int64_t)s->since_mm * 1000);
             }
             s->votes++;
             if (s->votes >= g->cfg.confirm) {
@@ -557,6 +636,12 @@ static void hazards(sl_ground_t *g, const fit_out_t *o, const uint32_t *sig2, co
             }
         }
     }
+}
+
+// A hazard holds or is being voted for.
+static bool suspect(const sl_ground_sector_t *s)
+{
+    return s->kind != SL_GROUND_FLAT || (s->votes > 0U && s->vote_kind != SL_GROUND_FLAT);
 }
 
 void sl_ground_end_rotation(sl_ground_t *g)
@@ -571,26 +656,34 @@ void sl_ground_end_rotation(sl_ground_t *g)
         if (s->age < UINT8_MAX && !s->fresh) {
             s->age++;
         }
-        // travel since a hazard's onset, towards the sector's direction
-        if (g->moving && (s->votes > 0U || s->kind != SL_GROUND_FLAT)) {
+        // travel towards the sector's direction: since its last sample on the plane, and
+        // since a hazard's onset
+        if (g->moving) {
             const int32_t cdeg = sl_ground_sector_cdeg(g, k);
+            const sl_bam32_t bam = (sl_bam32_t)(uint32_t)((uint32_t)cdeg * 119304U +
+                                                          (((uint32_t)cdeg * 21U) >> 5));
             sl_q30_t sp, cp;
-            sl_tilt_sincos_q30((sl_bam32_t)(uint32_t)(int32_t)(((int64_t)cdeg * 4294967296LL) / 36000),
-                               &sp, &cp);
-            s->dist_um = sl_fx_sat32((int64_t)s->dist_um - (((int64_t)g->step_x_um * cp) >> 30));
+            sl_tilt_sincos_q30(bam, &sp, &cp);
+            const int32_t tow_um = (int32_t)(((int64_t)g->step_x_um * cp) >> 30);
+            const int32_t sm = (int32_t)s->since_mm + tow_um / 1000;
+            s->since_mm = (uint16_t)(sm < 0 ? 0 : (sm > UINT16_MAX ? UINT16_MAX : sm));
+            if (s->votes > 0U || s->kind != SL_GROUND_FLAT) {
+                s->dist_um = sl_fx_sat32((int64_t)s->dist_um - tow_um);
+            }
         }
         azs[k] = sector_az(g, k);
         s->in_fit = s->n > 0U && s->age <= g->cfg.stale_rotations;
         sig2[k] = s->in_fit ? sector_sig2(g, s, azs[k]) : UINT32_MAX;
         w[k] = s->in_fit ? (uint32_t)(((uint64_t)1 << W_EXP) / sig2[k]) : 0U;
-        if (s->in_fit && s->kind == SL_GROUND_FLAT) {
+        if (s->in_fit && !suspect(s)) {
             n_flat++;
         }
     }
-    // sectors with a confirmed hazard stay out of the plane while enough others remain
+    // sectors with a hazard, confirmed or being voted for, stay out of the plane while
+    // enough others remain
     if (n_flat >= SL_GROUND_MIN_SECTORS) {
         for (uint32_t k = 0; k < K_SECT; k++) {
-            if (g->sec[k].kind != SL_GROUND_FLAT) {
+            if (suspect(&g->sec[k])) {
                 g->sec[k].in_fit = false;
             }
         }
@@ -599,28 +692,30 @@ void sl_ground_end_rotation(sl_ground_t *g)
     memset(&o, 0, sizeof o);
     bool ok = fit_plane(g, w, &o);
     if (ok) {
-        // robust: the sectors far off the plane leave it
+        // robust: the sectors far off the plane (beyond half the smaller threshold and
+        // 2 sigma) leave it, twice (a drop-off over the front arc otherwise tilts it)
         const uint32_t lim = g->cfg.drop_um < g->cfg.step_um ? g->cfg.drop_um : g->cfg.step_um;
         const int32_t half = (int32_t)(lim * 8U / 1000U);
-        bool out = false;
-        for (uint32_t k = 0; k < K_SECT; k++) {
-            sl_ground_sector_t *s = &g->sec[k];
-            if (!s->in_fit) {
-                continue;
+        for (int pass = 0; pass < 2; pass++) {
+            bool out = false;
+            for (uint32_t k = 0; k < K_SECT; k++) {
+                sl_ground_sector_t *s = &g->sec[k];
+                if (!s->in_fit) {
+                    continue;
+                }
+                const int32_t r = resid_q4(s, &o);
+                const int32_t ar = r < 0 ? -r : r;
+                if (ar > half && (uint64_t)ar * (uint64_t)ar > 4U * (uint64_t)sig2[k]) {
+                    s->in_fit = false;
+                    out = true;
+                }
             }
-            const int32_t r = resid_q4(s, &o);
-            const int32_t ar = r < 0 ? -r : r;
-            if (ar > half && (uint64_t)ar * (uint64_t)ar > 9U * (uint64_t)sig2[k]) {
-                s->in_fit = false;
-                out = true;
-            }
-        }
-        if (out) {
             fit_out_t o2;
             memset(&o2, 0, sizeof o2);
-            if (fit_plane(g, w, &o2)) {
-                o = o2;
+            if (!out || !fit_plane(g, w, &o2)) {
+                break;
             }
+            o = o2;
         }
         // dispersion: chi2 / dof above 1 widens the sigmas
         uint64_t chi2 = 0U;
@@ -643,7 +738,12 @@ void sl_ground_end_rotation(sl_ground_t *g)
     if (ok) {
         g->stats.planes++;
         pl->sectors = o.n;
-        pl->height_mm = o.h_q4 / 16;
+        // the depth below the radar along the vehicle's z at its foot is h; the height
+        // above the plane (perpendicular) is h / sqrt(1 + a^2 + b^2)
+        const uint64_t n2 = ((uint64_t)1 << 32) + (uint64_t)(o.a_raw_q12 * o.a_raw_q12) +
+                            (uint64_t)(o.b_raw_q12 * o.b_raw_q12);
+        const uint64_t nq16 = sl_fx_isqrt64(n2);
+        pl->height_mm = (int32_t)(((int64_t)o.h_q4 * 4096) / (int64_t)(nq16 > 0U ? nq16 : 1U));
         pl->slope_x_q16 = sl_fx_sat32(o.a_raw_q12);
         pl->slope_y_q16 = sl_fx_sat32(o.b_raw_q12);
         pl->pitch_cdeg = slope_cdeg(-o.a_raw_q12);

@@ -51,6 +51,9 @@ void sl_pipeline_cfg_default(sl_pipeline_cfg_t *cfg, const sl_board_t *board)
     cfg->row_timeout_us = 1000000U;
     cfg->profile = true;
     sl_profile_cfg_default(&cfg->profile_cfg);
+    cfg->ground = SL_CFG_GROUND_DEFAULT != 0;
+    sl_ground_cfg_default(&cfg->ground_cfg, board);
+    cfg->ground_cfg.threshold = 0U; // the pipeline's threshold
 }
 
 uint8_t sl_pipeline_window(uint8_t n, uint8_t min_frames, int32_t speed_mm_s,
@@ -497,6 +500,20 @@ static void feed_held(sl_pipeline_t *p, uint32_t from, uint32_t to)
     }
 }
 
+// The ground's row: the raw message's 8-bit bins (the whole range), else (16-bit) the
+// scan's reduced row of the masked bins.
+static SL_NOINLINE void ground_row(sl_pipeline_t *p, const sl_scan_row_t *row)
+{
+    const sl_proto_fft_t *f = row->fft;
+    // the row thresholded for the mask serves the occupied test when the thresholds agree
+    const uint32_t *bits = p->ground.cfg.threshold == p->cfg.threshold ? p->bits : NULL;
+    if (f != NULL && f->bin_data != NULL && f->bytes_per_bin == 1U) {
+        sl_ground_row(&p->ground, row->idx, f->bin_data, f->bins, bits, p->mask_bins);
+    } else {
+        sl_ground_row(&p->ground, row->idx, row->power, p->mask_bins, bits, p->mask_bins);
+    }
+}
+
 static void on_row(void *ctx, const sl_scan_row_t *row)
 {
     sl_pipeline_t *p = ctx;
@@ -515,6 +532,9 @@ static void on_row(void *ctx, const sl_scan_row_t *row)
     sl_thresh_u8(row->power, p->mask_bins, p->cfg.threshold, p->bits);
     if (row->idx == p->drift.watch_az) { // once per rotation: the bins past the mask
         sl_drift_tail(&p->drift, row->fft, p->mask_bins, p->cfg.pow16_shift, p->cfg.threshold);
+    }
+    if (p->cfg.ground && row->idx >= sl_ground_want(&p->ground)) {
+        ground_row(p, row); // one row per sector and rotation
     }
     if (p->cfg.profile) {
         sl_profile_row(&p->prof, row->idx, row->power, p->mask_bins, p->bits,
@@ -727,6 +747,10 @@ static void on_rot(void *ctx, const sl_scan_rot_t *rot)
                      p->det_board.bin_size_um);
     }
     sl_drift_end_rotation(&p->drift);
+    if (p->cfg.ground) {
+        sl_ground_set_motion(&p->ground, p->motion_valid, p->speed_mm_s, p->rotation_us);
+        sl_ground_end_rotation(&p->ground);
+    }
     p->stats.rotations++;
     p->stats.azimuths_missing += rot->stats.missing;
     p->stats.targets += n_targets;
@@ -777,6 +801,7 @@ static void use_bin_size(sl_pipeline_t *p, uint32_t um)
     if (p->cfg.profile) {
         sl_detect_set_tail_slope(&p->detect, p->prof.slope_q8); // re-init cleared it
     }
+    sl_ground_set_bin_size(&p->ground, p->det_board.bin_size_um);
 }
 
 // A Configuration message (its parsed form stays out of on_msg's frame, which the FFT
@@ -915,6 +940,11 @@ sl_err_t sl_pipeline_init(sl_pipeline_t *p, const sl_board_t *board,
         p->tilt.max_tan_q16 = c->detect.max_lean_tan_q16;
     }
     sl_drift_init(&p->drift, board);
+    if (e == SL_OK && c->ground) {
+        p->cfg.ground_cfg.threshold = c->ground_cfg.threshold != 0U ? c->ground_cfg.threshold
+                                                                    : c->threshold;
+        e = sl_ground_init(&p->ground, board, &p->cfg.ground_cfg);
+    }
     sl_can_ids_t ids;
     if (e == SL_OK) {
         sl_can_ids_from_board(&ids, board);

@@ -13,8 +13,9 @@
 /// (phi the azimuth in the vehicle frame, clockwise from forward; d the depth of the point
 /// below the radar). A ground plane below the radar is d = h + a x + b y, so every sector
 /// is one linear equation in (h, a, b) and the weighted least-squares fit over the ring is
-/// exact for a plane (no small-angle step): h the radar's height above the ground at its
-/// foot, pitch = atan(a) (nose DOWN positive, ISO: the ground ahead nearer below the
+/// exact for a plane (no small-angle step): h the depth of the plane below the radar along
+/// the vehicle's z (the radar's height above the plane is h / sqrt(1 + a^2 + b^2)),
+/// pitch = atan(-a) (nose DOWN positive, ISO: the ground ahead nearer below the
 /// radar), roll = atan(b) (right side DOWN positive, ISO: the ground on the left further
 /// below). The residual of a sector, d - (h + a x + b y), is the ground's height below
 /// the plane there: > 0 lower (a ditch, a drop-off), < 0 higher (a kerb, a bank, a step).
@@ -40,11 +41,12 @@
 /// row is the raw message's 8-bit values (the whole range: the edge may lie past the
 /// masked bins). Around the expected edge e0 = H / sin(theta) / bin (the board's flat
 /// ground):
-/// 1. coarse start c: the start of the run of bins >= `threshold` (single-bin gaps
-///    allowed) that reaches the window's outer end, searched over
-///    [e0 - search_in_bins, e0 + search_out_bins); none: "no ground";
-/// 2. occupied: two adjacent bins >= threshold in [near_exclusion, c - 2) (a target stands
-///    in the shadow on this azimuth): the sector is skipped this rotation;
+/// 1. coarse start c: from e0, back through the run of bins >= `threshold` it stands in
+///    (single-bin gaps allowed), or on to the first two adjacent bins >= `threshold`,
+///    within [e0 - search_in_bins, e0 + search_out_bins); none: "no ground"; a run from
+///    the window's start on: "bad edge";
+/// 2. occupied: two adjacent bins >= threshold in [near_exclusion, c - m) (a target stands
+///    in the shadow on this azimuth; m below): the sector is skipped this rotation;
 /// 3. the edge with sub-bin precision, as the half-power point of the ground's step
 ///    through the range response: with powers y (sl_vscale_power) over
 ///    [c - m, c + m) (m = `margin_bins`, the response's half extent: the CTS350-X's
@@ -53,9 +55,13 @@
 ///        e = (c + m) - sum_k (y_k - f) / (A - f)
 ///    (a step of height A - f convolved with any symmetric response integrates to
 ///    (A - f)(c + m - e) over the window: the area estimator, exact at the half-power
-///    point and far less sensitive to speckle than a threshold crossing); iterated once
-///    with c = round(e). Rejected ("bad edge") when A <= 2 f (no contrast) or e leaves
-///    the window;
+///    point and far less sensitive to speckle than a threshold crossing), less the
+///    first-order bias of 1 / (A - f) from a noisy A (Var(A) from the plateau's scatter);
+///    once more with c = round(e) when that moved c by more than 3 bins (within 3 bins the
+///    response's mass beyond the window's ends moves e by < 0.03 bin). Powers relative
+///    to the window's largest value (a 64-entry table on the LOG2 scale: values more than
+///    10 octaves below count 0). Rejected ("bad edge") when fewer than half the plateau's
+///    bins are >= threshold (not ground), A <= 2 f (no contrast) or e leaves the window;
 /// 4. the sector's estimate: an exponentially weighted mean of its samples over
 ///    min(`avg_rotations`, the rotations the vehicle needs to move `avg_dist_um`) samples,
 ///    and the weighted mean square deviation of the samples from it: the sector's sigma
@@ -66,9 +72,11 @@
 /// - sectors with an estimate no older than `stale_rotations` enter a weighted fit (weight
 ///   1 / sigma_d^2, sigma_d = sigma_s sin(theta)); at least SL_GROUND_MIN_SECTORS, covering
 ///   three quadrants of the vehicle, else no plane (quality NONE);
-/// - robust: the sectors whose residual exceeds half the hazard threshold and 3 sigma
-///   (half of the smaller threshold) leave the fit and it is solved again (a drop-off over a few sectors does not tilt the
-///   plane); the residuals of every sector are then taken against that plane;
+/// - robust: sectors with a hazard, confirmed or being voted for, stay out (while
+///   SL_GROUND_MIN_SECTORS others remain); the sectors whose residual exceeds half the smaller threshold and 2 sigma
+///   leave the fit and it is solved again, twice (a drop-off over the front arc would
+///   otherwise read partly as pitch); the residuals of every sector are then taken
+///   against that plane;
 /// - sigmas: the fit's covariance (integer WLS), scaled by sqrt(chi2 / dof) when the
 ///   scatter about the plane exceeds what the sectors' sigmas explain;
 /// - quality: GOOD when every sigma is within `good_sigma_*`, COARSE otherwise; NONE
@@ -77,19 +85,26 @@
 ///   and beyond 3 sigma (sigma of the sector and of the plane there) in `confirm`
 ///   consecutive samples raises it; within 2/3 of the threshold on its side in `confirm`
 ///   samples, or no sample for `stale_rotations`, clears it (hysteresis);
-/// - distance: while moving (sl_ground_set_motion), each hazard carries the horizontal
-///   distance from the radar to the point where it was first seen, less the distance driven
-///   towards it since (odometry, projected on the sector's direction), less `front_um`
-///   (the radar to the vehicle's front along x): the edge of a drop-off lies between the
-///   last ring position that saw the ground at the plane and the first that did not, so
-///   this is an upper bound by at most one rotation's travel.
+/// - distance: each hazard carries the horizontal distance from the radar to where the
+///   ground at the plane's level ends, along the sector: the ray over the chassis edge
+///   meets the plane at rho = h / (tan(theta) - the plane's slope along the sector); the
+///   edge crossed that ring between the sector's last sample on the plane (within half
+///   the threshold on its side) and the next one, one rotation's travel later. At the vote
+///   that opens the hazard: rho + step / 2 - the travel towards the sector since that last
+///   sample (odometry, sl_ground_set_motion, projected on the sector's direction; +-half a
+///   step), then less the travel while it holds. Parked: rho (the edge is inside the ring).
+///   A single sample's noise beyond half the threshold makes the last sample on the plane
+///   an earlier one: the distance then errs near (by a rotation's travel per such sample).
+///   `front_um` (radar to the vehicle's front along x) is for the caller's distance to the
+///   front.
 ///
 /// ## Units, numbers, cost, RAM
 /// Heights, ranges: mm (int32); edges: bins Q8; slopes Q16; angles 0.01 deg. Integer only
 /// (64-bit sums, no division in the row path but one per sample); bit-identical on every
-/// target. sl_ground_row: O(window) = O(2 search + plateau + floor + 2 margin) byte reads
-/// and O(2 margin + plateau + floor) power conversions, one 64-bit division; the pipeline
-/// calls it for SL_CFG_GROUND_SECTORS rows per rotation. sl_ground_end_rotation:
+/// target. sl_ground_row: the coarse walk (a few bins), the occupied test (word-wise on
+/// the pipeline's thresholded row), 2 margin + plateau + floor table reads (twice at
+/// most), three 64-bit divisions, one sine/cosine; the pipeline calls it for
+/// SL_CFG_GROUND_SECTORS rows per rotation (measured: docs/PERFORMANCE.md). sl_ground_end_rotation:
 /// O(sectors) twice, one 2 x 2 solve, O(64) division steps. RAM: sizeof(sl_ground_t)
 /// (about 0.8 KB with 32 sectors). Stack: no arrays, a few 64-bit locals.
 /// Limits: a plane is only fitted where the ground returns above the threshold at the
@@ -117,6 +132,8 @@ extern "C" {
 #if SL_CFG_GROUND_SECTORS < 8 || SL_CFG_GROUND_SECTORS > 64
 #error "SL_CFG_GROUND_SECTORS must be in [8, 64]"
 #endif
+/// Entries of the value -> power table (values below the window's largest).
+#define SL_GROUND_LUT 64U
 /// Sectors needed for a plane.
 #define SL_GROUND_MIN_SECTORS 6U
 
@@ -143,7 +160,7 @@ typedef struct sl_ground_cfg {
     uint8_t search_in_bins;   ///< coarse search before e0 (default 32)
     uint8_t search_out_bins;  ///< ... and after it (default 48)
     uint8_t avg_rotations;    ///< samples averaged per sector at most (default 8)
-    uint32_t avg_dist_um;     ///< ... and while moving, over this distance (default 0.2 m)
+    uint32_t avg_dist_um;     ///< ... and while moving, over this distance (default 0.75 m)
     uint16_t sigma_min_q8;    ///< floor of a sector's sigma, bins Q8 (default 0.1 bin = 26)
     uint8_t stale_rotations;  ///< a sector's estimate is used this long (default 8)
     uint8_t confirm;          ///< samples to raise / clear a hazard (default 3)
@@ -163,7 +180,9 @@ typedef struct sl_ground_sector {
     int32_t resid_mm;      ///< ground below the plane (> 0 lower), last fit
     int32_t dist_um;       ///< hazard: radar to where the ground at the plane's level ends,
                            ///< less the travel towards it since (see above)
-    uint16_t sigma_mm;     ///< the residual's sigma (sector and plane), last fit
+    uint16_t sigma_mm;     ///< the residual's sigma (sector and plane), last fit; computed
+                           ///< beyond 2/3 of the threshold or while a hazard holds (else 0)
+    uint16_t since_mm;     ///< travel towards the sector since its last sample on the plane
     uint8_t n;             ///< samples in the mean (<= avg_n)
     uint8_t nv;            ///< samples in the scatter (<= avg_rotations)
     uint8_t age;           ///< rotations since the last sample (saturating)
@@ -177,7 +196,7 @@ typedef struct sl_ground_sector {
 typedef struct sl_ground_plane {
     uint8_t quality;       ///< sl_ground_quality_t
     uint8_t sectors;       ///< sectors in the fit
-    int32_t height_mm;     ///< radar above the plane, at its foot
+    int32_t height_mm;     ///< the radar's height above the plane (perpendicular to it)
     int32_t pitch_cdeg;    ///< nose down > 0 (ISO 8855)
     int32_t roll_cdeg;     ///< right side down > 0 (ISO 8855)
     uint16_t height_sigma_mm;
@@ -201,6 +220,11 @@ typedef struct sl_ground {
     sl_ground_cfg_t cfg;
     const sl_board_t *board;     ///< borrowed
     uint32_t bin_um;             ///< bin size in use
+    int64_t e0_num;              ///< H / bin x 2^38: e0 (bins Q8) = e0_num / sin_theta_q30
+    uint16_t near_bins;          ///< the board's near-field band in bins of bin_um
+    uint32_t az_step_bam;        ///< 2^32 / azimuths
+    uint32_t yaw_bam;            ///< the board's radar yaw, 2^32 per turn
+    uint16_t pow_q16[SL_GROUND_LUT]; ///< LOG2 scale: power of the value i below the largest
     uint16_t next_az;            ///< next azimuth to read this rotation
     uint8_t next_sector;         ///< its sector (SL_CFG_GROUND_SECTORS: done)
     uint16_t phase;              ///< rotation counter for the azimuth within each sector
@@ -231,10 +255,14 @@ static inline uint16_t sl_ground_want(const sl_ground_t *g)
     return g->next_az;
 }
 
-/// One row (azimuth `az`, `bins` 8-bit values from range 0). Reads it when `az` is the
-/// wanted azimuth; rows past the wanted one (the wanted row was lost) skip to the next
-/// sector's. O(window) for a read row, O(1) otherwise.
-void sl_ground_row(sl_ground_t *g, uint16_t az, const uint8_t *row, uint32_t bins);
+/// One row (azimuth `az`, `bins` 8-bit values from range 0; `bits` (nullable) the same
+/// row's first `bits_n` bins thresholded at cfg.threshold, bin k = bit k % 32 of word
+/// k / 32, as sl_thresh_u8 writes it: the occupied test reads them word-wise). Reads it
+/// when `az` is the wanted azimuth; rows past the wanted one (the wanted row was lost)
+/// skip to the next sector's. O(window) for a read row, O(1) otherwise. NULL `row`:
+/// counted as a short row.
+void sl_ground_row(sl_ground_t *g, uint16_t az, const uint8_t *row, uint32_t bins,
+                   const uint32_t *bits, uint32_t bits_n);
 
 /// Motion during the rotation now ending (speed mm/s, > 0 forward; rotation period us);
 /// `valid` false: unknown (distances are not advanced, averaging as parked). O(1).
@@ -251,17 +279,18 @@ int sl_ground_worst(const sl_ground_t *g);
 /// (board's radar yaw included), in [0, 36000). O(1).
 int32_t sl_ground_sector_cdeg(const sl_ground_t *g, uint32_t k);
 
-/// One edge from a row (the sample of step 1-3 above), for tests and tools: the edge in
-/// slant bins Q8 searched around `e0_q8`, or a negative sl_ground_edge_err_t. Pure. The
-/// row's bins [0, bins). O(window).
+/// One edge from a row (the sample of steps 1-3 above, `bits` as for sl_ground_row), for
+/// tests and tools: the edge in slant bins Q8 searched around `e0_q8`, or a negative
+/// sl_ground_edge_err_t. Reads `g` (its cfg, table, near-field band), changes nothing.
+/// O(window).
 typedef enum sl_ground_edge_err {
     SL_GROUND_EDGE_NO_GROUND = -1,
     SL_GROUND_EDGE_OCCUPIED = -2,
     SL_GROUND_EDGE_BAD = -3,
     SL_GROUND_EDGE_SHORT = -4,
 } sl_ground_edge_err_t;
-int32_t sl_ground_edge_q8(const sl_ground_cfg_t *cfg, const uint8_t *row, uint32_t bins,
-                          int32_t e0_q8, uint32_t near_bins);
+int32_t sl_ground_edge_q8(const sl_ground_t *g, const uint8_t *row, uint32_t bins,
+                          const uint32_t *bits, uint32_t bits_n, int32_t e0_q8);
 
 #ifdef __cplusplus
 }

@@ -137,7 +137,8 @@
 /// SL_CFG_MASK_BINS / 8 bytes; then detection (8,424 B), the tracker (1,864 B), the scan
 /// bookkeeping (624 B), the range profiles (sl_profile.h, 2.3 KB), the 3D tilt history
 /// (sl_tiltobs.h: 2,480 B firmware, 7.4 KB host default), the reassembly buffer
-/// (SL_PIPELINE_REASM_BYTES), a row buffer and the theta drift watch (sl_drift.h, 60 B).
+/// (SL_PIPELINE_REASM_BYTES), a row buffer, the theta drift watch (sl_drift.h, 60 B) and
+/// the ground (sl_ground.h: 1,280 B with 32 sectors, its configuration 36 B).
 ///
 /// Measured sizes per configuration: docs/PERFORMANCE.md ("Core modules").
 ///
@@ -191,6 +192,7 @@
 #include "shadowlean/sl_detect.h"
 #include "shadowlean/sl_drift.h"
 #include "shadowlean/sl_err.h"
+#include "shadowlean/sl_ground.h"
 #include "shadowlean/sl_mask.h"
 #include "shadowlean/sl_port.h"
 #include "shadowlean/sl_profile.h"
@@ -260,6 +262,12 @@ typedef struct sl_pipeline_cfg {
     bool profile;                ///< refine bounds from range profiles (sl_profile.h;
                                  ///< default true); false = the mask's bounds and d(r)
     sl_profile_cfg_t profile_cfg; ///< profile parameters (sl_profile_cfg_default)
+    // --- the ground from the shadow's edge (sl_ground.h)
+    bool ground;                 ///< attitude, terrain, DROP/STEP (default
+                                 ///< SL_CFG_GROUND_DEFAULT: host on, firmware off)
+    sl_ground_cfg_t ground_cfg;  ///< its parameters (sl_ground_cfg_default; threshold 0:
+                                 ///< the pipeline's `threshold`; scale: the radar's value
+                                 ///< scale, default the CTS350-X's)
 } sl_pipeline_cfg_t;
 
 /// Defaults for `board` (threshold, n from the board; detection and tracker defaults;
@@ -387,6 +395,8 @@ typedef struct sl_pipeline {
     uint8_t reasm[SL_PIPELINE_REASM_BYTES]; ///< decoder reassembly buffer
     sl_drift_t drift;            ///< theta drift watch (sl_drift.h): Health.ThetaDrift, THETA_DRIFT
                                  ///< (last: the hot fields keep their offsets)
+    sl_ground_t ground;          ///< the ground from the shadow's edge (sl_ground.h), with
+                                 ///< cfg.ground
 } sl_pipeline_t;
 
 /// RAM budget of the firmware configuration (CTS350-X: 400 azimuths, n <= 16, masked bins
@@ -402,17 +412,20 @@ _Static_assert(sizeof(sl_pipeline_t) <= 65536U, "sl_pipeline_t: 64 KiB RAM budge
 #endif
 /// Any azimuth count, bins and n with the default target/candidate capacities: the mask
 /// dominates; everything else except the tilt history (sl_tiltobs_t, sized by
-/// SL_CFG_TILT_TRACKS x SL_CFG_TILT_OBS_PER_TRACK: 2.5 KB firmware, 7.4 KB host) stays under
+/// SL_CFG_TILT_TRACKS x SL_CFG_TILT_OBS_PER_TRACK: 2.5 KB firmware, 7.4 KB host) and the
+/// ground (sl_ground_t and its configuration, sized by SL_CFG_GROUND_SECTORS) stays under
 /// 17,536 B (17,412 B in the host configuration, with detection's link table, 168 B, its
 /// per-azimuth peaks, 776 B, the CAN sender's E2E configuration, 24 B, and the
 /// VehicleMotion receiver with its Profile 11 state, 104 B).
 #if SL_CFG_MAX_TARGETS <= 32 && SL_CFG_DETECT_MAX_CANDIDATES <= 32 && SL_CFG_DETECT_MAX_SPAN <= 24 \
     && SL_CFG_MAX_AZIMUTHS <= 400
 #if defined(__cplusplus)
-static_assert(sizeof(sl_pipeline_t) <= sizeof(sl_mask_t) + sizeof(sl_tiltobs_t) + 17536U,
+static_assert(sizeof(sl_pipeline_t) <= sizeof(sl_mask_t) + sizeof(sl_tiltobs_t) + sizeof(sl_ground_t) +
+                                             sizeof(sl_ground_cfg_t) + 17536U,
               "sl_pipeline_t budget");
 #else
-_Static_assert(sizeof(sl_pipeline_t) <= sizeof(sl_mask_t) + sizeof(sl_tiltobs_t) + 17536U,
+_Static_assert(sizeof(sl_pipeline_t) <= sizeof(sl_mask_t) + sizeof(sl_tiltobs_t) + sizeof(sl_ground_t) +
+                                             sizeof(sl_ground_cfg_t) + 17536U,
                "sl_pipeline_t budget");
 #endif
 #endif
