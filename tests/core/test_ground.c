@@ -28,7 +28,8 @@ static const sl_board_t *board(void)
 }
 
 typedef struct truth {
-    double h_m, pitch_deg, roll_deg; // ISO 8855: pitch nose down > 0, roll right down > 0
+    double h_m, pitch_deg, roll_deg; // h: the plane's depth below the radar at its foot;
+                                     // ISO 8855: pitch nose down > 0, roll right down > 0
     double drop_m;                   // extra depth of the ground in [az_lo, az_hi) deg
     double az_lo, az_hi;
     double drop_x_m;                 // > 0: ground lower from this forward distance on
@@ -200,7 +201,10 @@ static void test_attitude_speckle(void **state)
         const truth_t t = {.h_m = cases[c][0], .pitch_deg = cases[c][1], .roll_deg = cases[c][2],
                            .speckle = true, .seed = 11U + c, .pole_az = -1};
         run(&g, &t, 40);
-        const double eh = g.plane.height_mm - cases[c][0] * 1000;
+        // the height above the plane, perpendicular: the depth below the radar at its foot
+        // (the truth's h) over sqrt(1 + a^2 + b^2)
+        const double ta = tan(cases[c][1] * kPi / 180.0), tb = tan(cases[c][2] * kPi / 180.0);
+        const double eh = g.plane.height_mm - cases[c][0] * 1000 / sqrt(1 + ta * ta + tb * tb);
         const double ep = g.plane.pitch_cdeg / 100.0 - cases[c][1];
         const double er = g.plane.roll_cdeg / 100.0 - cases[c][2];
         print_message("attitude %u: h %d mm (err %.1f, sigma %u) pitch %.2f (err %.2f, sigma %.2f) "
