@@ -22,13 +22,14 @@ void sl_ground_cfg_default(sl_ground_cfg_t *cfg, const sl_board_t *board)
     cfg->scale = s;
     cfg->threshold = board != NULL ? board->threshold : 40U;
     cfg->margin_bins = 10U;
-    cfg->plateau_bins = 16U;
+    cfg->plateau_bins = 32U;
     cfg->floor_bins = 8U;
     cfg->search_in_bins = 32U;
     cfg->search_out_bins = 48U;
     cfg->avg_rotations = 8U;
     cfg->avg_dist_um = 750000U;
     cfg->sigma_min_q8 = 26U;
+    cfg->decay_pow = 3U;
     cfg->stale_rotations = 8U;
     cfg->confirm = 3U;
     cfg->drop_um = 150000U;
@@ -74,7 +75,7 @@ sl_err_t sl_ground_init(sl_ground_t *g, const sl_board_t *board, const sl_ground
         c.plateau_bins > 64U || c.floor_bins == 0U || c.floor_bins > 64U ||
         c.avg_rotations == 0U || c.confirm == 0U || c.drop_um == 0U || c.drop_um > 10000000U || c.step_um == 0U ||
         c.step_um > 10000000U ||
-        c.stale_rotations == 0U || sl_vscale_lp(&c.scale, 1U) == INT32_MIN) {
+        c.stale_rotations == 0U || c.decay_pow > 4U || sl_vscale_lp(&c.scale, 1U) == INT32_MIN) {
         return SL_ERR_ARG;
     }
     memset(g, 0, sizeof *g);
@@ -90,6 +91,7 @@ sl_err_t sl_ground_init(sl_ground_t *g, const sl_board_t *board, const sl_ground
         g->pow_q16[i] = (uint16_t)(v > UINT16_MAX ? UINT16_MAX : v);
     }
     sl_ground_set_bin_size(g, board->bin_size_um);
+    g->decay_q8 = (int16_t)(c.decay_pow * 256U);
     for (uint32_t k = 0; k < K_SECT; k++) {
         g->sec[k].age = UINT8_MAX;
     }
@@ -144,8 +146,36 @@ static bool pair_in(const uint32_t *bits, uint32_t lo, uint32_t end)
     return false;
 }
 
+// The ground's level falls with range as (e / r)^n (n_q8 = n x 256). L0 = S / (A - f) (bins
+// Q8, the window's end to the edge) took the plateau's mean as the level at the edge: the
+// level there is (A - f) / w, w = (e / kc)^n (kc the plateau's centre), and the window
+// integrates it as L - n L^2 / (2 e) to second order: L = L1 + n L1^2 / (2 e), L1 = w L0,
+// with e = a1 - L (twice).
+static int64_t decay_corrected(int32_t n_q8, int64_t l0_q8, int32_t a1, int32_t p1)
+{
+    if (n_q8 <= 0 || l0_q8 <= 0) {
+        return l0_q8;
+    }
+    const int64_t kc_q8 = ((int64_t)a1 + p1) << 7;
+    int64_t l = l0_q8;
+    for (int it = 0; it < 2; it++) {
+        const int64_t e_q8 = ((int64_t)a1 << 8) - l;
+        if (e_q8 <= 0) {
+            return l0_q8;
+        }
+        const int64_t r_q16 = (e_q8 << 16) / kc_q8; // < 1
+        // w = 2^(n log2 r): log2 r in Q8 octaves (<= 0)
+        const int32_t lr_q8 = (sl_lin_log2_q16((uint64_t)(r_q16 > 0 ? r_q16 : 1)) - 16 * 65536) / 256;
+        const int64_t w_q16 = sl_lp_to_lin_q16((int32_t)(((int64_t)n_q8 * lr_q8) / 256));
+        const int64_t l1 = (l0_q8 * w_q16) >> 16;
+        l = l1 + (((int64_t)n_q8 * l1 * l1) >> 8) / (2 * e_q8);
+    }
+    return l;
+}
+
 int32_t sl_ground_edge_q8(const sl_ground_t *g, const uint8_t *row, uint32_t bins,
-                          const uint32_t *bits, uint32_t bits_n, int32_t e0_q8)
+                          const uint32_t *bits, uint32_t bits_n, int32_t e0_q8,
+                          sl_ground_edge_aux_t *aux)
 {
     SL_ASSERT(g != NULL && row != NULL);
     const sl_ground_cfg_t *cfg = &g->cfg;
@@ -217,7 +247,6 @@ int32_t sl_ground_edge_q8(const sl_ground_t *g, const uint8_t *row, uint32_t bin
         }
         // one pass: the floor's, the window's and the plateau's sums
         uint32_t sf = 0U, sw = 0U, sa = 0U;
-        uint64_t sq = 0U;
         int32_t lit = 0;
         for (int32_t k = f0; k < p1; k++) {
             const uint32_t pk = power_of(g, row[k], vmax);
@@ -227,28 +256,39 @@ int32_t sl_ground_edge_q8(const sl_ground_t *g, const uint8_t *row, uint32_t bin
                 sw += pk;
             } else {
                 sa += pk;
-                sq += (uint64_t)pk * pk;
                 lit += (int32_t)row[k] >= thr ? 1 : 0;
             }
         }
-        if (2 * lit < np) {
+        if (4 * lit < np) {
             return SL_GROUND_EDGE_BAD; // not a run of ground after the edge
         }
         const uint32_t f = f0 < a0 ? sf / (uint32_t)(a0 - f0) : 0U;
         const uint32_t A = sa / (uint32_t)np;
-        if (A <= 2U * f || A == 0U) {
-            return SL_GROUND_EDGE_BAD;
+        if (4U * A <= 5U * f || A == 0U) {
+            return SL_GROUND_EDGE_BAD; // no contrast (a weaker test selects speckle peaks)
         }
         const int64_t s = (int64_t)sw - (int64_t)f * (a1 - a0);
         const uint32_t af = A - f;
         int64_t q = (s * 256) / (int64_t)af;
-        // 1 / (A - f) from a noisy A is biased high by Var(A) / (A - f)^2 (first order):
-        // Var(A) from the plateau's own scatter (its bins taken as independent)
-        const uint64_t a2 = (uint64_t)A * A * (uint64_t)np;
-        const uint64_t var = sq > a2 ? (sq - a2) / (uint64_t)(np > 1 ? np - 1 : 1) : 0U;
-        uint64_t rel_q16 = ((var / (uint64_t)np) << 16) / ((uint64_t)af * af);
-        rel_q16 = rel_q16 > 32768U ? 32768U : rel_q16;
-        q -= (q * (int64_t)rel_q16) / 65536;
+        q = decay_corrected(g->decay_q8, q, a1, p1);
+        if (aux != NULL) {
+            // the ground's level at the edge in the scale's power (the sector's weight)
+            const uint64_t pv = cfg->scale.kind == (uint8_t)SL_VSCALE_LINEAR
+                                    ? 65536U
+                                    : sl_vscale_power(&cfg->scale, vmax, 16);
+            const uint64_t lv = ((uint64_t)af * pv) >> 16;
+            aux->level = lv == 0U ? 1U : (lv > (1U << 26) ? (1U << 26) : (uint32_t)lv);
+            // the plateau's halves: the first's share of its power, and their centres
+            const int32_t mid = a1 + np / 2;
+            uint32_t s1 = 0U;
+            for (int32_t k = a1; k < mid; k++) {
+                s1 += power_of(g, row[k], vmax);
+            }
+            aux->share1_q16 = sa > 0U ? (uint32_t)(((uint64_t)s1 << 16) / sa) : 32768U;
+            // log2 of the centres' ratio, Q16 octaves
+            const uint64_t k1 = (uint64_t)(a1 + mid), k2 = (uint64_t)(mid + p1);
+            aux->lever_q16 = (uint32_t)(sl_lin_log2_q16(k2 << 16) - sl_lin_log2_q16(k1 << 16));
+        }
         e_q8 = (int32_t)(((int64_t)a1 << 8) - q);
         if (e_q8 < (a0 << 8) || e_q8 > (a1 << 8)) {
             return SL_GROUND_EDGE_BAD;
@@ -277,7 +317,7 @@ static uint8_t avg_n(const sl_ground_t *g)
     return (uint8_t)n;
 }
 
-static void add_sample(sl_ground_t *g, uint32_t k, uint16_t az, int32_t e_q8)
+static void add_sample(sl_ground_t *g, uint32_t k, uint16_t az, int32_t e_q8, uint32_t w)
 {
     const sl_board_t *b = g->board;
     const sl_incline_geom_t *geo = &b->geom[az];
@@ -315,17 +355,24 @@ static void add_sample(sl_ground_t *g, uint32_t k, uint16_t az, int32_t e_q8)
         s->var_q = 0U;
         s->n = 1U;
         s->nv = 1U;
+        s->wsum = w;
         return;
     }
-    // the mean over avg_n() samples, the scatter over avg_rotations samples
+    // Weighted by the ground's level at the edge: sum w e = sum (w (c + m) - S) has no
+    // ratio in it, so the mean carries no bias from a noisy level (one sample's
+    // S / (A - f) does). The mean over avg_n() samples, the scatter over avg_rotations.
     const uint32_t nm = avg_n(g);
     const uint32_t n1 = (uint32_t)s->n + 1U > nm ? nm : (uint32_t)s->n + 1U;
     const uint32_t nv = (uint32_t)s->nv + 1U > g->cfg.avg_rotations ? g->cfg.avg_rotations
                                                                     : (uint32_t)s->nv + 1U;
+    uint64_t W = (uint64_t)s->wsum - s->wsum / n1 + w;
+    W = W > UINT32_MAX ? UINT32_MAX : W;
+    const int64_t f_q16 = (int64_t)(((uint64_t)w << 16) / (W > 0U ? W : 1U));
     const int32_t dd = d_um - s->d_um;
-    s->x_um += (x_um - s->x_um) / (int32_t)n1;
-    s->y_um += (y_um - s->y_um) / (int32_t)n1;
-    s->d_um += dd / (int32_t)n1;
+    s->x_um += (int32_t)(((int64_t)(x_um - s->x_um) * f_q16) >> 16);
+    s->y_um += (int32_t)(((int64_t)(y_um - s->y_um) * f_q16) >> 16);
+    s->d_um += (int32_t)(((int64_t)dd * f_q16) >> 16);
+    s->wsum = (uint32_t)W;
     // var = (1 - 1/nv) (var + dd^2 / nv), in (10 um)^2; a deviation counts at most
     // 3 sigma (3 sqrt(var), at least 1 cm) so that one change of the ground (a sector
     // driving onto a drop-off) does not make the sector's sigma hide it
@@ -338,6 +385,32 @@ static void add_sample(sl_ground_t *g, uint32_t k, uint16_t az, int32_t e_q8)
     s->var_q = vn > UINT32_MAX ? UINT32_MAX : (uint32_t)vn;
     s->n = (uint8_t)n1;
     s->nv = (uint8_t)nv;
+}
+
+// The decay's exponent from the plateaus' halves over many samples: n = log2(P1 / P2) /
+// log2(k2 / k1), with P1, P2 the halves' shares summed (a ratio of sums: speckle averages
+// out) and the lever the mean log2 ratio of their centres; the sums halve every
+// SL_GROUND_DECAY_SAMPLES samples (a running window).
+static void learn_decay(sl_ground_t *g, const sl_ground_edge_aux_t *aux)
+{
+    if (aux->lever_q16 == 0U) {
+        return;
+    }
+    g->dec_h1 += aux->share1_q16;
+    g->dec_h2 += 65536U - aux->share1_q16;
+    g->dec_lever += aux->lever_q16;
+    g->dec_n++;
+    if (g->dec_n >= SL_GROUND_DECAY_SAMPLES) {
+        const int64_t lr = sl_lin_log2_q16(g->dec_h1) - sl_lin_log2_q16(g->dec_h2); // Q16
+        const int64_t lever = (int64_t)(g->dec_lever / g->dec_n);
+        int64_t n_q8 = lever > 0 ? (lr * 256) / lever : 0;
+        n_q8 = n_q8 < 0 ? 0 : (n_q8 > 6 * 256 ? 6 * 256 : n_q8);
+        g->decay_q8 = (int16_t)n_q8;
+        g->dec_h1 >>= 1;
+        g->dec_h2 >>= 1;
+        g->dec_lever >>= 1;
+        g->dec_n >>= 1;
+    }
 }
 
 void sl_ground_row(sl_ground_t *g, uint16_t az, const uint8_t *row, uint32_t bins,
@@ -363,7 +436,8 @@ void sl_ground_row(sl_ground_t *g, uint16_t az, const uint8_t *row, uint32_t bin
     }
     // e0: the flat ground's edge, H / sin(theta) in bins Q8
     const int32_t e0_q8 = (int32_t)(g->e0_num / sin_q30);
-    const int32_t e = sl_ground_edge_q8(g, row, bins, bits, bits_n, e0_q8);
+    sl_ground_edge_aux_t aux = {32768U, 0U, 1U};
+    const int32_t e = sl_ground_edge_q8(g, row, bins, bits, bits_n, e0_q8, &aux);
     switch (e) {
     case SL_GROUND_EDGE_NO_GROUND:
         g->stats.no_ground++;
@@ -380,7 +454,8 @@ void sl_ground_row(sl_ground_t *g, uint16_t az, const uint8_t *row, uint32_t bin
     default:
         break;
     }
-    add_sample(g, k, az, e);
+    add_sample(g, k, az, e, aux.level);
+    learn_decay(g, &aux);
 }
 
 void sl_ground_set_motion(sl_ground_t *g, bool valid, int32_t speed_mm_s, uint32_t rotation_us)
@@ -432,18 +507,19 @@ static int64_t muldiv_pow2(int64_t num, int64_t den, int k)
 // A sector's variance of d, (1/16 mm)^2: the scatter of its mean plus the floor.
 static uint32_t sector_sig2(const sl_ground_t *g, const sl_ground_sector_t *s, uint16_t az)
 {
-    // var_q is (10 um)^2 = (0.16 x 1/16 mm)^2: x 0.0256 = x 64 / 2500
-    const uint64_t v = (uint64_t)s->var_q * 64U / 2500U / (s->n > 0U ? s->n : 1U);
+    // one sample's variance: the observed scatter (var_q, (10 um)^2 = x 64 / 2500 in
+    // (1/16 mm)^2) shrunk towards the prior (half the response's half-power width, 4 bins,
+    // as a depth) with SL_GROUND_PRIOR_WEIGHT samples' weight: a few samples' scatter is
+    // often far below the truth
+    const int64_t pr = ((int64_t)4 * g->bin_um * g->board->geom[az].sin_theta_q30 >> 30) * 16 / 1000;
+    const uint64_t obs = (uint64_t)s->var_q * 64U / 2500U;
+    const uint64_t one = (obs * s->nv + (uint64_t)(pr * pr) * SL_GROUND_PRIOR_WEIGHT) /
+                         ((uint64_t)s->nv + SL_GROUND_PRIOR_WEIGHT);
+    const uint64_t v = one / (s->n > 0U ? s->n : 1U);
     // floor: sigma_min_q8 bins x bin x sin(theta), 1/16 mm
     const int64_t fl = ((int64_t)g->cfg.sigma_min_q8 * g->bin_um / 256 *
                         g->board->geom[az].sin_theta_q30 >> 30) * 16 / 1000;
     uint64_t s2 = v + (uint64_t)(fl * fl);
-    if (s->nv < 3U) {
-        // scatter not yet known: the response's half-power width (8 bins) as the sigma
-        const int64_t pr = ((int64_t)8 * g->bin_um * g->board->geom[az].sin_theta_q30 >> 30) *
-                           16 / 1000;
-        s2 += (uint64_t)(pr * pr);
-    }
     if (s2 < SIG2_MIN) {
         s2 = SIG2_MIN;
     }
@@ -592,8 +668,8 @@ static void hazards(sl_ground_t *g, const fit_out_t *o, const uint32_t *sig2, co
         s->sigma_mm = ar * 3 >= lim * 2 || s->kind != SL_GROUND_FLAT
                           ? sat_u16(sl_fx_isqrt64(v) / 16U)
                           : 0U;
-        if (!s->fresh) {
-            continue;
+        if (!s->fresh || s->nv < g->cfg.avg_rotations) {
+            continue; // no vote before the sector's scatter is known over a full window
         }
         uint8_t now;
         if (ar > lim && (uint64_t)ar * (uint64_t)ar > 9U * v) {

@@ -27,7 +27,7 @@ void usage(FILE *out)
 {
     std::fprintf(out,
                  "usage: sl-eval terrain SCENE.ini... [--rotations N] [--warmup N] [--front M]\n"
-                 "                       [--threads N] [--json]\n"
+                 "                       [--threads N] [--json] [--hazards]\n"
                  "  Runs the core pipeline with the ground module on each scene (the scene's\n"
                  "  speed as the motion input) and compares every rotation's plane and hazards\n"
                  "  with the scene's truth ([vehicle] pitch_deg, roll_deg, height_offset_m and\n"
@@ -43,7 +43,9 @@ void usage(FILE *out)
                  "    from the vehicle's front (--front M ahead of the radar; default the\n"
                  "    cylinder's radius, else 0) to the edge at the first DROP within 45 deg of\n"
                  "    forward, true and as reported.\n"
-                 "  --rotations N: override the scene's; --json: one JSON object per scene.\n");
+                 "  --rotations N: override the scene's; --json: one JSON object per scene;\n"
+                 "  --hazards: every hazard onset (rotation, sector, kind, residual, sigma,\n"
+                 "  distance, true or false).\n");
 }
 
 struct Hazard {
@@ -94,7 +96,7 @@ sl_vscale_t scale_for(const Scene &s)
 }
 
 SceneResult run_scene(const std::string &path, int rotations, int warmup, double front_arg,
-                      int threads)
+                      int threads, bool dump_hazards)
 {
     Scene scene = load_scene(path);
     if (rotations > 0) {
@@ -182,6 +184,12 @@ SceneResult run_scene(const std::string &path, int rotations, int warmup, double
                 const bool ok = terrain_change(scene, pose.o.x, pose.o.y, ux, uy, ring + 1.0,
                                                kind == SL_GROUND_DROP ? -1 : +1);
                 (ok ? res.true_onsets : res.false_onsets)++;
+                if (dump_hazards) {
+                    std::printf("  onset: rotation %d sector %u at %.1f deg %s residual %d mm sigma %u mm "
+                                "distance %.2f m: %s\n",
+                                k, s, cd, kind == SL_GROUND_DROP ? "DROP" : "STEP", sec.resid_mm, sec.sigma_mm,
+                                sec.dist_um * 1e-6, ok ? "true" : "false");
+                }
                 // the first DROP ahead
                 const double off = std::fabs(std::remainder(cd, 360.0));
                 if (kind == SL_GROUND_DROP && ok && off <= 45.0 && !res.drop_warned) {
@@ -255,7 +263,7 @@ int cmd_terrain(int argc, char **argv)
     std::vector<std::string> scenes;
     int rotations = 0, warmup = 16, threads = 0;
     double front = -1;
-    bool json = false;
+    bool json = false, dump = false;
     for (int i = 0; i < argc; i++) {
         const std::string a = argv[i];
         const bool has = i + 1 < argc;
@@ -269,6 +277,8 @@ int cmd_terrain(int argc, char **argv)
             threads = std::atoi(argv[++i]);
         } else if (a == "--json") {
             json = true;
+        } else if (a == "--hazards") {
+            dump = true;
         } else if (a == "-q" || a == "--quiet") {
         } else if (!a.empty() && a[0] == '-') {
             return sl_cli_unknown("sl-eval terrain", argv[i], usage);
@@ -280,7 +290,7 @@ int cmd_terrain(int argc, char **argv)
         return sl_cli_usage_error("sl-eval terrain", "no scene", usage);
     }
     for (const auto &path : scenes) {
-        const SceneResult r = run_scene(path, rotations, warmup, front, threads);
+        const SceneResult r = run_scene(path, rotations, warmup, front, threads, dump);
         const double fph = r.hours > 0 ? r.false_onsets / r.hours : NAN;
         if (json) {
             std::printf("{\"scene\": \"%s\", \"rotations\": %d, \"scored\": %d, \"good\": %d, "

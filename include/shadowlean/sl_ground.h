@@ -56,7 +56,13 @@
 ///    (a step of height A - f convolved with any symmetric response integrates to
 ///    (A - f)(c + m - e) over the window: the area estimator, exact at the half-power
 ///    point and far less sensitive to speckle than a threshold crossing), less the
-///    first-order bias of 1 / (A - f) from a noisy A (Var(A) from the plateau's scatter);
+///    with the ground's level falling past the edge as (e / r)^n (`decay_pow`; flat
+///    ground: the depressions one bin spans fall as r^-2 and the grazing angle's shading
+///    as r^-1, n = 3; the beam's elevation pattern changes it): the level at the edge is
+///    the plateau's over (e / kc)^n (kc its centre) and the window integrates
+///    L - n L^2 / (2 e) of it (L = c + m - e). n is learned from the stream: the
+///    plateaus' halves summed over SL_GROUND_DECAY_SAMPLES samples (a running window),
+///    n = log2(P1 / P2) / log2(k2 / k1); `decay_pow` until the first window is in;
 ///    once more with c = round(e) when that moved c by more than 3 bins (within 3 bins the
 ///    response's mass beyond the window's ends moves e by < 0.03 bin). Powers relative
 ///    to the window's largest value (a 64-entry table on the LOG2 scale: values more than
@@ -64,9 +70,13 @@
 ///    bins are >= threshold (not ground), A <= 2 f (no contrast) or e leaves the window;
 /// 4. the sector's estimate: an exponentially weighted mean of its samples over
 ///    min(`avg_rotations`, the rotations the vehicle needs to move `avg_dist_um`) samples,
-///    and the weighted mean square deviation of the samples from it: the sector's sigma
-///    is the observed scatter of its samples (speckle, clutter, the vehicle's own
-///    motion), sqrt(var / samples averaged), never below `sigma_min_q8`.
+///    each weighted by its ground level A - f (sum (A - f) e = sum ((A - f)(c + m) - S):
+///    the mean carries no bias from a noisy level, which 1 / (A - f) of one sample has),
+///    and the mean square deviation of the samples from it: the sector's sigma is the
+///    observed scatter of its samples (speckle, clutter, the vehicle's own motion) shrunk
+///    towards a prior (half the response's half-power width, 4 bins, with
+///    SL_GROUND_PRIOR_WEIGHT samples' weight: a few samples' scatter is often far below
+///    the truth), over the samples averaged, never below `sigma_min_q8`.
 ///
 /// ## The plane and the hazards (sl_ground_end_rotation)
 /// - sectors with an estimate no older than `stale_rotations` enter a weighted fit (weight
@@ -83,7 +93,8 @@
 ///   without a plane. A number the module cannot stand behind is sent COARSE or NONE;
 /// - DROP / STEP per sector: the residual beyond `drop_um` (lower) or `step_um` (higher)
 ///   and beyond 3 sigma (sigma of the sector and of the plane there) in `confirm`
-///   consecutive samples raises it; within 2/3 of the threshold on its side in `confirm`
+///   consecutive samples raises it (votes only once the sector's scatter holds
+///   `avg_rotations` samples); within 2/3 of the threshold on its side in `confirm`
 ///   samples, or no sample for `stale_rotations`, clears it (hysteresis);
 /// - distance: each hazard carries the horizontal distance from the radar to where the
 ///   ground at the plane's level ends, along the sector: the ray over the chassis edge
@@ -134,6 +145,10 @@ extern "C" {
 #endif
 /// Entries of the value -> power table (values below the window's largest).
 #define SL_GROUND_LUT 64U
+/// Samples per window of the decay's learning.
+#define SL_GROUND_DECAY_SAMPLES 256U
+/// Weight of the prior sigma in a sector's scatter, in samples.
+#define SL_GROUND_PRIOR_WEIGHT 4U
 /// Sectors needed for a plane.
 #define SL_GROUND_MIN_SECTORS 6U
 
@@ -155,13 +170,15 @@ typedef struct sl_ground_cfg {
     sl_vscale_t scale;        ///< 8-bit value -> power (default SL_VSCALE_CTS350X)
     uint16_t threshold;       ///< ground bins: value >= this (default: the board's)
     uint8_t margin_bins;      ///< response half extent m (default 10, CTS350-X -20 dB)
-    uint8_t plateau_bins;     ///< bins of ground level after the window (default 16)
+    uint8_t plateau_bins;     ///< bins of ground level after the window (default 32)
     uint8_t floor_bins;       ///< bins of floor before the window (default 8)
     uint8_t search_in_bins;   ///< coarse search before e0 (default 32)
     uint8_t search_out_bins;  ///< ... and after it (default 48)
     uint8_t avg_rotations;    ///< samples averaged per sector at most (default 8)
     uint32_t avg_dist_um;     ///< ... and while moving, over this distance (default 0.75 m)
     uint16_t sigma_min_q8;    ///< floor of a sector's sigma, bins Q8 (default 0.1 bin = 26)
+    uint8_t decay_pow;        ///< the ground's level falls as range^-n past the edge: n until
+                              ///< learned (0..4; default 3: flat ground, step 3 below)
     uint8_t stale_rotations;  ///< a sector's estimate is used this long (default 8)
     uint8_t confirm;          ///< samples to raise / clear a hazard (default 3)
     uint32_t drop_um;         ///< DROP: ground lower than the plane by more (default 0.15 m)
@@ -176,7 +193,8 @@ typedef struct sl_ground_sector {
     int32_t x_um;          ///< averaged ground point at the edge: forward of the radar
     int32_t y_um;          ///< ... left of the radar
     int32_t d_um;          ///< ... depth below the radar
-    uint32_t var_q;        ///< weighted mean square deviation of d's samples, (10 um)^2
+    uint32_t var_q;        ///< mean square deviation of d's samples, (10 um)^2
+    uint32_t wsum;         ///< the samples' levels summed (exponentially weighted)
     int32_t resid_mm;      ///< ground below the plane (> 0 lower), last fit
     int32_t dist_um;       ///< hazard: radar to where the ground at the plane's level ends,
                            ///< less the travel towards it since (see above)
@@ -225,6 +243,10 @@ typedef struct sl_ground {
     uint32_t az_step_bam;        ///< 2^32 / azimuths
     uint32_t yaw_bam;            ///< the board's radar yaw, 2^32 per turn
     uint16_t pow_q16[SL_GROUND_LUT]; ///< LOG2 scale: power of the value i below the largest
+    int16_t decay_q8;            ///< the ground's decay exponent n in use, Q8
+    uint32_t dec_n;              ///< decay learning: samples in the window
+    uint32_t dec_h1, dec_h2;     ///< ... the plateaus' halves' shares summed, Q16
+    uint32_t dec_lever;          ///< ... log2 of their centres' ratio summed, Q16
     uint16_t next_az;            ///< next azimuth to read this rotation
     uint8_t next_sector;         ///< its sector (SL_CFG_GROUND_SECTORS: done)
     uint16_t phase;              ///< rotation counter for the azimuth within each sector
@@ -242,7 +264,7 @@ void sl_ground_cfg_default(sl_ground_cfg_t *cfg, const sl_board_t *board);
 /// Init for `board` (borrowed) and `cfg` (copied; NULL: defaults). SL_ERR_ARG for NULL
 /// `g`/`board`, a board without azimuths or theta table, or a cfg out of range
 /// (margin_bins 0 or > 32, plateau_bins or floor_bins 0 or > 64, avg_rotations 0,
-/// confirm 0, drop_um or step_um 0 or > 10 m, an invalid scale). O(sectors).
+/// decay_pow > 4, confirm 0, drop_um or step_um 0 or > 10 m, an invalid scale). O(sectors).
 sl_err_t sl_ground_init(sl_ground_t *g, const sl_board_t *board, const sl_ground_cfg_t *cfg);
 
 /// The radar's bin size (a Configuration's; 0 is ignored). O(1).
@@ -281,8 +303,15 @@ int32_t sl_ground_sector_cdeg(const sl_ground_t *g, uint32_t k);
 
 /// One edge from a row (the sample of steps 1-3 above, `bits` as for sl_ground_row), for
 /// tests and tools: the edge in slant bins Q8 searched around `e0_q8`, or a negative
-/// sl_ground_edge_err_t. Reads `g` (its cfg, table, near-field band), changes nothing.
+/// sl_ground_edge_err_t. Reads `g` (its cfg, table, near-field band, decay), changes
+/// nothing; `aux` (nullable) gets what the decay's learning reads.
 /// O(window).
+/// What one edge tells the decay's learning (sl_ground_edge_q8's `aux`).
+typedef struct sl_ground_edge_aux {
+    uint32_t share1_q16;   ///< the plateau's first half's share of its power, Q16
+    uint32_t lever_q16;    ///< log2 of the halves' centres' ratio, Q16 (0: no plateau read)
+    uint32_t level;        ///< the ground's level at the edge, the scale's power >> 16 (>= 1)
+} sl_ground_edge_aux_t;
 typedef enum sl_ground_edge_err {
     SL_GROUND_EDGE_NO_GROUND = -1,
     SL_GROUND_EDGE_OCCUPIED = -2,
@@ -290,7 +319,8 @@ typedef enum sl_ground_edge_err {
     SL_GROUND_EDGE_SHORT = -4,
 } sl_ground_edge_err_t;
 int32_t sl_ground_edge_q8(const sl_ground_t *g, const uint8_t *row, uint32_t bins,
-                          const uint32_t *bits, uint32_t bits_n, int32_t e0_q8);
+                          const uint32_t *bits, uint32_t bits_n, int32_t e0_q8,
+                          sl_ground_edge_aux_t *aux);
 
 #ifdef __cplusplus
 }

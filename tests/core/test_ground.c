@@ -3,7 +3,8 @@
 // paper-sim board: the ground return starts where the ray at the board's theta meets a
 // plane (height, pitch, roll) plus terrain; its power is a step from the floor to the
 // ground's level through a Gaussian range response (sigma 3.4 bins, the CTS350-X's), on
-// the CTS350-X value scale, optionally with single-look speckle (exponential power).
+// the CTS350-X value scale, optionally with single-look speckle (exponential power). Past the
+// edge the ground's level falls as (e / r)^3 (flat ground).
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -75,7 +76,9 @@ static void make_row(uint8_t *row, double e_bins, const truth_t *t, uint64_t *rs
 {
     const double floor_p = pow(2.0, 12.0 / 6.02), ground_p = pow(2.0, 70.0 / 6.02);
     for (unsigned k = 0; k < BINS; k++) {
-        double p = floor_p + ground_p * cdf(k + 0.5 - e_bins);
+        // flat ground: the level falls as (e / r)^3 past the edge (sl_ground.h, step 3)
+        const double x = k + 0.5 > e_bins ? k + 0.5 : e_bins;
+        double p = floor_p + ground_p * cdf(k + 0.5 - e_bins) * pow(e_bins / x, 3.0);
         if (pole && k >= 80 && k < 90) {
             p += pow(2.0, 90.0 / 6.02);
         }
@@ -138,7 +141,7 @@ static void test_edge_sub_bin(void **state)
     for (int i = 0; i < 16; i++) {
         const double e = 130.0 + i / 16.0;
         make_row(row, e, &t, NULL, false);
-        const int32_t q = sl_ground_edge_q8(&g, row, BINS, NULL, 0U, (int32_t)(134.3 * 256));
+        const int32_t q = sl_ground_edge_q8(&g, row, BINS, NULL, 0U, (int32_t)(134.3 * 256), NULL);
         assert_true(q > 0);
         // the 8-bit values' rounding (0.5 dB: +-3 % of a bin's power) is the only error:
         // within 0.25 bin (0.5 cm of depth)
@@ -154,18 +157,18 @@ static void test_edge_errors(void **state)
     const truth_t t = {0};
     uint8_t row[BINS];
     make_row(row, 134.0, &t, NULL, true);
-    assert_int_equal(sl_ground_edge_q8(&g, row, BINS, NULL, 0U, 134 * 256), SL_GROUND_EDGE_OCCUPIED);
+    assert_int_equal(sl_ground_edge_q8(&g, row, BINS, NULL, 0U, 134 * 256, NULL), SL_GROUND_EDGE_OCCUPIED);
     // the same from the thresholded bits (word-wise)
     uint32_t bits[BINS / 32U] = {0};
     for (unsigned k = 0; k < 128U; k++) {
         bits[k / 32U] |= (row[k] >= 40U ? 1U : 0U) << (k % 32U);
     }
     memset(row + 80, 0, 10); // the bytes no longer show it: the bits do
-    assert_int_equal(sl_ground_edge_q8(&g, row, BINS, bits, 128U, 134 * 256), SL_GROUND_EDGE_OCCUPIED);
+    assert_int_equal(sl_ground_edge_q8(&g, row, BINS, bits, 128U, 134 * 256, NULL), SL_GROUND_EDGE_OCCUPIED);
     memset(row, 5, sizeof row);
-    assert_int_equal(sl_ground_edge_q8(&g, row, BINS, NULL, 0U, 134 * 256), SL_GROUND_EDGE_NO_GROUND);
+    assert_int_equal(sl_ground_edge_q8(&g, row, BINS, NULL, 0U, 134 * 256, NULL), SL_GROUND_EDGE_NO_GROUND);
     make_row(row, 134.0, &t, NULL, false);
-    assert_int_equal(sl_ground_edge_q8(&g, row, 150U, NULL, 0U, 134 * 256), SL_GROUND_EDGE_SHORT);
+    assert_int_equal(sl_ground_edge_q8(&g, row, 150U, NULL, 0U, 134 * 256, NULL), SL_GROUND_EDGE_SHORT);
     sl_ground_cfg_t cfg;
     sl_ground_cfg_default(&cfg, board());
     cfg.margin_bins = 0U;
