@@ -27,6 +27,7 @@ void sl_ground_cfg_default(sl_ground_cfg_t *cfg, const sl_board_t *board)
     cfg->search_in_bins = 32U;
     cfg->search_out_bins = 48U;
     cfg->avg_rotations = 8U;
+    cfg->reads = SL_CFG_GROUND_READS;
     cfg->avg_dist_um = 750000U;
     cfg->sigma_min_q8 = 26U;
     cfg->decay_pow = 3U;
@@ -45,18 +46,41 @@ static uint16_t sector_first(const sl_ground_t *g, uint32_t k)
     return (uint16_t)((k * g->board->azimuths + K_SECT - 1U) / K_SECT);
 }
 
-// The azimuth sector k reads this rotation.
+// Sector k's azimuths this rotation: offsets o0, o0 + stride, ... within the sector,
+// stride = len / reads, o0 = phase mod stride (over the rotations every azimuth).
+static uint32_t sector_stride(const sl_ground_t *g, uint32_t len)
+{
+    const uint32_t st = len / g->cfg.reads;
+    return st > 0U ? st : 1U;
+}
+
+// The first azimuth sector k reads this rotation.
 static uint16_t sector_az(const sl_ground_t *g, uint32_t k)
 {
     const uint32_t a = sector_first(g, k);
     const uint32_t len = (uint32_t)sector_first(g, k + 1U) - a;
-    return (uint16_t)(a + (len > 0U ? (uint32_t)g->phase % len : 0U));
+    return (uint16_t)(a + (len > 0U ? (uint32_t)g->phase % sector_stride(g, len) : 0U));
 }
 
 static void want_sector(sl_ground_t *g, uint32_t k)
 {
     g->next_sector = (uint8_t)k;
     g->next_az = k < K_SECT ? sector_az(g, k) : UINT16_MAX;
+}
+
+// After reading `az` of the wanted sector: its next azimuth, else the next sector's.
+static void want_next(sl_ground_t *g, uint16_t az)
+{
+    const uint32_t k = g->next_sector;
+    const uint32_t a = sector_first(g, k);
+    const uint32_t len = (uint32_t)sector_first(g, k + 1U) - a;
+    const uint32_t st = sector_stride(g, len);
+    const uint32_t nxt = (uint32_t)az + st;
+    if (((uint32_t)az - a) / st + 1U < g->cfg.reads && nxt < a + len) {
+        g->next_az = (uint16_t)nxt;
+    } else {
+        want_sector(g, k + 1U);
+    }
 }
 
 sl_err_t sl_ground_init(sl_ground_t *g, const sl_board_t *board, const sl_ground_cfg_t *cfg)
@@ -73,7 +97,8 @@ sl_err_t sl_ground_init(sl_ground_t *g, const sl_board_t *board, const sl_ground
     }
     if (c.margin_bins == 0U || c.margin_bins > 32U || c.plateau_bins == 0U ||
         c.plateau_bins > 64U || c.floor_bins == 0U || c.floor_bins > 64U ||
-        c.avg_rotations == 0U || c.confirm == 0U || c.drop_um == 0U || c.drop_um > 10000000U || c.step_um == 0U ||
+        c.avg_rotations == 0U || c.reads == 0U || c.reads > 8U ||
+        (uint32_t)c.avg_rotations * c.reads > 255U || c.confirm == 0U || c.drop_um == 0U || c.drop_um > 10000000U || c.step_um == 0U ||
         c.step_um > 10000000U ||
         c.stale_rotations == 0U || c.decay_pow > 4U || sl_vscale_lp(&c.scale, 1U) == INT32_MIN) {
         return SL_ERR_ARG;
@@ -337,16 +362,15 @@ static void add_sample(sl_ground_t *g, uint32_t k, uint16_t az, int32_t e_q8, ui
     g->stats.samples++;
     s->fresh = true;
     s->age = 0U;
-    // this sample on the last plane (within half the threshold on its side): the ground at the
-    // plane's level still reached the ring here; the travel since is counted from now
+    // this sample's residual on the last plane, summed over the rotation
     const sl_ground_plane_t *pl = &g->plane;
     if (pl->quality != (uint8_t)SL_GROUND_NONE) {
         const int64_t dp = (int64_t)pl->height_mm * 1000 + (((int64_t)pl->slope_x_q16 * x_um +
                                                               (int64_t)pl->slope_y_q16 * y_um) >> 16);
-        const int64_t r = (int64_t)d_um - dp;
-        if (r * 2 < (int64_t)g->cfg.drop_um && -r * 2 < (int64_t)g->cfg.step_um) {
-            s->since_mm = 0U;
-        }
+        const int64_t r = ((int64_t)d_um - dp) / 1000;
+        const int32_t rs = (int32_t)s->rot_sum_mm + (int32_t)(r > 30000 ? 30000 : (r < -30000 ? -30000 : r));
+        s->rot_sum_mm = (int16_t)(rs > INT16_MAX ? INT16_MAX : (rs < INT16_MIN ? INT16_MIN : rs));
+        s->rot_n++;
     }
     if (s->n == 0U) {
         s->x_um = x_um;
@@ -361,10 +385,10 @@ static void add_sample(sl_ground_t *g, uint32_t k, uint16_t az, int32_t e_q8, ui
     // Weighted by the ground's level at the edge: sum w e = sum (w (c + m) - S) has no
     // ratio in it, so the mean carries no bias from a noisy level (one sample's
     // S / (A - f) does). The mean over avg_n() samples, the scatter over avg_rotations.
-    const uint32_t nm = avg_n(g);
+    const uint32_t nm = avg_n(g) * g->cfg.reads;
     const uint32_t n1 = (uint32_t)s->n + 1U > nm ? nm : (uint32_t)s->n + 1U;
-    const uint32_t nv = (uint32_t)s->nv + 1U > g->cfg.avg_rotations ? g->cfg.avg_rotations
-                                                                    : (uint32_t)s->nv + 1U;
+    const uint32_t nvm = (uint32_t)g->cfg.avg_rotations * g->cfg.reads;
+    const uint32_t nv = (uint32_t)s->nv + 1U > nvm ? nvm : (uint32_t)s->nv + 1U;
     uint64_t W = (uint64_t)s->wsum - s->wsum / n1 + w;
     W = W > UINT32_MAX ? UINT32_MAX : W;
     const int64_t f_q16 = (int64_t)(((uint64_t)w << 16) / (W > 0U ? W : 1U));
@@ -418,13 +442,13 @@ void sl_ground_row(sl_ground_t *g, uint16_t az, const uint8_t *row, uint32_t bin
 {
     SL_ASSERT(g != NULL);
     while (g->next_sector < K_SECT && az > g->next_az) {
-        want_sector(g, (uint32_t)g->next_sector + 1U); // the wanted row was lost
+        want_next(g, g->next_az); // the wanted row was lost
     }
     if (g->next_sector >= K_SECT || az != g->next_az) {
         return;
     }
     const uint32_t k = g->next_sector;
-    want_sector(g, k + 1U);
+    want_next(g, az);
     if (row == NULL) {
         g->stats.short_rows++;
         return;
@@ -668,7 +692,7 @@ static void hazards(sl_ground_t *g, const fit_out_t *o, const uint32_t *sig2, co
         s->sigma_mm = ar * 3 >= lim * 2 || s->kind != SL_GROUND_FLAT
                           ? sat_u16(sl_fx_isqrt64(v) / 16U)
                           : 0U;
-        if (!s->fresh || s->nv < g->cfg.avg_rotations) {
+        if (!s->fresh || s->nv < (uint32_t)g->cfg.avg_rotations * g->cfg.reads) {
             continue; // no vote before the sector's scatter is known over a full window
         }
         uint8_t now;
@@ -714,6 +738,54 @@ static void hazards(sl_ground_t *g, const fit_out_t *o, const uint32_t *sig2, co
     }
 }
 
+// One parameter: the fit's x (variance v) and the prior's xp (vp + q). A fit more than
+// 4 sigma off the prior: the prior is dropped (the attitude really changed).
+static bool fuse1(int64_t *x, uint64_t *v, int64_t xp, uint64_t vp, uint64_t q)
+{
+    const uint64_t vq = vp + q;
+    const uint64_t vs = *v + vq;
+    const int64_t d = *x - xp;
+    const uint64_t ad = (uint64_t)(d < 0 ? -d : d);
+    if (vs == 0U || ad > 4U * sl_fx_isqrt64(vs)) {
+        return false;
+    }
+    // x + (xp - x) v / (v + vq): shifts keep the products in 64 bits
+    int sh = 0;
+    while ((vs >> sh) > ((uint64_t)1 << 30)) {
+        sh++;
+    }
+    const int64_t num = (int64_t)(*v >> sh);
+    const int64_t den = (int64_t)(vs >> sh);
+    *x -= den > 0 ? (d * num) / den : 0;
+    *v = den > 0 ? (uint64_t)(((*v >> sh) * (vq >> sh)) / (uint64_t)den) << sh : *v;
+    return true;
+}
+
+// The plane filtered over rotations: the fit fused with the previous rotation's plane
+// plus the process noise (SL_GROUND_Q_*: how far the attitude may move in a rotation);
+// the result is the next rotation's prior.
+static void fuse_prior(sl_ground_t *g, fit_out_t *o)
+{
+    if (g->prior_ok) {
+        fit_out_t f = *o;
+        bool ok = fuse1(&f.a_raw_q12, &f.var_a_q32, g->prior_a_q16, g->prior_va, SL_GROUND_Q_SLOPE);
+        ok = ok && fuse1(&f.b_raw_q12, &f.var_b_q32, g->prior_b_q16, g->prior_vb, SL_GROUND_Q_SLOPE);
+        int64_t h = f.h_q4;
+        ok = ok && fuse1(&h, &f.var_h_q8, g->prior_h_q4, g->prior_vh, SL_GROUND_Q_H);
+        f.h_q4 = (int32_t)h;
+        if (ok) {
+            *o = f;
+        }
+    }
+    g->prior_ok = true;
+    g->prior_a_q16 = sl_fx_sat32(o->a_raw_q12);
+    g->prior_b_q16 = sl_fx_sat32(o->b_raw_q12);
+    g->prior_h_q4 = o->h_q4;
+    g->prior_va = o->var_a_q32 > UINT32_MAX ? UINT32_MAX : (uint32_t)o->var_a_q32;
+    g->prior_vb = o->var_b_q32 > UINT32_MAX ? UINT32_MAX : (uint32_t)o->var_b_q32;
+    g->prior_vh = o->var_h_q8 > UINT32_MAX ? UINT32_MAX : (uint32_t)o->var_h_q8;
+}
+
 // A hazard holds or is being voted for.
 static bool suspect(const sl_ground_sector_t *s)
 {
@@ -734,6 +806,16 @@ void sl_ground_end_rotation(sl_ground_t *g)
         }
         // travel towards the sector's direction: since its last sample on the plane, and
         // since a hazard's onset
+        if (s->rot_n > 0U) {
+            // the rotation's samples on the plane on average (within half the threshold on
+            // their side): the ring still on the ground's level
+            const int32_t mr = (int32_t)s->rot_sum_mm / (int32_t)s->rot_n;
+            if (mr * 2000 < (int32_t)g->cfg.drop_um && -mr * 2000 < (int32_t)g->cfg.step_um) {
+                s->since_mm = 0U;
+            }
+        }
+        s->rot_sum_mm = 0;
+        s->rot_n = 0U;
         if (g->moving) {
             const int32_t cdeg = sl_ground_sector_cdeg(g, k);
             const sl_bam32_t bam = (sl_bam32_t)(uint32_t)((uint32_t)cdeg * 119304U +
@@ -761,6 +843,42 @@ void sl_ground_end_rotation(sl_ground_t *g)
         for (uint32_t k = 0; k < K_SECT; k++) {
             if (suspect(&g->sec[k])) {
                 g->sec[k].in_fit = false;
+            }
+        }
+    }
+    // the gate: sectors far off the previous rotation's plane (its attitude can have moved
+    // by the process noise since) stay out of this one's fit; a drop-off coming into the
+    // ring ahead is then terrain, not pitch. Without enough sectors left, no gate.
+    const uint32_t lim0 = g->cfg.drop_um < g->cfg.step_um ? g->cfg.drop_um : g->cfg.step_um;
+    const int32_t half0 = (int32_t)(lim0 * 8U / 1000U);
+    uint32_t gated = 0U;
+    if (g->prior_ok) {
+        fit_out_t pr;
+        memset(&pr, 0, sizeof pr);
+        pr.a_raw_q12 = g->prior_a_q16;
+        pr.b_raw_q12 = g->prior_b_q16;
+        pr.h_q4 = g->prior_h_q4;
+        uint32_t left = 0U;
+        for (uint32_t k = 0; k < K_SECT; k++) {
+            sl_ground_sector_t *s = &g->sec[k];
+            if (!s->in_fit) {
+                continue;
+            }
+            const int32_t r = resid_q4(s, &pr);
+            const int32_t ar = r < 0 ? -r : r;
+            const uint64_t v = (uint64_t)sig2[k] + g->prior_vh + SL_GROUND_Q_H;
+            if (ar > half0 && (uint64_t)ar * (uint64_t)ar > 4U * v) {
+                s->in_fit = false;
+                gated |= 1U << (k & 31U);
+            } else {
+                left++;
+            }
+        }
+        if (left < SL_GROUND_MIN_SECTORS) {
+            for (uint32_t k = 0; k < K_SECT; k++) {
+                if ((gated >> (k & 31U)) & 1U) {
+                    g->sec[k].in_fit = true;
+                }
             }
         }
     }
@@ -809,6 +927,9 @@ void sl_ground_end_rotation(sl_ground_t *g)
             o.var_b_q32 = o.var_b_q32 > (UINT64_MAX >> 20) ? UINT64_MAX >> 4 : (o.var_b_q32 * disp_q16) >> 16;
             o.var_h_q8 = o.var_h_q8 > (UINT64_MAX >> 20) ? UINT64_MAX >> 4 : (o.var_h_q8 * disp_q16) >> 16;
         }
+        fuse_prior(g, &o);
+    } else {
+        g->prior_ok = false;
     }
     sl_ground_plane_t *pl = &g->plane;
     if (ok) {

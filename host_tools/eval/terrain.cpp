@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <memory>
 #include <stdexcept>
@@ -158,6 +159,13 @@ SceneResult run_scene(const std::string &path, int rotations, int warmup, double
             res.h_err_max = std::max(res.h_err_max, std::fabs(eh));
             res.p_err_max = std::max(res.p_err_max, std::fabs(ep));
             res.r_err_max = std::max(res.r_err_max, std::fabs(er));
+        }
+        if (std::getenv("SL_TERRAIN_DEBUG") != nullptr) {
+            std::printf("r %d h %d p %d n %u |", k, g.plane.height_mm, g.plane.pitch_cdeg, g.plane.sectors);
+            for (uint32_t s : {29U, 30U, 31U, 0U, 1U, 2U, 3U}) {
+                std::printf(" %d/%u/%u%s", g.sec[s].resid_mm, g.sec[s].sigma_mm, g.sec[s].n, g.sec[s].in_fit ? "" : "x");
+            }
+            std::printf("\n");
         }
         for (uint32_t s = 0; s < SL_CFG_GROUND_SECTORS; s++) {
             const sl_ground_sector_t &sec = g.sec[s];

@@ -35,9 +35,11 @@
 /// The edges are the board's geometry read backwards: a wrong theta(az) table is a
 /// residual pattern that is the same on every rotation and every ground.
 ///
-/// ## One sample (sl_ground_row, one azimuth per sector per rotation)
-/// Sector k (SL_CFG_GROUND_SECTORS equal sectors of the rotation) reads, in rotation n,
-/// azimuth first(k) + n mod len(k): over the rotations every azimuth of the sector. The
+/// ## One sample (sl_ground_row, `reads` azimuths per sector per rotation)
+/// Sector k (SL_CFG_GROUND_SECTORS equal sectors of the rotation, len(k) azimuths) reads,
+/// in rotation n, the azimuths first(k) + n mod s + j s, s = len(k) / reads, j = 0 ..
+/// reads - 1: spread over the sector (independent speckle), and over the rotations every
+/// azimuth of it. The
 /// row is the raw message's 8-bit values (the whole range: the edge may lie past the
 /// masked bins). Around the expected edge e0 = H / sin(theta) / bin (the board's flat
 /// ground):
@@ -69,7 +71,8 @@
 ///    10 octaves below count 0). Rejected ("bad edge") when fewer than half the plateau's
 ///    bins are >= threshold (not ground), A <= 2 f (no contrast) or e leaves the window;
 /// 4. the sector's estimate: an exponentially weighted mean of its samples over
-///    min(`avg_rotations`, the rotations the vehicle needs to move `avg_dist_um`) samples,
+///    min(`avg_rotations`, the rotations the vehicle needs to move `avg_dist_um`) rotations'
+///    samples,
 ///    each weighted by its ground level A - f (sum (A - f) e = sum ((A - f)(c + m) - S):
 ///    the mean carries no bias from a noisy level, which 1 / (A - f) of one sample has),
 ///    and the mean square deviation of the samples from it: the sector's sigma is the
@@ -79,6 +82,10 @@
 ///    the truth), over the samples averaged, never below `sigma_min_q8`.
 ///
 /// ## The plane and the hazards (sl_ground_end_rotation)
+/// - the gate: sectors off the previous rotation's plane by more than half the smaller
+///   threshold and 2 sigma (with its variance and the process noise SL_GROUND_Q_*) stay
+///   out of the fit (a drop-off coming into the ring ahead is terrain, not pitch); fewer
+///   than SL_GROUND_MIN_SECTORS left: no gate;
 /// - sectors with an estimate no older than `stale_rotations` enter a weighted fit (weight
 ///   1 / sigma_d^2, sigma_d = sigma_s sin(theta)); at least SL_GROUND_MIN_SECTORS, covering
 ///   three quadrants of the vehicle, else no plane (quality NONE);
@@ -89,23 +96,27 @@
 ///   against that plane;
 /// - sigmas: the fit's covariance (integer WLS), scaled by sqrt(chi2 / dof) when the
 ///   scatter about the plane exceeds what the sectors' sigmas explain;
+/// - the plane filtered over rotations: each parameter of the fit fused with the previous
+///   rotation's plus the process noise (inverse-variance weights); a fit more than 4
+///   sigma off it restarts the filter (the attitude really changed);
 /// - quality: GOOD when every sigma is within `good_sigma_*`, COARSE otherwise; NONE
 ///   without a plane. A number the module cannot stand behind is sent COARSE or NONE;
 /// - DROP / STEP per sector: the residual beyond `drop_um` (lower) or `step_um` (higher)
 ///   and beyond 3 sigma (sigma of the sector and of the plane there) in `confirm`
-///   consecutive samples raises it (votes only once the sector's scatter holds
-///   `avg_rotations` samples); within 2/3 of the threshold on its side in `confirm`
+///   consecutive rotations raises it (votes only once the sector's scatter holds
+///   `avg_rotations` x `reads` samples); within 2/3 of the threshold on its side in `confirm`
 ///   samples, or no sample for `stale_rotations`, clears it (hysteresis);
 /// - distance: each hazard carries the horizontal distance from the radar to where the
 ///   ground at the plane's level ends, along the sector: the ray over the chassis edge
 ///   meets the plane at rho = h / (tan(theta) - the plane's slope along the sector); the
-///   edge crossed that ring between the sector's last sample on the plane (within half
-///   the threshold on its side) and the next one, one rotation's travel later. At the vote
+///   edge crossed that ring between the sector's last rotation whose samples were on the
+///   plane on average (within half the threshold on their side) and the next one, one
+///   rotation's travel later. At the vote
 ///   that opens the hazard: rho + step / 2 - the travel towards the sector since that last
 ///   sample (odometry, sl_ground_set_motion, projected on the sector's direction; +-half a
 ///   step), then less the travel while it holds. Parked: rho (the edge is inside the ring).
-///   A single sample's noise beyond half the threshold makes the last sample on the plane
-///   an earlier one: the distance then errs near (by a rotation's travel per such sample).
+///   Noise beyond half the threshold in such a mean makes that rotation an earlier one:
+///   the distance then errs near (by a rotation's travel per such rotation).
 ///   `front_um` (radar to the vehicle's front along x) is for the caller's distance to the
 ///   front.
 ///
@@ -149,6 +160,19 @@ extern "C" {
 #define SL_GROUND_DECAY_SAMPLES 256U
 /// Weight of the prior sigma in a sector's scatter, in samples.
 #define SL_GROUND_PRIOR_WEIGHT 4U
+/// Rows read per sector and rotation by default: 4 in the host configuration, 1 in the
+/// firmware one (masked bins <= 192: its instruction budget).
+#ifndef SL_CFG_GROUND_READS
+#if SL_CFG_MASK_BINS <= 192
+#define SL_CFG_GROUND_READS 1U
+#else
+#define SL_CFG_GROUND_READS 4U
+#endif
+#endif
+/// Process noise of the plane per rotation: slope (tan 0.25 deg)^2 in Q32, depth (10 mm)^2
+/// in (1/16 mm)^2 (1 deg/s and 40 mm/s at 4 Hz: a body on its suspension).
+#define SL_GROUND_Q_SLOPE 81700U
+#define SL_GROUND_Q_H 25600U
 /// Sectors needed for a plane.
 #define SL_GROUND_MIN_SECTORS 6U
 
@@ -174,7 +198,9 @@ typedef struct sl_ground_cfg {
     uint8_t floor_bins;       ///< bins of floor before the window (default 8)
     uint8_t search_in_bins;   ///< coarse search before e0 (default 32)
     uint8_t search_out_bins;  ///< ... and after it (default 48)
-    uint8_t avg_rotations;    ///< samples averaged per sector at most (default 8)
+    uint8_t reads;            ///< rows read per sector and rotation (1..8; default
+                              ///< SL_CFG_GROUND_READS)
+    uint8_t avg_rotations;    ///< rotations averaged per sector at most (default 8)
     uint32_t avg_dist_um;     ///< ... and while moving, over this distance (default 0.75 m)
     uint16_t sigma_min_q8;    ///< floor of a sector's sigma, bins Q8 (default 0.1 bin = 26)
     uint8_t decay_pow;        ///< the ground's level falls as range^-n past the edge: n until
@@ -200,15 +226,18 @@ typedef struct sl_ground_sector {
                            ///< less the travel towards it since (see above)
     uint16_t sigma_mm;     ///< the residual's sigma (sector and plane), last fit; computed
                            ///< beyond 2/3 of the threshold or while a hazard holds (else 0)
-    uint16_t since_mm;     ///< travel towards the sector since its last sample on the plane
-    uint8_t n;             ///< samples in the mean (<= avg_n)
-    uint8_t nv;            ///< samples in the scatter (<= avg_rotations)
+    uint16_t since_mm;     ///< travel towards the sector since the last rotation whose
+                           ///< samples were on the plane on average
+    uint8_t n;             ///< samples in the mean (<= the rotations averaged x reads)
+    uint8_t nv;            ///< samples in the scatter (<= avg_rotations x reads)
     uint8_t age;           ///< rotations since the last sample (saturating)
     uint8_t kind;          ///< sl_ground_kind_t confirmed
     uint8_t votes;         ///< consecutive samples against `kind`
     uint8_t vote_kind;     ///< what they vote for
     bool fresh;            ///< a sample this rotation
     bool in_fit;           ///< used by the last plane
+    int16_t rot_sum_mm;    ///< this rotation's samples' residuals on the last plane, summed
+    uint8_t rot_n;         ///< ... their count
 } sl_ground_sector_t;
 
 typedef struct sl_ground_plane {
@@ -254,6 +283,11 @@ typedef struct sl_ground {
     uint32_t step_um;            ///< distance driven in the last rotation
     int32_t step_x_um;           ///< ... its forward component (signed)
     sl_ground_plane_t plane;
+    bool prior_ok;               ///< the previous rotation's plane (the prior) holds
+    int32_t prior_a_q16, prior_b_q16; ///< its slopes (depth per mm, Q16 of 1/16 mm)
+    int32_t prior_h_q4;          ///< its depth at the radar's foot, 1/16 mm
+    uint32_t prior_va, prior_vb; ///< its slopes' variances, Q32
+    uint32_t prior_vh;           ///< its depth's variance, (1/16 mm)^2
     sl_ground_sector_t sec[SL_CFG_GROUND_SECTORS];
     sl_ground_stats_t stats;
 } sl_ground_t;
@@ -264,6 +298,7 @@ void sl_ground_cfg_default(sl_ground_cfg_t *cfg, const sl_board_t *board);
 /// Init for `board` (borrowed) and `cfg` (copied; NULL: defaults). SL_ERR_ARG for NULL
 /// `g`/`board`, a board without azimuths or theta table, or a cfg out of range
 /// (margin_bins 0 or > 32, plateau_bins or floor_bins 0 or > 64, avg_rotations 0,
+/// reads 0 or > 8, avg_rotations x reads > 255,
 /// decay_pow > 4, confirm 0, drop_um or step_um 0 or > 10 m, an invalid scale). O(sectors).
 sl_err_t sl_ground_init(sl_ground_t *g, const sl_board_t *board, const sl_ground_cfg_t *cfg);
 
