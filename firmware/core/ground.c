@@ -672,6 +672,13 @@ static uint16_t sat_u16(uint64_t v)
     return v > UINT16_MAX ? UINT16_MAX : (uint16_t)v;
 }
 
+// The hazard point's horizontal distance from the radar.
+static int32_t hazard_dist(const sl_ground_sector_t *s)
+{
+    const uint64_t d2 = (uint64_t)((int64_t)s->hx_um * s->hx_um) + (uint64_t)((int64_t)s->hy_um * s->hy_um);
+    return sl_fx_sat32((int64_t)sl_fx_isqrt64(d2));
+}
+
 static void hazards(sl_ground_t *g, const fit_out_t *o, const uint32_t *sig2, const uint16_t *azs)
 {
     const int32_t drop = (int32_t)(g->cfg.drop_um * 16U / 1000U);
@@ -696,7 +703,7 @@ static void hazards(sl_ground_t *g, const fit_out_t *o, const uint32_t *sig2, co
             continue; // no vote before the sector's scatter is known over a full window
         }
         uint8_t now;
-        if (ar > lim && (uint64_t)ar * (uint64_t)ar > 9U * v) {
+        if (ar > lim && (uint64_t)ar * (uint64_t)ar > 16U * v) {
             now = r > 0 ? SL_GROUND_DROP : SL_GROUND_STEP;
         } else if (ar * 3 < lim * 2) {
             now = SL_GROUND_FLAT;
@@ -724,10 +731,15 @@ static void hazards(sl_ground_t *g, const fit_out_t *o, const uint32_t *sig2, co
                         : (int64_t)1 << 30;
                 const int64_t den = tan_q16 - along_q16;
                 const int64_t ring = den > 0 ? (((int64_t)o->h_q4 * 1000 / 16) << 16) / den : rho;
-                // the ground's end crossed the ring between the last sample on the plane and
-                // the next one (one step later): the middle of that, less the travel since
-                s->dist_um = sl_fx_sat32(ring + (int64_t)(g->step_um / 2U) -
-                                         (int64_t)s->since_mm * 1000);
+                // the point of the ring along the sector; the ground's end crossed the ring
+                // between the last rotation on the plane and the next one (one step later):
+                // the middle of that, moved back by the forward travel since
+                if (rho > 0) {
+                    s->hx_um = sl_fx_sat32((int64_t)s->x_um * ring / rho + g->step_x_um / 2 -
+                                           (int64_t)s->since_mm * 1000);
+                    s->hy_um = sl_fx_sat32((int64_t)s->y_um * ring / rho);
+                }
+                s->dist_um = hazard_dist(s);
             }
             s->votes++;
             if (s->votes >= g->cfg.confirm) {
@@ -807,26 +819,23 @@ void sl_ground_end_rotation(sl_ground_t *g)
         // travel towards the sector's direction: since its last sample on the plane, and
         // since a hazard's onset
         if (s->rot_n > 0U) {
-            // the rotation's samples on the plane on average (within half the threshold on
-            // their side): the ring still on the ground's level
+            // the rotation's samples on the plane on average (within a quarter of the
+            // threshold on their side): the ring still on the ground's level
             const int32_t mr = (int32_t)s->rot_sum_mm / (int32_t)s->rot_n;
-            if (mr * 2000 < (int32_t)g->cfg.drop_um && -mr * 2000 < (int32_t)g->cfg.step_um) {
+            if (mr * 4000 < (int32_t)g->cfg.drop_um && -mr * 4000 < (int32_t)g->cfg.step_um) {
                 s->since_mm = 0U;
             }
         }
         s->rot_sum_mm = 0;
         s->rot_n = 0U;
         if (g->moving) {
-            const int32_t cdeg = sl_ground_sector_cdeg(g, k);
-            const sl_bam32_t bam = (sl_bam32_t)(uint32_t)((uint32_t)cdeg * 119304U +
-                                                          (((uint32_t)cdeg * 21U) >> 5));
-            sl_q30_t sp, cp;
-            sl_tilt_sincos_q30(bam, &sp, &cp);
-            const int32_t tow_um = (int32_t)(((int64_t)g->step_x_um * cp) >> 30);
-            const int32_t sm = (int32_t)s->since_mm + tow_um / 1000;
+            // the forward travel: since the last rotation on the plane, and the hazard's
+            // point moving back in the vehicle frame (straight motion)
+            const int32_t sm = (int32_t)s->since_mm + g->step_x_um / 1000;
             s->since_mm = (uint16_t)(sm < 0 ? 0 : (sm > UINT16_MAX ? UINT16_MAX : sm));
             if (s->votes > 0U || s->kind != SL_GROUND_FLAT) {
-                s->dist_um = sl_fx_sat32((int64_t)s->dist_um - tow_um);
+                s->hx_um = sl_fx_sat32((int64_t)s->hx_um - g->step_x_um);
+                s->dist_um = hazard_dist(s);
             }
         }
         azs[k] = sector_az(g, k);

@@ -197,12 +197,15 @@ SceneResult run_scene(const std::string &path, int rotations, int warmup, double
                                 "distance %.2f m: %s\n",
                                 k, s, cd, kind == SL_GROUND_DROP ? "DROP" : "STEP", sec.resid_mm, sec.sigma_mm,
                                 sec.dist_um * 1e-6, ok ? "true" : "false");
+                    if (std::getenv("SL_TERRAIN_DEBUG") != nullptr) {
+                        std::printf("    hx %.2f since %u\n", sec.hx_um * 1e-6, sec.since_mm);
+                    }
                 }
                 // the first DROP ahead
                 const double off = std::fabs(std::remainder(cd, 360.0));
                 if (kind == SL_GROUND_DROP && ok && off <= 45.0 && !res.drop_warned) {
                     res.drop_warned = true;
-                    res.drop_reported_m = sec.dist_um * 1e-6 * std::cos(sim_d2r(off)) - front;
+                    res.drop_reported_m = sec.hx_um * 1e-6 - front;
                 }
             }
             prev_kind[s] = kind;
@@ -257,6 +260,17 @@ SceneResult run_scene(const std::string &path, int rotations, int warmup, double
     return res;
 }
 
+// A JSON number, null when not finite.
+std::string num(double v, int decimals)
+{
+    if (!std::isfinite(v)) {
+        return "null";
+    }
+    char b[48];
+    std::snprintf(b, sizeof b, "%.*f", decimals, v);
+    return b;
+}
+
 double mean(double s, int n)
 {
     return n > 0 ? s / n : NAN;
@@ -302,16 +316,18 @@ int cmd_terrain(int argc, char **argv)
         const double fph = r.hours > 0 ? r.false_onsets / r.hours : NAN;
         if (json) {
             std::printf("{\"scene\": \"%s\", \"rotations\": %d, \"scored\": %d, \"good\": %d, "
-                        "\"height_err_mean_mm\": %.1f, \"height_err_max_mm\": %.1f, "
-                        "\"pitch_err_mean_deg\": %.3f, \"pitch_err_max_deg\": %.3f, "
-                        "\"roll_err_mean_deg\": %.3f, \"roll_err_max_deg\": %.3f, "
-                        "\"true_hazard_onsets\": %d, \"false_hazard_onsets\": %d, \"false_per_hour\": %.2f, "
+                        "\"height_err_mean_mm\": %s, \"height_err_max_mm\": %s, "
+                        "\"pitch_err_mean_deg\": %s, \"pitch_err_max_deg\": %s, "
+                        "\"roll_err_mean_deg\": %s, \"roll_err_max_deg\": %s, "
+                        "\"true_hazard_onsets\": %d, \"false_hazard_onsets\": %d, \"false_per_hour\": %s, "
                         "\"terrain_pieces\": %d, \"terrain_pieces_found\": %d, "
-                        "\"drop_warned\": %s, \"drop_true_m\": %.2f, \"drop_reported_m\": %.2f}\n",
-                        r.name.c_str(), r.rotations, r.scored, r.good, 1e3 * mean(r.h_err_sum, r.scored),
-                        1e3 * r.h_err_max, mean(r.p_err_sum, r.scored), r.p_err_max, mean(r.r_err_sum, r.scored),
-                        r.r_err_max, r.true_onsets, r.false_onsets, fph, r.pieces, r.pieces_found,
-                        r.drop_warned ? "true" : "false", r.drop_true_m, r.drop_reported_m);
+                        "\"drop_warned\": %s, \"drop_true_m\": %s, \"drop_reported_m\": %s}\n",
+                        r.name.c_str(), r.rotations, r.scored, r.good, num(1e3 * mean(r.h_err_sum, r.scored), 1).c_str(),
+                        num(1e3 * r.h_err_max, 1).c_str(), num(mean(r.p_err_sum, r.scored), 3).c_str(),
+                        num(r.p_err_max, 3).c_str(), num(mean(r.r_err_sum, r.scored), 3).c_str(),
+                        num(r.r_err_max, 3).c_str(), r.true_onsets, r.false_onsets, num(fph, 2).c_str(), r.pieces,
+                        r.pieces_found, r.drop_warned ? "true" : "false", num(r.drop_true_m, 2).c_str(),
+                        num(r.drop_reported_m, 2).c_str());
             continue;
         }
         std::printf("%s: %d rotations, plane in %d, scored %d (GOOD %d)\n", r.name.c_str(), r.rotations,

@@ -102,23 +102,24 @@
 /// - quality: GOOD when every sigma is within `good_sigma_*`, COARSE otherwise; NONE
 ///   without a plane. A number the module cannot stand behind is sent COARSE or NONE;
 /// - DROP / STEP per sector: the residual beyond `drop_um` (lower) or `step_um` (higher)
-///   and beyond 3 sigma (sigma of the sector and of the plane there) in `confirm`
+///   and beyond 4 sigma (sigma of the sector and of the plane there; 32 sectors decide
+///   about 460,000 times an hour at 4 Hz: 3 sigma would raise hundreds) in `confirm`
 ///   consecutive rotations raises it (votes only once the sector's scatter holds
 ///   `avg_rotations` x `reads` samples); within 2/3 of the threshold on its side in `confirm`
 ///   samples, or no sample for `stale_rotations`, clears it (hysteresis);
-/// - distance: each hazard carries the horizontal distance from the radar to where the
-///   ground at the plane's level ends, along the sector: the ray over the chassis edge
-///   meets the plane at rho = h / (tan(theta) - the plane's slope along the sector); the
-///   edge crossed that ring between the sector's last rotation whose samples were on the
-///   plane on average (within half the threshold on their side) and the next one, one
-///   rotation's travel later. At the vote
-///   that opens the hazard: rho + step / 2 - the travel towards the sector since that last
-///   sample (odometry, sl_ground_set_motion, projected on the sector's direction; +-half a
-///   step), then less the travel while it holds. Parked: rho (the edge is inside the ring).
-///   Noise beyond half the threshold in such a mean makes that rotation an earlier one:
-///   the distance then errs near (by a rotation's travel per such rotation).
-///   `front_um` (radar to the vehicle's front along x) is for the caller's distance to the
-///   front.
+/// - distance: each hazard carries the point where the ground at the plane's level ends
+///   along its sector (vehicle frame) and its horizontal distance from the radar: the ray
+///   over the chassis edge meets the plane at rho = h / (tan(theta) - the plane's slope
+///   along the sector); the ground's end crossed that ring between the sector's last
+///   rotation whose samples were on the plane on average (within a quarter of the
+///   threshold on their side: a plane still following the edge halves the step) and the
+///   next one, one rotation's travel later: at the vote that opens the
+///   hazard the ring's point moved back by the forward travel since that rotation, less
+///   half a step (odometry, sl_ground_set_motion; straight motion), then back by the
+///   travel while it holds. Parked: the ring's point (the edge is inside the ring). Noise
+///   beyond a quarter of the threshold in such a rotation's mean dates it earlier: the
+///   point then errs near. `front_um` (radar to the vehicle's front along x) is for the caller's
+///   distance to the front (x - front_um).
 ///
 /// ## Units, numbers, cost, RAM
 /// Heights, ranges: mm (int32); edges: bins Q8; slopes Q16; angles 0.01 deg. Integer only
@@ -222,12 +223,13 @@ typedef struct sl_ground_sector {
     uint32_t var_q;        ///< mean square deviation of d's samples, (10 um)^2
     uint32_t wsum;         ///< the samples' levels summed (exponentially weighted)
     int32_t resid_mm;      ///< ground below the plane (> 0 lower), last fit
-    int32_t dist_um;       ///< hazard: radar to where the ground at the plane's level ends,
-                           ///< less the travel towards it since (see above)
+    int32_t hx_um, hy_um;  ///< hazard: where the ground at the plane's level ends along
+                           ///< the sector, vehicle frame, moved back by the travel since
+    int32_t dist_um;       ///< ... its horizontal distance from the radar (see above)
     uint16_t sigma_mm;     ///< the residual's sigma (sector and plane), last fit; computed
                            ///< beyond 2/3 of the threshold or while a hazard holds (else 0)
-    uint16_t since_mm;     ///< travel towards the sector since the last rotation whose
-                           ///< samples were on the plane on average
+    uint16_t since_mm;     ///< forward travel since the last rotation whose samples were
+                           ///< on the plane on average
     uint8_t n;             ///< samples in the mean (<= the rotations averaged x reads)
     uint8_t nv;            ///< samples in the scatter (<= avg_rotations x reads)
     uint8_t age;           ///< rotations since the last sample (saturating)

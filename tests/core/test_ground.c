@@ -331,7 +331,7 @@ static void test_drop_ahead_moving(void **state)
             for (unsigned k = 0; k < SL_CFG_GROUND_SECTORS; k++) {
                 const int32_t cd = sl_ground_sector_cdeg(&g, k);
                 if (g.sec[k].kind == SL_GROUND_DROP && (cd < 3000 || cd > 33000)) {
-                    first_dist = g.sec[k].dist_um * 1e-6 * cos(cd * kPi / 18000.0);
+                    first_dist = g.sec[k].hx_um * 1e-6;
                     if (getenv("GROUND_DEBUG") != NULL) {
                         print_message("sector %u cd %d dist %d\n", k, cd, g.sec[k].dist_um);
                     }
