@@ -10,6 +10,8 @@
 #include "shadowlean/sl_incline.h"
 #include "shadowlean/sl_tilt.h"
 
+#if SL_CFG_GROUND
+
 #define K_SECT ((uint32_t)SL_CFG_GROUND_SECTORS)
 #define W_EXP 28         // weights: 2^W_EXP / sigma^2, sigma in 1/16 mm
 #define SIG2_MIN 256U    // sigma >= 1 mm (16^2 in (1/16 mm)^2)
@@ -1003,3 +1005,5 @@ int32_t sl_ground_sector_cdeg(const sl_ground_t *g, uint32_t k)
     c %= 36000;
     return c < 0 ? c + 36000 : c;
 }
+
+#endif // SL_CFG_GROUND

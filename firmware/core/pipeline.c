@@ -51,9 +51,11 @@ void sl_pipeline_cfg_default(sl_pipeline_cfg_t *cfg, const sl_board_t *board)
     cfg->row_timeout_us = 1000000U;
     cfg->profile = true;
     sl_profile_cfg_default(&cfg->profile_cfg);
-    cfg->ground = SL_CFG_GROUND_DEFAULT != 0;
+#if SL_CFG_GROUND
+    cfg->ground = true;
     sl_ground_cfg_default(&cfg->ground_cfg, board);
     cfg->ground_cfg.threshold = 0U; // the pipeline's threshold
+#endif
 }
 
 uint8_t sl_pipeline_window(uint8_t n, uint8_t min_frames, int32_t speed_mm_s,
@@ -500,6 +502,7 @@ static void feed_held(sl_pipeline_t *p, uint32_t from, uint32_t to)
     }
 }
 
+#if SL_CFG_GROUND
 // The ground's row: the raw message's 8-bit bins (the whole range), else (16-bit) the
 // scan's reduced row of the masked bins.
 static SL_NOINLINE void ground_row(sl_pipeline_t *p, const sl_scan_row_t *row)
@@ -513,6 +516,7 @@ static SL_NOINLINE void ground_row(sl_pipeline_t *p, const sl_scan_row_t *row)
         sl_ground_row(&p->ground, row->idx, row->power, p->mask_bins, bits, p->mask_bins);
     }
 }
+#endif
 
 static void on_row(void *ctx, const sl_scan_row_t *row)
 {
@@ -533,9 +537,11 @@ static void on_row(void *ctx, const sl_scan_row_t *row)
     if (row->idx == p->drift.watch_az) { // once per rotation: the bins past the mask
         sl_drift_tail(&p->drift, row->fft, p->mask_bins, p->cfg.pow16_shift, p->cfg.threshold);
     }
+#if SL_CFG_GROUND
     if (p->cfg.ground && row->idx >= sl_ground_want(&p->ground)) {
-        ground_row(p, row); // one row per sector and rotation
+        ground_row(p, row); // `reads` rows per sector and rotation
     }
+#endif
     if (p->cfg.profile) {
         sl_profile_row(&p->prof, row->idx, row->power, p->mask_bins, p->bits,
                        p->detect.win_bins[row->idx < p->detect.azimuths ? row->idx : 0U]);
@@ -747,10 +753,12 @@ static void on_rot(void *ctx, const sl_scan_rot_t *rot)
                      p->det_board.bin_size_um);
     }
     sl_drift_end_rotation(&p->drift);
+#if SL_CFG_GROUND
     if (p->cfg.ground) {
         sl_ground_set_motion(&p->ground, p->motion_valid, p->speed_mm_s, p->rotation_us);
         sl_ground_end_rotation(&p->ground);
     }
+#endif
     p->stats.rotations++;
     p->stats.azimuths_missing += rot->stats.missing;
     p->stats.targets += n_targets;
@@ -801,7 +809,9 @@ static void use_bin_size(sl_pipeline_t *p, uint32_t um)
     if (p->cfg.profile) {
         sl_detect_set_tail_slope(&p->detect, p->prof.slope_q8); // re-init cleared it
     }
+#if SL_CFG_GROUND
     sl_ground_set_bin_size(&p->ground, p->det_board.bin_size_um);
+#endif
 }
 
 // A Configuration message (its parsed form stays out of on_msg's frame, which the FFT
@@ -940,11 +950,13 @@ sl_err_t sl_pipeline_init(sl_pipeline_t *p, const sl_board_t *board,
         p->tilt.max_tan_q16 = c->detect.max_lean_tan_q16;
     }
     sl_drift_init(&p->drift, board);
+#if SL_CFG_GROUND
     if (e == SL_OK && c->ground) {
         p->cfg.ground_cfg.threshold = c->ground_cfg.threshold != 0U ? c->ground_cfg.threshold
                                                                     : c->threshold;
         e = sl_ground_init(&p->ground, board, &p->cfg.ground_cfg);
     }
+#endif
     sl_can_ids_t ids;
     if (e == SL_OK) {
         sl_can_ids_from_board(&ids, board);

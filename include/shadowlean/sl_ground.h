@@ -130,6 +130,8 @@
 /// SL_CFG_GROUND_SECTORS rows per rotation (measured: docs/PERFORMANCE.md). sl_ground_end_rotation:
 /// O(sectors) twice, one 2 x 2 solve, O(64) division steps. RAM: sizeof(sl_ground_t)
 /// (about 0.8 KB with 32 sectors). Stack: no arrays, a few 64-bit locals.
+/// Compiled in with SL_CFG_GROUND (sl_config.h: the host configuration); without it the
+/// types remain and the functions are not defined.
 /// Limits: a plane is only fitted where the ground returns above the threshold at the
 /// shadow's edge on three quadrants; frozen speckle (a parked vehicle, a static scene)
 /// leaves each sector a fixed error that only the other azimuths of the sector average;
@@ -161,14 +163,9 @@ extern "C" {
 #define SL_GROUND_DECAY_SAMPLES 256U
 /// Weight of the prior sigma in a sector's scatter, in samples.
 #define SL_GROUND_PRIOR_WEIGHT 4U
-/// Rows read per sector and rotation by default: 4 in the host configuration, 1 in the
-/// firmware one (masked bins <= 192: its instruction budget).
+/// Rows read per sector and rotation by default.
 #ifndef SL_CFG_GROUND_READS
-#if SL_CFG_MASK_BINS <= 192
-#define SL_CFG_GROUND_READS 1U
-#else
 #define SL_CFG_GROUND_READS 4U
-#endif
 #endif
 /// Process noise of the plane per rotation: slope (tan 0.25 deg)^2 in Q32, depth (10 mm)^2
 /// in (1/16 mm)^2 (1 deg/s and 40 mm/s at 4 Hz: a body on its suspension).
@@ -200,7 +197,7 @@ typedef struct sl_ground_cfg {
     uint8_t search_in_bins;   ///< coarse search before e0 (default 32)
     uint8_t search_out_bins;  ///< ... and after it (default 48)
     uint8_t reads;            ///< rows read per sector and rotation (1..8; default
-                              ///< SL_CFG_GROUND_READS)
+                              ///< SL_CFG_GROUND_READS, 4)
     uint8_t avg_rotations;    ///< rotations averaged per sector at most (default 8)
     uint32_t avg_dist_um;     ///< ... and while moving, over this distance (default 0.75 m)
     uint16_t sigma_min_q8;    ///< floor of a sector's sigma, bins Q8 (default 0.1 bin = 26)

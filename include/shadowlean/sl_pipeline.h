@@ -137,8 +137,8 @@
 /// SL_CFG_MASK_BINS / 8 bytes; then detection (8,424 B), the tracker (1,864 B), the scan
 /// bookkeeping (624 B), the range profiles (sl_profile.h, 2.3 KB), the 3D tilt history
 /// (sl_tiltobs.h: 2,480 B firmware, 7.4 KB host default), the reassembly buffer
-/// (SL_PIPELINE_REASM_BYTES), a row buffer, the theta drift watch (sl_drift.h, 60 B) and
-/// the ground (sl_ground.h: 1,280 B with 32 sectors, its configuration 36 B).
+/// (SL_PIPELINE_REASM_BYTES), a row buffer, the theta drift watch (sl_drift.h, 60 B) and,
+/// with SL_CFG_GROUND (host configuration), the ground (sl_ground.h, SL_PIPELINE_GROUND_BYTES).
 ///
 /// Measured sizes per configuration: docs/PERFORMANCE.md ("Core modules").
 ///
@@ -262,12 +262,13 @@ typedef struct sl_pipeline_cfg {
     bool profile;                ///< refine bounds from range profiles (sl_profile.h;
                                  ///< default true); false = the mask's bounds and d(r)
     sl_profile_cfg_t profile_cfg; ///< profile parameters (sl_profile_cfg_default)
-    // --- the ground from the shadow's edge (sl_ground.h)
-    bool ground;                 ///< attitude, terrain, DROP/STEP (default
-                                 ///< SL_CFG_GROUND_DEFAULT: host on, firmware off)
+#if SL_CFG_GROUND
+    // --- the ground from the shadow's edge (sl_ground.h; with SL_CFG_GROUND only)
+    bool ground;                 ///< attitude, terrain, DROP/STEP (default true)
     sl_ground_cfg_t ground_cfg;  ///< its parameters (sl_ground_cfg_default; threshold 0:
                                  ///< the pipeline's `threshold`; scale: the radar's value
                                  ///< scale, default the CTS350-X's)
+#endif
 } sl_pipeline_cfg_t;
 
 /// Defaults for `board` (threshold, n from the board; detection and tracker defaults;
@@ -395,8 +396,10 @@ typedef struct sl_pipeline {
     uint8_t reasm[SL_PIPELINE_REASM_BYTES]; ///< decoder reassembly buffer
     sl_drift_t drift;            ///< theta drift watch (sl_drift.h): Health.ThetaDrift, THETA_DRIFT
                                  ///< (last: the hot fields keep their offsets)
+#if SL_CFG_GROUND
     sl_ground_t ground;          ///< the ground from the shadow's edge (sl_ground.h), with
                                  ///< cfg.ground
+#endif
 } sl_pipeline_t;
 
 /// RAM budget of the firmware configuration (CTS350-X: 400 azimuths, n <= 16, masked bins
@@ -410,6 +413,12 @@ static_assert(sizeof(sl_pipeline_t) <= 65536U, "sl_pipeline_t: 64 KiB RAM budget
 _Static_assert(sizeof(sl_pipeline_t) <= 65536U, "sl_pipeline_t: 64 KiB RAM budget");
 #endif
 #endif
+/// The ground's share of the pipeline (its state and configuration), 0 without it.
+#if SL_CFG_GROUND
+#define SL_PIPELINE_GROUND_BYTES (sizeof(sl_ground_t) + sizeof(sl_ground_cfg_t))
+#else
+#define SL_PIPELINE_GROUND_BYTES 0U
+#endif
 /// Any azimuth count, bins and n with the default target/candidate capacities: the mask
 /// dominates; everything else except the tilt history (sl_tiltobs_t, sized by
 /// SL_CFG_TILT_TRACKS x SL_CFG_TILT_OBS_PER_TRACK: 2.5 KB firmware, 7.4 KB host) and the
@@ -420,12 +429,12 @@ _Static_assert(sizeof(sl_pipeline_t) <= 65536U, "sl_pipeline_t: 64 KiB RAM budge
 #if SL_CFG_MAX_TARGETS <= 32 && SL_CFG_DETECT_MAX_CANDIDATES <= 32 && SL_CFG_DETECT_MAX_SPAN <= 24 \
     && SL_CFG_MAX_AZIMUTHS <= 400
 #if defined(__cplusplus)
-static_assert(sizeof(sl_pipeline_t) <= sizeof(sl_mask_t) + sizeof(sl_tiltobs_t) + sizeof(sl_ground_t) +
-                                             sizeof(sl_ground_cfg_t) + 17536U,
+static_assert(sizeof(sl_pipeline_t) <= sizeof(sl_mask_t) + sizeof(sl_tiltobs_t) + SL_PIPELINE_GROUND_BYTES +
+                                             17536U,
               "sl_pipeline_t budget");
 #else
-_Static_assert(sizeof(sl_pipeline_t) <= sizeof(sl_mask_t) + sizeof(sl_tiltobs_t) + sizeof(sl_ground_t) +
-                                             sizeof(sl_ground_cfg_t) + 17536U,
+_Static_assert(sizeof(sl_pipeline_t) <= sizeof(sl_mask_t) + sizeof(sl_tiltobs_t) + SL_PIPELINE_GROUND_BYTES +
+                                             17536U,
                "sl_pipeline_t budget");
 #endif
 #endif
