@@ -46,7 +46,12 @@ void usage(FILE *out)
                  "    forward, true and as reported.\n"
                  "  --rotations N: override the scene's; --json: one JSON object per scene;\n"
                  "  --hazards: every hazard onset (rotation, sector, kind, residual, sigma,\n"
-                 "  distance, true or false).\n");
+                 "  distance, true or false).\n"
+                 "usage: sl-eval terrain --capture FILE [--board NAME] [--speed M/S]\n"
+                 "  A raw capture (e.g. sl-replay from-oxford), board default robotcar-leaf: per\n"
+                 "  rotation the plane (quality, sectors, height, pitch, roll with sigmas) and\n"
+                 "  the confirmed hazards, then each sector's ground point; --speed: a constant\n"
+                 "  motion input (default none).\n");
 }
 
 struct Hazard {
@@ -276,6 +281,69 @@ double mean(double s, int n)
     return n > 0 ? s / n : NAN;
 }
 
+// A capture (a real radar's stream): the plane and the hazards per rotation, no truth.
+int run_capture(const std::string &path, const std::string &board, double speed_mps)
+{
+    const sl_board_t *b = sl_board_find(board.c_str());
+    if (b == nullptr) {
+        throw std::runtime_error("board " + board + " is not linked in");
+    }
+    sl_pipeline_cfg_t cfg;
+    sl_pipeline_cfg_default(&cfg, b);
+    cfg.ground = true;
+    std::unique_ptr<sl_pipeline_t> p(new sl_pipeline_t());
+    if (sl_pipeline_init(p.get(), b, &cfg) != SL_OK) {
+        throw std::runtime_error("sl_pipeline_init failed");
+    }
+    std::FILE *f = std::fopen(path.c_str(), "rb");
+    if (f == nullptr) {
+        throw std::runtime_error("cannot open " + path);
+    }
+    std::vector<uint8_t> buf(65536);
+    uint64_t now = 1000000U;
+    uint32_t done = 0;
+    std::printf("%s (board %s): rotation, quality, sectors, height mm (sigma), pitch deg (sigma), "
+                "roll deg (sigma), hazards\n",
+                path.c_str(), board.c_str());
+    size_t n = 0;
+    while ((n = std::fread(buf.data(), 1, buf.size(), f)) > 0) {
+        if (speed_mps >= 0) {
+            sl_pipeline_set_motion(p.get(), static_cast<int32_t>(std::lround(speed_mps * 1000)), true, 0, true,
+                                   now);
+        }
+        sl_pipeline_feed(p.get(), buf.data(), n, now);
+        now += 10000U;
+        while (done < p->stats.rotations) {
+            const sl_ground_t &g = p->ground;
+            std::printf("  %u: %s %u %d (%u) %.2f (%.2f) %.2f (%.2f)", done,
+                        g.plane.quality == SL_GROUND_GOOD ? "GOOD"
+                                                          : (g.plane.quality == SL_GROUND_COARSE ? "COARSE" : "NONE"),
+                        g.plane.sectors, g.plane.height_mm, g.plane.height_sigma_mm, g.plane.pitch_cdeg * 0.01,
+                        g.plane.pitch_sigma_cdeg * 0.01, g.plane.roll_cdeg * 0.01, g.plane.roll_sigma_cdeg * 0.01);
+            for (uint32_t s = 0; s < SL_CFG_GROUND_SECTORS; s++) {
+                if (g.sec[s].kind != SL_GROUND_FLAT) {
+                    std::printf(" %s@%.1fdeg:%dmm", g.sec[s].kind == SL_GROUND_DROP ? "DROP" : "STEP",
+                                sl_ground_sector_cdeg(&g, s) * 0.01, g.sec[s].resid_mm);
+                }
+            }
+            std::printf("\n");
+            done++;
+        }
+    }
+    std::fclose(f);
+    sl_pipeline_finish(p.get(), now);
+    const sl_ground_stats_t &st = p->ground.stats;
+    std::printf("  edges: %u samples, %u occupied, %u no ground, %u bad, %u short; decay n %.2f\n", st.samples,
+                st.occupied, st.no_ground, st.bad_edge, st.short_rows, p->ground.decay_q8 / 256.0);
+    for (uint32_t s = 0; s < SL_CFG_GROUND_SECTORS; s++) {
+        const sl_ground_sector_t &sec = p->ground.sec[s];
+        std::printf("  sector %2u at %5.1f deg: n %u, ground point x %.2f y %.2f m, residual %d mm\n", s,
+                    sl_ground_sector_cdeg(&p->ground, s) * 0.01, sec.n, sec.x_um * 1e-6, sec.y_um * 1e-6,
+                    sec.resid_mm);
+    }
+    return 0;
+}
+
 } // namespace
 } // namespace sl
 
@@ -286,6 +354,8 @@ int cmd_terrain(int argc, char **argv)
     int rotations = 0, warmup = 16, threads = 0;
     double front = -1;
     bool json = false, dump = false;
+    std::string capture, board = "robotcar-leaf";
+    double speed = -1;
     for (int i = 0; i < argc; i++) {
         const std::string a = argv[i];
         const bool has = i + 1 < argc;
@@ -301,12 +371,21 @@ int cmd_terrain(int argc, char **argv)
             json = true;
         } else if (a == "--hazards") {
             dump = true;
+        } else if (a == "--capture" && has) {
+            capture = argv[++i];
+        } else if (a == "--board" && has) {
+            board = argv[++i];
+        } else if (a == "--speed" && has) {
+            speed = std::atof(argv[++i]);
         } else if (a == "-q" || a == "--quiet") {
         } else if (!a.empty() && a[0] == '-') {
             return sl_cli_unknown("sl-eval terrain", argv[i], usage);
         } else {
             scenes.push_back(a);
         }
+    }
+    if (!capture.empty()) {
+        return run_capture(capture, board, speed);
     }
     if (scenes.empty()) {
         return sl_cli_usage_error("sl-eval terrain", "no scene", usage);
