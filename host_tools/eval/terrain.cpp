@@ -28,7 +28,7 @@ void usage(FILE *out)
 {
     std::fprintf(out,
                  "usage: sl-eval terrain SCENE.ini... [--rotations N] [--warmup N] [--front M]\n"
-                 "                       [--threads N] [--json] [--hazards]\n"
+                 "                       [--threads N] [--json] [--json-out FILE] [--hazards]\n"
                  "  Runs the core pipeline with the ground module on each scene (the scene's\n"
                  "  speed as the motion input) and compares every rotation's plane and hazards\n"
                  "  with the scene's truth ([vehicle] pitch_deg, roll_deg, height_offset_m and\n"
@@ -45,6 +45,8 @@ void usage(FILE *out)
                  "    cylinder's radius, else 0) to the edge at the first DROP within 45 deg of\n"
                  "    forward, true and as reported.\n"
                  "  --rotations N: override the scene's; --json: one JSON object per scene;\n"
+                 "  --json-out FILE: the same objects in one JSON document (schema\n"
+                 "  shadowlean-eval-terrain/1, docs/JSON_OUTPUTS.md);\n"
                  "  --hazards: every hazard onset (rotation, sector, kind, residual, sigma,\n"
                  "  distance, true or false).\n"
                  "usage: sl-eval terrain --capture FILE [--board NAME] [--speed M/S]\n"
@@ -165,13 +167,6 @@ SceneResult run_scene(const std::string &path, int rotations, int warmup, double
             res.p_err_max = std::max(res.p_err_max, std::fabs(ep));
             res.r_err_max = std::max(res.r_err_max, std::fabs(er));
         }
-        if (std::getenv("SL_TERRAIN_DEBUG") != nullptr) {
-            std::printf("r %d h %d p %d n %u |", k, g.plane.height_mm, g.plane.pitch_cdeg, g.plane.sectors);
-            for (uint32_t s : {29U, 30U, 31U, 0U, 1U, 2U, 3U}) {
-                std::printf(" %d/%u/%u%s", g.sec[s].resid_mm, g.sec[s].sigma_mm, g.sec[s].n, g.sec[s].in_fit ? "" : "x");
-            }
-            std::printf("\n");
-        }
         for (uint32_t s = 0; s < SL_CFG_GROUND_SECTORS; s++) {
             const sl_ground_sector_t &sec = g.sec[s];
             const int kind = sec.kind;
@@ -202,9 +197,6 @@ SceneResult run_scene(const std::string &path, int rotations, int warmup, double
                                 "distance %.2f m: %s\n",
                                 k, s, cd, kind == SL_GROUND_DROP ? "DROP" : "STEP", sec.resid_mm, sec.sigma_mm,
                                 sec.dist_um * 1e-6, ok ? "true" : "false");
-                    if (std::getenv("SL_TERRAIN_DEBUG") != nullptr) {
-                        std::printf("    hx %.2f since %u\n", sec.hx_um * 1e-6, sec.since_mm);
-                    }
                 }
                 // the first DROP ahead
                 const double off = std::fabs(std::remainder(cd, 360.0));
@@ -354,6 +346,7 @@ int cmd_terrain(int argc, char **argv)
     int rotations = 0, warmup = 16, threads = 0;
     double front = -1;
     bool json = false, dump = false;
+    std::string json_out;
     std::string capture, board = "robotcar-leaf";
     double speed = -1;
     for (int i = 0; i < argc; i++) {
@@ -369,6 +362,8 @@ int cmd_terrain(int argc, char **argv)
             threads = std::atoi(argv[++i]);
         } else if (a == "--json") {
             json = true;
+        } else if (a == "--json-out" && has) {
+            json_out = argv[++i];
         } else if (a == "--hazards") {
             dump = true;
         } else if (a == "--capture" && has) {
@@ -390,23 +385,31 @@ int cmd_terrain(int argc, char **argv)
     if (scenes.empty()) {
         return sl_cli_usage_error("sl-eval terrain", "no scene", usage);
     }
+    std::vector<std::string> objs;
     for (const auto &path : scenes) {
         const SceneResult r = run_scene(path, rotations, warmup, front, threads, dump);
         const double fph = r.hours > 0 ? r.false_onsets / r.hours : NAN;
-        if (json) {
-            std::printf("{\"scene\": \"%s\", \"rotations\": %d, \"scored\": %d, \"good\": %d, "
+        {
+            char line[2048];
+            std::snprintf(line, sizeof line, "{\"scene\": \"%s\", \"rotations\": %d, \"scored\": %d, \"good\": %d, "
                         "\"height_err_mean_mm\": %s, \"height_err_max_mm\": %s, "
                         "\"pitch_err_mean_deg\": %s, \"pitch_err_max_deg\": %s, "
                         "\"roll_err_mean_deg\": %s, \"roll_err_max_deg\": %s, "
                         "\"true_hazard_onsets\": %d, \"false_hazard_onsets\": %d, \"false_per_hour\": %s, "
                         "\"terrain_pieces\": %d, \"terrain_pieces_found\": %d, "
                         "\"drop_warned\": %s, \"drop_true_m\": %s, \"drop_reported_m\": %s}\n",
-                        r.name.c_str(), r.rotations, r.scored, r.good, num(1e3 * mean(r.h_err_sum, r.scored), 1).c_str(),
+                        r.name.substr(r.name.find_last_of('/') + 1).c_str(), r.rotations, r.scored, r.good, num(1e3 * mean(r.h_err_sum, r.scored), 1).c_str(),
                         num(1e3 * r.h_err_max, 1).c_str(), num(mean(r.p_err_sum, r.scored), 3).c_str(),
                         num(r.p_err_max, 3).c_str(), num(mean(r.r_err_sum, r.scored), 3).c_str(),
                         num(r.r_err_max, 3).c_str(), r.true_onsets, r.false_onsets, num(fph, 2).c_str(), r.pieces,
                         r.pieces_found, r.drop_warned ? "true" : "false", num(r.drop_true_m, 2).c_str(),
                         num(r.drop_reported_m, 2).c_str());
+            objs.push_back(line);
+            if (json) {
+                std::printf("%s", line);
+            }
+        }
+        if (json) {
             continue;
         }
         std::printf("%s: %d rotations, plane in %d, scored %d (GOOD %d)\n", r.name.c_str(), r.rotations,
@@ -428,6 +431,25 @@ int cmd_terrain(int argc, char **argv)
         }
         std::printf("  edges: %u samples, %u occupied, %u no ground, %u bad, %u short\n", r.samples, r.occupied,
                     r.no_ground, r.bad_edge, r.short_rows);
+    }
+    if (!json_out.empty()) {
+        std::FILE *o = std::fopen(json_out.c_str(), "w");
+        if (o == nullptr) {
+            std::fprintf(stderr, "sl-eval terrain: cannot write %s\n", json_out.c_str());
+            return 1;
+        }
+        std::fprintf(o, "{\"schema\": \"shadowlean-eval-terrain/1\", \"experiment\": \"terrain\", \"scenes\": [\n");
+        for (size_t i = 0; i < objs.size(); i++) {
+            std::string l = objs[i];
+            while (!l.empty() && l.back() == '\n') {
+                l.pop_back();
+            }
+            std::fprintf(o, "  %s%s\n", l.c_str(), i + 1 < objs.size() ? "," : "");
+        }
+        std::fprintf(o, "]}\n");
+        if (std::fclose(o) != 0) {
+            return 1;
+        }
     }
     return 0;
 }

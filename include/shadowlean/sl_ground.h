@@ -126,10 +126,11 @@
 /// (64-bit sums, no division in the row path but one per sample); bit-identical on every
 /// target. sl_ground_row: the coarse walk (a few bins), the occupied test (word-wise on
 /// the pipeline's thresholded row), 2 margin + plateau + floor table reads (twice at
-/// most), three 64-bit divisions, one sine/cosine; the pipeline calls it for
-/// SL_CFG_GROUND_SECTORS rows per rotation (measured: docs/PERFORMANCE.md). sl_ground_end_rotation:
-/// O(sectors) twice, one 2 x 2 solve, O(64) division steps. RAM: sizeof(sl_ground_t)
-/// (about 0.8 KB with 32 sectors). Stack: no arrays, a few 64-bit locals.
+/// most), a few 64-bit divisions, one sine/cosine, two base-2 logarithms; the pipeline
+/// calls it for SL_CFG_GROUND_SECTORS x `reads` rows per rotation. sl_ground_end_rotation:
+/// O(sectors) passes (the gate, up to three fits, the residuals), 2 x 2 solves, O(64)
+/// division steps per variance. RAM: sizeof(sl_ground_t), 2,000 B with 32 sectors (52 B
+/// each). Stack: sl_ground_end_rotation holds three per-sector arrays (10 B per sector).
 /// Compiled in with SL_CFG_GROUND (sl_config.h: the host configuration); without it the
 /// types remain and the functions are not defined.
 /// Limits: a plane is only fitted where the ground returns above the threshold at the

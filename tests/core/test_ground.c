@@ -312,7 +312,6 @@ static void test_drop_ahead_moving(void **state)
     (void)state;
     sl_ground_t g;
     init(&g);
-    const sl_board_t *b = board();
     const double edge_x = 9.0; // world x of the drop-off; the radar starts at 0
     uint64_t rs = 7U;
     double first_dist = -1, first_true = -1;
@@ -322,25 +321,16 @@ static void test_drop_ahead_moving(void **state)
                      .seed = 1, .pole_az = -1};
         sl_ground_set_motion(&g, true, 1000, 250000U);
         rotation(&g, &t, &rs);
-        if (getenv("GROUND_DEBUG") != NULL) {
-            print_message("r %d xr %.2f h %d p %d fit %u s0 n %u resid %d sigma %u kind %u votes %d stats s %u ng %u bad %u sh %u occ %u\n", r, xr, g.plane.height_mm, g.plane.pitch_cdeg, g.plane.sectors,
-                          g.sec[0].n, g.sec[0].resid_mm, g.sec[0].sigma_mm, g.sec[0].kind, g.sec[0].votes * 1000000 + g.sec[0].dist_um / 1000,
-                          g.stats.samples, g.stats.no_ground, g.stats.bad_edge, g.stats.short_rows, g.stats.occupied);
-        }
         if (first_dist < 0) {
             for (unsigned k = 0; k < SL_CFG_GROUND_SECTORS; k++) {
                 const int32_t cd = sl_ground_sector_cdeg(&g, k);
                 if (g.sec[k].kind == SL_GROUND_DROP && (cd < 3000 || cd > 33000)) {
                     first_dist = g.sec[k].hx_um * 1e-6;
-                    if (getenv("GROUND_DEBUG") != NULL) {
-                        print_message("sector %u cd %d dist %d\n", k, cd, g.sec[k].dist_um);
-                    }
                     first_true = edge_x - xr;
                 }
             }
         }
     }
-    (void)b;
     print_message("drop ahead: first warning at %.2f m (true %.2f m)\n", first_dist, first_true);
     assert_true(first_true > 2.5);
     assert_true(first_dist - first_true < 0.225);
