@@ -122,8 +122,8 @@
 ///   distance to the front (x - front_um).
 ///
 /// ## Units, numbers, cost, RAM
-/// Heights, ranges: mm (int32); edges: bins Q8; slopes Q16; angles 0.01 deg. Integer only
-/// (64-bit sums, no division in the row path but one per sample); bit-identical on every
+/// Heights, ranges: mm (int32) and um in the sector state; edges: bins Q8; slopes Q16;
+/// angles 0.01 deg. Integer only (64-bit sums and divisions); bit-identical on every
 /// target. sl_ground_row: the coarse walk (a few bins), the occupied test (word-wise on
 /// the pipeline's thresholded row), 2 margin + plateau + floor table reads (twice at
 /// most), a few 64-bit divisions, one sine/cosine, two base-2 logarithms; the pipeline
@@ -133,6 +133,8 @@
 /// each). Stack: sl_ground_end_rotation holds three per-sector arrays (10 B per sector).
 /// Compiled in with SL_CFG_GROUND (sl_config.h: the host configuration); without it the
 /// types remain and the functions are not defined.
+/// Errors: bad rows are counted in `stats` (no ground, occupied, bad edge, short) and cost
+/// the sector that rotation's sample; a rotation without a plane sends quality NONE.
 /// Limits: a plane is only fitted where the ground returns above the threshold at the
 /// shadow's edge on three quadrants; frozen speckle (a parked vehicle, a static scene)
 /// leaves each sector a fixed error that only the other azimuths of the sector average;
