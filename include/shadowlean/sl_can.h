@@ -122,7 +122,8 @@
 /// | 32 | 8  | Reconnects        | u | 0..255   | radar link re-opened since start (saturating) |
 /// | 40 | 12 | CandidatesDropped | u | 0..4095  | detection candidates dropped for lack of target slots (saturating) |
 /// | 52 | 8  | ThetaDrift        | s | -12.8..12.7 deg, 0.1 deg | live theta minus the loaded calibration's (sl_drift.h); 0 while there is no estimate; saturating |
-/// | 60 | 4  | (reserved)        |   | 0        | |
+/// | 60 | 2  | ResponseSource    | u | 0..2     | the range response in use (sl_response.h): PRIOR (the board's), LEARNED (from this stream), CALIBRATED (the vehicle's calibration) |
+/// | 62 | 2  | (reserved)        |   | 0        | |
 ///
 /// Fault bits (the DBC carries a value table naming each bit's value): a bit is set in a
 /// Health frame when its condition held at any time since the previous Health frame, or
@@ -416,6 +417,7 @@ typedef enum sl_can_link_state {
 #define SL_CAN_HEALTH_DRIFT_CDEG_PER_LSB 10   ///< 0.1 deg
 #define SL_CAN_HEALTH_DRIFT_RAW_MIN (-128)
 #define SL_CAN_HEALTH_DRIFT_RAW_MAX 127
+#define SL_CAN_RESPONSE_SOURCE_MAX 2U ///< Health.ResponseSource: sl_response_source_t
 
 #define SL_CAN_MOTION_SPEED_MM_S_PER_LSB 10  ///< 0.01 m/s
 #define SL_CAN_MOTION_YAW_CDEG_S_PER_LSB 1   ///< 0.01 deg/s
@@ -487,6 +489,8 @@ typedef struct sl_can_health {
     uint32_t reconnects;         ///< in: radar link reconnects since start (saturates at 255)
     uint32_t candidates_dropped; ///< in: candidates dropped for lack of target slots (4095)
     int16_t theta_drift_cdeg;    ///< in: ThetaDrift, 0.01 deg (sent in 0.1 deg, saturating)
+    uint8_t response_source;     ///< in: ResponseSource, sl_response_source_t (0..2; more
+                                 ///< is sent as 2, counted in stats.clamped_frames)
     uint8_t counter;             ///< decode only
 } sl_can_health_t;
 
