@@ -498,7 +498,7 @@ static void update_thresholds(sl_pipeline_t *p)
 
 // The row the sensor model reads: one azimuth per rotation, moving by 247 of 400 azimuths
 // (the golden section of the turn) each rotation, so successive rows spread over the turn
-// and every azimuth is read in turn. The floor is read inside the shadow (beyond the
+// and every azimuth is read in turn, or to the next azimuth after a row that gave a peak. The floor is read inside the shadow (beyond the
 // near-field band): there only the receiver's noise and sparse targets are. The shape is
 // read from isolated peaks beyond the shadow, over the message's own 8-bit bins (past the
 // masked ones where the radar sends them), over LEARN_PEAK_BINS beyond the shadow's edge
@@ -519,7 +519,7 @@ static SL_NOINLINE void learn_row(sl_pipeline_t *p, const sl_scan_row_t *row)
         const uint32_t reach = edge + 1U + LEARN_PEAK_BINS;
         const uint32_t n = f->bins < reach ? f->bins : reach;
         if (edge + 1U < n) {
-            (void)sl_response_learn_peaks(&p->resp, f->bin_data, n, edge + 1U, n);
+            p->learn_hit = sl_response_learn_peaks(&p->resp, f->bin_data, n, edge + 1U, n) > 0;
         }
     }
 }
@@ -537,8 +537,12 @@ static void model_end_rotation(sl_pipeline_t *p)
         (void)sl_response_update(&p->resp);
     }
     update_thresholds(p);
+    // A row that gave a peak is followed by its neighbour (the beam holds a point return
+    // over a few azimuths); otherwise the next row is 247 of 400 azimuths on.
     const uint32_t naz = p->det_board.azimuths;
-    p->learn_az = (uint16_t)(((uint32_t)p->learn_az + (naz * 618U + 500U) / 1000U) % naz);
+    const uint32_t step = p->learn_hit ? 1U : (naz * 618U + 500U) / 1000U;
+    p->learn_az = (uint16_t)(((uint32_t)p->learn_az + step) % naz);
+    p->learn_hit = false;
 }
 
 // Thresholds one row into p->bits band by band (on_row calls sl_thresh_u8 itself while every

@@ -263,8 +263,9 @@ typedef struct sl_pipeline_cfg {
                                  ///< CTS350-X's)
     bool learn;                  ///< the model reads one row per rotation (default true; the
                                  ///< azimuth moves by 247 of 400 each rotation, so successive
-                                 ///< rows spread over the turn); false: the board's prior and
-                                 ///< no floor, detection at `threshold`
+                                 ///< rows spread over the turn, or by one after a row that
+                                 ///< gave a peak); false: the board's prior and no floor,
+                                 ///< detection at `threshold`
     uint16_t floor_margin_lp;    ///< occupied also needs the learned noise floor's mean plus
                                  ///< this, log2 power Q8 (default 851: 10 dB, an exponential
                                  ///< noise sample exceeds it with probability e^-10)
@@ -352,6 +353,7 @@ typedef struct sl_pipeline {
     uint16_t next_az;            ///< internal: next azimuth detection expects
     uint16_t learn_az;           ///< internal: the azimuth the sensor model reads this rotation
     bool thr_flat;               ///< every band's threshold is cfg.threshold (thr_band)
+    bool learn_hit;              ///< internal: this rotation's learning row gave a peak
     uint32_t r_max_um;           ///< farthest range detection reads (for the yaw term)
     uint32_t rotation_us;        ///< last measured rotation period
     bool motion_valid;           ///< motion used for the current rotation
