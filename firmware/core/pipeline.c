@@ -1034,8 +1034,13 @@ sl_err_t sl_pipeline_init(sl_pipeline_t *p, const sl_board_t *board,
     }
     sl_drift_init(&p->drift, board);
     if (e == SL_OK) {
-        // The board's prior, NULL: the CTS350-X lobe (sl_board.h).
+        // The board's prior, NULL: the CTS350-X lobe (sl_board.h); a calibration's response
+        // (sl_calblob.h) is the one in use from the start, as CALIBRATED.
         e = sl_response_init(&p->resp, &c->value_scale, board->response_prior_q8, NULL);
+        if (e == SL_OK && board->response_calibrated != 0U && board->response_prior_q8 != NULL) {
+            e = sl_response_set(&p->resp, board->response_prior_q8,
+                                (uint8_t)SL_RESPONSE_CALIBRATED);
+        }
         p->learn_az = 0U;
         update_thresholds(p);
     }

@@ -231,6 +231,11 @@ static bool plausible(const uint16_t *d, int32_t lim)
     return true;
 }
 
+bool sl_response_plausible(const uint16_t drop_q8[SL_RESP_TAPS], int32_t down_to_lp)
+{
+    return drop_q8 != NULL && plausible(drop_q8, down_to_lp);
+}
+
 static void derive(sl_response_t *r)
 {
     uint64_t s1 = 0, s2 = 0;

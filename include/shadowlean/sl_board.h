@@ -88,6 +88,8 @@ typedef struct sl_board {
     /// `response.prior` = cts350x (the lobe measured on the CTS350-X) or ideal (one bin).
     /// NULL: the built-in CTS350-X lobe.
     const uint16_t *response_prior_q8;
+    uint8_t response_calibrated;   ///< 1: response_prior_q8 is the vehicle's calibration's
+                                   ///< (sl_calblob.h), used as SL_RESPONSE_CALIBRATED
     const sl_incline_geom_t *geom; ///< trig + branch bounds per azimuth
     const int16_t *theta_cdeg;     ///< opening angle theta per azimuth, 0.01 deg
     const uint32_t *shadow_um;     ///< ground shadow radius R = H / tan(theta) per azimuth

@@ -177,6 +177,11 @@ void sl_response_prior_cts350x(uint16_t drop_q8[SL_RESP_TAPS]);
 sl_err_t sl_response_init(sl_response_t *r, const sl_vscale_t *scale,
                           const uint16_t *prior_q8, const sl_response_cfg_t *cfg);
 
+/// True when `drop_q8` is a plausible response: 0 at the centre, non-decreasing away from it
+/// on each side down to a drop of `down_to_lp` (log2 Q8), below half power within
+/// SL_CFG_RESP_HALF bins on each side (the gates of a learned shape). O(taps).
+bool sl_response_plausible(const uint16_t drop_q8[SL_RESP_TAPS], int32_t down_to_lp);
+
 /// Use `drop_q8` (a calibration's, SL_RESPONSE_CALIBRATED) instead of the prior / learned
 /// shape. SL_ERR_ARG when it fails the plausibility gates. O(taps x SUB).
 sl_err_t sl_response_set(sl_response_t *r, const uint16_t drop_q8[SL_RESP_TAPS], uint8_t source);
