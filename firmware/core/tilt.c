@@ -311,14 +311,14 @@ typedef struct alt_search {
     int32_t ty_q24;
     int64_t distinct_q24;  // |t - t_best| above this is a different answer
     int64_t alt_r_q54;     // best score among different answers in the window
+    size_t alt_start;      // ... its interval
+    size_t alt_len;
     bool found;
 } alt_search_t;
 
 static void visit_alt(const fit_ctx_t *f, void *ctx, size_t start, size_t len, int64_t u,
                       int64_t v, int64_t s)
 {
-    (void)start;
-    (void)len;
     alt_search_t *a = (alt_search_t *)ctx;
     const int64_t r = score(f, u, v, s);
     if (r - a->best_r_q54 > a->window_q54 || (a->found && r >= a->alt_r_q54)) {
@@ -331,6 +331,8 @@ static void visit_alt(const fit_ctx_t *f, void *ctx, size_t start, size_t len, i
     const int64_t dy = (int64_t)ty - a->ty_q24;
     if (dx * dx + dy * dy > a->distinct_q24 * a->distinct_q24) {
         a->alt_r_q54 = r;
+        a->alt_start = start;
+        a->alt_len = len;
         a->found = true;
     }
 }
@@ -432,19 +434,14 @@ static int64_t bias_bound_q30(const fit_ctx_t *f, sl_q30_t p1, sl_q30_t p2)
     return div_round(mean_q30 * P2_30, f->det_q30);
 }
 
-static void report(const fit_ctx_t *f, const sl_tilt_params_t *prm, uint64_t choice, int32_t tx32,
-                   int32_t ty32, uint32_t chi2_q8, sl_tilt_result_t *out)
+// One reading: tilt, direction, their sigmas and the base of the tilt vector (tx32, ty32)
+// whose chi-square is chi2_q8.
+static void reading_of(const fit_ctx_t *f, const sl_tilt_params_t *prm, int32_t tx32,
+                       int32_t ty32, uint32_t chi2_q8, sl_tilt_reading_t *out)
 {
     SL_ASSERT(f->n >= SL_TILT_MIN_OBS); // sl_tilt_fit's gate: dof = n - 2 > 0, mean over n
     out->tx_q24 = tx32;
     out->ty_q24 = ty32;
-    out->chi2_q8 = chi2_q8;
-    unsigned mirrored = 0U;
-    for (size_t k = 0; k < f->n; ++k) {
-        mirrored += (unsigned)((choice >> k) & 1U);
-    }
-    out->n_mirrored = (uint8_t)mirrored;
-    out->mirrored_mask = (uint32_t)choice;
 
     // Tilt and direction.
     const int64_t tx = tx32;
@@ -535,6 +532,40 @@ static void report(const fit_ctx_t *f, const sl_tilt_params_t *prm, uint64_t cho
     const int64_t h = (int64_t)prm->radar_height_um;
     out->base_x_um = sl_fx_sat32(div_round(sx, n) - sl_fx_rshift_round64(h * tx, 24U));
     out->base_y_um = sl_fx_sat32(div_round(sy, n) - sl_fx_rshift_round64(h * ty, 24U));
+}
+
+static void report(const fit_ctx_t *f, const sl_tilt_params_t *prm, uint64_t choice, int32_t tx32,
+                   int32_t ty32, uint32_t chi2_q8, sl_tilt_result_t *out)
+{
+    out->chi2_q8 = chi2_q8;
+    unsigned mirrored = 0U;
+    for (size_t k = 0; k < f->n; ++k) {
+        mirrored += (unsigned)((choice >> k) & 1U);
+    }
+    out->n_mirrored = (uint8_t)mirrored;
+    out->mirrored_mask = (uint32_t)choice;
+    sl_tilt_reading_t rd;
+    reading_of(f, prm, tx32, ty32, chi2_q8, &rd);
+    out->tx_q24 = rd.tx_q24;
+    out->ty_q24 = rd.ty_q24;
+    out->psi_cdeg = rd.psi_cdeg;
+    out->phi_cdeg = rd.phi_cdeg;
+    out->psi_sigma_cdeg = rd.psi_sigma_cdeg;
+    out->phi_sigma_cdeg = rd.phi_sigma_cdeg;
+    out->base_x_um = rd.base_x_um;
+    out->base_y_um = rd.base_y_um;
+}
+
+// The fold reading of candidate interval (start, len) in bearing order: bit k set =
+// measurement k read as its mirror.
+static uint64_t interval_choice(const fit_ctx_t *f, size_t start, size_t len)
+{
+    uint64_t ch = 0U;
+    for (size_t j = 0; j < len; ++j) {
+        const size_t idx = start + j;
+        ch |= (uint64_t)1U << f->wk->order[(idx >= f->m) ? idx - f->m : idx];
+    }
+    return ch;
 }
 
 // Bearing of a measurement relative to `ref` (signed bam32).
@@ -650,11 +681,7 @@ sl_err_t sl_tilt_fit(const sl_tilt_obs_t *obs, size_t n, const sl_tilt_params_t 
     uint32_t chi2 = UINT32_MAX;
     int64_t best_r = INT64_MAX;
     for (size_t c = 0; c < top.n; ++c) {
-        uint64_t ch = 0U;
-        for (size_t j = 0; j < top.c[c].len; ++j) {
-            const size_t idx = top.c[c].start + j;
-            ch |= (uint64_t)1U << work->order[(idx >= m) ? idx - m : idx];
-        }
+        const uint64_t ch = interval_choice(&f, top.c[c].start, top.c[c].len);
         int32_t cx;
         int32_t cy;
         solve_exact(&f, ch, &cx, &cy);
@@ -716,7 +743,14 @@ sl_err_t sl_tilt_fit(const sl_tilt_obs_t *obs, size_t n, const sl_tilt_params_t 
         // estimate would call every reading ambiguous, and that is not what is wrong.
         out->quality = (uint8_t)SL_TILT_INCONSISTENT;
     } else if (ambiguous) {
+        // Both readings: the other one solved exactly from the measurements, as the best.
         out->quality = (uint8_t)SL_TILT_AMBIGUOUS;
+        const uint64_t ch = interval_choice(&f, alt.alt_start, alt.alt_len);
+        int32_t cx;
+        int32_t cy;
+        solve_exact(&f, ch, &cx, &cy);
+        reading_of(&f, prm, cx, cy, chi2_direct_q8(&f, ch, cx, cy), &out->mirror);
+        out->mirror_mask = (uint32_t)ch;
     } else {
         out->quality = (uint8_t)SL_TILT_FITTED;
     }

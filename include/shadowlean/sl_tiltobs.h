@@ -239,11 +239,17 @@ void sl_tiltobs_fit_pending(sl_tiltobs_t *o);
 /// The ring of track `id`, or NULL. O(rings).
 const sl_tiltobs_ring_t *sl_tiltobs_find(const sl_tiltobs_t *o, uint16_t id);
 
-/// Result of `r` in the vehicle frame at the current pose. False (and `out` zeroed) when
-/// `r` has no fit yet. Quality other than FITTED/AMBIGUOUS: only `quality` is meaningful.
-/// O(1).
+/// Result of `r` in the vehicle frame at the current pose (for an AMBIGUOUS fit: its best
+/// reading). False (and `out` zeroed) when `r` has no fit yet. Quality other than
+/// FITTED/AMBIGUOUS: only `quality` is meaningful. O(1).
 bool sl_tiltobs_vehicle(const sl_tiltobs_t *o, const sl_tiltobs_ring_t *r,
                         sl_tiltobs_vehicle_t *out);
+
+/// The other reading of an AMBIGUOUS fit of `r` (sl_tilt_result_t.mirror) in the vehicle
+/// frame at the current pose, as sl_tiltobs_vehicle(). False (`out` zeroed but for
+/// `quality`) when `r` has no fit or its fit is not AMBIGUOUS. O(1).
+bool sl_tiltobs_vehicle_mirror(const sl_tiltobs_t *o, const sl_tiltobs_ring_t *r,
+                               sl_tiltobs_vehicle_t *out);
 
 #ifdef __cplusplus
 }

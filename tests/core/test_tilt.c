@@ -484,7 +484,7 @@ static void test_never_a_confident_wrong_direction(void **state)
     // Short and long passes, random poles, 0.5 deg noise: FITTED implies the direction is
     // within 30 deg (psi >= 5); otherwise the fit must say AMBIGUOUS or INSUFFICIENT_MOTION.
     rng = 12345;
-    unsigned fitted = 0, ambiguous = 0, other = 0;
+    unsigned fitted = 0, ambiguous = 0, other = 0, among = 0;
     for (int i = 0; i < 300; ++i) {
         scene_t sc = base_scene();
         sc.psi = 5.0 + 15.0 * urand();
@@ -519,12 +519,24 @@ static void test_never_a_confident_wrong_direction(void **state)
             assert_true(ephi <= 30.0);
         } else if (r.quality == SL_TILT_AMBIGUOUS) {
             ++ambiguous;
+            // Both readings: the other one is the double-precision solution of its reading
+            // of the fold, differs from the best, and the truth is one of the two.
+            double mtx, mty, mdet;
+            dsolve(&s, r.mirror_mask, &mtx, &mty, &mdet);
+            assert_true(fabs(r.mirror.tx_q24 / 16777216.0 - mtx) <= 2e-5);
+            assert_true(fabs(r.mirror.ty_q24 / 16777216.0 - mty) <= 2e-5);
+            assert_true(r.mirror.tx_q24 != r.tx_q24 || r.mirror.ty_q24 != r.ty_q24);
+            const double e0 = fabs(wrap180(r.phi_cdeg / 100.0 - sc.phi));
+            const double e1 = fabs(wrap180(r.mirror.phi_cdeg / 100.0 - sc.phi));
+            among += (e0 <= 30.0 || e1 <= 30.0) ? 1U : 0U;
         } else {
             ++other;
         }
     }
-    printf("fitted %u, ambiguous %u, too few / insufficient motion %u\n", fitted, ambiguous, other);
+    printf("fitted %u, ambiguous %u (the truth's direction within 30 deg of one of the two "
+           "readings: %u), too few / insufficient motion %u\n", fitted, ambiguous, among, other);
     assert_true(fitted >= 150);
+    assert_true(among * 10U >= ambiguous * 9U);
 }
 
 // ---------------------------------------------------------------------------------------
@@ -608,11 +620,19 @@ static void test_issue12_recorded_mirror_passes_are_not_fitted(void **state)
                "(n %u)\n", p->phi, p->offset, r.quality, r.psi_cdeg / 100.0, r.phi_cdeg / 100.0,
                r.chi2_q8 / 256.0, r.chi2_other_q8 / 256.0, r.n_obs);
         // The data cannot tell the readings apart: the best (the mirror, psi 7-8) is reported
-        // with AMBIGUOUS, never as FITTED.
+        // with AMBIGUOUS, never as FITTED, and the truth is its other reading.
         if (r.quality == SL_TILT_FITTED) {
             assert_true(fabs(epsi) <= 1.0 && fabs(ephi) <= 10.0);
         }
         assert_int_equal(r.quality, SL_TILT_AMBIGUOUS);
+        const sl_tilt_reading_t *m = &r.mirror;
+        printf("  other reading: psi %.2f +- %.2f phi %.2f +- %.2f mask %08x\n", m->psi_cdeg / 100.0,
+               m->psi_sigma_cdeg / 100.0, m->phi_cdeg / 100.0, m->phi_sigma_cdeg / 100.0,
+               r.mirror_mask);
+        assert_true(fabs(m->psi_cdeg / 100.0 - 20.0) <= 1.0);
+        assert_true(fabs(wrap180(m->phi_cdeg / 100.0 - p->phi)) <= 10.0);
+        assert_true(r.mirror_mask != r.mirrored_mask);
+        assert_true(m->psi_sigma_cdeg > 0U && m->phi_sigma_cdeg > 0U);
     }
 }
 
