@@ -297,7 +297,8 @@ static void emit_status(sl_pipeline_t *p)
 
 // What LeanWarning says about a track (sl_pipeline.h, "LeanWarning and the fitted tilt"):
 // the tracker's level, filtered in-plane alpha and sigma, or, when the track's drive-by fit
-// is FITTED, the tilt towards the vehicle's path, its sigma and the level of that lean.
+// is FITTED, the tilt towards the vehicle's path, its sigma and the level of that lean; when
+// it is AMBIGUOUS, the same of the more dangerous of its two readings.
 typedef struct warn_view {
     uint8_t level;
     bool valid;        // a lean number
@@ -329,37 +330,52 @@ static SL_NOINLINE void warn_view(const sl_pipeline_t *p, const sl_track_t *t, w
     if (!p->tilt.moving) {
         return;
     }
+    const sl_tiltobs_ring_t *r = sl_tiltobs_find(&p->tilt, t->id);
     sl_tiltobs_vehicle_t tv;
-    if (sl_tiltobs_vehicle(&p->tilt, sl_tiltobs_find(&p->tilt, t->id), &tv) &&
-        tv.quality == (uint8_t)SL_TILT_FITTED) {
-        v->valid = true;
-        v->fitted = true;
-        v->lean_cdeg = tv.lean_path_cdeg;
-        v->sigma_cdeg = tv.lean_path_sigma_cdeg;
-        v->level = lean_level(p, tv.lean_path_cdeg);
+    if (!sl_tiltobs_vehicle(&p->tilt, r, &tv) ||
+        (tv.quality != (uint8_t)SL_TILT_FITTED && tv.quality != (uint8_t)SL_TILT_AMBIGUOUS)) {
+        return;
+    }
+    v->valid = true;
+    v->fitted = true;
+    v->lean_cdeg = tv.lean_path_cdeg;
+    v->sigma_cdeg = tv.lean_path_sigma_cdeg;
+    v->level = lean_level(p, tv.lean_path_cdeg);
+    if (sl_tiltobs_vehicle_mirror(&p->tilt, r, &tv)) { // AMBIGUOUS: the other reading
+        const uint8_t lv = lean_level(p, tv.lean_path_cdeg);
+        if (lv > v->level || (lv == v->level && tv.lean_path_cdeg > v->lean_cdeg)) {
+            v->lean_cdeg = tv.lean_path_cdeg;
+            v->sigma_cdeg = tv.lean_path_sigma_cdeg;
+            v->level = lv;
+        }
     }
 }
 
-// PoleTilt of track `t` when it has an observation history with a fit.
+// PoleTilt of track `t` when it has an observation history with a fit; an AMBIGUOUS fit's
+// frame is followed by its other reading's (Quality MIRROR, sl_can.h).
 static SL_NOINLINE void emit_tilt(sl_pipeline_t *p, const sl_track_t *t)
 {
-    sl_tiltobs_vehicle_t tv;
-    if (!p->tilt.moving || !sl_tiltobs_vehicle(&p->tilt, sl_tiltobs_find(&p->tilt, t->id), &tv)) {
-        return;
-    }
-    const sl_can_pole_tilt_t pt = {
-        .target_id = (uint8_t)(t->id & 15U),
-        .quality = tv.quality,
-        .tilt_cdeg = tv.psi_cdeg,
-        .direction_cdeg = tv.phi_cdeg,
-        .tilt_sigma_cdeg = tv.psi_sigma_cdeg,
-        .direction_sigma_cdeg = tv.phi_sigma_cdeg,
-        .base_x_um = tv.base_x_um,
-        .base_y_um = tv.base_y_um,
-    };
-    sl_can_frame_t f;
-    if (sl_can_encode_pole_tilt(&p->can, &pt, &f) == SL_OK) {
-        can_send(p, &f);
+    const sl_tiltobs_ring_t *r = sl_tiltobs_find(&p->tilt, t->id);
+    for (uint32_t k = 0U; k < 2U && p->tilt.moving; k++) {
+        sl_tiltobs_vehicle_t tv;
+        if (!(k == 0U ? sl_tiltobs_vehicle(&p->tilt, r, &tv)
+                      : sl_tiltobs_vehicle_mirror(&p->tilt, r, &tv))) {
+            return;
+        }
+        const sl_can_pole_tilt_t pt = {
+            .target_id = (uint8_t)(t->id & 15U),
+            .quality = k == 0U ? tv.quality : (uint8_t)SL_CAN_TILT_MIRROR,
+            .tilt_cdeg = tv.psi_cdeg,
+            .direction_cdeg = tv.phi_cdeg,
+            .tilt_sigma_cdeg = tv.psi_sigma_cdeg,
+            .direction_sigma_cdeg = tv.phi_sigma_cdeg,
+            .base_x_um = tv.base_x_um,
+            .base_y_um = tv.base_y_um,
+        };
+        sl_can_frame_t f;
+        if (sl_can_encode_pole_tilt(&p->can, &pt, &f) == SL_OK) {
+            can_send(p, &f);
+        }
     }
 }
 
