@@ -203,6 +203,15 @@ static uint16_t obs_sigma(const sl_tilt_obs_t *o)
     return (o->sigma_q16 < SL_TILT_SIGMA_MIN_Q16) ? (uint16_t)SL_TILT_SIGMA_MIN_Q16 : o->sigma_q16;
 }
 
+// Relative weight of measurement k, (sigma_min / sigma_k)^2, Q16 (1 .. 2^16): recomputed
+// where it is needed (one 32-bit division) rather than kept in the scratch memory.
+static int64_t weight_q16(const fit_ctx_t *f, size_t k)
+{
+    const uint32_t r_q16 = ((uint32_t)f->sigma_min_q16 << 16) / obs_sigma(&f->obs[k]); // <= 1.0
+    const uint32_t w = (uint32_t)(((uint64_t)r_q16 * r_q16) >> 16);
+    return (w == 0U) ? 1 : (int64_t)w;
+}
+
 // Predicted tan(alpha) = -(t . e), Q12.
 static int32_t predict_q12(const sl_tilt_obs_t *o, int32_t tx_q24, int32_t ty_q24)
 {
@@ -296,7 +305,7 @@ static void solve_exact(const fit_ctx_t *f, uint64_t choice, int32_t *tx, int32_
     int64_t V = 0;
     for (size_t k = 0; k < f->n; ++k) {
         const sl_tilt_obs_t *o = &f->obs[k];
-        const int64_t w = (int64_t)f->wk->w_q16[k];
+        const int64_t w = weight_q16(f, k);
         const int64_t t = ((choice >> k) & 1U) != 0U ? o->tan_mirror_q12 : o->tan_q12;
         U += w * o->cos_a_q15 * t;
         V += w * o->sin_a_q15 * t;
@@ -425,7 +434,7 @@ static int64_t bias_bound_q30(const fit_ctx_t *f, sl_q30_t p1, sl_q30_t p2)
         const sl_tilt_obs_t *o = &f->obs[k];
         int64_t q = (g1 * o->cos_a_q15 + g2 * o->sin_a_q15) >> 15; // Q30, |.| <= 2
         q = (q < 0) ? -q : q;
-        sum_q46 += (((int64_t)f->wk->w_q16[k] * (int64_t)obs_sigma(o)) >> 16) * q;
+        sum_q46 += ((weight_q16(f, k) * (int64_t)obs_sigma(o)) >> 16) * q;
     }
     const int64_t mean_q30 = div_round(sum_q46, f->w_sum_q16); // sum(w sigma |adj e|) / W
     if (mean_q30 >= 2 * f->det_q30) {
@@ -609,11 +618,8 @@ sl_err_t sl_tilt_fit(const sl_tilt_obs_t *obs, size_t n, const sl_tilt_params_t 
     int64_t V = 0;
     int64_t S = 0; // Q40
     for (size_t k = 0; k < n; ++k) {
-        const uint64_t r_q16 = ((uint64_t)smin << 16) / obs_sigma(&obs[k]); // <= 1.0
-        uint32_t w = (uint32_t)((r_q16 * r_q16) >> 16);
-        w = (w == 0U) ? 1U : w;
-        work->w_q16[k] = w;
-        f.w_sum_q16 += (int64_t)w;
+        const int64_t w = weight_q16(&f, k);
+        f.w_sum_q16 += w;
         const int64_t c = obs[k].cos_a_q15;
         const int64_t s = obs[k].sin_a_q15;
         const int64_t t = obs[k].tan_q12;
@@ -663,7 +669,7 @@ sl_err_t sl_tilt_fit(const sl_tilt_obs_t *obs, size_t n, const sl_tilt_params_t 
     }
     for (size_t j = 0; j < m; ++j) {
         const sl_tilt_obs_t *o = &obs[work->order[j]];
-        const int64_t w = (int64_t)work->w_q16[work->order[j]];
+        const int64_t w = weight_q16(&f, work->order[j]);
         const int64_t t0 = o->tan_q12;
         const int64_t t1 = o->tan_mirror_q12;
         work->du_q24[j] = sl_fx_sat32(div_round(w * o->cos_a_q15 * (t1 - t0), W * 8));

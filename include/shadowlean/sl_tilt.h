@@ -178,9 +178,8 @@ bool sl_tilt_obs_make(sl_tilt_obs_t *out, int32_t radar_x_um, int32_t radar_y_um
                       uint16_t alpha_sigma_cdeg, uint8_t branch, const sl_incline_geom_t *geom);
 
 /// Scratch memory of a fit (caller-owned, so the fit's stack stays small: ~150 bytes).
-/// 548 bytes; one per pipeline is enough (fits do not overlap).
+/// 416 bytes; one per pipeline is enough (fits do not overlap).
 typedef struct sl_tilt_work {
-    uint32_t w_q16[SL_TILT_MAX_OBS];  ///< relative weights (sigma_min / sigma_k)^2
     int32_t du_q24[SL_TILT_MAX_OBS];  ///< per mirrorable measurement, in bearing order:
     int32_t dv_q24[SL_TILT_MAX_OBS];  ///< the change of mean(w c T), mean(w s T),
     int32_t ds_q24[SL_TILT_MAX_OBS];  ///< mean(w T^2) when it is read as its mirror

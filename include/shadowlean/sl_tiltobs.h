@@ -77,8 +77,8 @@
 /// vehicle origin) and the lean towards the vehicle's path (what LeanWarning uses).
 ///
 /// Units: um, bam32 (2^32 per turn), cdeg (0.01 deg). No allocation, no float; every array
-/// is inside the struct. RAM: SL_CFG_TILT_TRACKS x (SL_CFG_TILT_OBS_PER_TRACK x 24 + 72)
-/// + 672 bytes (x86-64: firmware configuration 4 x 16: 2,496 B; host default 8 x 32: 7,392 B).
+/// is inside the struct. RAM: SL_CFG_TILT_TRACKS x (SL_CFG_TILT_OBS_PER_TRACK x 24 + 104)
+/// + 544 bytes (x86-64: firmware configuration 4 x 16: 2,496 B; host default 8 x 32: 7,520 B).
 /// Cost per rotation: O(tracks x targets) for the matching (only for updated tracks) + O(1)
 /// per observation (three table sine/cosine, two 64-bit divisions) + at most
 /// SL_CFG_TILT_FITS_PER_ROTATION fits (sl_tilt.h: O(n + m^2)), each of 8 observations or
