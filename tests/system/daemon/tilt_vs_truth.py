@@ -17,6 +17,8 @@ with psi_deg >= --min-psi (default 5), the circular |TiltDirection - phi_deg| <=
 ones (the fit's honest answer when few observations do not separate the mirror hypotheses):
 the last one and the MIRROR frame of the same TargetId that follows it in the rotation are
 its two readings, and the truth must be one of them (Tilt and TiltDirection as above).
+Always: every AMBIGUOUS frame is followed directly by a MIRROR frame of its TargetId and
+every MIRROR frame follows one (docs/CAN_REFERENCE.md, "Two readings of the 3D tilt").
 Exit 0 when every pole passes.
 
 With --max-sigmas K the check is the frames' honesty instead: EVERY FITTED frame matched to
@@ -58,6 +60,7 @@ def main(argv):
     # Rotation groups with their PoleTilt frames.
     groups, tilts = [], []
     n_tilt = 0
+    prev = None  # the PoleTilt frame before this one
     for _, d in decoded:
         if d is None:
             continue
@@ -66,10 +69,19 @@ def main(argv):
             if not d.crc_ok or not d.reencode_ok:
                 print("FAIL: a PoleTilt frame does not pass the DBC's E2E CRC / re-encoding")
                 return 1
+            amb_before = prev is not None and prev.raw["Quality"] == 1
+            if (d.raw["Quality"] == 5) != (amb_before and prev.raw["TargetId"] == d.raw["TargetId"]) \
+                    or (amb_before and d.raw["Quality"] != 5):
+                print(f"FAIL: PoleTilt frame {n_tilt}: AMBIGUOUS and MIRROR frames not paired")
+                return 1
+            prev = d
             tilts.append(d)
         elif d.name == "Status":
             groups.append((d.raw["Rotations"] - 1, tilts))
             tilts = []
+    if prev is not None and prev.raw["Quality"] == 1:
+        print("FAIL: the last PoleTilt frame is AMBIGUOUS without its MIRROR frame")
+        return 1
     if n_tilt == 0 and opts["--max-sigmas"] <= 0.0:
         print("FAIL: no PoleTilt frame in the log")
         return 1
