@@ -564,6 +564,8 @@ void sl_tiltobs_fit_pending(sl_tiltobs_t *o)
                 r->res.quality = (uint8_t)SL_TILT_TOO_FEW;
             } else if (o->max_tan_q16 != 0U && tx * tx + ty * ty > lim * lim) {
                 r->res.quality = (uint8_t)SL_TILT_INCONSISTENT;
+                memset(&r->res.mirror, 0, sizeof r->res.mirror);
+                r->res.mirror_mask = 0U;
                 o->stats.too_steep++;
             }
         }
