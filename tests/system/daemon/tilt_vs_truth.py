@@ -18,7 +18,10 @@ ones (the fit's honest answer when few observations do not separate the mirror h
 the last one and the MIRROR frame of the same TargetId that follows it in the rotation are
 its two readings, and the truth must be one of them (Tilt and TiltDirection as above).
 Always: every AMBIGUOUS frame is followed directly by a MIRROR frame of its TargetId and
-every MIRROR frame follows one (docs/CAN_REFERENCE.md, "Two readings of the 3D tilt").
+every MIRROR frame follows one (docs/CAN_REFERENCE.md, "Two readings of the 3D tilt"); a
+LeanWarning about such a target that carries the fitted lean (Quality FILTERED) carries the
+lean over the path of one of the two readings (atan(-sign(BaseY) tan(Tilt) sin(TiltDirection)),
+within 0.5 deg), the larger one when both lean over the path.
 Exit 0 when every pole passes.
 
 With --max-sigmas K the check is the frames' honesty instead: EVERY FITTED frame matched to
@@ -59,8 +62,13 @@ def main(argv):
     decoded = scd.decode_log(pos[0], pos[1])
     # Rotation groups with their PoleTilt frames.
     groups, tilts = [], []
-    n_tilt = 0
+    n_tilt = n_warn_checked = 0
     prev = None  # the PoleTilt frame before this one
+    pairs, warning = {}, None  # this rotation's AMBIGUOUS + MIRROR pairs by TargetId; LeanWarning
+
+    def path_lean(f):
+        ty = math.tan(math.radians(f.phys["Tilt"])) * math.sin(math.radians(f.phys["TiltDirection"]))
+        return math.degrees(math.atan(-ty if f.phys["BaseY"] >= 0 else ty))
     for _, d in decoded:
         if d is None:
             continue
@@ -74,11 +82,25 @@ def main(argv):
                     or (amb_before and d.raw["Quality"] != 5):
                 print(f"FAIL: PoleTilt frame {n_tilt}: AMBIGUOUS and MIRROR frames not paired")
                 return 1
+            if d.raw["Quality"] == 5:
+                pairs[d.raw["TargetId"]] = (prev, d)
             prev = d
             tilts.append(d)
+        elif d.name == "LeanWarning":
+            warning = d
         elif d.name == "Status":
             groups.append((d.raw["Rotations"] - 1, tilts))
             tilts = []
+            if warning is not None and warning.raw["HasTarget"] == 1 and warning.raw["Quality"] == 4 \
+                    and warning.raw["TargetId"] in pairs:
+                n_warn_checked += 1
+                leans = sorted(path_lean(f) for f in pairs[warning.raw["TargetId"]])
+                lean = warning.phys["Lean"]
+                if min(abs(lean - x) for x in leans) > 0.5 or (leans[0] > 0 and abs(lean - leans[1]) > 0.5):
+                    print(f"FAIL: LeanWarning Lean {lean:.2f} of an AMBIGUOUS target, its readings' path "
+                          f"leans {leans[0]:.2f} / {leans[1]:.2f}")
+                    return 1
+            pairs, warning = {}, None
     if prev is not None and prev.raw["Quality"] == 1:
         print("FAIL: the last PoleTilt frame is AMBIGUOUS without its MIRROR frame")
         return 1
@@ -131,7 +153,7 @@ def main(argv):
     if opts["--max-sigmas"] > 0.0:
         return sigma_check(truth, fitted, opts["--max-sigmas"], n_tilt)
     bad = 0
-    print(f"PoleTilt frames: {n_tilt}")
+    print(f"PoleTilt frames: {n_tilt}; LeanWarning frames about an AMBIGUOUS target checked: {n_warn_checked}")
     print(f"{'pole':<10} {'rot':>4} {'psi':>6} {'Tilt':>6} {'err':>6} {'phi':>7} {'Dir':>5} {'err':>6} "
           f"{'base err':>8} quality")
     for name in sorted(truth):
