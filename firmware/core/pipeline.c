@@ -352,15 +352,21 @@ static SL_NOINLINE void warn_view(const sl_pipeline_t *p, const sl_track_t *t, w
 }
 
 // PoleTilt of track `t` when it has an observation history with a fit; an AMBIGUOUS fit's
-// frame is followed by its other reading's (Quality MIRROR, sl_can.h).
+// frame is followed by its other reading's (Quality MIRROR, sl_can.h): the two pass the
+// output ceiling together or not at all.
 static SL_NOINLINE void emit_tilt(sl_pipeline_t *p, const sl_track_t *t)
 {
     const sl_tiltobs_ring_t *r = sl_tiltobs_find(&p->tilt, t->id);
+    bool send = false;
     for (uint32_t k = 0U; k < 2U && p->tilt.moving; k++) {
         sl_tiltobs_vehicle_t tv;
         if (!(k == 0U ? sl_tiltobs_vehicle(&p->tilt, r, &tv)
                       : sl_tiltobs_vehicle_mirror(&p->tilt, r, &tv))) {
             return;
+        }
+        if (k == 0U) {
+            const uint32_t frames = tv.quality == (uint8_t)SL_TILT_AMBIGUOUS ? 2U : 1U;
+            send = p->cfg.port.can_tx != NULL && can_budget(p, false, frames);
         }
         const sl_can_pole_tilt_t pt = {
             .target_id = (uint8_t)(t->id & 15U),
@@ -373,8 +379,8 @@ static SL_NOINLINE void emit_tilt(sl_pipeline_t *p, const sl_track_t *t)
             .base_y_um = tv.base_y_um,
         };
         sl_can_frame_t f;
-        if (sl_can_encode_pole_tilt(&p->can, &pt, &f) == SL_OK) {
-            can_send(p, &f);
+        if (sl_can_encode_pole_tilt(&p->can, &pt, &f) == SL_OK && send) {
+            can_out(p, &f);
         }
     }
 }
