@@ -479,6 +479,48 @@ static uint32_t other_reading_z2(const sl_tiltobs_ring_t *r, const lev_ctx_t *l,
                : deleted_z2(r, l, k, z2_q8_of(resid_q24(r, k, true), r->obs[k].sigma_q16));
 }
 
+// The observation to drop from the ring's fit (sl_tiltobs.h, "Outlier rejection"): an
+// INCONSISTENT fit's worst one, a FITTED fit's when it is gross, an AMBIGUOUS fit's when it
+// is gross under both its readings; within the ring's bound of drops. False: none. O(n).
+static SL_NOINLINE bool outlier_of(const sl_tiltobs_ring_t *r, uint32_t *w)
+{
+    const bool incons = r->res.quality == (uint8_t)SL_TILT_INCONSISTENT;
+    const bool amb = r->res.quality == (uint8_t)SL_TILT_AMBIGUOUS;
+    if (!(incons || amb || r->res.quality == (uint8_t)SL_TILT_FITTED) ||
+        r->count < SL_TILTOBS_OUTLIER_MIN_N ||
+        (uint32_t)r->dropped + 1U > (uint32_t)r->count / SL_TILTOBS_OUTLIER_DIV) {
+        return false;
+    }
+    uint32_t z2_q8;
+    lev_ctx_t lev;
+    lev_init(r, &lev);
+    *w = worst_obs(r, &lev, &z2_q8);
+    return incons || (gross(r, z2_q8) && (!amb || gross(r, other_reading_z2(r, &lev, *w))));
+}
+
+// A result (FITTED or AMBIGUOUS) stands on SL_TILT_MIN_OBS observations without a ramp at a
+// bound, else it is TOO_FEW, as sl_tilt_fit's (no values); nor is it a tilt beyond the
+// largest a pole may have (max_tan_q16), else INCONSISTENT (sl_tiltobs.h, 3.).
+static void gate_result(sl_tiltobs_t *o, sl_tiltobs_ring_t *r)
+{
+    if (r->res.quality != (uint8_t)SL_TILT_FITTED && r->res.quality != (uint8_t)SL_TILT_AMBIGUOUS) {
+        return;
+    }
+    const int64_t tx = r->res.tx_q24, ty = r->res.ty_q24;
+    const int64_t lim = (int64_t)o->max_tan_q16 << 8; // Q24
+    if ((uint32_t)r->count - marked(r, SL_TILT_OBS_RAMP) < SL_TILT_MIN_OBS) {
+        const uint8_t n_obs = r->res.n_obs;
+        memset(&r->res, 0, sizeof r->res);
+        r->res.n_obs = n_obs;
+        r->res.quality = (uint8_t)SL_TILT_TOO_FEW;
+    } else if (o->max_tan_q16 != 0U && tx * tx + ty * ty > lim * lim) {
+        r->res.quality = (uint8_t)SL_TILT_INCONSISTENT;
+        memset(&r->res.mirror, 0, sizeof r->res.mirror);
+        r->res.mirror_mask = 0U;
+        o->stats.too_steep++;
+    }
+}
+
 void sl_tiltobs_fit_pending(sl_tiltobs_t *o)
 {
     SL_ASSERT(o != NULL);
@@ -522,53 +564,25 @@ void sl_tiltobs_fit_pending(sl_tiltobs_t *o)
         // next call looks for another.
         bool again = false;
         const bool incons = r->res.quality == (uint8_t)SL_TILT_INCONSISTENT;
-        const bool amb = r->res.quality == (uint8_t)SL_TILT_AMBIGUOUS;
-        if (SL_CFG_TILT_FITS_PER_ROTATION >= 2 &&
-            (incons || amb || r->res.quality == (uint8_t)SL_TILT_FITTED) &&
-            r->count >= SL_TILTOBS_OUTLIER_MIN_N &&
-            (uint32_t)r->dropped + 1U <= (uint32_t)r->count / SL_TILTOBS_OUTLIER_DIV) {
-            uint32_t z2_q8;
-            lev_ctx_t lev;
-            lev_init(r, &lev);
-            const uint32_t w = worst_obs(r, &lev, &z2_q8);
-            if (incons || (gross(r, z2_q8) && (!amb || gross(r, other_reading_z2(r, &lev, w))))) {
-                if (done >= (uint32_t)SL_CFG_TILT_FITS_PER_ROTATION) {
-                    o->rr = (uint8_t)idx;
-                    break;
-                }
-                drop_obs(r, w);
-                r->dropped++;
-                if (incons) {
-                    o->stats.outliers++;
-                } else {
-                    o->stats.gross++;
-                    again = true;
-                }
-                (void)sl_tilt_fit(r->obs, r->count, &o->prm, &o->work, &r->res);
-                o->stats.fits++;
-                done++;
+        uint32_t w = 0U;
+        if (SL_CFG_TILT_FITS_PER_ROTATION >= 2 && outlier_of(r, &w)) {
+            if (done >= (uint32_t)SL_CFG_TILT_FITS_PER_ROTATION) {
+                o->rr = (uint8_t)idx;
+                break;
             }
-        }
-        // A result (FITTED or AMBIGUOUS) stands on SL_TILT_MIN_OBS observations without a
-        // ramp at a bound, else it is TOO_FEW, as sl_tilt_fit's (no values); nor is it a
-        // tilt beyond the largest a pole may have (max_tan_q16), else INCONSISTENT
-        // (sl_tiltobs.h, 3.).
-        if (r->res.quality == (uint8_t)SL_TILT_FITTED ||
-            r->res.quality == (uint8_t)SL_TILT_AMBIGUOUS) {
-            const int64_t tx = r->res.tx_q24, ty = r->res.ty_q24;
-            const int64_t lim = (int64_t)o->max_tan_q16 << 8; // Q24
-            if ((uint32_t)r->count - marked(r, SL_TILT_OBS_RAMP) < SL_TILT_MIN_OBS) {
-                const uint8_t n_obs = r->res.n_obs;
-                memset(&r->res, 0, sizeof r->res);
-                r->res.n_obs = n_obs;
-                r->res.quality = (uint8_t)SL_TILT_TOO_FEW;
-            } else if (o->max_tan_q16 != 0U && tx * tx + ty * ty > lim * lim) {
-                r->res.quality = (uint8_t)SL_TILT_INCONSISTENT;
-                memset(&r->res.mirror, 0, sizeof r->res.mirror);
-                r->res.mirror_mask = 0U;
-                o->stats.too_steep++;
+            drop_obs(r, w);
+            r->dropped++;
+            if (incons) {
+                o->stats.outliers++;
+            } else {
+                o->stats.gross++;
+                again = true;
             }
+            (void)sl_tilt_fit(r->obs, r->count, &o->prm, &o->work, &r->res);
+            o->stats.fits++;
+            done++;
         }
+        gate_result(o, r);
         r->fitted = 1U;
         if (!again) {
             r->fresh = 0U;
