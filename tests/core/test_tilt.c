@@ -35,6 +35,9 @@ static const double PI = 3.14159265358979323846;
 // Digest of the noise-free sweep's results (see digest_result), from x86-64; must match on
 // every target.
 #define RESULTS_DIGEST 0x19511377afff247aULL
+// Digest of the AMBIGUOUS results' other readings of the random noisy passes
+// (test_never_a_confident_wrong_direction), from x86-64; must match on every target.
+#define MIRROR_DIGEST 0xb2d4304d814e64fbULL
 
 static double rad(double d) { return d * PI / 180.0; }
 static double deg(double r) { return r * 180.0 / PI; }
@@ -485,6 +488,7 @@ static void test_never_a_confident_wrong_direction(void **state)
     // within 30 deg (psi >= 5); otherwise the fit must say AMBIGUOUS or INSUFFICIENT_MOTION.
     rng = 12345;
     unsigned fitted = 0, ambiguous = 0, other = 0, among = 0;
+    digest = 14695981039346656037ULL;
     for (int i = 0; i < 300; ++i) {
         scene_t sc = base_scene();
         sc.psi = 5.0 + 15.0 * urand();
@@ -529,6 +533,10 @@ static void test_never_a_confident_wrong_direction(void **state)
             const double e0 = fabs(wrap180(r.phi_cdeg / 100.0 - sc.phi));
             const double e1 = fabs(wrap180(r.mirror.phi_cdeg / 100.0 - sc.phi));
             among += (e0 <= 30.0 || e1 <= 30.0) ? 1U : 0U;
+            const sl_tilt_reading_t *m = &r.mirror;
+            const int32_t f[] = {m->tx_q24, m->ty_q24, m->psi_cdeg, m->phi_cdeg, m->psi_sigma_cdeg,
+                                 m->phi_sigma_cdeg, m->base_x_um, m->base_y_um, (int32_t)r.mirror_mask};
+            for (size_t i = 0; i < sizeof f / sizeof f[0]; ++i) digest_i32(f[i]);
         } else {
             ++other;
         }
@@ -537,6 +545,8 @@ static void test_never_a_confident_wrong_direction(void **state)
            "readings: %u), too few / insufficient motion %u\n", fitted, ambiguous, among, other);
     assert_true(fitted >= 150);
     assert_true(among * 10U >= ambiguous * 9U);
+    printf("other readings digest %016llx\n", (unsigned long long)digest);
+    assert_true(digest == MIRROR_DIGEST);
 }
 
 // ---------------------------------------------------------------------------------------
