@@ -33,8 +33,8 @@
 /// from the measurements like the best) in `mirror`, with its own sigmas and base. An
 /// AMBIGUOUS result is an answer, not a failure: the pole is one of the two readings
 /// (`sl-eval driveby` scores it so), and a consumer that acts on the lean must consider
-/// both (sl_tiltobs.h: LeanWarning takes the one leaning further over the path). Never a
-/// confident wrong direction.
+/// both (LeanWarning takes the more dangerous one: sl_pipeline.h, "LeanWarning and the
+/// fitted tilt"). Never a confident wrong direction.
 ///
 /// The ambiguity margin. The stated sigmas are a floor, not the whole error: quantised range
 /// bounds, the group's union extent and the azimuth cells add errors that are neither
@@ -92,7 +92,9 @@
 /// Cost: sl_tilt_obs_make O(1) (three sine/cosine lookups, two 64-bit divisions);
 /// sl_tilt_fit O(n + m^2) (about 30 multiply-adds per interval candidate) plus O(TOP_K x n)
 /// for the exact solves, divisions only outside the candidate loop except for candidates
-/// near the best; an AMBIGUOUS fit solves and reports its second reading too (O(n)). No state, no allocation: pure functions, reentrant, any context.
+/// near the best; each measurement's weight is recomputed where it is read (one 32-bit
+/// division), and an AMBIGUOUS fit solves and reports its second reading too (O(n)). No
+/// state, no allocation: pure functions, reentrant, any context.
 #ifndef SHADOWLEAN_SL_TILT_H
 #define SHADOWLEAN_SL_TILT_H
 

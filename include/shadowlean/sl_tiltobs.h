@@ -74,7 +74,9 @@
 /// Outputs per ring: `res` (the last fit, odometry frame relative to the anchor) and, via
 /// `sl_tiltobs_vehicle()`, the tilt in the vehicle frame at the current pose (what the
 /// PoleTilt CAN message carries: direction CCW from forward, base x forward / y left of the
-/// vehicle origin) and the lean towards the vehicle's path (what LeanWarning uses).
+/// vehicle origin) and the lean towards the vehicle's path (what LeanWarning uses); for an
+/// AMBIGUOUS fit the same of its other reading via `sl_tiltobs_vehicle_mirror()` (PoleTilt
+/// MIRROR; LeanWarning takes the more dangerous of the two).
 ///
 /// Units: um, bam32 (2^32 per turn), cdeg (0.01 deg). No allocation, no float; every array
 /// is inside the struct. RAM: SL_CFG_TILT_TRACKS x (SL_CFG_TILT_OBS_PER_TRACK x 24 + 104)
