@@ -298,7 +298,8 @@ static void emit_status(sl_pipeline_t *p)
 // What LeanWarning says about a track (sl_pipeline.h, "LeanWarning and the fitted tilt"):
 // the tracker's level, filtered in-plane alpha and sigma, or, when the track's drive-by fit
 // is FITTED, the tilt towards the vehicle's path, its sigma and the level of that lean; when
-// it is AMBIGUOUS, the same of the more dangerous of its two readings.
+// it is AMBIGUOUS, the same of the more dangerous of its two readings that are usable
+// (ambiguous_usable), else the tracker's.
 typedef struct warn_view {
     uint8_t level;
     bool valid;        // a lean number
@@ -320,6 +321,17 @@ static uint8_t lean_level(const sl_pipeline_t *p, int32_t a)
     return (uint8_t)SL_WARN_NONE;
 }
 
+// An AMBIGUOUS fit's reading speaks for the warning only when it is a pole's (its tilt
+// within the largest lean the detector keeps a pole for) and its lean over the path is known
+// within the tracker's sigma limit (cfg.track.max_sigma_cdeg, as a tracker's level rises).
+static bool ambiguous_usable(const sl_pipeline_t *p, const sl_tiltobs_vehicle_t *tv)
+{
+    const uint16_t mt = p->tilt.max_tan_q16;
+    const int32_t max_psi = (mt == 0U) ? 9000
+        : sl_incline_bam32_to_cdeg(sl_incline_atan2_bam32((int32_t)mt, (int32_t)65536));
+    return tv->psi_cdeg <= max_psi && tv->lean_path_sigma_cdeg <= p->cfg.track.max_sigma_cdeg;
+}
+
 static SL_NOINLINE void warn_view(const sl_pipeline_t *p, const sl_track_t *t, warn_view_t *v)
 {
     v->level = t->level;
@@ -336,14 +348,18 @@ static SL_NOINLINE void warn_view(const sl_pipeline_t *p, const sl_track_t *t, w
         (tv.quality != (uint8_t)SL_TILT_FITTED && tv.quality != (uint8_t)SL_TILT_AMBIGUOUS)) {
         return;
     }
-    v->valid = true;
-    v->fitted = true;
-    v->lean_cdeg = tv.lean_path_cdeg;
-    v->sigma_cdeg = tv.lean_path_sigma_cdeg;
-    v->level = lean_level(p, tv.lean_path_cdeg);
-    if (sl_tiltobs_vehicle_mirror(&p->tilt, r, &tv)) { // AMBIGUOUS: the other reading
+    const bool amb = tv.quality == (uint8_t)SL_TILT_AMBIGUOUS;
+    for (uint32_t k = 0U; k < 2U; k++) { // the best reading, then an AMBIGUOUS fit's other one
+        if (k == 1U && !sl_tiltobs_vehicle_mirror(&p->tilt, r, &tv)) {
+            break;
+        }
+        if (amb && !ambiguous_usable(p, &tv)) {
+            continue;
+        }
         const uint8_t lv = lean_level(p, tv.lean_path_cdeg);
-        if (lv > v->level || (lv == v->level && tv.lean_path_cdeg > v->lean_cdeg)) {
+        if (!v->fitted || lv > v->level || (lv == v->level && tv.lean_path_cdeg > v->lean_cdeg)) {
+            v->valid = true;
+            v->fitted = true;
             v->lean_cdeg = tv.lean_path_cdeg;
             v->sigma_cdeg = tv.lean_path_sigma_cdeg;
             v->level = lv;

@@ -19,9 +19,12 @@ the last one and the MIRROR frame of the same TargetId that follows it in the ro
 its two readings, and the truth must be one of them (Tilt and TiltDirection as above).
 Always: every AMBIGUOUS frame is followed directly by a MIRROR frame of its TargetId and
 every MIRROR frame follows one (docs/CAN_REFERENCE.md, "Two readings of the 3D tilt"); a
-LeanWarning about such a target that carries the fitted lean (Quality FILTERED) carries the
-lean over the path of one of the two readings (atan(-sign(BaseY) tan(Tilt) sin(TiltDirection)),
-within 0.5 deg), the larger one when both lean over the path.
+LeanWarning about such a target carries the lean over the path (atan(-sign(BaseY) tan(Tilt)
+sin(TiltDirection)), within 0.5 deg) of one of the readings whose path-lean sigma (from
+TiltSigma and DirectionSigma, as the module computes it) is within the tracker's 3 deg
+limit, the larger when they all lean over the path; with none such, anything (the track's
+own values). Readings whose sigma is within 0.3 deg of the limit (the frames' rounding)
+leave the rotation unchecked.
 Exit 0 when every pole passes.
 
 With --max-sigmas K the check is the frames' honesty instead: EVERY FITTED frame matched to
@@ -69,6 +72,16 @@ def main(argv):
     def path_lean(f):
         ty = math.tan(math.radians(f.phys["Tilt"])) * math.sin(math.radians(f.phys["TiltDirection"]))
         return math.degrees(math.atan(-ty if f.phys["BaseY"] >= 0 else ty))
+
+    def path_lean_sigma(f):  # sl_tiltobs.c, lean_sigma_cdeg
+        t = math.tan(math.radians(f.phys["Tilt"]))
+        phi = math.radians(f.phys["TiltDirection"])
+        tn, tp = abs(t * math.sin(phi)), abs(t * math.cos(phi))
+        along = math.radians(f.phys["TiltSigma"]) * (1 + t * t)
+        a1, a2 = along, 0.0
+        if f.raw["DirectionSigma"] < 63 and t > 0:
+            a1, a2 = along * tn / t, math.radians(f.phys["DirectionSigma"]) * tp
+        return math.degrees(math.hypot(a1, a2) / (1 + tn * tn))
     for _, d in decoded:
         if d is None:
             continue
@@ -91,14 +104,17 @@ def main(argv):
         elif d.name == "Status":
             groups.append((d.raw["Rotations"] - 1, tilts))
             tilts = []
-            if warning is not None and warning.raw["HasTarget"] == 1 and warning.raw["Quality"] == 4 \
-                    and warning.raw["TargetId"] in pairs:
-                n_warn_checked += 1
-                leans = sorted(path_lean(f) for f in pairs[warning.raw["TargetId"]])
+            two = pairs.get(warning.raw["TargetId"]) if warning is not None else None
+            sig = [path_lean_sigma(f) for f in two] if two else []
+            if two and warning.raw["HasTarget"] == 1 and warning.raw["Quality"] == 4 and \
+                    all(f.raw["Clamped"] == 0 for f in two) and all(abs(s - 3.0) > 0.3 for s in sig):
+                leans = sorted(path_lean(f) for f, s in zip(two, sig) if s < 3.0)
                 lean = warning.phys["Lean"]
-                if min(abs(lean - x) for x in leans) > 0.5 or (leans[0] > 0 and abs(lean - leans[1]) > 0.5):
-                    print(f"FAIL: LeanWarning Lean {lean:.2f} of an AMBIGUOUS target, its readings' path "
-                          f"leans {leans[0]:.2f} / {leans[1]:.2f}")
+                n_warn_checked += 1 if leans else 0
+                if leans and (min(abs(lean - x) for x in leans) > 0.5 or
+                              (leans[0] > 0 and abs(lean - leans[-1]) > 0.5)):
+                    print(f"FAIL: LeanWarning Lean {lean:.2f} of an AMBIGUOUS target, its usable readings' "
+                          f"path leans {', '.join(f'{x:.2f}' for x in leans)}")
                     return 1
             pairs, warning = {}, None
     if prev is not None and prev.raw["Quality"] == 1:
