@@ -182,8 +182,8 @@ def driveby_tables(d, title):
                 f"within them): **{s['answered']} of {s['checked']}**; of the AMBIGUOUS passes the truth is the "
                 f"best reading in {s['ambiguous_truth_best']}, the other in {s['ambiguous_truth_other']}; "
                 f"{s['fitted_outside']} FITTED outside the bounds. Passes whose observations separate the mirror "
-                f"(separation at the truth >= 9): **{s['separated_answered']} of {s['separated']}** answered "
-                f"({s['separated_fitted']} FITTED, {s['separated_ambiguous']} AMBIGUOUS)."]
+                f"(separation at the truth >= 9): **{s['separated_answered']} of {s['separated']}** answered; "
+                f"{s['separated_fitted']} of them ended FITTED, {s['separated_ambiguous']} AMBIGUOUS."]
     return "\n".join(out)
 
 

@@ -952,8 +952,8 @@ int cmd_driveby(int argc, char **argv)
                           "truth one of its two readings within them); %d AMBIGUOUS: the truth is the best "
                           "reading in %d, the other in %d; %d FITTED outside the bounds\n",
                      n_ans, n_check, amb5, amb_best, amb_other, fitted_out);
-        std::fprintf(txt, "driveby separated: psi >= 5 and separation >= 9: %d passes, %d answered (%d FITTED, "
-                          "%d AMBIGUOUS)\n",
+        std::fprintf(txt, "driveby separated: psi >= 5 and separation >= 9: %d passes, %d answered; %d ended "
+                          "FITTED, %d AMBIGUOUS\n",
                      n_sep, n_sep_ans, n_sep_fitted, n_sep_amb);
     }
     if (json || !json_out.empty()) {
