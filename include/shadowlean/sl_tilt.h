@@ -84,7 +84,9 @@
 ///
 /// Accuracy (tests/core/test_tilt.c): given the same stored measurements, the fixed-point
 /// tilt vector agrees with a double-precision implementation of the same estimator to
-/// 2e-5 in tan units (0.001 deg; measured 2.6e-6), the base to 2 mm (measured 0.74 mm).
+/// 2e-5 in tan units (0.001 deg; measured 2.6e-6), the base to 2 mm (measured 0.74 mm); an
+/// AMBIGUOUS result's other reading agrees with the double solution of its reading of the
+/// fold to the same 2e-5.
 /// Against simulated drive-bys (bearing quantised to 0.9 deg azimuth cells): tilt within
 /// 1 deg and direction within 10 deg for tilts of 5-20 deg, also for poles leaning away
 /// beyond the fold; with 1 deg of noise on every alpha, within 2 deg and 20 deg.

@@ -14,8 +14,10 @@
 // weights); the fit against the simulated truth (tilt, direction, base) for straight and
 // curved paths, both sides of the path, tilts 3-20 deg, directions all around, poles leaning
 // away beyond the fold; noise; and the safety property: a direction that is wrong by more
-// than 30 deg is never reported as FITTED. Issue #12: three passes recorded from `sl-eval
-// driveby` whose fit read the fold's mirror as FITTED, and drive-bys with range bounds
+// than 30 deg is never reported as FITTED, and an AMBIGUOUS result holds the truth in one of
+// its two readings (the other one checked against the double solution of its reading of the
+// fold). Issue #12: three passes recorded from `sl-eval driveby` whose fit read the fold's
+// mirror as FITTED (the truth is the AMBIGUOUS result's other reading), and drive-bys with range bounds
 // quantised to the board's bins (errors neither Gaussian nor independent) in which no FITTED
 // fit may read the fold the wrong way.
 #include <setjmp.h>
