@@ -15,7 +15,7 @@ static const sl_can_value_name_t quality_names[] = {
 };
 static const sl_can_value_name_t tilt_quality_names[] = {
     {0U, "FITTED"}, {1U, "AMBIGUOUS"}, {2U, "INSUFFICIENT_MOTION"}, {3U, "TOO_FEW"},
-    {4U, "INCONSISTENT"},
+    {4U, "INCONSISTENT"}, {5U, "MIRROR"},
 };
 static const sl_can_value_name_t level_names[] = {
     {0U, "NONE"}, {1U, "CAUTION"}, {2U, "DANGER"},
@@ -482,7 +482,7 @@ sl_err_t sl_can_encode_pole_tilt(sl_can_tx_t *tx, const sl_can_pole_tilt_t *in,
     }
     put_sig(d, &s[L_QUALITY], q);
     put_sig(d, &s[L_TARGET], clamp_raw(&s[L_TARGET], in->target_id, &cl));
-    if (q == SL_CAN_TILT_FITTED || q == SL_CAN_TILT_AMBIGUOUS) {
+    if (q == SL_CAN_TILT_FITTED || q == SL_CAN_TILT_AMBIGUOUS || q == SL_CAN_TILT_MIRROR) {
         put_phys(d, &s[L_TILT], in->tilt_cdeg, SL_CAN_TILT_CDEG_PER_LSB, &cl);
         put_azimuth(d, &s[L_DIR], in->direction_cdeg, SL_CAN_TILT_DIR_CDEG_PER_LSB);
         put_phys(d, &s[L_SIGMA], in->tilt_sigma_cdeg, SL_CAN_TILT_SIGMA_CDEG_PER_LSB, &cl);

@@ -308,7 +308,9 @@ static void emit_status(sl_pipeline_t *p)
 
 // What LeanWarning says about a track (sl_pipeline.h, "LeanWarning and the fitted tilt"):
 // the tracker's level, filtered in-plane alpha and sigma, or, when the track's drive-by fit
-// is FITTED, the tilt towards the vehicle's path, its sigma and the level of that lean.
+// is FITTED, the tilt towards the vehicle's path, its sigma and the level of that lean; when
+// it is AMBIGUOUS, the same of the more dangerous of its two readings that are usable
+// (ambiguous_usable), else the tracker's.
 typedef struct warn_view {
     uint8_t level;
     bool valid;        // a lean number
@@ -330,6 +332,17 @@ static uint8_t lean_level(const sl_pipeline_t *p, int32_t a)
     return (uint8_t)SL_WARN_NONE;
 }
 
+// An AMBIGUOUS fit's reading speaks for the warning only when it is a pole's (its tilt
+// within the largest lean the detector keeps a pole for) and its lean over the path is known
+// within the tracker's sigma limit (cfg.track.max_sigma_cdeg, as a tracker's level rises).
+static bool ambiguous_usable(const sl_pipeline_t *p, const sl_tiltobs_vehicle_t *tv)
+{
+    const uint16_t mt = p->tilt.max_tan_q16;
+    const int32_t max_psi = (mt == 0U) ? 9000
+        : sl_incline_bam32_to_cdeg(sl_incline_atan2_bam32((int32_t)mt, (int32_t)65536));
+    return tv->psi_cdeg <= max_psi && tv->lean_path_sigma_cdeg <= p->cfg.track.max_sigma_cdeg;
+}
+
 static SL_NOINLINE void warn_view(const sl_pipeline_t *p, const sl_track_t *t, warn_view_t *v)
 {
     v->level = t->level;
@@ -340,37 +353,62 @@ static SL_NOINLINE void warn_view(const sl_pipeline_t *p, const sl_track_t *t, w
     if (!p->tilt.moving) {
         return;
     }
+    const sl_tiltobs_ring_t *r = sl_tiltobs_find(&p->tilt, t->id);
     sl_tiltobs_vehicle_t tv;
-    if (sl_tiltobs_vehicle(&p->tilt, sl_tiltobs_find(&p->tilt, t->id), &tv) &&
-        tv.quality == (uint8_t)SL_TILT_FITTED) {
-        v->valid = true;
-        v->fitted = true;
-        v->lean_cdeg = tv.lean_path_cdeg;
-        v->sigma_cdeg = tv.lean_path_sigma_cdeg;
-        v->level = lean_level(p, tv.lean_path_cdeg);
+    if (!sl_tiltobs_vehicle(&p->tilt, r, &tv) ||
+        (tv.quality != (uint8_t)SL_TILT_FITTED && tv.quality != (uint8_t)SL_TILT_AMBIGUOUS)) {
+        return;
+    }
+    const bool amb = tv.quality == (uint8_t)SL_TILT_AMBIGUOUS;
+    for (uint32_t k = 0U; k < 2U; k++) { // the best reading, then an AMBIGUOUS fit's other one
+        if (k == 1U && !sl_tiltobs_vehicle_mirror(&p->tilt, r, &tv)) {
+            break;
+        }
+        if (amb && !ambiguous_usable(p, &tv)) {
+            continue;
+        }
+        const uint8_t lv = lean_level(p, tv.lean_path_cdeg);
+        if (!v->fitted || lv > v->level || (lv == v->level && tv.lean_path_cdeg > v->lean_cdeg)) {
+            v->valid = true;
+            v->fitted = true;
+            v->lean_cdeg = tv.lean_path_cdeg;
+            v->sigma_cdeg = tv.lean_path_sigma_cdeg;
+            v->level = lv;
+        }
     }
 }
 
-// PoleTilt of track `t` when it has an observation history with a fit.
+// PoleTilt of track `t` when it has an observation history with a fit; an AMBIGUOUS fit's
+// frame is followed by its other reading's (Quality MIRROR, sl_can.h): the two pass the
+// output ceiling together or not at all.
 static SL_NOINLINE void emit_tilt(sl_pipeline_t *p, const sl_track_t *t)
 {
-    sl_tiltobs_vehicle_t tv;
-    if (!p->tilt.moving || !sl_tiltobs_vehicle(&p->tilt, sl_tiltobs_find(&p->tilt, t->id), &tv)) {
-        return;
-    }
-    const sl_can_pole_tilt_t pt = {
-        .target_id = (uint8_t)(t->id & 15U),
-        .quality = tv.quality,
-        .tilt_cdeg = tv.psi_cdeg,
-        .direction_cdeg = tv.phi_cdeg,
-        .tilt_sigma_cdeg = tv.psi_sigma_cdeg,
-        .direction_sigma_cdeg = tv.phi_sigma_cdeg,
-        .base_x_um = tv.base_x_um,
-        .base_y_um = tv.base_y_um,
-    };
-    sl_can_frame_t f;
-    if (sl_can_encode_pole_tilt(&p->can, &pt, &f) == SL_OK) {
-        can_send(p, &f);
+    const sl_tiltobs_ring_t *r = sl_tiltobs_find(&p->tilt, t->id);
+    bool send = false;
+    for (uint32_t k = 0U; k < 2U && p->tilt.moving; k++) {
+        sl_tiltobs_vehicle_t tv;
+        if (!(k == 0U ? sl_tiltobs_vehicle(&p->tilt, r, &tv)
+                      : sl_tiltobs_vehicle_mirror(&p->tilt, r, &tv))) {
+            return;
+        }
+        if (k == 0U) {
+            const uint32_t frames = tv.quality == (uint8_t)SL_TILT_AMBIGUOUS ? 2U : 1U;
+            send = p->cfg.port.can_tx != NULL && can_budget(p, false, frames);
+        }
+        const sl_can_pole_tilt_t pt = {
+            .target_id = (uint8_t)(t->id & 15U),
+            .quality = k == 0U ? tv.quality : (uint8_t)SL_CAN_TILT_MIRROR,
+            .tilt_cdeg = tv.psi_cdeg,
+            .direction_cdeg = tv.phi_cdeg,
+            .tilt_sigma_cdeg = tv.psi_sigma_cdeg,
+            .direction_sigma_cdeg = tv.phi_sigma_cdeg,
+            .base_x_um = tv.base_x_um,
+            .base_y_um = tv.base_y_um,
+        };
+        sl_can_frame_t f;
+        if (sl_can_encode_pole_tilt(&p->can, &pt, &f) == SL_OK && send) {
+            can_out(p, &f);
+        }
     }
 }
 

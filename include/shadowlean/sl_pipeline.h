@@ -80,8 +80,11 @@
 /// per rotation (round robin). A rotation without motion input clears every ring (the
 /// odometry has a hole), so without motion nothing changes on CAN.
 /// PoleTilt: the ring's latest fit in the vehicle frame at the rotation's end (sl_can.h).
-/// LeanWarning and the fitted tilt: for a confirmed track whose fit is FITTED (not
-/// AMBIGUOUS), the warning uses the tilt TOWARDS THE VEHICLE'S PATH instead of the in-plane
+/// LeanWarning and the fitted tilt: for a confirmed track whose fit is FITTED or AMBIGUOUS
+/// (of an AMBIGUOUS fit's two readings, the more dangerous one: the higher level, then the
+/// larger lean towards the path, among the readings within the detector's largest lean
+/// whose path-lean sigma is within cfg.track.max_sigma_cdeg; with neither, the track's
+/// values as below), the warning uses the tilt TOWARDS THE VEHICLE'S PATH instead of the in-plane
 /// alpha: lean = atan(-sign(base_y) t_y) with t the tilt vector and base_y the base's
 /// lateral offset in the vehicle frame (> 0: the top leans over the path, the sign
 /// convention of Lean), its sigma that of the path lean (sl_tiltobs_vehicle_t

@@ -304,7 +304,9 @@ static void test_canmsg_pole_tilt_layout_encode_decode(void **state)
     // Random round trips against the reference rounding.
     for (int k = 0; k < 20000; k++) {
         in.target_id = (uint8_t)rnd_range(0, 15);
-        in.quality = (uint8_t)rnd_range(0, 1);
+        const uint8_t with_values[3] = {SL_CAN_TILT_FITTED, SL_CAN_TILT_AMBIGUOUS,
+                                        SL_CAN_TILT_MIRROR};
+        in.quality = with_values[rnd_range(0, 2)];
         in.tilt_cdeg = (int32_t)rnd_range(0, 3000);
         in.direction_cdeg = (int32_t)rnd_range(-72000, 72000);
         in.tilt_sigma_cdeg = (uint32_t)rnd_range(0, 800);
@@ -333,17 +335,19 @@ static void test_canmsg_pole_tilt_layout_encode_decode(void **state)
         assert_int_equal(out.quality, in.quality);
     }
     // Qualities without numbers send zeros; an unknown quality is INCONSISTENT + Clamped.
-    for (uint8_t q = 2; q <= 5; q++) {
+    const uint8_t no_values[4] = {2, 3, 4, 6};
+    for (size_t i = 0; i < 4U; i++) {
+        const uint8_t q = no_values[i];
         in.quality = q;
         in.tilt_cdeg = 1000;
         in.base_x_um = 9000000; // would clamp if it were sent
         assert_int_equal(sl_can_encode_pole_tilt(&tx, &in, &f), SL_OK);
         assert_int_equal(sl_can_decode_pole_tilt(&f, E2E(POLE_TILT), &out), SL_OK);
-        assert_int_equal(out.quality, q > 4 ? SL_CAN_TILT_INCONSISTENT : q);
+        assert_int_equal(out.quality, q > SL_CAN_TILT_QUALITY_MAX ? SL_CAN_TILT_INCONSISTENT : q);
         assert_int_equal(out.tilt_cdeg, 0);
         assert_int_equal(out.base_x_um, 0);
         assert_int_equal(out.direction_cdeg, 0);
-        assert_int_equal(out.clamped, q > 4);
+        assert_int_equal(out.clamped, q > SL_CAN_TILT_QUALITY_MAX);
     }
     // Another message's frame fails the CRC (Data ID 0x56 is PoleTilt's own).
     in.quality = 0;
