@@ -392,7 +392,10 @@ static SL_NOINLINE void emit_tilt(sl_pipeline_t *p, const sl_track_t *t)
             return;
         }
         if (k == 0U) {
-            const uint32_t frames = tv.quality == (uint8_t)SL_TILT_AMBIGUOUS ? 2U : 1U;
+            uint32_t frames = 1U; // an AMBIGUOUS frame goes with its MIRROR frame
+            if (tv.quality == (uint8_t)SL_TILT_AMBIGUOUS) {
+                frames = 2U;
+            }
             send = p->cfg.port.can_tx != NULL && can_budget(p, false, frames);
         }
         const sl_can_pole_tilt_t pt = {

@@ -470,7 +470,7 @@ static void reading_base(const fit_ctx_t *f, const sl_tilt_params_t *prm, sl_til
         sx += (int64_t)o->radar_x_um + sl_fx_rshift_round64(d0_um * o->cos_a_q15, 15U);
         sy += (int64_t)o->radar_y_um + sl_fx_rshift_round64(d0_um * o->sin_a_q15, 15U);
     }
-    const int64_t n = (int64_t)f->n;
+    const int64_t n = f->n > 0U ? (int64_t)f->n : 1; // sl_tilt_fit's gate keeps n >= 3
     const int64_t h = (int64_t)prm->radar_height_um;
     out->base_x_um = sl_fx_sat32(div_round(sx, n) - sl_fx_rshift_round64(h * tx32, 24U));
     out->base_y_um = sl_fx_sat32(div_round(sy, n) - sl_fx_rshift_round64(h * ty32, 24U));

@@ -327,7 +327,7 @@ static uint32_t z2_q8_of(int64_t ad_q24, uint32_t sigma_q16)
 }
 
 // Relative weight of observation k, (SL_TILT_SIGMA_MIN_Q16 / sigma_k)^2, Q16 (<= 1).
-static uint32_t weight_q16(const sl_tilt_obs_t *ob)
+static uint32_t obs_weight_q16(const sl_tilt_obs_t *ob)
 {
     const uint64_t q = ((uint64_t)SL_TILT_SIGMA_MIN_Q16 << 16) / ob->sigma_q16; // <= 2^16
     return (uint32_t)((q * q) >> 16);
@@ -345,7 +345,7 @@ static SL_NOINLINE void lev_init(const sl_tiltobs_ring_t *r, lev_ctx_t *l)
     l->m22 = 0;
     for (uint32_t k = 0; k < r->count; k++) {
         const sl_tilt_obs_t *ob = &r->obs[k];
-        const int64_t w = weight_q16(ob);
+        const int64_t w = obs_weight_q16(ob);
         const int64_t c = ob->cos_a_q15, s = ob->sin_a_q15;
         l->m11 += (w * ((c * c) >> 14)) >> 16; // Q16 x Q16 >> 16
         l->m12 += (w * ((c * s) >> 14)) >> 16;
@@ -369,7 +369,7 @@ static uint32_t deleted_z2(const sl_tiltobs_ring_t *r, const lev_ctx_t *l, uint3
     const int64_t c = ob->cos_a_q15, s = ob->sin_a_q15;
     // e' adj(M) e, Q32: (Q30 x Q16) >> 14
     const int64_t quad = ((c * c) * l->m22 - 2 * (c * s) * l->m12 + (s * s) * l->m11) >> 14;
-    int64_t h = ((int64_t)weight_q16(ob) * (quad < 0 ? 0 : quad)) / l->det; // Q16
+    int64_t h = ((int64_t)obs_weight_q16(ob) * (quad < 0 ? 0 : quad)) / l->det; // Q16
     h = h > 61440 ? 61440 : h;                                             // 1 - h >= 1/16
     const uint64_t z = ((uint64_t)z2_q8 << 16) / (uint64_t)(65536 - h);
     return z >= UINT32_MAX ? UINT32_MAX : (uint32_t)z;
