@@ -194,6 +194,13 @@ def driveby_tables(d, title):
             f"direction; base offset within {f(s['max_abs_err_offset_m'])} m. Of the {s['ambiguous_checked']} "
             f"AMBIGUOUS passes, {s['ambiguous_inseparable']} hold observations whose mirror no 3-sigma rule can tell "
             "from the truth even if exact."]
+    if "answered" in s:  # the AMBIGUOUS passes' two readings (PoleTilt AMBIGUOUS + MIRROR)
+        out += ["", f"Answered (FITTED within the bounds, or AMBIGUOUS with the truth one of its two readings "
+                f"within them): **{s['answered']} of {s['checked']}**; of the AMBIGUOUS passes the truth is the "
+                f"best reading in {s['ambiguous_truth_best']}, the other in {s['ambiguous_truth_other']}; "
+                f"{s['fitted_outside']} FITTED outside the bounds. Passes whose observations separate the mirror "
+                f"(separation at the truth >= 9): **{s['separated_answered']} of {s['separated']}** answered; "
+                f"{s['separated_fitted']} of them ended FITTED, {s['separated_ambiguous']} AMBIGUOUS."]
     return "\n".join(out)
 
 

@@ -19,6 +19,30 @@ int sld_targets_write_header(FILE *fp, const sl_board_t *b, const sl_pipeline_cf
     return n < 0 ? -1 : 0;
 }
 
+// ,"model":{...},"targets":[ : the sensor model after the rotation.
+static int write_model(FILE *fp, const sl_pipeline_rotation_t *r)
+{
+    const sl_response_t *m = r->model;
+    int bad = 0;
+    bad |= fprintf(fp, ",\"model\":{\"response\":\"%s\",\"peaks\":%" PRIu32
+                       ",\"half_power_bins\":%.3f,\"floor_db\":[",
+                   m->source == SL_RESPONSE_LEARNED      ? "learned"
+                   : m->source == SL_RESPONSE_CALIBRATED ? "calibrated"
+                                                         : "prior",
+                   m->learn_n, sl_response_hpw_q8(m) / 256.0) < 0;
+    for (uint16_t b = 0; b < r->bands; b++) {
+        const int32_t f = sl_response_floor_lp(m, (uint32_t)b * SL_RESP_FLOOR_BAND);
+        bad |= (f == INT32_MIN ? fprintf(fp, "%snull", b ? "," : "")
+                               : fprintf(fp, "%s%.2f", b ? "," : "", f * 3.0103 / 256.0)) < 0;
+    }
+    bad |= fputs("],\"threshold\":[", fp) < 0;
+    for (uint16_t b = 0; b < r->bands; b++) {
+        bad |= fprintf(fp, "%s%u", b ? "," : "", (unsigned)r->threshold[b]) < 0;
+    }
+    bad |= fputs("]},\"targets\":[", fp) < 0;
+    return bad ? -1 : 0;
+}
+
 int sld_targets_write_rotation(FILE *fp, const sl_pipeline_rotation_t *r)
 {
     int bad = 0;
@@ -27,11 +51,12 @@ int sld_targets_write_rotation(FILE *fp, const sl_pipeline_rotation_t *r)
                    ",\"t_first_us\":%" PRIu64 ",\"t_last_us\":%" PRIu64
                    ",\"azimuths\":%u,\"valid\":%u,\"missing\":%u,\"end\":%u,\"frames_eff\":%u"
                    ",\"level\":%u,\"motion_valid\":%s,\"speed_mm_s\":%" PRId32
-                   ",\"yaw_rate_cdeg_s\":%" PRId32 ",\"targets\":[",
+                   ",\"yaw_rate_cdeg_s\":%" PRId32,
                    r->rotation, r->now_us, r->t_first_us, r->t_last_us, (unsigned)r->azimuths,
                    (unsigned)r->valid, (unsigned)r->missing, (unsigned)r->end,
                    (unsigned)r->frames_eff, (unsigned)r->level,
                    r->motion_valid ? "true" : "false", r->speed_mm_s, r->yaw_rate_cdeg_s) < 0;
+    bad |= write_model(fp, r) < 0;
     for (uint16_t i = 0; i < r->n_targets; i++) {
         const sl_target_t *t = &r->targets[i];
         bad |= fprintf(fp,

@@ -787,6 +787,25 @@ static void log_stats(daemon_t *d, int level, const char *what)
                                                                        : "--r2-offset, not enough of its own yet",
                 g_pipe.prof.stats.resid_samples);
     }
+    // The sensor model: the response in use and the noise floor the occupied thresholds read.
+    const sl_response_t *rs = &g_pipe.resp;
+    char fl[8 * 24] = "";
+    size_t fo = 0;
+    for (uint32_t b = 0; b * SL_RESP_FLOOR_BAND < g_pipe.mask_bins && fo + 24 < sizeof fl; b++) {
+        const int32_t f = sl_response_floor_lp(rs, b * SL_RESP_FLOOR_BAND);
+        fo += (size_t)(f == INT32_MIN
+                           ? snprintf(fl + fo, sizeof fl - fo, " -/%u", (unsigned)g_pipe.thr_band[b])
+                           : snprintf(fl + fo, sizeof fl - fo, " %.1f/%u", f * 3.0103 / 256.0,
+                                      (unsigned)g_pipe.thr_band[b]));
+    }
+    sld_log(SLD_LOG_INFO, "%s: sensor model: range response %s (half power %.2f bins; %" PRIu32
+            " isolated peaks learned from %" PRIu32 " rows, %" PRIu32 " with a rival, %" PRIu32
+            " implausible); noise floor dB / occupied threshold per %u bins:%s", what,
+            rs->source == SL_RESPONSE_LEARNED      ? "learned from the stream"
+            : rs->source == SL_RESPONSE_CALIBRATED ? "from the calibration"
+                                                   : "the board's prior",
+            sl_response_hpw_q8(rs) / 256.0, rs->learn_n, rs->stats.rows, rs->stats.rivals,
+            rs->stats.implausible, (unsigned)SL_RESP_FLOOR_BAND, fl);
     const sl_drift_t *dw = &g_pipe.drift;
     sld_log(SLD_LOG_INFO, "%s: theta drift watch: %s %+.2f deg%s; samples %" PRIu32 ", no ground %" PRIu32
             ", occupied %" PRIu32 ", outliers %" PRIu32, what, dw->valid ? "estimate" : "no estimate",

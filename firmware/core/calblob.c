@@ -30,6 +30,7 @@
 #define ELONG_D_MAX_UM 5000000 // the board parser's bounds: |d| <= 5 m, r <= 200 m
 #define ELONG_R_MAX_UM 200000000U
 #define THETA_SIGMA_MAX_CDEG 1000U
+#define RESP_CHECK_LP 1701 // a calibrated response is checked down to 20 dB (20 / 3.0103 x 256)
 // Elongation points this build can hold from a blob: the format's slots or the capacity.
 #if SL_CFG_MAX_ELONG_POINTS < 16
 #define ELONG_CAP ((uint32_t)SL_CFG_MAX_ELONG_POINTS)
@@ -173,7 +174,8 @@ sl_ssize_t sl_calblob_write(const sl_board_t *board, uint8_t *buf, size_t cap)
         return SL_ERR_ARG;
     }
     const size_t az = board->azimuths;
-    const size_t total = SL_CALBLOB_BYTES(az);
+    const bool resp = board->response_calibrated != 0U && board->response_prior_q8 != NULL;
+    const size_t total = SL_CALBLOB_BYTES(az) + (resp ? SL_CALBLOB_RESPONSE_BYTES : 0U);
     if (cap < total) {
         return SL_ERR_FULL;
     }
@@ -188,6 +190,7 @@ sl_ssize_t sl_calblob_write(const sl_board_t *board, uint8_t *buf, size_t cap)
     memcpy(buf + OFF_NAME, board->name, name_len(board->name));
     put32(buf + OFF_ID, sl_calblob_board_id(board));
     put16(buf + OFF_AZ, board->azimuths);
+    put16(buf + OFF_FLAGS, resp ? SL_CALBLOB_FLAG_RESPONSE : 0U);
     put32(buf + OFF_HEIGHT, board->radar_height_um);
     put32(buf + OFF_RADIUS, board->pole_radius_um);
     put16(buf + OFF_NEAR, board->near_exclusion_bins);
@@ -207,6 +210,13 @@ sl_ssize_t sl_calblob_write(const sl_board_t *board, uint8_t *buf, size_t cap)
         put32(&ps[4U * i], board->shadow_um[i]);
         put16(&pt[2U * i], (uint32_t)(uint16_t)board->theta_cdeg[i]);
         put16(&pb[2U * i], board->shadow_bins[i]);
+    }
+    if (resp) {
+        uint8_t *const pr = &pb[2U * az];
+        put16(pr, SL_RESP_TAPS);
+        for (size_t i = 0; i < (size_t)SL_RESP_TAPS; i++) {
+            put16(&pr[2U + 2U * i], board->response_prior_q8[i]);
+        }
     }
     put32(buf + OFF_CRC, blob_crc(buf, total));
     return (sl_ssize_t)total;
@@ -297,6 +307,20 @@ static const char *check_scalars(const uint8_t *b, const sl_board_t *nom, uint32
     return NULL;
 }
 
+// The response section at `pr`: its tap count and a plausible shape (the learner's gates,
+// down to 20 dB). NULL when it is usable, else the failed check's name.
+static const char *check_response(const uint8_t *pr)
+{
+    if (get16(pr) != (uint16_t)SL_RESP_TAPS) {
+        return "response_taps";
+    }
+    uint16_t d[SL_RESP_TAPS];
+    for (uint32_t i = 0; i < (uint32_t)SL_RESP_TAPS; i++) {
+        d[i] = get16(pr + 2U + 2U * i);
+    }
+    return sl_response_plausible(d, RESP_CHECK_LP) ? NULL : "response";
+}
+
 static sl_err_t fail(sl_calblob_info_t *info, sl_err_t e, const char *what, uint32_t index)
 {
     if (info != NULL) {
@@ -335,8 +359,10 @@ sl_err_t sl_calblob_open(const uint8_t *blob, size_t len, const sl_board_t *nomi
     if (version != SL_CALBLOB_VERSION) {
         return fail(info, SL_ERR_CAL_VERSION, "version", 0U);
     }
+    const uint16_t flags = get16(blob + OFF_FLAGS);
+    const bool resp = (flags & SL_CALBLOB_FLAG_RESPONSE) != 0U;
     if (get16(blob + OFF_HDR) != SL_CALBLOB_HEADER_BYTES || (size_t)total != len ||
-        (size_t)total != SL_CALBLOB_BYTES(az)) {
+        (size_t)total != SL_CALBLOB_BYTES(az) + (resp ? SL_CALBLOB_RESPONSE_BYTES : 0U)) {
         return fail(info, SL_ERR_CAL_SIZE, "size", 0U);
     }
     if (blob_crc(blob, total) != get32(blob + OFF_CRC)) {
@@ -353,7 +379,7 @@ sl_err_t sl_calblob_open(const uint8_t *blob, size_t len, const sl_board_t *nomi
     if (get32(blob + OFF_ID) != sl_calblob_board_id(nominal)) {
         return fail(info, SL_ERR_CAL_BOARD, "board_id", 0U);
     }
-    if (get16(blob + OFF_FLAGS) != 0U) {
+    if ((flags & (uint16_t)~SL_CALBLOB_FLAG_RESPONSE) != 0U) {
         return fail(info, SL_ERR_CAL_VALUE, "flags", 0U);
     }
     uint32_t index = 0U;
@@ -373,6 +399,13 @@ sl_err_t sl_calblob_open(const uint8_t *blob, size_t len, const sl_board_t *nomi
                                  get16(pb + 2U * i), height);
         if (w != NULL) {
             return fail(info, SL_ERR_CAL_VALUE, w, i);
+        }
+    }
+    const uint8_t *pr = pb + 2U * (size_t)az;
+    if (resp) {
+        const char *w = check_response(pr);
+        if (w != NULL) {
+            return fail(info, SL_ERR_CAL_VALUE, w, 0U);
         }
     }
     const bool in_place = little_endian() && aligned4(blob);
@@ -398,6 +431,9 @@ sl_err_t sl_calblob_open(const uint8_t *blob, size_t len, const sl_board_t *nomi
         v.shadow_um = (const uint32_t *)(const void *)ps;
         v.theta_cdeg = (const int16_t *)(const void *)pt;
         v.shadow_bins = (const uint16_t *)(const void *)pb;
+        if (resp) {
+            v.response_prior_q8 = (const uint16_t *)(const void *)(pr + 2U);
+        }
     } else {
         for (uint32_t i = 0; i < az; i++) {
             geom_get(&ws->geom[i], pg + SL_CALBLOB_GEOM_BYTES * i);
@@ -409,7 +445,14 @@ sl_err_t sl_calblob_open(const uint8_t *blob, size_t len, const sl_board_t *nomi
         v.shadow_um = ws->shadow_um;
         v.theta_cdeg = ws->theta_cdeg;
         v.shadow_bins = ws->shadow_bins;
+        if (resp) {
+            for (uint32_t i = 0; i < (uint32_t)SL_RESP_TAPS; i++) {
+                ws->response_q8[i] = get16(pr + 2U + 2U * i);
+            }
+            v.response_prior_q8 = ws->response_q8;
+        }
     }
+    v.response_calibrated = resp ? 1U : 0U;
     if (info != NULL) {
         info->zero_copy = in_place;
     }

@@ -15,7 +15,7 @@ static const sl_can_value_name_t quality_names[] = {
 };
 static const sl_can_value_name_t tilt_quality_names[] = {
     {0U, "FITTED"}, {1U, "AMBIGUOUS"}, {2U, "INSUFFICIENT_MOTION"}, {3U, "TOO_FEW"},
-    {4U, "INCONSISTENT"},
+    {4U, "INCONSISTENT"}, {5U, "MIRROR"},
 };
 static const sl_can_value_name_t level_names[] = {
     {0U, "NONE"}, {1U, "CAUTION"}, {2U, "DANGER"},
@@ -23,6 +23,10 @@ static const sl_can_value_name_t level_names[] = {
 static const sl_can_value_name_t link_names[] = {
     {0U, "DISCONNECTED"}, {1U, "CONNECTING"}, {2U, "WAIT_CONFIG"}, {3U, "STREAMING"},
     {4U, "SILENT"},
+};
+
+static const sl_can_value_name_t response_names[] = {
+    {0U, "PRIOR"}, {1U, "LEARNED"}, {2U, "CALIBRATED"},
 };
 
 static const sl_can_value_name_t fault_names[] = {
@@ -113,7 +117,7 @@ static const sl_can_signal_desc_t motion_sigs[M_N] = {
      SL_CAN_MOTION_RAW_MAX, "deg/s", NULL, 0U},
 };
 
-enum { H_FAULT = 2, H_RECONNECTS, H_CAND_DROPPED, H_DRIFT, H_N };
+enum { H_FAULT = 2, H_RECONNECTS, H_CAND_DROPPED, H_DRIFT, H_RESPONSE, H_N };
 static const sl_can_signal_desc_t health_sigs[H_N] = {
     E2E_SIGNALS,
     {"Fault", 16U, 16U, false, 1, 1, 0, 65535, "", fault_names, NV(fault_names)},
@@ -122,6 +126,8 @@ static const sl_can_signal_desc_t health_sigs[H_N] = {
      (int32_t)SL_CAN_HEALTH_CANDIDATES_DROPPED_MAX, "", NULL, 0U},
     {"ThetaDrift", 52U, 8U, true, SL_CAN_HEALTH_DRIFT_CDEG_PER_LSB, 100, SL_CAN_HEALTH_DRIFT_RAW_MIN,
      SL_CAN_HEALTH_DRIFT_RAW_MAX, "deg", NULL, 0U},
+    {"ResponseSource", 60U, 2U, false, 1, 1, 0, (int32_t)SL_CAN_RESPONSE_SOURCE_MAX, "",
+     response_names, NV(response_names)},
 };
 
 enum { L_QUALITY = 2, L_CLAMPED, L_TARGET, L_TILT, L_DIR, L_SIGMA, L_DIR_SIGMA, L_BX, L_BY, L_N };
@@ -476,7 +482,7 @@ sl_err_t sl_can_encode_pole_tilt(sl_can_tx_t *tx, const sl_can_pole_tilt_t *in,
     }
     put_sig(d, &s[L_QUALITY], q);
     put_sig(d, &s[L_TARGET], clamp_raw(&s[L_TARGET], in->target_id, &cl));
-    if (q == SL_CAN_TILT_FITTED || q == SL_CAN_TILT_AMBIGUOUS) {
+    if (q == SL_CAN_TILT_FITTED || q == SL_CAN_TILT_AMBIGUOUS || q == SL_CAN_TILT_MIRROR) {
         put_phys(d, &s[L_TILT], in->tilt_cdeg, SL_CAN_TILT_CDEG_PER_LSB, &cl);
         put_azimuth(d, &s[L_DIR], in->direction_cdeg, SL_CAN_TILT_DIR_CDEG_PER_LSB);
         put_phys(d, &s[L_SIGMA], in->tilt_sigma_cdeg, SL_CAN_TILT_SIGMA_CDEG_PER_LSB, &cl);
@@ -525,6 +531,7 @@ sl_err_t sl_can_encode_health(sl_can_tx_t *tx, const sl_can_health_t *in, sl_can
     put_sig(d, &s[H_RECONNECTS], clamp_raw(&s[H_RECONNECTS], in->reconnects, &sat));
     put_sig(d, &s[H_CAND_DROPPED], clamp_raw(&s[H_CAND_DROPPED], in->candidates_dropped, &sat));
     put_phys(d, &s[H_DRIFT], in->theta_drift_cdeg, SL_CAN_HEALTH_DRIFT_CDEG_PER_LSB, &sat);
+    put_sig(d, &s[H_RESPONSE], clamp_raw(&s[H_RESPONSE], in->response_source, &sat));
     finish(tx, SL_CAN_MSG_HEALTH, d, sat, out);
     return SL_OK;
 }
@@ -795,6 +802,7 @@ sl_err_t sl_can_decode_health(const sl_can_frame_t *f, const sl_can_e2e_cfg_t *e
     out->reconnects = (uint32_t)get_sig(d, &s[H_RECONNECTS]);
     out->candidates_dropped = (uint32_t)get_sig(d, &s[H_CAND_DROPPED]);
     out->theta_drift_cdeg = (int16_t)(get_sig(d, &s[H_DRIFT]) * SL_CAN_HEALTH_DRIFT_CDEG_PER_LSB);
+    out->response_source = (uint8_t)get_sig(d, &s[H_RESPONSE]);
     return SL_OK;
 }
 

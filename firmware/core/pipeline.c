@@ -19,6 +19,8 @@
 
 #define ROTATION_US_MIN 50000U   // plausible radar rotation periods for the measured T
 #define ROTATION_US_MAX 2000000U
+#define LEARN_PEAK_BINS 256U     // bins beyond the shadow's edge the shape is learned from
+#define MODEL_UPDATE_ROTATIONS 16U // rotations between adoptions of the learned shape
 
 static void set_err(sl_pipeline_t *p, sl_err_t e, uint8_t reason, const char *msg)
 {
@@ -49,6 +51,14 @@ void sl_pipeline_cfg_default(sl_pipeline_cfg_t *cfg, const sl_board_t *board)
     cfg->motion_timeout_us = 500000U;
     cfg->rotation_us = 250000U;
     cfg->row_timeout_us = 1000000U;
+    const sl_vscale_t cts = SL_VSCALE_CTS350X;
+    cfg->value_scale = cts;
+    if (board != NULL && !(board->value_scale.kind == (uint8_t)SL_VSCALE_LOG2 &&
+                           board->value_scale.cpo_q8 == 0U)) {
+        cfg->value_scale = board->value_scale;
+    }
+    cfg->learn = true;
+    cfg->floor_margin_lp = 851U; // 10 dB = 10 / 3.0103 octaves x 256
     cfg->profile = true;
     sl_profile_cfg_default(&cfg->profile_cfg);
 #if SL_CFG_GROUND
@@ -273,6 +283,7 @@ static void emit_status(sl_pipeline_t *p)
         .reconnects = p->stats.reconnects,
         .candidates_dropped = p->detect.stats.target_overflow,
         .theta_drift_cdeg = sl_drift_cdeg(&p->drift),
+        .response_source = p->resp.source,
     };
     p->faults_seen |= faults;
     sl_can_frame_t hf;
@@ -302,7 +313,9 @@ static void emit_status(sl_pipeline_t *p)
 
 // What LeanWarning says about a track (sl_pipeline.h, "LeanWarning and the fitted tilt"):
 // the tracker's level, filtered in-plane alpha and sigma, or, when the track's drive-by fit
-// is FITTED, the tilt towards the vehicle's path, its sigma and the level of that lean.
+// is FITTED, the tilt towards the vehicle's path, its sigma and the level of that lean; when
+// it is AMBIGUOUS, the same of the more dangerous of its two readings that are usable
+// (ambiguous_usable), else the tracker's.
 typedef struct warn_view {
     uint8_t level;
     bool valid;        // a lean number
@@ -324,6 +337,17 @@ static uint8_t lean_level(const sl_pipeline_t *p, int32_t a)
     return (uint8_t)SL_WARN_NONE;
 }
 
+// An AMBIGUOUS fit's reading speaks for the warning only when it is a pole's (its tilt
+// within the largest lean the detector keeps a pole for) and its lean over the path is known
+// within the tracker's sigma limit (cfg.track.max_sigma_cdeg, as a tracker's level rises).
+static bool ambiguous_usable(const sl_pipeline_t *p, const sl_tiltobs_vehicle_t *tv)
+{
+    const uint16_t mt = p->tilt.max_tan_q16;
+    const int32_t max_psi = (mt == 0U) ? 9000
+        : sl_incline_bam32_to_cdeg(sl_incline_atan2_bam32((int32_t)mt, (int32_t)65536));
+    return tv->psi_cdeg <= max_psi && tv->lean_path_sigma_cdeg <= p->cfg.track.max_sigma_cdeg;
+}
+
 static SL_NOINLINE void warn_view(const sl_pipeline_t *p, const sl_track_t *t, warn_view_t *v)
 {
     v->level = t->level;
@@ -334,37 +358,65 @@ static SL_NOINLINE void warn_view(const sl_pipeline_t *p, const sl_track_t *t, w
     if (!p->tilt.moving) {
         return;
     }
+    const sl_tiltobs_ring_t *r = sl_tiltobs_find(&p->tilt, t->id);
     sl_tiltobs_vehicle_t tv;
-    if (sl_tiltobs_vehicle(&p->tilt, sl_tiltobs_find(&p->tilt, t->id), &tv) &&
-        tv.quality == (uint8_t)SL_TILT_FITTED) {
-        v->valid = true;
-        v->fitted = true;
-        v->lean_cdeg = tv.lean_path_cdeg;
-        v->sigma_cdeg = tv.lean_path_sigma_cdeg;
-        v->level = lean_level(p, tv.lean_path_cdeg);
+    if (!sl_tiltobs_vehicle(&p->tilt, r, &tv) ||
+        (tv.quality != (uint8_t)SL_TILT_FITTED && tv.quality != (uint8_t)SL_TILT_AMBIGUOUS)) {
+        return;
+    }
+    const bool amb = tv.quality == (uint8_t)SL_TILT_AMBIGUOUS;
+    for (uint32_t k = 0U; k < 2U; k++) { // the best reading, then an AMBIGUOUS fit's other one
+        if (k == 1U && !sl_tiltobs_vehicle_mirror(&p->tilt, r, &tv)) {
+            break;
+        }
+        if (amb && !ambiguous_usable(p, &tv)) {
+            continue;
+        }
+        const uint8_t lv = lean_level(p, tv.lean_path_cdeg);
+        if (!v->fitted || lv > v->level || (lv == v->level && tv.lean_path_cdeg > v->lean_cdeg)) {
+            v->valid = true;
+            v->fitted = true;
+            v->lean_cdeg = tv.lean_path_cdeg;
+            v->sigma_cdeg = tv.lean_path_sigma_cdeg;
+            v->level = lv;
+        }
     }
 }
 
-// PoleTilt of track `t` when it has an observation history with a fit.
+// PoleTilt of track `t` when it has an observation history with a fit; an AMBIGUOUS fit's
+// frame is followed by its other reading's (Quality MIRROR, sl_can.h): the two pass the
+// output ceiling together or not at all.
 static SL_NOINLINE void emit_tilt(sl_pipeline_t *p, const sl_track_t *t)
 {
-    sl_tiltobs_vehicle_t tv;
-    if (!p->tilt.moving || !sl_tiltobs_vehicle(&p->tilt, sl_tiltobs_find(&p->tilt, t->id), &tv)) {
-        return;
-    }
-    const sl_can_pole_tilt_t pt = {
-        .target_id = (uint8_t)(t->id & 15U),
-        .quality = tv.quality,
-        .tilt_cdeg = tv.psi_cdeg,
-        .direction_cdeg = tv.phi_cdeg,
-        .tilt_sigma_cdeg = tv.psi_sigma_cdeg,
-        .direction_sigma_cdeg = tv.phi_sigma_cdeg,
-        .base_x_um = tv.base_x_um,
-        .base_y_um = tv.base_y_um,
-    };
-    sl_can_frame_t f;
-    if (sl_can_encode_pole_tilt(&p->can, &pt, &f) == SL_OK) {
-        can_send(p, &f);
+    const sl_tiltobs_ring_t *r = sl_tiltobs_find(&p->tilt, t->id);
+    bool send = false;
+    for (uint32_t k = 0U; k < 2U && p->tilt.moving; k++) {
+        sl_tiltobs_vehicle_t tv;
+        if (!(k == 0U ? sl_tiltobs_vehicle(&p->tilt, r, &tv)
+                      : sl_tiltobs_vehicle_mirror(&p->tilt, r, &tv))) {
+            return;
+        }
+        if (k == 0U) {
+            uint32_t frames = 1U; // an AMBIGUOUS frame goes with its MIRROR frame
+            if (tv.quality == (uint8_t)SL_TILT_AMBIGUOUS) {
+                frames = 2U;
+            }
+            send = p->cfg.port.can_tx != NULL && can_budget(p, false, frames);
+        }
+        const sl_can_pole_tilt_t pt = {
+            .target_id = (uint8_t)(t->id & 15U),
+            .quality = k == 0U ? tv.quality : (uint8_t)SL_CAN_TILT_MIRROR,
+            .tilt_cdeg = tv.psi_cdeg,
+            .direction_cdeg = tv.phi_cdeg,
+            .tilt_sigma_cdeg = tv.psi_sigma_cdeg,
+            .direction_sigma_cdeg = tv.phi_sigma_cdeg,
+            .base_x_um = tv.base_x_um,
+            .base_y_um = tv.base_y_um,
+        };
+        sl_can_frame_t f;
+        if (sl_can_encode_pole_tilt(&p->can, &pt, &f) == SL_OK && send) {
+            can_out(p, &f);
+        }
     }
 }
 
@@ -454,6 +506,102 @@ static void detect_hints_from_tracks(sl_pipeline_t *p)
     }
 }
 
+// ------------------------------------------------------------------------- sensor model
+
+// The smallest 8-bit value whose power is at least lp (255 when none is).
+static uint8_t value_at_least(const sl_response_t *r, int32_t lp)
+{
+    uint32_t v = 0U;
+    while (v < 255U && r->lp_q8[v] < lp) {
+        v++;
+    }
+    return (uint8_t)v;
+}
+
+// Occupied thresholds per floor band: the configured one, raised where the learned noise
+// floor's mean plus the margin is higher (a radar whose receiver noise sits above the
+// configured threshold would otherwise mark every bin occupied). Bands with no floor yet,
+// or one the 8-bit scale does not resolve (sl_response_floor_resolved), keep the configured
+// threshold.
+static void update_thresholds(sl_pipeline_t *p)
+{
+    const uint32_t base = p->cfg.threshold > 255U ? 255U : p->cfg.threshold;
+    const uint32_t bands = ((uint32_t)p->mask_bins + SL_RESP_FLOOR_BAND - 1U) / SL_RESP_FLOOR_BAND;
+    p->thr_flat = true;
+    for (uint32_t b = 0; b < SL_CFG_RESP_FLOOR_BANDS; b++) {
+        uint32_t t = base;
+        const int32_t fl = b < bands ? sl_response_floor_lp(&p->resp, b * SL_RESP_FLOOR_BAND)
+                                     : INT32_MIN;
+        if (fl != INT32_MIN && p->cfg.learn &&
+            sl_response_floor_resolved(&p->resp, b * SL_RESP_FLOOR_BAND)) {
+            const uint32_t v = value_at_least(&p->resp, fl + (int32_t)p->cfg.floor_margin_lp);
+            t = v > t ? v : t;
+        }
+        p->thr_band[b] = (uint8_t)t;
+        p->thr_flat = p->thr_flat && t == base;
+    }
+}
+
+// The row the sensor model reads: one azimuth per rotation, moving by 247 of 400 azimuths
+// (the golden section of the turn) each rotation, so successive rows spread over the turn
+// and every azimuth is read in turn, or to the next azimuth after a row that gave a peak. The floor is read inside the shadow (beyond the
+// near-field band): there only the receiver's noise and sparse targets are. The shape is
+// read from isolated peaks beyond the shadow, over the message's own 8-bit bins (past the
+// masked ones where the radar sends them), over LEARN_PEAK_BINS beyond the shadow's edge
+// (the near scene, where returns are strongest; the cost per rotation stays bounded however
+// long the radar's rows are): inside the shadow a slender target's own extent would be
+// taken for the response.
+static SL_NOINLINE void learn_row(sl_pipeline_t *p, const sl_scan_row_t *row)
+{
+    const uint32_t near = p->det_board.near_exclusion_bins;
+    const uint32_t edge = p->det_board.shadow_bins != NULL ? p->det_board.shadow_bins[row->idx]
+                                                           : 0U;
+    const uint32_t in_end = edge < p->mask_bins ? edge : p->mask_bins;
+    if (near < in_end) {
+        (void)sl_response_learn_floor(&p->resp, row->power, p->mask_bins, near, in_end);
+    }
+    const sl_proto_fft_t *f = row->fft;
+    if (f != NULL && f->bin_data != NULL && f->bytes_per_bin == 1U) {
+        const uint32_t reach = edge + 1U + LEARN_PEAK_BINS;
+        const uint32_t n = f->bins < reach ? f->bins : reach;
+        if (edge + 1U < n) {
+            p->learn_hit = sl_response_learn_peaks(&p->resp, f->bin_data, n, edge + 1U, n) > 0;
+        }
+    }
+}
+
+// Rotation end: the thresholds follow the floor; every MODEL_UPDATE_ROTATIONS rotations the
+// learned shape replaces the one in use once enough peaks agree (sl_response.h: deriving
+// the taps, cumulative and speckle correlation costs tens of thousands of instructions, and
+// the running medians move by a step per peak).
+static void model_end_rotation(sl_pipeline_t *p)
+{
+    if (!p->cfg.learn) {
+        return;
+    }
+    if (p->stats.rotations % MODEL_UPDATE_ROTATIONS == MODEL_UPDATE_ROTATIONS - 1U) {
+        (void)sl_response_update(&p->resp);
+    }
+    update_thresholds(p);
+    // A row that gave a peak is followed by its neighbour (the beam holds a point return
+    // over a few azimuths); otherwise the next row is 247 of 400 azimuths on.
+    const uint32_t naz = p->det_board.azimuths;
+    const uint32_t step = p->learn_hit ? 1U : (naz * 618U + 500U) / 1000U;
+    p->learn_az = (uint16_t)(((uint32_t)p->learn_az + step) % naz);
+    p->learn_hit = false;
+}
+
+// Thresholds one row into p->bits band by band (on_row calls sl_thresh_u8 itself while every
+// band has the configured threshold).
+static SL_NOINLINE void threshold_bands(sl_pipeline_t *p, const uint8_t *power)
+{
+    for (uint32_t k = 0; k < p->mask_bins; k += SL_RESP_FLOOR_BAND) {
+        const uint32_t n = p->mask_bins - k < SL_RESP_FLOOR_BAND ? p->mask_bins - k
+                                                                 : SL_RESP_FLOOR_BAND;
+        sl_thresh_u8(power + k, n, p->thr_band[k / SL_RESP_FLOOR_BAND], p->bits + k / 32U);
+    }
+}
+
 static void begin_rotation(sl_pipeline_t *p)
 {
     sl_can_vehicle_motion_t m;
@@ -533,7 +681,14 @@ static void on_row(void *ctx, const sl_scan_row_t *row)
     p->rows_since_health++;
     p->last_row_us = p->now_us;
     p->have_row = true;
-    sl_thresh_u8(row->power, p->mask_bins, p->cfg.threshold, p->bits);
+    if (p->thr_flat) {
+        sl_thresh_u8(row->power, p->mask_bins, p->cfg.threshold, p->bits);
+    } else {
+        threshold_bands(p, row->power);
+    }
+    if (row->idx == p->learn_az && p->cfg.learn) {
+        learn_row(p, row);
+    }
     if (row->idx == p->drift.watch_az) { // once per rotation: the bins past the mask
         sl_drift_tail(&p->drift, row->fft, p->mask_bins, p->cfg.pow16_shift, p->cfg.threshold);
     }
@@ -615,6 +770,9 @@ static SL_NOINLINE void report_rotation(sl_pipeline_t *p, const sl_scan_rot_t *r
         .tracks = p->tracker.tracks,
         .n_track_slots = SL_CFG_MAX_TARGETS,
         .level = (uint8_t)sl_track_max_level(&p->tracker),
+        .model = &p->resp,
+        .threshold = p->thr_band,
+        .bands = (uint16_t)(((uint32_t)p->mask_bins + SL_RESP_FLOOR_BAND - 1U) / SL_RESP_FLOOR_BAND),
     };
     p->cfg.port.on_rotation(p->cfg.port.ctx, &r);
 }
@@ -753,6 +911,7 @@ static void on_rot(void *ctx, const sl_scan_rot_t *rot)
                      p->det_board.bin_size_um);
     }
     sl_drift_end_rotation(&p->drift);
+    model_end_rotation(p);
 #if SL_CFG_GROUND
     if (p->cfg.ground) {
         sl_ground_set_motion(&p->ground, p->motion_valid, p->speed_mm_s, p->rotation_us);
@@ -950,10 +1109,22 @@ sl_err_t sl_pipeline_init(sl_pipeline_t *p, const sl_board_t *board,
         p->tilt.max_tan_q16 = c->detect.max_lean_tan_q16;
     }
     sl_drift_init(&p->drift, board);
+    if (e == SL_OK) {
+        // The board's prior, NULL: the CTS350-X lobe (sl_board.h); a calibration's response
+        // (sl_calblob.h) is the one in use from the start, as CALIBRATED.
+        e = sl_response_init(&p->resp, &c->value_scale, board->response_prior_q8, NULL);
+        if (e == SL_OK && board->response_calibrated != 0U && board->response_prior_q8 != NULL) {
+            e = sl_response_set(&p->resp, board->response_prior_q8,
+                                (uint8_t)SL_RESPONSE_CALIBRATED);
+        }
+        p->learn_az = 0U;
+        update_thresholds(p);
+    }
 #if SL_CFG_GROUND
     if (e == SL_OK && c->ground) {
         p->cfg.ground_cfg.threshold = c->ground_cfg.threshold != 0U ? c->ground_cfg.threshold
                                                                     : c->threshold;
+        p->cfg.ground_cfg.scale = c->value_scale; // the values' scale: the pipeline's
         e = sl_ground_init(&p->ground, board, &p->cfg.ground_cfg);
     }
 #endif

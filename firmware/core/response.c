@@ -231,6 +231,11 @@ static bool plausible(const uint16_t *d, int32_t lim)
     return true;
 }
 
+bool sl_response_plausible(const uint16_t drop_q8[SL_RESP_TAPS], int32_t down_to_lp)
+{
+    return drop_q8 != NULL && plausible(drop_q8, down_to_lp);
+}
+
 static void derive(sl_response_t *r)
 {
     uint64_t s1 = 0, s2 = 0;
@@ -305,6 +310,10 @@ sl_err_t sl_response_init(sl_response_t *r, const sl_vscale_t *scale, const uint
     }
     memset(r, 0, sizeof(*r));
     r->scale = *scale;
+    for (uint32_t v = 0; v < 256U; v++) {
+        const int32_t lp = sl_vscale_lp(scale, (uint8_t)v);
+        r->lp_q8[v] = (int16_t)(lp > INT16_MAX ? INT16_MAX : lp);
+    }
     if (cfg != NULL) {
         r->cfg = *cfg;
     } else {
@@ -314,13 +323,12 @@ sl_err_t sl_response_init(sl_response_t *r, const sl_vscale_t *scale, const uint
         r->cfg.isolation = 2U;
     }
     if (prior_q8 != NULL) {
-        memcpy(r->prior_q8, prior_q8, sizeof(r->prior_q8));
+        memcpy(r->drop_q8, prior_q8, sizeof(r->drop_q8));
     } else {
-        sl_response_prior_cts350x(r->prior_q8);
+        sl_response_prior_cts350x(r->drop_q8);
     }
-    memcpy(r->drop_q8, r->prior_q8, sizeof(r->drop_q8));
     for (int i = 0; i < SL_RESP_TAPS; i++) {
-        r->learn_q8[i] = (int32_t)r->prior_q8[i];
+        r->learn_q8[i] = (int32_t)r->drop_q8[i];
     }
     for (int b = 0; b < SL_CFG_RESP_FLOOR_BANDS; b++) {
         r->floor_q8[b] = INT32_MIN;
@@ -377,13 +385,35 @@ int32_t sl_response_floor_lp(const sl_response_t *r, uint32_t bin)
     return (r->floor_n[b] == 0U) ? INT32_MIN : r->floor_q8[b] + INV_LN2_LP;
 }
 
+bool sl_response_floor_resolved(const sl_response_t *r, uint32_t bin)
+{
+    if (r == NULL) {
+        return false;
+    }
+    const uint32_t b = band_of(bin);
+    return r->floor_n[b] >= SL_RESP_FLOOR_MIN_N && r->floor_q8[b] > r->lp_q8[0];
+}
+
+// The floor a peak at bin k is measured against: its band's, else the nearest band before
+// it that has one (the receiver's noise does not fall with range; beyond the shadow a band's
+// own median is the scene's).
+static int32_t peak_floor_lp(const sl_response_t *r, uint32_t k)
+{
+    for (uint32_t b = band_of(k) + 1U; b-- > 0U;) {
+        if (r->floor_n[b] != 0U) {
+            return r->floor_q8[b] + INV_LN2_LP;
+        }
+    }
+    return INT32_MIN;
+}
+
 // Rival check walking outward from the plateau's edge `from` in direction `dir`.
 static bool isolated(const sl_response_t *r, const uint8_t *row, int32_t from, int dir,
                      int32_t lp_pk)
 {
     int32_t lo = lp_pk;
     for (uint32_t k = 1; k <= r->cfg.isolation; k++) {
-        const int32_t lp = sl_vscale_lp(&r->scale, row[from + dir * (int32_t)k]);
+        const int32_t lp = r->lp_q8[row[from + dir * (int32_t)k]];
         if (lp > lp_pk) {
             return false;
         }
@@ -405,10 +435,10 @@ static void learn_peak(sl_response_t *r, const uint8_t *row, int32_t first, int3
     for (int o = -HALF; o <= HALF; o++) {
         int32_t lp;
         if ((c2 & 1) == 0) {
-            lp = sl_vscale_lp(&r->scale, row[c2 / 2 + o]);
+            lp = r->lp_q8[row[c2 / 2 + o]];
         } else {
             const int32_t lo = (c2 - 1) / 2 + o;
-            lp = (sl_vscale_lp(&r->scale, row[lo]) + sl_vscale_lp(&r->scale, row[lo + 1])) / 2;
+            lp = (r->lp_q8[row[lo]] + r->lp_q8[row[lo + 1]]) / 2;
         }
         int32_t drop = lp_pk - lp;
         if (drop < 0) {
@@ -421,17 +451,16 @@ static void learn_peak(sl_response_t *r, const uint8_t *row, int32_t first, int3
     r->learn_n++;
 }
 
-int sl_response_learn_row(sl_response_t *r, const uint8_t *row, uint32_t bins, uint32_t min_bin,
-                          uint32_t max_bin)
+int sl_response_learn_floor(sl_response_t *r, const uint8_t *row, uint32_t bins,
+                            uint32_t min_bin, uint32_t max_bin)
 {
     if (r == NULL || row == NULL || min_bin >= max_bin || max_bin > bins) {
         return (int)SL_ERR_ARG;
     }
-    r->stats.rows++;
-    // floor: every 4th bin
+    // every 4th bin: neighbouring bins share one speckle draw
     for (uint32_t k = min_bin; k < max_bin; k += 4U) {
         const uint32_t b = band_of(k);
-        const int32_t lp = sl_vscale_lp(&r->scale, row[k]);
+        const int32_t lp = r->lp_q8[row[k]];
         if (r->floor_n[b] == 0U) {
             r->floor_q8[b] = lp;
         } else {
@@ -441,13 +470,25 @@ int sl_response_learn_row(sl_response_t *r, const uint8_t *row, uint32_t bins, u
             r->floor_n[b]++;
         }
     }
+    return 0;
+}
+
+int sl_response_learn_peaks(sl_response_t *r, const uint8_t *row, uint32_t bins,
+                            uint32_t min_bin, uint32_t max_bin)
+{
+    if (r == NULL || row == NULL || min_bin >= max_bin || max_bin > bins) {
+        return (int)SL_ERR_ARG;
+    }
+    r->stats.rows++;
     const uint32_t reach = (r->cfg.isolation > HALF + 1U) ? r->cfg.isolation : HALF + 1U;
     if (max_bin - min_bin <= 2U * reach + 1U) {
         return 0;
     }
     int accepted = 0;
+    uint32_t examined = 0U; // candidates whose isolation was checked: bounded work per row
     uint32_t k = min_bin + reach;
-    while (k < max_bin - reach && accepted < (int)r->cfg.max_peaks_per_row) {
+    while (k < max_bin - reach && accepted < (int)r->cfg.max_peaks_per_row &&
+           examined < 2U * (uint32_t)r->cfg.max_peaks_per_row) {
         const uint8_t v = row[k];
         if (v <= row[k - 1U]) {
             k++;
@@ -461,9 +502,10 @@ int sl_response_learn_row(sl_response_t *r, const uint8_t *row, uint32_t bins, u
             k = last + 1U;
             continue;
         }
-        const int32_t lp_pk = sl_vscale_lp(&r->scale, v);
-        const int32_t fl = sl_response_floor_lp(r, k);
+        const int32_t lp_pk = r->lp_q8[v];
+        const int32_t fl = peak_floor_lp(r, k);
         if (fl != INT32_MIN && lp_pk - fl >= r->cfg.peak_min_lp && last - k <= 4U) {
+            examined++;
             if (isolated(r, row, (int32_t)k, -1, lp_pk) &&
                 isolated(r, row, (int32_t)last, 1, lp_pk)) {
                 learn_peak(r, row, (int32_t)k, (int32_t)last, lp_pk);
@@ -477,6 +519,13 @@ int sl_response_learn_row(sl_response_t *r, const uint8_t *row, uint32_t bins, u
         k = last + 1U;
     }
     return accepted;
+}
+
+int sl_response_learn_row(sl_response_t *r, const uint8_t *row, uint32_t bins, uint32_t min_bin,
+                          uint32_t max_bin)
+{
+    const int e = sl_response_learn_floor(r, row, bins, min_bin, max_bin);
+    return e < 0 ? e : sl_response_learn_peaks(r, row, bins, min_bin, max_bin);
 }
 
 bool sl_response_update(sl_response_t *r)

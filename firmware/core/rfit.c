@@ -24,7 +24,34 @@ typedef struct pieces {
     uint8_t np;
 } pieces_t;
 
+typedef struct normal {
+    int64_t n[3][3]; // Fisher information (unweighted), Q28
+    int64_t g[3];    // score, Q28
+} normal_t;
+
+typedef struct ldl {
+    int64_t d[3];   // Q28
+    int64_t l10, l20, l21; // Q16
+    bool ok;
+} ldl_t;
+
+#define RING SL_RESP_TAPS
+
+// The fit's work memory (sl_rfit_ws_t): the model's pieces at the point being evaluated,
+// the normal equations and their factor, and the covariance pass's ring of the last RING
+// samples' projected Jacobians. Each user rebuilds what it reads; none is live across
+// another's use.
+typedef struct work {
+    pieces_t p;
+    normal_t ne;
+    ldl_t f;
+    int16_t ra[RING], rb[RING]; // projected Jacobians, Q10
+} work_t;
+
+_Static_assert(sizeof(work_t) <= sizeof(sl_rfit_ws_t), "sl_rfit_ws_t: SL_RFIT_WS_BYTES too small");
+
 typedef struct ctx {
+    work_t *w;
     const sl_response_t *r;
     const sl_rfit_in_t *in;
     int sh;         // normalisation: v >> sh (sh >= 0) or v << -sh
@@ -200,22 +227,17 @@ static uint64_t jacobian_at(const ctx_t *c, const pieces_t *p, uint64_t level, u
     return mu;
 }
 
-typedef struct normal {
-    int64_t n[3][3]; // Fisher information (unweighted), Q28
-    int64_t g[3];    // score, Q28
-} normal_t;
-
 // The Fisher information and score at (a, b, level), parameters (ln level, a, b) in
 // (1, bins, bins).
 static void normal_eq(ctx_t *c, int32_t a, int32_t b, uint64_t level, normal_t *ne)
 {
-    pieces_t p0;
-    pieces_build(c, a, b, &p0);
+    pieces_t *const p0 = &c->w->p;
+    pieces_build(c, a, b, p0);
     memset(ne, 0, sizeof(*ne));
     int64_t g38[3] = {0, 0, 0}; // score, Q38
     for (uint32_t k = 0; k < c->in->n; k++) {
         int64_t j[3];
-        const uint64_t mu = jacobian_at(c, &p0, level, k, j);
+        const uint64_t mu = jacobian_at(c, p0, level, k, j);
         // the residual in Q24: near the optimum it is a few 1e-5 of mu per sample
         int64_t rt = (((int64_t)y_at(c, k) - (int64_t)mu) * 16777216) / (int64_t)mu;
         if (rt > ((int64_t)64 << 24)) {
@@ -237,12 +259,6 @@ static void normal_eq(ctx_t *c, int32_t a, int32_t b, uint64_t level, normal_t *
         }
     }
 }
-
-typedef struct ldl {
-    int64_t d[3];   // Q28
-    int64_t l10, l20, l21; // Q16
-    bool ok;
-} ldl_t;
 
 static int64_t div_q16(int64_t num, int64_t den)
 {
@@ -413,7 +429,6 @@ static int64_t mulsh(int64_t a, int64_t b, unsigned s)
     return sl_fx_rshift_round64(a * b, s);
 }
 
-#define RING SL_RESP_TAPS
 #define SAT ((int64_t)1 << 61)
 
 // The bounds' covariance: the sandwich N^-1 M N^-1 of the independence likelihood, M the
@@ -434,13 +449,14 @@ static void covariance(ctx_t *c, int32_t a, int32_t b, uint64_t level, const ldl
     if (g_a >= SAT || g_b >= SAT) {
         return;
     }
-    pieces_t p0;
-    pieces_build(c, a, b, &p0);
-    int16_t ra[RING], rb[RING]; // projected Jacobians of the last RING samples, Q10
+    pieces_t *const p0 = &c->w->p;
+    pieces_build(c, a, b, p0);
+    int16_t *const ra = c->w->ra; // projected Jacobians of the last RING samples, Q10
+    int16_t *const rb = c->w->rb;
     int64_t m_aa = 0, m_bb = 0, m_ab = 0; // Q28 (Q10 x Q10 x Q15 >> 7)
     for (uint32_t k = 0; k < c->in->n; k++) {
         int64_t j[3];
-        (void)jacobian_at(c, &p0, level, k, j);
+        (void)jacobian_at(c, p0, level, k, j);
         int64_t ta = sl_fx_rshift_round64(j[1] - sl_fx_rshift_round64(f->l10 * j[0], 16), 4);
         int64_t tb = sl_fx_rshift_round64(j[2] - sl_fx_rshift_round64(f->l20 * j[0], 16), 4);
         ta = (ta > 32767) ? 32767 : ((ta < -32767) ? -32767 : ta);
@@ -496,11 +512,11 @@ static void covariance(ctx_t *c, int32_t a, int32_t b, uint64_t level, const ldl
 
 static void deviance(ctx_t *c, int32_t a, int32_t b, uint64_t level, sl_rfit_out_t *out)
 {
-    pieces_t p;
-    pieces_build(c, a, b, &p);
+    pieces_t *const p = &c->w->p;
+    pieces_build(c, a, b, p);
     int64_t d = 0; // Q16
     for (uint32_t k = 0; k < c->in->n; k++) {
-        const uint64_t mu = mu_of(c, level, model_at(c, &p, k, NULL, NULL), k);
+        const uint64_t mu = mu_of(c, level, model_at(c, p, k, NULL, NULL), k);
         uint32_t y = y_at(c, k);
         if (y == 0U) {
             y = 1U;
@@ -568,14 +584,14 @@ static bool fisher_step(ctx_t *c, const normal_t *ne, const ldl_t *f, int32_t *a
         *converged = true; // the step is below the bounds' resolution
         return true;
     }
-    pieces_t p;
+    pieces_t *const p = &c->w->p;
     bool small = false; // what is left of the step is below the resolution
     for (int h = 0; h <= SL_RFIT_HALVINGS && !small; h++) {
         int32_t na = *a + da, nb = *b + db;
         keep_inside(c, &na, &nb);
         const uint64_t nl = scale_level(*level, dl);
-        pieces_build(c, na, nb, &p);
-        const int64_t jn = nll(c, &p, nl);
+        pieces_build(c, na, nb, p);
+        const int64_t jn = nll(c, p, nl);
         if (jn <= *j) {
             *a = na;
             *b = nb;
@@ -594,7 +610,14 @@ static bool fisher_step(ctx_t *c, const normal_t *ne, const ldl_t *f, int32_t *a
 
 sl_err_t sl_rfit(const sl_response_t *r, const sl_rfit_in_t *in, sl_rfit_out_t *out)
 {
-    if (r == NULL || in == NULL || out == NULL || in->y == NULL || in->n < 8U ||
+    sl_rfit_ws_t ws;
+    return sl_rfit_ws(r, in, &ws, out);
+}
+
+sl_err_t sl_rfit_ws(const sl_response_t *r, const sl_rfit_in_t *in, sl_rfit_ws_t *ws,
+                    sl_rfit_out_t *out)
+{
+    if (r == NULL || in == NULL || out == NULL || ws == NULL || in->y == NULL || in->n < 8U ||
         in->n > SL_RFIT_MAX_N || in->looks_q8 < 256U || (in->f == NULL && in->floor == 0U) ||
         in->shape > (uint8_t)SL_RFIT_FOOT ||
         (in->shape == (uint8_t)SL_RFIT_FOOT && in->origin_q8 == 0U)) {
@@ -603,6 +626,7 @@ sl_err_t sl_rfit(const sl_response_t *r, const sl_rfit_in_t *in, sl_rfit_out_t *
     memset(out, 0, sizeof(*out));
     ctx_t c;
     memset(&c, 0, sizeof(c));
+    c.w = (work_t *)(void *)ws; // MISRA 11.5 (docs/MISRA.md): the opaque workspace's layout
     c.r = r;
     c.in = in;
     c.ct = r->cum[SL_RESP_CUM - 1];
@@ -618,36 +642,35 @@ sl_err_t sl_rfit(const sl_response_t *r, const sl_rfit_in_t *in, sl_rfit_out_t *
         return SL_OK;
     }
     keep_inside(&c, &a, &b);
-    pieces_t p;
-    pieces_build(&c, a, b, &p);
-    int64_t j = nll(&c, &p, level);
+    pieces_build(&c, a, b, &c.w->p);
+    int64_t j = nll(&c, &c.w->p, level);
     bool converged = false;
     bool fresh = false; // ne and f hold the information at (a, b, level)
-    normal_t ne;
-    ldl_t f;
+    normal_t *const ne = &c.w->ne;
+    ldl_t *const f = &c.w->f;
     uint8_t it = 0;
     bool done = false;
     for (; it < SL_RFIT_ITERS && !done; it++) {
-        normal_eq(&c, a, b, level, &ne);
-        f = factor(&ne);
+        normal_eq(&c, a, b, level, ne);
+        *f = factor(ne);
         fresh = true; // ne and f are the information at (a, b, level) until a step moves it
-        if (!f.ok) {
+        if (!f->ok) {
             done = true;
         } else {
-            done = fisher_step(&c, &ne, &f, &a, &b, &level, &j, &converged);
+            done = fisher_step(&c, ne, f, &a, &b, &level, &j, &converged);
             fresh = done;
         }
     }
     if (!fresh) {
-        normal_eq(&c, a, b, level, &ne);
-        f = factor(&ne);
+        normal_eq(&c, a, b, level, ne);
+        *f = factor(ne);
     }
     out->a_q8 = a;
     out->b_q8 = b;
     out->iters = it;
     out->nll_q16 = j;
-    if (f.ok) {
-        covariance(&c, a, b, level, &f, out);
+    if (f->ok) {
+        covariance(&c, a, b, level, f, out);
     } else {
         out->sigma_a_q8 = UINT32_MAX;
         out->sigma_b_q8 = UINT32_MAX;
@@ -689,7 +712,7 @@ sl_err_t sl_rfit_model(const sl_response_t *r, uint8_t shape, uint32_t origin_q8
     if (c.ct == 0U) {
         return SL_ERR_ARG;
     }
-    pieces_t p;
+    pieces_t p; // the model alone: no workspace
     pieces_build(&c, a_q8, (b_q8 - a_q8 < 1) ? a_q8 + 1 : b_q8, &p);
     for (uint32_t k = 0; k < n; k++) {
         const int64_t m = sl_fx_rshift_round64(model_at(&c, &p, k, NULL, NULL), 8);

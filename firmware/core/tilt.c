@@ -5,6 +5,8 @@
 
 #include <string.h>
 
+#include "compiler.h"
+
 // sin(i * 90 deg / 256) for i = 0..256, Q30, rounded to nearest:
 //   python3 -c "import math; print([int(math.floor(math.sin(i*math.pi/512)*2**30+0.5))
 //               for i in range(257)])"
@@ -203,6 +205,15 @@ static uint16_t obs_sigma(const sl_tilt_obs_t *o)
     return (o->sigma_q16 < SL_TILT_SIGMA_MIN_Q16) ? (uint16_t)SL_TILT_SIGMA_MIN_Q16 : o->sigma_q16;
 }
 
+// Relative weight of measurement k, (sigma_min / sigma_k)^2, Q16 (1 .. 2^16): recomputed
+// where it is needed (one 32-bit division) rather than kept in the scratch memory.
+static int64_t weight_q16(const fit_ctx_t *f, size_t k)
+{
+    const uint32_t r_q16 = ((uint32_t)f->sigma_min_q16 << 16) / obs_sigma(&f->obs[k]); // <= 1.0
+    const uint32_t w = (uint32_t)(((uint64_t)r_q16 * r_q16) >> 16);
+    return (w == 0U) ? 1 : (int64_t)w;
+}
+
 // Predicted tan(alpha) = -(t . e), Q12.
 static int32_t predict_q12(const sl_tilt_obs_t *o, int32_t tx_q24, int32_t ty_q24)
 {
@@ -296,7 +307,7 @@ static void solve_exact(const fit_ctx_t *f, uint64_t choice, int32_t *tx, int32_
     int64_t V = 0;
     for (size_t k = 0; k < f->n; ++k) {
         const sl_tilt_obs_t *o = &f->obs[k];
-        const int64_t w = (int64_t)f->wk->w_q16[k];
+        const int64_t w = weight_q16(f, k);
         const int64_t t = ((choice >> k) & 1U) != 0U ? o->tan_mirror_q12 : o->tan_q12;
         U += w * o->cos_a_q15 * t;
         V += w * o->sin_a_q15 * t;
@@ -311,14 +322,14 @@ typedef struct alt_search {
     int32_t ty_q24;
     int64_t distinct_q24;  // |t - t_best| above this is a different answer
     int64_t alt_r_q54;     // best score among different answers in the window
+    size_t alt_start;      // ... its interval
+    size_t alt_len;
     bool found;
 } alt_search_t;
 
 static void visit_alt(const fit_ctx_t *f, void *ctx, size_t start, size_t len, int64_t u,
                       int64_t v, int64_t s)
 {
-    (void)start;
-    (void)len;
     alt_search_t *a = (alt_search_t *)ctx;
     const int64_t r = score(f, u, v, s);
     if (r - a->best_r_q54 > a->window_q54 || (a->found && r >= a->alt_r_q54)) {
@@ -331,6 +342,8 @@ static void visit_alt(const fit_ctx_t *f, void *ctx, size_t start, size_t len, i
     const int64_t dy = (int64_t)ty - a->ty_q24;
     if (dx * dx + dy * dy > a->distinct_q24 * a->distinct_q24) {
         a->alt_r_q54 = r;
+        a->alt_start = start;
+        a->alt_len = len;
         a->found = true;
     }
 }
@@ -423,7 +436,7 @@ static int64_t bias_bound_q30(const fit_ctx_t *f, sl_q30_t p1, sl_q30_t p2)
         const sl_tilt_obs_t *o = &f->obs[k];
         int64_t q = (g1 * o->cos_a_q15 + g2 * o->sin_a_q15) >> 15; // Q30, |.| <= 2
         q = (q < 0) ? -q : q;
-        sum_q46 += (((int64_t)f->wk->w_q16[k] * (int64_t)obs_sigma(o)) >> 16) * q;
+        sum_q46 += ((weight_q16(f, k) * (int64_t)obs_sigma(o)) >> 16) * q;
     }
     const int64_t mean_q30 = div_round(sum_q46, f->w_sum_q16); // sum(w sigma |adj e|) / W
     if (mean_q30 >= 2 * f->det_q30) {
@@ -432,19 +445,45 @@ static int64_t bias_bound_q30(const fit_ctx_t *f, sl_q30_t p1, sl_q30_t p2)
     return div_round(mean_q30 * P2_30, f->det_q30);
 }
 
-static void report(const fit_ctx_t *f, const sl_tilt_params_t *prm, uint64_t choice, int32_t tx32,
-                   int32_t ty32, uint32_t chi2_q8, sl_tilt_result_t *out)
+// The reading's base: each measurement's point at radar height, averaged, minus H t.
+static void reading_base(const fit_ctx_t *f, const sl_tilt_params_t *prm, sl_tilt_reading_t *out)
+{
+    const int32_t tx32 = out->tx_q24;
+    const int32_t ty32 = out->ty_q24;
+    const int64_t tanb_q12 = div_round((int64_t)prm->sin_beta_q30 * 4096, prm->cos_beta_q30);
+    int64_t sx = 0;
+    int64_t sy = 0;
+    for (size_t k = 0; k < f->n; ++k) {
+        const sl_tilt_obs_t *o = &f->obs[k];
+        const int64_t p = predict_q12(o, tx32, ty32); // fitted tan(alpha), Q12
+        int64_t d0_um;
+        if (p >= tanb_q12) {
+            // r1 on the +beta ray: d0 = r1 (cos b + sin b tan alpha)
+            const int64_t f_q30 = prm->cos_beta_q30 +
+                                  sl_fx_rshift_round64((int64_t)prm->sin_beta_q30 * p, 12U);
+            d0_um = sl_fx_rshift_round64((int64_t)o->r1_um * f_q30, 30U);
+        } else {
+            // r1 is the perpendicular foot: d0 = r1 / cos alpha = r1 sqrt(1 + tan^2)
+            const uint64_t sec_q12 = sl_fx_isqrt64(((uint64_t)1 << 24) + (uint64_t)(p * p));
+            d0_um = sl_fx_rshift_round64((int64_t)o->r1_um * (int64_t)sec_q12, 12U);
+        }
+        sx += (int64_t)o->radar_x_um + sl_fx_rshift_round64(d0_um * o->cos_a_q15, 15U);
+        sy += (int64_t)o->radar_y_um + sl_fx_rshift_round64(d0_um * o->sin_a_q15, 15U);
+    }
+    const int64_t n = f->n > 0U ? (int64_t)f->n : 1; // sl_tilt_fit's gate keeps n >= 3
+    const int64_t h = (int64_t)prm->radar_height_um;
+    out->base_x_um = sl_fx_sat32(div_round(sx, n) - sl_fx_rshift_round64(h * tx32, 24U));
+    out->base_y_um = sl_fx_sat32(div_round(sy, n) - sl_fx_rshift_round64(h * ty32, 24U));
+}
+
+// One reading: tilt, direction, their sigmas and the base of the tilt vector (tx32, ty32)
+// whose chi-square is chi2_q8.
+static void reading_of(const fit_ctx_t *f, const sl_tilt_params_t *prm, int32_t tx32,
+                       int32_t ty32, uint32_t chi2_q8, sl_tilt_reading_t *out)
 {
     SL_ASSERT(f->n >= SL_TILT_MIN_OBS); // sl_tilt_fit's gate: dof = n - 2 > 0, mean over n
     out->tx_q24 = tx32;
     out->ty_q24 = ty32;
-    out->chi2_q8 = chi2_q8;
-    unsigned mirrored = 0U;
-    for (size_t k = 0; k < f->n; ++k) {
-        mirrored += (unsigned)((choice >> k) & 1U);
-    }
-    out->n_mirrored = (uint8_t)mirrored;
-    out->mirrored_mask = (uint32_t)choice;
 
     // Tilt and direction.
     const int64_t tx = tx32;
@@ -509,38 +548,208 @@ static void report(const fit_ctx_t *f, const sl_tilt_params_t *prm, uint64_t cho
     out->psi_sigma_cdeg = rad_q30_to_cdeg(div_round(sig_psi_q30 << 24, sec2_q24), UINT16_MAX);
     out->phi_sigma_cdeg = (!oriented || tn_q24 == 0U) ? 18000U
         : rad_q30_to_cdeg(div_round(sig_q30[1] << 24, (int64_t)tn_q24), 18000U);
+    reading_base(f, prm, out);
+}
 
-    // Base: each measurement's point at radar height, averaged, minus H t.
-    const int64_t tanb_q12 = div_round((int64_t)prm->sin_beta_q30 * 4096, prm->cos_beta_q30);
-    int64_t sx = 0;
-    int64_t sy = 0;
+
+static void report(const fit_ctx_t *f, const sl_tilt_params_t *prm, uint64_t choice, int32_t tx32,
+                   int32_t ty32, uint32_t chi2_q8, sl_tilt_result_t *out)
+{
+    out->chi2_q8 = chi2_q8;
+    unsigned mirrored = 0U;
     for (size_t k = 0; k < f->n; ++k) {
-        const sl_tilt_obs_t *o = &f->obs[k];
-        const int64_t p = predict_q12(o, tx32, ty32); // fitted tan(alpha), Q12
-        int64_t d0_um;
-        if (p >= tanb_q12) {
-            // r1 on the +beta ray: d0 = r1 (cos b + sin b tan alpha)
-            const int64_t f_q30 = prm->cos_beta_q30 +
-                                  sl_fx_rshift_round64((int64_t)prm->sin_beta_q30 * p, 12U);
-            d0_um = sl_fx_rshift_round64((int64_t)o->r1_um * f_q30, 30U);
-        } else {
-            // r1 is the perpendicular foot: d0 = r1 / cos alpha = r1 sqrt(1 + tan^2)
-            const uint64_t sec_q12 = sl_fx_isqrt64(((uint64_t)1 << 24) + (uint64_t)(p * p));
-            d0_um = sl_fx_rshift_round64((int64_t)o->r1_um * (int64_t)sec_q12, 12U);
-        }
-        sx += (int64_t)o->radar_x_um + sl_fx_rshift_round64(d0_um * o->cos_a_q15, 15U);
-        sy += (int64_t)o->radar_y_um + sl_fx_rshift_round64(d0_um * o->sin_a_q15, 15U);
+        mirrored += (unsigned)((choice >> k) & 1U);
     }
-    const int64_t n = (int64_t)f->n;
-    const int64_t h = (int64_t)prm->radar_height_um;
-    out->base_x_um = sl_fx_sat32(div_round(sx, n) - sl_fx_rshift_round64(h * tx, 24U));
-    out->base_y_um = sl_fx_sat32(div_round(sy, n) - sl_fx_rshift_round64(h * ty, 24U));
+    out->n_mirrored = (uint8_t)mirrored;
+    out->mirrored_mask = (uint32_t)choice;
+    sl_tilt_reading_t rd;
+    reading_of(f, prm, tx32, ty32, chi2_q8, &rd);
+    out->tx_q24 = rd.tx_q24;
+    out->ty_q24 = rd.ty_q24;
+    out->psi_cdeg = rd.psi_cdeg;
+    out->phi_cdeg = rd.phi_cdeg;
+    out->psi_sigma_cdeg = rd.psi_sigma_cdeg;
+    out->phi_sigma_cdeg = rd.phi_sigma_cdeg;
+    out->base_x_um = rd.base_x_um;
+    out->base_y_um = rd.base_y_um;
+}
+
+// The fold reading of candidate interval (start, len) in bearing order: bit k set =
+// measurement k read as its mirror.
+static uint64_t interval_choice(const fit_ctx_t *f, size_t start, size_t len)
+{
+    uint64_t ch = 0U;
+    for (size_t j = 0; j < len; ++j) {
+        const size_t idx = start + j;
+        ch |= (uint64_t)1U << f->wk->order[(idx >= f->m) ? idx - f->m : idx];
+    }
+    return ch;
 }
 
 // Bearing of a measurement relative to `ref` (signed bam32).
 static int32_t rel_bearing(const sl_tilt_obs_t *o, sl_bam32_t ref)
 {
     return (int32_t)(sl_incline_atan2_bam32(o->sin_a_q15, o->cos_a_q15) - ref);
+}
+
+// The weights (sigma_min / sigma_k)^2 and the moments that do not depend on the fold:
+// the normalised bearing moments and their determinant, (u, v, s) as measured. False when
+// the bearings do not spread (SL_TILT_INSUFFICIENT_MOTION).
+static bool fit_moments(fit_ctx_t *f)
+{
+    uint16_t smin = UINT16_MAX;
+    for (size_t k = 0; k < f->n; ++k) {
+        const uint16_t s = obs_sigma(&f->obs[k]);
+        smin = (s < smin) ? s : smin;
+    }
+    f->sigma_min_q16 = smin;
+    int64_t A = 0; // Q46
+    int64_t B = 0;
+    int64_t C = 0;
+    int64_t U = 0; // Q43
+    int64_t V = 0;
+    int64_t S = 0; // Q40
+    for (size_t k = 0; k < f->n; ++k) {
+        const int64_t w = weight_q16(f, k);
+        f->w_sum_q16 += w;
+        const int64_t c = f->obs[k].cos_a_q15;
+        const int64_t s = f->obs[k].sin_a_q15;
+        const int64_t t = f->obs[k].tan_q12;
+        A += (int64_t)w * c * c;
+        B += (int64_t)w * c * s;
+        C += (int64_t)w * s * s;
+        U += (int64_t)w * c * t;
+        V += (int64_t)w * s * t;
+        S += (int64_t)w * t * t;
+    }
+    const int64_t W = f->w_sum_q16;
+    f->a_q30 = sl_fx_sat32(div_round(A, W));
+    f->b_q30 = sl_fx_sat32(div_round(B, W));
+    f->c_q30 = sl_fx_sat32(div_round(C, W));
+    f->det_q30 = sl_fx_rshift_round64((int64_t)f->a_q30 * f->c_q30 - (int64_t)f->b_q30 * f->b_q30, 30U);
+    if (f->det_q30 < SL_TILT_MIN_SPREAD_Q30) {
+        return false;
+    }
+    f->u0_q24 = div_round(U, W * 8);
+    f->v0_q24 = div_round(V, W * 8);
+    f->s0_q24 = div_round(S, W);
+    return true;
+}
+
+// Mirrorable measurements in bearing order (around their mean direction), with the change
+// each makes to (u, v, s) when read as the mirror.
+static void fit_fold_order(fit_ctx_t *f)
+{
+    sl_tilt_work_t *wk = f->wk;
+    const sl_tilt_obs_t *obs = f->obs;
+    const int64_t W = f->w_sum_q16;
+    int64_t mc = 0;
+    int64_t ms = 0;
+    size_t m = 0;
+    for (size_t k = 0; k < f->n; ++k) {
+        if (obs[k].mirrorable != 0U) {
+            mc += obs[k].cos_a_q15;
+            ms += obs[k].sin_a_q15;
+            wk->order[m++] = (uint8_t)k;
+        }
+    }
+    f->m = m;
+    const sl_bam32_t ref = sl_incline_atan2_bam32(sl_fx_sat32(ms), sl_fx_sat32(mc));
+    for (size_t i = 1; i < m; ++i) { // insertion sort, m <= 32
+        const uint8_t key = wk->order[i];
+        const int32_t kb = rel_bearing(&obs[key], ref);
+        size_t j = i;
+        while (j > 0U && rel_bearing(&obs[wk->order[j - 1U]], ref) > kb) {
+            wk->order[j] = wk->order[j - 1U];
+            --j;
+        }
+        wk->order[j] = key;
+    }
+    for (size_t j = 0; j < m; ++j) {
+        const sl_tilt_obs_t *o = &obs[wk->order[j]];
+        const int64_t w = weight_q16(f, wk->order[j]);
+        const int64_t t0 = o->tan_q12;
+        const int64_t t1 = o->tan_mirror_q12;
+        wk->du_q24[j] = sl_fx_sat32(div_round(w * o->cos_a_q15 * (t1 - t0), W * 8));
+        wk->dv_q24[j] = sl_fx_sat32(div_round(w * o->sin_a_q15 * (t1 - t0), W * 8));
+        wk->ds_q24[j] = sl_fx_sat32(div_round(w * (t1 * t1 - t0 * t0), W));
+    }
+}
+
+// The best reading of the fold: the TOP_K intervals by score, then the best of them by
+// exact chi-square. Returns the best score (for the ambiguity window).
+typedef struct best_fit {
+    uint64_t choice;
+    int32_t tx_q24;
+    int32_t ty_q24;
+    uint32_t chi2_q8;
+} best_fit_t;
+
+static SL_NOINLINE int64_t fit_best(const fit_ctx_t *f, best_fit_t *b)
+{
+    top_k_t top;
+    memset(&top, 0, sizeof top);
+    enumerate(f, visit_best, &top);
+    b->chi2_q8 = UINT32_MAX;
+    int64_t best_r = INT64_MAX;
+    for (size_t c = 0; c < top.n; ++c) {
+        const uint64_t ch = interval_choice(f, top.c[c].start, top.c[c].len);
+        int32_t cx;
+        int32_t cy;
+        solve_exact(f, ch, &cx, &cy);
+        const uint32_t x2 = chi2_direct_q8(f, ch, cx, cy);
+        if (c == 0U || x2 < b->chi2_q8) {
+            b->chi2_q8 = x2;
+            b->choice = ch;
+            b->tx_q24 = cx;
+            b->ty_q24 = cy;
+        }
+        best_r = (top.c[c].r_q54 < best_r) ? top.c[c].r_q54 : best_r;
+    }
+    return best_r;
+}
+
+// The ambiguity margin, chi-square units (Q8). The stated sigmas are a floor, not the whole
+// error: quantised bounds, the union extent and the azimuth cells add errors that are neither
+// Gaussian nor independent from one rotation to the next. So the scale of the chi-square is
+// estimated from the best fit's residuals, s^2 = max(1, chi2 / dof) (the same inflation
+// reading_of() applies to the sigmas), and with a scale estimated from dof residuals the
+// 3-sigma test of the difference is Student's t with dof degrees of freedom, not the
+// normal's 9: margin = t^2 s^2 (sl_tilt.h).
+static uint64_t ambiguity_margin_q8(uint32_t chi2_q8, uint32_t dof)
+{
+    uint64_t s2_q8 = (uint64_t)chi2_q8 / dof;
+    s2_q8 = (s2_q8 < 256U) ? 256U : s2_q8;
+    const uint64_t margin_q8 = ((uint64_t)t2_3sigma_q8[dof - T2_DOF_MIN] * s2_q8) >> 8;
+    return (margin_q8 > UINT32_MAX) ? UINT32_MAX : margin_q8;
+}
+
+// Pass 2: the best candidate with a different answer than `b`, within a window of scores
+// that covers the margin (and at least 16 x the normal's 9, so chi2_other says how far the
+// nearest other reading is).
+static SL_NOINLINE void fit_other(const fit_ctx_t *f, const best_fit_t *b, int64_t best_r,
+                                  uint64_t margin_q8, alt_search_t *alt)
+{
+    memset(alt, 0, sizeof *alt);
+    alt->best_r_q54 = best_r;
+    // margin in score units: d chi2 = W d(r / det) / sigma_min^2 -> d r = chi2 sigma^2 det / W
+    const uint64_t sig2 = (uint64_t)f->sigma_min_q16 * f->sigma_min_q16; // Q32
+    const int64_t per_chi2_q46 = (int64_t)((sig2 * (uint64_t)f->det_q30) / (uint64_t)f->w_sum_q16);
+    const uint64_t window_q8 = max_u64(margin_q8, (uint64_t)16 * (uint64_t)SL_TILT_AMBIGUITY_CHI2_Q8);
+    alt->window_q54 = (per_chi2_q46 > 0 && window_q8 > (uint64_t)INT64_MAX / (uint64_t)per_chi2_q46)
+                          ? INT64_MAX
+                          : per_chi2_q46 * (int64_t)window_q8;
+    alt->tx_q24 = b->tx_q24;
+    alt->ty_q24 = b->ty_q24;
+    const int64_t tx = b->tx_q24;
+    const int64_t ty = b->ty_q24;
+    const int64_t tn = (int64_t)sl_fx_isqrt64((uint64_t)(tx * tx + ty * ty));
+    const int64_t d_min = P2_24 * 35 / 1000; // 0.035 (2 deg)
+    const int64_t d_rel = tn * 3 / 10;
+    alt->distinct_q24 = (d_rel > d_min) ? d_rel : d_min;
+    if (f->m > 0U) {
+        enumerate(f, visit_alt, alt);
+    }
 }
 
 sl_err_t sl_tilt_fit(const sl_tilt_obs_t *obs, size_t n, const sl_tilt_params_t *prm,
@@ -564,159 +773,36 @@ sl_err_t sl_tilt_fit(const sl_tilt_obs_t *obs, size_t n, const sl_tilt_params_t 
     f.obs = obs;
     f.n = n;
     f.wk = work;
-    uint16_t smin = UINT16_MAX;
-    for (size_t k = 0; k < n; ++k) {
-        const uint16_t s = obs_sigma(&obs[k]);
-        smin = (s < smin) ? s : smin;
-    }
-    f.sigma_min_q16 = smin;
-    // Weights (sigma_min / sigma_k)^2 and the moments that do not depend on the fold.
-    int64_t A = 0; // Q46
-    int64_t B = 0;
-    int64_t C = 0;
-    int64_t U = 0; // Q43
-    int64_t V = 0;
-    int64_t S = 0; // Q40
-    for (size_t k = 0; k < n; ++k) {
-        const uint64_t r_q16 = ((uint64_t)smin << 16) / obs_sigma(&obs[k]); // <= 1.0
-        uint32_t w = (uint32_t)((r_q16 * r_q16) >> 16);
-        w = (w == 0U) ? 1U : w;
-        work->w_q16[k] = w;
-        f.w_sum_q16 += (int64_t)w;
-        const int64_t c = obs[k].cos_a_q15;
-        const int64_t s = obs[k].sin_a_q15;
-        const int64_t t = obs[k].tan_q12;
-        A += (int64_t)w * c * c;
-        B += (int64_t)w * c * s;
-        C += (int64_t)w * s * s;
-        U += (int64_t)w * c * t;
-        V += (int64_t)w * s * t;
-        S += (int64_t)w * t * t;
-    }
-    const int64_t W = f.w_sum_q16;
-    f.a_q30 = sl_fx_sat32(div_round(A, W));
-    f.b_q30 = sl_fx_sat32(div_round(B, W));
-    f.c_q30 = sl_fx_sat32(div_round(C, W));
-    f.det_q30 = sl_fx_rshift_round64((int64_t)f.a_q30 * f.c_q30 - (int64_t)f.b_q30 * f.b_q30, 30U);
-    if (f.det_q30 < SL_TILT_MIN_SPREAD_Q30) {
+    if (!fit_moments(&f)) {
         out->quality = (uint8_t)SL_TILT_INSUFFICIENT_MOTION;
         return SL_OK;
     }
-    f.u0_q24 = div_round(U, W * 8);
-    f.v0_q24 = div_round(V, W * 8);
-    f.s0_q24 = div_round(S, W);
-
-    // Mirrorable measurements in bearing order (around their mean direction), with the
-    // change each makes to (u, v, s) when read as the mirror.
-    int64_t mc = 0;
-    int64_t ms = 0;
-    size_t m = 0;
-    for (size_t k = 0; k < n; ++k) {
-        if (obs[k].mirrorable != 0U) {
-            mc += obs[k].cos_a_q15;
-            ms += obs[k].sin_a_q15;
-            work->order[m++] = (uint8_t)k;
-        }
-    }
-    f.m = m;
-    const sl_bam32_t ref = sl_incline_atan2_bam32(sl_fx_sat32(ms), sl_fx_sat32(mc));
-    for (size_t i = 1; i < m; ++i) { // insertion sort, m <= 32
-        const uint8_t key = work->order[i];
-        const int32_t kb = rel_bearing(&obs[key], ref);
-        size_t j = i;
-        while (j > 0U && rel_bearing(&obs[work->order[j - 1U]], ref) > kb) {
-            work->order[j] = work->order[j - 1U];
-            --j;
-        }
-        work->order[j] = key;
-    }
-    for (size_t j = 0; j < m; ++j) {
-        const sl_tilt_obs_t *o = &obs[work->order[j]];
-        const int64_t w = (int64_t)work->w_q16[work->order[j]];
-        const int64_t t0 = o->tan_q12;
-        const int64_t t1 = o->tan_mirror_q12;
-        work->du_q24[j] = sl_fx_sat32(div_round(w * o->cos_a_q15 * (t1 - t0), W * 8));
-        work->dv_q24[j] = sl_fx_sat32(div_round(w * o->sin_a_q15 * (t1 - t0), W * 8));
-        work->ds_q24[j] = sl_fx_sat32(div_round(w * (t1 * t1 - t0 * t0), W));
-    }
-
-    // Pass 1: the TOP_K intervals by score; then the best of them by exact chi-square.
-    top_k_t top;
-    memset(&top, 0, sizeof top);
-    enumerate(&f, visit_best, &top);
-    uint64_t choice = 0U;
-    int32_t tx = 0;
-    int32_t ty = 0;
-    uint32_t chi2 = UINT32_MAX;
-    int64_t best_r = INT64_MAX;
-    for (size_t c = 0; c < top.n; ++c) {
-        uint64_t ch = 0U;
-        for (size_t j = 0; j < top.c[c].len; ++j) {
-            const size_t idx = top.c[c].start + j;
-            ch |= (uint64_t)1U << work->order[(idx >= m) ? idx - m : idx];
-        }
-        int32_t cx;
-        int32_t cy;
-        solve_exact(&f, ch, &cx, &cy);
-        const uint32_t x2 = chi2_direct_q8(&f, ch, cx, cy);
-        if (c == 0U || x2 < chi2) {
-            chi2 = x2;
-            choice = ch;
-            tx = cx;
-            ty = cy;
-        }
-        best_r = (top.c[c].r_q54 < best_r) ? top.c[c].r_q54 : best_r;
-    }
-
-    // The ambiguity margin, chi-square units (Q8). The stated sigmas are a floor, not the
-    // whole error: quantised bounds, the union extent and the azimuth cells add errors that are
-    // neither Gaussian nor independent from one rotation to the next. So the scale of the
-    // chi-square is estimated from the best fit's residuals, s^2 = max(1, chi2 / dof) (the same
-    // inflation report() applies to the sigmas), and with a scale estimated from dof residuals
-    // the 3-sigma test of the difference is Student's t with dof degrees of freedom, not the
-    // normal's 9: margin = t^2 s^2 (sl_tilt.h).
+    fit_fold_order(&f);
+    best_fit_t b;
+    const int64_t best_r = fit_best(&f, &b);
     const uint32_t dof = (uint32_t)n - 2U;
-    uint64_t s2_q8 = (uint64_t)chi2 / dof;
-    s2_q8 = (s2_q8 < 256U) ? 256U : s2_q8;
-    uint64_t margin_q8 = ((uint64_t)t2_3sigma_q8[dof - T2_DOF_MIN] * s2_q8) >> 8;
-    margin_q8 = (margin_q8 > UINT32_MAX) ? UINT32_MAX : margin_q8;
-
-    // Pass 2: the best candidate with a different answer, within a window of scores that
-    // covers the margin (and at least 16 x the normal's 9, so chi2_other says how far the
-    // nearest other reading is).
+    const uint64_t margin_q8 = ambiguity_margin_q8(b.chi2_q8, dof);
     alt_search_t alt;
-    memset(&alt, 0, sizeof alt);
-    alt.best_r_q54 = best_r;
-    // margin in score units: d chi2 = W d(r / det) / sigma_min^2 -> d r = chi2 sigma^2 det / W
-    const uint64_t sig2 = (uint64_t)smin * smin; // Q32
-    const int64_t per_chi2_q46 = (int64_t)((sig2 * (uint64_t)f.det_q30) / (uint64_t)W);
-    const uint64_t window_q8 = max_u64(margin_q8, (uint64_t)16 * (uint64_t)SL_TILT_AMBIGUITY_CHI2_Q8);
-    alt.window_q54 = (per_chi2_q46 > 0 && window_q8 > (uint64_t)INT64_MAX / (uint64_t)per_chi2_q46)
-                         ? INT64_MAX
-                         : per_chi2_q46 * (int64_t)window_q8;
-    alt.tx_q24 = tx;
-    alt.ty_q24 = ty;
-    {
-        const int64_t tn = (int64_t)sl_fx_isqrt64((uint64_t)((int64_t)tx * tx + (int64_t)ty * ty));
-        const int64_t d_min = P2_24 * 35 / 1000; // 0.035 (2 deg)
-        const int64_t d_rel = tn * 3 / 10;
-        alt.distinct_q24 = (d_rel > d_min) ? d_rel : d_min;
-    }
-    if (m > 0U) {
-        enumerate(&f, visit_alt, &alt);
-    }
+    fit_other(&f, &b, best_r, margin_q8, &alt);
     out->chi2_other_q8 = alt.found ? chi2_of_score_q8(&f, alt.alt_r_q54) : UINT32_MAX;
 
-    report(&f, prm, choice, tx, ty, chi2, out);
+    report(&f, prm, b.choice, b.tx_q24, b.ty_q24, b.chi2_q8, out);
     const uint32_t best_chi2_fast = chi2_of_score_q8(&f, best_r);
     const bool ambiguous = alt.found &&
         ((uint64_t)out->chi2_other_q8 < (uint64_t)best_chi2_fast + margin_q8);
-    if ((uint64_t)chi2 > (uint64_t)SL_TILT_INCONSISTENT_CHI2_Q8 * dof) {
+    if ((uint64_t)b.chi2_q8 > (uint64_t)SL_TILT_INCONSISTENT_CHI2_Q8 * dof) {
         // Not a straight pole seen as measured (whatever reading of the fold): its scale
         // estimate would call every reading ambiguous, and that is not what is wrong.
         out->quality = (uint8_t)SL_TILT_INCONSISTENT;
     } else if (ambiguous) {
+        // Both readings: the other one solved exactly from the measurements, as the best.
         out->quality = (uint8_t)SL_TILT_AMBIGUOUS;
+        const uint64_t ch = interval_choice(&f, alt.alt_start, alt.alt_len);
+        int32_t cx;
+        int32_t cy;
+        solve_exact(&f, ch, &cx, &cy);
+        reading_of(&f, prm, cx, cy, chi2_direct_q8(&f, ch, cx, cy), &out->mirror);
+        out->mirror_mask = (uint32_t)ch;
     } else {
         out->quality = (uint8_t)SL_TILT_FITTED;
     }

@@ -327,7 +327,7 @@ static uint32_t z2_q8_of(int64_t ad_q24, uint32_t sigma_q16)
 }
 
 // Relative weight of observation k, (SL_TILT_SIGMA_MIN_Q16 / sigma_k)^2, Q16 (<= 1).
-static uint32_t weight_q16(const sl_tilt_obs_t *ob)
+static uint32_t obs_weight_q16(const sl_tilt_obs_t *ob)
 {
     const uint64_t q = ((uint64_t)SL_TILT_SIGMA_MIN_Q16 << 16) / ob->sigma_q16; // <= 2^16
     return (uint32_t)((q * q) >> 16);
@@ -345,7 +345,7 @@ static SL_NOINLINE void lev_init(const sl_tiltobs_ring_t *r, lev_ctx_t *l)
     l->m22 = 0;
     for (uint32_t k = 0; k < r->count; k++) {
         const sl_tilt_obs_t *ob = &r->obs[k];
-        const int64_t w = weight_q16(ob);
+        const int64_t w = obs_weight_q16(ob);
         const int64_t c = ob->cos_a_q15, s = ob->sin_a_q15;
         l->m11 += (w * ((c * c) >> 14)) >> 16; // Q16 x Q16 >> 16
         l->m12 += (w * ((c * s) >> 14)) >> 16;
@@ -369,7 +369,7 @@ static uint32_t deleted_z2(const sl_tiltobs_ring_t *r, const lev_ctx_t *l, uint3
     const int64_t c = ob->cos_a_q15, s = ob->sin_a_q15;
     // e' adj(M) e, Q32: (Q30 x Q16) >> 14
     const int64_t quad = ((c * c) * l->m22 - 2 * (c * s) * l->m12 + (s * s) * l->m11) >> 14;
-    int64_t h = ((int64_t)weight_q16(ob) * (quad < 0 ? 0 : quad)) / l->det; // Q16
+    int64_t h = ((int64_t)obs_weight_q16(ob) * (quad < 0 ? 0 : quad)) / l->det; // Q16
     h = h > 61440 ? 61440 : h;                                             // 1 - h >= 1/16
     const uint64_t z = ((uint64_t)z2_q8 << 16) / (uint64_t)(65536 - h);
     return z >= UINT32_MAX ? UINT32_MAX : (uint32_t)z;
@@ -479,6 +479,48 @@ static uint32_t other_reading_z2(const sl_tiltobs_ring_t *r, const lev_ctx_t *l,
                : deleted_z2(r, l, k, z2_q8_of(resid_q24(r, k, true), r->obs[k].sigma_q16));
 }
 
+// The observation to drop from the ring's fit (sl_tiltobs.h, "Outlier rejection"): an
+// INCONSISTENT fit's worst one, a FITTED fit's when it is gross, an AMBIGUOUS fit's when it
+// is gross under both its readings; within the ring's bound of drops. False: none. O(n).
+static SL_NOINLINE bool outlier_of(const sl_tiltobs_ring_t *r, uint32_t *w)
+{
+    const bool incons = r->res.quality == (uint8_t)SL_TILT_INCONSISTENT;
+    const bool amb = r->res.quality == (uint8_t)SL_TILT_AMBIGUOUS;
+    if (!(incons || amb || r->res.quality == (uint8_t)SL_TILT_FITTED) ||
+        r->count < SL_TILTOBS_OUTLIER_MIN_N ||
+        (uint32_t)r->dropped + 1U > (uint32_t)r->count / SL_TILTOBS_OUTLIER_DIV) {
+        return false;
+    }
+    uint32_t z2_q8;
+    lev_ctx_t lev;
+    lev_init(r, &lev);
+    *w = worst_obs(r, &lev, &z2_q8);
+    return incons || (gross(r, z2_q8) && (!amb || gross(r, other_reading_z2(r, &lev, *w))));
+}
+
+// A result (FITTED or AMBIGUOUS) stands on SL_TILT_MIN_OBS observations without a ramp at a
+// bound, else it is TOO_FEW, as sl_tilt_fit's (no values); nor is it a tilt beyond the
+// largest a pole may have (max_tan_q16), else INCONSISTENT (sl_tiltobs.h, 3.).
+static void gate_result(sl_tiltobs_t *o, sl_tiltobs_ring_t *r)
+{
+    if (r->res.quality != (uint8_t)SL_TILT_FITTED && r->res.quality != (uint8_t)SL_TILT_AMBIGUOUS) {
+        return;
+    }
+    const int64_t tx = r->res.tx_q24, ty = r->res.ty_q24;
+    const int64_t lim = (int64_t)o->max_tan_q16 << 8; // Q24
+    if ((uint32_t)r->count - marked(r, SL_TILT_OBS_RAMP) < SL_TILT_MIN_OBS) {
+        const uint8_t n_obs = r->res.n_obs;
+        memset(&r->res, 0, sizeof r->res);
+        r->res.n_obs = n_obs;
+        r->res.quality = (uint8_t)SL_TILT_TOO_FEW;
+    } else if (o->max_tan_q16 != 0U && tx * tx + ty * ty > lim * lim) {
+        r->res.quality = (uint8_t)SL_TILT_INCONSISTENT;
+        memset(&r->res.mirror, 0, sizeof r->res.mirror);
+        r->res.mirror_mask = 0U;
+        o->stats.too_steep++;
+    }
+}
+
 void sl_tiltobs_fit_pending(sl_tiltobs_t *o)
 {
     SL_ASSERT(o != NULL);
@@ -522,51 +564,25 @@ void sl_tiltobs_fit_pending(sl_tiltobs_t *o)
         // next call looks for another.
         bool again = false;
         const bool incons = r->res.quality == (uint8_t)SL_TILT_INCONSISTENT;
-        const bool amb = r->res.quality == (uint8_t)SL_TILT_AMBIGUOUS;
-        if (SL_CFG_TILT_FITS_PER_ROTATION >= 2 &&
-            (incons || amb || r->res.quality == (uint8_t)SL_TILT_FITTED) &&
-            r->count >= SL_TILTOBS_OUTLIER_MIN_N &&
-            (uint32_t)r->dropped + 1U <= (uint32_t)r->count / SL_TILTOBS_OUTLIER_DIV) {
-            uint32_t z2_q8;
-            lev_ctx_t lev;
-            lev_init(r, &lev);
-            const uint32_t w = worst_obs(r, &lev, &z2_q8);
-            if (incons || (gross(r, z2_q8) && (!amb || gross(r, other_reading_z2(r, &lev, w))))) {
-                if (done >= (uint32_t)SL_CFG_TILT_FITS_PER_ROTATION) {
-                    o->rr = (uint8_t)idx;
-                    break;
-                }
-                drop_obs(r, w);
-                r->dropped++;
-                if (incons) {
-                    o->stats.outliers++;
-                } else {
-                    o->stats.gross++;
-                    again = true;
-                }
-                (void)sl_tilt_fit(r->obs, r->count, &o->prm, &o->work, &r->res);
-                o->stats.fits++;
-                done++;
+        uint32_t w = 0U;
+        if (SL_CFG_TILT_FITS_PER_ROTATION >= 2 && outlier_of(r, &w)) {
+            if (done >= (uint32_t)SL_CFG_TILT_FITS_PER_ROTATION) {
+                o->rr = (uint8_t)idx;
+                break;
             }
-        }
-        // A result (FITTED or AMBIGUOUS) stands on SL_TILT_MIN_OBS observations without a
-        // ramp at a bound, else it is TOO_FEW, as sl_tilt_fit's (no values); nor is it a
-        // tilt beyond the largest a pole may have (max_tan_q16), else INCONSISTENT
-        // (sl_tiltobs.h, 3.).
-        if (r->res.quality == (uint8_t)SL_TILT_FITTED ||
-            r->res.quality == (uint8_t)SL_TILT_AMBIGUOUS) {
-            const int64_t tx = r->res.tx_q24, ty = r->res.ty_q24;
-            const int64_t lim = (int64_t)o->max_tan_q16 << 8; // Q24
-            if ((uint32_t)r->count - marked(r, SL_TILT_OBS_RAMP) < SL_TILT_MIN_OBS) {
-                const uint8_t n_obs = r->res.n_obs;
-                memset(&r->res, 0, sizeof r->res);
-                r->res.n_obs = n_obs;
-                r->res.quality = (uint8_t)SL_TILT_TOO_FEW;
-            } else if (o->max_tan_q16 != 0U && tx * tx + ty * ty > lim * lim) {
-                r->res.quality = (uint8_t)SL_TILT_INCONSISTENT;
-                o->stats.too_steep++;
+            drop_obs(r, w);
+            r->dropped++;
+            if (incons) {
+                o->stats.outliers++;
+            } else {
+                o->stats.gross++;
+                again = true;
             }
+            (void)sl_tilt_fit(r->obs, r->count, &o->prm, &o->work, &r->res);
+            o->stats.fits++;
+            done++;
         }
+        gate_result(o, r);
         r->fitted = 1U;
         if (!again) {
             r->fresh = 0U;
@@ -583,19 +599,20 @@ void sl_tiltobs_fit_pending(sl_tiltobs_t *o)
 // (`tn_q24`; `tp_q24` the one along the path, vehicle frame): d t_n = (t_n / |t|) d|t| +
 // t_p d phi, d|t| = (1 + |t|^2) d psi; when the direction is not determined, the tilt sigma
 // (the larger one, sl_tilt.h) in every direction. Then / (1 + t_n^2). O(1).
-static uint16_t lean_sigma_cdeg(const sl_tilt_result_t *res, int64_t tp_q24, int64_t tn_q24)
+static uint16_t lean_sigma_cdeg(uint16_t psi_sigma_cdeg, uint16_t phi_sigma_cdeg, int64_t tp_q24,
+                                int64_t tn_q24)
 {
     const int64_t an = (tn_q24 < 0) ? -tn_q24 : tn_q24;
     const int64_t ap = (tp_q24 < 0) ? -tp_q24 : tp_q24;
     const int64_t t2_q24 = (an * an + ap * ap) >> 24;                       // |t|^2
     const int64_t tnorm_q24 = (int64_t)sl_fx_isqrt64((uint64_t)t2_q24 << 24);
-    const int64_t along_q24 = (((int64_t)res->psi_sigma_cdeg * RAD_Q24_PER_CDEG) *
+    const int64_t along_q24 = (((int64_t)psi_sigma_cdeg * RAD_Q24_PER_CDEG) *
                                (((int64_t)1 << 24) + t2_q24)) >> 24;        // sigma of |t|
     int64_t a1 = along_q24;
     int64_t a2 = 0;
-    if (res->phi_sigma_cdeg < 18000U && tnorm_q24 > 0) {
+    if (phi_sigma_cdeg < 18000U && tnorm_q24 > 0) {
         a1 = (along_q24 * an) / tnorm_q24;
-        a2 = (((int64_t)res->phi_sigma_cdeg * RAD_Q24_PER_CDEG) * ap) >> 24;
+        a2 = (((int64_t)phi_sigma_cdeg * RAD_Q24_PER_CDEG) * ap) >> 24;
     }
     const int64_t sig_q24 = (int64_t)sl_fx_isqrt64((uint64_t)(a1 * a1) + (uint64_t)(a2 * a2));
     const int64_t lean_q24 = (sig_q24 << 24) / (((int64_t)1 << 24) + ((an * an) >> 24));
@@ -603,8 +620,10 @@ static uint16_t lean_sigma_cdeg(const sl_tilt_result_t *res, int64_t tp_q24, int
     return (cdeg > (int64_t)UINT16_MAX) ? (uint16_t)UINT16_MAX : (uint16_t)cdeg;
 }
 
-bool sl_tiltobs_vehicle(const sl_tiltobs_t *o, const sl_tiltobs_ring_t *r,
-                        sl_tiltobs_vehicle_t *out)
+// Reading `mirror` (false: the fit's best; true: an AMBIGUOUS fit's other one) of ring `r`
+// in the vehicle frame at the current pose (sl_tiltobs_vehicle, _vehicle_mirror).
+static bool vehicle_reading(const sl_tiltobs_t *o, const sl_tiltobs_ring_t *r, bool mirror,
+                            sl_tiltobs_vehicle_t *out)
 {
     SL_ASSERT(o != NULL && out != NULL);
     memset(out, 0, sizeof *out);
@@ -612,34 +631,52 @@ bool sl_tiltobs_vehicle(const sl_tiltobs_t *o, const sl_tiltobs_ring_t *r,
         return false;
     }
     const sl_tilt_result_t *res = &r->res;
+    const sl_tilt_reading_t *m = &res->mirror;
     out->quality = res->quality;
+    if (mirror && res->quality != (uint8_t)SL_TILT_AMBIGUOUS) {
+        return false;
+    }
     if (res->quality != (uint8_t)SL_TILT_FITTED && res->quality != (uint8_t)SL_TILT_AMBIGUOUS) {
         return true;
     }
+    const int64_t rtx = mirror ? m->tx_q24 : res->tx_q24;
+    const int64_t rty = mirror ? m->ty_q24 : res->ty_q24;
     sl_q30_t s;
     sl_q30_t c;
     sl_tilt_sincos_q30(o->odom.yaw, &s, &c);
     const int32_t yaw_cdeg = sl_incline_bam32_to_cdeg(o->odom.yaw); // signed
-    int32_t phi = (res->phi_cdeg - yaw_cdeg) % 36000;
+    int32_t phi = ((mirror ? m->phi_cdeg : res->phi_cdeg) - yaw_cdeg) % 36000;
     if (phi < 0) {
         phi += 36000;
     }
-    out->psi_cdeg = res->psi_cdeg;
+    out->psi_cdeg = mirror ? m->psi_cdeg : res->psi_cdeg;
     out->phi_cdeg = phi;
-    out->psi_sigma_cdeg = res->psi_sigma_cdeg;
-    out->phi_sigma_cdeg = res->phi_sigma_cdeg;
-    const int64_t dx = r->anchor_x_um + res->base_x_um - o->odom.x_um;
-    const int64_t dy = r->anchor_y_um + res->base_y_um - o->odom.y_um;
+    out->psi_sigma_cdeg = mirror ? m->psi_sigma_cdeg : res->psi_sigma_cdeg;
+    out->phi_sigma_cdeg = mirror ? m->phi_sigma_cdeg : res->phi_sigma_cdeg;
+    const int64_t dx = r->anchor_x_um + (mirror ? m->base_x_um : res->base_x_um) - o->odom.x_um;
+    const int64_t dy = r->anchor_y_um + (mirror ? m->base_y_um : res->base_y_um) - o->odom.y_um;
     const int64_t bx = sl_fx_rshift_round64(dx * c + dy * s, 30U);
     const int64_t by = sl_fx_rshift_round64(dy * c - dx * s, 30U);
     out->base_x_um = sat32(bx);
     out->base_y_um = sat32(by);
     // Tilt vector's y component in the vehicle frame (Q24), towards the path = -sign(y_b).
-    const int64_t ty_v = sl_fx_rshift_round64((int64_t)res->ty_q24 * c - (int64_t)res->tx_q24 * s, 30U);
+    const int64_t ty_v = sl_fx_rshift_round64(rty * c - rtx * s, 30U);
     const int64_t towards = (by >= 0) ? -ty_v : ty_v;
     const sl_bam32_t lean = sl_incline_atan2_bam32(sat32(towards), (int32_t)0x1000000);
     out->lean_path_cdeg = sl_incline_bam32_to_cdeg(lean);
-    const int64_t tx_v = sl_fx_rshift_round64((int64_t)res->tx_q24 * c + (int64_t)res->ty_q24 * s, 30U);
-    out->lean_path_sigma_cdeg = lean_sigma_cdeg(res, tx_v, ty_v);
+    const int64_t tx_v = sl_fx_rshift_round64(rtx * c + rty * s, 30U);
+    out->lean_path_sigma_cdeg = lean_sigma_cdeg(out->psi_sigma_cdeg, out->phi_sigma_cdeg, tx_v, ty_v);
     return true;
+}
+
+bool sl_tiltobs_vehicle(const sl_tiltobs_t *o, const sl_tiltobs_ring_t *r,
+                        sl_tiltobs_vehicle_t *out)
+{
+    return vehicle_reading(o, r, false, out);
+}
+
+bool sl_tiltobs_vehicle_mirror(const sl_tiltobs_t *o, const sl_tiltobs_ring_t *r,
+                               sl_tiltobs_vehicle_t *out)
+{
+    return vehicle_reading(o, r, true, out);
 }

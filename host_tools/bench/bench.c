@@ -2,7 +2,7 @@
 // sl-bench: the whole detection pipeline (sl_pipeline_feed) over a capture file.
 //
 //   sl-bench CAPTURE [--board NAME] [--chunk BYTES] [--repeat N] [--loop N] [--n N]
-//                    [--beam-cdeg N] [--threshold T] [--speed-mm-s V] [--no-profile]
+//                    [--beam-cdeg N] [--threshold T] [--speed-mm-s V] [--no-profile] [--no-learn]
 //                    [--callgrind run|latency] [--quiet]
 //
 // CAPTURE is a raw Colossus stream (`.colossus`: sl-sim, `sl-replay from-oxford`,
@@ -120,6 +120,7 @@ typedef struct opts {
     int repeat, loop, n, beam_cdeg, threshold;
     long speed_mm_s;
     int no_profile;
+    int no_learn;
     bool quiet;
 } opts_t;
 
@@ -131,7 +132,7 @@ typedef struct opts {
 static void usage(FILE *out)
 {
     fprintf(out, "usage: " SL_BENCH_PROG " CAPTURE [--board NAME] [--chunk BYTES] [--repeat N] "
-                 "[--loop N] [--n N] [--beam-cdeg N] [--threshold T] [--speed-mm-s V] [--no-profile] "
+                 "[--loop N] [--n N] [--beam-cdeg N] [--threshold T] [--speed-mm-s V] [--no-profile] [--no-learn] "
                  "[--callgrind run|latency] [--quiet]\n");
 }
 
@@ -219,6 +220,9 @@ static int init_pipeline(const opts_t *o, const sl_board_t *board)
     if (o->beam_cdeg > 0) {
         c.detect.beam_width_cdeg = (uint16_t)o->beam_cdeg;
     }
+    if (o->no_learn) {
+        c.learn = false; // the board's prior, no floor: detection at the threshold
+    }
     if (o->no_profile) {
         c.profile = false; // the mask's bounds and the board's d(r) (sl_profile.h off)
     }
@@ -273,6 +277,8 @@ int main(int argc, char **argv)
             o.beam_cdeg = atoi(v), i++;
         } else if (strcmp(a, "--no-profile") == 0) {
             o.no_profile = 1;
+        } else if (strcmp(a, "--no-learn") == 0) {
+            o.no_learn = 1;
         } else if (strcmp(a, "--threshold") == 0 && v) {
             o.threshold = atoi(v), i++;
         } else if (strcmp(a, "--speed-mm-s") == 0 && v) {
@@ -402,6 +408,21 @@ int main(int argc, char **argv)
                ts->observations, ts->fits, ts->resets, ts->no_ring, sizeof(sl_tiltobs_t));
         printf("detect_window: near %u win_max %u\n", (unsigned)g_pl.detect.near_bins,
                (unsigned)win_max);
+        const sl_response_t *rs = &g_pl.resp;
+        printf("model: response %s peaks %" PRIu32 " half_power_bins %.2f floor_dB/threshold",
+               rs->source == SL_RESPONSE_LEARNED      ? "learned"
+               : rs->source == SL_RESPONSE_CALIBRATED ? "calibrated"
+                                                      : "prior",
+               rs->learn_n, sl_response_hpw_q8(rs) / 256.0);
+        for (uint32_t b = 0; b * SL_RESP_FLOOR_BAND < g_pl.mask_bins; b++) {
+            const int32_t fl = sl_response_floor_lp(rs, b * SL_RESP_FLOOR_BAND);
+            if (fl == INT32_MIN) {
+                printf(" -/%u", (unsigned)g_pl.thr_band[b]);
+            } else {
+                printf(" %.1f/%u", fl * 3.0103 / 256.0, (unsigned)g_pl.thr_band[b]);
+            }
+        }
+        printf("\n");
         printf("wall_s: %.6f\n", best);
         printf("MB_per_s: %.1f\n", (double)n / best / 1e6);
         printf("us_per_azimuth: %.4f\n",

@@ -53,6 +53,7 @@ const std::set<std::string> kKnown = {
     "can.data_id_mode_pole_lean", "can.data_id_mode_lean_warning", "can.data_id_mode_status",
     "can.data_id_mode_vehicle_motion", "can.data_id_mode_health", "can.data_id_mode_pole_tilt",
     "can.max_delta_counter_vehicle_motion",
+    "response.value_scale", "response.values_per_octave", "response.prior",
 };
 
 // The board keys' message names, in sl_can_msg_t order.
@@ -409,6 +410,19 @@ BoardSpec load_board(const std::string &name_or_path)
     }
     b.can_max_delta_counter_motion = static_cast<unsigned>(
         r.integer("can.max_delta_counter_vehicle_motion", 1, 14, 2L));
+    const std::string scale = r.str("response.value_scale", "log2");
+    if (scale != "log2" && scale != "linear") {
+        r.fail("response.value_scale", "'" + scale + "' is not log2 or linear");
+    }
+    b.value_scale_linear = scale == "linear";
+    b.values_per_octave = r.real("response.values_per_octave", 1.0, 16.0, 6.02);
+    if (b.value_scale_linear && r.has("response.values_per_octave")) {
+        r.fail("response.values_per_octave", "only for value_scale = log2");
+    }
+    b.response_prior = r.str("response.prior", "cts350x");
+    if (b.response_prior != "cts350x" && b.response_prior != "ideal") {
+        r.fail("response.prior", "'" + b.response_prior + "' is not cts350x or ideal");
+    }
     const std::set<unsigned> ids = {b.can_id_pole_lean, b.can_id_lean_warning, b.can_id_status,
                                     b.can_id_vehicle_motion, b.can_id_health,
                                     b.can_id_pole_tilt};

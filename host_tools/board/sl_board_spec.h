@@ -60,6 +60,11 @@ struct BoardSpec {
     unsigned can_data_id[6] = {0x0051, 0x0052, 0x0053, 0x0054, 0x0055, 0x0056};
     unsigned can_data_id_mode[6] = {0, 0, 0, 0, 0, 0};
     unsigned can_max_delta_counter_motion = 2;
+    // The sensor model's prior ([response]): the 8-bit values' scale and the range response
+    // a point return makes before any is learned from the stream.
+    bool value_scale_linear = false;   // value_scale = log2 (default) | linear
+    double values_per_octave = 6.02;   // log2 scale: values per octave of power
+    std::string response_prior = "cts350x"; // cts350x (the measured lobe) | ideal (one bin)
 
     /// Opening angle theta (deg) of azimuth index i: the depression of the ray that grazes
     /// the chassis edge. NaN when the chassis does not surround the radar on that azimuth.

@@ -108,7 +108,10 @@ const std::map<std::string, std::string> kMessageComments = {
      "While driving (a motion input is present): one frame per confirmed target and radar "
      "rotation that has an observation history (GenMsgSendType CyclicIfActive): the pole's "
      "3D tilt fitted from its in-plane leans over the drive-by. The values are meaningful "
-     "only when Quality is FITTED or AMBIGUOUS (then the direction may be the mirror image)."},
+     "only when Quality is FITTED, AMBIGUOUS or MIRROR. AMBIGUOUS: the observations cannot "
+     "tell the pole from its mirror image; the frame carries the better-fitting reading and "
+     "is followed in the same rotation by a frame of the same TargetId with Quality MIRROR "
+     "carrying the other one: the pole is one of the two."},
     {"Health", "Sent right after every Status: why the output may be degraded or blind. "
                "Any Fault bit set means do not trust an absent warning. A bit is set when "
                "its condition held since the previous Health frame or still holds."},
@@ -162,9 +165,11 @@ const std::map<std::string, std::string> kSignalComments = {
     {"Health.Reconnects", "Radar link reconnects since start (saturating at 255)."},
     {"Health.CandidatesDropped", "Detection candidates dropped for lack of target slots since "
                                  "start (saturating at 4095)."},
-    {"PoleTilt.Quality", "Fit quality: FITTED, AMBIGUOUS (mirror hypothesis fits as well), "
-                         "INSUFFICIENT_MOTION (bearings do not spread), TOO_FEW "
-                         "(observations), INCONSISTENT (residuals far above the sigmas)."},
+    {"PoleTilt.Quality", "Fit quality: FITTED, AMBIGUOUS (the mirror hypothesis fits as well: "
+                         "this is one of two readings), INSUFFICIENT_MOTION (bearings do not "
+                         "spread), TOO_FEW (observations), INCONSISTENT (residuals far above "
+                         "the sigmas), MIRROR (the other reading of the AMBIGUOUS frame just "
+                         "sent for this TargetId)."},
     {"PoleTilt.Clamped", "1: at least one value hit its range limit."},
     {"PoleTilt.TargetId", "Tracker id of the target (as in PoleLean)."},
     {"PoleTilt.Tilt", "Tilt of the pole from vertical (psi)."},

@@ -13,6 +13,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "calib_cmds.h"
+#include "calib_ini.h"
 #include "oxford.h"
 #include "sl_board_spec.h"
 #include "sl_progress.h"
@@ -36,16 +37,20 @@ double drop_counts(const sl_vscale_t &s, uint16_t drop_q8)
     return drop_q8 / 256.0 * 3.0103; // a linear scale: report dB
 }
 
-void write_ini(FILE *f, const sl_response_t &r)
+// The [response] block of the vehicle's calibration file (calib_ini.h).
+std::string ini_block(const sl_response_t &r, const std::string &source)
 {
-    std::fprintf(f, "# The radar's range response, measured by sl-calib response: the drop below a\n"
-                    "# point return's centre at offsets -%d..+%d bins, in 1/256 octave of power.\n"
-                    "[response]\ndrops_q8 = ",
-                 SL_CFG_RESP_HALF, SL_CFG_RESP_HALF);
-    for (int i = 0; i < SL_RESP_TAPS; i++) {
-        std::fprintf(f, "%s%u", i ? ", " : "", r.drop_q8[i]);
+    std::string o = "; The radar's range response: the drop below a point return's centre at\n"
+                    "; offsets -" + std::to_string(SL_CFG_RESP_HALF) + "..+" +
+                    std::to_string(SL_CFG_RESP_HALF) + " bins, in 1/256 octave of power.\n"
+                    "[response]\ntool = " + sl::calib_tool_version() + "\ndate = " + sl::calib_utc_date() +
+                    "\nsource = " + source + "\npeaks = " + std::to_string(r.learn_n) +
+                    "\ndrops_q8 =";
+    for (int i = 0; i < SL_RESP_TAPS; i++) { // continuation lines: inih's 200-character limit
+        o += (i > 0 && i % 12 == 0 ? "\n   " : "") + std::string(" ") +
+             std::to_string(r.drop_q8[i]) + (i + 1 < SL_RESP_TAPS ? "," : "");
     }
-    std::fprintf(f, "\npeaks = %u\n", r.learn_n);
+    return o + "\n";
 }
 
 } // namespace
@@ -160,14 +165,16 @@ int cmd_response(const ResponseArgs &a)
                         a.linear ? lp / 256.0 * 3.0103 : lp / 256.0 * scale.cpo_q8 / 256.0);
         }
     }
-    if (!a.out_ini.empty()) {
-        FILE *f = std::fopen(a.out_ini.c_str(), "w");
-        if (f == nullptr) {
-            std::fprintf(stderr, "sl-calib: cannot write %s\n", a.out_ini.c_str());
+    if (!a.out_ini.empty() && r.source == SL_RESPONSE_LEARNED) {
+        std::string why;
+        if (!sl::write_calib_block(a.out_ini, "response", ini_block(r, a.input), "[response]", &why)) {
+            std::fprintf(stderr, "sl-calib: %s\n", why.c_str());
             return 1;
         }
-        write_ini(f, r);
-        std::fclose(f);
+    } else if (!a.out_ini.empty()) {
+        std::fprintf(stderr, "sl-calib: response: too few isolated peaks (%u of %u) or an "
+                             "implausible shape: %s not written\n",
+                     r.learn_n, r.cfg.min_peaks, a.out_ini.c_str());
     }
     if (r.learn_n == 0) {
         std::fprintf(stderr, "sl-calib: response: no isolated strong return in %s\n",

@@ -382,14 +382,7 @@ int cmd_run(int argc, char **argv)
         sl::ModelEvalOptions mo;
         mo.scale = sl_vscale_t{(uint8_t)SL_VSCALE_LOG2, 1541U};
         if (!scene_path.empty()) {
-            const sl::Scene sc = sl::load_scene(scene_path);
-            if (sc.mapping == sl::OutputMapping::Linear) {
-                mo.scale = sl_vscale_t{(uint8_t)SL_VSCALE_LINEAR, 0U};
-            } else {
-                const double cpo = sc.log_db_per_decade * std::log10(2.0) / (sc.log_power ? 1.0 : 2.0);
-                mo.scale = sl_vscale_t{(uint8_t)SL_VSCALE_LOG2,
-                                       static_cast<uint16_t>(std::lround(cpo * 256.0))};
-            }
+            mo.scale = sl::scene_value_scale(sl::load_scene(scene_path));
         }
         mo.looks = looks;
         mo.learn = model_learn;

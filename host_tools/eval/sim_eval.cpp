@@ -391,6 +391,16 @@ void simulate_decode(const Scene &scene, int threads,
 const char *const kPipelineLabel =
     "core pipeline (sl_pipeline: mask + detection + corrections + alpha; n_eff from motion)";
 
+sl_vscale_t scene_value_scale(const Scene &s)
+{
+    if (s.mapping == OutputMapping::Linear) {
+        return sl_vscale_t{static_cast<uint8_t>(SL_VSCALE_LINEAR), 0U};
+    }
+    const double cpo = s.log_db_per_decade * std::log10(2.0) / (s.log_power ? 1.0 : 2.0);
+    return sl_vscale_t{static_cast<uint8_t>(SL_VSCALE_LOG2),
+                       static_cast<uint16_t>(std::lround(cpo * 256.0))};
+}
+
 PipeCfg pipe_cfg_for_scene(const Scene &s)
 {
     PipeCfg c;
@@ -401,6 +411,7 @@ PipeCfg pipe_cfg_for_scene(const Scene &s)
     // a constant number of values per bin); a linear rendering (the paper's simulation
     // style, no smear) is read from the mask's bounds.
     c.profile = s.mapping == OutputMapping::Log ? -1 : 0;
+    c.value_scale = scene_value_scale(s);
     c.speed_mps = s.speed_mps;
     c.rotation_hz = s.rotation_hz;
     return c;
@@ -466,6 +477,9 @@ PipelineEval::PipelineEval(const PipeCfg &c) : m_(new Impl)
         pc.profile = c.profile != 0;
     }
     pc.profile_cfg.prior_r2_offset_um = c.prior_r2_offset_um;
+    if (c.value_scale.kind != static_cast<uint8_t>(SL_VSCALE_LOG2) || c.value_scale.cpo_q8 != 0U) {
+        pc.value_scale = c.value_scale;
+    }
     const sl_err_t e = sl_pipeline_init(m_->p.get(), b, &pc);
     if (e != SL_OK) {
         const std::string msg = m_->p->last_err_msg != nullptr ? m_->p->last_err_msg : "?";

@@ -18,6 +18,7 @@
 
 #include "capture.h"
 #include "shadowlean/sl_proto.h"
+#include "shadowlean/sl_response.h"
 #include "sim_scene.h"
 #include "sim_truth.h"
 #include "sl_board_spec.h"
@@ -165,14 +166,20 @@ struct PipeCfg {
     bool clip_ambiguous = false; ///< ErrStats: count AMBIGUOUS as the model's bound
     double rotation_hz = 4;     ///< for now_us (the pipeline measures the period itself)
     int32_t prior_r2_offset_um = 0; ///< cfg.profile_cfg.prior_r2_offset_um (0: none)
+    sl_vscale_t value_scale{0, 0}; ///< what the values are (LOG2 with 0 per octave: board's)
 };
 
 /// Pipeline defaults for a simulated scene: its board, the simulated azimuth window as the
 /// beam (2 x scene_az_cutoff_deg: a touched bin reads >= detect_floor, so the return spans
 /// the whole window), threshold = detect_floor for the linear mapping (else the board's),
-/// range profiles only for the log mapping (their tail model reads log values), speed = the
-/// scene's.
+/// range profiles only for the log mapping (their tail model reads log values), the value
+/// scale of the scene's output mapping, speed = the scene's.
 PipeCfg pipe_cfg_for_scene(const Scene &s);
+
+/// The value scale of a scene's output mapping: linear energy, or round(c log10 N) of a
+/// power or a magnitude N as a log2 scale of c log10(2) (power) or c log10(2) / 2
+/// (magnitude) values per octave of power.
+sl_vscale_t scene_value_scale(const Scene &s);
 
 /// Result for one pole.
 struct PipeEval {

@@ -88,21 +88,6 @@ struct SceneResult {
     uint32_t samples = 0, occupied = 0, no_ground = 0, bad_edge = 0, short_rows = 0;
 };
 
-sl_vscale_t scale_for(const Scene &s)
-{
-    if (s.mapping == OutputMapping::Log && s.log_power && s.log_navtech) {
-        const sl_vscale_t v = SL_VSCALE_CTS350X;
-        sl_vscale_t o = v;
-        // values per octave of power: log_db_per_decade x log10(2) ... per the scene's curve
-        o.cpo_q8 = static_cast<uint16_t>(std::lround(s.log_db_per_decade * std::log10(2.0) * 256.0));
-        return o;
-    }
-    sl_vscale_t lin{};
-    lin.kind = static_cast<uint8_t>(SL_VSCALE_LINEAR);
-    lin.cpo_q8 = 256U;
-    return lin;
-}
-
 SceneResult run_scene(const std::string &path, int rotations, int warmup, double front_arg,
                       int threads, bool dump_hazards)
 {
@@ -130,7 +115,7 @@ SceneResult run_scene(const std::string &path, int rotations, int warmup, double
         cfg.profile = pc.profile != 0;
     }
     cfg.ground = true;
-    cfg.ground_cfg.scale = scale_for(scene);
+    cfg.value_scale = scene_value_scale(scene);
     std::unique_ptr<sl_pipeline_t> p(new sl_pipeline_t());
     const sl_err_t e = sl_pipeline_init(p.get(), b, &cfg);
     if (e != SL_OK) {

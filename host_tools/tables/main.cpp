@@ -38,6 +38,8 @@ namespace {
 
 constexpr const char *kVersion = "sl-tables 1.0";
 constexpr double kPi = 3.14159265358979323846;
+// An ideal sensor's taps beside the centre: 64 octaves (193 dB) down, beyond any 8-bit scale.
+constexpr unsigned kIdealDropQ8 = 64U * 256U;
 
 std::string c_name(const std::string &n)
 {
@@ -100,11 +102,23 @@ struct Tables {
     std::vector<unsigned> shadow_bins;
     std::vector<int16_t> theta_cdeg16;   // the same, in the core's types
     std::vector<uint16_t> shadow_bins16;
+    std::vector<uint16_t> response_prior_q8; // SL_RESP_TAPS drops, log2 power Q8
 };
 
 Tables make_tables(const sl::BoardSpec &b)
 {
     Tables t;
+    // The response prior: the core's own CTS350-X table (one source), or an ideal sensor
+    // whose point return stays in its bin (every other tap far below anything measurable).
+    t.response_prior_q8.assign(SL_RESP_TAPS, 0);
+    if (b.response_prior == "cts350x") {
+        sl_response_prior_cts350x(t.response_prior_q8.data());
+    } else {
+        for (int i = 0; i < SL_RESP_TAPS; i++) {
+            t.response_prior_q8[static_cast<size_t>(i)] =
+                i == SL_CFG_RESP_HALF ? 0U : static_cast<uint16_t>(kIdealDropQ8);
+        }
+    }
     for (int i = 0; i < b.azimuths; i++) {
         const double th = b.theta_deg(i);
         const double r = b.shadow_radius_m(i);
@@ -203,6 +217,10 @@ sl_board_t make_board(const sl::BoardSpec &b, const Tables &t, const std::string
         v.can_data_id_mode[m] = static_cast<uint8_t>(b.can_data_id_mode[m]);
     }
     v.can_max_delta_counter_motion = static_cast<uint8_t>(b.can_max_delta_counter_motion);
+    v.value_scale.kind = static_cast<uint8_t>(b.value_scale_linear ? SL_VSCALE_LINEAR : SL_VSCALE_LOG2);
+    v.value_scale.cpo_q8 =
+        b.value_scale_linear ? 0U : static_cast<uint16_t>(rnd(b.values_per_octave * 256.0));
+    v.response_prior_q8 = t.response_prior_q8.data();
     v.geom = t.geom.data();
     v.theta_cdeg = t.theta_cdeg16.data();
     v.shadow_um = t.shadow_um.data();
@@ -240,6 +258,15 @@ void write_source(const sl_board_t &v, const std::string &path, const std::strin
         }
         o << "\n};\n\n";
     };
+    o << "#if SL_RESP_TAPS != " << SL_RESP_TAPS << "\n#error \"board " << v.name
+      << ": the response prior has " << SL_RESP_TAPS << " taps (SL_CFG_RESP_HALF)\"\n#endif\n";
+    o << "// The range response's prior: drop below the centre per offset, log2 power Q8.\n"
+      << "static const uint16_t response_prior_q8[" << SL_RESP_TAPS << "] = {";
+    for (int i = 0; i < SL_RESP_TAPS; i++) {
+        o << (i % 12 == 0 ? "\n    " : " ") << v.response_prior_q8[i] << "u"
+          << (i + 1 < SL_RESP_TAPS ? "," : "");
+    }
+    o << "\n};\n\n";
     arr("int16_t", "theta_cdeg", [&](size_t i) { return std::to_string(v.theta_cdeg[i]); }, 10);
     arr("uint32_t", "shadow_um", [&](size_t i) { return std::to_string(v.shadow_um[i]) + "u"; }, 8);
     arr("uint16_t", "shadow_bins", [&](size_t i) { return std::to_string(v.shadow_bins[i]) + "u"; }, 12);
@@ -296,6 +323,9 @@ void write_source(const sl_board_t &v, const std::string &path, const std::strin
     o << "},\n"
       << "    .can_max_delta_counter_motion = " << unsigned(v.can_max_delta_counter_motion)
       << "u,\n"
+      << "    .value_scale = {" << unsigned(v.value_scale.kind) << "u, " << v.value_scale.cpo_q8
+      << "u},\n"
+      << "    .response_prior_q8 = response_prior_q8,\n"
       << "    .geom = geom,\n"
       << "    .theta_cdeg = theta_cdeg,\n"
       << "    .shadow_um = shadow_um,\n"

@@ -20,6 +20,7 @@
 
 #include "shadowlean/sl_config.h"
 #include "shadowlean/sl_incline.h"
+#include "shadowlean/sl_response.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -81,6 +82,14 @@ typedef struct sl_board {
     /// WRONG_SEQUENCE (sl_can.h).
     uint8_t can_max_delta_counter_motion;
     // --- generated per-azimuth tables, `azimuths` entries each
+    sl_vscale_t value_scale;       ///< what the 8-bit values are (board `response.value_scale`)
+    /// The range response a point return makes before one is learned from the stream:
+    /// SL_RESP_TAPS drops below the centre, log2 power Q8 (sl_response.h); board
+    /// `response.prior` = cts350x (the lobe measured on the CTS350-X) or ideal (one bin).
+    /// NULL: the built-in CTS350-X lobe.
+    const uint16_t *response_prior_q8;
+    uint8_t response_calibrated;   ///< 1: response_prior_q8 is the vehicle's calibration's
+                                   ///< (sl_calblob.h), used as SL_RESPONSE_CALIBRATED
     const sl_incline_geom_t *geom; ///< trig + branch bounds per azimuth
     const int16_t *theta_cdeg;     ///< opening angle theta per azimuth, 0.01 deg
     const uint32_t *shadow_um;     ///< ground shadow radius R = H / tan(theta) per azimuth

@@ -122,7 +122,8 @@
 /// | 32 | 8  | Reconnects        | u | 0..255   | radar link re-opened since start (saturating) |
 /// | 40 | 12 | CandidatesDropped | u | 0..4095  | detection candidates dropped for lack of target slots (saturating) |
 /// | 52 | 8  | ThetaDrift        | s | -12.8..12.7 deg, 0.1 deg | live theta minus the loaded calibration's (sl_drift.h); 0 while there is no estimate; saturating |
-/// | 60 | 4  | (reserved)        |   | 0        | |
+/// | 60 | 2  | ResponseSource    | u | 0..2     | the range response in use (sl_response.h): PRIOR (the board's), LEARNED (from this stream), CALIBRATED (the vehicle's calibration) |
+/// | 62 | 2  | (reserved)        |   | 0        | |
 ///
 /// Fault bits (the DBC carries a value table naming each bit's value): a bit is set in a
 /// Health frame when its condition held at any time since the previous Health frame, or
@@ -163,7 +164,7 @@
 /// |------:|----:|----------------|------|--------|------------------|------|------|
 /// |  0 | 8  | Crc            | u | 1    | 0..255          |     | E2E, Data ID 0x0056 |
 /// |  8 | 4  | Counter        | u | 1    | 0..14           |     | E2E |
-/// | 12 | 3  | Quality        | u | 1    | 0..4            |     | sl_can_tilt_quality_t |
+/// | 12 | 3  | Quality        | u | 1    | 0..5            |     | sl_can_tilt_quality_t |
 /// | 15 | 1  | Clamped        | u | 1    | 0..1            |     | 1 = a value below hit its range limit |
 /// | 16 | 4  | TargetId       | u | 1    | 0..15           |     | tracker id (as PoleLean) |
 /// | 20 | 8  | Tilt           | u | 0.1  | 0..25.5         | deg | psi, tilt from vertical |
@@ -173,10 +174,14 @@
 /// | 48 | 8  | BaseX          | s | 0.05 | -6.4..6.35      | m   | pole base, vehicle frame at the frame's time, x forward |
 /// | 56 | 8  | BaseY          | s | 0.05 | -6.4..6.35      | m   | ... y left |
 ///
-/// Quality: FITTED (0) and AMBIGUOUS (1: the mirror hypothesis fits as well; the better one
-/// is sent, do not trust the direction) carry numbers; INSUFFICIENT_MOTION (2), TOO_FEW (3)
-/// and INCONSISTENT (4) send every value as 0. The fit runs per rotation on at most
-/// SL_CFG_TILT_FITS_PER_ROTATION tracks; a frame carries the track's latest fit.
+/// Quality: FITTED (0), AMBIGUOUS (1) and MIRROR (5) carry numbers; INSUFFICIENT_MOTION
+/// (2), TOO_FEW (3) and INCONSISTENT (4) send every value as 0. An AMBIGUOUS fit (the
+/// observations cannot tell the pole from its mirror image: sl_tilt.h) is an answer with
+/// two readings: its frame carries the better-fitting one and is followed, in the same
+/// rotation, by a second PoleTilt frame of the same TargetId with Quality MIRROR carrying
+/// the other (tilt, direction, their sigmas, base); the pole is one of the two. MIRROR
+/// never goes out alone. The fit runs per rotation on at most SL_CFG_TILT_FITS_PER_ROTATION
+/// tracks; a frame carries the track's latest fit.
 ///
 /// ## VehicleMotion (board `can.id_vehicle_motion`, VEHICLE -> SHADOWLEAN, input)
 ///
@@ -324,8 +329,10 @@ typedef enum sl_can_tilt_quality {
     SL_CAN_TILT_INSUFFICIENT_MOTION = 2,
     SL_CAN_TILT_TOO_FEW = 3,
     SL_CAN_TILT_INCONSISTENT = 4,
+    SL_CAN_TILT_MIRROR = 5, ///< the other reading of the AMBIGUOUS fit sent just before it
+                            ///< with the same TargetId (not a sl_tilt_quality_t value)
 } sl_can_tilt_quality_t;
-#define SL_CAN_TILT_QUALITY_MAX 4U
+#define SL_CAN_TILT_QUALITY_MAX 5U
 
 /// LeanWarning.Level.
 typedef enum sl_can_level {
@@ -416,6 +423,7 @@ typedef enum sl_can_link_state {
 #define SL_CAN_HEALTH_DRIFT_CDEG_PER_LSB 10   ///< 0.1 deg
 #define SL_CAN_HEALTH_DRIFT_RAW_MIN (-128)
 #define SL_CAN_HEALTH_DRIFT_RAW_MAX 127
+#define SL_CAN_RESPONSE_SOURCE_MAX 2U ///< Health.ResponseSource: sl_response_source_t
 
 #define SL_CAN_MOTION_SPEED_MM_S_PER_LSB 10  ///< 0.01 m/s
 #define SL_CAN_MOTION_YAW_CDEG_S_PER_LSB 1   ///< 0.01 deg/s
@@ -487,6 +495,8 @@ typedef struct sl_can_health {
     uint32_t reconnects;         ///< in: radar link reconnects since start (saturates at 255)
     uint32_t candidates_dropped; ///< in: candidates dropped for lack of target slots (4095)
     int16_t theta_drift_cdeg;    ///< in: ThetaDrift, 0.01 deg (sent in 0.1 deg, saturating)
+    uint8_t response_source;     ///< in: ResponseSource, sl_response_source_t (0..2; more
+                                 ///< is sent as 2, counted in stats.clamped_frames)
     uint8_t counter;             ///< decode only
 } sl_can_health_t;
 
@@ -627,8 +637,8 @@ sl_err_t sl_can_encode_lean_warning(sl_can_tx_t *tx, const sl_can_lean_warning_t
                                     sl_can_frame_t *out);
 
 /// Encode one PoleTilt frame (same rules as PoleLean: clamped values set Clamped; quality
-/// > 4 is sent as INCONSISTENT with Clamped set; a quality other than FITTED/AMBIGUOUS sends
-/// every value field as 0). The direction is an angle: reduced mod 360 deg, then rounded
+/// > 5 is sent as INCONSISTENT with Clamped set; a quality other than FITTED, AMBIGUOUS or
+/// MIRROR sends every value field as 0). The direction is an angle: reduced mod 360 deg, then rounded
 /// (359.6 deg is sent as 0).
 sl_err_t sl_can_encode_pole_tilt(sl_can_tx_t *tx, const sl_can_pole_tilt_t *in,
                                  sl_can_frame_t *out);

@@ -80,8 +80,11 @@
 /// per rotation (round robin). A rotation without motion input clears every ring (the
 /// odometry has a hole), so without motion nothing changes on CAN.
 /// PoleTilt: the ring's latest fit in the vehicle frame at the rotation's end (sl_can.h).
-/// LeanWarning and the fitted tilt: for a confirmed track whose fit is FITTED (not
-/// AMBIGUOUS), the warning uses the tilt TOWARDS THE VEHICLE'S PATH instead of the in-plane
+/// LeanWarning and the fitted tilt: for a confirmed track whose fit is FITTED or AMBIGUOUS
+/// (of an AMBIGUOUS fit's two readings, the more dangerous one: the higher level, then the
+/// larger lean towards the path, among the readings within the detector's largest lean
+/// whose path-lean sigma is within cfg.track.max_sigma_cdeg; with neither, the track's
+/// values as below), the warning uses the tilt TOWARDS THE VEHICLE'S PATH instead of the in-plane
 /// alpha: lean = atan(-sign(base_y) t_y) with t the tilt vector and base_y the base's
 /// lateral offset in the vehicle frame (> 0: the top leans over the path, the sign
 /// convention of Lean), its sigma that of the path lean (sl_tiltobs_vehicle_t
@@ -197,6 +200,7 @@
 #include "shadowlean/sl_port.h"
 #include "shadowlean/sl_profile.h"
 #include "shadowlean/sl_proto.h"
+#include "shadowlean/sl_response.h"
 #include "shadowlean/sl_scan.h"
 #include "shadowlean/sl_thresh.h"
 #include "shadowlean/sl_tiltobs.h"
@@ -258,6 +262,18 @@ typedef struct sl_pipeline_cfg {
     uint32_t rotation_us;        ///< rotation period when timestamps are unusable (250000)
     uint32_t row_timeout_us;     ///< Status says STREAMING (and Health has no NO_USABLE_ROWS)
                                  ///< only while a usable row arrived within this (1 s; 0 = 1 s)
+    // --- the sensor model (sl_response.h)
+    sl_vscale_t value_scale;     ///< what the 8-bit values are (default the board's; a board
+                                 ///< without one, kind LOG2 with 0 values per octave: the
+                                 ///< CTS350-X's)
+    bool learn;                  ///< the model reads one row per rotation (default true; the
+                                 ///< azimuth moves by 247 of 400 each rotation, so successive
+                                 ///< rows spread over the turn, or by one after a row that
+                                 ///< gave a peak); false: the board's prior and no floor,
+                                 ///< detection at `threshold`
+    uint16_t floor_margin_lp;    ///< occupied also needs the learned noise floor's mean plus
+                                 ///< this, log2 power Q8 (default 851: 10 dB, an exponential
+                                 ///< noise sample exceeds it with probability e^-10)
     // --- extraction
     bool profile;                ///< refine bounds from range profiles (sl_profile.h;
                                  ///< default true); false = the mask's bounds and d(r)
@@ -266,8 +282,8 @@ typedef struct sl_pipeline_cfg {
     // --- the ground from the shadow's edge (sl_ground.h; with SL_CFG_GROUND only)
     bool ground;                 ///< attitude, terrain, DROP/STEP (default true)
     sl_ground_cfg_t ground_cfg;  ///< its parameters (sl_ground_cfg_default; threshold 0:
-                                 ///< the pipeline's `threshold`; scale: the radar's value
-                                 ///< scale, default the CTS350-X's)
+                                 ///< the pipeline's `threshold`; its scale is replaced by
+                                 ///< `value_scale`)
 #endif
 } sl_pipeline_cfg_t;
 
@@ -296,6 +312,9 @@ struct sl_pipeline_rotation {
     const sl_track_t *tracks;    ///< tracker slots (sl_track.h); use those with `live`
     uint16_t n_track_slots;      ///< SL_CFG_MAX_TARGETS
     uint8_t level;               ///< sl_warn_level_t: highest level over live tracks
+    const sl_response_t *model;  ///< the sensor model after this rotation (sl_response.h)
+    const uint8_t *threshold;    ///< occupied threshold per band of SL_RESP_FLOOR_BAND bins
+    uint16_t bands;              ///< bands over the masked bins (entries of `threshold`)
 };
 
 /// Counters (cumulative since init; never asserted). The stage stats are in the stages
@@ -344,6 +363,9 @@ typedef struct sl_pipeline {
     bool ready;                  ///< init succeeded
     bool geometry_bad;           ///< the radar's last Configuration did not match the board
     uint16_t next_az;            ///< internal: next azimuth detection expects
+    uint16_t learn_az;           ///< internal: the azimuth the sensor model reads this rotation
+    bool thr_flat;               ///< every band's threshold is cfg.threshold (thr_band)
+    bool learn_hit;              ///< internal: this rotation's learning row gave a peak
     uint32_t r_max_um;           ///< farthest range detection reads (for the yaw term)
     uint32_t rotation_us;        ///< last measured rotation period
     bool motion_valid;           ///< motion used for the current rotation
@@ -395,7 +417,11 @@ typedef struct sl_pipeline {
     uint8_t row8[SL_CFG_MASK_BINS]; ///< scan's row buffer (16-bit reduction, short rows)
     uint8_t reasm[SL_PIPELINE_REASM_BYTES]; ///< decoder reassembly buffer
     sl_drift_t drift;            ///< theta drift watch (sl_drift.h): Health.ThetaDrift, THETA_DRIFT
-                                 ///< (last: the hot fields keep their offsets)
+    // the sensor model (last: the hot fields keep their offsets)
+    sl_response_t resp;          ///< range response and noise floor (sl_response.h): the
+                                 ///< board's prior, learned from one row per rotation
+    uint8_t thr_band[SL_CFG_RESP_FLOOR_BANDS]; ///< occupied threshold per band of
+                                 ///< SL_RESP_FLOOR_BAND bins: max(threshold, floor + margin)
 #if SL_CFG_GROUND
     sl_ground_t ground;          ///< the ground from the shadow's edge (sl_ground.h), with
                                  ///< cfg.ground
@@ -422,19 +448,19 @@ _Static_assert(sizeof(sl_pipeline_t) <= 65536U, "sl_pipeline_t: 64 KiB RAM budge
 /// Any azimuth count, bins and n with the default target/candidate capacities: the mask
 /// dominates; everything else except the tilt history (sl_tiltobs_t, sized by
 /// SL_CFG_TILT_TRACKS x SL_CFG_TILT_OBS_PER_TRACK: 2.5 KB firmware, 7.4 KB host) and the
-/// ground (sl_ground_t and its configuration, sized by SL_CFG_GROUND_SECTORS) stays under
-/// 17,536 B (17,412 B in the host configuration, with detection's link table, 168 B, its
+/// sensor model (sl_response_t, about 2.6 KB) and the ground (sl_ground_t and its
+/// configuration, sized by SL_CFG_GROUND_SECTORS) stays under 17,600 B (17,412 B in the host configuration, with detection's link table, 168 B, its
 /// per-azimuth peaks, 776 B, the CAN sender's E2E configuration, 24 B, and the
 /// VehicleMotion receiver with its Profile 11 state, 104 B).
 #if SL_CFG_MAX_TARGETS <= 32 && SL_CFG_DETECT_MAX_CANDIDATES <= 32 && SL_CFG_DETECT_MAX_SPAN <= 24 \
     && SL_CFG_MAX_AZIMUTHS <= 400
 #if defined(__cplusplus)
-static_assert(sizeof(sl_pipeline_t) <= sizeof(sl_mask_t) + sizeof(sl_tiltobs_t) + SL_PIPELINE_GROUND_BYTES +
-                                             17536U,
+static_assert(sizeof(sl_pipeline_t) <= sizeof(sl_mask_t) + sizeof(sl_tiltobs_t) +
+                                             sizeof(sl_response_t) + SL_PIPELINE_GROUND_BYTES + 17600U,
               "sl_pipeline_t budget");
 #else
-_Static_assert(sizeof(sl_pipeline_t) <= sizeof(sl_mask_t) + sizeof(sl_tiltobs_t) + SL_PIPELINE_GROUND_BYTES +
-                                             17536U,
+_Static_assert(sizeof(sl_pipeline_t) <= sizeof(sl_mask_t) + sizeof(sl_tiltobs_t) +
+                                             sizeof(sl_response_t) + SL_PIPELINE_GROUND_BYTES + 17600U,
                "sl_pipeline_t budget");
 #endif
 #endif

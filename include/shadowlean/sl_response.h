@@ -30,8 +30,8 @@
 /// ~8 bins, -20 dB at +-10 bins, a first sidelobe near -32 dB at 12-16 bins.
 ///
 /// ## Learning from the stream
-/// sl_response_learn_row() reads one row (one azimuth, the caller chooses which: the
-/// pipeline samples one per rotation) outside the shadow, between `min_bin` and `max_bin`:
+/// sl_response_learn_peaks() reads one row (one azimuth, the caller chooses which: the
+/// pipeline samples a few per rotation) beyond the shadow, between `min_bin` and `max_bin`:
 /// - peaks: bins whose lp is at least `cfg.peak_min_lp` above the row's floor estimate, that
 ///   are the maximum of +-`cfg.isolation` bins and have no second comparable peak (within
 ///   `cfg.rival_lp` of it behind a dip of `cfg.dip_lp`) within that distance; the centre is
@@ -45,13 +45,15 @@
 ///   an implausible estimate keeps the prior and is counted (`stats.implausible`).
 /// - the floor: per range band of `SL_RESP_FLOOR_BAND` bins, a running median of lp over
 ///   every 4th bin of the rows read (an exponential noise's median is its mean times ln 2:
-///   sl_response_floor_lp returns the mean's lp). It is read over the whole row, so bands
-///   where the scene dominates (a wall) read high; bands are independent.
+///   sl_response_floor_lp returns the mean's lp), read by sl_response_learn_floor() over the
+///   bins the caller gives (the pipeline: inside the shadow, where only the receiver's noise
+///   and sparse targets are); bands are independent.
 ///
 /// ## Ownership, memory, cost
-/// Caller-owned, no allocation, no float. RAM: sizeof(sl_response_t) (about 2.2 KB with the
-/// defaults). sl_response_learn_row: O(max_bin - min_bin) with a 2 x isolation window per
-/// candidate peak (at most `cfg.max_peaks_per_row` accepted); sl_response_update: O(taps x
+/// Caller-owned, no allocation, no float. RAM: sizeof(sl_response_t) (about 2.6 KB with the
+/// defaults). sl_response_learn_peaks: O(max_bin - min_bin) with a 2 x isolation window per
+/// candidate peak (at most 2 x `cfg.max_peaks_per_row` candidates examined, at most
+/// `cfg.max_peaks_per_row` accepted); sl_response_update: O(taps x
 /// SL_RESP_SUB). Not reentrant per instance.
 #ifndef SHADOWLEAN_SL_RESPONSE_H
 #define SHADOWLEAN_SL_RESPONSE_H
@@ -133,7 +135,7 @@ typedef struct sl_response_cfg {
 } sl_response_cfg_t;
 
 typedef struct sl_response_stats {
-    uint32_t rows;        ///< rows read by sl_response_learn_row
+    uint32_t rows;        ///< rows read by sl_response_learn_peaks
     uint32_t peaks;       ///< peaks accepted
     uint32_t rivals;      ///< candidate peaks rejected for a comparable neighbour
     uint32_t implausible; ///< updates where the learned shape failed the gates (prior kept)
@@ -143,9 +145,10 @@ typedef struct sl_response_stats {
 typedef struct sl_response {
     sl_vscale_t scale;
     sl_response_cfg_t cfg;
+    int16_t lp_q8[256];                   ///< derived: sl_vscale_lp of every value
+                                          ///< (saturating at 128 octaves)
     uint8_t source;                       ///< sl_response_source_t of `drop_q8`
     uint16_t drop_q8[SL_RESP_TAPS];       ///< in use: drop below the centre, log2 Q8
-    uint16_t prior_q8[SL_RESP_TAPS];      ///< the prior
     int32_t learn_q8[SL_RESP_TAPS];       ///< running medians (learned drops), log2 Q8
     uint32_t learn_n;                     ///< peaks aggregated into learn_q8
     uint32_t tap_q22[SL_RESP_TAPS];       ///< derived: linear taps, centre 2^22
@@ -174,13 +177,42 @@ void sl_response_prior_cts350x(uint16_t drop_q8[SL_RESP_TAPS]);
 sl_err_t sl_response_init(sl_response_t *r, const sl_vscale_t *scale,
                           const uint16_t *prior_q8, const sl_response_cfg_t *cfg);
 
+/// True when `drop_q8` is a plausible response: 0 at the centre, non-decreasing away from it
+/// on each side down to a drop of `down_to_lp` (log2 Q8), below half power within
+/// SL_CFG_RESP_HALF bins on each side (the gates of a learned shape). O(taps).
+bool sl_response_plausible(const uint16_t drop_q8[SL_RESP_TAPS], int32_t down_to_lp);
+
 /// Use `drop_q8` (a calibration's, SL_RESPONSE_CALIBRATED) instead of the prior / learned
 /// shape. SL_ERR_ARG when it fails the plausibility gates. O(taps x SUB).
 sl_err_t sl_response_set(sl_response_t *r, const uint16_t drop_q8[SL_RESP_TAPS], uint8_t source);
 
-/// Reads one row of `bins` 8-bit values; learns the floor over [min_bin, max_bin) and peaks
-/// whose +-isolation window lies inside it. Returns the peaks accepted (>= 0) or SL_ERR_ARG.
-/// Does not change the response in use: call sl_response_update() (e.g. once per rotation).
+/// Reads one row of `bins` 8-bit values; learns the floor over [min_bin, max_bin). Returns 0
+/// or SL_ERR_ARG. The pipeline reads it inside the shadow, where the floor is the receiver's
+/// noise and the targets are sparse. O(max_bin - min_bin) / 4.
+int sl_response_learn_floor(sl_response_t *r, const uint8_t *row, uint32_t bins,
+                            uint32_t min_bin, uint32_t max_bin);
+
+/// Reads one row of `bins` 8-bit values; learns the shape from the peaks whose +-isolation
+/// window lies inside [min_bin, max_bin), against the floor learned in the peak's band, else
+/// in the nearest band before it (no peak before any floor is learned). Returns the peaks accepted (>= 0) or
+/// SL_ERR_ARG. Does not change the response in use: call sl_response_update() (e.g. once per
+/// rotation). The pipeline reads it beyond the shadow, where a slender target's own extent
+/// cannot be taken for the response.
+int sl_response_learn_peaks(sl_response_t *r, const uint8_t *row, uint32_t bins,
+                            uint32_t min_bin, uint32_t max_bin);
+
+/// Samples a band's floor needs before sl_response_floor_resolved() vouches for it (the
+/// running median starts at the first sample and moves by a shrinking step per sample).
+#define SL_RESP_FLOOR_MIN_N 64U
+
+/// True when the floor of `bin`'s band is learned from at least SL_RESP_FLOOR_MIN_N samples
+/// and its median is above the scale's value 0: a floor whose median reads 0 is below the
+/// quantiser's first step (a noise-free rendering, or a receiver whose noise the 8-bit scale
+/// does not resolve), and its level is not known, only bounded. O(1).
+bool sl_response_floor_resolved(const sl_response_t *r, uint32_t bin);
+
+/// sl_response_learn_floor and sl_response_learn_peaks over the same bins (a tool measuring
+/// the response of a capture's rows).
 int sl_response_learn_row(sl_response_t *r, const uint8_t *row, uint32_t bins, uint32_t min_bin,
                           uint32_t max_bin);
 

@@ -69,8 +69,8 @@
 /// reads of the cumulative response and of the response each), then up to
 /// SL_RFIT_HALVINGS + 1 objective evaluations (the model, one 64-bit division and one log
 /// per sample); the covariance one more pass with the speckle correlation's lags
-/// (<= SL_RESP_TAPS per sample). Stack: about 1.4 KB at most on Cortex-M0 -Os (sl_rfit,
-/// its covariance pass with the lag ring, the model). Flash: firmware/size_budget.txt.
+/// (<= SL_RESP_TAPS per sample). Stack and work memory: sl_rfit_ws(). Flash:
+/// firmware/size_budget.txt.
 #ifndef SHADOWLEAN_SL_RFIT_H
 #define SHADOWLEAN_SL_RFIT_H
 
@@ -130,9 +130,24 @@ typedef struct sl_rfit_out {
     uint16_t evals;             ///< objective evaluations used
 } sl_rfit_out_t;
 
+/// Work memory of one fit: the model's pieces, the normal equations and the covariance
+/// pass's ring of SL_RESP_TAPS samples (layout private to rfit.c). Caller-owned; borrowed
+/// for the call of sl_rfit_ws().
+#define SL_RFIT_WS_BYTES (344U + 4U * (unsigned)SL_RESP_TAPS)
+typedef struct sl_rfit_ws {
+    uint64_t u[(SL_RFIT_WS_BYTES + 7U) / 8U];
+} sl_rfit_ws_t;
+
 /// Fits [a, b]. SL_ERR_ARG on NULL pointers, n out of range, looks < 1, or a zero floor;
-/// otherwise SL_OK with `out->quality` saying what the result is worth.
+/// otherwise SL_OK with `out->quality` saying what the result is worth. Its work memory
+/// (sl_rfit_ws_t, 508 B with the default 41 taps) is on the stack: see sl_rfit_ws().
 sl_err_t sl_rfit(const sl_response_t *r, const sl_rfit_in_t *in, sl_rfit_out_t *out);
+
+/// sl_rfit() with the work memory in `ws` (the caller's, e.g. static): the same results bit
+/// for bit, the stack that much shallower (a pipeline's deepest call chain). SL_ERR_ARG also
+/// for a NULL `ws`.
+sl_err_t sl_rfit_ws(const sl_response_t *r, const sl_rfit_in_t *in, sl_rfit_ws_t *ws,
+                    sl_rfit_out_t *out);
 
 /// The model profile m_k(a, b) for k < n (Q16 of the total: sum over all k of an interval
 /// well inside the window is 65536 x area). Exposed for tests and the host tools. SL_ERR_ARG

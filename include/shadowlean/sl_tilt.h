@@ -27,8 +27,14 @@
 /// SL_TILT_TOP_K of them exactly from the measurements and keeps the smallest chi-square.
 /// Over a pass the true tilt traces a sinusoid in bearing and its mirror does not, so the
 /// residuals separate them; when another candidate with a different answer (|t - t'| >
-/// max(0.035, 0.3 |t|)) fits within the ambiguity margin of the best, the best is reported
-/// with quality SL_TILT_AMBIGUOUS: never a confident wrong direction.
+/// max(0.035, 0.3 |t|)) fits within the ambiguity margin of the best, the quality is
+/// SL_TILT_AMBIGUOUS and the result carries BOTH readings: the best as the result's own
+/// fields, the other (the best-scoring candidate with a different answer, solved exactly
+/// from the measurements like the best) in `mirror`, with its own sigmas and base. An
+/// AMBIGUOUS result is an answer, not a failure: the pole is one of the two readings
+/// (`sl-eval driveby` scores it so), and a consumer that acts on the lean must consider
+/// both (LeanWarning takes the more dangerous one: sl_pipeline.h, "LeanWarning and the
+/// fitted tilt"). Never a confident wrong direction.
 ///
 /// The ambiguity margin. The stated sigmas are a floor, not the whole error: quantised range
 /// bounds, the group's union extent and the azimuth cells add errors that are neither
@@ -78,7 +84,9 @@
 ///
 /// Accuracy (tests/core/test_tilt.c): given the same stored measurements, the fixed-point
 /// tilt vector agrees with a double-precision implementation of the same estimator to
-/// 2e-5 in tan units (0.001 deg; measured 2.6e-6), the base to 2 mm (measured 0.74 mm).
+/// 2e-5 in tan units (0.001 deg; measured 2.6e-6), the base to 2 mm (measured 0.74 mm); an
+/// AMBIGUOUS result's other reading agrees with the double solution of its reading of the
+/// fold to the same 2e-5.
 /// Against simulated drive-bys (bearing quantised to 0.9 deg azimuth cells): tilt within
 /// 1 deg and direction within 10 deg for tilts of 5-20 deg, also for poles leaning away
 /// beyond the fold; with 1 deg of noise on every alpha, within 2 deg and 20 deg.
@@ -86,7 +94,9 @@
 /// Cost: sl_tilt_obs_make O(1) (three sine/cosine lookups, two 64-bit divisions);
 /// sl_tilt_fit O(n + m^2) (about 30 multiply-adds per interval candidate) plus O(TOP_K x n)
 /// for the exact solves, divisions only outside the candidate loop except for candidates
-/// near the best. No state, no allocation: pure functions, reentrant, any context.
+/// near the best; each measurement's weight is recomputed where it is read (one 32-bit
+/// division), and an AMBIGUOUS fit solves and reports its second reading too (O(n)). No
+/// state, no allocation: pure functions, reentrant, any context.
 #ifndef SHADOWLEAN_SL_TILT_H
 #define SHADOWLEAN_SL_TILT_H
 
@@ -125,8 +135,8 @@ extern "C" {
 /// What a fit says.
 typedef enum sl_tilt_quality {
     SL_TILT_FITTED = 0,              ///< tilt, direction and base from a well-posed fit
-    SL_TILT_AMBIGUOUS = 1,           ///< the mirror hypothesis fits as well (the better one
-                                     ///< is reported; do not trust the direction)
+    SL_TILT_AMBIGUOUS = 1,           ///< the mirror hypothesis fits as well: the pole is
+                                     ///< the reported reading or `mirror` (both set)
     SL_TILT_INSUFFICIENT_MOTION = 2, ///< the bearings do not spread enough (parked, or the
                                      ///< pole straight ahead); nothing but `n_obs` is set
     SL_TILT_TOO_FEW = 3,             ///< fewer than SL_TILT_MIN_OBS measurements
@@ -172,9 +182,8 @@ bool sl_tilt_obs_make(sl_tilt_obs_t *out, int32_t radar_x_um, int32_t radar_y_um
                       uint16_t alpha_sigma_cdeg, uint8_t branch, const sl_incline_geom_t *geom);
 
 /// Scratch memory of a fit (caller-owned, so the fit's stack stays small: ~150 bytes).
-/// 548 bytes; one per pipeline is enough (fits do not overlap).
+/// 416 bytes; one per pipeline is enough (fits do not overlap).
 typedef struct sl_tilt_work {
-    uint32_t w_q16[SL_TILT_MAX_OBS];  ///< relative weights (sigma_min / sigma_k)^2
     int32_t du_q24[SL_TILT_MAX_OBS];  ///< per mirrorable measurement, in bearing order:
     int32_t dv_q24[SL_TILT_MAX_OBS];  ///< the change of mean(w c T), mean(w s T),
     int32_t ds_q24[SL_TILT_MAX_OBS];  ///< mean(w T^2) when it is read as its mirror
@@ -187,6 +196,19 @@ typedef struct sl_tilt_params {
     sl_q30_t cos_beta_q30;    ///< upper emission bound beta (sl_incline_geom_t has them)
     sl_q30_t sin_beta_q30;
 } sl_tilt_params_t;
+
+/// One reading of a fit: tilt vector, tilt, direction, their sigmas and the base (the
+/// fields of the same names in `sl_tilt_result_t`). 28 bytes.
+typedef struct sl_tilt_reading {
+    int32_t tx_q24;           ///< tilt vector, odometry frame, Q24
+    int32_t ty_q24;
+    int32_t psi_cdeg;         ///< tilt from vertical, 0..9000
+    int32_t phi_cdeg;         ///< direction the top leans towards, CCW from +x, 0..35999
+    uint16_t psi_sigma_cdeg;  ///< 1-sigma (file comment, "The stated sigmas")
+    uint16_t phi_sigma_cdeg;  ///< 1-sigma; 18000 when not oriented
+    int32_t base_x_um;        ///< pole base on the ground, odometry frame
+    int32_t base_y_um;
+} sl_tilt_reading_t;
 
 /// Result of a fit. Every field is set on every call (0 when not meaningful).
 typedef struct sl_tilt_result {
@@ -207,6 +229,10 @@ typedef struct sl_tilt_result {
     uint32_t chi2_q8;         ///< chi-square of the reported fit, Q8
     uint32_t chi2_other_q8;   ///< chi-square of the other hypothesis (UINT32_MAX if none
                               ///< within max(16 x 9, the ambiguity margin) of the best)
+    sl_tilt_reading_t mirror; ///< SL_TILT_AMBIGUOUS only: the other hypothesis's reading,
+                              ///< its sigmas inflated by its own chi2 / dof (all 0 otherwise)
+    uint32_t mirror_mask;     ///< SL_TILT_AMBIGUOUS only: its reading of the fold (as
+                              ///< `mirrored_mask`)
 } sl_tilt_result_t;
 
 /// Fits tilt, direction and base to `n` measurements (any order). `n` <= SL_TILT_MAX_OBS.

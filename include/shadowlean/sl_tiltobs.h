@@ -74,11 +74,13 @@
 /// Outputs per ring: `res` (the last fit, odometry frame relative to the anchor) and, via
 /// `sl_tiltobs_vehicle()`, the tilt in the vehicle frame at the current pose (what the
 /// PoleTilt CAN message carries: direction CCW from forward, base x forward / y left of the
-/// vehicle origin) and the lean towards the vehicle's path (what LeanWarning uses).
+/// vehicle origin) and the lean towards the vehicle's path (what LeanWarning uses); for an
+/// AMBIGUOUS fit the same of its other reading via `sl_tiltobs_vehicle_mirror()` (PoleTilt
+/// MIRROR; LeanWarning takes the more dangerous of the two).
 ///
 /// Units: um, bam32 (2^32 per turn), cdeg (0.01 deg). No allocation, no float; every array
-/// is inside the struct. RAM: SL_CFG_TILT_TRACKS x (SL_CFG_TILT_OBS_PER_TRACK x 24 + 72)
-/// + 672 bytes (x86-64: firmware configuration 4 x 16: 2,496 B; host default 8 x 32: 7,392 B).
+/// is inside the struct. RAM: SL_CFG_TILT_TRACKS x (SL_CFG_TILT_OBS_PER_TRACK x 24 + 104)
+/// + 544 bytes (x86-64: firmware configuration 4 x 16: 2,496 B; host default 8 x 32: 7,520 B).
 /// Cost per rotation: O(tracks x targets) for the matching (only for updated tracks) + O(1)
 /// per observation (three table sine/cosine, two 64-bit divisions) + at most
 /// SL_CFG_TILT_FITS_PER_ROTATION fits (sl_tilt.h: O(n + m^2)), each of 8 observations or
@@ -239,11 +241,17 @@ void sl_tiltobs_fit_pending(sl_tiltobs_t *o);
 /// The ring of track `id`, or NULL. O(rings).
 const sl_tiltobs_ring_t *sl_tiltobs_find(const sl_tiltobs_t *o, uint16_t id);
 
-/// Result of `r` in the vehicle frame at the current pose. False (and `out` zeroed) when
-/// `r` has no fit yet. Quality other than FITTED/AMBIGUOUS: only `quality` is meaningful.
-/// O(1).
+/// Result of `r` in the vehicle frame at the current pose (for an AMBIGUOUS fit: its best
+/// reading). False (and `out` zeroed) when `r` has no fit yet. Quality other than
+/// FITTED/AMBIGUOUS: only `quality` is meaningful. O(1).
 bool sl_tiltobs_vehicle(const sl_tiltobs_t *o, const sl_tiltobs_ring_t *r,
                         sl_tiltobs_vehicle_t *out);
+
+/// The other reading of an AMBIGUOUS fit of `r` (sl_tilt_result_t.mirror) in the vehicle
+/// frame at the current pose, as sl_tiltobs_vehicle(). False (`out` zeroed but for
+/// `quality`) when `r` has no fit or its fit is not AMBIGUOUS. O(1).
+bool sl_tiltobs_vehicle_mirror(const sl_tiltobs_t *o, const sl_tiltobs_ring_t *r,
+                               sl_tiltobs_vehicle_t *out);
 
 #ifdef __cplusplus
 }

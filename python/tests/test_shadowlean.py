@@ -82,6 +82,20 @@ class Crc(unittest.TestCase):
         self.assertEqual(sl.protect(0x0355, bytes(8), 0, sl.MODE_NIBBLE), bytes.fromhex("5c30000000000000"))
         self.assertEqual(sl.protect(0x0355, bytes(8), 1, sl.MODE_NIBBLE), bytes.fromhex("0131000000000000"))
 
+    def test_pole_tilt_mirror_reading_decodes_by_name(self):
+        # The other reading of an AMBIGUOUS tilt: Quality 5 MIRROR, its values as any reading's
+        # (TargetId 2, Tilt 15.9 deg, TiltDirection 110 deg, BaseY -2.5 m).
+        db = sl.load_dbc(dbc_of("paper-sim"))
+        fr = next(f for f in db.frames if f.name == "PoleTilt")
+        raw = (5 << 12) | (2 << 16) | (159 << 20) | (110 << 28) | ((-50 & 0xFF) << 56)
+        d = sl.decode(db, fr.arbitration_id.id, False, with_crc(db, "PoleTilt", raw.to_bytes(8, "little")))
+        self.assertTrue(d.crc_ok and d.reencode_ok)
+        self.assertEqual(d.named["Quality"], "MIRROR")
+        self.assertEqual(d.raw["TargetId"], 2)
+        self.assertAlmostEqual(d.phys["Tilt"], 15.9)
+        self.assertAlmostEqual(d.phys["TiltDirection"], 110.0)
+        self.assertAlmostEqual(d.phys["BaseY"], -2.5)
+
     def test_worked_example_of_sl_can_h(self):
         # Status, Data ID 0x0053 (11A), bytes 1..7 = 30 02 00 00 00 00 00 -> CRC 0x93.
         self.assertEqual(sl.e2e_crc(0x0053, bytes.fromhex("0030020000000000")), 0x93)

@@ -166,6 +166,83 @@ static void recrc(uint8_t *b, size_t n)
     put32le(b + 12, c);
 }
 
+// A calibration's range response travels in the blob's response section (flags bit 0): it
+// opens as the view's prior with response_calibrated set, read in place or decoded into the
+// workspace (odd address), and a pipeline started on the view uses it as CALIBRATED. A blob
+// without the section keeps the nominal board's prior.
+static void test_calblob_response_section_round_trips(void **state)
+{
+    (void)state;
+    const sl_board_t *nom = sl_board_find("robotcar-leaf");
+    assert_non_null(nom);
+    uint16_t cal[SL_RESP_TAPS];
+    sl_response_prior_cts350x(cal);
+    cal[SL_CFG_RESP_HALF - 1] = (uint16_t)(cal[SL_CFG_RESP_HALF - 1] + 3U); // not the prior
+    cal[SL_CFG_RESP_HALF + 1] = (uint16_t)(cal[SL_CFG_RESP_HALF + 1] + 3U);
+    sl_board_t b = *nom;
+    b.response_prior_q8 = cal;
+    b.response_calibrated = 1U;
+    for (size_t off = 0; off < 2U; off++) {
+        uint8_t *buf = g_buf.b + off;
+        const sl_ssize_t n = sl_calblob_write(&b, buf, SL_CALBLOB_MAX_BYTES);
+        assert_int_equal(n, (sl_ssize_t)(SL_CALBLOB_BYTES(nom->azimuths) + SL_CALBLOB_RESPONSE_BYTES));
+        assert_int_equal(buf[54], SL_CALBLOB_FLAG_RESPONSE);
+        sl_board_t v;
+        sl_calblob_info_t info;
+        assert_int_equal(sl_calblob_open(buf, (size_t)n, nom, &g_ws, &v, &info), SL_OK);
+        assert_int_equal(v.response_calibrated, 1U);
+        assert_memory_equal(v.response_prior_q8, cal, sizeof cal);
+        if (off == 1U) {
+            assert_ptr_equal(v.response_prior_q8, g_ws.response_q8);
+        }
+        assert_int_equal(sl_pipeline_init(&g_pipe, &v, NULL), SL_OK);
+        assert_int_equal(g_pipe.resp.source, SL_RESPONSE_CALIBRATED);
+        assert_memory_equal(g_pipe.resp.drop_q8, cal, sizeof cal);
+    }
+    const size_t n0 = write_blob(nom, g_buf.b);
+    sl_board_t v0;
+    assert_int_equal(sl_calblob_open(g_buf.b, n0, nom, &g_ws, &v0, NULL), SL_OK);
+    assert_int_equal(v0.response_calibrated, 0U);
+    assert_ptr_equal(v0.response_prior_q8, nom->response_prior_q8);
+    assert_int_equal(sl_pipeline_init(&g_pipe, &v0, NULL), SL_OK);
+    assert_int_equal(g_pipe.resp.source, SL_RESPONSE_PRIOR);
+}
+
+// The response section is checked like a learned shape: its tap count must be this build's,
+// the shape plausible (falling on both sides); unknown flag bits are refused; each with
+// the view untouched.
+static void test_calblob_bad_response_section_is_refused(void **state)
+{
+    (void)state;
+    const sl_board_t *nom = sl_board_find("robotcar-leaf");
+    assert_non_null(nom);
+    uint16_t cal[SL_RESP_TAPS];
+    sl_response_prior_cts350x(cal);
+    sl_board_t b = *nom;
+    b.response_prior_q8 = cal;
+    b.response_calibrated = 1U;
+    const size_t n = (size_t)sl_calblob_write(&b, g_buf.b, SL_CALBLOB_MAX_BYTES);
+    uint8_t *const resp = g_buf.b + SL_CALBLOB_BYTES(nom->azimuths);
+    put16le(resp, (uint16_t)(SL_RESP_TAPS - 2));
+    recrc(g_buf.b, n);
+    expect_reject(g_buf.b, n, nom, SL_ERR_CAL_VALUE, "response_taps");
+    put16le(resp, (uint16_t)SL_RESP_TAPS);
+    put16le(resp + 2U + 2U * (SL_CFG_RESP_HALF + 2), 0U); // a second peak beside the centre
+    recrc(g_buf.b, n);
+    expect_reject(g_buf.b, n, nom, SL_ERR_CAL_VALUE, "response");
+    put16le(resp + 2U + 2U * (SL_CFG_RESP_HALF + 2), cal[SL_CFG_RESP_HALF + 2]);
+    put16le(g_buf.b + 54, 0x0003U);
+    recrc(g_buf.b, n);
+    expect_reject(g_buf.b, n, nom, SL_ERR_CAL_VALUE, "flags");
+    put16le(g_buf.b + 54, 0U); // the section without its flag: the size no longer matches
+    recrc(g_buf.b, n);
+    expect_reject(g_buf.b, n, nom, SL_ERR_CAL_SIZE, "size");
+    put16le(g_buf.b + 54, SL_CALBLOB_FLAG_RESPONSE);
+    recrc(g_buf.b, n);
+    sl_board_t v;
+    assert_int_equal(sl_calblob_open(g_buf.b, n, nom, &g_ws, &v, NULL), SL_OK);
+}
+
 static void test_calblob_every_bit_flip_is_rejected(void **state)
 {
     (void)state;
@@ -402,6 +479,8 @@ int main(void)
         cmocka_unit_test(test_calblob_out_of_range_values_are_refused),
         cmocka_unit_test(test_calblob_mutations_with_valid_crc_never_yield_out_of_range_tables),
         cmocka_unit_test(test_calblob_writer_arguments),
+        cmocka_unit_test(test_calblob_response_section_round_trips),
+        cmocka_unit_test(test_calblob_bad_response_section_is_refused),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

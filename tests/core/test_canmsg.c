@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "shadowlean/sl_can.h"
+#include "shadowlean/sl_response.h"
 
 /// The default E2E configuration of message SL_CAN_MSG_<m>.
 #define E2E(m) (&sl_can_e2e_defaults[SL_CAN_MSG_##m])
@@ -303,7 +304,9 @@ static void test_canmsg_pole_tilt_layout_encode_decode(void **state)
     // Random round trips against the reference rounding.
     for (int k = 0; k < 20000; k++) {
         in.target_id = (uint8_t)rnd_range(0, 15);
-        in.quality = (uint8_t)rnd_range(0, 1);
+        const uint8_t with_values[3] = {SL_CAN_TILT_FITTED, SL_CAN_TILT_AMBIGUOUS,
+                                        SL_CAN_TILT_MIRROR};
+        in.quality = with_values[rnd_range(0, 2)];
         in.tilt_cdeg = (int32_t)rnd_range(0, 3000);
         in.direction_cdeg = (int32_t)rnd_range(-72000, 72000);
         in.tilt_sigma_cdeg = (uint32_t)rnd_range(0, 800);
@@ -332,17 +335,19 @@ static void test_canmsg_pole_tilt_layout_encode_decode(void **state)
         assert_int_equal(out.quality, in.quality);
     }
     // Qualities without numbers send zeros; an unknown quality is INCONSISTENT + Clamped.
-    for (uint8_t q = 2; q <= 5; q++) {
+    const uint8_t no_values[4] = {2, 3, 4, 6};
+    for (size_t i = 0; i < 4U; i++) {
+        const uint8_t q = no_values[i];
         in.quality = q;
         in.tilt_cdeg = 1000;
         in.base_x_um = 9000000; // would clamp if it were sent
         assert_int_equal(sl_can_encode_pole_tilt(&tx, &in, &f), SL_OK);
         assert_int_equal(sl_can_decode_pole_tilt(&f, E2E(POLE_TILT), &out), SL_OK);
-        assert_int_equal(out.quality, q > 4 ? SL_CAN_TILT_INCONSISTENT : q);
+        assert_int_equal(out.quality, q > SL_CAN_TILT_QUALITY_MAX ? SL_CAN_TILT_INCONSISTENT : q);
         assert_int_equal(out.tilt_cdeg, 0);
         assert_int_equal(out.base_x_um, 0);
         assert_int_equal(out.direction_cdeg, 0);
-        assert_int_equal(out.clamped, q > 4);
+        assert_int_equal(out.clamped, q > SL_CAN_TILT_QUALITY_MAX);
     }
     // Another message's frame fails the CRC (Data ID 0x56 is PoleTilt's own).
     in.quality = 0;
@@ -762,7 +767,7 @@ static void test_canmsg_health_theta_drift_round_trips_and_saturates(void **stat
         assert_int_equal(sl_can_encode_health(&tx, &in, &f), SL_OK);
         assert_int_equal(sl_can_decode_health(&f, E2E(HEALTH), &out), SL_OK);
         assert_int_equal(out.theta_drift_cdeg, in.theta_drift_cdeg);
-        assert_int_equal(f.data[7] & 0xF0U, 0); // reserved 60|4
+        assert_int_equal(f.data[7] & 0xF0U, 0); // ResponseSource 60|2 (PRIOR) and reserved 62|2
     }
     assert_int_equal(tx.stats.clamped_frames, 0);
     // Golden: +2.0 deg = raw 20 = 0x14 at 52|8 (little-endian bit numbering), THETA_DRIFT.
@@ -782,6 +787,32 @@ static void test_canmsg_health_theta_drift_round_trips_and_saturates(void **stat
     sl_can_decode_health(&f, E2E(HEALTH), &out);
     assert_int_equal(out.theta_drift_cdeg, -1280);
     assert_int_equal(tx.stats.clamped_frames, 1);
+}
+
+// ResponseSource at 60|2: each sl_response_source_t value round-trips at its bits; a value
+// beyond CALIBRATED is sent as CALIBRATED and counted clamped; the reserved bits 62|2 stay 0.
+static void test_canmsg_health_response_source_round_trips_and_saturates(void **state)
+{
+    (void)state;
+    sl_can_tx_t tx;
+    tx_setup(&tx);
+    sl_can_frame_t f;
+    sl_can_health_t out;
+    for (uint8_t v = 0; v <= (uint8_t)SL_CAN_RESPONSE_SOURCE_MAX; v++) {
+        const sl_can_health_t in = {.response_source = v};
+        assert_int_equal(sl_can_encode_health(&tx, &in, &f), SL_OK);
+        assert_int_equal((f.data[7] >> 4) & 3U, v);
+        assert_int_equal(f.data[7] & 0xC0U, 0);
+        assert_int_equal(sl_can_decode_health(&f, E2E(HEALTH), &out), SL_OK);
+        assert_int_equal(out.response_source, v);
+    }
+    assert_int_equal(tx.stats.clamped_frames, 0);
+    const sl_can_health_t big = {.response_source = 3U};
+    sl_can_encode_health(&tx, &big, &f);
+    sl_can_decode_health(&f, E2E(HEALTH), &out);
+    assert_int_equal(out.response_source, SL_CAN_RESPONSE_SOURCE_MAX);
+    assert_int_equal(tx.stats.clamped_frames, 1);
+    assert_int_equal(SL_CAN_RESPONSE_SOURCE_MAX, SL_RESPONSE_CALIBRATED);
 }
 
 static void test_canmsg_vehicle_motion_round_trips_full_range(void **state)
@@ -1065,6 +1096,7 @@ int main(void)
         cmocka_unit_test(test_canmsg_lean_warning_round_trips_and_clamps),
         cmocka_unit_test(test_canmsg_status_counters_saturate_and_flag),
         cmocka_unit_test(test_canmsg_health_theta_drift_round_trips_and_saturates),
+        cmocka_unit_test(test_canmsg_health_response_source_round_trips_and_saturates),
         cmocka_unit_test(test_canmsg_vehicle_motion_round_trips_full_range),
         cmocka_unit_test(test_canmsg_health_round_trips_saturates_and_keeps_reserved_bits_zero),
         cmocka_unit_test(test_canmsg_counter_wraps_modulo_15_per_message),

@@ -374,6 +374,37 @@ static void test_rfit_flags_what_the_model_does_not_explain(void **state)
     in.n = N;
     in.shape = SL_RFIT_FOOT; // without an origin
     assert_int_equal(sl_rfit(&r, &in, &out), SL_ERR_ARG);
+    in.shape = SL_RFIT_UNIFORM;
+    assert_int_equal(sl_rfit_ws(&r, &in, NULL, &out), SL_ERR_ARG); // no work memory
+}
+
+// The work memory in the caller's hands (sl_rfit_ws, e.g. static beside a pipeline) gives
+// the same result, field for field, as sl_rfit's on its stack, however dirty it was.
+static void test_rfit_ws_is_sl_rfit_bit_for_bit(void **state)
+{
+    (void)state;
+    sl_response_t r;
+    assert_int_equal(sl_response_init(&r, &k_cts, NULL, NULL), SL_OK);
+    sl_ro_resp_t o;
+    sl_ro_resp_from_drops(r.drop_q8, &o);
+    uint32_t y[N];
+    render(&o, SL_RFIT_FOOT, 100.0, 20.3, 31.7, 1e6, 40.0, y);
+    sl_rfit_in_t in = {0};
+    in.y = y;
+    in.n = N;
+    in.looks_q8 = 8 * 256;
+    in.floor = 40;
+    in.shape = SL_RFIT_FOOT;
+    in.origin_q8 = 100U * 256U;
+    static sl_rfit_ws_t ws;
+    memset(&ws, 0xA5, sizeof ws);
+    sl_rfit_out_t a, b;
+    memset(&a, 0, sizeof a);
+    memset(&b, 0xFF, sizeof b);
+    assert_int_equal(sl_rfit(&r, &in, &a), SL_OK);
+    assert_int_equal(sl_rfit_ws(&r, &in, &ws, &b), SL_OK);
+    assert_int_equal(a.quality, SL_RFIT_OK);
+    assert_memory_equal(&a, &b, sizeof a);
 }
 
 // One frozen speckle draw says less than eight: the stated sigma grows (by ~sqrt(8)).
@@ -551,6 +582,7 @@ int main(void)
         cmocka_unit_test(test_rfit_sigmas_match_the_scatter_under_speckle),
         cmocka_unit_test(test_rfit_agrees_with_the_double_oracle),
         cmocka_unit_test(test_rfit_flags_what_the_model_does_not_explain),
+        cmocka_unit_test(test_rfit_ws_is_sl_rfit_bit_for_bit),
         cmocka_unit_test(test_rfit_frozen_speckle_states_a_wider_sigma),
         cmocka_unit_test(test_response_learns_the_lobe_and_floor_from_rows),
         cmocka_unit_test(test_response_ignores_peaks_with_rivals),

@@ -14,8 +14,10 @@
 // weights); the fit against the simulated truth (tilt, direction, base) for straight and
 // curved paths, both sides of the path, tilts 3-20 deg, directions all around, poles leaning
 // away beyond the fold; noise; and the safety property: a direction that is wrong by more
-// than 30 deg is never reported as FITTED. Issue #12: three passes recorded from `sl-eval
-// driveby` whose fit read the fold's mirror as FITTED, and drive-bys with range bounds
+// than 30 deg is never reported as FITTED, and an AMBIGUOUS result holds the truth in one of
+// its two readings (the other one checked against the double solution of its reading of the
+// fold). Issue #12: three passes recorded from `sl-eval driveby` whose fit read the fold's
+// mirror as FITTED (the truth is the AMBIGUOUS result's other reading), and drive-bys with range bounds
 // quantised to the board's bins (errors neither Gaussian nor independent) in which no FITTED
 // fit may read the fold the wrong way.
 #include <setjmp.h>
@@ -35,6 +37,9 @@ static const double PI = 3.14159265358979323846;
 // Digest of the noise-free sweep's results (see digest_result), from x86-64; must match on
 // every target.
 #define RESULTS_DIGEST 0x19511377afff247aULL
+// Digest of the AMBIGUOUS results' other readings of the random noisy passes
+// (test_never_a_confident_wrong_direction), from x86-64; must match on every target.
+#define MIRROR_DIGEST 0xb2d4304d814e64fbULL
 
 static double rad(double d) { return d * PI / 180.0; }
 static double deg(double r) { return r * 180.0 / PI; }
@@ -484,7 +489,8 @@ static void test_never_a_confident_wrong_direction(void **state)
     // Short and long passes, random poles, 0.5 deg noise: FITTED implies the direction is
     // within 30 deg (psi >= 5); otherwise the fit must say AMBIGUOUS or INSUFFICIENT_MOTION.
     rng = 12345;
-    unsigned fitted = 0, ambiguous = 0, other = 0;
+    unsigned fitted = 0, ambiguous = 0, other = 0, among = 0;
+    digest = 14695981039346656037ULL;
     for (int i = 0; i < 300; ++i) {
         scene_t sc = base_scene();
         sc.psi = 5.0 + 15.0 * urand();
@@ -519,12 +525,30 @@ static void test_never_a_confident_wrong_direction(void **state)
             assert_true(ephi <= 30.0);
         } else if (r.quality == SL_TILT_AMBIGUOUS) {
             ++ambiguous;
+            // Both readings: the other one is the double-precision solution of its reading
+            // of the fold, differs from the best, and the truth is one of the two.
+            double mtx, mty, mdet;
+            dsolve(&s, r.mirror_mask, &mtx, &mty, &mdet);
+            assert_true(fabs(r.mirror.tx_q24 / 16777216.0 - mtx) <= 2e-5);
+            assert_true(fabs(r.mirror.ty_q24 / 16777216.0 - mty) <= 2e-5);
+            assert_true(r.mirror.tx_q24 != r.tx_q24 || r.mirror.ty_q24 != r.ty_q24);
+            const double e0 = fabs(wrap180(r.phi_cdeg / 100.0 - sc.phi));
+            const double e1 = fabs(wrap180(r.mirror.phi_cdeg / 100.0 - sc.phi));
+            among += (e0 <= 30.0 || e1 <= 30.0) ? 1U : 0U;
+            const sl_tilt_reading_t *m = &r.mirror;
+            const int32_t f[] = {m->tx_q24, m->ty_q24, m->psi_cdeg, m->phi_cdeg, m->psi_sigma_cdeg,
+                                 m->phi_sigma_cdeg, m->base_x_um, m->base_y_um, (int32_t)r.mirror_mask};
+            for (size_t i = 0; i < sizeof f / sizeof f[0]; ++i) digest_i32(f[i]);
         } else {
             ++other;
         }
     }
-    printf("fitted %u, ambiguous %u, too few / insufficient motion %u\n", fitted, ambiguous, other);
+    printf("fitted %u, ambiguous %u (the truth's direction within 30 deg of one of the two "
+           "readings: %u), too few / insufficient motion %u\n", fitted, ambiguous, among, other);
     assert_true(fitted >= 150);
+    assert_true(among * 10U >= ambiguous * 9U);
+    printf("other readings digest %016llx\n", (unsigned long long)digest);
+    assert_true(digest == MIRROR_DIGEST);
 }
 
 // ---------------------------------------------------------------------------------------
@@ -608,11 +632,19 @@ static void test_issue12_recorded_mirror_passes_are_not_fitted(void **state)
                "(n %u)\n", p->phi, p->offset, r.quality, r.psi_cdeg / 100.0, r.phi_cdeg / 100.0,
                r.chi2_q8 / 256.0, r.chi2_other_q8 / 256.0, r.n_obs);
         // The data cannot tell the readings apart: the best (the mirror, psi 7-8) is reported
-        // with AMBIGUOUS, never as FITTED.
+        // with AMBIGUOUS, never as FITTED, and the truth is its other reading.
         if (r.quality == SL_TILT_FITTED) {
             assert_true(fabs(epsi) <= 1.0 && fabs(ephi) <= 10.0);
         }
         assert_int_equal(r.quality, SL_TILT_AMBIGUOUS);
+        const sl_tilt_reading_t *m = &r.mirror;
+        printf("  other reading: psi %.2f +- %.2f phi %.2f +- %.2f mask %08x\n", m->psi_cdeg / 100.0,
+               m->psi_sigma_cdeg / 100.0, m->phi_cdeg / 100.0, m->phi_sigma_cdeg / 100.0,
+               r.mirror_mask);
+        assert_true(fabs(m->psi_cdeg / 100.0 - 20.0) <= 1.0);
+        assert_true(fabs(wrap180(m->phi_cdeg / 100.0 - p->phi)) <= 10.0);
+        assert_true(r.mirror_mask != r.mirrored_mask);
+        assert_true(m->psi_sigma_cdeg > 0U && m->phi_sigma_cdeg > 0U);
     }
 }
 

@@ -752,6 +752,53 @@ static void test_degenerate_inputs(void **state)
     assert_int_equal(obs.stats.observations, 0U);
 }
 
+// An AMBIGUOUS fit's other reading in the vehicle frame is what its best reading would be
+// were the fit that reading (the same rotation to the current pose, the same path lean); a
+// fit that is not AMBIGUOUS has none.
+static void test_an_ambiguous_fit_gives_its_other_reading(void **state)
+{
+    (void)state;
+    assert_int_equal(sl_tiltobs_init(&obs, board()), SL_OK);
+    for (int k = 0; k < 7; ++k) sl_tiltobs_advance(&obs, true, 2000, 1500, 250000U); // turning
+    sl_tiltobs_ring_t *r = &obs.ring[0];
+    r->track_id = 3;
+    r->fitted = 1;
+    r->anchor_x_um = 1500000;
+    r->anchor_y_um = -700000;
+    sl_tilt_result_t *res = &r->res;
+    res->quality = SL_TILT_AMBIGUOUS;
+    res->tx_q24 = -2000000; res->ty_q24 = 1400000; res->psi_cdeg = 820; res->phi_cdeg = 14500;
+    res->psi_sigma_cdeg = 40; res->phi_sigma_cdeg = 700;
+    res->base_x_um = 4000000; res->base_y_um = 2500000;
+    const sl_tilt_reading_t m = {5200000, 3900000, 2110, 3686, 75, 900, 4100000, 2450000};
+    res->mirror = m;
+    sl_tiltobs_vehicle_t best, other, as_best;
+    assert_true(sl_tiltobs_vehicle(&obs, r, &best));
+    assert_true(sl_tiltobs_vehicle_mirror(&obs, r, &other));
+    assert_int_equal(best.quality, SL_TILT_AMBIGUOUS);
+    assert_int_equal(other.quality, SL_TILT_AMBIGUOUS);
+    assert_int_not_equal(best.phi_cdeg, other.phi_cdeg);
+    // the same ring fitted as the other reading
+    const sl_tilt_result_t kept = *res;
+    res->quality = SL_TILT_FITTED;
+    res->tx_q24 = m.tx_q24; res->ty_q24 = m.ty_q24; res->psi_cdeg = m.psi_cdeg;
+    res->phi_cdeg = m.phi_cdeg; res->psi_sigma_cdeg = m.psi_sigma_cdeg;
+    res->phi_sigma_cdeg = m.phi_sigma_cdeg; res->base_x_um = m.base_x_um;
+    res->base_y_um = m.base_y_um;
+    assert_true(sl_tiltobs_vehicle(&obs, r, &as_best));
+    as_best.quality = SL_TILT_AMBIGUOUS;
+    assert_memory_equal(&as_best, &other, sizeof other);
+    // FITTED: no other reading
+    sl_tiltobs_vehicle_t none;
+    assert_false(sl_tiltobs_vehicle_mirror(&obs, r, &none));
+    assert_int_equal(none.quality, SL_TILT_FITTED);
+    assert_int_equal(none.psi_cdeg, 0);
+    *res = kept;
+    res->quality = SL_TILT_INCONSISTENT;
+    assert_false(sl_tiltobs_vehicle_mirror(&obs, r, &none));
+    assert_false(sl_tiltobs_vehicle_mirror(&obs, NULL, &none));
+}
+
 // Before its track is confirmed a pole's observations go into a provisional ring: never
 // fitted nor reported; at confirmation the ring is fitted with all of them (a fast pass
 // keeps its first rotations). Same result as a track confirmed from its first sighting.
@@ -920,6 +967,7 @@ int main(void)
         cmocka_unit_test(test_fits_beyond_the_largest_tilt_are_inconsistent),
         cmocka_unit_test(test_ramps_do_not_make_a_fit),
         cmocka_unit_test(test_degenerate_inputs),
+        cmocka_unit_test(test_an_ambiguous_fit_gives_its_other_reading),
         cmocka_unit_test(test_observations_before_confirmation_are_kept),
         cmocka_unit_test(test_early_observations_yield_and_restart),
     };

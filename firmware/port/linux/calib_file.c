@@ -31,6 +31,8 @@ typedef struct ctx {
     bool elong_set;
     double elong_r[SL_CFG_MAX_ELONG_POINTS];
     double elong_d[SL_CFG_MAX_ELONG_POINTS];
+    unsigned resp_n;             // [response] drops_q8 values read (continuation lines add)
+    uint16_t resp_q8[SL_RESP_TAPS];
     // the calibrated tables being built (serialised into the blob)
     sl_incline_geom_t geom[SL_CFG_MAX_AZIMUTHS];
     int16_t theta[SL_CFG_MAX_AZIMUTHS];
@@ -142,6 +144,32 @@ static int scalar(ctx_t *c, const char *key, const char *val, double lo, double 
     return 1;
 }
 
+// [response] drops_q8: SL_RESP_TAPS integers (comma separated, over continuation lines,
+// which inih passes as repeats of the key), the drop below a point return's centre at
+// offsets -SL_CFG_RESP_HALF .. +SL_CFG_RESP_HALF, log2 power Q8. Count and shape: build().
+static int drops(ctx_t *c, const char *value)
+{
+    const char *s = value;
+    while (*s != '\0') {
+        char *end = NULL;
+        errno = 0;
+        const long v = strtol(s, &end, 10);
+        if (end == s || errno != 0 || v < 0 || v > 65535) {
+            return bad(c, "drops_q8: '%s' is not a list of integers 0..65535", value);
+        }
+        if (c->resp_n >= (unsigned)SL_RESP_TAPS) {
+            return bad(c, "drops_q8: more than %d values (offsets -%d..+%d)", SL_RESP_TAPS,
+                       SL_CFG_RESP_HALF, SL_CFG_RESP_HALF);
+        }
+        c->resp_q8[c->resp_n++] = (uint16_t)v;
+        s = end;
+        while (*s == ' ' || *s == '\t' || *s == ',') {
+            s++;
+        }
+    }
+    return 1;
+}
+
 static int on_entry(void *user, const char *section, const char *name, const char *value)
 {
     ctx_t *c = user;
@@ -192,6 +220,16 @@ static int on_entry(void *user, const char *section, const char *name, const cha
             }
         }
         return bad(c, "[calib] %s: unknown key", name);
+    }
+    if (strcmp(section, "response") == 0) {
+        if (strcmp(name, "drops_q8") == 0) {
+            return drops(c, value);
+        }
+        if (strcmp(name, "peaks") == 0 || strcmp(name, "tool") == 0 ||
+            strcmp(name, "date") == 0 || strcmp(name, "source") == 0) {
+            return 1; // provenance
+        }
+        return bad(c, "[response] %s: unknown key", name);
     }
     if (strcmp(section, "detect") == 0 && strcmp(name, "elongation") == 0) {
         c->elong_set = true;
@@ -268,7 +306,20 @@ static int build(const char *path, ctx_t *c, uint8_t **blob, size_t *len, char *
             v.elong_d_um[i] = (int32_t)llround(c->elong_d[i] * 1e6);
         }
     }
-    const size_t size = SL_CALBLOB_BYTES(az);
+    if (c->resp_n != 0U && c->resp_n != (unsigned)SL_RESP_TAPS) {
+        return fail(err, n, "%s: [response] drops_q8: %u values, this build reads %d (offsets "
+                    "-%d..+%d)", path, c->resp_n, SL_RESP_TAPS, SL_CFG_RESP_HALF, SL_CFG_RESP_HALF);
+    }
+    if (c->resp_n != 0U && !sl_response_plausible(c->resp_q8, 1701)) { // 20 dB, as sl_calblob
+        return fail(err, n, "%s: [response] drops_q8: not a plausible response (0 at the centre, "
+                    "falling on both sides to 20 dB, half power within %d bins)", path,
+                    SL_CFG_RESP_HALF);
+    }
+    if (c->resp_n != 0U) {
+        v.response_prior_q8 = c->resp_q8;
+        v.response_calibrated = 1U;
+    }
+    const size_t size = SL_CALBLOB_BYTES(az) + (c->resp_n != 0U ? SL_CALBLOB_RESPONSE_BYTES : 0U);
     uint8_t *b = malloc(size);
     if (b == NULL) {
         return fail(err, n, "%s: out of memory", path);

@@ -9,7 +9,7 @@
 
 // Frames and rotations are copied to these buffers by the port callbacks (cheap, inside
 // the measured feed) and printed after the feed returns (outside it).
-#define FW_MAX_FRAMES 96U
+#define FW_MAX_FRAMES 64U
 #define FW_MAX_ROTS 4U
 
 typedef struct fw_rot {

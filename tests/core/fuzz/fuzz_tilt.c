@@ -30,7 +30,8 @@
 // free ring empty, `pending` = the rings with `fresh` set, a ring's drops within its bound;
 // every result in range (quality an sl_tilt_quality_t; FITTED/AMBIGUOUS: n_obs within
 // [SL_TILT_MIN_OBS, count], psi 0..9000 cdeg, phi 0..35999, and the vehicle-frame view's
-// psi, phi, direction sigma and path lean in range).
+// psi, phi, direction sigma and path lean in range; AMBIGUOUS: the other reading the same,
+// with a reading of the fold other than the best's; any other quality: no other reading).
 //
 // The same file builds two ways (as fuzz_proto.c):
 //  - -DSL_FUZZ_LIBFUZZER -fsanitize=fuzzer: the `fuzz_tilt` libFuzzer binary;
@@ -137,6 +138,20 @@ static void check_state(const sl_tiltobs_t *o)
             CHECK(v.phi_cdeg >= 0 && v.phi_cdeg < 36000);
             CHECK(v.phi_sigma_cdeg <= 18000U);
             CHECK(v.lean_path_cdeg >= -9000 && v.lean_path_cdeg <= 9000);
+        }
+        sl_tiltobs_vehicle_t m;
+        const bool other = sl_tiltobs_vehicle_mirror(o, r, &m);
+        CHECK(other == (v.quality == (uint8_t)SL_TILT_AMBIGUOUS));
+        if (other) {
+            const sl_tilt_reading_t *mr = &r->res.mirror;
+            CHECK(mr->psi_cdeg >= 0 && mr->psi_cdeg <= 9000);
+            CHECK(mr->phi_cdeg >= 0 && mr->phi_cdeg < 36000);
+            CHECK(m.psi_cdeg == mr->psi_cdeg && m.phi_cdeg >= 0 && m.phi_cdeg < 36000);
+            CHECK(m.phi_sigma_cdeg <= 18000U);
+            CHECK(m.lean_path_cdeg >= -9000 && m.lean_path_cdeg <= 9000);
+            CHECK(r->res.mirror_mask != r->res.mirrored_mask);
+        } else {
+            CHECK(r->res.mirror_mask == 0U && r->res.mirror.tx_q24 == 0 && r->res.mirror.ty_q24 == 0);
         }
     }
     CHECK(fresh == o->pending);

@@ -9,7 +9,8 @@
 # the right values, or FITTED within their sigmas a little over 1 deg of tilt); every FITTED
 # fit along the passes within 3 of its stated sigmas; the separation line (how many AMBIGUOUS
 # passes held observations that cannot tell the mirror from the truth even if exact) counts
-# the table's AMBIGUOUS passes.
+# the table's AMBIGUOUS passes; every AMBIGUOUS pass of psi >= 5 holds the truth in one of
+# its two readings (PoleTilt AMBIGUOUS + MIRROR) within the bounds.
 set -u
 EVAL=$1; FWS=$2; OUT=$3
 mkdir -p "$OUT"
@@ -33,5 +34,12 @@ sep=$(sed -n 's/^driveby separation: psi >= 5: \([0-9]*\) AMBIGUOUS, \([0-9]*\) 
 set -- $sep
 [ "$1" -eq "$amb" ] && [ "$2" -le "$1" ] ||
     { echo "FAIL: separation line counts $1 / $2 AMBIGUOUS, the table $amb"; exit 1; }
+grep -E '^driveby (answered|separated):' "$OUT/sweep.txt"
+ans=$(sed -n 's/^driveby answered: .* \([0-9]*\) AMBIGUOUS: the truth is the best reading in \([0-9]*\), the other in \([0-9]*\);.*/\1 \2 \3/p' \
+    "$OUT/sweep.txt")
+[ -n "$ans" ] || { echo "FAIL: no answered line"; exit 1; }
+set -- $ans
+[ "$1" -eq "$amb" ] && [ $(($2 + $3)) -eq "$1" ] ||
+    { echo "FAIL: $1 AMBIGUOUS passes, the truth among the readings of $(($2 + $3))"; exit 1; }
 echo "driveby_tilt_sweep: $within of 432 within 1 deg / 10 deg, no FITTED direction off;" \
      "$amb AMBIGUOUS, $2 of them on observations that cannot separate the mirror: OK"
