@@ -25,6 +25,9 @@ RUNS = {
                                    "sim_driveby_tilt_along_the_path"),
     "driveby_realistic": ("sl-eval driveby --realistic --json-out docs/results/driveby_realistic.json",
                           "sim_driveby_tilt_realistic"),
+    "terrain": ("sl-eval terrain ../../../../scenes/ground_attitude.ini ../../../../scenes/ground_kerb.ini "
+                "../../../../scenes/ground_dropoff.ini ../../../../scenes/ground_flat_drive.ini --threads 1 "
+                "--json-out docs/results/terrain.json", "sim_ground_terrain"),
     "driveby_realistic_3ms": ("sl-eval driveby --realistic --speeds 3 --offset 3 --offset -3 --psi 5 --psi 10 --psi 20 "
                               "--json-out docs/results/driveby_realistic_3ms.json", "sim_driveby_tilt_realistic_3ms"),
 }
@@ -85,6 +88,20 @@ def headline(res):
         rows.append([label, f"3D tilt, poles tilted >= 5 deg: FITTED within {b['psi_deg']:g} deg tilt / "
                      f"{b['phi_deg']:g} deg direction", f"{s['within_bounds']} of {s['checked']}",
                      "`sl-eval driveby" + (" --realistic`" if d["condition"] == "realistic" else "`"), test])
+    te = {r["scene"]: r for r in res.get("terrain", {}).get("scenes", [])}
+    if te:
+        att = [te[n] for n in ("ground_attitude.ini", "ground_kerb.ini", "ground_flat_drive.ini") if n in te]
+        pr = max(max(r["pitch_err_max_deg"], r["roll_err_max_deg"]) for r in att) if att else None
+        d = te.get("ground_dropoff.ini", {})
+        fl = te.get("ground_flat_drive.ini", {})
+        k = te.get("ground_kerb.ini", {})
+        rows.append(["simulation, CTS350-X physics: the ground from the shadow's edge (parked with attitude, "
+                     "a 0.1 m kerb, a 0.2 m drop-off at 1 m/s, 10 min of flat driving with clutter and poles)",
+                     "pitch/roll error, max; kerb found as STEP; the vehicle's front to the drop-off at the first "
+                     "DROP; false hazards in 10 min",
+                     f"{f(pr)} deg; {'yes' if k.get('terrain_pieces_found') else 'no'}; "
+                     f"{f(d.get('drop_true_m'))} m; {fl.get('false_hazard_onsets', '-')}",
+                     "`sl-eval terrain`", "`sim_ground_terrain`"])
     return table(["condition", "metric", "result", "command", "test"], rows)
 
 

@@ -61,6 +61,11 @@ void sl_pipeline_cfg_default(sl_pipeline_cfg_t *cfg, const sl_board_t *board)
     cfg->floor_margin_lp = 851U; // 10 dB = 10 / 3.0103 octaves x 256
     cfg->profile = true;
     sl_profile_cfg_default(&cfg->profile_cfg);
+#if SL_CFG_GROUND
+    cfg->ground = true;
+    sl_ground_cfg_default(&cfg->ground_cfg, board);
+    cfg->ground_cfg.threshold = 0U; // the pipeline's threshold
+#endif
 }
 
 uint8_t sl_pipeline_window(uint8_t n, uint8_t min_frames, int32_t speed_mm_s,
@@ -645,6 +650,22 @@ static void feed_held(sl_pipeline_t *p, uint32_t from, uint32_t to)
     }
 }
 
+#if SL_CFG_GROUND
+// The ground's row: the raw message's 8-bit bins (the whole range), else (16-bit) the
+// scan's reduced row of the masked bins.
+static SL_NOINLINE void ground_row(sl_pipeline_t *p, const sl_scan_row_t *row)
+{
+    const sl_proto_fft_t *f = row->fft;
+    // the row thresholded for the mask serves the occupied test when the thresholds agree
+    const uint32_t *bits = p->ground.cfg.threshold == p->cfg.threshold ? p->bits : NULL;
+    if (f != NULL && f->bin_data != NULL && f->bytes_per_bin == 1U) {
+        sl_ground_row(&p->ground, row->idx, f->bin_data, f->bins, bits, p->mask_bins);
+    } else {
+        sl_ground_row(&p->ground, row->idx, row->power, p->mask_bins, bits, p->mask_bins);
+    }
+}
+#endif
+
 static void on_row(void *ctx, const sl_scan_row_t *row)
 {
     sl_pipeline_t *p = ctx;
@@ -671,6 +692,11 @@ static void on_row(void *ctx, const sl_scan_row_t *row)
     if (row->idx == p->drift.watch_az) { // once per rotation: the bins past the mask
         sl_drift_tail(&p->drift, row->fft, p->mask_bins, p->cfg.pow16_shift, p->cfg.threshold);
     }
+#if SL_CFG_GROUND
+    if (p->cfg.ground && row->idx >= sl_ground_want(&p->ground)) {
+        ground_row(p, row); // `reads` rows per sector and rotation
+    }
+#endif
     if (p->cfg.profile) {
         sl_profile_row(&p->prof, row->idx, row->power, p->mask_bins, p->bits,
                        p->detect.win_bins[row->idx < p->detect.azimuths ? row->idx : 0U]);
@@ -886,6 +912,12 @@ static void on_rot(void *ctx, const sl_scan_rot_t *rot)
     }
     sl_drift_end_rotation(&p->drift);
     model_end_rotation(p);
+#if SL_CFG_GROUND
+    if (p->cfg.ground) {
+        sl_ground_set_motion(&p->ground, p->motion_valid, p->speed_mm_s, p->rotation_us);
+        sl_ground_end_rotation(&p->ground);
+    }
+#endif
     p->stats.rotations++;
     p->stats.azimuths_missing += rot->stats.missing;
     p->stats.targets += n_targets;
@@ -936,6 +968,9 @@ static void use_bin_size(sl_pipeline_t *p, uint32_t um)
     if (p->cfg.profile) {
         sl_detect_set_tail_slope(&p->detect, p->prof.slope_q8); // re-init cleared it
     }
+#if SL_CFG_GROUND
+    sl_ground_set_bin_size(&p->ground, p->det_board.bin_size_um);
+#endif
 }
 
 // A Configuration message (its parsed form stays out of on_msg's frame, which the FFT
@@ -1085,6 +1120,14 @@ sl_err_t sl_pipeline_init(sl_pipeline_t *p, const sl_board_t *board,
         p->learn_az = 0U;
         update_thresholds(p);
     }
+#if SL_CFG_GROUND
+    if (e == SL_OK && c->ground) {
+        p->cfg.ground_cfg.threshold = c->ground_cfg.threshold != 0U ? c->ground_cfg.threshold
+                                                                    : c->threshold;
+        p->cfg.ground_cfg.scale = c->value_scale; // the values' scale: the pipeline's
+        e = sl_ground_init(&p->ground, board, &p->cfg.ground_cfg);
+    }
+#endif
     sl_can_ids_t ids;
     if (e == SL_OK) {
         sl_can_ids_from_board(&ids, board);

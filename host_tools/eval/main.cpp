@@ -16,6 +16,7 @@
 #include "sl_cli.h"
 #include "sl_progress.h"
 #include "sim_render.h"
+#include "terrain.h"
 
 namespace {
 
@@ -81,6 +82,10 @@ void usage(FILE *out)
                  "      the rejection counters, the observations behind the result and the fold's\n"
                  "      interval readings and the mirror's separation at the truth; --obs-log: every fit\n"
                  "      of the pass as one JSON line.\n"
+                 "  sl-eval terrain SCENE.ini... [--rotations N] [--warmup N] [--front M] [--threads N] [--json]\n"
+                 "      The ground from the shadow's edge (attitude, height, DROP/STEP, distance of the\n"
+                 "      first warning of a drop-off ahead) against the scene's terrain and attitude\n"
+                 "      (sl-eval terrain --help).\n"
                  "Progress goes to stderr when it is a terminal; -q/--quiet silences it.\n");
 }
 
@@ -520,7 +525,7 @@ int main(int argc, char **argv)
         return sl_cli_usage_error("sl-eval", "missing command (table1, realistic or run)", usage);
     }
     const std::string cmd = argv[1];
-    if (cmd == "table1" || cmd == "realistic" || cmd == "run" || cmd == "driveby") {
+    if (cmd == "table1" || cmd == "realistic" || cmd == "run" || cmd == "driveby" || cmd == "terrain") {
         const int sub = sl_cli_info(argc - 1, argv + 1, "sl-eval", usage);
         if (sub != SL_CLI_CONTINUE) {
             return sub;
@@ -538,6 +543,9 @@ int main(int argc, char **argv)
         }
         if (cmd == "driveby") {
             return cmd_driveby(argc - 2, argv + 2);
+        }
+        if (cmd == "terrain") {
+            return cmd_terrain(argc - 2, argv + 2);
         }
     } catch (const std::exception &e) {
         std::fprintf(stderr, "sl-eval: %s\n", e.what());

@@ -298,7 +298,19 @@ Simulator::Simulator(const Scene &scene) : s_(scene)
             ground_cum_[static_cast<size_t>(n) - 1] +
             (f(x0) + 4 * f(0.5 * (x0 + x1)) + f(x1)) / 6.0 * ground_cum_step_;
     }
-    if (s_.ground) {
+    if (s_.ground && scene_terrain(s_)) {
+        terrain_moving_ = s_.speed_mps != 0.0 || s_.yaw_rate_dps != 0.0;
+        if (!terrain_moving_) {
+            const RadarPose pose = radar_pose_at(s_, 0.0);
+            ground_cols_.resize(static_cast<size_t>(b.azimuths));
+            for (int i = 0; i < b.azimuths; i++) {
+                SimColumn c;
+                c.reset(bins());
+                ground_terrain(pose, i, c);
+                ground_cols_[static_cast<size_t>(i)] = c.energy;
+            }
+        }
+    } else if (s_.ground) {
         const int ncols = b.chassis_type == "cylinder" ? 1 : b.azimuths;
         ground_cols_.resize(static_cast<size_t>(ncols));
         for (int i = 0; i < ncols; i++) {
@@ -943,6 +955,96 @@ void Simulator::ground_analytic(int i, SimColumn &col) const
     }
 }
 
+double scene_ground_z(const Scene &s, double x, double y)
+{
+    double z = 0;
+    for (const auto &t : s.terrain) {
+        const double a = sim_d2r(t.dir_deg);
+        const double u = (x - t.x_m) * std::cos(a) + (y - t.y_m) * std::sin(a);
+        if (u >= 0 && (!t.strip || u < t.width_m)) {
+            z += t.height_m;
+        }
+    }
+    return z;
+}
+
+bool scene_terrain(const Scene &s)
+{
+    return !s.terrain.empty() || s.pitch_deg != 0.0 || s.roll_deg != 0.0 ||
+           s.height_offset_m != 0.0;
+}
+
+void Simulator::ground_terrain(const RadarPose &r, int i, SimColumn &col) const
+{
+    const BoardSpec &b = s_.board;
+    const double H = b.radar_height_m + s_.height_offset_m, bin = bin_m();
+    const int nb = bins();
+    // a few bearings across the beam: the terrain path marches every one of them
+    const int K = std::min(s_.ground_az_samples, 9);
+    const double step = 0.01, rmax = s_.ground_max_range_m;
+    auto C = [&](double x) {
+        const double u = std::clamp(x, 0.0, 90.0) / ground_cum_step_;
+        const size_t n = std::min(ground_cum_.size() - 2, static_cast<size_t>(u));
+        const double f = u - static_cast<double>(n);
+        return ground_cum_[n] + f * (ground_cum_[n + 1] - ground_cum_[n]);
+    };
+    const double cp = std::cos(sim_d2r(s_.pitch_deg)), sp = std::sin(sim_d2r(s_.pitch_deg));
+    const double cq = std::cos(sim_d2r(s_.roll_deg)), sq = std::sin(sim_d2r(s_.roll_deg));
+    const double h = sim_d2r(r.heading_deg);
+    const double fx = std::cos(h), fy = std::sin(h);
+    for (int k = 0; k < K; k++) {
+        const double d = K == 1 ? 0.0 : -cut_az_ + 2.0 * cut_az_ * k / (K - 1);
+        const double wk = K == 1 ? 1.0 : (2.0 * cut_az_ / (K - 1)) * ((k == 0 || k == K - 1) ? 0.5 : 1.0);
+        const double g = azimuth_gain(d) * wk;
+        if (g <= 0) {
+            continue;
+        }
+        const double phi = az_deg_[static_cast<size_t>(i)] + d;
+        const double th = chassis_theta_deg(b, phi);
+        const double lo_d = std::max(0.0, -s_.elev_top_deg);
+        const double hi_d = s_.knife_edge && std::isfinite(th) ? -s_.elev_bottom_deg
+                                                               : std::min(th, -s_.elev_bottom_deg);
+        if (!(hi_d > lo_d)) {
+            continue;
+        }
+        // the bearing's direction on the ground (vehicle frame: clockwise from forward)
+        const double vxh = std::cos(sim_d2r(phi)), vyh = -std::sin(sim_d2r(phi));
+        const double ux = vxh * fx - vyh * fy, uy = vxh * fy + vyh * fx;
+        double seen = 90.0, prev_r = H;
+        for (double rho = step; rho <= rmax; rho += step) {
+            const double px = r.o.x + rho * ux, py = r.o.y + rho * uy;
+            const double wz = scene_ground_z(s_, px, py) - H;
+            // level frame (heading removed) -> vehicle frame: Rx(roll)^T Ry(pitch)^T
+            const double wx = rho * vxh, wy = rho * vyh;
+            const double ax = cp * wx - sp * wz, az = sp * wx + cp * wz;
+            const double vx = ax, vy = cq * wy + sq * az, vz = -sq * wy + cq * az;
+            const double x = sim_r2d(std::atan2(-vz, std::hypot(vx, vy)));
+            const double rr = std::sqrt(rho * rho + wz * wz);
+            if (x < seen) {
+                const double a = std::max(x, lo_d), c = std::min(seen, hi_d);
+                const double rm = 0.5 * (rr + prev_r);
+                const int j = static_cast<int>(std::floor(rm / bin));
+                if (c > a && j >= 0 && j < nb) {
+                    double E = s_.ground_reflectivity * g * (C(c) - C(a));
+                    if (s_.knife_edge) {
+                        E *= knife_edge_gain(phi, -0.5 * (a + c), rm);
+                    }
+                    col.energy[static_cast<size_t>(j)] += E;
+                    if (E > 0) {
+                        col.touched[static_cast<size_t>(j)] = 1;
+                        col.peak[static_cast<size_t>(j)] = std::max(
+                            col.peak[static_cast<size_t>(j)],
+                            static_cast<float>(s_.ground_reflectivity * azimuth_gain(d) *
+                                               elevation_gain(-0.5 * (a + c))));
+                    }
+                }
+                seen = x;
+            }
+            prev_r = rr;
+        }
+    }
+}
+
 bool Simulator::boxes_in_window(const RadarPose &r, int i) const
 {
     const double a_c = az_deg_[static_cast<size_t>(i)];
@@ -1041,6 +1143,8 @@ void Simulator::column_from(const RotationGeom &rg, int i, SimColumn &col) const
     const RadarPose pose = radar_pose_at(s_, time_of(rg.k, i));
     if (!boxes_.empty() && boxes_in_window(pose, i)) {
         grid_ground_boxes(pose, i, col);
+    } else if (s_.ground && terrain_moving_) {
+        ground_terrain(pose, i, col);
     } else if (s_.ground && !ground_cols_.empty()) {
         const auto &g = ground_cols_[ground_cols_.size() == 1 ? 0 : static_cast<size_t>(i)];
         for (size_t j = 0; j < g.size(); j++) {

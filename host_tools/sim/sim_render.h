@@ -138,6 +138,10 @@ private:
     void rotation_geom(int k, RotationGeom &rg) const;
     void column_from(const RotationGeom &rg, int i, SimColumn &col) const;
     void ground_analytic(int i, SimColumn &col) const;
+    /// The ground of azimuth i with terrain and the vehicle's attitude (scene_terrain()):
+    /// surface points marched outwards along the azimuth, each lit over the depressions it
+    /// alone is the first hit of (nearer ground higher in the radar's view hides it).
+    void ground_terrain(const RadarPose &r, int i, SimColumn &col) const;
     bool boxes_in_window(const RadarPose &r, int i) const;
     void grid_ground_boxes(const RadarPose &r, int i, SimColumn &col) const;
     void splat_pole(const PoleView &pv, int i, SimColumn *col, double *r1s, double *r2s) const;
@@ -160,6 +164,7 @@ private:
     std::vector<double> ground_cum_;
     double ground_cum_step_ = 0.001;
     std::vector<std::vector<double>> ground_cols_; ///< per azimuth (or 1 for a cylinder)
+    bool terrain_moving_ = false; ///< terrain or attitude while moving: per column
     // static scenes (speed 0): the geometry of every azimuth, computed once
     std::vector<SimColumn> static_cols_;
     // deterministic output (no noise, no per-rotation speckle): the 8-bit bins of columns
@@ -202,6 +207,11 @@ void sim_run(const Simulator &sim, int first, int count, int threads,
 /// re <= 1e-9: sharp (uniform over [a, c]). Exact, closed form (no sampling).
 void sim_splat_profile(std::vector<double> &e, double bin, double a, double c, double re,
                        double E, int first_bin = 0);
+
+/// The ground's height at world (x, y): the sum of the scene's terrain pieces (0: flat).
+double scene_ground_z(const Scene &s, double x, double y);
+/// The scene has terrain or a vehicle attitude (the ground is then marched, not analytic).
+bool scene_terrain(const Scene &s);
 
 /// Elevation gain (power, peak 1) of a scene's beam at elevation e (deg).
 double sim_elevation_gain(const Scene &s, double e_deg);

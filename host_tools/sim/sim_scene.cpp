@@ -153,7 +153,8 @@ Scene build(const Parsed &p)
             continue;
         }
         if (name.rfind("pole.", 0) == 0 || name.rfind("box.", 0) == 0 ||
-            name.rfind("wall.", 0) == 0 || name.rfind("point.", 0) == 0) {
+            name.rfind("wall.", 0) == 0 || name.rfind("point.", 0) == 0 ||
+            name.rfind("terrain.", 0) == 0) {
             if (name.find('.') + 1 >= name.size()) {
                 throw SceneError(p.file + ": [" + name + "]: object sections need a name");
             }
@@ -161,7 +162,7 @@ Scene build(const Parsed &p)
         }
         throw SceneError(p.file + ": [" + name +
                          "]: unknown section (scene, vehicle, ground, beam, output, effects, clutter, "
-                         "pole.<name>, box.<name>, wall.<name>, point.<name>)");
+                         "pole.<name>, box.<name>, wall.<name>, point.<name>, terrain.<name>)");
     }
     auto sec = [&](const std::string &n) {
         auto it = p.sections.find(n);
@@ -193,12 +194,16 @@ Scene build(const Parsed &p)
     }
     {
         Sec c = sec("vehicle");
-        c.only({"x_m", "y_m", "heading_deg", "speed_mps", "yaw_rate_dps"});
+        c.only({"x_m", "y_m", "heading_deg", "speed_mps", "yaw_rate_dps", "pitch_deg", "roll_deg",
+                "height_offset_m"});
         s.vehicle_x_m = c.real("x_m", 0, -1e5, 1e5);
         s.vehicle_y_m = c.real("y_m", 0, -1e5, 1e5);
         s.heading_deg = c.real("heading_deg", s.heading_deg, -360, 360);
         s.speed_mps = c.real("speed_mps", 0, -100, 100);
         s.yaw_rate_dps = c.real("yaw_rate_dps", 0, -180, 180);
+        s.pitch_deg = c.real("pitch_deg", 0, -20, 20);
+        s.roll_deg = c.real("roll_deg", 0, -20, 20);
+        s.height_offset_m = c.real("height_offset_m", 0, -1, 1);
     }
     {
         Sec c = sec("ground");
@@ -355,6 +360,17 @@ Scene build(const Parsed &p)
             b.height_m = c.real("height_m", 1, 0.001, 1000);
             b.reflectivity = c.real("reflectivity", b.reflectivity, 0, 1e9);
             s.boxes.push_back(b);
+        } else if (kind == "terrain") {
+            c.only({"kind", "x_m", "y_m", "dir_deg", "width_m", "height_m"});
+            SceneTerrain t;
+            t.name = obj;
+            t.strip = c.choice<bool>("kind", false, {{"step", false}, {"strip", true}});
+            t.x_m = c.real("x_m", 0, -1e5, 1e5);
+            t.y_m = c.real("y_m", 0, -1e5, 1e5);
+            t.dir_deg = c.real("dir_deg", 0, -360, 360);
+            t.width_m = c.real("width_m", t.width_m, 0.01, 1e4);
+            t.height_m = c.real("height_m", 0, -5, 5);
+            s.terrain.push_back(t);
         } else if (kind == "point") {
             c.only({"x_m", "y_m", "z_m", "energy"});
             ScenePoint q;

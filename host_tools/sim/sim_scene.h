@@ -40,6 +40,16 @@ struct ScenePole {
     double segment_gap = 0.1;
 };
 
+/// A piece of terrain ([terrain.<name>]): the ground's height changes by `height_m` (> 0 up:
+/// a kerb, a step, a bank; < 0 down: a ditch, a drop-off) beyond the line through (x, y)
+/// across the direction `dir_deg` (world, CCW from +x): kind step, everywhere beyond it;
+/// kind strip, for `width_m` beyond it (a ditch, a kerb of that width). Heights add up.
+struct SceneTerrain {
+    std::string name;
+    bool strip = false;
+    double x_m = 0, y_m = 0, dir_deg = 0, width_m = 0.5, height_m = 0;
+};
+
 /// An oriented box on (or above) the ground; walls are thin boxes.
 struct SceneBox {
     std::string name;
@@ -85,6 +95,10 @@ struct Scene {
     // [vehicle]
     double vehicle_x_m = 0, vehicle_y_m = 0, heading_deg = 90.0, speed_mps = 0;
     double yaw_rate_dps = 0; ///< constant yaw rate, deg/s CCW (a circular path)
+    /// attitude over the ground, rotating about the radar (ISO 8855: pitch nose down > 0,
+    /// roll right side down > 0) and the radar's height above the board's (body raised > 0)
+    double pitch_deg = 0, roll_deg = 0, height_offset_m = 0;
+    std::vector<SceneTerrain> terrain; ///< [terrain.<name>]
     // objects
     std::vector<ScenePole> poles;
     std::vector<SceneBox> boxes;

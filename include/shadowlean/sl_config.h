@@ -90,4 +90,17 @@
 #define SL_CFG_TILT_FITS_PER_ROTATION 2
 #endif
 
+/// The ground from the shadow's edge (sl_ground.h) compiled in, and on in
+/// sl_pipeline_cfg_default(): 1 in the host configuration, 0 in the firmware configuration
+/// (masked bins <= 192), whose flash, stack and per-azimuth instruction budgets
+/// (docs/INTEGRATION.md, "Footprint") it does not fit: there ground.c compiles to nothing
+/// and the pipeline carries no sl_ground_t.
+#ifndef SL_CFG_GROUND
+#if SL_CFG_MASK_BINS <= 192
+#define SL_CFG_GROUND 0
+#else
+#define SL_CFG_GROUND 1
+#endif
+#endif
+
 #endif // SHADOWLEAN_SL_CONFIG_H

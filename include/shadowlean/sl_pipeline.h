@@ -140,7 +140,8 @@
 /// SL_CFG_MASK_BINS / 8 bytes; then detection (8,424 B), the tracker (1,864 B), the scan
 /// bookkeeping (624 B), the range profiles (sl_profile.h, 2.3 KB), the 3D tilt history
 /// (sl_tiltobs.h: 2,480 B firmware, 7.4 KB host default), the reassembly buffer
-/// (SL_PIPELINE_REASM_BYTES), a row buffer and the theta drift watch (sl_drift.h, 60 B).
+/// (SL_PIPELINE_REASM_BYTES), a row buffer, the theta drift watch (sl_drift.h, 60 B) and,
+/// with SL_CFG_GROUND (host configuration), the ground (sl_ground.h, SL_PIPELINE_GROUND_BYTES).
 ///
 /// Measured sizes per configuration: docs/PERFORMANCE.md ("Core modules").
 ///
@@ -194,6 +195,7 @@
 #include "shadowlean/sl_detect.h"
 #include "shadowlean/sl_drift.h"
 #include "shadowlean/sl_err.h"
+#include "shadowlean/sl_ground.h"
 #include "shadowlean/sl_mask.h"
 #include "shadowlean/sl_port.h"
 #include "shadowlean/sl_profile.h"
@@ -276,6 +278,13 @@ typedef struct sl_pipeline_cfg {
     bool profile;                ///< refine bounds from range profiles (sl_profile.h;
                                  ///< default true); false = the mask's bounds and d(r)
     sl_profile_cfg_t profile_cfg; ///< profile parameters (sl_profile_cfg_default)
+#if SL_CFG_GROUND
+    // --- the ground from the shadow's edge (sl_ground.h; with SL_CFG_GROUND only)
+    bool ground;                 ///< attitude, terrain, DROP/STEP (default true)
+    sl_ground_cfg_t ground_cfg;  ///< its parameters (sl_ground_cfg_default; threshold 0:
+                                 ///< the pipeline's `threshold`; its scale is replaced by
+                                 ///< `value_scale`)
+#endif
 } sl_pipeline_cfg_t;
 
 /// Defaults for `board` (threshold, n from the board; detection and tracker defaults;
@@ -413,6 +422,10 @@ typedef struct sl_pipeline {
                                  ///< board's prior, learned from one row per rotation
     uint8_t thr_band[SL_CFG_RESP_FLOOR_BANDS]; ///< occupied threshold per band of
                                  ///< SL_RESP_FLOOR_BAND bins: max(threshold, floor + margin)
+#if SL_CFG_GROUND
+    sl_ground_t ground;          ///< the ground from the shadow's edge (sl_ground.h), with
+                                 ///< cfg.ground
+#endif
 } sl_pipeline_t;
 
 /// RAM budget of the firmware configuration (CTS350-X: 400 azimuths, n <= 16, masked bins
@@ -426,21 +439,28 @@ static_assert(sizeof(sl_pipeline_t) <= 65536U, "sl_pipeline_t: 64 KiB RAM budget
 _Static_assert(sizeof(sl_pipeline_t) <= 65536U, "sl_pipeline_t: 64 KiB RAM budget");
 #endif
 #endif
+/// The ground's share of the pipeline (its state and configuration), 0 without it.
+#if SL_CFG_GROUND
+#define SL_PIPELINE_GROUND_BYTES (sizeof(sl_ground_t) + sizeof(sl_ground_cfg_t))
+#else
+#define SL_PIPELINE_GROUND_BYTES 0U
+#endif
 /// Any azimuth count, bins and n with the default target/candidate capacities: the mask
 /// dominates; everything else except the tilt history (sl_tiltobs_t, sized by
 /// SL_CFG_TILT_TRACKS x SL_CFG_TILT_OBS_PER_TRACK: 2.5 KB firmware, 7.4 KB host) and the
-/// sensor model (sl_response_t, about 2.6 KB) stays under 17,600 B (17,412 B in the host configuration, with detection's link table, 168 B, its
+/// sensor model (sl_response_t, about 2.6 KB) and the ground (sl_ground_t and its
+/// configuration, sized by SL_CFG_GROUND_SECTORS) stays under 17,600 B (17,412 B in the host configuration, with detection's link table, 168 B, its
 /// per-azimuth peaks, 776 B, the CAN sender's E2E configuration, 24 B, and the
 /// VehicleMotion receiver with its Profile 11 state, 104 B).
 #if SL_CFG_MAX_TARGETS <= 32 && SL_CFG_DETECT_MAX_CANDIDATES <= 32 && SL_CFG_DETECT_MAX_SPAN <= 24 \
     && SL_CFG_MAX_AZIMUTHS <= 400
 #if defined(__cplusplus)
-static_assert(sizeof(sl_pipeline_t) <=
-                  sizeof(sl_mask_t) + sizeof(sl_tiltobs_t) + sizeof(sl_response_t) + 17600U,
+static_assert(sizeof(sl_pipeline_t) <= sizeof(sl_mask_t) + sizeof(sl_tiltobs_t) +
+                                             sizeof(sl_response_t) + SL_PIPELINE_GROUND_BYTES + 17600U,
               "sl_pipeline_t budget");
 #else
-_Static_assert(sizeof(sl_pipeline_t) <=
-                   sizeof(sl_mask_t) + sizeof(sl_tiltobs_t) + sizeof(sl_response_t) + 17600U,
+_Static_assert(sizeof(sl_pipeline_t) <= sizeof(sl_mask_t) + sizeof(sl_tiltobs_t) +
+                                             sizeof(sl_response_t) + SL_PIPELINE_GROUND_BYTES + 17600U,
                "sl_pipeline_t budget");
 #endif
 #endif
