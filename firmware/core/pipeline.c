@@ -544,13 +544,13 @@ static void update_thresholds(sl_pipeline_t *p)
 
 // The row the sensor model reads: one azimuth per rotation, moving by 247 of 400 azimuths
 // (the golden section of the turn) each rotation, so successive rows spread over the turn
-// and every azimuth is read in turn, or to the next azimuth after a row that gave a peak. The floor is read inside the shadow (beyond the
-// near-field band): there only the receiver's noise and sparse targets are. The shape is
-// read from isolated peaks beyond the shadow, over the message's own 8-bit bins (past the
-// masked ones where the radar sends them), over LEARN_PEAK_BINS beyond the shadow's edge
-// (the near scene, where returns are strongest; the cost per rotation stays bounded however
-// long the radar's rows are): inside the shadow a slender target's own extent would be
-// taken for the response.
+// and every azimuth is read in turn, or to the next azimuth after a row that gave a peak.
+// The floor is read inside the shadow (beyond the near-field band): there only the
+// receiver's noise and sparse targets are. The shape is read from isolated peaks beyond the
+// shadow, over the message's own 8-bit bins (past the masked ones where the radar sends
+// them), over LEARN_PEAK_BINS beyond the shadow's edge (the near scene, where returns are
+// strongest; the cost per rotation stays bounded however long the radar's rows are): inside
+// the shadow a slender target's own extent would be taken for the response.
 static SL_NOINLINE void learn_row(sl_pipeline_t *p, const sl_scan_row_t *row)
 {
     const uint32_t near = p->det_board.near_exclusion_bins;
