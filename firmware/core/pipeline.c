@@ -60,6 +60,7 @@ void sl_pipeline_cfg_default(sl_pipeline_cfg_t *cfg, const sl_board_t *board)
     cfg->learn = true;
     cfg->floor_margin_lp = 851U; // 10 dB = 10 / 3.0103 octaves x 256
     cfg->profile = true;
+    cfg->fit = false;
     sl_profile_cfg_default(&cfg->profile_cfg);
 #if SL_CFG_GROUND
     cfg->ground = true;
@@ -870,6 +871,13 @@ static void on_rot(void *ctx, const sl_scan_rot_t *rot)
     uint32_t n_targets = nt > 0 ? (uint32_t)nt : 0U;
     if (p->cfg.profile) {
         for (uint32_t i = 0; i < n_targets; i++) {
+#if SL_CFG_FIT
+            if (p->cfg.fit) {
+                (void)sl_profile_refine_fit(&p->prof, p->board, &p->resp, p->cfg.threshold,
+                                            &p->detect.targets[i]);
+                continue;
+            }
+#endif
             (void)sl_profile_refine(&p->prof, p->board, p->cfg.threshold, &p->detect.targets[i]);
         }
         n_targets = shadow_after_refine(p, n_targets);
@@ -901,7 +909,7 @@ static void on_rot(void *ctx, const sl_scan_rot_t *rot)
     // a tail in its bounds: not a 3D-tilt observation. From the start of the stream: its
     // first rotations (the first hits of every track while moving) come before any
     // evidence either way.
-    p->tilt.verified_only = p->cfg.profile && !sl_profile_clean(&p->prof);
+    p->tilt.verified_only = p->cfg.profile && (p->cfg.fit || !sl_profile_clean(&p->prof));
     sl_tiltobs_update(&p->tilt, p->tracker.tracks, p->detect.targets, n_targets);
     // Drift watch (sl_drift.h): one azimuth per rotation, read from the mask's stable row at
     // the rotation's end, joined with its raw tail when the mask's end is settled (stable-free
@@ -1048,7 +1056,8 @@ sl_err_t sl_pipeline_init(sl_pipeline_t *p, const sl_board_t *board,
     }
     p->board = board;
     const sl_pipeline_cfg_t *c = &p->cfg;
-    if (c->pow16_shift > 15U || c->max_missed == 255U || c->mask_frames == 0U) {
+    if (c->pow16_shift > 15U || c->max_missed == 255U || c->mask_frames == 0U ||
+        (c->fit && SL_CFG_FIT == 0)) {
         set_err(p, SL_ERR_ARG, (uint8_t)SL_PIPELINE_BAD_ARG, "configuration value out of range");
         return SL_ERR_ARG;
     }

@@ -1424,3 +1424,165 @@ uint32_t sl_profile_reserve(sl_profile_t *pr, uint16_t az, uint16_t bin_first, u
     }
     return got;
 }
+
+#if SL_CFG_FIT
+// E[log2 P] of an exponentially distributed power P lies log2(e) x Euler's gamma below
+// log2 E[P]: 0.833 octave, Q8. Profile sums are means of 8-bit values, i.e. of log power on
+// a LOG2 scale: the noise floor's mean power (sl_response_floor_lp) is moved by as much to
+// be the background the sums see.
+#define SPECKLE_LOG_BIAS_Q8 213
+
+// lp (Q8) of a sum's mean value over `frames` rows: the scale's lp table interpolated
+// between whole values.
+static int32_t mean_lp(const sl_response_t *resp, uint32_t sum, uint32_t frames)
+{
+    const uint32_t v0 = sum / frames;
+    if (v0 >= 255U) {
+        return resp->lp_q8[255];
+    }
+    const int32_t fr = (int32_t)(((sum - v0 * frames) << 8) / frames);
+    const int32_t l0 = resp->lp_q8[v0];
+    const int32_t l1 = resp->lp_q8[v0 + 1U];
+    return l0 + ((l1 - l0) * fr) / 256;
+}
+
+// The fit's observed and background powers for samples 0 .. n - 1 of `sum` (bin0 + k), in
+// a common scale with the window's brightest sample at 2^24.
+static void fit_inputs(sl_profile_t *pr, const sl_response_t *resp, const uint16_t *sum,
+                       uint32_t n, uint32_t frames, uint32_t bin0)
+{
+    int32_t top = INT32_MIN;
+    for (uint32_t k = 0; k < n; k++) {
+        const int32_t lp = mean_lp(resp, sum[k], frames);
+        pr->fit_y[k] = (uint32_t)lp;
+        top = lp > top ? lp : top;
+    }
+    const int32_t bias = resp->scale.kind == (uint8_t)SL_VSCALE_LOG2 ? SPECKLE_LOG_BIAS_Q8 : 0;
+    for (uint32_t k = 0; k < n; k++) {
+        int32_t fl = sl_response_floor_lp(resp, bin0 + k);
+        fl = (fl == INT32_MIN || fl < resp->lp_q8[0]) ? resp->lp_q8[0] : fl;
+        const uint32_t f = sl_lp_to_lin_q16(fl - bias - top + 8 * 256);
+        pr->fit_f[k] = f == 0U ? 1U : f;
+        pr->fit_y[k] = sl_lp_to_lin_q16((int32_t)pr->fit_y[k] - top + 8 * 256);
+    }
+}
+
+// A fitted position (bins Q8 from sample 0 of a window starting at bin `bin0`) as a range:
+// sample k is bin bin0 + k, whose centre lies at (bin0 + k + 1/2) bins.
+static int64_t fit_range_um(uint32_t bin0, int32_t x_q8, uint32_t bin_um)
+{
+    const int64_t q8 = (int64_t)bin0 * 256 + 128 + x_q8;
+    return (q8 * (int64_t)bin_um + 128) / 256;
+}
+
+static uint32_t fit_sigma_um(uint32_t s_q8, uint32_t bin_um)
+{
+    const uint64_t v = ((uint64_t)s_q8 * bin_um + 128U) / 256U;
+    return v > UINT32_MAX ? UINT32_MAX : (uint32_t)v;
+}
+
+// The target's bounds and alpha from a fit `o` of the window at `bin0`.
+static void apply_fit(const sl_board_t *board, const sl_rfit_out_t *o, uint32_t bin0,
+                      bool summed, sl_target_t *t)
+{
+    const uint32_t b = board->bin_size_um;
+    const bool slant = (t->flags & SL_TARGET_SLANT) != 0U;
+    // The detector's bounds are half-bin centres + radius terms (- d on r2): keep the
+    // radius terms, replace the centres, drop d.
+    const int64_t r1_hb_mask = (int64_t)((((uint64_t)2U * t->bin_first + 1U) * b + 1U) / 2U);
+    const int64_t r2_hb_mask = (int64_t)((((uint64_t)2U * t->bin_last + 1U) * b + 1U) / 2U);
+    const int64_t r1_term = (int64_t)t->r1_um - r1_hb_mask;
+    const int64_t r2_term = (int64_t)t->r2_um - (r2_hb_mask - (int64_t)t->elong_um);
+    const int64_t r2 = fit_range_um(bin0, o->b_q8, b);
+    if (!slant) {
+        t->r1_um = sl_fx_usat32(fit_range_um(bin0, o->a_q8, b) + r1_term);
+    }
+    t->r2_um = sl_fx_usat32(r2 + r2_term);
+    t->elong_um = sl_fx_sat32(r2_hb_mask - r2);
+    t->flags = (uint16_t)((t->flags & ~(SL_TARGET_ELONG | SL_TARGET_COARSE | SL_TARGET_WALKED)) |
+                          SL_TARGET_PROFILE | (summed ? SL_TARGET_COARSE : 0U));
+    if (board->geom == NULL) {
+        return;
+    }
+    const uint32_t s1 = sl_detect_r1_sigma_um(t, fit_sigma_um(o->sigma_a_q8, b));
+    const uint32_t s2 = fit_sigma_um(o->sigma_b_q8, b);
+    const uint32_t sr = sl_incline_bounds_sigma_corr_um(t->r1_um, t->r2_um, s1, s2,
+                                                        slant ? 0 : o->corr_q15);
+    const sl_incline_result_t res =
+        sl_incline_estimate(t->r1_um, t->r2_um, &board->geom[t->az], sr, board->theta_sigma_cdeg);
+    t->alpha_cdeg = res.alpha_cdeg;
+    t->sigma_cdeg = res.sigma_cdeg;
+    t->incline_flag = res.flag;
+    t->incline_branch = res.branch;
+    if (o->quality == (uint8_t)SL_RFIT_OUT_OF_MODEL) {
+        // a return the model does not explain: no lean to stand behind
+        t->alpha_cdeg = 0;
+        t->incline_flag = (uint8_t)SL_INCLINE_OUT_OF_DOMAIN;
+        t->incline_branch = (uint8_t)SL_INCLINE_BRANCH_NONE;
+    }
+}
+
+uint8_t sl_profile_refine_fit(sl_profile_t *pr, const sl_board_t *board,
+                              const sl_response_t *resp, uint32_t threshold, sl_target_t *t)
+{
+    SL_ASSERT(pr != NULL && board != NULL && resp != NULL && t != NULL);
+    const uint8_t si = t->az < pr->azimuths ? pr->slot_of[t->az] : (uint8_t)SL_PROFILE_NONE;
+    if (si == SL_PROFILE_NONE || pr->slot[si].frames == 0U || t->bin_first < pr->slot[si].bin0) {
+        const uint8_t why = (si != SL_PROFILE_NONE && pr->slot[si].frames != 0U)
+                                ? (uint8_t)SL_PROFILE_LEAD_CUT
+                                : (uint8_t)SL_PROFILE_NO_SLOT;
+        pr->stats.fallback[why]++;
+        widen_unverified(pr, board, t, true);
+        return why;
+    }
+    const uint16_t *sum = pr->slot[si].sum;
+    uint32_t frames = pr->slot[si].frames;
+    uint32_t bin0 = pr->slot[si].bin0;
+    uint32_t n = SL_CFG_PROFILE_BINS;
+    const bool summed = frames >= pr->cfg.min_frames;
+    if (!summed) {
+        uint32_t tol = 0U;
+        const uint32_t f = combine_neighbours(pr, t, si, threshold, &bin0, &n, &tol);
+        if (f > frames) {
+            sum = pr->scratch;
+            frames = f;
+            pr->stats.spatial++;
+        }
+    }
+    // The window ends at the shadow edge: beyond it the lit ground returns.
+    if (t->shadow_slant_um != 0U && board->bin_size_um != 0U) {
+        const uint32_t eb = t->shadow_slant_um / board->bin_size_um;
+        const uint32_t e = eb > bin0 ? eb - bin0 : 0U;
+        n = e < n ? e : n;
+    }
+    if (n < 8U) {
+        pr->stats.fallback[SL_PROFILE_TAIL_CUT]++;
+        widen_unverified(pr, board, t, true);
+        return (uint8_t)SL_PROFILE_TAIL_CUT;
+    }
+    fit_inputs(pr, resp, sum, n, frames, bin0);
+    sl_rfit_in_t in;
+    memset(&in, 0, sizeof in);
+    in.y = pr->fit_y;
+    in.f = pr->fit_f;
+    in.n = (uint16_t)n;
+    in.looks_q8 = 256U;
+    in.shape = (uint8_t)SL_RFIT_FOOT;
+    in.origin_q8 = bin0 * 256U + 128U;
+    sl_rfit_out_t o;
+    pr->stats.fits++;
+    if (sl_rfit_ws(resp, &in, &pr->fit_ws, &o) != SL_OK) {
+        o.quality = (uint8_t)SL_RFIT_NO_SIGNAL;
+    }
+    pr->stats.fit_quality[o.quality & 3U]++;
+    if (o.quality == (uint8_t)SL_RFIT_NO_SIGNAL || o.sigma_a_q8 == UINT32_MAX ||
+        o.sigma_b_q8 == UINT32_MAX) {
+        pr->stats.fallback[SL_PROFILE_NO_RUN]++;
+        widen_unverified(pr, board, t, true);
+        return (uint8_t)SL_PROFILE_NO_RUN;
+    }
+    apply_fit(board, &o, bin0, summed, t);
+    pr->stats.extracted++;
+    return (uint8_t)SL_PROFILE_OK;
+}
+#endif // SL_CFG_FIT

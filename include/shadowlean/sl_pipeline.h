@@ -141,7 +141,8 @@
 /// bookkeeping (624 B), the range profiles (sl_profile.h, 2.3 KB), the 3D tilt history
 /// (sl_tiltobs.h: 2,480 B firmware, 7.4 KB host default), the reassembly buffer
 /// (SL_PIPELINE_REASM_BYTES), a row buffer, the theta drift watch (sl_drift.h, 60 B) and,
-/// with SL_CFG_GROUND (host configuration), the ground (sl_ground.h, SL_PIPELINE_GROUND_BYTES).
+/// with SL_CFG_GROUND (host configuration), the ground (sl_ground.h, SL_PIPELINE_GROUND_BYTES),
+/// with SL_CFG_FIT (host configuration) the fit's buffers (SL_PIPELINE_FIT_BYTES).
 ///
 /// Measured sizes per configuration: docs/PERFORMANCE.md ("Core modules").
 ///
@@ -278,6 +279,13 @@ typedef struct sl_pipeline_cfg {
     bool profile;                ///< refine bounds from range profiles (sl_profile.h;
                                  ///< default true); false = the mask's bounds and d(r)
     sl_profile_cfg_t profile_cfg; ///< profile parameters (sl_profile_cfg_default)
+    bool fit;                    ///< bounds from a fit of the sensor model to the profile
+                                 ///< (sl_profile_refine_fit; default false) instead of the
+                                 ///< profile's walk (sl_profile_refine); SL_CFG_FIT only
+                                 ///< (else sl_pipeline_init refuses it). The fit reads the
+                                 ///< range response in use (`resp`): a board prior or a
+                                 ///< calibration that matches the radar, or one learned
+                                 ///< from the stream
 #if SL_CFG_GROUND
     // --- the ground from the shadow's edge (sl_ground.h; with SL_CFG_GROUND only)
     bool ground;                 ///< attitude, terrain, DROP/STEP (default true)
@@ -445,22 +453,31 @@ _Static_assert(sizeof(sl_pipeline_t) <= 65536U, "sl_pipeline_t: 64 KiB RAM budge
 #else
 #define SL_PIPELINE_GROUND_BYTES 0U
 #endif
+/// The fit's buffers in the profile (SL_CFG_FIT), 0 without it.
+#if SL_CFG_FIT
+#define SL_PIPELINE_FIT_BYTES (8U * SL_CFG_PROFILE_BINS + sizeof(sl_rfit_ws_t))
+#else
+#define SL_PIPELINE_FIT_BYTES 0U
+#endif
 /// Any azimuth count, bins and n with the default target/candidate capacities: the mask
 /// dominates; everything else except the tilt history (sl_tiltobs_t, sized by
 /// SL_CFG_TILT_TRACKS x SL_CFG_TILT_OBS_PER_TRACK: 2.5 KB firmware, 7.4 KB host) and the
 /// sensor model (sl_response_t, about 2.6 KB) and the ground (sl_ground_t and its
-/// configuration, sized by SL_CFG_GROUND_SECTORS) stays under 17,600 B (17,412 B in the host configuration, with detection's link table, 168 B, its
+/// configuration, sized by SL_CFG_GROUND_SECTORS) and the fit's buffers
+/// (SL_PIPELINE_FIT_BYTES) stays under 17,600 B (17,412 B in the host configuration, with detection's link table, 168 B, its
 /// per-azimuth peaks, 776 B, the CAN sender's E2E configuration, 24 B, and the
 /// VehicleMotion receiver with its Profile 11 state, 104 B).
 #if SL_CFG_MAX_TARGETS <= 32 && SL_CFG_DETECT_MAX_CANDIDATES <= 32 && SL_CFG_DETECT_MAX_SPAN <= 24 \
     && SL_CFG_MAX_AZIMUTHS <= 400
 #if defined(__cplusplus)
 static_assert(sizeof(sl_pipeline_t) <= sizeof(sl_mask_t) + sizeof(sl_tiltobs_t) +
-                                             sizeof(sl_response_t) + SL_PIPELINE_GROUND_BYTES + 17600U,
+                                             sizeof(sl_response_t) + SL_PIPELINE_GROUND_BYTES +
+                                             SL_PIPELINE_FIT_BYTES + 17600U,
               "sl_pipeline_t budget");
 #else
 _Static_assert(sizeof(sl_pipeline_t) <= sizeof(sl_mask_t) + sizeof(sl_tiltobs_t) +
-                                             sizeof(sl_response_t) + SL_PIPELINE_GROUND_BYTES + 17600U,
+                                             sizeof(sl_response_t) + SL_PIPELINE_GROUND_BYTES +
+                                             SL_PIPELINE_FIT_BYTES + 17600U,
                "sl_pipeline_t budget");
 #endif
 #endif
