@@ -72,6 +72,9 @@ static void slot_add(const sl_profile_t *pr, sl_profile_slot_t *s, const uint8_t
             s->sum[k] = (uint16_t)(s->sum[k] >> 1);
         }
         s->frames = (uint16_t)(s->frames >> 1);
+#if SL_CFG_FIT
+        s->fit_frames = (uint16_t)(s->fit_frames >> 1); // the same mean: the fit stands
+#endif
     }
     const uint32_t b0 = s->bin0;
     const uint32_t m = n > b0 ? (n - b0 < SL_CFG_PROFILE_BINS ? n - b0 : SL_CFG_PROFILE_BINS) : 0U;
@@ -1522,6 +1525,56 @@ static void apply_fit(const sl_board_t *board, const sl_rfit_out_t *o, uint32_t 
     }
 }
 
+// The fit's window inside a profile of n bins from bin0: the target's run (the mask's
+// first to last bin) and half the response's support either side (-20 dB on the CTS350-X
+// lobe), cut at the shadow edge (beyond it the lit ground returns). *lo: its first sample.
+// @return its samples.
+static uint32_t fit_window(const sl_board_t *board, const sl_target_t *t, uint32_t bin0,
+                           uint32_t n, uint32_t *lo)
+{
+    const uint32_t half = SL_CFG_RESP_HALF / 2U;
+    const uint32_t first = t->bin_first > bin0 ? t->bin_first - bin0 : 0U;
+    *lo = first > half ? first - half : 0U;
+    uint32_t hi = (t->bin_last > bin0 ? t->bin_last - bin0 : 0U) + half + 1U;
+    hi = hi < n ? hi : n;
+    if (t->shadow_slant_um != 0U && board->bin_size_um != 0U) {
+        const uint32_t eb = t->shadow_slant_um / board->bin_size_um;
+        const uint32_t e = eb > bin0 ? eb - bin0 : 0U;
+        hi = e < hi ? e : hi;
+    }
+    return hi > *lo ? hi - *lo : 0U;
+}
+
+// Fits the window [lo, lo + n) of `sum` (`frames` rows, from bin0) into `o`; a warm start
+// from `warm` (bounds from bin0, Q8) when given.
+static void fit_run(sl_profile_t *pr, const sl_response_t *resp, const uint16_t *sum,
+                    uint32_t frames, uint32_t bin0, uint32_t lo, uint32_t n,
+                    const sl_profile_slot_t *warm, sl_rfit_out_t *o)
+{
+    fit_inputs(pr, resp, &sum[lo], n, frames, bin0 + lo);
+    sl_rfit_in_t in;
+    memset(&in, 0, sizeof in);
+    in.y = pr->fit_y;
+    in.f = pr->fit_f;
+    in.n = (uint16_t)n;
+    in.looks_q8 = 256U;
+    in.shape = (uint8_t)SL_RFIT_FOOT;
+    in.origin_q8 = (bin0 + lo) * 256U + 128U;
+    if (warm != NULL) {
+        in.warm = 1U;
+        in.a0_q8 = warm->fit_a_q8 - (int32_t)(lo * 256U);
+        in.b0_q8 = warm->fit_b_q8 - (int32_t)(lo * 256U);
+    }
+    pr->stats.fits++;
+    if (sl_rfit_ws(resp, &in, &pr->fit_ws, o) != SL_OK) {
+        memset(o, 0, sizeof *o);
+        o->quality = (uint8_t)SL_RFIT_NO_SIGNAL;
+    }
+    pr->stats.fit_quality[o->quality & 3U]++;
+    o->a_q8 += (int32_t)(lo * 256U); // from bin0
+    o->b_q8 += (int32_t)(lo * 256U);
+}
+
 uint8_t sl_profile_refine_fit(sl_profile_t *pr, const sl_board_t *board,
                               const sl_response_t *resp, uint32_t threshold, sl_target_t *t)
 {
@@ -1535,9 +1588,10 @@ uint8_t sl_profile_refine_fit(sl_profile_t *pr, const sl_board_t *board,
         widen_unverified(pr, board, t, true);
         return why;
     }
-    const uint16_t *sum = pr->slot[si].sum;
-    uint32_t frames = pr->slot[si].frames;
-    uint32_t bin0 = pr->slot[si].bin0;
+    sl_profile_slot_t *s = &pr->slot[si];
+    const uint16_t *sum = s->sum;
+    uint32_t frames = s->frames;
+    uint32_t bin0 = s->bin0;
     uint32_t n = SL_CFG_PROFILE_BINS;
     const bool summed = frames >= pr->cfg.min_frames;
     if (!summed) {
@@ -1549,32 +1603,38 @@ uint8_t sl_profile_refine_fit(sl_profile_t *pr, const sl_board_t *board,
             pr->stats.spatial++;
         }
     }
-    // The window ends at the shadow edge: beyond it the lit ground returns.
-    if (t->shadow_slant_um != 0U && board->bin_size_um != 0U) {
-        const uint32_t eb = t->shadow_slant_um / board->bin_size_um;
-        const uint32_t e = eb > bin0 ? eb - bin0 : 0U;
-        n = e < n ? e : n;
-    }
+    uint32_t lo = 0U;
+    n = fit_window(board, t, bin0, n, &lo);
     if (n < 8U) {
         pr->stats.fallback[SL_PROFILE_TAIL_CUT]++;
         widen_unverified(pr, board, t, true);
         return (uint8_t)SL_PROFILE_TAIL_CUT;
     }
-    fit_inputs(pr, resp, sum, n, frames, bin0);
-    sl_rfit_in_t in;
-    memset(&in, 0, sizeof in);
-    in.y = pr->fit_y;
-    in.f = pr->fit_f;
-    in.n = (uint16_t)n;
-    in.looks_q8 = 256U;
-    in.shape = (uint8_t)SL_RFIT_FOOT;
-    in.origin_q8 = bin0 * 256U + 128U;
     sl_rfit_out_t o;
-    pr->stats.fits++;
-    if (sl_rfit_ws(resp, &in, &pr->fit_ws, &o) != SL_OK) {
-        o.quality = (uint8_t)SL_RFIT_NO_SIGNAL;
+    memset(&o, 0, sizeof o);
+    if (summed && s->fit_frames != 0U && s->frames < s->fit_frames + s->fit_frames / 4U + 1U) {
+        // The sum grew by less than a quarter since its last fit: that fit stands (a
+        // summed fit's error repeats from rotation to rotation anyway: COARSE).
+        pr->stats.fits_reused++;
+        o.a_q8 = s->fit_a_q8;
+        o.b_q8 = s->fit_b_q8;
+        o.sigma_a_q8 = s->fit_sa_q8;
+        o.sigma_b_q8 = s->fit_sb_q8;
+        o.corr_q15 = s->fit_corr_q15;
+        o.quality = s->fit_quality;
+    } else {
+        fit_run(pr, resp, sum, frames, bin0, lo, n,
+                summed && s->fit_frames != 0U ? s : NULL, &o);
+        if (summed) {
+            s->fit_frames = s->frames;
+            s->fit_quality = o.quality;
+            s->fit_a_q8 = o.a_q8;
+            s->fit_b_q8 = o.b_q8;
+            s->fit_sa_q8 = o.sigma_a_q8;
+            s->fit_sb_q8 = o.sigma_b_q8;
+            s->fit_corr_q15 = o.corr_q15;
+        }
     }
-    pr->stats.fit_quality[o.quality & 3U]++;
     if (o.quality == (uint8_t)SL_RFIT_NO_SIGNAL || o.sigma_a_q8 == UINT32_MAX ||
         o.sigma_b_q8 == UINT32_MAX) {
         pr->stats.fallback[SL_PROFILE_NO_RUN]++;

@@ -412,6 +412,10 @@ static bool start(const ctx_t *c, int32_t *a, int32_t *b, uint64_t *level)
     const int32_t w_q8 = (int32_t)sl_fx_isqrt64(w2_q16);
     *a = (int32_t)c_q8 - w_q8 / 2;
     *b = *a + w_q8;
+    if (c->in->warm != 0U) {
+        *a = c->in->a0_q8;
+        *b = c->in->b0_q8;
+    }
     *level = s0;
     return true;
 }

@@ -453,9 +453,10 @@ _Static_assert(sizeof(sl_pipeline_t) <= 65536U, "sl_pipeline_t: 64 KiB RAM budge
 #else
 #define SL_PIPELINE_GROUND_BYTES 0U
 #endif
-/// The fit's buffers in the profile (SL_CFG_FIT), 0 without it.
+/// The fit's buffers in the profile and its results per slot (SL_CFG_FIT), 0 without it.
 #if SL_CFG_FIT
-#define SL_PIPELINE_FIT_BYTES (8U * SL_CFG_PROFILE_BINS + sizeof(sl_rfit_ws_t))
+#define SL_PIPELINE_FIT_BYTES \
+    (8U * SL_CFG_PROFILE_BINS + sizeof(sl_rfit_ws_t) + 32U * SL_CFG_PROFILE_SLOTS)
 #else
 #define SL_PIPELINE_FIT_BYTES 0U
 #endif

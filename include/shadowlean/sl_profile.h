@@ -450,6 +450,13 @@ typedef struct sl_profile_slot {
     uint8_t lead_seen; ///< this slot's rise counted for the front part (once per sum), or
                        ///< not to be: claimed on evidence while moving
     uint8_t resid_seen; ///< this slot's walk-end residual counted (once per sum)
+#if SL_CFG_FIT
+    uint16_t fit_frames; ///< rows in the sum at its last fit (0: none; halved with the sum)
+    uint8_t fit_quality; ///< that fit's sl_rfit_quality_t
+    int32_t fit_a_q8, fit_b_q8; ///< its bounds, bins Q8 from bin0
+    uint32_t fit_sa_q8, fit_sb_q8; ///< their sigmas, bins Q8
+    int32_t fit_corr_q15; ///< their correlation
+#endif
 } sl_profile_slot_t;
 
 /// Result of one extraction (bins relative to the slot's bin0).
@@ -491,6 +498,8 @@ typedef struct sl_profile_stats {
     uint32_t front_skipped; ///< targets whose r1 moved past the stream's front part
     uint32_t resid_samples; ///< upright-pole residuals counted ("Online calibration")
     uint32_t fits;          ///< sl_profile_refine_fit: fits run
+    uint32_t fits_reused;   ///< ... targets given their slot's last fit (its sum grew by
+                            ///< less than a quarter since)
     uint32_t fit_quality[4]; ///< ... by sl_rfit_quality_t
 } sl_profile_stats_t;
 
