@@ -58,6 +58,7 @@ void sl_pipeline_cfg_default(sl_pipeline_cfg_t *cfg, const sl_board_t *board)
         cfg->value_scale = board->value_scale;
     }
     cfg->learn = true;
+    cfg->learn_fast = SL_CFG_FIT != 0;
     cfg->floor_margin_lp = 851U; // 10 dB = 10 / 3.0103 octaves x 256
     cfg->profile = true;
     cfg->fit = false;
@@ -571,6 +572,12 @@ static SL_NOINLINE void learn_row(sl_pipeline_t *p, const sl_scan_row_t *row)
     }
 }
 
+// cfg.learn_fast applies: the shape in use is still the board's prior.
+static bool learning_fast(const sl_pipeline_t *p)
+{
+    return p->cfg.learn_fast && p->resp.source == (uint8_t)SL_RESPONSE_PRIOR;
+}
+
 // Rotation end: the thresholds follow the floor; every MODEL_UPDATE_ROTATIONS rotations the
 // learned shape replaces the one in use once enough peaks agree (sl_response.h: deriving
 // the taps, cumulative and speckle correlation costs tens of thousands of instructions, and
@@ -580,7 +587,8 @@ static void model_end_rotation(sl_pipeline_t *p)
     if (!p->cfg.learn) {
         return;
     }
-    if (p->stats.rotations % MODEL_UPDATE_ROTATIONS == MODEL_UPDATE_ROTATIONS - 1U) {
+    if (p->stats.rotations % MODEL_UPDATE_ROTATIONS == MODEL_UPDATE_ROTATIONS - 1U ||
+        (learning_fast(p) && p->resp.learn_n >= p->resp.cfg.min_peaks)) {
         (void)sl_response_update(&p->resp);
     }
     update_thresholds(p);
@@ -687,7 +695,7 @@ static void on_row(void *ctx, const sl_scan_row_t *row)
     } else {
         threshold_bands(p, row->power);
     }
-    if (row->idx == p->learn_az && p->cfg.learn) {
+    if (p->cfg.learn && (row->idx == p->learn_az || learning_fast(p))) {
         learn_row(p, row);
     }
     if (row->idx == p->drift.watch_az) { // once per rotation: the bins past the mask

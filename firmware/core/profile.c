@@ -1461,11 +1461,19 @@ static void fit_inputs(sl_profile_t *pr, const sl_response_t *resp, const uint16
         top = lp > top ? lp : top;
     }
     const int32_t bias = resp->scale.kind == (uint8_t)SL_VSCALE_LOG2 ? SPECKLE_LOG_BIAS_Q8 : 0;
+    // The response is known over its taps only: below the level of its outermost taps the
+    // model cannot tell a return's far sidelobes from the floor, and a step to nothing beyond
+    // them would read as position. The background is at least the brightest sample times
+    // that level (the taps are Q22 of the centre, the brightest sample 2^24).
+    const uint32_t te = resp->tap_q22[0] > resp->tap_q22[SL_RESP_TAPS - 1]
+                            ? resp->tap_q22[0]
+                            : resp->tap_q22[SL_RESP_TAPS - 1];
+    const uint32_t f_min = te < (1U << 22) ? te << 2 : 1U << 24;
     for (uint32_t k = 0; k < n; k++) {
         int32_t fl = sl_response_floor_lp(resp, bin0 + k);
         fl = (fl == INT32_MIN || fl < resp->lp_q8[0]) ? resp->lp_q8[0] : fl;
         const uint32_t f = sl_lp_to_lin_q16(fl - bias - top + 8 * 256);
-        pr->fit_f[k] = f == 0U ? 1U : f;
+        pr->fit_f[k] = f > f_min ? f : (f_min == 0U ? 1U : f_min);
         pr->fit_y[k] = sl_lp_to_lin_q16((int32_t)pr->fit_y[k] - top + 8 * 256);
     }
 }
@@ -1566,13 +1574,27 @@ static void fit_run(sl_profile_t *pr, const sl_response_t *resp, const uint16_t 
         in.b0_q8 = warm->fit_b_q8 - (int32_t)(lo * 256U);
     }
     pr->stats.fits++;
-    if (sl_rfit_ws(resp, &in, &pr->fit_ws, o) != SL_OK) {
+    sl_err_t e = sl_rfit_ws(resp, &in, &pr->fit_ws, o);
+    if (e == SL_OK && in.warm != 0U &&
+        (o->quality == (uint8_t)SL_RFIT_NOT_CONVERGED || o->sigma_a_q8 == UINT32_MAX ||
+         o->sigma_b_q8 == UINT32_MAX)) {
+        in.warm = 0U; // the earlier bounds led nowhere: from the moments
+        pr->stats.fits++;
+        e = sl_rfit_ws(resp, &in, &pr->fit_ws, o);
+    }
+    if (e != SL_OK) {
         memset(o, 0, sizeof *o);
         o->quality = (uint8_t)SL_RFIT_NO_SIGNAL;
     }
     pr->stats.fit_quality[o->quality & 3U]++;
     o->a_q8 += (int32_t)(lo * 256U); // from bin0
     o->b_q8 += (int32_t)(lo * 256U);
+}
+
+// A fit gives bounds with sigmas (OUT_OF_MODEL included: it says so on the bus).
+static bool fit_usable(uint8_t quality, uint32_t sa_q8, uint32_t sb_q8)
+{
+    return quality != (uint8_t)SL_RFIT_NO_SIGNAL && sa_q8 != UINT32_MAX && sb_q8 != UINT32_MAX;
 }
 
 uint8_t sl_profile_refine_fit(sl_profile_t *pr, const sl_board_t *board,
@@ -1623,9 +1645,20 @@ uint8_t sl_profile_refine_fit(sl_profile_t *pr, const sl_board_t *board,
         o.corr_q15 = s->fit_corr_q15;
         o.quality = s->fit_quality;
     } else {
-        fit_run(pr, resp, sum, frames, bin0, lo, n,
-                summed && s->fit_frames != 0U ? s : NULL, &o);
-        if (summed) {
+        const bool had = summed && s->fit_frames != 0U && fit_usable(s->fit_quality,
+                                                                     s->fit_sa_q8, s->fit_sb_q8);
+        fit_run(pr, resp, sum, frames, bin0, lo, n, had ? s : NULL, &o);
+        if (had && !fit_usable(o.quality, o.sigma_a_q8, o.sigma_b_q8)) {
+            // a refit without a usable answer keeps the slot's last one (counted)
+            pr->stats.fits_kept++;
+            s->fit_frames = s->frames;
+            o.a_q8 = s->fit_a_q8;
+            o.b_q8 = s->fit_b_q8;
+            o.sigma_a_q8 = s->fit_sa_q8;
+            o.sigma_b_q8 = s->fit_sb_q8;
+            o.corr_q15 = s->fit_corr_q15;
+            o.quality = s->fit_quality;
+        } else if (summed) {
             s->fit_frames = s->frames;
             s->fit_quality = o.quality;
             s->fit_a_q8 = o.a_q8;
@@ -1635,8 +1668,7 @@ uint8_t sl_profile_refine_fit(sl_profile_t *pr, const sl_board_t *board,
             s->fit_corr_q15 = o.corr_q15;
         }
     }
-    if (o.quality == (uint8_t)SL_RFIT_NO_SIGNAL || o.sigma_a_q8 == UINT32_MAX ||
-        o.sigma_b_q8 == UINT32_MAX) {
+    if (!fit_usable(o.quality, o.sigma_a_q8, o.sigma_b_q8)) {
         pr->stats.fallback[SL_PROFILE_NO_RUN]++;
         widen_unverified(pr, board, t, true);
         return (uint8_t)SL_PROFILE_NO_RUN;

@@ -272,6 +272,13 @@ typedef struct sl_pipeline_cfg {
                                  ///< rows spread over the turn, or by one after a row that
                                  ///< gave a peak); false: the board's prior and no floor,
                                  ///< detection at `threshold`
+    bool learn_fast;             ///< while the shape in use is the board's prior, the
+                                 ///< sensor model reads every row and adopts a learned
+                                 ///< shape at the first rotation end it passes the gates
+                                 ///< (then one row per rotation and every 16 rotations);
+                                 ///< default true with SL_CFG_FIT (host configuration: a few
+                                 ///< thousand instructions per row), false in the firmware
+                                 ///< configuration (its per-azimuth budget)
     uint16_t floor_margin_lp;    ///< occupied also needs the learned noise floor's mean plus
                                  ///< this, log2 power Q8 (default 851: 10 dB, an exponential
                                  ///< noise sample exceeds it with probability e^-10)

@@ -500,6 +500,7 @@ typedef struct sl_profile_stats {
     uint32_t fits;          ///< sl_profile_refine_fit: fits run
     uint32_t fits_reused;   ///< ... targets given their slot's last fit (its sum grew by
                             ///< less than a quarter since)
+    uint32_t fits_kept;     ///< ... refits without bounds or sigmas: the slot's last fit kept
     uint32_t fit_quality[4]; ///< ... by sl_rfit_quality_t
 } sl_profile_stats_t;
 
