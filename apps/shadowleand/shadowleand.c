@@ -764,6 +764,17 @@ static void log_stats(daemon_t *d, int level, const char *what)
                 ps->fallback[SL_PROFILE_TAIL_CUT],
             g_pipe.tilt.stats.observations, g_pipe.tilt.stats.unverified,
             g_pipe.tilt.stats.outliers, g_pipe.tilt.stats.gross);
+#if SL_CFG_FIT
+    if (g_pipe.cfg.fit) {
+        sld_log(SLD_LOG_INFO, "%s: sensor model's fit: %" PRIu32 " fits run, %" PRIu32
+                " targets given their slot's last fit, %" PRIu32 " refits without an answer "
+                "(the last fit kept); OK %" PRIu32 ", out of model %" PRIu32 ", no signal %" PRIu32
+                ", not converged %" PRIu32,
+                what, ps->fits, ps->fits_reused, ps->fits_kept, ps->fit_quality[SL_RFIT_OK],
+                ps->fit_quality[SL_RFIT_OUT_OF_MODEL], ps->fit_quality[SL_RFIT_NO_SIGNAL],
+                ps->fit_quality[SL_RFIT_NOT_CONVERGED]);
+    }
+#endif
     if (g_pipe.prof.slope_q8 != 0U) { // what --tail-slope takes on the next start
         sld_log(SLD_LOG_INFO, "%s: tail slope %.4f values/bin (%s; %" PRIu32 " fits taken, %" PRIu32
                 " refused)", what, g_pipe.prof.slope_q8 / 256.0,

@@ -572,11 +572,13 @@ static SL_NOINLINE void learn_row(sl_pipeline_t *p, const sl_scan_row_t *row)
     }
 }
 
+#if SL_CFG_FIT
 // cfg.learn_fast applies: the shape in use is still the board's prior.
 static bool learning_fast(const sl_pipeline_t *p)
 {
     return p->cfg.learn_fast && p->resp.source == (uint8_t)SL_RESPONSE_PRIOR;
 }
+#endif
 
 // Rotation end: the thresholds follow the floor; every MODEL_UPDATE_ROTATIONS rotations the
 // learned shape replaces the one in use once enough peaks agree (sl_response.h: deriving
@@ -587,8 +589,11 @@ static void model_end_rotation(sl_pipeline_t *p)
     if (!p->cfg.learn) {
         return;
     }
-    if (p->stats.rotations % MODEL_UPDATE_ROTATIONS == MODEL_UPDATE_ROTATIONS - 1U ||
-        (learning_fast(p) && p->resp.learn_n >= p->resp.cfg.min_peaks)) {
+    bool update = p->stats.rotations % MODEL_UPDATE_ROTATIONS == MODEL_UPDATE_ROTATIONS - 1U;
+#if SL_CFG_FIT
+    update = update || (learning_fast(p) && p->resp.learn_n >= p->resp.cfg.min_peaks);
+#endif
+    if (update) {
         (void)sl_response_update(&p->resp);
     }
     update_thresholds(p);
@@ -695,9 +700,14 @@ static void on_row(void *ctx, const sl_scan_row_t *row)
     } else {
         threshold_bands(p, row->power);
     }
-    if (p->cfg.learn && (row->idx == p->learn_az || learning_fast(p))) {
+    if (row->idx == p->learn_az && p->cfg.learn) {
         learn_row(p, row);
     }
+#if SL_CFG_FIT
+    else if (p->cfg.learn && learning_fast(p)) {
+        learn_row(p, row);
+    }
+#endif
     if (row->idx == p->drift.watch_az) { // once per rotation: the bins past the mask
         sl_drift_tail(&p->drift, row->fft, p->mask_bins, p->cfg.pow16_shift, p->cfg.threshold);
     }

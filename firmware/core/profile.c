@@ -74,12 +74,18 @@ static void slot_add(const sl_profile_t *pr, sl_profile_slot_t *s, const uint8_t
         s->frames = (uint16_t)(s->frames >> 1);
 #if SL_CFG_FIT
         s->fit_frames = (uint16_t)(s->fit_frames >> 1); // the same mean: the fit stands
+        for (uint32_t k = 0; k < SL_CFG_PROFILE_BINS; k++) {
+            s->sq[k] >>= 1;
+        }
 #endif
     }
     const uint32_t b0 = s->bin0;
     const uint32_t m = n > b0 ? (n - b0 < SL_CFG_PROFILE_BINS ? n - b0 : SL_CFG_PROFILE_BINS) : 0U;
     for (uint32_t k = 0; k < m; k++) {
         s->sum[k] = (uint16_t)(s->sum[k] + power[b0 + k]);
+#if SL_CFG_FIT
+        s->sq[k] += (uint32_t)power[b0 + k] * power[b0 + k];
+#endif
     }
     s->frames++;
 }
@@ -1553,10 +1559,54 @@ static uint32_t fit_window(const sl_board_t *board, const sl_target_t *t, uint32
     return hi > *lo ? hi - *lo : 0U;
 }
 
+// Independent looks in a slot's mean over `frames` rows (Q8, >= 256): the speckle of a
+// return's bins (those within 10 dB of its brightest, where the floor's own noise is far
+// below) splits into a part frozen over the rows (a parked vehicle) and a part drawn anew
+// each row; nu, the changing part's share of an exponential power's variance, is their
+// variance over the rows against that of one draw (LOG2: (1.85 x values per octave)^2
+// values^2, the log of an exponential; LINEAR: mean^2), at most 1. The mean of the logs of
+// `frames` draws of which nu change has the variance of (1 - nu) + nu / frames single draws,
+// and a mean of L independent powers that of 1 / L draws over 1.645 (the trigamma function at
+// 1): looks = 1 / (1.645 ((1 - nu) + nu / frames)), at least 1.
+static uint16_t temporal_looks_q8(const sl_response_t *resp, const sl_profile_slot_t *s,
+                                  uint32_t lo, uint32_t n)
+{
+    const uint64_t f = s->frames;
+    if (f < 2U) {
+        return 256U;
+    }
+    uint32_t top = 0U;
+    for (uint32_t k = lo; k < lo + n; k++) {
+        top = s->sum[k] > top ? s->sum[k] : top;
+    }
+    const bool lin = resp->scale.kind != (uint8_t)SL_VSCALE_LOG2;
+    // LOG2: 10 dB = 3.32 octaves; LINEAR: a tenth of the power
+    const uint64_t below = lin ? 0U : (f * 850U * resp->scale.cpo_q8) >> 16;
+    uint64_t vsum = 0U, ref = 0U;
+    for (uint32_t k = lo; k < lo + n; k++) {
+        const uint64_t sk = s->sum[k];
+        const bool bright = lin ? sk * 10U >= top : sk + below >= top;
+        if (bright && f * s->sq[k] >= sk * sk) {
+            vsum += f * s->sq[k] - sk * sk; // variance x f^2
+            // one exponential draw's variance x f^2
+            ref += lin ? sk * sk : (f * f * (474U * (uint64_t)resp->scale.cpo_q8 >> 8) *
+                                    (474U * (uint64_t)resp->scale.cpo_q8 >> 8)) >> 16;
+        }
+    }
+    if (ref == 0U) {
+        return 256U;
+    }
+    const uint64_t nu_q16 = vsum >= ref ? 65536U : (vsum << 16) / ref;
+    // 1.645 ((1 - nu) + nu / f), Q16
+    const uint64_t d = (107807U * ((65536U - nu_q16) + nu_q16 / f)) >> 16;
+    const uint64_t l = d == 0U ? 65535U : (256U << 16) / d;
+    return (uint16_t)(l < 256U ? 256U : (l > 65535U ? 65535U : l));
+}
+
 // Fits the window [lo, lo + n) of `sum` (`frames` rows, from bin0) into `o`; a warm start
 // from `warm` (bounds from bin0, Q8) when given.
 static void fit_run(sl_profile_t *pr, const sl_response_t *resp, const uint16_t *sum,
-                    uint32_t frames, uint32_t bin0, uint32_t lo, uint32_t n,
+                    uint32_t frames, uint32_t bin0, uint32_t lo, uint32_t n, uint16_t looks_q8,
                     const sl_profile_slot_t *warm, sl_rfit_out_t *o)
 {
     fit_inputs(pr, resp, &sum[lo], n, frames, bin0 + lo);
@@ -1565,7 +1615,7 @@ static void fit_run(sl_profile_t *pr, const sl_response_t *resp, const uint16_t 
     in.y = pr->fit_y;
     in.f = pr->fit_f;
     in.n = (uint16_t)n;
-    in.looks_q8 = 256U;
+    in.looks_q8 = looks_q8;
     in.shape = (uint8_t)SL_RFIT_FOOT;
     in.origin_q8 = (bin0 + lo) * 256U + 128U;
     if (warm != NULL) {
@@ -1647,7 +1697,8 @@ uint8_t sl_profile_refine_fit(sl_profile_t *pr, const sl_board_t *board,
     } else {
         const bool had = summed && s->fit_frames != 0U && fit_usable(s->fit_quality,
                                                                      s->fit_sa_q8, s->fit_sb_q8);
-        fit_run(pr, resp, sum, frames, bin0, lo, n, had ? s : NULL, &o);
+        fit_run(pr, resp, sum, frames, bin0, lo, n,
+                summed ? temporal_looks_q8(resp, s, lo, n) : 256U, had ? s : NULL, &o);
         if (had && !fit_usable(o.quality, o.sigma_a_q8, o.sigma_b_q8)) {
             // a refit without a usable answer keeps the slot's last one (counted)
             pr->stats.fits_kept++;

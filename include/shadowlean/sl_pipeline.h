@@ -277,8 +277,8 @@ typedef struct sl_pipeline_cfg {
                                  ///< shape at the first rotation end it passes the gates
                                  ///< (then one row per rotation and every 16 rotations);
                                  ///< default true with SL_CFG_FIT (host configuration: a few
-                                 ///< thousand instructions per row), false in the firmware
-                                 ///< configuration (its per-azimuth budget)
+                                 ///< thousand instructions per row); without SL_CFG_FIT
+                                 ///< (firmware: its per-azimuth budget) not read
     uint16_t floor_margin_lp;    ///< occupied also needs the learned noise floor's mean plus
                                  ///< this, log2 power Q8 (default 851: 10 dB, an exponential
                                  ///< noise sample exceeds it with probability e^-10)
@@ -463,7 +463,8 @@ _Static_assert(sizeof(sl_pipeline_t) <= 65536U, "sl_pipeline_t: 64 KiB RAM budge
 /// The fit's buffers in the profile and its results per slot (SL_CFG_FIT), 0 without it.
 #if SL_CFG_FIT
 #define SL_PIPELINE_FIT_BYTES \
-    (8U * SL_CFG_PROFILE_BINS + sizeof(sl_rfit_ws_t) + 32U * SL_CFG_PROFILE_SLOTS)
+    (8U * SL_CFG_PROFILE_BINS + sizeof(sl_rfit_ws_t) +                                     \
+     (32U + 4U * SL_CFG_PROFILE_BINS) * SL_CFG_PROFILE_SLOTS)
 #else
 #define SL_PIPELINE_FIT_BYTES 0U
 #endif

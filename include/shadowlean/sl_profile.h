@@ -456,6 +456,8 @@ typedef struct sl_profile_slot {
     int32_t fit_a_q8, fit_b_q8; ///< its bounds, bins Q8 from bin0
     uint32_t fit_sa_q8, fit_sb_q8; ///< their sigmas, bins Q8
     int32_t fit_corr_q15; ///< their correlation
+    uint32_t sq[SL_CFG_PROFILE_BINS]; ///< sum of the squared values (halved with `sum`): how
+                                      ///< much of the speckle changes from row to row
 #endif
 } sl_profile_slot_t;
 
@@ -683,16 +685,23 @@ uint8_t sl_profile_refine(sl_profile_t *pr, const sl_board_t *board, uint32_t th
 /// Refine a detected target with a fit of its return (sl_rfit.h) on the profile of its
 /// azimuth (while moving: this rotation's rows of it and its neighbours, as
 /// sl_profile_refine): the profile's mean values turned into power through `resp`'s value
-/// scale, the background per sample from `resp`'s noise floor, the window cut at the shadow
-/// edge, the pole's return modelled as SL_RFIT_FOOT convolved with `resp`'s range
-/// response, one independent look (a frozen speckle draw is one draw however many
-/// rotations are summed). r1 / r2 from the fitted bounds (the detector's radius terms
+/// scale, the background per sample from `resp`'s noise floor (at least the brightest
+/// sample times the level of the response's outermost taps, below which the model cannot
+/// tell a far sidelobe from the floor), the window the target's run and half the response's
+/// support either side, cut at the shadow edge, the pole's return modelled as SL_RFIT_FOOT
+/// convolved with `resp`'s range response; independent looks from how much of the speckle
+/// of the return's bins changes from row to row (the slot's sums of squares: one look for a
+/// frozen draw however many rotations are summed, and for one rotation's rows). A summed fit
+/// stands until the sum grows by a quarter; a refit starts from it, and one that gives no
+/// bounds or sigmas keeps it. r1 / r2 from the fitted bounds (the detector's radius terms
 /// kept), alpha re-estimated with the sigma the fit's covariance gives (the bounds'
 /// correlation included); a fit the model does not explain (SL_RFIT_OUT_OF_MODEL) leaves
 /// the target with `incline_flag` SL_INCLINE_OUT_OF_DOMAIN (Quality OUT_OF_MODEL on the bus),
 /// a fit without signal or sigma keeps the mask's bounds, widened. Flags: SL_TARGET_PROFILE,
 /// and SL_TARGET_COARSE for sums over rotations (their errors repeat). @return the
-/// sl_profile_fail_t (SL_PROFILE_OK: fitted). With SL_CFG_FIT only.
+/// sl_profile_fail_t (SL_PROFILE_OK: fitted). Cost: one fit (sl_rfit.h) of at most
+/// SL_CFG_PROFILE_BINS samples per target whose slot's sum grew by a quarter, else O(1).
+/// With SL_CFG_FIT only.
 #if SL_CFG_FIT
 uint8_t sl_profile_refine_fit(sl_profile_t *pr, const sl_board_t *board,
                               const sl_response_t *resp, uint32_t threshold, sl_target_t *t);
