@@ -228,10 +228,13 @@
 /// | 45 | 11 | Distance   | u | 0.01  | 0..20.47        | m   | horizontal, radar to where the ground at the plane's level ends along the sector |
 /// | 56 | 8  | Sigma      | u | 0.005 | 0..1.275        | m   | 1-sigma of HeightDiff (the sector's and the plane's) |
 ///
-/// Bit 15 is reserved (0). Distance is measured when the hazard is first voted for and
-/// moved back by the forward odometry while it holds (sl_ground.h, "distance"); parked,
-/// the ring's point. The distance to the vehicle's front is Distance less the radar's
-/// distance to the front along the sector.
+/// Bit 15 is reserved (0). HeightDiff and Sigma are the rotation's last plane fit's: a
+/// hazard holds through its hysteresis (sl_ground.h) while HeightDiff lies inside the
+/// threshold, and once the vehicle's whole ring is over the new level the plane follows it
+/// (HeightDiff small or of the other sign) until the sector clears. Distance is measured
+/// when the hazard is first voted for and moved back by the forward odometry while it holds
+/// (sl_ground.h, "distance"); parked, the ring's point. The distance to the vehicle's front
+/// is Distance less the radar's distance to the front along the sector.
 ///
 /// ## VehicleMotion (board `can.id_vehicle_motion`, VEHICLE -> SHADOWLEAN, input)
 ///

@@ -667,7 +667,8 @@ static void test_pipeline_can_frames_decode_to_the_targets(void **state)
     for (int i = 0; i < 4; i++) {
         sl_can_e2e_rx_init(&rx[i], SL_CAN_COUNTER_MODULO - 1U);
     }
-    int pole_frames[MAXROT] = {0}, statuses = 0, warnings = 0, healths = 0;
+    int pole_frames[MAXROT] = {0}, statuses = 0, warnings = 0, healths = 0, planes = 0;
+    (void)planes;
     const int n = B->mask_frames, confirm = c.confirm_hits;
     for (int i = 0; i < rec.ncan; i++) {
         const sl_can_frame_t *f = &rec.can[i];
@@ -733,10 +734,28 @@ static void test_pipeline_can_frames_decode_to_the_targets(void **state)
             assert_int_equal(h.fault, 0); // a clean stream raises no fault
             assert_int_equal(h.reconnects, 0);
             assert_int_equal(h.candidates_dropped, 0);
+#if SL_CFG_GROUND
+        } else if (f->id == B->can_id_ground_plane) {
+            // One per rotation with the ground on (the default), before its Status.
+            sl_can_ground_plane_t g;
+            assert_int_equal(sl_can_decode_ground_plane(f, E2E(GROUND_PLANE), &g), SL_OK);
+            assert_int_equal(g.counter, (unsigned)planes % SL_CAN_COUNTER_MODULO);
+            assert_int_equal(statuses, planes);
+            assert_true(g.quality <= SL_CAN_GROUND_GOOD);
+            planes++;
+        } else if (f->id == B->can_id_ground_hazard) {
+            sl_can_ground_hazard_t h;
+            assert_int_equal(sl_can_decode_ground_hazard(f, E2E(GROUND_HAZARD), &h), SL_OK);
+            assert_true(h.kind == SL_CAN_GROUND_DROP || h.kind == SL_CAN_GROUND_STEP);
+            assert_int_equal(statuses + 1, planes); // after its rotation's GroundPlane
+#endif
         } else {
             fail_msg("frame with unexpected id 0x%x", (unsigned)f->id);
         }
     }
+#if SL_CFG_GROUND
+    assert_int_equal(planes, 24);
+#endif
     assert_int_equal(healths, 24);
     assert_int_equal(statuses, 24);
     assert_int_equal(warnings, 24);
