@@ -141,8 +141,9 @@
 ///   by more than 1 % (ranges follow the radar's value; the board is not this installation).
 /// - bit6 AZIMUTH_DISORDER: azimuths stepped back beyond the reorder window.
 /// - bit7 CAN_RATE_LIMITED: frames were withheld by the hard output ceiling: token buckets
-///   on the port's clock refilled with SL_CAN_MAX_DATA_FRAMES_PER_100MS PoleLean +
-///   LeanWarning and SL_CAN_MAX_STATUS_FRAMES_PER_100MS Status + Health frames per 100 ms,
+///   on the port's clock refilled with SL_CAN_MAX_DATA_FRAMES_PER_100MS data frames
+///   (PoleLean, LeanWarning, PoleTilt, GroundPlane, GroundHazard) and
+///   SL_CAN_MAX_STATUS_FRAMES_PER_100MS Status + Health frames per 100 ms,
 ///   holding at most SL_CAN_BURST_WINDOWS x that (the backlog of a ~3 s stall of a 4 Hz
 ///   radar). Sustained: 48 frames x ~130 bits per 100 ms, under 13 % of a 500 kbit/s bus;
 ///   in any 100 ms at most (SL_CAN_BURST_WINDOWS + 1) x 48 frames, whatever the input.
