@@ -450,7 +450,8 @@ typedef enum sl_can_link_state {
 /// LINK_FLAPPING: this many reconnects within this window.
 #define SL_CAN_FLAP_RECONNECTS 3U
 #define SL_CAN_FLAP_WINDOW_MS 30000U
-/// Hard output ceiling per 100 ms (a rotation with 32 targets sends 33 data frames).
+/// Hard output ceiling per 100 ms (a rotation with 32 targets sends 33 data frames, with
+/// the ground on one GroundPlane more and a GroundHazard per confirmed sector).
 #define SL_CAN_MAX_DATA_FRAMES_PER_100MS 40U
 #define SL_CAN_MAX_STATUS_FRAMES_PER_100MS 8U
 #define SL_CAN_BURST_WINDOWS 3U
