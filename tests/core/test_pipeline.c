@@ -771,6 +771,31 @@ static void test_pipeline_can_frames_decode_to_the_targets(void **state)
     assert_int_equal(pl.stats.can_frames, rec.ncan);
 }
 
+#if !SL_CFG_GROUND
+// The firmware configuration has no ground: GroundPlane and GroundHazard keep their names,
+// Data IDs and the board's ids (a DBC of the host configuration describes the same bus),
+// without a signal table; mode 11C stays refused for them (their layout has signals in
+// bits 12..15). test_pipeline_can_frames_decode_to_the_targets fails on any frame of theirs.
+static void test_pipeline_fw_ground_messages_keep_their_identity_only(void **state)
+{
+    (void)state;
+    const sl_can_message_desc_t *gp = sl_can_layout(SL_CAN_MSG_GROUND_PLANE);
+    const sl_can_message_desc_t *gh = sl_can_layout(SL_CAN_MSG_GROUND_HAZARD);
+    assert_string_equal(gp->name, "GroundPlane");
+    assert_string_equal(gh->name, "GroundHazard");
+    assert_int_equal(gp->data_id, SL_CAN_DATA_ID_GROUND_PLANE);
+    assert_int_equal(gp->n_signals, 0);
+    assert_null(gh->signals);
+    sl_can_ids_t ids;
+    sl_can_ids_from_board(&ids, B);
+    assert_int_equal(ids.id[SL_CAN_MSG_GROUND_PLANE], B->can_id_ground_plane);
+    sl_can_tx_t tx;
+    assert_int_equal(sl_can_tx_init(&tx, &ids), SL_OK);
+    ids.e2e[SL_CAN_MSG_GROUND_HAZARD].mode = SL_CAN_E2E_MODE_NIBBLE;
+    assert_int_equal(sl_can_tx_init(&tx, &ids), SL_ERR_ARG);
+}
+#endif
+
 // Lost azimuths (random and a burst over the 0 deg pole), junk bytes with partial
 // signatures, duplicated and swapped messages, and a radar restart (cut mid-message,
 // new Configuration, sweep counters from 0), fed in random chunks.
@@ -1742,6 +1767,9 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_pipeline_detects_poles_at_minus10_0_plus10_deg_after_n_rotations),
         cmocka_unit_test(test_pipeline_can_frames_decode_to_the_targets),
+#if !SL_CFG_GROUND
+        cmocka_unit_test(test_pipeline_fw_ground_messages_keep_their_identity_only),
+#endif
         cmocka_unit_test(test_pipeline_survives_missing_azimuths_junk_duplicates_and_a_radar_restart),
         cmocka_unit_test(test_pipeline_handles_broken_empty_and_saturated_scans),
         cmocka_unit_test(test_pipeline_16_bit_stream_gives_the_same_targets),
