@@ -164,6 +164,15 @@ static int apply(sld_opts_t *o, const char *section, const char *key, const char
             BAD("expected 0 (none) or 2 .. 7 bins");
         }
         o->front_bins = (uint8_t)v;
+    } else if (IS("daemon", "extract")) {
+        // sl_pipeline_cfg_t.fit (the fit needs SL_CFG_FIT: the host configuration)
+        if (strcmp(val, "fit") == 0 && SL_CFG_FIT) {
+            o->fit = true;
+        } else if (strcmp(val, "walk") == 0) {
+            o->fit = false;
+        } else {
+            BAD(SL_CFG_FIT ? "expected walk or fit" : "expected walk (this build has no fit)");
+        }
     } else if (IS("daemon", "r2_offset_mm")) {
         // sl_profile_cfg_t.prior_r2_offset_um: -100 .. +100 mm (0 = none)
         char *end = NULL;
@@ -381,6 +390,7 @@ static const cli_opt_t k_cli[] = {
     {"--tail-slope", "daemon", "tail_slope", 1, NULL},
     {"--front-bins", "daemon", "front_bins", 1, NULL},
     {"--r2-offset", "daemon", "r2_offset_mm", 1, NULL},
+    {"--extract", "daemon", "extract", 1, NULL},
     {"--status-period-ms", "daemon", "status_period_ms", 1, NULL},
     {"--duration", "daemon", "duration", 1, NULL},
     {"--exit-idle", "daemon", "exit_idle", 1, NULL},
@@ -456,6 +466,9 @@ void sld_opts_usage(void *fpv)
         "  --r2-offset MM           [daemon] r2_offset_mm     the walk-end offset of r2 an earlier run learned on\n"
         "                                                     upright poles (\"walk-end offset\"): used until the\n"
         "                                                     stream has learned its own (0 = none, default)\n"
+        "  --extract walk|fit       [daemon] extract          a target's bounds from its range profile: the\n"
+        "                                                     profile's walk (default), or the fit of the sensor\n"
+        "                                                     model (range response, noise floor) to it\n"
         "  --status-period-ms N     [daemon] status_period_ms Status frame period without data (1000)\n"
         "  --duration S             [daemon] duration         stop after S seconds (0 = never)\n"
         "  --exit-idle S            [daemon] exit_idle        radar: stop after S s without FFT data (once data came)\n"
@@ -642,6 +655,7 @@ void sld_opts_print(const sld_opts_t *o, void *fpv)
     if (o->r2_offset_um != 0) {
         fprintf(fp, "r2_offset_mm = %.3f\n", (double)o->r2_offset_um / 1000.0);
     }
+    fprintf(fp, "extract = %s\n", o->fit ? "fit" : "walk");
     fprintf(fp, "\n[input]\n");
     if (o->radar_host[0] != '\0') {
         const bool v6 = strchr(o->radar_host, ':') != NULL;

@@ -254,3 +254,26 @@ uint32_t sl_incline_bounds_sigma_um(uint32_t r1_um, uint32_t r2_um, uint32_t s1_
     const uint64_t v = w * ((uint64_t)s2_um * s2_um) + (65536U - w) * ((uint64_t)s1_um * s1_um);
     return sl_fx_isqrt64(sl_fx_urshift_round64(v, 16U));
 }
+
+#if SL_CFG_FIT
+uint32_t sl_incline_bounds_sigma_corr_um(uint32_t r1_um, uint32_t r2_um, uint32_t s1_um,
+                                         uint32_t s2_um, int32_t corr_q15)
+{
+    const uint32_t s = sl_incline_bounds_sigma_um(r1_um, r2_um, s1_um, s2_um);
+    if (corr_q15 == 0 || s1_um > (1U << 24) || s2_um > (1U << 24)) {
+        return s; // no correlation, or sigmas of 16 m and more: s^2 alone (64-bit range)
+    }
+    // the cross term 2 corr s1 s2 r1 r2 / (r1^2 + r2^2) (ranges in mm), taken off s^2
+    const uint64_t a = (uint64_t)(r1_um / 1000U), c = (uint64_t)(r2_um / 1000U);
+    const uint64_t den = a * a + c * c;
+    const int32_t k = corr_q15 > 32767 ? 32767 : (corr_q15 < -32767 ? -32767 : corr_q15);
+    const uint64_t w2 = den == 0U ? 65536U : ((2U * a * c) << 16) / den; // <= 1, Q16
+    const uint64_t x = ((uint64_t)s1_um * s2_um * w2) >> 16;
+    const uint64_t cross = (x * (uint64_t)(k < 0 ? -k : k)) >> 15;
+    const uint64_t s2 = (uint64_t)s * s;
+    if (k < 0) {
+        return sl_fx_isqrt64(s2 + cross);
+    }
+    return sl_fx_isqrt64(s2 > cross ? s2 - cross : 0U);
+}
+#endif

@@ -58,8 +58,10 @@ void sl_pipeline_cfg_default(sl_pipeline_cfg_t *cfg, const sl_board_t *board)
         cfg->value_scale = board->value_scale;
     }
     cfg->learn = true;
+    cfg->learn_fast = SL_CFG_FIT != 0;
     cfg->floor_margin_lp = 851U; // 10 dB = 10 / 3.0103 octaves x 256
     cfg->profile = true;
+    cfg->fit = false;
     sl_profile_cfg_default(&cfg->profile_cfg);
 #if SL_CFG_GROUND
     cfg->ground = true;
@@ -616,6 +618,12 @@ static SL_NOINLINE void learn_row(sl_pipeline_t *p, const sl_scan_row_t *row)
     }
 }
 
+// cfg.learn_fast applies: the shape in use is still the board's prior.
+static bool learning_fast(const sl_pipeline_t *p)
+{
+    return p->cfg.learn_fast && p->resp.source == (uint8_t)SL_RESPONSE_PRIOR;
+}
+
 // Rotation end: the thresholds follow the floor; every MODEL_UPDATE_ROTATIONS rotations the
 // learned shape replaces the one in use once enough peaks agree (sl_response.h: deriving
 // the taps, cumulative and speckle correlation costs tens of thousands of instructions, and
@@ -625,7 +633,8 @@ static void model_end_rotation(sl_pipeline_t *p)
     if (!p->cfg.learn) {
         return;
     }
-    if (p->stats.rotations % MODEL_UPDATE_ROTATIONS == MODEL_UPDATE_ROTATIONS - 1U) {
+    if (p->stats.rotations % MODEL_UPDATE_ROTATIONS == MODEL_UPDATE_ROTATIONS - 1U ||
+        (learning_fast(p) && p->resp.learn_n >= p->resp.cfg.min_peaks)) {
         (void)sl_response_update(&p->resp);
     }
     update_thresholds(p);
@@ -732,7 +741,7 @@ static void on_row(void *ctx, const sl_scan_row_t *row)
     } else {
         threshold_bands(p, row->power);
     }
-    if (row->idx == p->learn_az && p->cfg.learn) {
+    if (p->cfg.learn && (row->idx == p->learn_az || learning_fast(p))) {
         learn_row(p, row);
     }
     if (row->idx == p->drift.watch_az) { // once per rotation: the bins past the mask
@@ -916,6 +925,13 @@ static void on_rot(void *ctx, const sl_scan_rot_t *rot)
     uint32_t n_targets = nt > 0 ? (uint32_t)nt : 0U;
     if (p->cfg.profile) {
         for (uint32_t i = 0; i < n_targets; i++) {
+#if SL_CFG_FIT
+            if (p->cfg.fit) {
+                (void)sl_profile_refine_fit(&p->prof, p->board, &p->resp, p->cfg.threshold,
+                                            &p->detect.targets[i]);
+                continue;
+            }
+#endif
             (void)sl_profile_refine(&p->prof, p->board, p->cfg.threshold, &p->detect.targets[i]);
         }
         n_targets = shadow_after_refine(p, n_targets);
@@ -947,7 +963,7 @@ static void on_rot(void *ctx, const sl_scan_rot_t *rot)
     // a tail in its bounds: not a 3D-tilt observation. From the start of the stream: its
     // first rotations (the first hits of every track while moving) come before any
     // evidence either way.
-    p->tilt.verified_only = p->cfg.profile && !sl_profile_clean(&p->prof);
+    p->tilt.verified_only = p->cfg.profile && (p->cfg.fit || !sl_profile_clean(&p->prof));
     sl_tiltobs_update(&p->tilt, p->tracker.tracks, p->detect.targets, n_targets);
     // Drift watch (sl_drift.h): one azimuth per rotation, read from the mask's stable row at
     // the rotation's end, joined with its raw tail when the mask's end is settled (stable-free
@@ -1094,7 +1110,8 @@ sl_err_t sl_pipeline_init(sl_pipeline_t *p, const sl_board_t *board,
     }
     p->board = board;
     const sl_pipeline_cfg_t *c = &p->cfg;
-    if (c->pow16_shift > 15U || c->max_missed == 255U || c->mask_frames == 0U) {
+    if (c->pow16_shift > 15U || c->max_missed == 255U || c->mask_frames == 0U ||
+        (c->fit && SL_CFG_FIT == 0)) {
         set_err(p, SL_ERR_ARG, (uint8_t)SL_PIPELINE_BAD_ARG, "configuration value out of range");
         return SL_ERR_ARG;
     }

@@ -72,6 +72,9 @@ static void slot_add(const sl_profile_t *pr, sl_profile_slot_t *s, const uint8_t
             s->sum[k] = (uint16_t)(s->sum[k] >> 1);
         }
         s->frames = (uint16_t)(s->frames >> 1);
+#if SL_CFG_FIT
+        s->fit_frames = (uint16_t)(s->fit_frames >> 1); // the same mean: the fit stands
+#endif
     }
     const uint32_t b0 = s->bin0;
     const uint32_t m = n > b0 ? (n - b0 < SL_CFG_PROFILE_BINS ? n - b0 : SL_CFG_PROFILE_BINS) : 0U;
@@ -1424,3 +1427,254 @@ uint32_t sl_profile_reserve(sl_profile_t *pr, uint16_t az, uint16_t bin_first, u
     }
     return got;
 }
+
+#if SL_CFG_FIT
+// E[log2 P] of an exponentially distributed power P lies log2(e) x Euler's gamma below
+// log2 E[P]: 0.833 octave, Q8. Profile sums are means of 8-bit values, i.e. of log power on
+// a LOG2 scale: the noise floor's mean power (sl_response_floor_lp) is moved by as much to
+// be the background the sums see.
+#define SPECKLE_LOG_BIAS_Q8 213
+
+// lp (Q8) of a sum's mean value over `frames` rows: the scale's lp table interpolated
+// between whole values.
+static int32_t mean_lp(const sl_response_t *resp, uint32_t sum, uint32_t frames)
+{
+    const uint32_t v0 = sum / frames;
+    if (v0 >= 255U) {
+        return resp->lp_q8[255];
+    }
+    const int32_t fr = (int32_t)(((sum - v0 * frames) << 8) / frames);
+    const int32_t l0 = resp->lp_q8[v0];
+    const int32_t l1 = resp->lp_q8[v0 + 1U];
+    return l0 + ((l1 - l0) * fr) / 256;
+}
+
+// The fit's observed and background powers for samples 0 .. n - 1 of `sum` (bin0 + k), in
+// a common scale with the window's brightest sample at 2^24.
+static void fit_inputs(sl_profile_t *pr, const sl_response_t *resp, const uint16_t *sum,
+                       uint32_t n, uint32_t frames, uint32_t bin0)
+{
+    int32_t top = INT32_MIN;
+    for (uint32_t k = 0; k < n; k++) {
+        const int32_t lp = mean_lp(resp, sum[k], frames);
+        pr->fit_y[k] = (uint32_t)lp;
+        top = lp > top ? lp : top;
+    }
+    const int32_t bias = resp->scale.kind == (uint8_t)SL_VSCALE_LOG2 ? SPECKLE_LOG_BIAS_Q8 : 0;
+    // The response is known over its taps only: below the level of its outermost taps the
+    // model cannot tell a return's far sidelobes from the floor, and a step to nothing beyond
+    // them would read as position. The background is at least the brightest sample times
+    // that level (the taps are Q22 of the centre, the brightest sample 2^24).
+    const uint32_t te = resp->tap_q22[0] > resp->tap_q22[SL_RESP_TAPS - 1]
+                            ? resp->tap_q22[0]
+                            : resp->tap_q22[SL_RESP_TAPS - 1];
+    const uint32_t f_min = te < (1U << 22) ? te << 2 : 1U << 24;
+    for (uint32_t k = 0; k < n; k++) {
+        int32_t fl = sl_response_floor_lp(resp, bin0 + k);
+        fl = (fl == INT32_MIN || fl < resp->lp_q8[0]) ? resp->lp_q8[0] : fl;
+        const uint32_t f = sl_lp_to_lin_q16(fl - bias - top + 8 * 256);
+        pr->fit_f[k] = f > f_min ? f : (f_min == 0U ? 1U : f_min);
+        pr->fit_y[k] = sl_lp_to_lin_q16((int32_t)pr->fit_y[k] - top + 8 * 256);
+    }
+}
+
+// A fitted position (bins Q8 from sample 0 of a window starting at bin `bin0`) as a range:
+// sample k is bin bin0 + k, whose centre lies at (bin0 + k + 1/2) bins.
+static int64_t fit_range_um(uint32_t bin0, int32_t x_q8, uint32_t bin_um)
+{
+    const int64_t q8 = (int64_t)bin0 * 256 + 128 + x_q8;
+    return (q8 * (int64_t)bin_um + 128) / 256;
+}
+
+static uint32_t fit_sigma_um(uint32_t s_q8, uint32_t bin_um)
+{
+    const uint64_t v = ((uint64_t)s_q8 * bin_um + 128U) / 256U;
+    return v > UINT32_MAX ? UINT32_MAX : (uint32_t)v;
+}
+
+// The target's bounds and alpha from a fit `o` of the window at `bin0`.
+static void apply_fit(const sl_board_t *board, const sl_rfit_out_t *o, uint32_t bin0,
+                      bool summed, sl_target_t *t)
+{
+    const uint32_t b = board->bin_size_um;
+    const bool slant = (t->flags & SL_TARGET_SLANT) != 0U;
+    // The detector's bounds are half-bin centres + radius terms (- d on r2): keep the
+    // radius terms, replace the centres, drop d.
+    const int64_t r1_hb_mask = (int64_t)((((uint64_t)2U * t->bin_first + 1U) * b + 1U) / 2U);
+    const int64_t r2_hb_mask = (int64_t)((((uint64_t)2U * t->bin_last + 1U) * b + 1U) / 2U);
+    const int64_t r1_term = (int64_t)t->r1_um - r1_hb_mask;
+    const int64_t r2_term = (int64_t)t->r2_um - (r2_hb_mask - (int64_t)t->elong_um);
+    const int64_t r2 = fit_range_um(bin0, o->b_q8, b);
+    if (!slant) {
+        t->r1_um = sl_fx_usat32(fit_range_um(bin0, o->a_q8, b) + r1_term);
+    }
+    t->r2_um = sl_fx_usat32(r2 + r2_term);
+    t->elong_um = sl_fx_sat32(r2_hb_mask - r2);
+    t->flags = (uint16_t)((t->flags & ~(SL_TARGET_ELONG | SL_TARGET_COARSE | SL_TARGET_WALKED)) |
+                          SL_TARGET_PROFILE | (summed ? SL_TARGET_COARSE : 0U));
+    if (board->geom == NULL) {
+        return;
+    }
+    const uint32_t s1 = sl_detect_r1_sigma_um(t, fit_sigma_um(o->sigma_a_q8, b));
+    const uint32_t s2 = fit_sigma_um(o->sigma_b_q8, b);
+    const uint32_t sr = sl_incline_bounds_sigma_corr_um(t->r1_um, t->r2_um, s1, s2,
+                                                        slant ? 0 : o->corr_q15);
+    const sl_incline_result_t res =
+        sl_incline_estimate(t->r1_um, t->r2_um, &board->geom[t->az], sr, board->theta_sigma_cdeg);
+    t->alpha_cdeg = res.alpha_cdeg;
+    t->sigma_cdeg = res.sigma_cdeg;
+    t->incline_flag = res.flag;
+    t->incline_branch = res.branch;
+    if (o->quality == (uint8_t)SL_RFIT_OUT_OF_MODEL) {
+        // a return the model does not explain: no lean to stand behind
+        t->alpha_cdeg = 0;
+        t->incline_flag = (uint8_t)SL_INCLINE_OUT_OF_DOMAIN;
+        t->incline_branch = (uint8_t)SL_INCLINE_BRANCH_NONE;
+    }
+}
+
+// The fit's window inside a profile of n bins from bin0: the target's run (the mask's
+// first to last bin) and half the response's support either side (-20 dB on the CTS350-X
+// lobe), cut at the shadow edge (beyond it the lit ground returns). *lo: its first sample.
+// @return its samples.
+static uint32_t fit_window(const sl_board_t *board, const sl_target_t *t, uint32_t bin0,
+                           uint32_t n, uint32_t *lo)
+{
+    const uint32_t half = SL_CFG_RESP_HALF / 2U;
+    const uint32_t first = t->bin_first > bin0 ? t->bin_first - bin0 : 0U;
+    *lo = first > half ? first - half : 0U;
+    uint32_t hi = (t->bin_last > bin0 ? t->bin_last - bin0 : 0U) + half + 1U;
+    hi = hi < n ? hi : n;
+    if (t->shadow_slant_um != 0U && board->bin_size_um != 0U) {
+        const uint32_t eb = t->shadow_slant_um / board->bin_size_um;
+        const uint32_t e = eb > bin0 ? eb - bin0 : 0U;
+        hi = e < hi ? e : hi;
+    }
+    return hi > *lo ? hi - *lo : 0U;
+}
+
+// Fits the window [lo, lo + n) of `sum` (`frames` rows, from bin0) into `o`; a warm start
+// from `warm` (bounds from bin0, Q8) when given.
+static void fit_run(sl_profile_t *pr, const sl_response_t *resp, const uint16_t *sum,
+                    uint32_t frames, uint32_t bin0, uint32_t lo, uint32_t n,
+                    const sl_profile_slot_t *warm, sl_rfit_out_t *o)
+{
+    fit_inputs(pr, resp, &sum[lo], n, frames, bin0 + lo);
+    sl_rfit_in_t in;
+    memset(&in, 0, sizeof in);
+    in.y = pr->fit_y;
+    in.f = pr->fit_f;
+    in.n = (uint16_t)n;
+    in.looks_q8 = 256U;
+    in.shape = (uint8_t)SL_RFIT_FOOT;
+    in.origin_q8 = (bin0 + lo) * 256U + 128U;
+    if (warm != NULL) {
+        in.warm = 1U;
+        in.a0_q8 = warm->fit_a_q8 - (int32_t)(lo * 256U);
+        in.b0_q8 = warm->fit_b_q8 - (int32_t)(lo * 256U);
+    }
+    pr->stats.fits++;
+    sl_err_t e = sl_rfit_ws(resp, &in, &pr->fit_ws, o);
+    if (e == SL_OK && in.warm != 0U &&
+        (o->quality == (uint8_t)SL_RFIT_NOT_CONVERGED || o->sigma_a_q8 == UINT32_MAX ||
+         o->sigma_b_q8 == UINT32_MAX)) {
+        in.warm = 0U; // the earlier bounds led nowhere: from the moments
+        pr->stats.fits++;
+        e = sl_rfit_ws(resp, &in, &pr->fit_ws, o);
+    }
+    if (e != SL_OK) {
+        memset(o, 0, sizeof *o);
+        o->quality = (uint8_t)SL_RFIT_NO_SIGNAL;
+    }
+    pr->stats.fit_quality[o->quality & 3U]++;
+    o->a_q8 += (int32_t)(lo * 256U); // from bin0
+    o->b_q8 += (int32_t)(lo * 256U);
+}
+
+// A fit gives bounds with sigmas (OUT_OF_MODEL included: it says so on the bus).
+static bool fit_usable(uint8_t quality, uint32_t sa_q8, uint32_t sb_q8)
+{
+    return quality != (uint8_t)SL_RFIT_NO_SIGNAL && sa_q8 != UINT32_MAX && sb_q8 != UINT32_MAX;
+}
+
+uint8_t sl_profile_refine_fit(sl_profile_t *pr, const sl_board_t *board,
+                              const sl_response_t *resp, uint32_t threshold, sl_target_t *t)
+{
+    SL_ASSERT(pr != NULL && board != NULL && resp != NULL && t != NULL);
+    const uint8_t si = t->az < pr->azimuths ? pr->slot_of[t->az] : (uint8_t)SL_PROFILE_NONE;
+    if (si == SL_PROFILE_NONE || pr->slot[si].frames == 0U || t->bin_first < pr->slot[si].bin0) {
+        const uint8_t why = (si != SL_PROFILE_NONE && pr->slot[si].frames != 0U)
+                                ? (uint8_t)SL_PROFILE_LEAD_CUT
+                                : (uint8_t)SL_PROFILE_NO_SLOT;
+        pr->stats.fallback[why]++;
+        widen_unverified(pr, board, t, true);
+        return why;
+    }
+    sl_profile_slot_t *s = &pr->slot[si];
+    const uint16_t *sum = s->sum;
+    uint32_t frames = s->frames;
+    uint32_t bin0 = s->bin0;
+    uint32_t n = SL_CFG_PROFILE_BINS;
+    const bool summed = frames >= pr->cfg.min_frames;
+    if (!summed) {
+        uint32_t tol = 0U;
+        const uint32_t f = combine_neighbours(pr, t, si, threshold, &bin0, &n, &tol);
+        if (f > frames) {
+            sum = pr->scratch;
+            frames = f;
+            pr->stats.spatial++;
+        }
+    }
+    uint32_t lo = 0U;
+    n = fit_window(board, t, bin0, n, &lo);
+    if (n < 8U) {
+        pr->stats.fallback[SL_PROFILE_TAIL_CUT]++;
+        widen_unverified(pr, board, t, true);
+        return (uint8_t)SL_PROFILE_TAIL_CUT;
+    }
+    sl_rfit_out_t o;
+    memset(&o, 0, sizeof o);
+    if (summed && s->fit_frames != 0U && s->frames < s->fit_frames + s->fit_frames / 4U + 1U) {
+        // The sum grew by less than a quarter since its last fit: that fit stands (a
+        // summed fit's error repeats from rotation to rotation anyway: COARSE).
+        pr->stats.fits_reused++;
+        o.a_q8 = s->fit_a_q8;
+        o.b_q8 = s->fit_b_q8;
+        o.sigma_a_q8 = s->fit_sa_q8;
+        o.sigma_b_q8 = s->fit_sb_q8;
+        o.corr_q15 = s->fit_corr_q15;
+        o.quality = s->fit_quality;
+    } else {
+        const bool had = summed && s->fit_frames != 0U && fit_usable(s->fit_quality,
+                                                                     s->fit_sa_q8, s->fit_sb_q8);
+        fit_run(pr, resp, sum, frames, bin0, lo, n, had ? s : NULL, &o);
+        if (had && !fit_usable(o.quality, o.sigma_a_q8, o.sigma_b_q8)) {
+            // a refit without a usable answer keeps the slot's last one (counted)
+            pr->stats.fits_kept++;
+            s->fit_frames = s->frames;
+            o.a_q8 = s->fit_a_q8;
+            o.b_q8 = s->fit_b_q8;
+            o.sigma_a_q8 = s->fit_sa_q8;
+            o.sigma_b_q8 = s->fit_sb_q8;
+            o.corr_q15 = s->fit_corr_q15;
+            o.quality = s->fit_quality;
+        } else if (summed) {
+            s->fit_frames = s->frames;
+            s->fit_quality = o.quality;
+            s->fit_a_q8 = o.a_q8;
+            s->fit_b_q8 = o.b_q8;
+            s->fit_sa_q8 = o.sigma_a_q8;
+            s->fit_sb_q8 = o.sigma_b_q8;
+            s->fit_corr_q15 = o.corr_q15;
+        }
+    }
+    if (!fit_usable(o.quality, o.sigma_a_q8, o.sigma_b_q8)) {
+        pr->stats.fallback[SL_PROFILE_NO_RUN]++;
+        widen_unverified(pr, board, t, true);
+        return (uint8_t)SL_PROFILE_NO_RUN;
+    }
+    apply_fit(board, &o, bin0, summed, t);
+    pr->stats.extracted++;
+    return (uint8_t)SL_PROFILE_OK;
+}
+#endif // SL_CFG_FIT

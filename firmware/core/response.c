@@ -362,6 +362,10 @@ static int32_t median_step(uint32_t n)
 
 static void median_update(int32_t *est, int32_t sample, uint32_t n)
 {
+    if (n == 0U) {
+        *est = sample; // the first sample starts the estimate (not the prior: a prior far
+        return;        // from the radar's shape would take more steps than peaks come)
+    }
     const int32_t step = median_step(n);
     if (sample > *est) {
         *est += (sample - *est < step) ? sample - *est : step;

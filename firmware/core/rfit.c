@@ -412,6 +412,10 @@ static bool start(const ctx_t *c, int32_t *a, int32_t *b, uint64_t *level)
     const int32_t w_q8 = (int32_t)sl_fx_isqrt64(w2_q16);
     *a = (int32_t)c_q8 - w_q8 / 2;
     *b = *a + w_q8;
+    if (c->in->warm != 0U) {
+        *a = c->in->a0_q8;
+        *b = c->in->b0_q8;
+    }
     *level = s0;
     return true;
 }
@@ -430,6 +434,16 @@ static int64_t mulsh(int64_t a, int64_t b, unsigned s)
 }
 
 #define SAT ((int64_t)1 << 61)
+
+// v x 256 / looks_q8 without losing a small v's digits or overflowing a large one.
+static int64_t per_looks(int64_t v, uint16_t looks_q8)
+{
+    const int64_t lim = (int64_t)1 << 52;
+    if (v < lim && v > -lim) {
+        return (v * 256) / (int64_t)looks_q8;
+    }
+    return (v / (int64_t)looks_q8) * 256;
+}
 
 // The bounds' covariance: the sandwich N^-1 M N^-1 of the independence likelihood, M the
 // score's covariance under the speckle's correlation between bins (rho2 of sl_response.h),
@@ -486,10 +500,10 @@ static void covariance(ctx_t *c, int32_t a, int32_t b, uint64_t level, const ldl
     int64_t c_aa = mulsh(p_aa, g_a, 16) + mulsh(p_ab, g_ab, 16);
     int64_t c_bb = mulsh(p_ba, g_ab, 16) + mulsh(p_bb, g_b, 16);
     int64_t c_ab = mulsh(p_aa, g_ab, 16) + mulsh(p_ab, g_b, 16);
-    // per look -> the looks averaged
-    c_aa = (c_aa / (int64_t)c->in->looks_q8) * 256;
-    c_bb = (c_bb / (int64_t)c->in->looks_q8) * 256;
-    c_ab = (c_ab / (int64_t)c->in->looks_q8) * 256;
+    // per look -> the looks averaged (a small variance keeps its digits: multiplied first)
+    c_aa = per_looks(c_aa, c->in->looks_q8);
+    c_bb = per_looks(c_bb, c->in->looks_q8);
+    c_ab = per_looks(c_ab, c->in->looks_q8);
     if (c_aa <= 0 || c_bb <= 0 || c_aa >= SAT / 2 || c_bb >= SAT / 2) {
         return;
     }

@@ -3,6 +3,7 @@
 //
 //   sl-bench CAPTURE [--board NAME] [--chunk BYTES] [--repeat N] [--loop N] [--n N]
 //                    [--beam-cdeg N] [--threshold T] [--speed-mm-s V] [--no-profile] [--no-learn]
+//                    [--fit]
 //                    [--callgrind run|latency] [--quiet]
 //
 // CAPTURE is a raw Colossus stream (`.colossus`: sl-sim, `sl-replay from-oxford`,
@@ -121,6 +122,7 @@ typedef struct opts {
     long speed_mm_s;
     int no_profile;
     int no_learn;
+    int fit;
     bool quiet;
 } opts_t;
 
@@ -133,7 +135,7 @@ static void usage(FILE *out)
 {
     fprintf(out, "usage: " SL_BENCH_PROG " CAPTURE [--board NAME] [--chunk BYTES] [--repeat N] "
                  "[--loop N] [--n N] [--beam-cdeg N] [--threshold T] [--speed-mm-s V] [--no-profile] [--no-learn] "
-                 "[--callgrind run|latency] [--quiet]\n");
+                 "[--fit] [--callgrind run|latency] [--quiet]\n");
 }
 
 static bool takes_value(const char *a)
@@ -226,6 +228,9 @@ static int init_pipeline(const opts_t *o, const sl_board_t *board)
     if (o->no_profile) {
         c.profile = false; // the mask's bounds and the board's d(r) (sl_profile.h off)
     }
+    if (o->fit) {
+        c.fit = true; // bounds from the sensor model's fit (SL_CFG_FIT builds: sl-bench-host)
+    }
     if (o->threshold >= 0) {
         c.threshold = (uint16_t)o->threshold;
     }
@@ -279,6 +284,8 @@ int main(int argc, char **argv)
             o.no_profile = 1;
         } else if (strcmp(a, "--no-learn") == 0) {
             o.no_learn = 1;
+        } else if (strcmp(a, "--fit") == 0) {
+            o.fit = 1;
         } else if (strcmp(a, "--threshold") == 0 && v) {
             o.threshold = atoi(v), i++;
         } else if (strcmp(a, "--speed-mm-s") == 0 && v) {

@@ -62,12 +62,15 @@ void usage(FILE *out)
                  "      --hard-set NAME=VALUE (implies --hard): one of those parameters, by the name above.\n"
                  "  sl-eval run CAPTURE.colossus GT.csv [--board NAME] [--scene SCENE.ini]\n"
                  "             [--threshold T] [--beta DEG] [--raw|--half-bin] [--r1-add M] [--d M]\n"
-                 "             [--extract bbox|pipeline] [--beam-deg DEG] [--speed M/S] [--no-width-radius]\n"
+                 "             [--extract bbox|pipeline|fit|model] [--beam-deg DEG] [--speed M/S]\n"
+                 "             [--no-width-radius]\n"
                  "             [--calibration FILE] [--looks N] [--prior]\n"
                  "      Evaluates one capture made by sl-sim against its ground truth (raw or pcap, streamed;\n"
                  "      - = stdin). --extract pipeline: the core pipeline (beam, threshold and speed from\n"
                  "      --scene, or the options); --calibration: on the board's calibrated view (a vehicle's\n"
-                 "      INI or blob). --extract model: the forward model of the return (the core's sensor\n"
+                 "      INI or blob). --extract fit: the pipeline with its bounds from the fit of the sensor\n"
+                 "      model to each target's range profile (cfg.fit; the range response in use: the\n"
+                 "      board's prior, the calibration's, or learned). --extract model: the forward model of the return (the core's sensor\n"
                  "      model learned from the capture's rows beyond the poles, or the CTS350-X prior with\n"
                  "      --prior) fitted per pole and azimuth over the rotations summed (--looks: independent\n"
                  "      speckle looks in the sum, default 1: frozen); the value scale from --scene.\n"
@@ -296,7 +299,7 @@ int cmd_run(int argc, char **argv)
     std::string cap, gtp, board, scene_path, calibration;
     double threshold = -1, beta = 0, r1_add = 0, d = 0;
     sl::Proc::Bounds bounds = sl::Proc::Bounds::HalfBin;
-    bool pipeline = false, model = false, no_width_radius = false, model_learn = true;
+    bool pipeline = false, model = false, no_width_radius = false, model_learn = true, fit = false;
     double beam_deg = -1, speed = -1, looks = 1;
     for (int i = 0; i < argc; i++) {
         const std::string a = argv[i];
@@ -313,11 +316,12 @@ int cmd_run(int argc, char **argv)
             if (missing) {
                 return sl_cli_bad_value("sl-eval", "--extract", "needs a value", usage);
             }
-            if (m != "pipeline" && m != "bbox" && m != "model") {
-                return sl_cli_bad_value("sl-eval", "--extract", "must be bbox, pipeline or model",
-                                        usage);
+            if (m != "pipeline" && m != "bbox" && m != "model" && m != "fit") {
+                return sl_cli_bad_value("sl-eval", "--extract",
+                                        "must be bbox, pipeline, fit or model", usage);
             }
-            pipeline = m == "pipeline";
+            pipeline = m == "pipeline" || m == "fit";
+            fit = m == "fit";
             model = m == "model";
         } else if (a == "--looks") {
             looks = std::atof(next().c_str());
@@ -414,6 +418,7 @@ int cmd_run(int argc, char **argv)
             pc.board = b.name;
         }
         pc.calibration = calibration; // the vehicle's calibration (INI or blob), if any
+        pc.fit = fit;
         if (beam_deg > 0) {
             pc.beam_deg = beam_deg;
         }

@@ -476,6 +476,7 @@ PipelineEval::PipelineEval(const PipeCfg &c) : m_(new Impl)
     if (c.profile >= 0) {
         pc.profile = c.profile != 0;
     }
+    pc.fit = c.fit;
     pc.profile_cfg.prior_r2_offset_um = c.prior_r2_offset_um;
     if (c.value_scale.kind != static_cast<uint8_t>(SL_VSCALE_LOG2) || c.value_scale.cpo_q8 != 0U) {
         pc.value_scale = c.value_scale;

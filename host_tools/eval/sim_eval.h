@@ -162,6 +162,7 @@ struct PipeCfg {
     int mask_frames = 0;        ///< > 0: overrides the board's n
     int radius_from_width = -1; ///< cfg.detect.radius_from_width: -1 default (on), 0 off, 1 on
     int profile = -1;           ///< cfg.profile (range-profile bounds): -1 default (on), 0 off, 1 on
+    bool fit = false;           ///< cfg.fit: bounds from the sensor model's fit (sl_profile_refine_fit)
     int assoc_az = 3;           ///< a target is the pole's when |az - truth azimuth| <= this
     bool clip_ambiguous = false; ///< ErrStats: count AMBIGUOUS as the model's bound
     double rotation_hz = 4;     ///< for now_us (the pipeline measures the period itself)

@@ -90,6 +90,19 @@
 #define SL_CFG_TILT_FITS_PER_ROTATION 2
 #endif
 
+/// The fit of the sensor model to a target's range profile (sl_profile_refine_fit, the
+/// pipeline's `cfg.fit`) compiled in: 1 in the host configuration, 0 in the firmware
+/// configuration (masked bins <= 192), whose stack budget (the fit runs at the rotation's
+/// end, inside the decoder's callbacks) and per-azimuth instruction budget it does not fit
+/// yet: there the profile carries no fit buffers and `cfg.fit` is refused.
+#ifndef SL_CFG_FIT
+#if SL_CFG_MASK_BINS <= 192
+#define SL_CFG_FIT 0
+#else
+#define SL_CFG_FIT 1
+#endif
+#endif
+
 /// The ground from the shadow's edge (sl_ground.h) compiled in, and on in
 /// sl_pipeline_cfg_default(): 1 in the host configuration, 0 in the firmware configuration
 /// (masked bins <= 192), whose flash, stack and per-azimuth instruction budgets

@@ -59,6 +59,7 @@
 #include <stdbool.h>
 #include <stdint.h>
 
+#include "shadowlean/sl_config.h"
 #include "shadowlean/sl_fx.h"
 
 #ifdef __cplusplus
@@ -176,6 +177,16 @@ sl_incline_result_t sl_incline_estimate(uint32_t r1_um, uint32_t r2_um,
 /// same sigma back when s1 == s2). Pure, one 64-bit division and one isqrt.
 uint32_t sl_incline_bounds_sigma_um(uint32_t r1_um, uint32_t r2_um, uint32_t s1_um,
                                     uint32_t s2_um);
+
+/// sl_incline_bounds_sigma_um for bounds whose errors correlate with `corr_q15` (Q15, in
+/// [-32767, 32767]; a fit of both bounds to one return, sl_rfit.h): sigma_rho^2 r1^2 = s2^2 +
+/// rho^2 s1^2 - 2 rho corr s1 s2, so s^2 = w s2^2 + (1 - w) s1^2 - 2 corr s1 s2 r1 r2 /
+/// (r1^2 + r2^2) (at least 0). corr 0, or a sigma above 2^24 um: sl_incline_bounds_sigma_um.
+/// Pure, two 64-bit divisions and two isqrt. With SL_CFG_FIT only (its one user).
+#if SL_CFG_FIT
+uint32_t sl_incline_bounds_sigma_corr_um(uint32_t r1_um, uint32_t r2_um, uint32_t s1_um,
+                                         uint32_t s2_um, int32_t corr_q15);
+#endif
 
 /// True when `geom` is inside the supported domain (see SL_INCLINE_THETA_MIN_CDEG): the
 /// same test sl_incline_estimate() applies. Checks theta_bam32 and beta_bam32 and that

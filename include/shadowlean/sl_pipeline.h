@@ -144,7 +144,8 @@
 /// bookkeeping (624 B), the range profiles (sl_profile.h, 2.3 KB), the 3D tilt history
 /// (sl_tiltobs.h: 2,480 B firmware, 7.4 KB host default), the reassembly buffer
 /// (SL_PIPELINE_REASM_BYTES), a row buffer, the theta drift watch (sl_drift.h, 60 B) and,
-/// with SL_CFG_GROUND (host configuration), the ground (sl_ground.h, SL_PIPELINE_GROUND_BYTES).
+/// with SL_CFG_GROUND (host configuration), the ground (sl_ground.h, SL_PIPELINE_GROUND_BYTES),
+/// with SL_CFG_FIT (host configuration) the fit's buffers (SL_PIPELINE_FIT_BYTES).
 ///
 /// Measured sizes per configuration: docs/PERFORMANCE.md ("Core modules").
 ///
@@ -274,6 +275,13 @@ typedef struct sl_pipeline_cfg {
                                  ///< rows spread over the turn, or by one after a row that
                                  ///< gave a peak); false: the board's prior and no floor,
                                  ///< detection at `threshold`
+    bool learn_fast;             ///< while the shape in use is the board's prior, the
+                                 ///< sensor model reads every row and adopts a learned
+                                 ///< shape at the first rotation end it passes the gates
+                                 ///< (then one row per rotation and every 16 rotations);
+                                 ///< default true with SL_CFG_FIT (host configuration: a few
+                                 ///< thousand instructions per row), false in the firmware
+                                 ///< configuration (its per-azimuth budget)
     uint16_t floor_margin_lp;    ///< occupied also needs the learned noise floor's mean plus
                                  ///< this, log2 power Q8 (default 851: 10 dB, an exponential
                                  ///< noise sample exceeds it with probability e^-10)
@@ -281,6 +289,13 @@ typedef struct sl_pipeline_cfg {
     bool profile;                ///< refine bounds from range profiles (sl_profile.h;
                                  ///< default true); false = the mask's bounds and d(r)
     sl_profile_cfg_t profile_cfg; ///< profile parameters (sl_profile_cfg_default)
+    bool fit;                    ///< bounds from a fit of the sensor model to the profile
+                                 ///< (sl_profile_refine_fit; default false) instead of the
+                                 ///< profile's walk (sl_profile_refine); SL_CFG_FIT only
+                                 ///< (else sl_pipeline_init refuses it). The fit reads the
+                                 ///< range response in use (`resp`): a board prior or a
+                                 ///< calibration that matches the radar, or one learned
+                                 ///< from the stream
 #if SL_CFG_GROUND
     // --- the ground from the shadow's edge (sl_ground.h; with SL_CFG_GROUND only)
     bool ground;                 ///< attitude, terrain, DROP/STEP (default true)
@@ -449,23 +464,33 @@ _Static_assert(sizeof(sl_pipeline_t) <= 65536U, "sl_pipeline_t: 64 KiB RAM budge
 #else
 #define SL_PIPELINE_GROUND_BYTES 0U
 #endif
+/// The fit's buffers in the profile and its results per slot (SL_CFG_FIT), 0 without it.
+#if SL_CFG_FIT
+#define SL_PIPELINE_FIT_BYTES \
+    (8U * SL_CFG_PROFILE_BINS + sizeof(sl_rfit_ws_t) + 32U * SL_CFG_PROFILE_SLOTS)
+#else
+#define SL_PIPELINE_FIT_BYTES 0U
+#endif
 /// Any azimuth count, bins and n with the default target/candidate capacities: the mask
 /// dominates; everything else except the tilt history (sl_tiltobs_t, sized by
 /// SL_CFG_TILT_TRACKS x SL_CFG_TILT_OBS_PER_TRACK: 2.5 KB firmware, 7.4 KB host) and the
 /// sensor model (sl_response_t, about 2.6 KB) and the ground (sl_ground_t and its
-/// configuration, sized by SL_CFG_GROUND_SECTORS) stays under 17,600 B (17,516 B in the host configuration, with detection's link table, 168 B, its
-/// per-azimuth peaks, 776 B, the CAN sender's ids, E2E configuration and counters for its
-/// eight messages, 80 B, and the
+/// configuration, sized by SL_CFG_GROUND_SECTORS) and the fit's buffers
+/// (SL_PIPELINE_FIT_BYTES) stays under 17,600 B (17,452 B in the host configuration, with
+/// detection's link table, 168 B, its per-azimuth peaks, 776 B, the CAN sender's ids, E2E
+/// configuration and counters for its eight messages, 80 B, and the
 /// VehicleMotion receiver with its Profile 11 state, 104 B).
 #if SL_CFG_MAX_TARGETS <= 32 && SL_CFG_DETECT_MAX_CANDIDATES <= 32 && SL_CFG_DETECT_MAX_SPAN <= 24 \
     && SL_CFG_MAX_AZIMUTHS <= 400
 #if defined(__cplusplus)
 static_assert(sizeof(sl_pipeline_t) <= sizeof(sl_mask_t) + sizeof(sl_tiltobs_t) +
-                                             sizeof(sl_response_t) + SL_PIPELINE_GROUND_BYTES + 17600U,
+                                             sizeof(sl_response_t) + SL_PIPELINE_GROUND_BYTES +
+                                             SL_PIPELINE_FIT_BYTES + 17600U,
               "sl_pipeline_t budget");
 #else
 _Static_assert(sizeof(sl_pipeline_t) <= sizeof(sl_mask_t) + sizeof(sl_tiltobs_t) +
-                                             sizeof(sl_response_t) + SL_PIPELINE_GROUND_BYTES + 17600U,
+                                             sizeof(sl_response_t) + SL_PIPELINE_GROUND_BYTES +
+                                             SL_PIPELINE_FIT_BYTES + 17600U,
                "sl_pipeline_t budget");
 #endif
 #endif

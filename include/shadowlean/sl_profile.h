@@ -327,7 +327,8 @@
 /// ## Ownership, memory, cost
 /// Caller-owned `sl_profile_t`, no allocation. RAM: SL_CFG_MAX_AZIMUTHS bytes + slots x
 /// (2 x SL_CFG_PROFILE_BINS + 10) + 2 x SL_CFG_PROFILE_BINS (the neighbours' sum) + ~70 B
-/// (2,304 B with the defaults on x86-64).
+/// (2,304 B with the defaults on x86-64); with SL_CFG_FIT also 8 x SL_CFG_PROFILE_BINS
+/// (the fit's powers) + sizeof(sl_rfit_ws_t).
 /// sl_profile_row: an unwatched azimuth costs one table read and a scan of the window's
 /// words for the first occupied bit; a watched one SL_CFG_PROFILE_BINS additions.
 /// sl_profile_extract: O(bins) with a 6- or 8-point integer fit per walked bin, 64-bit
@@ -342,6 +343,8 @@
 #include "shadowlean/sl_config.h"
 #include "shadowlean/sl_detect.h"
 #include "shadowlean/sl_err.h"
+#include "shadowlean/sl_response.h"
+#include "shadowlean/sl_rfit.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -447,6 +450,13 @@ typedef struct sl_profile_slot {
     uint8_t lead_seen; ///< this slot's rise counted for the front part (once per sum), or
                        ///< not to be: claimed on evidence while moving
     uint8_t resid_seen; ///< this slot's walk-end residual counted (once per sum)
+#if SL_CFG_FIT
+    uint16_t fit_frames; ///< rows in the sum at its last fit (0: none; halved with the sum)
+    uint8_t fit_quality; ///< that fit's sl_rfit_quality_t
+    int32_t fit_a_q8, fit_b_q8; ///< its bounds, bins Q8 from bin0
+    uint32_t fit_sa_q8, fit_sb_q8; ///< their sigmas, bins Q8
+    int32_t fit_corr_q15; ///< their correlation
+#endif
 } sl_profile_slot_t;
 
 /// Result of one extraction (bins relative to the slot's bin0).
@@ -487,6 +497,11 @@ typedef struct sl_profile_stats {
                             ///< kernel's support or the beam, not ended: "Cut-off returns")
     uint32_t front_skipped; ///< targets whose r1 moved past the stream's front part
     uint32_t resid_samples; ///< upright-pole residuals counted ("Online calibration")
+    uint32_t fits;          ///< sl_profile_refine_fit: fits run
+    uint32_t fits_reused;   ///< ... targets given their slot's last fit (its sum grew by
+                            ///< less than a quarter since)
+    uint32_t fits_kept;     ///< ... refits without bounds or sigmas: the slot's last fit kept
+    uint32_t fit_quality[4]; ///< ... by sl_rfit_quality_t
 } sl_profile_stats_t;
 
 typedef struct sl_profile {
@@ -517,6 +532,11 @@ typedef struct sl_profile {
     uint8_t slot_of[SL_CFG_MAX_AZIMUTHS]; ///< slot index per azimuth, SL_PROFILE_NONE
     sl_profile_slot_t slot[SL_CFG_PROFILE_SLOTS];
     uint16_t scratch[SL_CFG_PROFILE_BINS]; ///< neighbours' rows summed (sl_profile_refine)
+#if SL_CFG_FIT
+    uint32_t fit_y[SL_CFG_PROFILE_BINS];   ///< sl_profile_refine_fit: observed power
+    uint32_t fit_f[SL_CFG_PROFILE_BINS];   ///< ... and the background's, per sample
+    sl_rfit_ws_t fit_ws;                   ///< ... the fit's work memory
+#endif
     sl_profile_stats_t stats;
 } sl_profile_t;
 
@@ -659,6 +679,24 @@ sl_profile_bounds_t sl_profile_extract_noisy(const uint16_t *sum, uint32_t n, ui
 /// sl_profile_fail_t.
 uint8_t sl_profile_refine(sl_profile_t *pr, const sl_board_t *board, uint32_t threshold,
                           sl_target_t *t);
+
+/// Refine a detected target with a fit of its return (sl_rfit.h) on the profile of its
+/// azimuth (while moving: this rotation's rows of it and its neighbours, as
+/// sl_profile_refine): the profile's mean values turned into power through `resp`'s value
+/// scale, the background per sample from `resp`'s noise floor, the window cut at the shadow
+/// edge, the pole's return modelled as SL_RFIT_FOOT convolved with `resp`'s range
+/// response, one independent look (a frozen speckle draw is one draw however many
+/// rotations are summed). r1 / r2 from the fitted bounds (the detector's radius terms
+/// kept), alpha re-estimated with the sigma the fit's covariance gives (the bounds'
+/// correlation included); a fit the model does not explain (SL_RFIT_OUT_OF_MODEL) leaves
+/// the target with `incline_flag` SL_INCLINE_OUT_OF_DOMAIN (Quality OUT_OF_MODEL on the bus),
+/// a fit without signal or sigma keeps the mask's bounds, widened. Flags: SL_TARGET_PROFILE,
+/// and SL_TARGET_COARSE for sums over rotations (their errors repeat). @return the
+/// sl_profile_fail_t (SL_PROFILE_OK: fitted). With SL_CFG_FIT only.
+#if SL_CFG_FIT
+uint8_t sl_profile_refine_fit(sl_profile_t *pr, const sl_board_t *board,
+                              const sl_response_t *resp, uint32_t threshold, sl_target_t *t);
+#endif
 
 #ifdef __cplusplus
 }

@@ -31,7 +31,8 @@
 /// analytic: moving a bound moves a piece's end and its width), the level A a third
 /// parameter (its logarithm) of each step;
 /// start: the moments of the power above the floor (centroid and variance less the
-/// response's own); steps halved while J grows (at most SL_RFIT_HALVINGS), at most
+/// response's own), or the caller's bounds (`warm`: an earlier fit of the same return, a few
+/// iterations instead of many); steps halved while J grows (at most SL_RFIT_HALVINGS), at most
 /// SL_RFIT_ITERS iterations. a and b are kept inside the window and b >= a + 1/8 bin.
 ///
 /// ## Uncertainty and quality
@@ -112,6 +113,9 @@ typedef struct sl_rfit_in {
     uint16_t looks_q8;    ///< independent looks averaged into y, Q8 (>= 256)
     uint8_t shape;        ///< sl_rfit_shape_t
     uint32_t origin_q8;   ///< absolute range of sample 0 in bins, Q8 (SL_RFIT_FOOT)
+    uint8_t warm;         ///< 1: start from [a0_q8, b0_q8] (an earlier fit of the same
+                          ///< return) instead of the moments; the level from the moments
+    int32_t a0_q8, b0_q8; ///< the warm start, bins Q8 from sample 0 (kept inside the window)
 } sl_rfit_in_t;
 
 typedef struct sl_rfit_out {

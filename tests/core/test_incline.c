@@ -581,10 +581,40 @@ static void test_incline_bounds_sigma_combines_the_two_bounds(void **state)
     }
 }
 
+#if SL_CFG_FIT
+// sl_incline_bounds_sigma_corr_um: correlated bounds (a fit of both to one return), against
+// double precision: sigma_rho^2 r1^2 = s2^2 + rho^2 s1^2 - 2 rho c s1 s2 = s^2 (1 + rho^2);
+// c = 0 is sl_incline_bounds_sigma_um; a fully correlated pair of equal sigmas at equal
+// ranges cancels (a shift of the whole return leaves rho).
+static void test_incline_bounds_sigma_with_correlation(void **state)
+{
+    (void)state;
+    assert_int_equal(sl_incline_bounds_sigma_corr_um(3000000U, 3600000U, 12640U, 25288U, 0),
+                     sl_incline_bounds_sigma_um(3000000U, 3600000U, 12640U, 25288U));
+    assert_true(sl_incline_bounds_sigma_corr_um(3000000U, 3000000U, 20000U, 20000U, 32767) <= 160U);
+    const int32_t cs[] = {-32767, -16384, 9830, 26214, 32767};
+    const uint32_t r1s[] = {1500000U, 3000000U, 2400000U};
+    const uint32_t r2s[] = {1550000U, 3600000U, 5100000U};
+    for (size_t i = 0; i < sizeof r1s / sizeof r1s[0]; i++) {
+        for (size_t j = 0; j < sizeof cs / sizeof cs[0]; j++) {
+            const double r1 = r1s[i], r2 = r2s[i], s1 = 30000.0, s2 = 45000.0;
+            const double rho = r2 / r1, c = cs[j] / 32768.0;
+            const double v = (s2 * s2 + rho * rho * s1 * s1 - 2 * rho * c * s1 * s2) / (1 + rho * rho);
+            const double want = sqrt(v > 0 ? v : 0);
+            const double got = sl_incline_bounds_sigma_corr_um(r1s[i], r2s[i], 30000U, 45000U, cs[j]);
+            assert_true(fabs(got - want) <= 2.0 + 1e-3 * 45000.0);
+        }
+    }
+}
+#endif
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_incline_bounds_sigma_combines_the_two_bounds),
+#if SL_CFG_FIT
+        cmocka_unit_test(test_incline_bounds_sigma_with_correlation),
+#endif
         cmocka_unit_test(test_incline_atan_table_matches_libm_at_every_node),
         cmocka_unit_test(test_incline_atan2_is_accurate_in_all_octants),
         cmocka_unit_test(test_incline_bam32_to_cdeg_rounds_half_up),

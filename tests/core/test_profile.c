@@ -1600,6 +1600,99 @@ static void test_profile_the_walk_end_is_calibrated_on_upright_poles(void **stat
     assert_true(llabs(upright_resid(&t) - (res0 - 43800)) <= 1);
 }
 
+#if SL_CFG_FIT
+// Rows of a modelled return: the pole's own profile (SL_RFIT_FOOT, closest point at r1)
+// over [r1, r2] (ranges in bins) convolved with the CTS350-X response, a second one of the
+// same level over [r3, r3 + 8] when r3 > 0, on the sensor's value scale (0.5 dB per value)
+// with the peak at value 120 and no noise (value 0 below), `rows` rows on azimuth `az`
+// (bins from 0, the occupied bits at >= 40).
+static void fit_rows(const sl_response_t *resp, double r1, double r2, double r3, int rows,
+                     uint16_t az)
+{
+    enum { W0 = 40, N = 96 };
+    uint32_t m[N], m2[N];
+    memset(m2, 0, sizeof m2);
+    const uint32_t origin = W0 * 256U + 128U; // sample k is range k + W0 + 1/2 bins
+    assert_int_equal(sl_rfit_model(resp, SL_RFIT_FOOT, origin, (int32_t)lround((r1 - W0 - 0.5) * 256),
+                                   (int32_t)lround((r2 - W0 - 0.5) * 256), N, m),
+                     SL_OK);
+    if (r3 > 0) {
+        assert_int_equal(sl_rfit_model(resp, SL_RFIT_UNIFORM, origin,
+                                       (int32_t)lround((r3 - W0 - 0.5) * 256),
+                                       (int32_t)lround((r3 + 8 - W0 - 0.5) * 256), N, m2),
+                         SL_OK);
+    }
+    double peak = 0;
+    for (int k = 0; k < N; k++) {
+        peak = fmax(peak, (double)m[k] + (double)m2[k]);
+    }
+    uint8_t row[160];
+    uint32_t bits[5];
+    memset(row, 0, sizeof row);
+    memset(bits, 0, sizeof bits);
+    for (int k = 0; k < N; k++) {
+        const double p = ((double)m[k] + (double)m2[k]) / peak * pow(2.0, 120 / 6.02);
+        const double v = p > 1.0 ? round(6.02 * log2(p)) : 0.0;
+        row[W0 + k] = (uint8_t)(v > 255 ? 255 : v);
+        if (row[W0 + k] >= 40U) {
+            bits[(W0 + k) >> 5] |= 1U << ((W0 + k) & 31);
+        }
+    }
+    for (int f = 0; f < rows; f++) {
+        sl_profile_row(&pr, az, row, 160, bits, 160);
+    }
+}
+
+// sl_profile_refine_fit: the bounds of a return the model describes come back from the fit
+// (noise-free, the 8-bit rounding only), with an alpha within 3 of the finite sigma the
+// fit's covariance gives, flagged PROFILE and (summed rows) COARSE; a
+// return the model does not explain (two returns in the window) reaches the bus as
+// OUT_OF_MODEL (incline flag OUT_OF_DOMAIN), never as a lean; an unwatched azimuth keeps
+// the mask's bounds.
+static void test_profile_fit_recovers_the_bounds_of_a_modelled_return(void **state)
+{
+    (void)state;
+    static sl_response_t resp;
+    const sl_vscale_t sc = SL_VSCALE_CTS350X;
+    assert_int_equal(sl_response_init(&resp, &sc, NULL, NULL), SL_OK);
+    const sl_board_t board = geom_board();
+    const double r1 = 70.3, r2 = 84.6; // bins: rho 1.203, alpha ~ +8.5 deg at theta 26
+    assert_int_equal(sl_profile_init(&pr, 400, 0, NULL), SL_OK);
+    fit_rows(&resp, r1, r2, 0, 8, 100);
+    const uint8_t si = pr.slot_of[100];
+    assert_true(si != SL_PROFILE_NONE);
+    sl_target_t t = mask_target(100, 99, 3, (uint16_t)(pr.slot[si].bin0 + 6U), 92);
+    assert_int_equal(sl_profile_refine_fit(&pr, &board, &resp, 40, &t), SL_PROFILE_OK);
+    const double b = 43800.0;
+    // one look: the 8-bit rounding (+-6 % in power) is read as speckle, which leaves the far
+    // end of a return whose power lies near its closest point known to about a bin
+    assert_true(fabs(t.r1_um - r1 * b) <= 1.0 * b);
+    assert_true(fabs(t.r2_um - r2 * b) <= 2.0 * b);
+    assert_int_equal(t.incline_flag, SL_INCLINE_VALID);
+    const sl_incline_result_t truth = sl_incline_estimate((uint32_t)lround(r1 * b),
+                                                          (uint32_t)lround(r2 * b), &board.geom[100],
+                                                          board.range_sigma_um, 0);
+    assert_true(t.sigma_cdeg > 0U && t.sigma_cdeg < 1000U);
+    assert_true(llabs((long long)t.alpha_cdeg - truth.alpha_cdeg) <= 3LL * t.sigma_cdeg);
+    assert_int_equal(t.flags & (SL_TARGET_PROFILE | SL_TARGET_COARSE),
+                     SL_TARGET_PROFILE | SL_TARGET_COARSE);
+    assert_int_equal(pr.stats.fit_quality[SL_RFIT_OK], 1);
+    // a second return 18 bins behind the first: no FOOT over one interval explains it
+    assert_int_equal(sl_profile_init(&pr, 400, 0, NULL), SL_OK);
+    fit_rows(&resp, r1, r2, r2 + 18, 8, 100);
+    t = mask_target(100, 99, 3, (uint16_t)(pr.slot[pr.slot_of[100]].bin0 + 6U), 105);
+    assert_int_equal(sl_profile_refine_fit(&pr, &board, &resp, 40, &t), SL_PROFILE_OK);
+    assert_int_equal(pr.stats.fit_quality[SL_RFIT_OUT_OF_MODEL], 1);
+    assert_int_equal(t.incline_flag, SL_INCLINE_OUT_OF_DOMAIN);
+    // an azimuth without a slot: the mask's bounds stay
+    t = mask_target(200, 199, 3, 70, 92);
+    const uint32_t r2_mask = t.r2_um;
+    assert_int_equal(sl_profile_refine_fit(&pr, &board, &resp, 40, &t), SL_PROFILE_NO_SLOT);
+    assert_int_equal(t.r2_um, r2_mask);
+    assert_int_equal(t.flags & SL_TARGET_PROFILE, 0);
+}
+#endif
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -1629,6 +1722,9 @@ int main(void)
         cmocka_unit_test(test_profile_a_stream_of_cut_off_returns_is_unverified),
         cmocka_unit_test(test_profile_a_front_part_is_learned_on_leaning_away_returns),
         cmocka_unit_test(test_profile_the_walk_end_is_calibrated_on_upright_poles),
+#if SL_CFG_FIT
+        cmocka_unit_test(test_profile_fit_recovers_the_bounds_of_a_modelled_return),
+#endif
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
