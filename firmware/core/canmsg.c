@@ -4,6 +4,7 @@
 // limits from them, and the host DBC generator prints them.
 #include "shadowlean/sl_board.h"
 #include "shadowlean/sl_can.h"
+#include "shadowlean/sl_config.h"
 
 #include <string.h>
 
@@ -151,6 +152,57 @@ static const sl_can_signal_desc_t tilt_sigs[L_N] = {
      SL_CAN_TILT_BASE_RAW_MAX, "m", NULL, 0U},
 };
 
+#if SL_CFG_GROUND
+static const sl_can_value_name_t ground_quality_names[] = {
+    {0U, "NONE"}, {1U, "COARSE"}, {2U, "GOOD"},
+};
+static const sl_can_value_name_t ground_kind_names[] = {
+    {0U, "FLAT"}, {1U, "DROP"}, {2U, "STEP"},
+};
+
+enum { G_QUALITY = 2, G_CLAMPED, G_HEIGHT, G_PITCH, G_ROLL, G_HSIGMA, G_PSIGMA, G_RSIGMA, G_N };
+static const sl_can_signal_desc_t plane_sigs[G_N] = {
+    E2E_SIGNALS,
+    {"Quality", 12U, 2U, false, 1, 1, 0, (int32_t)SL_CAN_GROUND_QUALITY_MAX, "",
+     ground_quality_names, NV(ground_quality_names)},
+    {"Clamped", 14U, 1U, false, 1, 1, 0, 1, "", NULL, 0U},
+    {"Height", 15U, 12U, false, SL_CAN_GROUND_HEIGHT_MM_PER_LSB, 1000, 0,
+     SL_CAN_GROUND_HEIGHT_RAW_MAX, "m", NULL, 0U},
+    {"Pitch", 27U, 11U, true, SL_CAN_GROUND_ANGLE_CDEG_PER_LSB, 100, SL_CAN_GROUND_ANGLE_RAW_MIN,
+     SL_CAN_GROUND_ANGLE_RAW_MAX, "deg", NULL, 0U},
+    {"Roll", 38U, 11U, true, SL_CAN_GROUND_ANGLE_CDEG_PER_LSB, 100, SL_CAN_GROUND_ANGLE_RAW_MIN,
+     SL_CAN_GROUND_ANGLE_RAW_MAX, "deg", NULL, 0U},
+    {"HeightSigma", 49U, 5U, false, SL_CAN_GROUND_HSIGMA_MM_PER_LSB, 1000, 0,
+     SL_CAN_GROUND_SIGMA_RAW_MAX, "m", NULL, 0U},
+    {"PitchSigma", 54U, 5U, false, SL_CAN_GROUND_ASIGMA_CDEG_PER_LSB, 100, 0,
+     SL_CAN_GROUND_SIGMA_RAW_MAX, "deg", NULL, 0U},
+    {"RollSigma", 59U, 5U, false, SL_CAN_GROUND_ASIGMA_CDEG_PER_LSB, 100, 0,
+     SL_CAN_GROUND_SIGMA_RAW_MAX, "deg", NULL, 0U},
+};
+
+enum { Z_KIND = 2, Z_CLAMPED, Z_SECTOR, Z_AZ, Z_DIFF, Z_DIST, Z_SIGMA, Z_N };
+static const sl_can_signal_desc_t hazard_sigs[Z_N] = {
+    E2E_SIGNALS,
+    {"Kind", 12U, 2U, false, 1, 1, 0, (int32_t)SL_CAN_GROUND_KIND_MAX, "", ground_kind_names,
+     NV(ground_kind_names)},
+    {"Clamped", 14U, 1U, false, 1, 1, 0, 1, "", NULL, 0U},
+    {"Sector", 16U, 6U, false, 1, 1, 0, (int32_t)SL_CAN_HAZARD_SECTOR_MAX, "", NULL, 0U},
+    {"Azimuth", 22U, 12U, false, SL_CAN_HAZARD_AZIMUTH_CDEG_PER_LSB, 100, 0,
+     SL_CAN_HAZARD_AZIMUTH_RAW_MAX, "deg", NULL, 0U},
+    {"HeightDiff", 34U, 11U, true, SL_CAN_HAZARD_DIFF_MM_PER_LSB, 1000, SL_CAN_HAZARD_DIFF_RAW_MIN,
+     SL_CAN_HAZARD_DIFF_RAW_MAX, "m", NULL, 0U},
+    {"Distance", 45U, 11U, false, SL_CAN_HAZARD_DIST_MM_PER_LSB, 1000, 0,
+     SL_CAN_HAZARD_DIST_RAW_MAX, "m", NULL, 0U},
+    {"Sigma", 56U, 8U, false, SL_CAN_HAZARD_SIGMA_MM_PER_LSB, 1000, 0, SL_CAN_HAZARD_SIGMA_RAW_MAX,
+     "m", NULL, 0U},
+};
+#define GROUND_LAYOUT(sigs, n) sigs, n
+#else
+// The firmware configuration has no ground: its messages keep their identity (ids, Data
+// IDs, the DBC's names) without a signal table, encoder or decoder.
+#define GROUND_LAYOUT(sigs, n) NULL, 0U
+#endif
+
 static const sl_can_message_desc_t messages[SL_CAN_MSG_COUNT] = {
     {"PoleLean", SL_CAN_DATA_ID_POLE_LEAN, SL_CAN_CYCLE_MS_POLE_LEAN, 0U,
      (uint8_t)SL_CAN_SEND_CYCLIC_IF_ACTIVE, false, pole_sigs, P_N},
@@ -164,6 +216,10 @@ static const sl_can_message_desc_t messages[SL_CAN_MSG_COUNT] = {
      (uint8_t)SL_CAN_SEND_CYCLIC, false, health_sigs, H_N},
     {"PoleTilt", SL_CAN_DATA_ID_POLE_TILT, SL_CAN_CYCLE_MS_POLE_TILT, 0U,
      (uint8_t)SL_CAN_SEND_CYCLIC_IF_ACTIVE, false, tilt_sigs, L_N},
+    {"GroundPlane", SL_CAN_DATA_ID_GROUND_PLANE, SL_CAN_CYCLE_MS_GROUND_PLANE, 0U,
+     (uint8_t)SL_CAN_SEND_CYCLIC, false, GROUND_LAYOUT(plane_sigs, G_N)},
+    {"GroundHazard", SL_CAN_DATA_ID_GROUND_HAZARD, SL_CAN_CYCLE_MS_GROUND_HAZARD, 0U,
+     (uint8_t)SL_CAN_SEND_CYCLIC_IF_ACTIVE, false, GROUND_LAYOUT(hazard_sigs, Z_N)},
 };
 
 const sl_can_message_desc_t *sl_can_layout(sl_can_msg_t m)
@@ -307,6 +363,8 @@ const sl_can_e2e_cfg_t sl_can_e2e_defaults[SL_CAN_MSG_COUNT] = {
     {SL_CAN_DATA_ID_VEHICLE_MOTION, (uint8_t)SL_CAN_E2E_MODE_BOTH},
     {SL_CAN_DATA_ID_HEALTH, (uint8_t)SL_CAN_E2E_MODE_BOTH},
     {SL_CAN_DATA_ID_POLE_TILT, (uint8_t)SL_CAN_E2E_MODE_BOTH},
+    {SL_CAN_DATA_ID_GROUND_PLANE, (uint8_t)SL_CAN_E2E_MODE_BOTH},
+    {SL_CAN_DATA_ID_GROUND_HAZARD, (uint8_t)SL_CAN_E2E_MODE_BOTH},
 };
 
 _Static_assert(SL_BOARD_CAN_MSGS == SL_CAN_MSG_COUNT, "board CAN tables cover every message");
@@ -320,6 +378,8 @@ void sl_can_ids_default(sl_can_ids_t *ids)
     ids->id[SL_CAN_MSG_VEHICLE_MOTION] = SL_CAN_ID_DEFAULT_VEHICLE_MOTION;
     ids->id[SL_CAN_MSG_HEALTH] = SL_CAN_ID_DEFAULT_HEALTH;
     ids->id[SL_CAN_MSG_POLE_TILT] = SL_CAN_ID_DEFAULT_POLE_TILT;
+    ids->id[SL_CAN_MSG_GROUND_PLANE] = SL_CAN_ID_DEFAULT_GROUND_PLANE;
+    ids->id[SL_CAN_MSG_GROUND_HAZARD] = SL_CAN_ID_DEFAULT_GROUND_HAZARD;
     memcpy(ids->e2e, sl_can_e2e_defaults, sizeof ids->e2e);
 }
 
@@ -332,16 +392,22 @@ void sl_can_ids_from_board(sl_can_ids_t *ids, const struct sl_board *board)
     ids->id[SL_CAN_MSG_VEHICLE_MOTION] = board->can_id_vehicle_motion;
     ids->id[SL_CAN_MSG_HEALTH] = board->can_id_health;
     ids->id[SL_CAN_MSG_POLE_TILT] = board->can_id_pole_tilt;
+    ids->id[SL_CAN_MSG_GROUND_PLANE] = board->can_id_ground_plane;
+    ids->id[SL_CAN_MSG_GROUND_HAZARD] = board->can_id_ground_hazard;
     for (unsigned m = 0; m < (unsigned)SL_CAN_MSG_COUNT; m++) {
         ids->e2e[m].data_id = board->can_data_id[m];
         ids->e2e[m].mode = board->can_data_id_mode[m];
     }
 }
 
-/// Mode 11C sends the Data ID nibble in frame bits 12..15: only where no signal is.
+/// Mode 11C sends the Data ID nibble in frame bits 12..15: only where no signal is (a
+/// layout without its signal table in this configuration has them there).
 static bool nibble_free(sl_can_msg_t m)
 {
     const sl_can_message_desc_t *md = &messages[m];
+    if (md->n_signals == 0U) {
+        return false;
+    }
     for (unsigned i = 0; i < md->n_signals; i++) {
         const unsigned lo = md->signals[i].start;
         const unsigned hi = lo + md->signals[i].length; // exclusive
@@ -552,6 +618,63 @@ sl_err_t sl_can_encode_vehicle_motion(sl_can_tx_t *tx, const sl_can_vehicle_moti
     finish(tx, SL_CAN_MSG_VEHICLE_MOTION, d, cl, out);
     return SL_OK;
 }
+
+#if SL_CFG_GROUND
+sl_err_t sl_can_encode_ground_plane(sl_can_tx_t *tx, const sl_can_ground_plane_t *in,
+                                    sl_can_frame_t *out)
+{
+    if (tx == NULL || in == NULL || out == NULL) {
+        return SL_ERR_ARG;
+    }
+    const sl_can_signal_desc_t *s = plane_sigs;
+    uint8_t d[8] = {0};
+    bool cl = false;
+    uint32_t q = in->quality;
+    if (q > SL_CAN_GROUND_QUALITY_MAX) {
+        q = SL_CAN_GROUND_NONE;
+        cl = true;
+    }
+    put_sig(d, &s[G_QUALITY], q);
+    if (q != SL_CAN_GROUND_NONE) {
+        put_phys(d, &s[G_HEIGHT], in->height_mm, SL_CAN_GROUND_HEIGHT_MM_PER_LSB, &cl);
+        put_phys(d, &s[G_PITCH], in->pitch_cdeg, SL_CAN_GROUND_ANGLE_CDEG_PER_LSB, &cl);
+        put_phys(d, &s[G_ROLL], in->roll_cdeg, SL_CAN_GROUND_ANGLE_CDEG_PER_LSB, &cl);
+        put_phys(d, &s[G_HSIGMA], in->height_sigma_mm, SL_CAN_GROUND_HSIGMA_MM_PER_LSB, &cl);
+        put_phys(d, &s[G_PSIGMA], in->pitch_sigma_cdeg, SL_CAN_GROUND_ASIGMA_CDEG_PER_LSB, &cl);
+        put_phys(d, &s[G_RSIGMA], in->roll_sigma_cdeg, SL_CAN_GROUND_ASIGMA_CDEG_PER_LSB, &cl);
+    }
+    put_sig(d, &s[G_CLAMPED], cl ? 1 : 0);
+    finish(tx, SL_CAN_MSG_GROUND_PLANE, d, cl, out);
+    return SL_OK;
+}
+
+sl_err_t sl_can_encode_ground_hazard(sl_can_tx_t *tx, const sl_can_ground_hazard_t *in,
+                                     sl_can_frame_t *out)
+{
+    if (tx == NULL || in == NULL || out == NULL) {
+        return SL_ERR_ARG;
+    }
+    const sl_can_signal_desc_t *s = hazard_sigs;
+    uint8_t d[8] = {0};
+    bool cl = false;
+    uint32_t kind = in->kind;
+    if (kind > SL_CAN_GROUND_KIND_MAX) {
+        kind = SL_CAN_GROUND_FLAT; // no kind the consumer knows: no hazard numbers either
+        cl = true;
+    }
+    put_sig(d, &s[Z_KIND], kind);
+    if (kind != SL_CAN_GROUND_FLAT) {
+        put_sig(d, &s[Z_SECTOR], clamp_raw(&s[Z_SECTOR], in->sector, &cl));
+        put_azimuth(d, &s[Z_AZ], in->azimuth_cdeg, SL_CAN_HAZARD_AZIMUTH_CDEG_PER_LSB);
+        put_phys(d, &s[Z_DIFF], in->height_diff_mm, SL_CAN_HAZARD_DIFF_MM_PER_LSB, &cl);
+        put_phys(d, &s[Z_DIST], in->distance_um, SL_CAN_HAZARD_DIST_UM_PER_LSB, &cl); // um: one rounding
+        put_phys(d, &s[Z_SIGMA], in->sigma_mm, SL_CAN_HAZARD_SIGMA_MM_PER_LSB, &cl);
+    }
+    put_sig(d, &s[Z_CLAMPED], cl ? 1 : 0);
+    finish(tx, SL_CAN_MSG_GROUND_HAZARD, d, cl, out);
+    return SL_OK;
+}
+#endif // SL_CFG_GROUND
 
 // ---------------------------------------------------------------------------------------
 // E2E receiver and decoders
@@ -805,6 +928,50 @@ sl_err_t sl_can_decode_health(const sl_can_frame_t *f, const sl_can_e2e_cfg_t *e
     out->response_source = (uint8_t)get_sig(d, &s[H_RESPONSE]);
     return SL_OK;
 }
+
+#if SL_CFG_GROUND
+sl_err_t sl_can_decode_ground_plane(const sl_can_frame_t *f, const sl_can_e2e_cfg_t *e2e,
+                                    sl_can_ground_plane_t *out)
+{
+    const sl_err_t e = decode_check(f, e2e, out);
+    if (e != SL_OK) {
+        return e;
+    }
+    const sl_can_signal_desc_t *s = plane_sigs;
+    const uint8_t *d = f->data;
+    out->counter = (uint8_t)get_sig(d, &s[S_COUNTER]);
+    out->quality = (uint8_t)get_sig(d, &s[G_QUALITY]);
+    out->clamped = get_sig(d, &s[G_CLAMPED]) != 0;
+    out->height_mm = (int32_t)(get_sig(d, &s[G_HEIGHT]) * SL_CAN_GROUND_HEIGHT_MM_PER_LSB);
+    out->pitch_cdeg = (int32_t)(get_sig(d, &s[G_PITCH]) * SL_CAN_GROUND_ANGLE_CDEG_PER_LSB);
+    out->roll_cdeg = (int32_t)(get_sig(d, &s[G_ROLL]) * SL_CAN_GROUND_ANGLE_CDEG_PER_LSB);
+    out->height_sigma_mm = (uint32_t)(get_sig(d, &s[G_HSIGMA]) * SL_CAN_GROUND_HSIGMA_MM_PER_LSB);
+    out->pitch_sigma_cdeg =
+        (uint32_t)(get_sig(d, &s[G_PSIGMA]) * SL_CAN_GROUND_ASIGMA_CDEG_PER_LSB);
+    out->roll_sigma_cdeg = (uint32_t)(get_sig(d, &s[G_RSIGMA]) * SL_CAN_GROUND_ASIGMA_CDEG_PER_LSB);
+    return SL_OK;
+}
+
+sl_err_t sl_can_decode_ground_hazard(const sl_can_frame_t *f, const sl_can_e2e_cfg_t *e2e,
+                                     sl_can_ground_hazard_t *out)
+{
+    const sl_err_t e = decode_check(f, e2e, out);
+    if (e != SL_OK) {
+        return e;
+    }
+    const sl_can_signal_desc_t *s = hazard_sigs;
+    const uint8_t *d = f->data;
+    out->counter = (uint8_t)get_sig(d, &s[S_COUNTER]);
+    out->kind = (uint8_t)get_sig(d, &s[Z_KIND]);
+    out->clamped = get_sig(d, &s[Z_CLAMPED]) != 0;
+    out->sector = (uint8_t)get_sig(d, &s[Z_SECTOR]);
+    out->azimuth_cdeg = (int32_t)(get_sig(d, &s[Z_AZ]) * SL_CAN_HAZARD_AZIMUTH_CDEG_PER_LSB);
+    out->height_diff_mm = (int32_t)(get_sig(d, &s[Z_DIFF]) * SL_CAN_HAZARD_DIFF_MM_PER_LSB);
+    out->distance_um = (uint32_t)(get_sig(d, &s[Z_DIST]) * SL_CAN_HAZARD_DIST_UM_PER_LSB);
+    out->sigma_mm = (uint32_t)(get_sig(d, &s[Z_SIGMA]) * SL_CAN_HAZARD_SIGMA_MM_PER_LSB);
+    return SL_OK;
+}
+#endif // SL_CFG_GROUND
 
 // ---------------------------------------------------------------------------------------
 // VehicleMotion receiver

@@ -422,6 +422,47 @@ static SL_NOINLINE void emit_tilt(sl_pipeline_t *p, const sl_track_t *t)
     }
 }
 
+#if SL_CFG_GROUND
+// With the ground on: GroundPlane (NONE without a plane), then one GroundHazard per sector
+// with a confirmed hazard, in sector order (sl_can.h). Each frame passes the output ceiling
+// on its own, as PoleLean does; a withheld frame still advances its E2E counter.
+static SL_NOINLINE void emit_ground(sl_pipeline_t *p)
+{
+    const sl_ground_t *g = &p->ground;
+    const sl_ground_plane_t *pl = &g->plane;
+    const sl_can_ground_plane_t gp = {
+        .quality = pl->quality,
+        .height_mm = pl->height_mm,
+        .pitch_cdeg = pl->pitch_cdeg,
+        .roll_cdeg = pl->roll_cdeg,
+        .height_sigma_mm = pl->height_sigma_mm,
+        .pitch_sigma_cdeg = pl->pitch_sigma_cdeg,
+        .roll_sigma_cdeg = pl->roll_sigma_cdeg,
+    };
+    sl_can_frame_t f;
+    if (sl_can_encode_ground_plane(&p->can, &gp, &f) == SL_OK) {
+        can_send(p, &f);
+    }
+    for (uint32_t k = 0; k < (uint32_t)SL_CFG_GROUND_SECTORS; k++) {
+        const sl_ground_sector_t *s = &g->sec[k];
+        if (s->kind == (uint8_t)SL_GROUND_FLAT) {
+            continue;
+        }
+        const sl_can_ground_hazard_t h = {
+            .kind = s->kind,
+            .sector = (uint8_t)k,
+            .azimuth_cdeg = sl_ground_sector_cdeg(g, k),
+            .height_diff_mm = -s->resid_mm, // the ground above the plane (resid: below it)
+            .distance_um = s->dist_um > 0 ? (uint32_t)s->dist_um : 0U,
+            .sigma_mm = s->sigma_mm,
+        };
+        if (sl_can_encode_ground_hazard(&p->can, &h, &f) == SL_OK) {
+            can_send(p, &f);
+        }
+    }
+}
+#endif
+
 static void emit_can(sl_pipeline_t *p)
 {
     const sl_tracker_t *tr = &p->tracker;
@@ -487,6 +528,11 @@ static void emit_can(sl_pipeline_t *p)
     if (sl_can_encode_lean_warning(&p->can, &lw, &f) == SL_OK) {
         can_send(p, &f);
     }
+#if SL_CFG_GROUND
+    if (p->cfg.ground) {
+        emit_ground(p);
+    }
+#endif
     // Status last: it reports the drops of this rotation's frames too.
     emit_status(p);
 }

@@ -47,18 +47,21 @@ const std::set<std::string> kKnown = {
     "detect.range_sigma_m", "detect.theta_sigma_deg", "detect.caution_lean_deg",
     "detect.danger_lean_deg", "detect.track_timeout_s", "detect.elongation",
     "can.bitrate", "can.id_pole_lean", "can.id_lean_warning", "can.id_status",
-    "can.id_vehicle_motion", "can.id_health", "can.id_pole_tilt",
+    "can.id_vehicle_motion", "can.id_health", "can.id_pole_tilt", "can.id_ground_plane",
+    "can.id_ground_hazard",
     "can.data_id_pole_lean", "can.data_id_lean_warning", "can.data_id_status",
     "can.data_id_vehicle_motion", "can.data_id_health", "can.data_id_pole_tilt",
+    "can.data_id_ground_plane", "can.data_id_ground_hazard",
     "can.data_id_mode_pole_lean", "can.data_id_mode_lean_warning", "can.data_id_mode_status",
     "can.data_id_mode_vehicle_motion", "can.data_id_mode_health", "can.data_id_mode_pole_tilt",
+    "can.data_id_mode_ground_plane", "can.data_id_mode_ground_hazard",
     "can.max_delta_counter_vehicle_motion",
     "response.value_scale", "response.values_per_octave", "response.prior",
 };
 
 // The board keys' message names, in sl_can_msg_t order.
-const char *const kCanMsgKeys[6] = {"pole_lean",      "lean_warning", "status",
-                                    "vehicle_motion", "health",       "pole_tilt"};
+const char *const kCanMsgKeys[8] = {"pole_lean", "lean_warning", "status",       "vehicle_motion",
+                                    "health",    "pole_tilt",    "ground_plane", "ground_hazard"};
 
 class Reader {
 public:
@@ -381,8 +384,18 @@ BoardSpec load_board(const std::string &name_or_path)
                "missing (required: the PoleTilt message's CAN id, e.g. 0x5C4)");
     }
     b.can_id_pole_tilt = can_id("can.id_pole_tilt", 0x5C4);
+    if (!r.has("can.id_ground_plane")) {
+        r.fail("can.id_ground_plane",
+               "missing (required: the GroundPlane message's CAN id, e.g. 0x5C5)");
+    }
+    b.can_id_ground_plane = can_id("can.id_ground_plane", 0x5C5);
+    if (!r.has("can.id_ground_hazard")) {
+        r.fail("can.id_ground_hazard",
+               "missing (required: the GroundHazard message's CAN id, e.g. 0x5C6)");
+    }
+    b.can_id_ground_hazard = can_id("can.id_ground_hazard", 0x5C6);
     std::set<unsigned> data_ids;
-    for (unsigned m = 0; m < 6U; m++) {
+    for (unsigned m = 0; m < 8U; m++) {
         const std::string msg = kCanMsgKeys[m];
         const std::string kid = "can.data_id_" + msg, kmode = "can.data_id_mode_" + msg;
         b.can_data_id[m] = static_cast<unsigned>(
@@ -425,9 +438,10 @@ BoardSpec load_board(const std::string &name_or_path)
     }
     const std::set<unsigned> ids = {b.can_id_pole_lean, b.can_id_lean_warning, b.can_id_status,
                                     b.can_id_vehicle_motion, b.can_id_health,
-                                    b.can_id_pole_tilt};
-    if (ids.size() != 6U) {
-        r.fail("can", "the six CAN ids must differ");
+                                    b.can_id_pole_tilt, b.can_id_ground_plane,
+                                    b.can_id_ground_hazard};
+    if (ids.size() != 8U) {
+        r.fail("can", "the eight CAN ids must differ");
     }
 
     for (int i = 0; i < b.azimuths; i++) {

@@ -53,12 +53,12 @@ struct BoardSpec {
     // "0x18FF5A00 ext"). Defaults: SL_CAN_ID_DEFAULT_* (sl_can.h).
     unsigned can_id_pole_lean = 0x5C0, can_id_lean_warning = 0x5C1, can_id_status = 0x5C2,
              can_id_vehicle_motion = 0x5B0, can_id_health = 0x5C3,
-             can_id_pole_tilt = 0x5C4;
+             can_id_pole_tilt = 0x5C4, can_id_ground_plane = 0x5C5, can_id_ground_hazard = 0x5C6;
     // E2E Profile 11 per message, indexed by sl_can_msg_t (PoleLean, LeanWarning, Status,
-    // VehicleMotion, Health, PoleTilt): 16-bit Data ID and mode (0 = 11A both, 1 = 11C
-    // nibble); the VehicleMotion receiver's max delta counter.
-    unsigned can_data_id[6] = {0x0051, 0x0052, 0x0053, 0x0054, 0x0055, 0x0056};
-    unsigned can_data_id_mode[6] = {0, 0, 0, 0, 0, 0};
+    // VehicleMotion, Health, PoleTilt, GroundPlane, GroundHazard): 16-bit Data ID and mode
+    // (0 = 11A both, 1 = 11C nibble); the VehicleMotion receiver's max delta counter.
+    unsigned can_data_id[8] = {0x0051, 0x0052, 0x0053, 0x0054, 0x0055, 0x0056, 0x0057, 0x0058};
+    unsigned can_data_id_mode[8] = {0, 0, 0, 0, 0, 0, 0, 0};
     unsigned can_max_delta_counter_motion = 2;
     // The sensor model's prior ([response]): the 8-bit values' scale and the range response
     // a point return makes before any is learned from the stream.

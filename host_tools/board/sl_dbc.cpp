@@ -112,6 +112,17 @@ const std::map<std::string, std::string> kMessageComments = {
      "tell the pole from its mirror image; the frame carries the better-fitting reading and "
      "is followed in the same rotation by a frame of the same TargetId with Quality MIRROR "
      "carrying the other one: the pole is one of the two."},
+    {"GroundPlane",
+     "Once per rotation while the module's ground estimation is on: the vehicle's attitude "
+     "over the ground from where the ground return starts around the vehicle (the plane "
+     "through the ring of ground points 3-6 m out, filtered over rotations). Pitch and Roll "
+     "are relative to that ground, not to gravity. Quality NONE: no plane this rotation, "
+     "every value 0."},
+    {"GroundHazard",
+     "One frame per sector of the ring whose ground departs from the plane (DROP: lower, "
+     "STEP: higher, beyond the board's thresholds and 4 sigma, confirmed over rotations "
+     "with hysteresis), every rotation while it holds (GenMsgSendType CyclicIfActive), "
+     "right after that rotation's GroundPlane. No frame: no confirmed hazard."},
     {"Health", "Sent right after every Status: why the output may be degraded or blind. "
                "Any Fault bit set means do not trust an absent warning. A bit is set when "
                "its condition held since the previous Health frame or still holds."},
@@ -182,6 +193,31 @@ const std::map<std::string, std::string> kSignalComments = {
     {"PoleTilt.BaseX", "Pole base on the ground, vehicle frame at this frame's time: "
                        "forward of the vehicle origin."},
     {"PoleTilt.BaseY", "Pole base on the ground: left of the vehicle origin."},
+    {"GroundPlane.Quality", "NONE: no plane (every value 0); COARSE: a plane whose sigmas "
+                            "exceed the module's good limits; GOOD: within them."},
+    {"GroundPlane.Clamped", "1: at least one value hit its range limit (a sigma at its "
+                            "maximum means at least that)."},
+    {"GroundPlane.Height", "The radar's height above the ground plane, perpendicular to it."},
+    {"GroundPlane.Pitch", "Pitch of the vehicle over the ground plane; positive: nose down "
+                          "(ISO 8855)."},
+    {"GroundPlane.Roll", "Roll of the vehicle over the ground plane; positive: right side "
+                         "down (ISO 8855)."},
+    {"GroundPlane.HeightSigma", "1-sigma uncertainty of Height."},
+    {"GroundPlane.PitchSigma", "1-sigma uncertainty of Pitch."},
+    {"GroundPlane.RollSigma", "1-sigma uncertainty of Roll."},
+    {"GroundHazard.Kind", "DROP: the ground is lower than the plane (a ditch, a drop-off, a "
+                          "dock edge); STEP: higher (a kerb, a bank, a wall at the edge)."},
+    {"GroundHazard.Clamped", "1: at least one value hit its range limit."},
+    {"GroundHazard.Sector", "Sector of the ring (equal shares of the rotation), stable over "
+                            "rotations: the hazard's identity."},
+    {"GroundHazard.Azimuth", "The sector's centre, clockwise from the vehicle's forward axis "
+                             "seen from above."},
+    {"GroundHazard.HeightDiff", "The ground's height relative to the plane at the sector's "
+                                "edge: negative lower (DROP), positive higher (STEP)."},
+    {"GroundHazard.Distance", "Horizontal distance from the radar to where the ground at the "
+                              "plane's level ends along the sector, moved back by the "
+                              "vehicle's forward travel while the hazard holds."},
+    {"GroundHazard.Sigma", "1-sigma uncertainty of HeightDiff."},
     {"VehicleMotion.SpeedValid", "1: Speed is valid."},
     {"VehicleMotion.YawRateValid", "1: YawRate is valid."},
     {"VehicleMotion.Speed", "Vehicle speed over ground; positive forward."},
@@ -222,7 +258,8 @@ sl_can_ids_t can_ids(const BoardSpec &b)
     sl_can_ids_t ids{};
     const unsigned id[SL_CAN_MSG_COUNT] = {b.can_id_pole_lean,      b.can_id_lean_warning,
                                            b.can_id_status,         b.can_id_vehicle_motion,
-                                           b.can_id_health,         b.can_id_pole_tilt};
+                                           b.can_id_health,         b.can_id_pole_tilt,
+                                           b.can_id_ground_plane,   b.can_id_ground_hazard};
     for (unsigned m = 0; m < SL_CAN_MSG_COUNT; m++) {
         ids.id[m] = id[m];
         ids.e2e[m].data_id = static_cast<uint16_t>(b.can_data_id[m]);
@@ -303,8 +340,8 @@ std::string make_dbc(const BoardSpec &b)
            b.description)
       << ";\n";
     o << "CM_ BU_ " << kVehicle << " "
-      << q("The vehicle: consumes PoleLean, LeanWarning, Status, Health, PoleTilt; sends "
-             "VehicleMotion.")
+      << q("The vehicle: consumes PoleLean, LeanWarning, Status, Health, PoleTilt, "
+             "GroundPlane, GroundHazard; sends VehicleMotion.")
       << ";\n";
     for (unsigned mi = 0; mi < SL_CAN_MSG_COUNT; mi++) {
         const sl_can_message_desc_t &m = *sl_can_layout(static_cast<sl_can_msg_t>(mi));

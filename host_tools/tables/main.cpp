@@ -212,6 +212,8 @@ sl_board_t make_board(const sl::BoardSpec &b, const Tables &t, const std::string
     v.can_id_vehicle_motion = static_cast<uint32_t>(b.can_id_vehicle_motion);
     v.can_id_health = static_cast<uint32_t>(b.can_id_health);
     v.can_id_pole_tilt = static_cast<uint32_t>(b.can_id_pole_tilt);
+    v.can_id_ground_plane = static_cast<uint32_t>(b.can_id_ground_plane);
+    v.can_id_ground_hazard = static_cast<uint32_t>(b.can_id_ground_hazard);
     for (size_t m = 0; m < SL_BOARD_CAN_MSGS; m++) {
         v.can_data_id[m] = static_cast<uint16_t>(b.can_data_id[m]);
         v.can_data_id_mode[m] = static_cast<uint8_t>(b.can_data_id_mode[m]);
@@ -311,7 +313,9 @@ void write_source(const sl_board_t &v, const std::string &path, const std::strin
       << "    .can_id_status = " << v.can_id_status << "u,\n"
       << "    .can_id_vehicle_motion = " << v.can_id_vehicle_motion << "u,\n"
       << "    .can_id_health = " << v.can_id_health << "u,\n"
-      << "    .can_id_pole_tilt = " << v.can_id_pole_tilt << "u,\n";
+      << "    .can_id_pole_tilt = " << v.can_id_pole_tilt << "u,\n"
+      << "    .can_id_ground_plane = " << v.can_id_ground_plane << "u,\n"
+      << "    .can_id_ground_hazard = " << v.can_id_ground_hazard << "u,\n";
     o << "    .can_data_id = {";
     for (size_t m = 0; m < SL_BOARD_CAN_MSGS; m++) {
         o << (m ? ", " : "") << hex16(v.can_data_id[m]) << "u";

@@ -27,7 +27,7 @@ extern "C" {
 #endif
 
 /// Messages with a CAN id, Data ID and mode on a board (SL_CAN_MSG_COUNT in sl_can.h).
-#define SL_BOARD_CAN_MSGS 6
+#define SL_BOARD_CAN_MSGS 8
 
 /// A board: read-only constants, usually `static const` in flash.
 typedef struct sl_board {
@@ -71,8 +71,12 @@ typedef struct sl_board {
     uint32_t can_id_vehicle_motion;
     uint32_t can_id_health;        ///< Health message (required board key can.id_health)
     uint32_t can_id_pole_tilt;     ///< PoleTilt message (required board key can.id_pole_tilt)
+    uint32_t can_id_ground_plane;  ///< GroundPlane message (required board key can.id_ground_plane)
+    uint32_t can_id_ground_hazard; ///< GroundHazard message (required board key
+                                   ///< can.id_ground_hazard)
     /// E2E Profile 11 Data ID of each message (board keys can.data_id_*), indexed by
-    /// sl_can_msg_t (PoleLean, LeanWarning, Status, VehicleMotion, Health, PoleTilt).
+    /// sl_can_msg_t (PoleLean, LeanWarning, Status, VehicleMotion, Health, PoleTilt,
+    /// GroundPlane, GroundHazard).
     uint16_t can_data_id[SL_BOARD_CAN_MSGS];
     /// E2E Profile 11 Data ID mode of each message (sl_can_e2e_mode_t: 0 = 11A both,
     /// 1 = 11C nibble; board keys can.data_id_mode_*), indexed as can_data_id.

@@ -141,8 +141,9 @@
 ///   by more than 1 % (ranges follow the radar's value; the board is not this installation).
 /// - bit6 AZIMUTH_DISORDER: azimuths stepped back beyond the reorder window.
 /// - bit7 CAN_RATE_LIMITED: frames were withheld by the hard output ceiling: token buckets
-///   on the port's clock refilled with SL_CAN_MAX_DATA_FRAMES_PER_100MS PoleLean +
-///   LeanWarning and SL_CAN_MAX_STATUS_FRAMES_PER_100MS Status + Health frames per 100 ms,
+///   on the port's clock refilled with SL_CAN_MAX_DATA_FRAMES_PER_100MS data frames
+///   (PoleLean, LeanWarning, PoleTilt, GroundPlane, GroundHazard) and
+///   SL_CAN_MAX_STATUS_FRAMES_PER_100MS Status + Health frames per 100 ms,
 ///   holding at most SL_CAN_BURST_WINDOWS x that (the backlog of a ~3 s stall of a 4 Hz
 ///   radar). Sustained: 48 frames x ~130 bits per 100 ms, under 13 % of a 500 kbit/s bus;
 ///   in any 100 ms at most (SL_CAN_BURST_WINDOWS + 1) x 48 frames, whatever the input.
@@ -182,6 +183,59 @@
 /// the other (tilt, direction, their sigmas, base); the pole is one of the two. MIRROR
 /// never goes out alone. The fit runs per rotation on at most SL_CFG_TILT_FITS_PER_ROTATION
 /// tracks; a frame carries the track's latest fit.
+///
+/// ## GroundPlane (board `can.id_ground_plane`, SHADOWLEAN -> VEHICLE, once per rotation while the ground is on)
+///
+/// The vehicle's attitude over the ground from the shadow's edge (sl_ground.h): the plane
+/// fitted through the ground-return starts around the vehicle, filtered over rotations.
+/// Sent once per rotation while the pipeline's ground is on (cfg.ground, SL_CFG_GROUND:
+/// the host configuration), after LeanWarning and before Status.
+///
+/// | start | len | signal      | type | factor | range (physical) | unit | note |
+/// |------:|----:|-------------|------|--------|------------------|------|------|
+/// |  0 | 8  | Crc         | u | 1     | 0..255          |     | E2E, Data ID 0x0057 |
+/// |  8 | 4  | Counter     | u | 1     | 0..14           |     | E2E |
+/// | 12 | 2  | Quality     | u | 1     | 0..2            |     | sl_can_ground_quality_t |
+/// | 14 | 1  | Clamped     | u | 1     | 0..1            |     | 1 = a value below hit its range limit |
+/// | 15 | 12 | Height      | u | 0.002 | 0..8.19         | m   | radar above the plane, perpendicular to it |
+/// | 27 | 11 | Pitch       | s | 0.02  | -20.48..20.46   | deg | nose down > 0 (ISO 8855) |
+/// | 38 | 11 | Roll        | s | 0.02  | -20.48..20.46   | deg | right side down > 0 (ISO 8855) |
+/// | 49 | 5  | HeightSigma | u | 0.005 | 0..0.155        | m   | 1-sigma of Height |
+/// | 54 | 5  | PitchSigma  | u | 0.05  | 0..1.55         | deg | 1-sigma of Pitch |
+/// | 59 | 5  | RollSigma   | u | 0.05  | 0..1.55         | deg | 1-sigma of Roll |
+///
+/// Quality: NONE (0) = no plane this rotation (too few sectors with ground; every value is
+/// sent as 0); COARSE (1) = a plane whose sigmas exceed the module's good limits (20 mm,
+/// 0.3 deg by default); GOOD (2) = within them. Pitch and roll are relative to the ground
+/// under the ring (3-6 m around the vehicle), not to gravity. A sigma beyond its range is
+/// sent as its maximum with Clamped = 1 (a bound: at least that).
+///
+/// ## GroundHazard (board `can.id_ground_hazard`, SHADOWLEAN -> VEHICLE, one frame per confirmed hazard)
+///
+/// One frame per sector of the ring whose ground departs from the plane (sl_ground.h:
+/// DROP lower, STEP higher than the board's thresholds and 4 sigma, confirmed over
+/// rotations with hysteresis), every rotation while it stays confirmed, right after the
+/// GroundPlane frame of the rotation, in sector order.
+///
+/// | start | len | signal     | type | factor | range (physical) | unit | note |
+/// |------:|----:|------------|------|--------|------------------|------|------|
+/// |  0 | 8  | Crc        | u | 1     | 0..255          |     | E2E, Data ID 0x0058 |
+/// |  8 | 4  | Counter    | u | 1     | 0..14           |     | E2E |
+/// | 12 | 2  | Kind       | u | 1     | 0..2            |     | sl_can_ground_kind_t (DROP, STEP; FLAT never sent) |
+/// | 14 | 1  | Clamped    | u | 1     | 0..1            |     | 1 = a value below hit its range limit |
+/// | 16 | 6  | Sector     | u | 1     | 0..63           |     | sector of the ring (stable over rotations) |
+/// | 22 | 12 | Azimuth    | u | 0.1   | 0..359.9        | deg | the sector's centre, clockwise from vehicle forward |
+/// | 34 | 11 | HeightDiff | s | 0.005 | -5.12..5.115    | m   | the ground relative to the plane: < 0 lower (DROP), > 0 higher (STEP) |
+/// | 45 | 11 | Distance   | u | 0.01  | 0..20.47        | m   | horizontal, radar to where the ground at the plane's level ends along the sector |
+/// | 56 | 8  | Sigma      | u | 0.005 | 0..1.275        | m   | 1-sigma of HeightDiff (the sector's and the plane's) |
+///
+/// Bit 15 is reserved (0). HeightDiff and Sigma are the rotation's last plane fit's: a
+/// hazard holds through its hysteresis (sl_ground.h) while HeightDiff lies inside the
+/// threshold, and once the vehicle's whole ring is over the new level the plane follows it
+/// (HeightDiff small or of the other sign) until the sector clears. Distance is measured
+/// when the hazard is first voted for and moved back by the forward odometry while it holds
+/// (sl_ground.h, "distance"); parked, the ring's point. The distance to the vehicle's front
+/// is Distance less the radar's distance to the front along the sector.
 ///
 /// ## VehicleMotion (board `can.id_vehicle_motion`, VEHICLE -> SHADOWLEAN, input)
 ///
@@ -260,7 +314,9 @@ typedef enum sl_can_msg {
     SL_CAN_MSG_VEHICLE_MOTION = 3,
     SL_CAN_MSG_HEALTH = 4,
     SL_CAN_MSG_POLE_TILT = 5,
-    SL_CAN_MSG_COUNT = 6,
+    SL_CAN_MSG_GROUND_PLANE = 6,
+    SL_CAN_MSG_GROUND_HAZARD = 7,
+    SL_CAN_MSG_COUNT = 8,
 } sl_can_msg_t;
 
 /// Default E2E Data IDs (16-bit, mode 11A), used when the board file does not set one.
@@ -269,7 +325,9 @@ typedef enum sl_can_msg {
 #define SL_CAN_DATA_ID_STATUS 0x0053U
 #define SL_CAN_DATA_ID_VEHICLE_MOTION 0x0054U
 #define SL_CAN_DATA_ID_HEALTH 0x0055U
-#define SL_CAN_DATA_ID_POLE_TILT 0x0056U ///< every message has its own Data ID
+#define SL_CAN_DATA_ID_POLE_TILT 0x0056U
+#define SL_CAN_DATA_ID_GROUND_PLANE 0x0057U
+#define SL_CAN_DATA_ID_GROUND_HAZARD 0x0058U ///< every message has its own Data ID
 
 /// Default CAN ids (11-bit). They avoid the ids of a Continental ARS408 radar on the same
 /// bus (its inputs and outputs 0x200-0x27F, 0x300-0x37F, 0x400-0x47F, 0x600-0x67F,
@@ -281,6 +339,8 @@ typedef enum sl_can_msg {
 #define SL_CAN_ID_DEFAULT_VEHICLE_MOTION 0x5B0U
 #define SL_CAN_ID_DEFAULT_HEALTH 0x5C3U
 #define SL_CAN_ID_DEFAULT_POLE_TILT 0x5C4U
+#define SL_CAN_ID_DEFAULT_GROUND_PLANE 0x5C5U
+#define SL_CAN_ID_DEFAULT_GROUND_HAZARD 0x5C6U
 
 /// Default largest accepted counter step of the VehicleMotion receiver (one lost frame).
 #define SL_CAN_MAX_DELTA_COUNTER_DEFAULT 2U
@@ -297,14 +357,18 @@ typedef enum sl_can_msg {
 #define SL_CAN_CYCLE_MS_VEHICLE_MOTION 20U
 #define SL_CAN_CYCLE_MS_HEALTH 250U
 #define SL_CAN_CYCLE_MS_POLE_TILT 250U
+#define SL_CAN_CYCLE_MS_GROUND_PLANE 250U
+#define SL_CAN_CYCLE_MS_GROUND_HAZARD 250U
 #define SL_CAN_IDLE_CYCLE_MS_STATUS 1000U
 
 /// How a message is sent: the DBC attribute GenMsgSendType, whose value table is Vector's
 /// (0 Cyclic ... 9 NoMsgSendType), so the numbers are the DBC's.
 typedef enum sl_can_send_type {
-    SL_CAN_SEND_CYCLIC = 0,           ///< every cycle (LeanWarning, Status, Health, VehicleMotion)
+    SL_CAN_SEND_CYCLIC = 0,           ///< every cycle (LeanWarning, Status, Health,
+                                      ///< GroundPlane, VehicleMotion)
     SL_CAN_SEND_CYCLIC_IF_ACTIVE = 2, ///< every cycle while its object exists (PoleLean: one
-                                      ///< per confirmed track and rotation)
+                                      ///< per confirmed track and rotation; PoleTilt;
+                                      ///< GroundHazard: one per confirmed hazard)
 } sl_can_send_type_t;
 
 // ---------------------------------------------------------------------------------------
@@ -333,6 +397,22 @@ typedef enum sl_can_tilt_quality {
                             ///< with the same TargetId (not a sl_tilt_quality_t value)
 } sl_can_tilt_quality_t;
 #define SL_CAN_TILT_QUALITY_MAX 5U
+
+/// GroundPlane.Quality (the values of sl_ground_quality_t, sl_ground.h).
+typedef enum sl_can_ground_quality {
+    SL_CAN_GROUND_NONE = 0,   ///< no plane: every value is sent as 0
+    SL_CAN_GROUND_COARSE = 1, ///< a plane, sigmas beyond the module's good limits
+    SL_CAN_GROUND_GOOD = 2,   ///< a plane within them
+} sl_can_ground_quality_t;
+#define SL_CAN_GROUND_QUALITY_MAX 2U
+
+/// GroundHazard.Kind (the values of sl_ground_kind_t, sl_ground.h).
+typedef enum sl_can_ground_kind {
+    SL_CAN_GROUND_FLAT = 0, ///< no hazard (never sent by the module; every value is sent as 0)
+    SL_CAN_GROUND_DROP = 1, ///< ground lower than the plane
+    SL_CAN_GROUND_STEP = 2, ///< ground higher than the plane
+} sl_can_ground_kind_t;
+#define SL_CAN_GROUND_KIND_MAX 2U
 
 /// LeanWarning.Level.
 typedef enum sl_can_level {
@@ -370,7 +450,8 @@ typedef enum sl_can_link_state {
 /// LINK_FLAPPING: this many reconnects within this window.
 #define SL_CAN_FLAP_RECONNECTS 3U
 #define SL_CAN_FLAP_WINDOW_MS 30000U
-/// Hard output ceiling per 100 ms (a rotation with 32 targets sends 33 data frames).
+/// Hard output ceiling per 100 ms (a rotation with 32 targets sends 33 data frames, with
+/// the ground on one GroundPlane more and a GroundHazard per confirmed sector).
 #define SL_CAN_MAX_DATA_FRAMES_PER_100MS 40U
 #define SL_CAN_MAX_STATUS_FRAMES_PER_100MS 8U
 #define SL_CAN_BURST_WINDOWS 3U
@@ -413,6 +494,26 @@ typedef enum sl_can_link_state {
 #define SL_CAN_TILT_BASE_UM_PER_LSB 50000L   ///< 0.05 m: the encoder's step for um inputs
 #define SL_CAN_TILT_BASE_RAW_MIN (-128)
 #define SL_CAN_TILT_BASE_RAW_MAX 127
+
+#define SL_CAN_GROUND_HEIGHT_MM_PER_LSB 2      ///< 0.002 m (layout/DBC factor 2/1000)
+#define SL_CAN_GROUND_HEIGHT_RAW_MAX 4095
+#define SL_CAN_GROUND_ANGLE_CDEG_PER_LSB 2     ///< 0.02 deg (pitch, roll)
+#define SL_CAN_GROUND_ANGLE_RAW_MIN (-1024)
+#define SL_CAN_GROUND_ANGLE_RAW_MAX 1023
+#define SL_CAN_GROUND_HSIGMA_MM_PER_LSB 5      ///< 0.005 m
+#define SL_CAN_GROUND_ASIGMA_CDEG_PER_LSB 5    ///< 0.05 deg
+#define SL_CAN_GROUND_SIGMA_RAW_MAX 31         ///< the plane's three sigmas (5 bits)
+#define SL_CAN_HAZARD_SECTOR_MAX 63U
+#define SL_CAN_HAZARD_AZIMUTH_CDEG_PER_LSB 10  ///< 0.1 deg
+#define SL_CAN_HAZARD_AZIMUTH_RAW_MAX 3599
+#define SL_CAN_HAZARD_DIFF_MM_PER_LSB 5        ///< 0.005 m
+#define SL_CAN_HAZARD_DIFF_RAW_MIN (-1024)
+#define SL_CAN_HAZARD_DIFF_RAW_MAX 1023
+#define SL_CAN_HAZARD_DIST_MM_PER_LSB 10       ///< 0.01 m (layout/DBC factor 10/1000)
+#define SL_CAN_HAZARD_DIST_UM_PER_LSB 10000L   ///< 0.01 m: the encoder's step for um inputs
+#define SL_CAN_HAZARD_DIST_RAW_MAX 2047
+#define SL_CAN_HAZARD_SIGMA_MM_PER_LSB 5       ///< 0.005 m
+#define SL_CAN_HAZARD_SIGMA_RAW_MAX 255
 
 #define SL_CAN_STATUS_ROTATIONS_MAX 262143UL ///< 18 bits
 #define SL_CAN_STATUS_AZ_MISSING_MAX 16383UL ///< 14 bits
@@ -477,6 +578,34 @@ typedef struct sl_can_pole_tilt {
     bool clamped;               ///< decode only
     uint8_t counter;            ///< decode only
 } sl_can_pole_tilt_t;
+
+/// The ground plane of a rotation (GroundPlane). Heights in mm, the ground module's unit
+/// (rounded once more, to the signal's step, by the encoder).
+typedef struct sl_can_ground_plane {
+    uint8_t quality;            ///< in: sl_can_ground_quality_t (0..2); NONE sends every value as 0
+    int32_t height_mm;          ///< in: radar above the plane, perpendicular to it
+    int32_t pitch_cdeg;         ///< in: nose down > 0
+    int32_t roll_cdeg;          ///< in: right side down > 0
+    uint32_t height_sigma_mm;   ///< in
+    uint32_t pitch_sigma_cdeg;  ///< in
+    uint32_t roll_sigma_cdeg;   ///< in
+    bool clamped;               ///< decode only
+    uint8_t counter;            ///< decode only
+} sl_can_ground_plane_t;
+
+/// One confirmed hazard of the ring (GroundHazard).
+typedef struct sl_can_ground_hazard {
+    uint8_t kind;               ///< in: sl_can_ground_kind_t (1 DROP, 2 STEP); FLAT sends
+                                ///< every value as 0
+    uint8_t sector;             ///< in: 0..63
+    int32_t azimuth_cdeg;       ///< in: the sector's centre, clockwise from vehicle forward;
+                                ///< reduced mod 36000
+    int32_t height_diff_mm;     ///< in: ground above the plane (< 0 lower: DROP)
+    uint32_t distance_um;       ///< in: horizontal distance from the radar (rounded once, to 0.01 m)
+    uint32_t sigma_mm;          ///< in: 1-sigma of height_diff_mm
+    bool clamped;               ///< decode only
+    uint8_t counter;            ///< decode only
+} sl_can_ground_hazard_t;
 
 /// Module health (Status). Counters are totals since start; the encoder saturates them.
 typedef struct sl_can_status {
@@ -643,6 +772,19 @@ sl_err_t sl_can_encode_lean_warning(sl_can_tx_t *tx, const sl_can_lean_warning_t
 sl_err_t sl_can_encode_pole_tilt(sl_can_tx_t *tx, const sl_can_pole_tilt_t *in,
                                  sl_can_frame_t *out);
 
+/// Encode one GroundPlane frame (same rules as PoleLean: clamped values set Clamped;
+/// quality > 2 is sent as NONE with Clamped set; NONE sends every value as 0; a negative
+/// height or sigma is clamped to 0). Defined with SL_CFG_GROUND only (sl_config.h: the
+/// host configuration; the firmware configuration has no ground).
+sl_err_t sl_can_encode_ground_plane(sl_can_tx_t *tx, const sl_can_ground_plane_t *in,
+                                    sl_can_frame_t *out);
+
+/// Encode one GroundHazard frame (same rules: kind > 2 is sent as FLAT with Clamped set;
+/// FLAT sends every value as 0; sector > 63 is sent as 63 with Clamped set; the azimuth
+/// is reduced mod 360 deg). Defined with SL_CFG_GROUND only.
+sl_err_t sl_can_encode_ground_hazard(sl_can_tx_t *tx, const sl_can_ground_hazard_t *in,
+                                     sl_can_frame_t *out);
+
 /// Encode one Status frame. Counters saturate at their field maximum (Saturated bit);
 /// link_state > 4 is sent as DISCONNECTED with Saturated set.
 sl_err_t sl_can_encode_status(sl_can_tx_t *tx, const sl_can_status_t *in, sl_can_frame_t *out);
@@ -676,6 +818,11 @@ sl_err_t sl_can_decode_health(const sl_can_frame_t *f, const sl_can_e2e_cfg_t *e
                               sl_can_health_t *out);
 sl_err_t sl_can_decode_pole_tilt(const sl_can_frame_t *f, const sl_can_e2e_cfg_t *e2e,
                                  sl_can_pole_tilt_t *out);
+/// GroundPlane and GroundHazard: defined with SL_CFG_GROUND only (as their encoders).
+sl_err_t sl_can_decode_ground_plane(const sl_can_frame_t *f, const sl_can_e2e_cfg_t *e2e,
+                                    sl_can_ground_plane_t *out);
+sl_err_t sl_can_decode_ground_hazard(const sl_can_frame_t *f, const sl_can_e2e_cfg_t *e2e,
+                                     sl_can_ground_hazard_t *out);
 
 /// VehicleMotion receiver for the motion-aware masks: id match, the Profile 11 check
 /// (sl_can_e2e_check(), statuses counted in `e2e.stats`), latest used value with its time.
@@ -734,8 +881,8 @@ typedef struct sl_can_signal_desc {
     uint8_t start;            ///< Intel start bit (LSB position)
     uint8_t length;           ///< bits
     bool is_signed;           ///< two's complement
-    int32_t factor_num;
-    int32_t factor_den;
+    int16_t factor_num;       ///< 16 bits: every factor is a small fraction
+    int16_t factor_den;
     int32_t raw_min;
     int32_t raw_max;
     const char *unit;         ///< "" when none
@@ -755,7 +902,9 @@ typedef struct sl_can_message_desc {
     uint8_t n_signals;
 } sl_can_message_desc_t;
 
-/// Layout of message `m` (NULL when out of range). O(1).
+/// Layout of message `m` (NULL when out of range). O(1). Without SL_CFG_GROUND (the
+/// firmware configuration) GroundPlane and GroundHazard have their name, Data ID and
+/// cycle but no signals (n_signals 0): the DBC is generated in the host configuration.
 const sl_can_message_desc_t *sl_can_layout(sl_can_msg_t m);
 
 #ifdef __cplusplus

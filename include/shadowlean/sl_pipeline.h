@@ -46,7 +46,10 @@
 ///    the beam (`last_slant`, sl_detect.h stage 4: no one azimuth holds its run) sends its
 ///    PoleTilt without a PoleLean; one LeanWarning
 ///    (the most severe confirmed track: highest level, then largest |filtered alpha|;
-///    HasTarget = 0 when there is none); one Status (link state, rotations, missing
+///    HasTarget = 0 when there is none); with the ground on (`cfg.ground`, SL_CFG_GROUND),
+///    one GroundPlane (this rotation's plane; Quality NONE without one) and one
+///    GroundHazard per sector with a confirmed DROP or STEP, in sector order (sl_ground.h);
+///    one Status (link state, rotations, missing
 ///    azimuths, decoder resyncs, CAN drops; LinkState STREAMING only while usable rows
 ///    arrive: none since the previous Status and none within `cfg.row_timeout_us` -> SILENT), then one Health (Fault bits, Reconnects,
 ///    CandidatesDropped; sl_can.h). Every frame passes the hard output ceiling (token
@@ -419,7 +422,8 @@ typedef struct sl_pipeline {
     uint16_t faults_seen;        ///< every Fault bit sent since init
     uint8_t reconnect_next;      ///< internal: ring index
     bool can_clock_set;          ///< output ceiling: buckets initialised (full)
-    uint32_t can_tokens_data;    ///< output ceiling: PoleLean/LeanWarning tokens (1/1000)
+    uint32_t can_tokens_data;    ///< output ceiling: data frame tokens (PoleLean,
+                                 ///< LeanWarning, PoleTilt, GroundPlane, GroundHazard; 1/1000)
     uint32_t can_tokens_status;  ///< output ceiling: Status/Health tokens (1/1000)
     uint64_t can_clock_us;       ///< output ceiling: now_us of the last refill
     uint64_t reconnect_t_us[SL_CAN_FLAP_RECONNECTS]; ///< times of the last reconnects
@@ -473,8 +477,9 @@ _Static_assert(sizeof(sl_pipeline_t) <= 65536U, "sl_pipeline_t: 64 KiB RAM budge
 /// SL_CFG_TILT_TRACKS x SL_CFG_TILT_OBS_PER_TRACK: 2.5 KB firmware, 7.4 KB host) and the
 /// sensor model (sl_response_t, about 2.6 KB) and the ground (sl_ground_t and its
 /// configuration, sized by SL_CFG_GROUND_SECTORS) and the fit's buffers
-/// (SL_PIPELINE_FIT_BYTES) stays under 17,600 B (17,412 B in the host configuration, with detection's link table, 168 B, its
-/// per-azimuth peaks, 776 B, the CAN sender's E2E configuration, 24 B, and the
+/// (SL_PIPELINE_FIT_BYTES) stays under 17,600 B (17,452 B in the host configuration, with
+/// detection's link table, 168 B, its per-azimuth peaks, 776 B, the CAN sender's ids, E2E
+/// configuration and counters for its eight messages, 80 B, and the
 /// VehicleMotion receiver with its Profile 11 state, 104 B).
 #if SL_CFG_MAX_TARGETS <= 32 && SL_CFG_DETECT_MAX_CANDIDATES <= 32 && SL_CFG_DETECT_MAX_SPAN <= 24 \
     && SL_CFG_MAX_AZIMUTHS <= 400

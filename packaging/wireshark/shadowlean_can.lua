@@ -1,7 +1,8 @@
 -- SPDX-License-Identifier: MIT
 -- shadowlean_can.lua: Wireshark / tshark dissector for the CAN frames of a shadowlean
--- module (PoleLean, LeanWarning, Status, Health, PoleTilt, VehicleMotion) on SocketCAN
--- captures (candump/SocketCAN pcap, link type 227), with the AUTOSAR E2E Profile 11 check.
+-- module (PoleLean, LeanWarning, Status, Health, PoleTilt, GroundPlane, GroundHazard,
+-- VehicleMotion) on SocketCAN captures (candump/SocketCAN pcap, link type 227), with the
+-- AUTOSAR E2E Profile 11 check.
 --
 -- Everything comes from the board's generated DBC (boards/<board>/shadowlean.dbc, installed
 -- as /usr/share/shadowlean/dbc/<board>.dbc): ids (11-bit, or 29-bit: DBC ids with bit 31

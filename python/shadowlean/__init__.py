@@ -16,21 +16,21 @@ live buses python3-can; nothing here shares code with the C encoder.
 Command line: python3 -m shadowlean --help
 """
 from .candump import Frame, read_candump, parse_candump_line
-from .dbc import (LEVEL, LINK, QUALITY, Decoded, counter_modulo, decode, decode_frames, decode_log,
-                  frame_of, load_dbc)
+from .dbc import (GROUND_QUALITY, HAZARD_KIND, LEVEL, LINK, QUALITY, Decoded, counter_modulo, decode,
+                  decode_frames, decode_log, frame_of, load_dbc)
 from .e2e import (E2E_ERRORS, E2E_STATUSES, MODE_BOTH, MODE_NIBBLE, E2EMonitor, E2EStats,
                   crc8_0x1d, crc8_j1850, e2e_crc, protect)
 from .bus import frame_from_message, frames_from_bus, message_from_frame, open_bus
-from .report import groups, print_frames, print_summary, print_table
+from .report import format_ground, ground, groups, print_frames, print_ground, print_summary, print_table
 from ._version import __version__
 
 __all__ = [
     "Frame", "read_candump", "parse_candump_line",
-    "LEVEL", "LINK", "QUALITY", "Decoded", "counter_modulo", "decode", "decode_frames",
+    "GROUND_QUALITY", "HAZARD_KIND", "LEVEL", "LINK", "QUALITY", "Decoded", "counter_modulo", "decode", "decode_frames",
     "decode_log", "frame_of", "load_dbc",
     "E2E_ERRORS", "E2E_STATUSES", "MODE_BOTH", "MODE_NIBBLE", "E2EMonitor", "E2EStats",
     "crc8_0x1d", "crc8_j1850", "e2e_crc", "protect",
     "frame_from_message", "frames_from_bus", "message_from_frame", "open_bus",
-    "groups", "print_frames", "print_summary", "print_table",
+    "format_ground", "ground", "groups", "print_frames", "print_ground", "print_summary", "print_table",
     "__version__",
 ]

@@ -1,7 +1,8 @@
 # SPDX-License-Identifier: MIT
 """python3 -m shadowlean: decode and verify shadowlean CAN frames with a board's DBC.
 
-  python3 -m shadowlean decode LOG --dbc BOARD.dbc [--summary | --table [--last K]] [--check]
+  python3 -m shadowlean decode LOG --dbc BOARD.dbc [--summary | --table [--last K] | --ground]
+                             [--check]
   python3 -m shadowlean live --dbc BOARD.dbc [--channel vcan0] [--interface socketcan]
                              [--count N] [--idle-exit S] [--check]
 
@@ -19,7 +20,7 @@ from .bus import frames_from_bus, open_bus
 from .candump import read_candump
 from .dbc import decode, decode_frames, load_dbc
 from .e2e import E2EMonitor
-from .report import format_frame, print_e2e, print_frames, print_summary, print_table
+from .report import format_frame, print_e2e, print_frames, print_ground, print_summary, print_table
 
 PROG = "python3 -m shadowlean"
 
@@ -39,6 +40,8 @@ def _parser():
     g = d.add_mutually_exclusive_group()
     g.add_argument("--summary", action="store_true", help="one line per Status frame")
     g.add_argument("--table", action="store_true", help="PoleLean rows per rotation")
+    g.add_argument("--ground", action="store_true", help="one line per GroundPlane frame: "
+                   "the plane and the rotation's GroundHazard frames")
     d.add_argument("--last", type=int, metavar="K", help="--table: only the last K rotations")
     d.add_argument("--check", action="store_true",
                    help="E2E Profile 11 check per message (CRC, Data ID nibble, counter "
@@ -72,9 +75,11 @@ def _decode(a):
         print_summary(decoded)
     elif a.table:
         print_table(decoded, last=a.last)
+    elif a.ground:
+        print_ground(decoded)
     else:
         print_frames(decoded, monitor=mon)
-    if mon is not None and (a.summary or a.table):
+    if mon is not None and (a.summary or a.table or a.ground):
         for f, x in decoded:
             mon.check(x, f.data, f.t)
     if known == 0:

@@ -21,6 +21,8 @@ from .e2e import MODE_NIBBLE, e2e_crc, mode_of
 LINK = {0: "DISCONNECTED", 1: "CONNECTING", 2: "WAIT_CONFIG", 3: "STREAMING", 4: "SILENT"}
 LEVEL = {0: "NONE", 1: "CAUTION", 2: "DANGER"}
 QUALITY = {0: "VALID", 1: "AMBIGUOUS", 2: "OUT_OF_MODEL", 3: "INVALID", 4: "FILTERED"}
+GROUND_QUALITY = {0: "NONE", 1: "COARSE", 2: "GOOD"}
+HAZARD_KIND = {0: "FLAT", 1: "DROP", 2: "STEP"}
 
 
 def load_dbc(path):

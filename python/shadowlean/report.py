@@ -2,7 +2,7 @@
 """Text reports of decoded frames: every frame, one line per Status, the warnings table."""
 import sys
 
-from .dbc import LEVEL, LINK, QUALITY
+from .dbc import GROUND_QUALITY, HAZARD_KIND, LEVEL, LINK, QUALITY
 
 
 def groups(decoded):
@@ -20,6 +20,43 @@ def groups(decoded):
             out.append((d, warn, poles))
             poles, warn = [], None
     return out
+
+
+def ground(decoded):
+    """The ground per rotation [(plane, [hazards])]: each GroundPlane frame with the
+    GroundHazard frames sent after it (one per confirmed DROP / STEP sector)."""
+    out = []
+    for _, d in decoded:
+        if d is None or not d.length_ok:
+            continue
+        if d.name == "GroundPlane":
+            out.append((d, []))
+        elif d.name == "GroundHazard" and out:
+            out[-1][1].append(d)
+    return out
+
+
+def format_ground(plane, hazards):
+    """One line: the plane (quality, height, pitch, roll with their sigmas), then every
+    hazard (kind, azimuth, height relative to the plane, distance)."""
+    q = GROUND_QUALITY.get(plane.raw["Quality"], "?")
+    if plane.raw["Quality"] == 0:
+        line = f"{q:<6} no plane"
+    else:
+        p = plane.phys
+        line = (f"{q:<6} height {p['Height']:.3f}±{p['HeightSigma']:.3f} m  pitch {p['Pitch']:+.2f}"
+                f"±{p['PitchSigma']:.2f}°  roll {p['Roll']:+.2f}±{p['RollSigma']:.2f}°")
+    for h in hazards:
+        line += (f"  {HAZARD_KIND.get(h.raw['Kind'], '?')} az {h.phys['Azimuth']:.1f}° "
+                 f"{h.phys['HeightDiff']:+.3f} m at {h.phys['Distance']:.2f} m")
+    return line
+
+
+def print_ground(decoded, out=None):
+    """One line per GroundPlane frame (format_ground)."""
+    out = out or sys.stdout
+    for plane, hazards in ground(decoded):
+        out.write(format_ground(plane, hazards) + "\n")
 
 
 def format_frame(f, d, e2e=None):

@@ -73,8 +73,10 @@ class Crc(unittest.TestCase):
         # DBC in its mode; the same table as unit_canmsg and the dissector test (CRC bytes
         # from tests/system/daemon/p11_frames.py, the AUTOSAR library chaining).
         vectors = {"PoleLean": (0x03, 0x5E), "LeanWarning": (0xAC, 0xF1), "Status": (0xC9, 0x94),
-                   "VehicleMotion": (0xEF, 0xB2), "Health": (0x8A, 0xD7), "PoleTilt": (0x25, 0x78)}
+                   "VehicleMotion": (0xEF, 0xB2), "Health": (0x8A, 0xD7), "PoleTilt": (0x25, 0x78),
+                   "GroundPlane": (0x40, 0x1D), "GroundHazard": (0x69, 0x34)}
         db = sl.load_dbc(dbc_of("paper-sim"))
+        self.assertEqual(sorted(fr.name for fr in db.frames), sorted(vectors))
         for fr in db.frames:
             data_id = int(fr.attributes["SlE2EDataId"])
             for ctr in (0, 1):
@@ -95,6 +97,35 @@ class Crc(unittest.TestCase):
         self.assertAlmostEqual(d.phys["Tilt"], 15.9)
         self.assertAlmostEqual(d.phys["TiltDirection"], 110.0)
         self.assertAlmostEqual(d.phys["BaseY"], -2.5)
+
+    def test_ground_frames_decode_as_the_core_encoded_them(self):
+        # The bytes unit_canmsg pins for the C encoder (counter 0): GroundPlane GOOD, 2.58 m,
+        # pitch +1.5 deg, roll -1.0 deg, sigmas 10 mm / 0.2 / 0.25 deg; GroundHazard DROP in
+        # sector 3 at 33.8 deg, 0.2 m lower, 3.46 m away, sigma 30 mm.
+        db = sl.load_dbc(dbc_of("paper-sim"))
+        ids = {fr.name: fr.arbitration_id.id for fr in db.frames}
+        p = sl.decode(db, ids["GroundPlane"], False, bytes.fromhex("1b20855a82f30529"))
+        self.assertTrue(p.length_ok and p.crc_ok and p.reencode_ok)
+        self.assertEqual((p.name, p.named["Quality"], p.raw["Clamped"], p.counter), ("GroundPlane", "GOOD", 0, 0))
+        for sig, want in (("Height", 2.58), ("Pitch", 1.5), ("Roll", -1.0), ("HeightSigma", 0.01),
+                          ("PitchSigma", 0.2), ("RollSigma", 0.25)):
+            self.assertAlmostEqual(p.phys[sig], want, places=6, msg=sig)
+        h = sl.decode(db, ids["GroundHazard"], False, bytes.fromhex("eb108354605f2b06"))
+        self.assertTrue(h.length_ok and h.crc_ok and h.reencode_ok)
+        self.assertEqual((h.name, h.named["Kind"], h.raw["Sector"]), ("GroundHazard", "DROP", 3))
+        for sig, want in (("Azimuth", 33.8), ("HeightDiff", -0.2), ("Distance", 3.46), ("Sigma", 0.03)):
+            self.assertAlmostEqual(h.phys[sig], want, places=6, msg=sig)
+        self.assertEqual(sl.HAZARD_KIND[h.raw["Kind"]], "DROP")
+        self.assertIn("DROP az 33.8° -0.200 m at 3.46 m", sl.format_ground(p, [h]))
+        # A GroundPlane payload under the GroundHazard id fails the CRC (its Data ID differs).
+        self.assertFalse(sl.decode(db, ids["GroundHazard"], False, bytes.fromhex("1b20855a82f30529")).crc_ok)
+        # A STEP with its numbers at the signals' limits, Clamped set: decoded as such.
+        raw = (2 << 12) | (1 << 14) | (63 << 16) | (3599 << 22) | (1023 << 34) | (2047 << 45) | (255 << 56)
+        h = sl.decode(db, ids["GroundHazard"], False, with_crc(db, "GroundHazard", raw.to_bytes(8, "little")))
+        self.assertTrue(h.crc_ok and h.reencode_ok)
+        self.assertEqual((h.named["Kind"], h.raw["Clamped"], h.raw["Sector"]), ("STEP", 1, 63))
+        for sig, want in (("Azimuth", 359.9), ("HeightDiff", 5.115), ("Distance", 20.47), ("Sigma", 1.275)):
+            self.assertAlmostEqual(h.phys[sig], want, places=6, msg=sig)
 
     def test_worked_example_of_sl_can_h(self):
         # Status, Data ID 0x0053 (11A), bytes 1..7 = 30 02 00 00 00 00 00 -> CRC 0x93.
@@ -154,6 +185,29 @@ class GoldenLogs(unittest.TestCase):
                 # one Status per rotation, each followed by its Health
                 self.assertEqual(counters.get("Status"), counters.get("Health"))
                 self.assertGreaterEqual(counters.get("Status", 0), 5)
+
+    def test_one_ground_plane_per_rotation(self):
+        # The daemon's ground (on by default): one GroundPlane per rotation, before its Status;
+        # the demo's flat ground under paper-sim's radar at 2.58 m: GOOD, level, no hazard.
+        for log, board in LOGS.items():
+            with self.subTest(log=log):
+                decoded = sl.decode_log(dbc_of(board), os.path.join(GOLDEN, log))
+                names = [d.name for _, d in decoded]
+                self.assertEqual(names.count("GroundPlane"), names.count("LeanWarning"))
+                self.assertEqual(names.count("GroundPlane"), len(sl.groups(decoded)))
+                for i, n in enumerate(names):
+                    if n == "GroundPlane":  # after the rotation's LeanWarning, its hazards, Status
+                        self.assertEqual(names[i - 1], "LeanWarning")
+                        rest = [x for x in names[i + 1:] if x != "GroundHazard"]
+                        self.assertEqual(rest[0], "Status")
+        ground = sl.ground(sl.decode_log(dbc_of("paper-sim"), os.path.join(GOLDEN, "demo_three_poles.candump")))
+        self.assertGreaterEqual(len(ground), 20)
+        for plane, hazards in ground:
+            self.assertEqual(plane.named["Quality"], "GOOD")
+            self.assertAlmostEqual(plane.phys["Height"], 2.58, delta=0.05)
+            self.assertAlmostEqual(plane.phys["Pitch"], 0.0, delta=0.3)
+            self.assertAlmostEqual(plane.phys["Roll"], 0.0, delta=0.3)
+            self.assertEqual(hazards, [])
 
     def test_demo_scene_warns_of_the_right_pole(self):
         decoded = sl.decode_log(dbc_of("paper-sim"), os.path.join(GOLDEN, "demo_three_poles.candump"))
@@ -351,6 +405,11 @@ class Cli(unittest.TestCase):
         rc, out, _ = run_cli(["decode", log, "--dbc", dbc_of("paper-sim"), "--summary"])
         self.assertEqual(rc, 0)
         self.assertIn("more rotation(s) alike", out)
+        rc, out, _ = run_cli(["decode", log, "--dbc", dbc_of("paper-sim"), "--ground", "--check"])
+        self.assertEqual(rc, 0)
+        lines = out.splitlines()
+        self.assertTrue(lines[0].startswith("GOOD   height 2."), lines[0])
+        self.assertIn("GroundPlane", out)  # the E2E counts of --check follow
 
     def test_no_frame_of_the_dbc_is_an_error(self):
         with tempfile.NamedTemporaryFile("w", suffix=".log", delete=False) as fh:

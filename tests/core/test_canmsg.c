@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "shadowlean/sl_can.h"
+#include "shadowlean/sl_config.h"
 #include "shadowlean/sl_response.h"
 
 /// The default E2E configuration of message SL_CAN_MSG_<m>.
@@ -20,6 +21,8 @@
 #define ID_MOTION SL_CAN_ID_DEFAULT_VEHICLE_MOTION
 #define ID_HEALTH SL_CAN_ID_DEFAULT_HEALTH
 #define ID_TILT SL_CAN_ID_DEFAULT_POLE_TILT
+#define ID_GPLANE SL_CAN_ID_DEFAULT_GROUND_PLANE
+#define ID_GHAZARD SL_CAN_ID_DEFAULT_GROUND_HAZARD
 
 static uint64_t rng_state = 0x9E3779B97F4A7C15ull;
 static uint32_t rnd32(void)
@@ -40,7 +43,8 @@ static void tx_setup(sl_can_tx_t *tx)
 {
     sl_can_ids_t ids;
     sl_can_ids_default(&ids);
-    const uint32_t id[SL_CAN_MSG_COUNT] = {ID_POLE, ID_WARN, ID_STATUS, ID_MOTION, ID_HEALTH, ID_TILT};
+    const uint32_t id[SL_CAN_MSG_COUNT] = {ID_POLE,   ID_WARN, ID_STATUS, ID_MOTION,
+                                           ID_HEALTH, ID_TILT, ID_GPLANE, ID_GHAZARD};
     memcpy(ids.id, id, sizeof id);
     assert_int_equal(sl_can_tx_init(tx, &ids), SL_OK);
 }
@@ -149,6 +153,7 @@ static void test_canmsg_e2e_crc_of_every_message_matches_its_vectors(void **stat
         {SL_CAN_MSG_POLE_LEAN, {0x03, 0x5E}},      {SL_CAN_MSG_LEAN_WARNING, {0xAC, 0xF1}},
         {SL_CAN_MSG_STATUS, {0xC9, 0x94}},         {SL_CAN_MSG_VEHICLE_MOTION, {0xEF, 0xB2}},
         {SL_CAN_MSG_HEALTH, {0x8A, 0xD7}},         {SL_CAN_MSG_POLE_TILT, {0x25, 0x78}},
+        {SL_CAN_MSG_GROUND_PLANE, {0x40, 0x1D}},   {SL_CAN_MSG_GROUND_HAZARD, {0x69, 0x34}},
     };
     for (size_t k = 0; k < sizeof v / sizeof v[0]; k++) {
         for (uint8_t c = 0; c < 2U; c++) {
@@ -358,6 +363,286 @@ static void test_canmsg_pole_tilt_layout_encode_decode(void **state)
     assert_int_equal(sl_can_decode_pole_tilt(NULL, E2E(POLE_TILT), &out), SL_ERR_ARG);
 }
 
+#if SL_CFG_GROUND
+// GroundPlane bytes computed independently (tests/system/daemon/p11_frames.py packing the
+// fields by hand): GOOD, 2.58 m, pitch 1.5 deg, roll -1.0 deg, sigmas 10 mm, 0.2 and
+// 0.25 deg; counter 0 (Data ID 0x0057).
+static void test_canmsg_ground_plane_golden_bytes_and_round_trip(void **state)
+{
+    (void)state;
+    sl_can_tx_t tx;
+    tx_setup(&tx);
+    const sl_can_ground_plane_t in = {
+        .quality = SL_CAN_GROUND_GOOD, .height_mm = 2580, .pitch_cdeg = 150, .roll_cdeg = -100,
+        .height_sigma_mm = 10U, .pitch_sigma_cdeg = 20U, .roll_sigma_cdeg = 25U,
+    };
+    sl_can_frame_t f;
+    assert_int_equal(sl_can_encode_ground_plane(&tx, &in, &f), SL_OK);
+    const uint8_t want[8] = {0x1B, 0x20, 0x85, 0x5A, 0x82, 0xF3, 0x05, 0x29};
+    assert_int_equal(f.id, ID_GPLANE);
+    assert_int_equal(f.dlc, 8);
+    assert_int_equal(f.flags, 0);
+    assert_memory_equal(f.data, want, 8);
+    sl_can_ground_plane_t out;
+    assert_int_equal(sl_can_decode_ground_plane(&f, E2E(GROUND_PLANE), &out), SL_OK);
+    assert_int_equal(out.quality, SL_CAN_GROUND_GOOD);
+    assert_int_equal(out.height_mm, 2580);
+    assert_int_equal(out.pitch_cdeg, 150);
+    assert_int_equal(out.roll_cdeg, -100);
+    assert_int_equal(out.height_sigma_mm, 10);
+    assert_int_equal(out.pitch_sigma_cdeg, 20);
+    assert_int_equal(out.roll_sigma_cdeg, 25);
+    assert_false(out.clamped);
+    assert_int_equal(out.counter, 0);
+    // Every raw value of every field survives encode -> decode (the fields side by side).
+    for (int32_t r = -1024; r <= 4095; r++) {
+        const sl_can_ground_plane_t v = {
+            .quality = (uint8_t)(1U + (uint32_t)(r & 1)),
+            .height_mm = (r < 0 ? -r : r) * SL_CAN_GROUND_HEIGHT_MM_PER_LSB,
+            .pitch_cdeg = (r % 1024) * SL_CAN_GROUND_ANGLE_CDEG_PER_LSB,
+            .roll_cdeg = -(r % 1024) * SL_CAN_GROUND_ANGLE_CDEG_PER_LSB,
+            .height_sigma_mm = (uint32_t)((r & 31) * SL_CAN_GROUND_HSIGMA_MM_PER_LSB),
+            .pitch_sigma_cdeg = (uint32_t)(((r >> 5) & 31) * SL_CAN_GROUND_ASIGMA_CDEG_PER_LSB),
+            .roll_sigma_cdeg = (uint32_t)((31 - (r & 31)) * SL_CAN_GROUND_ASIGMA_CDEG_PER_LSB),
+        };
+        assert_int_equal(sl_can_encode_ground_plane(&tx, &v, &f), SL_OK);
+        assert_int_equal(sl_can_decode_ground_plane(&f, E2E(GROUND_PLANE), &out), SL_OK);
+        assert_int_equal(out.quality, v.quality);
+        assert_int_equal(out.height_mm, v.height_mm);
+        assert_int_equal(out.pitch_cdeg, v.pitch_cdeg);
+        assert_int_equal(out.roll_cdeg, v.roll_cdeg);
+        assert_int_equal(out.height_sigma_mm, v.height_sigma_mm);
+        assert_int_equal(out.pitch_sigma_cdeg, v.pitch_sigma_cdeg);
+        assert_int_equal(out.roll_sigma_cdeg, v.roll_sigma_cdeg);
+        assert_false(out.clamped);
+    }
+    assert_int_equal(tx.stats.clamped_frames, 0);
+}
+
+// Random physical values come back within half a step, rounded half up once; values out
+// of range are clamped to the limit and flagged, never wrapped.
+static void test_canmsg_ground_plane_rounds_once_and_saturates(void **state)
+{
+    (void)state;
+    sl_can_tx_t tx;
+    tx_setup(&tx);
+    sl_can_frame_t f;
+    sl_can_ground_plane_t out;
+    for (unsigned i = 0; i < 20000U; i++) {
+        const sl_can_ground_plane_t v = {
+            .quality = SL_CAN_GROUND_COARSE,
+            .height_mm = (int32_t)rnd_range(-100, 9000),
+            .pitch_cdeg = (int32_t)rnd_range(-2500, 2500),
+            .roll_cdeg = (int32_t)rnd_range(-2500, 2500),
+            .height_sigma_mm = (uint32_t)rnd_range(0, 200),
+            .pitch_sigma_cdeg = (uint32_t)rnd_range(0, 200),
+            .roll_sigma_cdeg = (uint32_t)rnd_range(0, 200),
+        };
+        assert_int_equal(sl_can_encode_ground_plane(&tx, &v, &f), SL_OK);
+        assert_int_equal(sl_can_decode_ground_plane(&f, E2E(GROUND_PLANE), &out), SL_OK);
+        const int64_t h = clamp64(ref_round(v.height_mm, 2), 0, 4095);
+        const int64_t p = clamp64(ref_round(v.pitch_cdeg, 2), -1024, 1023);
+        const int64_t r = clamp64(ref_round(v.roll_cdeg, 2), -1024, 1023);
+        const int64_t hs = clamp64(ref_round(v.height_sigma_mm, 5), 0, 31);
+        const int64_t ps = clamp64(ref_round(v.pitch_sigma_cdeg, 5), 0, 31);
+        const int64_t rs = clamp64(ref_round(v.roll_sigma_cdeg, 5), 0, 31);
+        assert_int_equal(out.height_mm, h * 2);
+        assert_int_equal(out.pitch_cdeg, p * 2);
+        assert_int_equal(out.roll_cdeg, r * 2);
+        assert_int_equal(out.height_sigma_mm, hs * 5);
+        assert_int_equal(out.pitch_sigma_cdeg, ps * 5);
+        assert_int_equal(out.roll_sigma_cdeg, rs * 5);
+        const bool cl = h != ref_round(v.height_mm, 2) || p != ref_round(v.pitch_cdeg, 2) ||
+                        r != ref_round(v.roll_cdeg, 2) || hs != ref_round(v.height_sigma_mm, 5) ||
+                        ps != ref_round(v.pitch_sigma_cdeg, 5) ||
+                        rs != ref_round(v.roll_sigma_cdeg, 5);
+        assert_int_equal(out.clamped, cl);
+    }
+    // Halves round up (towards +infinity): 2.581 m -> 2.582 m, -0.01 deg -> 0, -0.03 -> -0.02.
+    sl_can_ground_plane_t v = {.quality = SL_CAN_GROUND_GOOD, .height_mm = 2581,
+                               .pitch_cdeg = -1, .roll_cdeg = -3};
+    assert_int_equal(sl_can_encode_ground_plane(&tx, &v, &f), SL_OK);
+    assert_int_equal(sl_can_decode_ground_plane(&f, E2E(GROUND_PLANE), &out), SL_OK);
+    assert_int_equal(out.height_mm, 2582);
+    assert_int_equal(out.pitch_cdeg, 0);
+    assert_int_equal(out.roll_cdeg, -2);
+    // Saturation at every limit.
+    const uint32_t before = tx.stats.clamped_frames;
+    v = (sl_can_ground_plane_t){.quality = SL_CAN_GROUND_COARSE, .height_mm = INT32_MAX,
+                                .pitch_cdeg = INT32_MIN, .roll_cdeg = INT32_MAX,
+                                .height_sigma_mm = UINT32_MAX, .pitch_sigma_cdeg = 156U,
+                                .roll_sigma_cdeg = 1000U};
+    assert_int_equal(sl_can_encode_ground_plane(&tx, &v, &f), SL_OK);
+    assert_int_equal(sl_can_decode_ground_plane(&f, E2E(GROUND_PLANE), &out), SL_OK);
+    assert_true(out.clamped);
+    assert_int_equal(out.height_mm, 8190);
+    assert_int_equal(out.pitch_cdeg, -2048);
+    assert_int_equal(out.roll_cdeg, 2046);
+    assert_int_equal(out.height_sigma_mm, 155);
+    assert_int_equal(out.pitch_sigma_cdeg, 155);
+    assert_int_equal(out.roll_sigma_cdeg, 155);
+    assert_int_equal(tx.stats.clamped_frames, before + 1U);
+    v.height_mm = -2; // below the radar: clamped to 0, flagged (-1 mm rounds to 0)
+    v.pitch_cdeg = 0;
+    v.roll_cdeg = 0;
+    v.height_sigma_mm = v.pitch_sigma_cdeg = v.roll_sigma_cdeg = 0U;
+    assert_int_equal(sl_can_encode_ground_plane(&tx, &v, &f), SL_OK);
+    assert_int_equal(sl_can_decode_ground_plane(&f, E2E(GROUND_PLANE), &out), SL_OK);
+    assert_true(out.clamped);
+    assert_int_equal(out.height_mm, 0);
+    // NONE carries no numbers; an unknown quality is sent as NONE with Clamped set.
+    const uint8_t qs[] = {SL_CAN_GROUND_NONE, 3U, 200U};
+    for (size_t i = 0; i < sizeof qs; i++) {
+        v = (sl_can_ground_plane_t){.quality = qs[i], .height_mm = 2580, .pitch_cdeg = 9999,
+                                    .roll_sigma_cdeg = 30U};
+        assert_int_equal(sl_can_encode_ground_plane(&tx, &v, &f), SL_OK);
+        assert_int_equal(sl_can_decode_ground_plane(&f, E2E(GROUND_PLANE), &out), SL_OK);
+        assert_int_equal(out.quality, SL_CAN_GROUND_NONE);
+        assert_int_equal(out.clamped, qs[i] != SL_CAN_GROUND_NONE);
+        assert_int_equal(out.height_mm, 0);
+        assert_int_equal(out.pitch_cdeg, 0);
+        assert_int_equal(out.roll_sigma_cdeg, 0);
+        assert_int_equal(f.data[2] | f.data[3] | f.data[4] | f.data[5] | f.data[6] | f.data[7], 0);
+    }
+    assert_int_equal(sl_can_encode_ground_plane(NULL, &v, &f), SL_ERR_ARG);
+    assert_int_equal(sl_can_encode_ground_plane(&tx, NULL, &f), SL_ERR_ARG);
+    assert_int_equal(sl_can_decode_ground_plane(&f, E2E(GROUND_PLANE), NULL), SL_ERR_ARG);
+}
+
+// GroundHazard bytes computed independently (p11_frames.py): DROP in sector 3 at 33.75 deg
+// (rounded half up to 33.8), 0.2 m lower, 3.4567 m away, sigma 30 mm; counter 0.
+static void test_canmsg_ground_hazard_golden_bytes_and_round_trip(void **state)
+{
+    (void)state;
+    sl_can_tx_t tx;
+    tx_setup(&tx);
+    const sl_can_ground_hazard_t in = {
+        .kind = SL_CAN_GROUND_DROP, .sector = 3U, .azimuth_cdeg = 3375, .height_diff_mm = -200,
+        .distance_um = 3456700U, .sigma_mm = 30U,
+    };
+    sl_can_frame_t f;
+    assert_int_equal(sl_can_encode_ground_hazard(&tx, &in, &f), SL_OK);
+    const uint8_t want[8] = {0xEB, 0x10, 0x83, 0x54, 0x60, 0x5F, 0x2B, 0x06};
+    assert_int_equal(f.id, ID_GHAZARD);
+    assert_memory_equal(f.data, want, 8);
+    sl_can_ground_hazard_t out;
+    assert_int_equal(sl_can_decode_ground_hazard(&f, E2E(GROUND_HAZARD), &out), SL_OK);
+    assert_int_equal(out.kind, SL_CAN_GROUND_DROP);
+    assert_int_equal(out.sector, 3);
+    assert_int_equal(out.azimuth_cdeg, 3380);
+    assert_int_equal(out.height_diff_mm, -200);
+    assert_int_equal(out.distance_um, 3460000U);
+    assert_int_equal(out.sigma_mm, 30);
+    assert_false(out.clamped);
+    // Every raw value of every field survives encode -> decode.
+    for (int32_t r = -1024; r <= 3599; r++) {
+        const uint32_t u = (uint32_t)(r + 1024);
+        const sl_can_ground_hazard_t v = {
+            .kind = (uint8_t)(1U + (u & 1U)),
+            .sector = (uint8_t)(u & 63U),
+            .azimuth_cdeg = (r < 0 ? -r : r) * SL_CAN_HAZARD_AZIMUTH_CDEG_PER_LSB,
+            .height_diff_mm = (r % 1024) * SL_CAN_HAZARD_DIFF_MM_PER_LSB,
+            .distance_um = (u % 2048U) * (uint32_t)SL_CAN_HAZARD_DIST_UM_PER_LSB,
+            .sigma_mm = (u % 256U) * SL_CAN_HAZARD_SIGMA_MM_PER_LSB,
+        };
+        assert_int_equal(sl_can_encode_ground_hazard(&tx, &v, &f), SL_OK);
+        assert_int_equal(sl_can_decode_ground_hazard(&f, E2E(GROUND_HAZARD), &out), SL_OK);
+        assert_int_equal(out.kind, v.kind);
+        assert_int_equal(out.sector, v.sector);
+        assert_int_equal(out.azimuth_cdeg, v.azimuth_cdeg);
+        assert_int_equal(out.height_diff_mm, v.height_diff_mm);
+        assert_int_equal(out.distance_um, v.distance_um);
+        assert_int_equal(out.sigma_mm, v.sigma_mm);
+        assert_false(out.clamped);
+    }
+    assert_int_equal(tx.stats.clamped_frames, 0);
+    // A GroundPlane frame is not a GroundHazard (Data ID in the CRC), nor a short frame.
+    const sl_can_ground_plane_t pl = {.quality = SL_CAN_GROUND_GOOD, .height_mm = 2000};
+    assert_int_equal(sl_can_encode_ground_plane(&tx, &pl, &f), SL_OK);
+    assert_int_equal(sl_can_decode_ground_hazard(&f, E2E(GROUND_HAZARD), &out), SL_ERR_MALFORMED);
+    sl_can_ground_plane_t pout;
+    assert_int_equal(sl_can_decode_ground_plane(&f, E2E(GROUND_PLANE), &pout), SL_OK);
+    f.dlc = 7U;
+    assert_int_equal(sl_can_decode_ground_plane(&f, E2E(GROUND_PLANE), &pout), SL_ERR_MALFORMED);
+}
+
+static void test_canmsg_ground_hazard_rounds_once_and_saturates(void **state)
+{
+    (void)state;
+    sl_can_tx_t tx;
+    tx_setup(&tx);
+    sl_can_frame_t f;
+    sl_can_ground_hazard_t out;
+    // Distances are rounded once, from um: 12.344999 m -> 12.34 m, 12.345 m -> 12.35 m.
+    sl_can_ground_hazard_t v = {.kind = SL_CAN_GROUND_STEP, .sector = 9U, .distance_um = 12344999U};
+    assert_int_equal(sl_can_encode_ground_hazard(&tx, &v, &f), SL_OK);
+    assert_int_equal(sl_can_decode_ground_hazard(&f, E2E(GROUND_HAZARD), &out), SL_OK);
+    assert_int_equal(out.distance_um, 12340000U);
+    v.distance_um = 12345000U;
+    assert_int_equal(sl_can_encode_ground_hazard(&tx, &v, &f), SL_OK);
+    assert_int_equal(sl_can_decode_ground_hazard(&f, E2E(GROUND_HAZARD), &out), SL_OK);
+    assert_int_equal(out.distance_um, 12350000U);
+    assert_false(out.clamped);
+    // Azimuths are reduced modulo a turn (not clamped): 360.1 deg is 0.1, -0.5 deg is 359.5,
+    // 359.96 deg rounds to 0.
+    const int32_t az[][2] = {{36010, 10}, {-50, 35950}, {35996, 0}, {72000 + 1234, 1230}};
+    for (size_t i = 0; i < sizeof az / sizeof az[0]; i++) {
+        v.azimuth_cdeg = az[i][0];
+        assert_int_equal(sl_can_encode_ground_hazard(&tx, &v, &f), SL_OK);
+        assert_int_equal(sl_can_decode_ground_hazard(&f, E2E(GROUND_HAZARD), &out), SL_OK);
+        assert_int_equal(out.azimuth_cdeg, az[i][1]);
+        assert_false(out.clamped);
+    }
+    // Limits: sector 64 -> 63, the height difference beyond +-5.12 m, 20.47 m, 1.275 m.
+    const uint32_t before = tx.stats.clamped_frames;
+    v = (sl_can_ground_hazard_t){.kind = SL_CAN_GROUND_DROP, .sector = 64U,
+                                 .height_diff_mm = -6000, .distance_um = UINT32_MAX,
+                                 .sigma_mm = 2000U};
+    assert_int_equal(sl_can_encode_ground_hazard(&tx, &v, &f), SL_OK);
+    assert_int_equal(sl_can_decode_ground_hazard(&f, E2E(GROUND_HAZARD), &out), SL_OK);
+    assert_true(out.clamped);
+    assert_int_equal(out.sector, 63);
+    assert_int_equal(out.height_diff_mm, -5120);
+    assert_int_equal(out.distance_um, 20470000U);
+    assert_int_equal(out.sigma_mm, 1275);
+    v = (sl_can_ground_hazard_t){.kind = SL_CAN_GROUND_STEP, .sector = 1U, .height_diff_mm = INT32_MAX};
+    assert_int_equal(sl_can_encode_ground_hazard(&tx, &v, &f), SL_OK);
+    assert_int_equal(sl_can_decode_ground_hazard(&f, E2E(GROUND_HAZARD), &out), SL_OK);
+    assert_true(out.clamped);
+    assert_int_equal(out.height_diff_mm, 5115);
+    assert_int_equal(out.sector, 1);
+    assert_int_equal(tx.stats.clamped_frames, before + 2U);
+    // FLAT carries no numbers; an unknown kind is sent as FLAT with Clamped set.
+    const uint8_t ks[] = {SL_CAN_GROUND_FLAT, 3U, 255U};
+    for (size_t i = 0; i < sizeof ks; i++) {
+        v = (sl_can_ground_hazard_t){.kind = ks[i], .sector = 5U, .azimuth_cdeg = 9000,
+                                     .height_diff_mm = -300, .distance_um = 4000000U,
+                                     .sigma_mm = 20U};
+        assert_int_equal(sl_can_encode_ground_hazard(&tx, &v, &f), SL_OK);
+        assert_int_equal(sl_can_decode_ground_hazard(&f, E2E(GROUND_HAZARD), &out), SL_OK);
+        assert_int_equal(out.kind, SL_CAN_GROUND_FLAT);
+        assert_int_equal(out.clamped, ks[i] != SL_CAN_GROUND_FLAT);
+        assert_int_equal(out.sector, 0);
+        assert_int_equal(out.azimuth_cdeg, 0);
+        assert_int_equal(out.height_diff_mm, 0);
+        assert_int_equal(out.distance_um, 0U);
+        assert_int_equal(f.data[2] | f.data[3] | f.data[4] | f.data[5] | f.data[6] | f.data[7], 0);
+    }
+    // Bit 15 is reserved: never set.
+    for (unsigned i = 0; i < 2000U; i++) {
+        v = (sl_can_ground_hazard_t){.kind = (uint8_t)rnd_range(0, 4), .sector = (uint8_t)rnd32(),
+                                     .azimuth_cdeg = (int32_t)rnd32(),
+                                     .height_diff_mm = (int32_t)rnd32(),
+                                     .distance_um = rnd32(), .sigma_mm = rnd32()};
+        assert_int_equal(sl_can_encode_ground_hazard(&tx, &v, &f), SL_OK);
+        assert_int_equal(f.data[1] & 0x80U, 0);
+        assert_int_equal(sl_can_decode_ground_hazard(&f, E2E(GROUND_HAZARD), &out), SL_OK);
+    }
+    assert_int_equal(sl_can_encode_ground_hazard(&tx, NULL, &f), SL_ERR_ARG);
+    assert_int_equal(sl_can_decode_ground_hazard(NULL, E2E(GROUND_HAZARD), &out), SL_ERR_ARG);
+}
+#endif // SL_CFG_GROUND
+
 static void test_canmsg_layout_table_is_consistent(void **state)
 {
     (void)state;
@@ -405,6 +690,11 @@ static void test_canmsg_layout_table_is_consistent(void **state)
         {SL_CAN_MSG_LEAN_WARNING, "Lean", 1, 20},     {SL_CAN_MSG_LEAN_WARNING, "Range", 1, 100},
         {SL_CAN_MSG_LEAN_WARNING, "LeanSigma", 1, 10}, {SL_CAN_MSG_VEHICLE_MOTION, "Speed", 1, 100},
         {SL_CAN_MSG_VEHICLE_MOTION, "YawRate", 1, 100},
+        {SL_CAN_MSG_GROUND_PLANE, "Height", 1, 500},  {SL_CAN_MSG_GROUND_PLANE, "Pitch", 1, 50},
+        {SL_CAN_MSG_GROUND_PLANE, "Roll", 1, 50},     {SL_CAN_MSG_GROUND_PLANE, "HeightSigma", 1, 200},
+        {SL_CAN_MSG_GROUND_PLANE, "PitchSigma", 1, 20}, {SL_CAN_MSG_GROUND_PLANE, "RollSigma", 1, 20},
+        {SL_CAN_MSG_GROUND_HAZARD, "Azimuth", 1, 10}, {SL_CAN_MSG_GROUND_HAZARD, "HeightDiff", 1, 200},
+        {SL_CAN_MSG_GROUND_HAZARD, "Distance", 1, 100}, {SL_CAN_MSG_GROUND_HAZARD, "Sigma", 1, 200},
     };
     for (size_t k = 0; k < sizeof want / sizeof want[0]; k++) {
         const sl_can_message_desc_t *md = sl_can_layout(want[k].m);
@@ -985,7 +1275,7 @@ static void test_canmsg_tx_init_validates_ids(void **state)
     ids.id[SL_CAN_MSG_POLE_LEAN] = 0x80000000UL | 0x20000000UL;
     assert_int_equal(sl_can_tx_init(&tx, &ids), SL_ERR_ARG);
     const uint32_t eff[SL_CAN_MSG_COUNT] = {0x80000000UL | 0x18FF1234UL, 0x7FFU, 0U, 0x123U,
-                                            0x124U, 0x125U};
+                                            0x124U, 0x125U, 0x126U, 0x80000000UL | 0x127U};
     memcpy(ids.id, eff, sizeof eff);
     assert_int_equal(sl_can_tx_init(&tx, &ids), SL_OK);
     assert_int_equal(sl_can_tx_init(NULL, &ids), SL_ERR_ARG);
@@ -1104,6 +1394,12 @@ int main(void)
         cmocka_unit_test(test_canmsg_e2e_classifies_steps_with_the_max_delta_counter),
         cmocka_unit_test(test_canmsg_tx_init_validates_ids),
         cmocka_unit_test(test_canmsg_pole_tilt_layout_encode_decode),
+#if SL_CFG_GROUND
+        cmocka_unit_test(test_canmsg_ground_plane_golden_bytes_and_round_trip),
+        cmocka_unit_test(test_canmsg_ground_plane_rounds_once_and_saturates),
+        cmocka_unit_test(test_canmsg_ground_hazard_golden_bytes_and_round_trip),
+        cmocka_unit_test(test_canmsg_ground_hazard_rounds_once_and_saturates),
+#endif
         cmocka_unit_test(test_canmsg_motion_rx_checks_id_sequence_and_age),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

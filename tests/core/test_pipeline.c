@@ -667,7 +667,8 @@ static void test_pipeline_can_frames_decode_to_the_targets(void **state)
     for (int i = 0; i < 4; i++) {
         sl_can_e2e_rx_init(&rx[i], SL_CAN_COUNTER_MODULO - 1U);
     }
-    int pole_frames[MAXROT] = {0}, statuses = 0, warnings = 0, healths = 0;
+    int pole_frames[MAXROT] = {0}, statuses = 0, warnings = 0, healths = 0, planes = 0;
+    (void)planes;
     const int n = B->mask_frames, confirm = c.confirm_hits;
     for (int i = 0; i < rec.ncan; i++) {
         const sl_can_frame_t *f = &rec.can[i];
@@ -733,10 +734,28 @@ static void test_pipeline_can_frames_decode_to_the_targets(void **state)
             assert_int_equal(h.fault, 0); // a clean stream raises no fault
             assert_int_equal(h.reconnects, 0);
             assert_int_equal(h.candidates_dropped, 0);
+#if SL_CFG_GROUND
+        } else if (f->id == B->can_id_ground_plane) {
+            // One per rotation with the ground on (the default), before its Status.
+            sl_can_ground_plane_t g;
+            assert_int_equal(sl_can_decode_ground_plane(f, E2E(GROUND_PLANE), &g), SL_OK);
+            assert_int_equal(g.counter, (unsigned)planes % SL_CAN_COUNTER_MODULO);
+            assert_int_equal(statuses, planes);
+            assert_true(g.quality <= SL_CAN_GROUND_GOOD);
+            planes++;
+        } else if (f->id == B->can_id_ground_hazard) {
+            sl_can_ground_hazard_t h;
+            assert_int_equal(sl_can_decode_ground_hazard(f, E2E(GROUND_HAZARD), &h), SL_OK);
+            assert_true(h.kind == SL_CAN_GROUND_DROP || h.kind == SL_CAN_GROUND_STEP);
+            assert_int_equal(statuses + 1, planes); // after its rotation's GroundPlane
+#endif
         } else {
             fail_msg("frame with unexpected id 0x%x", (unsigned)f->id);
         }
     }
+#if SL_CFG_GROUND
+    assert_int_equal(planes, 24);
+#endif
     assert_int_equal(healths, 24);
     assert_int_equal(statuses, 24);
     assert_int_equal(warnings, 24);
@@ -751,6 +770,31 @@ static void test_pipeline_can_frames_decode_to_the_targets(void **state)
     assert_int_equal(pl.stats.can_dropped, 0);
     assert_int_equal(pl.stats.can_frames, rec.ncan);
 }
+
+#if !SL_CFG_GROUND
+// The firmware configuration has no ground: GroundPlane and GroundHazard keep their names,
+// Data IDs and the board's ids (a DBC of the host configuration describes the same bus),
+// without a signal table; mode 11C stays refused for them (their layout has signals in
+// bits 12..15). test_pipeline_can_frames_decode_to_the_targets fails on any frame of theirs.
+static void test_pipeline_fw_ground_messages_keep_their_identity_only(void **state)
+{
+    (void)state;
+    const sl_can_message_desc_t *gp = sl_can_layout(SL_CAN_MSG_GROUND_PLANE);
+    const sl_can_message_desc_t *gh = sl_can_layout(SL_CAN_MSG_GROUND_HAZARD);
+    assert_string_equal(gp->name, "GroundPlane");
+    assert_string_equal(gh->name, "GroundHazard");
+    assert_int_equal(gp->data_id, SL_CAN_DATA_ID_GROUND_PLANE);
+    assert_int_equal(gp->n_signals, 0);
+    assert_null(gh->signals);
+    sl_can_ids_t ids;
+    sl_can_ids_from_board(&ids, B);
+    assert_int_equal(ids.id[SL_CAN_MSG_GROUND_PLANE], B->can_id_ground_plane);
+    sl_can_tx_t tx;
+    assert_int_equal(sl_can_tx_init(&tx, &ids), SL_OK);
+    ids.e2e[SL_CAN_MSG_GROUND_HAZARD].mode = SL_CAN_E2E_MODE_NIBBLE;
+    assert_int_equal(sl_can_tx_init(&tx, &ids), SL_ERR_ARG);
+}
+#endif
 
 // Lost azimuths (random and a burst over the 0 deg pole), junk bytes with partial
 // signatures, duplicated and swapped messages, and a radar restart (cut mid-message,
@@ -1723,6 +1767,9 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_pipeline_detects_poles_at_minus10_0_plus10_deg_after_n_rotations),
         cmocka_unit_test(test_pipeline_can_frames_decode_to_the_targets),
+#if !SL_CFG_GROUND
+        cmocka_unit_test(test_pipeline_fw_ground_messages_keep_their_identity_only),
+#endif
         cmocka_unit_test(test_pipeline_survives_missing_azimuths_junk_duplicates_and_a_radar_restart),
         cmocka_unit_test(test_pipeline_handles_broken_empty_and_saturated_scans),
         cmocka_unit_test(test_pipeline_16_bit_stream_gives_the_same_targets),

@@ -151,6 +151,11 @@ sl_err_t fw_app_run(const fw_platform_t *pf, const char *board_name, const uint8
     g_state.res = res;
     sl_pipeline_cfg_t cfg;
     sl_pipeline_cfg_default(&cfg, board);
+#if SL_CFG_GROUND
+    // The host's run of this application (tests/core/thumb/host_frames.c) is the firmware
+    // configuration's reference, which has no ground: its frames (GroundPlane) stay off.
+    cfg.ground = false;
+#endif
     cfg.port.can_tx = port_can_tx;
     cfg.port.on_rotation = port_on_rotation;
     cfg.port.ctx = &g_state;

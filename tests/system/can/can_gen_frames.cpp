@@ -63,7 +63,7 @@ int main(int argc, char **argv)
         uint64_t t_us = 1700000000000000ULL;
         for (long i = 0; i < n; i++) {
             sl_can_frame_t f;
-            const int64_t kind = uni(0, 11);
+            const int64_t kind = uni(0, 13);
             if (kind < 6) {
                 sl_can_pole_lean_t p{};
                 p.target_id = static_cast<uint8_t>(value(0, 15, 0, 255));
@@ -130,6 +130,32 @@ int main(int argc, char **argv)
                    << " tilt_sigma_cdeg=" << t.tilt_sigma_cdeg
                    << " direction_sigma_cdeg=" << t.direction_sigma_cdeg << " base_x_um=" << t.base_x_um
                    << " base_y_um=" << t.base_y_um << "\n";
+            } else if (kind == 12) {
+                sl_can_ground_plane_t g{};
+                g.quality = static_cast<uint8_t>(chance(80) ? uni(1, 2) : value(0, 0, 0, 255));
+                g.height_mm = static_cast<int32_t>(value(0, 8190, -100000, 100000));
+                g.pitch_cdeg = static_cast<int32_t>(value(-2048, 2046, -100000, 100000));
+                g.roll_cdeg = static_cast<int32_t>(value(-2048, 2046, -100000, 100000));
+                g.height_sigma_mm = static_cast<uint32_t>(value(0, 155, 0, 100000));
+                g.pitch_sigma_cdeg = static_cast<uint32_t>(value(0, 155, 0, 100000));
+                g.roll_sigma_cdeg = static_cast<uint32_t>(value(0, 155, 0, 100000));
+                sl_can_encode_ground_plane(&tx, &g, &f);
+                ex << "GroundPlane quality=" << unsigned(g.quality) << " height_mm=" << g.height_mm
+                   << " pitch_cdeg=" << g.pitch_cdeg << " roll_cdeg=" << g.roll_cdeg
+                   << " height_sigma_mm=" << g.height_sigma_mm << " pitch_sigma_cdeg=" << g.pitch_sigma_cdeg
+                   << " roll_sigma_cdeg=" << g.roll_sigma_cdeg << "\n";
+            } else if (kind == 13) {
+                sl_can_ground_hazard_t h{};
+                h.kind = static_cast<uint8_t>(chance(80) ? uni(1, 2) : value(0, 0, 0, 255));
+                h.sector = static_cast<uint8_t>(value(0, 63, 0, 255));
+                h.azimuth_cdeg = static_cast<int32_t>(value(0, 35999, -1000000, 1000000));
+                h.height_diff_mm = static_cast<int32_t>(value(-5120, 5115, -100000, 100000));
+                h.distance_um = static_cast<uint32_t>(value(0, 20474999, 0, UINT32_MAX));
+                h.sigma_mm = static_cast<uint32_t>(value(0, 1275, 0, 100000));
+                sl_can_encode_ground_hazard(&tx, &h, &f);
+                ex << "GroundHazard kind=" << unsigned(h.kind) << " sector=" << unsigned(h.sector)
+                   << " azimuth_cdeg=" << h.azimuth_cdeg << " height_diff_mm=" << h.height_diff_mm
+                   << " distance_um=" << h.distance_um << " sigma_mm=" << h.sigma_mm << "\n";
             } else {
                 sl_can_vehicle_motion_t m{};
                 m.speed_mm_s = static_cast<int32_t>(value(-60000, 60000, -1000000, 1000000));

@@ -83,6 +83,23 @@ MAP = {
         "BaseX": ("base_x_um", 1000000, "num"),
         "BaseY": ("base_y_um", 1000000, "num"),
     },
+    "GroundPlane": {
+        "Quality": ("quality", 1, "gquality"),
+        "Height": ("height_mm", 1000, "num"),
+        "Pitch": ("pitch_cdeg", 100, "num"),
+        "Roll": ("roll_cdeg", 100, "num"),
+        "HeightSigma": ("height_sigma_mm", 1000, "num"),
+        "PitchSigma": ("pitch_sigma_cdeg", 100, "num"),
+        "RollSigma": ("roll_sigma_cdeg", 100, "num"),
+    },
+    "GroundHazard": {
+        "Kind": ("kind", 1, "gkind"),
+        "Sector": ("sector", 1, "id"),
+        "Azimuth": ("azimuth_cdeg", 100, "angle"),
+        "HeightDiff": ("height_diff_mm", 1000, "num"),
+        "Distance": ("distance_um", 1000000, "num"),
+        "Sigma": ("sigma_mm", 1000, "num"),
+    },
     "VehicleMotion": {
         "Speed": ("speed_mm_s", 1000, "num"),
         "YawRate": ("yaw_rate_cdeg_s", 100, "num"),
@@ -90,7 +107,11 @@ MAP = {
         "YawRateValid": ("yaw_rate_valid", 1, "flag"),
     },
 }
-FLAG = {"PoleLean": "Clamped", "LeanWarning": "Clamped", "Status": "Saturated", "PoleTilt": "Clamped"}
+FLAG = {"PoleLean": "Clamped", "LeanWarning": "Clamped", "Status": "Saturated", "PoleTilt": "Clamped",
+        "GroundPlane": "Clamped", "GroundHazard": "Clamped"}
+# GroundPlane Quality NONE (0) and GroundHazard Kind FLAT (0), also as the clamped form of an
+# unknown value, carry no numbers (sent as 0); the first field of each decides.
+NO_NUMBERS = {"GroundPlane": "Quality", "GroundHazard": "Kind"}
 # PoleTilt: qualities other than FITTED (0) / AMBIGUOUS (1) carry no numbers (sent as 0).
 TILT_VALUE_FIELDS = {"Tilt", "TiltDirection", "TiltSigma", "DirectionSigma", "BaseX", "BaseY"}
 TARGET_FIELDS = {"TargetId", "Quality", "Azimuth", "Lean", "Range", "LeanSigma"}
@@ -105,11 +126,12 @@ def expected_raw(sig, kind, value):
         return int(value), False
     if kind == "fault":
         return int(value) & 0x7FF, False  # bits 11..15 reserved: never sent
-    if kind in ("id", "quality", "level", "link", "tquality"):
+    if kind in ("id", "quality", "level", "link", "tquality", "gquality", "gkind"):
         v = int(value)
         if v <= rmax:
             return v, False
-        return {"id": rmax, "quality": 3, "level": 2, "link": 0, "tquality": 4}[kind], True
+        return {"id": rmax, "quality": 3, "level": 2, "link": 0, "tquality": 4, "gquality": 0,
+                "gkind": 0}[kind], True
     if kind == "angle":
         a = value - 360 * (value / 360).to_integral_value(rounding=decimal.ROUND_FLOOR)
         turn = int(D(360) / f)
@@ -159,7 +181,12 @@ def main():
         # signals
         any_clamped = False
         has_target = name != "LeanWarning" or inputs["has_target"] == "1"
+        numbers = True
         for sname, (key, scale, kind) in MAP[name].items():
+            if not numbers:
+                if d.raw[sname] != 0:
+                    errors.append(f"{where}: {sname} raw {d.raw[sname]}, want 0 (no numbers)")
+                continue
             sig = fr.signal_by_name(sname)
             f = dec(sig.factor)
             if name == "PoleTilt" and sname in TILT_VALUE_FIELDS and int(inputs["quality"]) not in (0, 1):
@@ -175,6 +202,8 @@ def main():
                 value = D(int(inputs[key])) / scale
                 want_raw, cl = expected_raw(sig, kind, value)
             any_clamped |= cl
+            if NO_NUMBERS.get(name) == sname and want_raw == 0:
+                numbers = False
             if d.raw[sname] != want_raw:
                 errors.append(f"{where}: {sname} raw {d.raw[sname]}, want {want_raw} "
                               f"(input {inputs.get(key)})")

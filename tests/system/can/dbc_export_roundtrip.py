@@ -21,9 +21,11 @@ with contextlib.redirect_stderr(io.StringIO()):
     import canmatrix.formats as cf
 
 SEND_TYPE = {"PoleLean": "CyclicIfActive", "LeanWarning": "Cyclic", "Status": "Cyclic",
-             "Health": "Cyclic", "VehicleMotion": "Cyclic", "PoleTilt": "CyclicIfActive"}
+             "Health": "Cyclic", "VehicleMotion": "Cyclic", "PoleTilt": "CyclicIfActive",
+             "GroundPlane": "Cyclic", "GroundHazard": "CyclicIfActive"}
 CYCLE = {"PoleLean": (250, None), "LeanWarning": (250, None), "Status": (250, 1000),
-         "Health": (250, 1000), "VehicleMotion": (20, None), "PoleTilt": (250, None)}
+         "Health": (250, 1000), "VehicleMotion": (20, None), "PoleTilt": (250, None),
+         "GroundPlane": (250, None), "GroundHazard": (250, None)}
 
 
 def load(path):

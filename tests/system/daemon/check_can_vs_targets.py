@@ -12,10 +12,14 @@ documented in sl_pipeline.h. Checks:
 - every frame: id known to the DBC, DLC 8, Crc = the E2E Profile 11 CRC (SlE2EDataId,
   SlE2EMode; the Python package's decoder), Counter = previous + 1 mod 15 per message, canmatrix re-encodes the
   decoded raw values to the same bytes;
-- frames come in rotation groups PoleLean* LeanWarning Status Health, one per JSON
+- frames come in rotation groups PoleLean* LeanWarning [GroundPlane GroundHazard*] Status
+  Health, one per JSON
   rotation record, in order (Status + Health without a group are idle Status frames:
   allowed with --idle-ok, rejected otherwise); every Status is followed at once by its
   Health; with --no-fault every rotation group's Health has Fault 0 (a clean stream);
+- the ground (the daemon's pipeline has it on): one GroundPlane in every rotation group or
+  in none, right after LeanWarning; GroundHazard frames only right after it (or another
+  GroundHazard), Kind DROP or STEP, in increasing Sector order; Quality NONE carries 0s;
 - PoleLean: one per confirmed track (live, updated, hits >= confirm_hits, not last updated
   by a SLANT target, whose PoleTilt comes alone) in slot order:
   TargetId = id mod 16, Azimuth = az x 360 / azimuths + yaw (+-0.1 deg), Quality
@@ -55,6 +59,31 @@ def az_deg(hdr, az):
 def ang_diff(a, b):
     d = abs(a - b) % 360.0
     return min(d, 360.0 - d)
+
+
+def check_ground(w, g, errors, seen):
+    """The ground's frames of one rotation group (see the module's docstring)."""
+    names = [d.name for d in g]
+    planes = [i for i, n in enumerate(names) if n == "GroundPlane"]
+    seen.add(len(planes))
+    if len(seen) > 1 or len(planes) > 1:
+        errors.append(f"{w}: {len(planes)} GroundPlane frames (one in every rotation or in none)")
+    sectors = []
+    for i, d in enumerate(g):
+        if d.name == "GroundPlane":
+            if i == 0 or names[i - 1] != "LeanWarning":
+                errors.append(f"{w}: GroundPlane not right after LeanWarning")
+            if d.raw["Quality"] == 0 and any(v != 0 for k, v in d.raw.items()
+                                             if k not in ("Crc", "Counter", "Quality", "Clamped")):
+                errors.append(f"{w}: GroundPlane NONE with values {d.raw}")
+        elif d.name == "GroundHazard":
+            if i == 0 or names[i - 1] not in ("GroundPlane", "GroundHazard"):
+                errors.append(f"{w}: GroundHazard not after its rotation's GroundPlane")
+            if d.raw["Kind"] not in (1, 2):
+                errors.append(f"{w}: GroundHazard Kind {d.raw['Kind']}, want DROP or STEP")
+            sectors.append(d.raw["Sector"])
+    if sectors != sorted(set(sectors)):
+        errors.append(f"{w}: GroundHazard sectors {sectors}, want increasing")
 
 
 def main(argv):
@@ -149,6 +178,7 @@ def main(argv):
     max_poles = 0
     last_tilt = {}
     last_dropped = 0
+    ground_seen = set()  # whether rotation groups had a GroundPlane: one kind only
     for k, (g, r) in enumerate(zip(groups, rots)):
         w = f"rotation {r['rotation']}"
         missing += r["missing"]
@@ -175,9 +205,12 @@ def main(argv):
             if tid not in tilts:
                 errors.append(f"{w}: no PoleTilt for target {tid}, updated by a SLANT target after a fit")
         g = [d for d in g if d.name != "PoleTilt"]
+        check_ground(w, g, errors, ground_seen)
+        g = [d for d in g if d.name not in ("GroundPlane", "GroundHazard")]
         rest = [d.name for d in g if d.name not in ("PoleLean", "PoleTilt")]
         if rest != ["LeanWarning", "Status", "Health"]:
-            errors.append(f"{w}: frames {[d.name for d in g]}, want PoleLean* LeanWarning Status Health")
+            errors.append(f"{w}: frames {[d.name for d in g]}, want PoleLean* LeanWarning "
+                          "[GroundPlane GroundHazard*] Status Health")
             continue
         if len(poles) != len(want_pl):
             errors.append(f"{w}: {len(poles)} PoleLean frames, {len(want_pl)} confirmed tracks seen")

@@ -139,7 +139,8 @@ def main():
     dbc = os.path.join(args.src, "boards", "paper-sim", "shadowlean.dbc")
     db = sl.load_dbc(dbc)
     table = {"PoleLean": (0x03, 0x5E), "LeanWarning": (0xAC, 0xF1), "Status": (0xC9, 0x94),
-             "VehicleMotion": (0xEF, 0xB2), "Health": (0x8A, 0xD7), "PoleTilt": (0x25, 0x78)}
+             "VehicleMotion": (0xEF, 0xB2), "Health": (0x8A, 0xD7), "PoleTilt": (0x25, 0x78),
+             "GroundPlane": (0x40, 0x1D), "GroundHazard": (0x69, 0x34)}
     frames = [(fr.arbitration_id.id, False, bytes([table[fr.name][c], c]) + bytes(6), fr.name, c)
               for fr in db.frames for c in (0, 1)]
     pcap = os.path.join(args.work, "messages.pcap")
@@ -147,7 +148,7 @@ def main():
     rows = tshark(args, pcap, dbc)
     bad = [f"{n} counter {c}: {r}" for (_, _, _, n, c), r in zip(frames, rows)
            if r["msg"] != n or r["crc"] != "good" or r["e2e"] != ("INITIAL" if c == 0 else "OK")]
-    check(len(rows) == 12 and not bad, "per-message vectors (6 messages x counter 0, 1) verify" +
+    check(len(rows) == 2 * len(table) and not bad, f"per-message vectors ({len(table)} messages x counter 0, 1) verify" +
           ("" if not bad else ": " + "; ".join(bad[:3])))
     h = next(fr for fr in sl.load_dbc(os.path.join(args.src, "boards", "paper-sim-29bit", "shadowlean.dbc")).frames
              if fr.name == "Health")
