@@ -167,9 +167,9 @@ static int apply(sld_opts_t *o, const char *section, const char *key, const char
     } else if (IS("daemon", "extract")) {
         // sl_pipeline_cfg_t.fit (the fit needs SL_CFG_FIT: the host configuration)
         if (strcmp(val, "fit") == 0 && SL_CFG_FIT) {
-            o->fit = true;
+            o->extract = 2U;
         } else if (strcmp(val, "walk") == 0) {
-            o->fit = false;
+            o->extract = 1U;
         } else {
             BAD(SL_CFG_FIT ? "expected walk or fit" : "expected walk (this build has no fit)");
         }
@@ -655,7 +655,9 @@ void sld_opts_print(const sld_opts_t *o, void *fpv)
     if (o->r2_offset_um != 0) {
         fprintf(fp, "r2_offset_mm = %.3f\n", (double)o->r2_offset_um / 1000.0);
     }
-    fprintf(fp, "extract = %s\n", o->fit ? "fit" : "walk");
+    if (o->extract != 0U) {
+        fprintf(fp, "extract = %s\n", o->extract == 2U ? "fit" : "walk");
+    }
     fprintf(fp, "\n[input]\n");
     if (o->radar_host[0] != '\0') {
         const bool v6 = strchr(o->radar_host, ':') != NULL;

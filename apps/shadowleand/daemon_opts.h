@@ -88,9 +88,10 @@ typedef struct sld_opts {
     int32_t r2_offset_um;              ///< --r2-offset MM: the walk-end offset of r2 learned
                                        ///< on upright poles by an earlier run, um (0 = none;
                                        ///< |mm| <= 100) [daemon] r2_offset_mm
-    bool fit;                          ///< --extract fit: bounds from the sensor model's fit
-                                       ///< (sl_pipeline_cfg_t.fit); walk: the profile's walk
-                                       ///< (default). [daemon] extract
+    uint8_t extract;                   ///< --extract walk|fit: a target's bounds from the
+                                       ///< profile's walk (1) or the sensor model's fit (2);
+                                       ///< 0: the pipeline's default (sl_pipeline_cfg_t.fit)
+                                       ///< [daemon] extract
 } sld_opts_t;
 
 /// Defaults: verbosity info, port 6317, timeouts as listed, everything else empty/off.

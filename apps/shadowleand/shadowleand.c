@@ -1082,7 +1082,9 @@ int main(int argc, char **argv)
     d->pcfg.profile_cfg.prior_slope_q8 = d->o.tail_slope_q8; // --tail-slope (0: none)
     d->pcfg.profile_cfg.prior_front_bins = d->o.front_bins;  // --front-bins (0: none)
     d->pcfg.profile_cfg.prior_r2_offset_um = d->o.r2_offset_um; // --r2-offset (0: none)
-    d->pcfg.fit = d->o.fit;                                      // --extract fit
+    if (d->o.extract != 0U) {
+        d->pcfg.fit = d->o.extract == 2U; // --extract walk|fit (else the pipeline's default)
+    }
     if (sl_pipeline_init(&g_pipe, d->board, &d->pcfg) != SL_OK) {
         sld_log(SLD_LOG_ERR, "pipeline for board %s: %s", d->board->name,
                 g_pipe.last_err_msg != NULL ? g_pipe.last_err_msg : "init failed");
