@@ -768,9 +768,10 @@ static void log_stats(daemon_t *d, int level, const char *what)
     if (g_pipe.cfg.fit) {
         sld_log(SLD_LOG_INFO, "%s: sensor model's fit: %" PRIu32 " fits run, %" PRIu32
                 " targets given their slot's last fit, %" PRIu32 " refits without an answer "
-                "(the last fit kept); OK %" PRIu32 ", out of model %" PRIu32 ", no signal %" PRIu32
+                "(the last fit kept), %" PRIu32 " answers from the flat density; OK %" PRIu32 ", out of model %" PRIu32 ", no signal %" PRIu32
                 ", not converged %" PRIu32,
-                what, ps->fits, ps->fits_reused, ps->fits_kept, ps->fit_quality[SL_RFIT_OK],
+                what, ps->fits, ps->fits_reused, ps->fits_kept, ps->fits_flat,
+                ps->fit_quality[SL_RFIT_OK],
                 ps->fit_quality[SL_RFIT_OUT_OF_MODEL], ps->fit_quality[SL_RFIT_NO_SIGNAL],
                 ps->fit_quality[SL_RFIT_NOT_CONVERGED]);
     }

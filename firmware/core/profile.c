@@ -1605,6 +1605,41 @@ static uint16_t temporal_looks_q8(const sl_response_t *resp, const sl_profile_sl
 
 // Fits the window [lo, lo + n) of `sum` (`frames` rows, from bin0) into `o`; a warm start
 // from `warm` (bounds from bin0, Q8) when given.
+// A fit gives bounds with sigmas (OUT_OF_MODEL included: it says so on the bus).
+static bool fit_usable(uint8_t quality, uint32_t sa_q8, uint32_t sb_q8)
+{
+    return quality != (uint8_t)SL_RFIT_NO_SIGNAL && sa_q8 != UINT32_MAX && sb_q8 != UINT32_MAX;
+}
+
+// One fit of `in` with density `shape` into `o`, from `in`'s warm start when it has one, again
+// from the moments when that leads nowhere.
+static void fit_shape(sl_profile_t *pr, const sl_response_t *resp, sl_rfit_in_t *in,
+                      uint8_t shape, sl_rfit_out_t *o)
+{
+    in->shape = shape;
+    const uint8_t warm = in->warm;
+    pr->stats.fits++;
+    sl_err_t e = sl_rfit_ws(resp, in, &pr->fit_ws, o);
+    if (e == SL_OK && in->warm != 0U &&
+        (o->quality == (uint8_t)SL_RFIT_NOT_CONVERGED || o->sigma_a_q8 == UINT32_MAX ||
+         o->sigma_b_q8 == UINT32_MAX)) {
+        in->warm = 0U; // the earlier bounds led nowhere: from the moments
+        pr->stats.fits++;
+        e = sl_rfit_ws(resp, in, &pr->fit_ws, o);
+    }
+    in->warm = warm;
+    if (e != SL_OK) {
+        memset(o, 0, sizeof *o);
+        o->quality = (uint8_t)SL_RFIT_NO_SIGNAL;
+    }
+}
+
+// Fits the window [lo, lo + n) of `sum` (`frames` rows, from bin0) into `o`; a warm start
+// from `warm` (bounds from bin0, Q8) when given. Both densities are fitted, a slender
+// target's (FOOT: its power at its closest point) and a flat one (UNIFORM: a return of the
+// same power per bin, as a target whose elevation pattern or reflectivity evens it out), and
+// the one that explains the samples better (the lower negative log-likelihood: the same
+// data, looks and parameters) is taken.
 static void fit_run(sl_profile_t *pr, const sl_response_t *resp, const uint16_t *sum,
                     uint32_t frames, uint32_t bin0, uint32_t lo, uint32_t n, uint16_t looks_q8,
                     const sl_profile_slot_t *warm, sl_rfit_out_t *o)
@@ -1616,35 +1651,24 @@ static void fit_run(sl_profile_t *pr, const sl_response_t *resp, const uint16_t 
     in.f = pr->fit_f;
     in.n = (uint16_t)n;
     in.looks_q8 = looks_q8;
-    in.shape = (uint8_t)SL_RFIT_FOOT;
     in.origin_q8 = (bin0 + lo) * 256U + 128U;
     if (warm != NULL) {
         in.warm = 1U;
         in.a0_q8 = warm->fit_a_q8 - (int32_t)(lo * 256U);
         in.b0_q8 = warm->fit_b_q8 - (int32_t)(lo * 256U);
     }
-    pr->stats.fits++;
-    sl_err_t e = sl_rfit_ws(resp, &in, &pr->fit_ws, o);
-    if (e == SL_OK && in.warm != 0U &&
-        (o->quality == (uint8_t)SL_RFIT_NOT_CONVERGED || o->sigma_a_q8 == UINT32_MAX ||
-         o->sigma_b_q8 == UINT32_MAX)) {
-        in.warm = 0U; // the earlier bounds led nowhere: from the moments
-        pr->stats.fits++;
-        e = sl_rfit_ws(resp, &in, &pr->fit_ws, o);
-    }
-    if (e != SL_OK) {
-        memset(o, 0, sizeof *o);
-        o->quality = (uint8_t)SL_RFIT_NO_SIGNAL;
+    sl_rfit_out_t flat;
+    fit_shape(pr, resp, &in, (uint8_t)SL_RFIT_FOOT, o);
+    fit_shape(pr, resp, &in, (uint8_t)SL_RFIT_UNIFORM, &flat);
+    const bool foot_ok = fit_usable(o->quality, o->sigma_a_q8, o->sigma_b_q8);
+    if (fit_usable(flat.quality, flat.sigma_a_q8, flat.sigma_b_q8) &&
+        (!foot_ok || flat.nll_q16 < o->nll_q16)) {
+        *o = flat;
+        pr->stats.fits_flat++;
     }
     pr->stats.fit_quality[o->quality & 3U]++;
     o->a_q8 += (int32_t)(lo * 256U); // from bin0
     o->b_q8 += (int32_t)(lo * 256U);
-}
-
-// A fit gives bounds with sigmas (OUT_OF_MODEL included: it says so on the bus).
-static bool fit_usable(uint8_t quality, uint32_t sa_q8, uint32_t sb_q8)
-{
-    return quality != (uint8_t)SL_RFIT_NO_SIGNAL && sa_q8 != UINT32_MAX && sb_q8 != UINT32_MAX;
 }
 
 uint8_t sl_profile_refine_fit(sl_profile_t *pr, const sl_board_t *board,

@@ -14,6 +14,7 @@
 #define NORM_BITS 20    // the window's peak is normalised to ~2^20
 #define JT_MAX ((int64_t)1 << 20) // scaled Jacobian and residual clamp (Q14: 64)
 #define LEVEL_MAX ((uint64_t)1 << 36) // the level's bound (the window's powers are ~2^20)
+#define FADE_P_Q16 66 // a fade deeper than speckle makes over the window: probability 1e-3
 
 typedef struct pieces {
     int32_t x[SL_RFIT_PIECES + 1]; // breakpoints, bins Q8 (window coordinates)
@@ -58,6 +59,7 @@ typedef struct ctx {
     uint32_t ct;    // the cumulative response's total
     int64_t w_q16;  // looks, Q16
     uint16_t evals;
+    bool faded;     // a sample far below the model (deviance())
 } ctx_t;
 
 static int64_t mulsh(int64_t a, int64_t b, unsigned s);
@@ -529,6 +531,7 @@ static void deviance(ctx_t *c, int32_t a, int32_t b, uint64_t level, sl_rfit_out
     pieces_t *const p = &c->w->p;
     pieces_build(c, a, b, p);
     int64_t d = 0; // Q16
+    int64_t rmin = INT64_MAX; // the smallest y / mu, Q16
     for (uint32_t k = 0; k < c->in->n; k++) {
         const uint64_t mu = mu_of(c, level, model_at(c, p, k, NULL, NULL), k);
         uint32_t y = y_at(c, k);
@@ -536,6 +539,7 @@ static void deviance(ctx_t *c, int32_t a, int32_t b, uint64_t level, sl_rfit_out
             y = 1U;
         }
         const int64_t ratio = (int64_t)((((uint64_t)y) << 16) / mu);
+        rmin = ratio < rmin ? ratio : rmin;
         const int64_t ln = sl_fx_rshift_round64(
             ((int64_t)sl_lin_log2_q16(y) - (int64_t)sl_lin_log2_q16(mu)) * LN2_Q16, 16);
         d += ratio - 65536 - ln;
@@ -550,6 +554,13 @@ static void deviance(ctx_t *c, int32_t a, int32_t b, uint64_t level, sl_rfit_out
     const uint64_t sq_q8 = sl_fx_isqrt64(2U * (uint64_t)c->in->n * c->r->s4_q8 * 256U);
     const uint64_t lim = e_q8 + 6U * sq_q8 + 8U * 256U;
     out->dev_limit_q8 = (lim > UINT32_MAX) ? UINT32_MAX : (uint32_t)lim;
+    // A fade: one look's power falls below x of its mean with probability 1 - e^-x ~ x, so
+    // over the window's n / ncorr independent cells a sample below FADE_P ncorr / n of the
+    // model happens by speckle with probability FADE_P at most (more looks: less still).
+    const uint64_t cells_q8 = 256U * (uint64_t)c->in->n; // n >= 8 (sl_rfit_ws)
+    const uint64_t fade_q16 =
+        ((uint64_t)FADE_P_Q16 * c->r->ncorr_q8) / (cells_q8 == 0U ? 1U : cells_q8);
+    c->faded = rmin < (int64_t)fade_q16;
     const uint64_t disp = (e_q8 == 0U) ? 256U : ((uint64_t)out->dev_q8 * 256U) / e_q8;
     out->dispersion_q8 = (disp < 256U) ? 256U : ((disp > UINT32_MAX) ? UINT32_MAX : (uint32_t)disp);
 }
@@ -696,7 +707,7 @@ sl_err_t sl_rfit_ws(const sl_response_t *r, const sl_rfit_in_t *in, sl_rfit_ws_t
     out->sigma_a_q8 = disperse(out->sigma_a_q8, out->dispersion_q8);
     out->sigma_b_q8 = disperse(out->sigma_b_q8, out->dispersion_q8);
     out->evals = c.evals;
-    if (out->dev_q8 > out->dev_limit_q8) {
+    if (out->dev_q8 > out->dev_limit_q8 || c.faded) {
         out->quality = (uint8_t)SL_RFIT_OUT_OF_MODEL;
     } else if (!converged) {
         out->quality = (uint8_t)SL_RFIT_NOT_CONVERGED;

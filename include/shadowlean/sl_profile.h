@@ -503,6 +503,8 @@ typedef struct sl_profile_stats {
     uint32_t fits_reused;   ///< ... targets given their slot's last fit (its sum grew by
                             ///< less than a quarter since)
     uint32_t fits_kept;     ///< ... refits without bounds or sigmas: the slot's last fit kept
+    uint32_t fits_flat;     ///< ... answers from the flat density (it explained the samples
+                            ///< better than the slender target's)
     uint32_t fit_quality[4]; ///< ... by sl_rfit_quality_t
 } sl_profile_stats_t;
 
@@ -689,7 +691,8 @@ uint8_t sl_profile_refine(sl_profile_t *pr, const sl_board_t *board, uint32_t th
 /// sample times the level of the response's outermost taps, below which the model cannot
 /// tell a far sidelobe from the floor), the window the target's run and half the response's
 /// support either side, cut at the shadow edge, the pole's return modelled as SL_RFIT_FOOT
-/// convolved with `resp`'s range response; independent looks from how much of the speckle
+/// and as SL_RFIT_UNIFORM convolved with `resp`'s range response, the one with the lower
+/// negative log-likelihood taken; independent looks from how much of the speckle
 /// of the return's bins changes from row to row (the slot's sums of squares: one look for a
 /// frozen draw however many rotations are summed, and for one rotation's rows). A summed fit
 /// stands until the sum grows by a quarter; a refit starts from it, and one that gives no
@@ -699,7 +702,7 @@ uint8_t sl_profile_refine(sl_profile_t *pr, const sl_board_t *board, uint32_t th
 /// the target with `incline_flag` SL_INCLINE_OUT_OF_DOMAIN (Quality OUT_OF_MODEL on the bus),
 /// a fit without signal or sigma keeps the mask's bounds, widened. Flags: SL_TARGET_PROFILE,
 /// and SL_TARGET_COARSE for sums over rotations (their errors repeat). @return the
-/// sl_profile_fail_t (SL_PROFILE_OK: fitted). Cost: one fit (sl_rfit.h) of at most
+/// sl_profile_fail_t (SL_PROFILE_OK: fitted). Cost: two fits (sl_rfit.h) of at most
 /// SL_CFG_PROFILE_BINS samples per target whose slot's sum grew by a quarter, else O(1).
 /// With SL_CFG_FIT only.
 #if SL_CFG_FIT

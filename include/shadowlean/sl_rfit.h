@@ -50,9 +50,11 @@
 /// - SL_RFIT_OK: converged, the deviance within what the noise explains;
 /// - SL_RFIT_OUT_OF_MODEL: the deviance D = 2 L sum (y/mu - 1 - ln(y/mu)) exceeds
 ///   E + 6 sqrt(V) + 8, E = n (1 + 1 / (6 L)) its expectation under the model and
-///   V = 2 n `s4` its variance with the bins' correlation: a return the model does not
-///   explain (two targets, a cut-off return, clutter); the bounds are returned but must not
-///   be trusted;
+///   V = 2 n `s4` its variance with the bins' correlation, or one sample lies below the
+///   model by more than speckle makes over the window (y / mu < 1e-3 ncorr / n: one look's
+///   power falls below x of its mean with probability ~x, over n / ncorr independent cells):
+///   a return the model does not explain (two targets, a cut-off return, clutter); the bounds
+///   are returned but must not be trusted;
 /// - SL_RFIT_NO_SIGNAL: no power above the floor to fit (the sums of y - f <= 0);
 /// - SL_RFIT_NOT_CONVERGED: the iteration limit was reached with steps still above 1/64 bin.
 ///
