@@ -21,6 +21,7 @@
 #define ROTATION_US_MAX 2000000U
 #define LEARN_PEAK_BINS 256U     // bins beyond the shadow's edge the shape is learned from
 #define MODEL_UPDATE_ROTATIONS 16U // rotations between adoptions of the learned shape
+#define LEARN_FAST_ROTATIONS 64U   // cfg.learn_fast: every row read in at most these rotations
 
 static void set_err(sl_pipeline_t *p, sl_err_t e, uint8_t reason, const char *msg)
 {
@@ -619,10 +620,13 @@ static SL_NOINLINE void learn_row(sl_pipeline_t *p, const sl_scan_row_t *row)
 }
 
 #if SL_CFG_FIT
-// cfg.learn_fast applies: the shape in use is still the board's prior.
+// cfg.learn_fast applies: the shape in use is still the board's prior, within the stream's
+// first LEARN_FAST_ROTATIONS rotations (a stream without isolated returns would otherwise
+// be read row by row for ever).
 static bool learning_fast(const sl_pipeline_t *p)
 {
-    return p->cfg.learn_fast && p->resp.source == (uint8_t)SL_RESPONSE_PRIOR;
+    return p->cfg.learn_fast && p->resp.source == (uint8_t)SL_RESPONSE_PRIOR &&
+           p->stats.rotations < LEARN_FAST_ROTATIONS;
 }
 #endif
 
