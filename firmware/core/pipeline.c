@@ -620,12 +620,12 @@ static SL_NOINLINE void learn_row(sl_pipeline_t *p, const sl_scan_row_t *row)
 }
 
 #if SL_CFG_FIT
-// cfg.learn_fast applies: the shape in use is still the board's prior, within the stream's
-// first LEARN_FAST_ROTATIONS rotations (a stream without isolated returns would otherwise
-// be read row by row for ever).
+// cfg.learn_fast applies: the fit reads the response (cfg.fit), the shape in use is still
+// the board's prior, within the stream's first LEARN_FAST_ROTATIONS rotations (a stream
+// without isolated returns would otherwise be read row by row for ever).
 static bool learning_fast(const sl_pipeline_t *p)
 {
-    return p->cfg.learn_fast && p->resp.source == (uint8_t)SL_RESPONSE_PRIOR &&
+    return p->cfg.fit && p->cfg.learn_fast && p->resp.source == (uint8_t)SL_RESPONSE_PRIOR &&
            p->stats.rotations < LEARN_FAST_ROTATIONS;
 }
 #endif

@@ -275,7 +275,8 @@ typedef struct sl_pipeline_cfg {
                                  ///< rows spread over the turn, or by one after a row that
                                  ///< gave a peak); false: the board's prior and no floor,
                                  ///< detection at `threshold`
-    bool learn_fast;             ///< while the shape in use is the board's prior, in the
+    bool learn_fast;             ///< with `fit` (the extraction that reads the response),
+                                 ///< while the shape in use is the board's prior, in the
                                  ///< stream's first 64 rotations, the
                                  ///< sensor model reads every row and adopts a learned
                                  ///< shape at the first rotation end it passes the gates

@@ -156,11 +156,6 @@ sl_err_t fw_app_run(const fw_platform_t *pf, const char *board_name, const uint8
     // configuration's reference, which has no ground: its frames (GroundPlane) stay off.
     cfg.ground = false;
 #endif
-#if SL_CFG_FIT
-    // ... nor the host's fast learning of the sensor model (every row until a shape is
-    // learned): the firmware reads one row per rotation.
-    cfg.learn_fast = false;
-#endif
     cfg.port.can_tx = port_can_tx;
     cfg.port.on_rotation = port_on_rotation;
     cfg.port.ctx = &g_state;
