@@ -1671,6 +1671,27 @@ static void fit_run(sl_profile_t *pr, const sl_response_t *resp, const uint16_t 
     o->b_q8 += (int32_t)(lo * 256U);
 }
 
+// The slot's last fit as a fit's result, and a fit's result kept in the slot.
+static void slot_fit_get(const sl_profile_slot_t *s, sl_rfit_out_t *o)
+{
+    o->a_q8 = s->fit_a_q8;
+    o->b_q8 = s->fit_b_q8;
+    o->sigma_a_q8 = s->fit_sa_q8;
+    o->sigma_b_q8 = s->fit_sb_q8;
+    o->corr_q15 = s->fit_corr_q15;
+    o->quality = s->fit_quality;
+}
+
+static void slot_fit_put(sl_profile_slot_t *s, const sl_rfit_out_t *o)
+{
+    s->fit_a_q8 = o->a_q8;
+    s->fit_b_q8 = o->b_q8;
+    s->fit_sa_q8 = o->sigma_a_q8;
+    s->fit_sb_q8 = o->sigma_b_q8;
+    s->fit_corr_q15 = o->corr_q15;
+    s->fit_quality = o->quality;
+}
+
 uint8_t sl_profile_refine_fit(sl_profile_t *pr, const sl_board_t *board,
                               const sl_response_t *resp, uint32_t threshold, sl_target_t *t)
 {
@@ -1712,12 +1733,7 @@ uint8_t sl_profile_refine_fit(sl_profile_t *pr, const sl_board_t *board,
         // The sum grew by less than a quarter since its last fit: that fit stands (a
         // summed fit's error repeats from rotation to rotation anyway: COARSE).
         pr->stats.fits_reused++;
-        o.a_q8 = s->fit_a_q8;
-        o.b_q8 = s->fit_b_q8;
-        o.sigma_a_q8 = s->fit_sa_q8;
-        o.sigma_b_q8 = s->fit_sb_q8;
-        o.corr_q15 = s->fit_corr_q15;
-        o.quality = s->fit_quality;
+        slot_fit_get(s, &o);
     } else {
         const bool had = summed && s->fit_frames != 0U && fit_usable(s->fit_quality,
                                                                      s->fit_sa_q8, s->fit_sb_q8);
@@ -1727,20 +1743,10 @@ uint8_t sl_profile_refine_fit(sl_profile_t *pr, const sl_board_t *board,
             // a refit without a usable answer keeps the slot's last one (counted)
             pr->stats.fits_kept++;
             s->fit_frames = s->frames;
-            o.a_q8 = s->fit_a_q8;
-            o.b_q8 = s->fit_b_q8;
-            o.sigma_a_q8 = s->fit_sa_q8;
-            o.sigma_b_q8 = s->fit_sb_q8;
-            o.corr_q15 = s->fit_corr_q15;
-            o.quality = s->fit_quality;
+            slot_fit_get(s, &o);
         } else if (summed) {
             s->fit_frames = s->frames;
-            s->fit_quality = o.quality;
-            s->fit_a_q8 = o.a_q8;
-            s->fit_b_q8 = o.b_q8;
-            s->fit_sa_q8 = o.sigma_a_q8;
-            s->fit_sb_q8 = o.sigma_b_q8;
-            s->fit_corr_q15 = o.corr_q15;
+            slot_fit_put(s, &o);
         }
     }
     if (!fit_usable(o.quality, o.sigma_a_q8, o.sigma_b_q8)) {

@@ -156,8 +156,9 @@ static void render(const sl_ro_resp_t *o, int shape, double origin, double a, do
     for (int k = 0; k < N; k++) y[k] = (uint32_t)lround(floor_p + level * m[k]);
 }
 
-static sl_rfit_out_t fit(const sl_response_t *r, const uint32_t *y, uint32_t floor_p, int shape,
-                         double origin, double looks)
+// A fit's input: N samples of y over a flat floor, `looks` looks, sample 0 at `origin` bins.
+static sl_rfit_in_t in_of(const uint32_t *y, uint32_t floor_p, int shape, double origin,
+                          double looks)
 {
     sl_rfit_in_t in = {0};
     in.y = y;
@@ -166,6 +167,13 @@ static sl_rfit_out_t fit(const sl_response_t *r, const uint32_t *y, uint32_t flo
     in.looks_q8 = (uint16_t)lround(looks * 256.0);
     in.shape = (uint8_t)shape;
     in.origin_q8 = (uint32_t)lround(origin * 256.0);
+    return in;
+}
+
+static sl_rfit_out_t fit(const sl_response_t *r, const uint32_t *y, uint32_t floor_p, int shape,
+                         double origin, double looks)
+{
+    const sl_rfit_in_t in = in_of(y, floor_p, shape, origin, looks);
     sl_rfit_out_t out;
     assert_int_equal(sl_rfit(r, &in, &out), SL_OK);
     return out;
@@ -218,12 +226,7 @@ static void test_rfit_warm_start_reaches_the_same_bounds_sooner(void **state)
     assert_int_equal(cold.quality, SL_RFIT_OK);
     const int32_t off[3] = {0, 256, -256};
     for (int i = 0; i < 3; i++) {
-        sl_rfit_in_t in = {0};
-        in.y = y;
-        in.floor = 40;
-        in.n = N;
-        in.looks_q8 = 256;
-        in.shape = SL_RFIT_UNIFORM;
+        sl_rfit_in_t in = in_of(y, 40, SL_RFIT_UNIFORM, 0, 1);
         in.warm = 1;
         in.a0_q8 = cold.a_q8 + off[i];
         in.b0_q8 = cold.b_q8 - off[i];
@@ -424,13 +427,7 @@ static void test_rfit_ws_is_sl_rfit_bit_for_bit(void **state)
     sl_ro_resp_from_drops(r.drop_q8, &o);
     uint32_t y[N];
     render(&o, SL_RFIT_FOOT, 100.0, 20.3, 31.7, 1e6, 40.0, y);
-    sl_rfit_in_t in = {0};
-    in.y = y;
-    in.n = N;
-    in.looks_q8 = 8 * 256;
-    in.floor = 40;
-    in.shape = SL_RFIT_FOOT;
-    in.origin_q8 = 100U * 256U;
+    const sl_rfit_in_t in = in_of(y, 40, SL_RFIT_FOOT, 100.0, 8);
     static sl_rfit_ws_t ws;
     memset(&ws, 0xA5, sizeof ws);
     sl_rfit_out_t a, b;
@@ -583,13 +580,7 @@ static void test_rfit_results_are_identical_on_every_target(void **state)
             const uint64_t mult = 1024U + rng_next() % 1024U; // speckle-like, x [1, 2)
             y[k] = (uint32_t)(50U + (((uint64_t)m[k] * 300U) * mult >> 10));
         }
-        sl_rfit_in_t in = {0};
-        in.y = y;
-        in.floor = 50;
-        in.n = N;
-        in.looks_q8 = (uint16_t)(256U << (t % 4));
-        in.shape = shape;
-        in.origin_q8 = 60U * 256U;
+        const sl_rfit_in_t in = in_of(y, 50, shape, 60.0, (double)(1U << (t % 4)));
         sl_rfit_out_t f;
         assert_int_equal(sl_rfit(&r, &in, &f), SL_OK);
         const int64_t v[] = {f.a_q8, f.b_q8, f.sigma_a_q8, f.sigma_b_q8, f.corr_q15, f.level,
